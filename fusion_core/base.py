@@ -1,0 +1,272 @@
+"""The step API that every estimator shares: parameters, input checks, run, state.
+
+A subclass declares PARAMS (its tuning parameters) and STATE (the names of the attributes that
+make up its internal state), and implements `_reset()` and `_update(ax, ay, az, gx, gy, gz, dt)`.
+Everything else (validation, the first-sample rule, batch runs, json state) is written once here.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any, ClassVar
+
+import numpy as np
+
+from .types import G, Estimate, InvalidSample, Param
+
+COMMON_PARAMS: tuple[Param, ...] = (
+    Param(
+        "max_dt", 1.0, "Longest accepted time between samples; a longer dt is rejected",
+        unit="s", low=0.0, low_open=True, tunable=True,
+    ),
+)
+INTEGRATION_PARAM = Param(
+    "integration", "trapezoid",
+    "Gyro integration rule: 'trapezoid' (average of the previous and current sample; Heun's "
+    "method on the Euler-rate kinematics) or 'rectangle' (the papers' rule: current rate times dt)",
+    choices=("trapezoid", "rectangle"), tunable=False,
+)
+MIN_ACC_NORM = 0.1 * G
+"""Accelerometer norm below which a sample is rejected (INTERFACE.md: 'norm near zero')."""
+
+
+def _plain(value: Any) -> Any:
+    """A json-serialisable copy of a state value (tuples become lists)."""
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _restore(template: Any, value: Any) -> Any:
+    """value in the shape of template (lists back to tuples where the state holds tuples)."""
+    if isinstance(template, tuple):
+        return tuple(_restore(t, v) for t, v in zip(template, value, strict=True))
+    if isinstance(template, list):
+        return [_restore(t, v) for t, v in zip(template, value, strict=True)]
+    if isinstance(template, float):
+        return float(value)
+    return value
+
+
+class Estimator:
+    """Base class of the five estimators. See the module docstring."""
+
+    PARAMS: ClassVar[tuple[Param, ...]] = ()
+    STATE: ClassVar[tuple[str, ...]] = ()
+    HAS_POSITION: ClassVar[bool] = False
+
+    def __init__(self, **params: Any) -> None:
+        specs = self.param_specs()
+        unknown = sorted(set(params) - set(specs))
+        if unknown:
+            raise ValueError(
+                f"unknown parameter(s) {', '.join(unknown)} for {type(self).__name__}: "
+                f"allowed {', '.join(specs)}"
+            )
+        values = {name: spec.default for name, spec in specs.items()}
+        values.update({name: specs[name].validate(v) for name, v in params.items()})
+        self._check_params(values)
+        self._params = values
+        self._configure()
+        self.reset()
+
+    # ----- parameters -------------------------------------------------------------------------
+    @classmethod
+    def param_specs(cls) -> dict[str, Param]:
+        """Every parameter of this estimator by name, in declaration order."""
+        return {p.name: p for p in (*cls.PARAMS, *COMMON_PARAMS)}
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """A copy of the current parameter values."""
+        return dict(self._params)
+
+    def set_param(self, name: str, value: Any) -> None:
+        """Change one tunable parameter of a running filter (the state is kept)."""
+        specs = self.param_specs()
+        if name not in specs:
+            raise ValueError(f"unknown parameter {name!r}: allowed {', '.join(specs)}")
+        if not specs[name].tunable:
+            raise ValueError(f"parameter {name!r} is fixed after construction: use a new instance")
+        values = dict(self._params)
+        values[name] = specs[name].validate(value)
+        self._check_params(values)
+        self._params = values
+        self._configure()
+
+    def _check_params(self, values: dict[str, Any]) -> None:
+        """Checks that involve several parameters; raise ValueError naming them."""
+
+    def _configure(self) -> None:
+        """Derive the constants the hot path uses from self._params (called after every change)."""
+
+    # ----- life cycle -------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Forget every sample: the next valid sample initialises the filter again."""
+        self.initialized = False
+        self.n_samples = 0
+        self.n_rejected = 0
+        self.gyro_prev = (0.0, 0.0, 0.0)
+        self._reset()
+        self.last = self._estimate()
+
+    def _reset(self) -> None:
+        raise NotImplementedError
+
+    def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
+        """Initialise from the first valid sample (attitude from the accelerometer)."""
+        raise NotImplementedError
+
+    def _update(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> None:
+        """Process one valid sample after the first."""
+        raise NotImplementedError
+
+    def _estimate(self) -> Estimate:
+        raise NotImplementedError
+
+    # ----- samples ----------------------------------------------------------------------------
+    def check_sample(self, acc: Sequence[float], gyro: Sequence[float], dt: float) -> None:
+        """Raise InvalidSample saying what is wrong with a sample; return None for a good one."""
+        ax, ay, az = acc
+        gx, gy, gz = gyro
+        for name, values in (("acc", (ax, ay, az)), ("gyro", (gx, gy, gz)), ("dt", (dt,))):
+            for v in values:
+                if not isinstance(v, (int, float)) or not math.isfinite(v):
+                    raise InvalidSample(f"{name}={_fmt(values)} is not finite")
+        if not 0.0 < dt <= self._params["max_dt"]:
+            raise InvalidSample(
+                f"dt={dt!r} s is outside the allowed range (0, max_dt={self._params['max_dt']!r}] s"
+            )
+        norm = math.sqrt(ax * ax + ay * ay + az * az)
+        if norm < MIN_ACC_NORM:
+            raise InvalidSample(
+                f"accelerometer norm {norm:.4g} m/s^2 is below {MIN_ACC_NORM:.4g} m/s^2 (0.1 g): "
+                "no gravity direction"
+            )
+
+    def step(self, acc: Sequence[float], gyro: Sequence[float], dt: float) -> Estimate:
+        """Process one IMU sample: specific force acc [m/s^2], body rate gyro [rad/s], dt [s].
+
+        dt is the time since the previous sample (ignored for the first valid sample, which
+        initialises roll and pitch from the accelerometer). A bad sample raises InvalidSample and
+        leaves the state exactly as it was.
+        """
+        try:
+            ax, ay, az = float(acc[0]), float(acc[1]), float(acc[2])
+            gx, gy, gz = float(gyro[0]), float(gyro[1]), float(gyro[2])
+            dt = float(dt)
+        except (TypeError, ValueError, IndexError) as err:
+            raise InvalidSample(f"sample is not three accelerations, three rates and dt: {err}")
+        self._check_values(ax, ay, az, gx, gy, gz, dt)
+        if self.initialized:
+            self._update(ax, ay, az, gx, gy, gz, dt)
+        else:
+            self._init(ax, ay, az, gx, gy, gz)
+            self.initialized = True
+        self.gyro_prev = (gx, gy, gz)
+        self.n_samples += 1
+        self.last = self._estimate()
+        return self.last
+
+    def _check_values(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> None:
+        # Fast path of check_sample: one finite test on the sum, details only on failure.
+        norm2 = ax * ax + ay * ay + az * az
+        if (
+            math.isfinite(norm2 + gx + gy + gz + dt)
+            and norm2 >= MIN_ACC_NORM * MIN_ACC_NORM
+            and 0.0 < dt <= self._params["max_dt"]
+        ):
+            return
+        self.check_sample((ax, ay, az), (gx, gy, gz), dt)
+        raise InvalidSample("sample rejected")  # not reached: check_sample raised
+
+    def run(
+        self,
+        acc: np.ndarray,
+        gyro: np.ndarray,
+        dt: np.ndarray | float,
+    ) -> dict[str, np.ndarray]:
+        """Run over N samples: acc, gyro [N, 3], dt [N] or a scalar.
+
+        Returns numpy arrays roll, pitch [N], bias [N, 3], rejected [N] (bool) and, for the
+        position filter, pos and vel [N, 3]. A rejected sample repeats the last estimate.
+        """
+        acc = np.asarray(acc, dtype=float)
+        gyro = np.asarray(gyro, dtype=float)
+        if acc.ndim != 2 or acc.shape[1] != 3 or gyro.shape != acc.shape:
+            raise ValueError(
+                f"acc and gyro must both have shape [N, 3]: got {acc.shape} and {gyro.shape}"
+            )
+        n = acc.shape[0]
+        dts = np.broadcast_to(np.asarray(dt, dtype=float), (n,))
+        out = {
+            "roll": np.empty(n),
+            "pitch": np.empty(n),
+            "bias": np.empty((n, 3)),
+            "rejected": np.zeros(n, dtype=bool),
+        }
+        if self.HAS_POSITION:
+            out["pos"] = np.empty((n, 3))
+            out["vel"] = np.empty((n, 3))
+        rows = []
+        step = self.step
+        for i, (a, w, h) in enumerate(zip(acc.tolist(), gyro.tolist(), dts.tolist())):
+            try:
+                est = step(a, w, h)
+            except InvalidSample:
+                out["rejected"][i] = True
+                self.n_rejected += 1
+                est = self.last
+            rows.append(est)
+        if n:
+            out["roll"][:] = [e.roll for e in rows]
+            out["pitch"][:] = [e.pitch for e in rows]
+            out["bias"][:] = [e.bias for e in rows]
+            if self.HAS_POSITION:
+                out["pos"][:] = [e.pos for e in rows]
+                out["vel"][:] = [e.vel for e in rows]
+        return out
+
+    # ----- state ------------------------------------------------------------------------------
+    _BASE_STATE: ClassVar[tuple[str, ...]] = ("initialized", "n_samples", "n_rejected", "gyro_prev")
+
+    def get_state(self) -> dict[str, Any]:
+        """The whole filter state and parameters as plain floats, ints, bools, strings and lists."""
+        state = {name: _plain(getattr(self, name)) for name in (*self._BASE_STATE, *self.STATE)}
+        return {"estimator": type(self).__name__, "params": dict(self._params), "state": state}
+
+    def set_state(self, snapshot: dict[str, Any]) -> None:
+        """Restore a get_state() snapshot: continuing from it is bit-identical."""
+        if snapshot.get("estimator") != type(self).__name__:
+            raise ValueError(
+                f"state of {snapshot.get('estimator')!r} cannot be restored into "
+                f"{type(self).__name__}"
+            )
+        names = (*self._BASE_STATE, *self.STATE)
+        state = snapshot["state"]
+        missing = sorted(set(names) - set(state))
+        if missing:
+            raise ValueError(f"state snapshot lacks {', '.join(missing)}")
+        specs = self.param_specs()
+        params = {k: specs[k].validate(v) for k, v in snapshot["params"].items()}
+        self._check_params(params)
+        self._params = params
+        self._configure()
+        for name in names:
+            setattr(self, name, _restore(getattr(self, name), state[name]))
+        self._restored()
+        self.last = self._estimate()
+
+    def _restored(self) -> None:
+        """Hook for subclasses whose state holds nested estimators."""
+
+
+def _fmt(values: tuple[float, ...]) -> str:
+    return "(" + ", ".join(repr(v) for v in values) + ")"

@@ -1,0 +1,165 @@
+"""Two-state [angle, bias] Kalman filter, one for roll and one for pitch.
+
+References:
+  W. Gui, Y. Tang, S. Mukhopadhyay (2015), eq. 5-26: x = [angle, bias], F = [[1, -dt], [0, 1]],
+  B = [dt, 0], H = [1, 0], Q = diag(Q_angle, Q_bias) dt, R = R_measure; Q_angle = 0.001,
+  Q_bias = 0.003, R_measure = 0.03 (angles in degrees); loop time 0.033 s.
+  Das & Mary, eq. 16-27: the same filter written scalar by scalar (P00..P11, K0, K1), with a
+  temporary copy of P in the covariance update. Jain & Epelbaum (EE444) derive the same
+  covariance propagation from the continuous Pdot = A P + P A' + Q (rotomotion tilt.c).
+
+Units. The papers feed the filter degrees and deg/s, and their Q and R are tuned for that. This
+class works in radians; its defaults are the papers' numbers times (pi/180)^2 (Q_angle in rad^2/s,
+Q_bias in rad^2/s^3, R_measure in rad^2). Scaling every angle-like state by k = pi/180 scales P,
+Q and R by k^2 and leaves the gain K unchanged, so on the same samples this filter's angles and
+biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks it to 1e-9 deg).
+"""
+
+from __future__ import annotations
+
+from .base import INTEGRATION_PARAM, Estimator
+from .complementary import ACC_GATE_PARAMS
+from .kinematics import accel_roll_pitch, clamp_pitch, euler_step, heun_euler_step, wrap_angle
+from .types import DEG, G, Estimate, Param
+
+DEG2 = DEG * DEG
+
+
+def predict_covariance(
+    P: tuple[float, float, float, float], dt: float, q_angle: float, q_bias: float
+) -> tuple[float, float, float, float]:
+    """P <- F P F' + Q with F = [[1, -dt], [0, 1]], Q = diag(q_angle, q_bias) dt (Das & Mary eq. 19-22)."""
+    P00, P01, P10, P11 = P
+    return (
+        P00 + dt * (dt * P11 - P01 - P10 + q_angle),
+        P01 - dt * P11,
+        P10 - dt * P11,
+        P11 + q_bias * dt,
+    )
+
+
+def measurement_update(
+    angle: float, bias: float, P: tuple[float, float, float, float], y: float, r: float
+) -> tuple[float, float, tuple[float, float, float, float], float, float]:
+    """Update with the innovation y = acc_angle - angle (Das & Mary eq. 23-27).
+
+    S = P00 + R; K = [P00, P10] / S; x += K y; P <- (I - K H) P using the old P values (the
+    papers' temporaries), not values already overwritten. Returns angle, bias, P, K0, K1.
+    """
+    P00, P01, P10, P11 = P
+    S = P00 + r
+    K0 = P00 / S
+    K1 = P10 / S
+    return (
+        angle + K0 * y,
+        bias + K1 * y,
+        (P00 - K0 * P00, P01 - K0 * P01, P10 - K1 * P00, P11 - K1 * P01),
+        K0,
+        K1,
+    )
+
+
+class AngleBiasKalmanFilter(Estimator):
+    """Gui et al. / Das & Mary 2-state Kalman filter, one for roll and one for pitch.
+
+    State per axis [angle, gyro bias]; the roll filter estimates the x gyro bias, the pitch filter
+    the y gyro bias. bias_z is 0: a bias about z does not change the accelerometer's tilt, so it
+    is unobservable here.
+
+    Propagation: the bias-corrected body rate (gx - bias_x, gy - bias_y, gz) drives the full Z-Y-X
+    Euler-rate kinematics (Heun's method with the previous and current sample, or the papers'
+    rectangle rule with integration="rectangle"), so roll and pitch do not couple when they move
+    together; the covariance follows the papers' F (their model, with the per-axis bias entering
+    with -dt). For roll-only motion this is exactly the papers' algorithm.
+
+    Measurement: roll and pitch from the accelerometer (atan2), applied only while
+    gate_low <= |acc|/g <= gate_high (the accelerometer-magnitude gate; outside it the filter
+    only predicts). The innovation is wrapped to [-pi, pi].
+
+    Initialisation: the first valid sample sets the angles from the accelerometer, biases 0 and
+    P = 0, like the papers' reference code.
+
+    Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2] (papers' 0.001, 0.003,
+    0.03 deg-based values converted, see the module docstring); gate_low, gate_high;
+    integration; max_dt [s].
+    """
+
+    PARAMS = (
+        Param(
+            "Q_angle", 0.001 * DEG2,
+            "Process noise of the angle per second of integration (papers' 0.001 deg^2/s)",
+            unit="rad2/s", low=0.0, display_unit="deg2/s",
+        ),
+        Param(
+            "Q_bias", 0.003 * DEG2,
+            "Process noise of the gyro bias per second (papers' 0.003 (deg/s)^2/s)",
+            unit="rad2/s3", low=0.0, display_unit="deg2/s3",
+        ),
+        Param(
+            "R_measure", 0.03 * DEG2,
+            "Variance of the accelerometer angle measurement (papers' 0.03 deg^2)",
+            unit="rad2", low=0.0, low_open=True, display_unit="deg2",
+        ),
+        *ACC_GATE_PARAMS,
+        INTEGRATION_PARAM,
+    )
+    STATE = ("roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch")
+
+    def _configure(self) -> None:
+        p = self._params
+        self._q_angle = p["Q_angle"]
+        self._q_bias = p["Q_bias"]
+        self._r = p["R_measure"]
+        self._gate_low2 = (p["gate_low"] * G) ** 2
+        self._gate_high2 = (p["gate_high"] * G) ** 2
+        self._trapezoid = p["integration"] == "trapezoid"
+
+    def _reset(self) -> None:
+        self.roll = 0.0
+        self.pitch = 0.0
+        self.bias_x = 0.0
+        self.bias_y = 0.0
+        self.P_roll = (0.0, 0.0, 0.0, 0.0)
+        self.P_pitch = (0.0, 0.0, 0.0, 0.0)
+        self.gain_roll = (0.0, 0.0)
+        self.gain_pitch = (0.0, 0.0)
+
+    def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
+        self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
+
+    def _update(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> None:
+        self.propagate(gx, gy, gz, dt)
+        norm2 = ax * ax + ay * ay + az * az
+        if self._gate_low2 <= norm2 <= self._gate_high2:
+            self.correct(ax, ay, az)
+
+    def propagate(self, gx: float, gy: float, gz: float, dt: float) -> None:
+        """Time update: angles by the Euler-rate kinematics, P by the papers' F and Q."""
+        bx, by = self.bias_x, self.bias_y
+        w1 = (gx - bx, gy - by, gz)
+        if self._trapezoid:
+            g0 = self.gyro_prev
+            roll, pitch = heun_euler_step(self.roll, self.pitch, (g0[0] - bx, g0[1] - by, g0[2]), w1, dt)
+        else:
+            roll, pitch = euler_step(self.roll, self.pitch, w1, dt)
+        self.roll = wrap_angle(roll)
+        self.pitch = clamp_pitch(pitch)
+        self.P_roll = predict_covariance(self.P_roll, dt, self._q_angle, self._q_bias)
+        self.P_pitch = predict_covariance(self.P_pitch, dt, self._q_angle, self._q_bias)
+
+    def correct(self, ax: float, ay: float, az: float) -> None:
+        """Measurement update of both axes with the accelerometer's roll and pitch."""
+        acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
+        roll, self.bias_x, self.P_roll, *self.gain_roll = measurement_update(
+            self.roll, self.bias_x, self.P_roll, wrap_angle(acc_roll - self.roll), self._r
+        )
+        pitch, self.bias_y, self.P_pitch, *self.gain_pitch = measurement_update(
+            self.pitch, self.bias_y, self.P_pitch, acc_pitch - self.pitch, self._r
+        )
+        self.roll = wrap_angle(roll)
+        self.pitch = clamp_pitch(pitch)
+
+    def _estimate(self) -> Estimate:
+        return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0))

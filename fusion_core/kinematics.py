@@ -1,0 +1,144 @@
+"""Attitude kinematics shared by the estimators, in this project's frame (x fwd, y left, z up).
+
+Plain-float functions: the estimators call them once or twice per sample, where numpy's per-call
+overhead on 3-vectors would dominate.
+"""
+
+from __future__ import annotations
+
+import math
+
+TWO_PI = 2.0 * math.pi
+_MIN_COS_PITCH = 1e-9  # keeps tan(pitch) finite at gimbal lock (pitch = +-pi/2)
+
+
+def wrap_angle(x: float) -> float:
+    """x wrapped to [-pi, pi]; exact (x itself) when |x| <= pi."""
+    return math.remainder(x, TWO_PI)
+
+
+def accel_roll_pitch(ax: float, ay: float, az: float) -> tuple[float, float]:
+    """Roll and pitch from a specific-force sample of a sensor at rest.
+
+    Inverts INTERFACE.md's  acc = g (-sin(theta), sin(phi) cos(theta), cos(phi) cos(theta)):
+    roll = atan2(ay, az) (Gui et al. eq. 3), pitch = atan2(-ax, sqrt(ay^2 + az^2)) (eq. 4,
+    written with atan2 so that it is defined for every direction).
+    """
+    return math.atan2(ay, az), math.atan2(-ax, math.sqrt(ay * ay + az * az))
+
+
+def euler_rates(
+    phi: float, theta: float, p: float, q: float, r: float
+) -> tuple[float, float]:
+    """Roll and pitch rates from body rates (Z-Y-X Euler kinematics, Duong Quoc et al. eq. 2).
+
+    phi_dot   = p + (q sin(phi) + r cos(phi)) tan(theta)
+    theta_dot = q cos(phi) - r sin(phi)
+    """
+    sp = math.sin(phi)
+    cp = math.cos(phi)
+    ct = math.cos(theta)
+    if abs(ct) < _MIN_COS_PITCH:
+        ct = math.copysign(_MIN_COS_PITCH, ct)
+    return p + (q * sp + r * cp) * math.sin(theta) / ct, q * cp - r * sp
+
+
+def heun_euler_step(
+    phi: float,
+    theta: float,
+    w0: tuple[float, float, float],
+    w1: tuple[float, float, float],
+    dt: float,
+) -> tuple[float, float]:
+    """Propagate roll and pitch over dt with Heun's method on the Euler-rate kinematics.
+
+    w0 is the (bias-corrected) body rate at the start of the interval, w1 at its end: the rate
+    is linear over the interval (trapezoid rule), so the local error is O(dt^3).
+    """
+    d1p, d1t = euler_rates(phi, theta, w0[0], w0[1], w0[2])
+    d2p, d2t = euler_rates(phi + dt * d1p, theta + dt * d1t, w1[0], w1[1], w1[2])
+    return phi + 0.5 * dt * (d1p + d2p), theta + 0.5 * dt * (d1t + d2t)
+
+
+def euler_step(
+    phi: float, theta: float, w1: tuple[float, float, float], dt: float
+) -> tuple[float, float]:
+    """Propagate roll and pitch with the papers' rectangle rule: the end-of-interval rate times dt."""
+    dp, dtheta = euler_rates(phi, theta, w1[0], w1[1], w1[2])
+    return phi + dt * dp, theta + dt * dtheta
+
+
+def clamp_pitch(theta: float) -> float:
+    """Pitch limited to [-pi/2, pi/2] (INTERFACE.md range)."""
+    return max(-0.5 * math.pi, min(0.5 * math.pi, theta))
+
+
+def quat_from_roll_pitch_yaw(
+    phi: float, theta: float, psi: float = 0.0
+) -> tuple[float, float, float, float]:
+    """Quaternion (w, x, y, z), body to world, of the Z-Y-X Euler angles (yaw psi, pitch, roll)."""
+    cr, sr = math.cos(0.5 * phi), math.sin(0.5 * phi)
+    cp, sp = math.cos(0.5 * theta), math.sin(0.5 * theta)
+    cy, sy = math.cos(0.5 * psi), math.sin(0.5 * psi)
+    return (
+        cr * cp * cy + sr * sp * sy,
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+    )
+
+
+def quat_roll_pitch(w: float, x: float, y: float, z: float) -> tuple[float, float]:
+    """Roll and pitch of a unit quaternion (body to world, Z-Y-X Euler)."""
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    s = 2.0 * (w * y - x * z)
+    return roll, math.asin(max(-1.0, min(1.0, s)))
+
+
+def quat_gravity_body(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
+    """World up axis e_z seen in the body frame, R^T e_z: the direction a resting accelerometer reads."""
+    return (
+        2.0 * (x * z - w * y),
+        2.0 * (y * z + w * x),
+        w * w - x * x - y * y + z * z,
+    )
+
+
+def quat_mul_rotvec(
+    q: tuple[float, float, float, float], vx: float, vy: float, vz: float
+) -> tuple[float, float, float, float]:
+    """q (x) exp(v/2): rotate the body frame by the rotation vector v (body axes), renormalised."""
+    w, x, y, z = q
+    angle = math.sqrt(vx * vx + vy * vy + vz * vz)
+    if angle < 1e-8:  # series of sin(a/2)/a and cos(a/2), exact to double precision here
+        c = 1.0 - angle * angle / 8.0
+        s = 0.5 - angle * angle / 48.0
+    else:
+        c = math.cos(0.5 * angle)
+        s = math.sin(0.5 * angle) / angle
+    bx, by, bz = s * vx, s * vy, s * vz
+    rw = w * c - x * bx - y * by - z * bz
+    rx = w * bx + x * c + y * bz - z * by
+    ry = w * by - x * bz + y * c + z * bx
+    rz = w * bz + x * by - y * bx + z * c
+    n = 1.0 / math.sqrt(rw * rw + rx * rx + ry * ry + rz * rz)
+    return rw * n, rx * n, ry * n, rz * n
+
+
+def rotation_increment(
+    w0: tuple[float, float, float], w1: tuple[float, float, float], dt: float
+) -> tuple[float, float, float]:
+    """Body rotation vector over one interval from the rates at its ends (trapezoid + coning).
+
+    phi = (w0 + w1)/2 dt + (w0 dt x w1 dt)/12: the two-sample coning correction for a rate that is
+    linear over the interval (Bortz 1971; Savage, Strapdown Analytics, eq. 7.1.1.1-11), so
+    simultaneous rotation about several axes integrates without an O(dt^3) drift.
+    """
+    a0, a1, a2 = w0[0] * dt, w0[1] * dt, w0[2] * dt
+    b0, b1, b2 = w1[0] * dt, w1[1] * dt, w1[2] * dt
+    k = 1.0 / 12.0
+    return (
+        0.5 * (a0 + b0) + k * (a1 * b2 - a2 * b1),
+        0.5 * (a1 + b1) + k * (a2 * b0 - a0 * b2),
+        0.5 * (a2 + b2) + k * (a0 * b1 - a1 * b0),
+    )

@@ -1,0 +1,100 @@
+"""Shared types and constants of fusion_core: the estimate, the bad-sample error, parameter specs.
+
+Conventions (../shared/INTERFACE.md, restated in README.md): SI units; body frame x forward,
+y left, z up; the accelerometer measures specific force, so a sensor lying still and level reads
+(0, 0, +G); attitude is Z-Y-X Euler (yaw, pitch, roll), roll in (-pi, pi], pitch in [-pi/2, pi/2].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+G = 9.80665
+"""Standard gravity [m/s^2]; the accelerometer norm of a sensor at rest."""
+
+DEG = math.pi / 180.0
+"""One degree in radians."""
+
+
+class Estimate(NamedTuple):
+    """One estimator output: the estimate at the time of the sample just processed.
+
+    roll, pitch [rad]; bias = (bias_x, bias_y, bias_z) gyro bias estimate [rad/s] (zeros for an
+    estimator without a bias state). pos, vel [m, m/s] only from the position filter.
+    """
+
+    roll: float
+    pitch: float
+    bias: tuple[float, float, float]
+    pos: tuple[float, float, float] | None = None
+    vel: tuple[float, float, float] | None = None
+
+
+class InvalidSample(ValueError):
+    """A sample that the estimator refused; the estimator state is exactly as before the call."""
+
+
+@dataclass(frozen=True)
+class Param:
+    """Declarative description of one tuning parameter, shared by fusion_core and fmu_src.
+
+    A numeric parameter is valid when low <(=) value <(=) high (open or closed bounds); a string
+    parameter when it is one of `choices`. `unit` is an SI unit string ("1" when dimensionless),
+    `display_unit` a friendlier unit for tools (for example "deg2/s"), `tunable` whether it may be
+    changed between samples of a running filter.
+    """
+
+    name: str
+    default: float | int | bool | str
+    description: str
+    unit: str = "1"
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple[str, ...] | None = None
+    display_unit: str | None = None
+    tunable: bool = True
+
+    @property
+    def kind(self) -> type:
+        return type(self.default)
+
+    def allowed(self) -> str:
+        """The allowed range in words, for error messages."""
+        if self.choices is not None:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        if self.kind is bool:
+            return "True or False"
+        lo = "-inf" if self.low is None else repr(self.low)
+        hi = "inf" if self.high is None else repr(self.high)
+        return f"{'(' if self.low_open or self.low is None else '['}{lo}, {hi}" + (
+            ")" if self.high_open or self.high is None else "]"
+        )
+
+    def validate(self, value: object) -> float | int | bool | str:
+        """Return the value converted to the parameter's type, or raise ValueError naming it."""
+        where = f"parameter {self.name!r}={value!r}"
+        if self.choices is not None:
+            if value not in self.choices:
+                raise ValueError(f"{where} is not allowed: expected {self.allowed()}")
+            return value  # type: ignore[return-value]
+        if self.kind is bool:
+            if not isinstance(value, (bool, int)) or value not in (0, 1):
+                raise ValueError(f"{where} is not allowed: expected True or False")
+            return bool(value)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"{where} is not a number: allowed range {self.allowed()}")
+        if self.kind is int and float(value) != int(value):
+            raise ValueError(f"{where} is not a whole number: allowed range {self.allowed()}")
+        v = float(value)
+        ok = math.isfinite(v) or (v == math.inf and self.high is None)
+        if self.low is not None:
+            ok = ok and (v > self.low if self.low_open else v >= self.low)
+        if self.high is not None:
+            ok = ok and (v < self.high if self.high_open else v <= self.high)
+        if not ok:
+            raise ValueError(f"{where} is out of range: allowed {self.allowed()} {self.unit}")
+        return int(v) if self.kind is int else v
