@@ -8,21 +8,30 @@ FMU layer (fmu_src) turns into FMU parameters.
 from .base import Estimator
 from .complementary import ComplementaryFilter
 from .kalman import AngleBiasKalmanFilter
-from .types import DEG, G, Estimate, InvalidSample, Param
+from .mgcf import GainScheduledComplementaryFilter
+from .position import PositionKalmanFilter
+from .types import DEG, Estimate, G, InvalidSample, Param
+from .ukf import UnscentedKalmanFilter
 
 ESTIMATORS: dict[str, type[Estimator]] = {
     "cf": ComplementaryFilter,
+    "mgcf": GainScheduledComplementaryFilter,
     "kf": AngleBiasKalmanFilter,
+    "ukf": UnscentedKalmanFilter,
+    "poskf": PositionKalmanFilter,
 }
 
 __all__ = [
     "DEG",
     "ESTIMATORS",
-    "G",
     "AngleBiasKalmanFilter",
     "ComplementaryFilter",
     "Estimate",
     "Estimator",
+    "G",
+    "GainScheduledComplementaryFilter",
     "InvalidSample",
     "Param",
+    "PositionKalmanFilter",
+    "UnscentedKalmanFilter",
 ]

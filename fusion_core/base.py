@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from .types import G, Estimate, InvalidSample, Param
+from .types import Estimate, G, InvalidSample, Param
 
 COMMON_PARAMS: tuple[Param, ...] = (
     Param(

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from .base import INTEGRATION_PARAM, Estimator
 from .kinematics import accel_roll_pitch, clamp_pitch, euler_step, heun_euler_step, wrap_angle
-from .types import G, Estimate, Param
+from .types import Estimate, G, Param
 
 ACC_GATE_PARAMS: tuple[Param, ...] = (
     Param(

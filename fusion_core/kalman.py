@@ -20,7 +20,7 @@ from __future__ import annotations
 from .base import INTEGRATION_PARAM, Estimator
 from .complementary import ACC_GATE_PARAMS
 from .kinematics import accel_roll_pitch, clamp_pitch, euler_step, heun_euler_step, wrap_angle
-from .types import DEG, G, Estimate, Param
+from .types import DEG, Estimate, G, Param
 
 DEG2 = DEG * DEG
 
@@ -56,6 +56,21 @@ def measurement_update(
         (P00 - K0 * P00, P01 - K0 * P01, P10 - K1 * P00, P11 - K1 * P01),
         K0,
         K1,
+    )
+
+
+def bias_update(
+    angle: float, bias: float, P: tuple[float, float, float, float], y: float, r: float
+) -> tuple[float, float, tuple[float, float, float, float]]:
+    """Update with a direct bias measurement, H = [0, 1], innovation y (standard Kalman form)."""
+    P00, P01, P10, P11 = P
+    S = P11 + r
+    K0 = P01 / S
+    K1 = P11 / S
+    return (
+        angle + K0 * y,
+        bias + K1 * y,
+        (P00 - K0 * P10, P01 - K0 * P11, P10 - K1 * P10, P11 - K1 * P11),
     )
 
 
@@ -152,14 +167,30 @@ class AngleBiasKalmanFilter(Estimator):
     def correct(self, ax: float, ay: float, az: float) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch."""
         acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
+        self.correct_innovation(wrap_angle(acc_roll - self.roll), acc_pitch - self.pitch)
+
+    def correct_innovation(self, y_roll: float, y_pitch: float) -> None:
+        """Measurement update with given innovations (accelerometer angle - predicted angle)."""
         roll, self.bias_x, self.P_roll, *self.gain_roll = measurement_update(
-            self.roll, self.bias_x, self.P_roll, wrap_angle(acc_roll - self.roll), self._r
+            self.roll, self.bias_x, self.P_roll, y_roll, self._r
         )
         pitch, self.bias_y, self.P_pitch, *self.gain_pitch = measurement_update(
-            self.pitch, self.bias_y, self.P_pitch, acc_pitch - self.pitch, self._r
+            self.pitch, self.bias_y, self.P_pitch, y_pitch, self._r
         )
         self.roll = wrap_angle(roll)
         self.pitch = clamp_pitch(pitch)
+
+    def correct_bias(self, z_x: float, z_y: float, r: float) -> None:
+        """Update with direct measurements z of the x and y gyro bias (variance r each).
+
+        Used as a zero-angular-rate update: a gyro at rest reads its bias.
+        """
+        self.roll, self.bias_x, self.P_roll = bias_update(
+            self.roll, self.bias_x, self.P_roll, z_x - self.bias_x, r
+        )
+        self.pitch, self.bias_y, self.P_pitch = bias_update(
+            self.pitch, self.bias_y, self.P_pitch, z_y - self.bias_y, r
+        )
 
     def _estimate(self) -> Estimate:
         return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0))
