@@ -161,7 +161,9 @@ class Estimator:
             gx, gy, gz = float(gyro[0]), float(gyro[1]), float(gyro[2])
             dt = float(dt)
         except (TypeError, ValueError, IndexError) as err:
-            raise InvalidSample(f"sample is not three accelerations, three rates and dt: {err}")
+            raise InvalidSample(
+                f"sample is not three accelerations, three rates and dt: {err}"
+            ) from None
         self._check_values(ax, ay, az, gx, gy, gz, dt)
         if self.initialized:
             self._update(ax, ay, az, gx, gy, gz, dt)
@@ -217,7 +219,7 @@ class Estimator:
             out["vel"] = np.empty((n, 3))
         rows = []
         step = self.step
-        for i, (a, w, h) in enumerate(zip(acc.tolist(), gyro.tolist(), dts.tolist())):
+        for i, (a, w, h) in enumerate(zip(acc.tolist(), gyro.tolist(), dts.tolist(), strict=True)):
             try:
                 est = step(a, w, h)
             except InvalidSample:

@@ -28,7 +28,7 @@ DEG2 = DEG * DEG
 def predict_covariance(
     P: tuple[float, float, float, float], dt: float, q_angle: float, q_bias: float
 ) -> tuple[float, float, float, float]:
-    """P <- F P F' + Q with F = [[1, -dt], [0, 1]], Q = diag(q_angle, q_bias) dt (Das & Mary eq. 19-22)."""
+    """F P F' + Q, F = [[1, -dt], [0, 1]], Q = diag(q_angle, q_bias) dt (Das & Mary eq. 19-22)."""
     P00, P01, P10, P11 = P
     return (
         P00 + dt * (dt * P11 - P01 - P10 + q_angle),
@@ -156,7 +156,8 @@ class AngleBiasKalmanFilter(Estimator):
         w1 = (gx - bx, gy - by, gz)
         if self._trapezoid:
             g0 = self.gyro_prev
-            roll, pitch = heun_euler_step(self.roll, self.pitch, (g0[0] - bx, g0[1] - by, g0[2]), w1, dt)
+            w0 = (g0[0] - bx, g0[1] - by, g0[2])
+            roll, pitch = heun_euler_step(self.roll, self.pitch, w0, w1, dt)
         else:
             roll, pitch = euler_step(self.roll, self.pitch, w1, dt)
         self.roll = wrap_angle(roll)

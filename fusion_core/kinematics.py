@@ -63,7 +63,7 @@ def heun_euler_step(
 def euler_step(
     phi: float, theta: float, w1: tuple[float, float, float], dt: float
 ) -> tuple[float, float]:
-    """Propagate roll and pitch with the papers' rectangle rule: the end-of-interval rate times dt."""
+    """Propagate roll and pitch with the papers' rectangle rule: end-of-interval rate times dt."""
     dp, dtheta = euler_rates(phi, theta, w1[0], w1[1], w1[2])
     return phi + dt * dp, theta + dt * dtheta
 
@@ -96,7 +96,7 @@ def quat_roll_pitch(w: float, x: float, y: float, z: float) -> tuple[float, floa
 
 
 def quat_gravity_body(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """World up axis e_z seen in the body frame, R^T e_z: the direction a resting accelerometer reads."""
+    """World up axis in body axes, R^T e_z: the direction a resting accelerometer reads."""
     return (
         2.0 * (x * z - w * y),
         2.0 * (y * z + w * x),

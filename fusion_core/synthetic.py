@@ -78,7 +78,7 @@ class Trajectory:
     )
 
     def truth(self, t: np.ndarray) -> dict[str, np.ndarray]:
-        """Truth at times t: angles, body rates omega [N,3], specific force f [N,3], pos, vel, acc."""
+        """Truth at times t: angles, body rates omega [N,3], specific force f [N,3], pos, vel."""
         t = np.asarray(t, dtype=float)
         phi, dphi, _ = self.roll(t)
         theta, dtheta, _ = self.pitch(t)
@@ -146,7 +146,7 @@ def record(
     Returns the truth (see Trajectory.truth) plus the IMU samples `acc_meas`, `gyro_meas` [N,3]
     and `dt` [N] (dt[0] is one period; the estimators ignore the first sample's dt).
     """
-    n = int(round(duration * rate)) + 1
+    n = round(duration * rate) + 1
     t = np.arange(n) / rate
     out = trajectory.truth(t)
     acc, gyro = out["f"].copy(), out["omega"].copy()
