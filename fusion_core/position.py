@@ -19,6 +19,9 @@ from .kalman import AngleBiasKalmanFilter
 from .kinematics import accel_roll_pitch, wrap_angle
 from .types import DEG, Estimate, G, Param
 
+TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "integration")
+"""Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
+
 Mat3 = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
 
@@ -154,7 +157,7 @@ class PositionKalmanFilter(Estimator):
         ),
         *(
             p for p in AngleBiasKalmanFilter.PARAMS
-            if p.name in ("Q_angle", "Q_bias", "R_measure", "integration")
+            if p.name in TILT_PARAMS
         ),
     )
     STATE = (
@@ -163,7 +166,7 @@ class PositionKalmanFilter(Estimator):
 
     def _configure(self) -> None:
         p = self._params
-        tilt_params = {k: p[k] for k in ("Q_angle", "Q_bias", "R_measure", "integration")}
+        tilt_params = {k: p[k] for k in TILT_PARAMS}
         if not hasattr(self, "tilt"):
             self.tilt = AngleBiasKalmanFilter(max_dt=p["max_dt"], **tilt_params)
         else:
