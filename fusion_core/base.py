@@ -44,8 +44,9 @@ def _restore(template: Any, value: Any) -> Any:
     """value in the shape of template (lists back to tuples where the state holds tuples)."""
     if isinstance(template, tuple):
         return tuple(_restore(t, v) for t, v in zip(template, value, strict=True))
-    if isinstance(template, list):
-        return [_restore(t, v) for t, v in zip(template, value, strict=True)]
+    if isinstance(template, list):  # a list may change length (queues): match what is there
+        n = len(template)
+        return [_restore(template[i] if i < n else None, v) for i, v in enumerate(value)]
     if isinstance(template, float):
         return float(value)
     return value

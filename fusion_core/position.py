@@ -199,7 +199,8 @@ class PositionKalmanFilter(Estimator):
         self.turned = (0.0, 0.0)
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
-        self.tilt.step((ax, ay, az), (gx, gy, gz), 1.0)
+        # The first sample's dt is not used; pass one the tilt stage accepts.
+        self.tilt.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
         a = self._level_acceleration(ax, ay, az)
         r = self._acc_var_density * 100.0  # one sample's variance at a nominal 100 Hz
         self.P = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, r))
