@@ -1,0 +1,148 @@
+"""Build and check the project's FMUs (the library behind `python build_fmu.py`).
+
+Every module fmu_src/models/<snake_name>_fmu.py is one FMU; its model name (and file name) is
+the CamelCase of <snake_name>. An FMU carries in resources/ its slave module, fusion_core, the
+runtime part of fmu_src, pythonfmu (added by pythonfmu's builder) and a requirements.txt with
+what the host interpreter must provide (numpy, scipy).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import tempfile
+import traceback
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+MODELS_DIR = HERE / "models"
+RUNTIME_FILES = ("__init__.py", "variables.py", "slave.py", "estimator.py", "model_description.py")
+"""The part of fmu_src an FMU needs at run time (not the build code, not the other models)."""
+REQUIREMENTS = "numpy>=1.24\nscipy>=1.10\n"
+"""What the host's Python must provide (resources/requirements.txt); pythonfmu is bundled."""
+
+
+def model_names() -> list[str]:
+    """Every FMU of the project, by model name."""
+    return sorted(_camel(p.name[: -len("_fmu.py")]) for p in MODELS_DIR.glob("*_fmu.py"))
+
+
+def _camel(snake: str) -> str:
+    return "".join(part.capitalize() for part in snake.split("_"))
+
+
+def _snake(camel: str) -> str:
+    return "".join("_" + c.lower() if c.isupper() else c for c in camel).lstrip("_")
+
+
+def script_path(name: str) -> Path:
+    """The slave module of the FMU called name."""
+    path = MODELS_DIR / f"{_snake(name)}_fmu.py"
+    if not path.is_file():
+        raise ValueError(f"no FMU called {name!r}: the FMUs are {', '.join(model_names())}")
+    return path
+
+
+def _stage(root: Path) -> list[Path]:
+    """Copy what goes into resources/ besides the slave module; return the paths."""
+    spec = importlib.util.find_spec("fusion_core")
+    if spec is None or not spec.submodule_search_locations:
+        raise RuntimeError("fusion_core is not importable: run from the repository root")
+    core = Path(next(iter(spec.submodule_search_locations)))
+    shutil.copytree(core, root / "fusion_core", ignore=shutil.ignore_patterns("__pycache__"))
+    (root / "fmu_src").mkdir()
+    for name in RUNTIME_FILES:
+        shutil.copy2(HERE / name, root / "fmu_src" / name)
+    (root / "requirements.txt").write_text(REQUIREMENTS)
+    return [root / "fusion_core", root / "fmu_src", root / "requirements.txt"]
+
+
+def build(name: str, out_dir: Path) -> Path:
+    """Build the FMU called name into out_dir/<name>.fmu and return its path."""
+    path = build_script(script_path(name), out_dir)
+    if path.name != f"{name}.fmu":
+        raise RuntimeError(f"{script_path(name).name} built {path.name}: its class must be {name}")
+    return path
+
+
+def build_script(script: Path, out_dir: Path) -> Path:
+    """Build the FMU of one slave module (any FmuSlave subclass) into out_dir; the FMU is
+    named after the class. The module name must be unique among the FMUs of a process."""
+    from pythonfmu import FmuBuilder
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="fmu_stage_") as tmp:
+        path = FmuBuilder.build_FMU(script, dest=out_dir, project_files=_stage(Path(tmp)))
+    return Path(path)
+
+
+def check(path: Path) -> list[str]:
+    """fmpy's validation problems plus the project's own: every variable has a description,
+    every Real variable a unit."""
+    from fmpy import read_model_description
+    from fmpy.validation import validate_fmu
+
+    problems = list(validate_fmu(str(path)))
+    if problems:
+        return problems
+    md = read_model_description(str(path))
+    for v in md.modelVariables:
+        if not (v.description or "").strip():
+            problems.append(f"variable {v.name!r} has no description")
+        if v.type == "Real" and not v.unit:
+            problems.append(f"Real variable {v.name!r} has no unit")
+    if not (md.description or "").strip():
+        problems.append("the model description has no description attribute")
+    return problems
+
+
+@dataclass
+class BuildResult:
+    """One row of the build table."""
+
+    name: str
+    path: Path | None = None
+    size: int = 0
+    variables: int = 0
+    problems: list[str] = field(default_factory=list)
+
+
+def build_all(names: Iterable[str], out_dir: Path) -> list[BuildResult]:
+    """Build and check each FMU; a failed build is a problem of its row, not an exception."""
+    from fmpy import read_model_description
+
+    results = []
+    for name in names:
+        result = BuildResult(name)
+        try:
+            result.path = build(name, out_dir)
+            result.size = result.path.stat().st_size
+            result.variables = len(read_model_description(str(result.path)).modelVariables)
+            result.problems = check(result.path)
+        except Exception as err:
+            last = traceback.format_exception_only(type(err), err)[-1].strip()
+            result.problems = [f"build failed: {last}"]
+        results.append(result)
+    return results
+
+
+def format_table(results: Sequence[BuildResult]) -> str:
+    """The build table: FMU, size, number of variables, validation problems."""
+    rows = [("FMU", "size", "variables", "validation problems")]
+    for r in results:
+        first = r.problems[0] if r.problems else ""
+        count = f"{len(r.problems)}" + (f": {first}" if first else "")
+        size = f"{r.size / 1024:.0f} kB" if r.path else "-"
+        rows.append((r.name, size, str(r.variables) if r.path else "-", count))
+    widths = [max(len(row[i]) for row in rows) for i in range(3)]
+    lines = []
+    for i, row in enumerate(rows):
+        cells = [row[0].ljust(widths[0]), row[1].rjust(widths[1]), row[2].rjust(widths[2]), row[3]]
+        lines.append("  ".join(cells).rstrip())
+        if i == 0:
+            lines.append("  ".join("-" * w for w in (*widths, len(rows[0][3]))))
+    for r in results:
+        lines += [f"{r.name}: {p}" for p in r.problems[1:]]
+    return "\n".join(lines)

@@ -1,0 +1,197 @@
+"""The estimator helper: everything the five estimator FMUs share, on top of FmuSlave.
+
+Variables (../shared/INTERFACE.md): inputs acc_x..z [m/s2], gyro_x..z [rad/s], dt [s];
+outputs roll, pitch [rad], bias_x..z [rad/s], invalid_samples [1] and, for the position filter,
+pos_x..z [m], vel_x..z [m/s]; one parameter per fusion_core `Param` of the estimator class.
+
+Sample semantics: the inputs set before doStep(t, h) are one new IMU sample (taken at t+h; dt is
+the time since the previous sample, and the estimator integrates over dt, not over h); the
+first doStep's sample initialises the estimator from the accelerometer; values set during
+initialisation are not a sample; the outputs after doStep(t, h) are the estimate for that
+sample. A rejected sample (NaN/inf, dt <= 0, dt > max_dt, |acc| < 0.1 g) leaves the filter
+state exactly as it was, counts in invalid_samples, logs a warning and the step returns OK.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import Any, ClassVar
+
+from fusion_core import G, InvalidSample
+from fusion_core.base import Estimator
+from fusion_core.types import Estimate
+
+from .slave import FmiLog, FmuSlave
+from .variables import (
+    Variable,
+    integer_output,
+    parameter_variable,
+    real_input,
+    real_output,
+)
+
+AXES = ("x", "y", "z")
+NO_BIAS_STATE = "always 0: this filter has no gyro-bias state"
+"""zero_bias reason for a filter without any bias state."""
+Z_BIAS_UNOBSERVABLE = (
+    "always 0: a bias about z does not change the accelerometer's tilt, so it is unobservable "
+    "in this filter"
+)
+"""zero_bias reason for bias_z of the per-axis [angle, bias] Kalman filters."""
+NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STATE for a in AXES})
+"""zero_bias of a filter without a bias state: all three bias outputs are 0."""
+NO_Z_BIAS_OUTPUT: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_UNOBSERVABLE})
+"""zero_bias of the per-axis [angle, bias] Kalman filters: bias_z is 0."""
+
+
+def estimator_variables(
+    cls: type[Estimator], zero_bias: Mapping[str, str] | None = None
+) -> tuple[Variable, ...]:
+    """The variable table of an estimator FMU: INTERFACE.md's inputs and outputs, then one
+    parameter per `cls.param_specs()` entry. zero_bias maps bias outputs that are always 0 to
+    the reason, which goes into their description."""
+    zero_bias = dict(zero_bias or {})
+    first = cls().last
+    axis_word = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
+    inputs = (
+        *(
+            real_input(
+                f"acc_{a}", "m/s2",
+                f"Accelerometer sample: specific force along body {axis_word[a]}; a sensor "
+                "lying still and level reads (0, 0, +9.80665)",
+                G if a == "z" else 0.0,
+            )
+            for a in AXES
+        ),
+        *(
+            real_input(
+                f"gyro_{a}", "rad/s",
+                f"Gyro sample: body angular rate about {axis_word[a]}", display_unit="deg/s",
+            )
+            for a in AXES
+        ),
+        real_input(
+            "dt", "s",
+            "Time since the previous IMU sample; the estimator integrates over dt, not over the "
+            "communication step. Ignored for the first sample (which initialises the attitude "
+            "from the accelerometer); dt <= 0 or dt > max_dt rejects the sample",
+            0.01,
+        ),
+    )
+    outputs: list[Variable] = [
+        real_output(
+            "roll", "rad",
+            "Roll estimate phi (Z-Y-X Euler angle about body x), in (-pi, pi], at the time of "
+            "the last sample processed", first.roll, "deg",
+        ),
+        real_output(
+            "pitch", "rad",
+            "Pitch estimate theta (Z-Y-X Euler angle about body y), in [-pi/2, pi/2], at the "
+            "time of the last sample processed", first.pitch, "deg",
+        ),
+    ]
+    for a, b in zip(AXES, first.bias, strict=True):
+        name = f"bias_{a}"
+        note = f"; {zero_bias.pop(name)}" if name in zero_bias else ""
+        outputs.append(
+            real_output(name, "rad/s", f"Gyro bias estimate about body {a}{note}", b, "deg/s")
+        )
+    if zero_bias:
+        raise ValueError(f"zero_bias names unknown outputs: {sorted(zero_bias)}")
+    outputs.append(
+        integer_output(
+            "invalid_samples",
+            "Samples rejected so far (NaN or infinite values, dt <= 0, dt > max_dt, "
+            "|acc| < 0.1 g); a rejected sample leaves the filter state unchanged",
+        )
+    )
+    if cls.HAS_POSITION:
+        pos = first.pos or (0.0, 0.0, 0.0)
+        vel = first.vel or (0.0, 0.0, 0.0)
+        outputs += [
+            real_output(f"pos_{a}", "m", f"Position estimate along level-frame {a} (start "
+                        "heading frame, origin at the first sample)", p)
+            for a, p in zip(AXES, pos, strict=True)
+        ]
+        outputs += [
+            real_output(f"vel_{a}", "m/s", f"Velocity estimate along level-frame {a}", v)
+            for a, v in zip(AXES, vel, strict=True)
+        ]
+    params = tuple(parameter_variable(p) for p in cls.param_specs().values())
+    table = (*inputs, *outputs, *params)
+    names = [v.name for v in table]
+    clash = sorted({n for n in names if names.count(n) > 1})
+    if clash:
+        raise ValueError(f"{cls.__name__}: parameter names clash with FMU variables: {clash}")
+    return table
+
+
+class EstimatorModel:
+    """A fusion_core estimator as an FmuSlave model: one sample per doStep."""
+
+    def __init__(self, cls: type[Estimator], params: dict[str, Any]) -> None:
+        self.estimator = cls(**params)
+        self.invalid_samples = 0
+        self._position = cls.HAS_POSITION
+
+    def step(
+        self, t: float, h: float, values: Mapping[str, Any], log: FmiLog
+    ) -> dict[str, Any]:
+        est = self.estimator
+        try:
+            estimate = est.step(
+                (values["acc_x"], values["acc_y"], values["acc_z"]),
+                (values["gyro_x"], values["gyro_y"], values["gyro_z"]),
+                values["dt"],
+            )
+        except InvalidSample as err:
+            self.invalid_samples += 1
+            log.warning(
+                f"sample at t = {t + h:.9g} s rejected, the filter state is kept: {err} "
+                f"({self.invalid_samples} rejected so far)"
+            )
+            estimate = est.last
+        return self.outputs(estimate)
+
+    def outputs(self, e: Estimate) -> dict[str, Any]:
+        """The output values for an estimate."""
+        bx, by, bz = e.bias
+        out: dict[str, Any] = {
+            "roll": e.roll, "pitch": e.pitch, "bias_x": bx, "bias_y": by, "bias_z": bz,
+            "invalid_samples": self.invalid_samples,
+        }
+        if self._position:
+            out["pos_x"], out["pos_y"], out["pos_z"] = e.pos or (0.0, 0.0, 0.0)
+            out["vel_x"], out["vel_y"], out["vel_z"] = e.vel or (0.0, 0.0, 0.0)
+        return out
+
+    def set_parameter(self, name: str, value: Any) -> None:
+        self.estimator.set_param(name, value)
+
+    def get_state(self) -> dict[str, Any]:
+        return {"estimator": self.estimator.get_state(), "invalid_samples": self.invalid_samples}
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        self.estimator.set_state(state["estimator"])
+        self.invalid_samples = int(state["invalid_samples"])
+
+
+class EstimatorSlave(FmuSlave):
+    """Base of the estimator FMUs: a subclass names its fusion_core class and its paper.
+
+    Class attributes of a subclass: `estimator` (the fusion_core class), `description` (the
+    modelDescription text naming the paper) and `zero_bias` (bias outputs that are always 0,
+    with the reason).
+    """
+
+    estimator: ClassVar[type[Estimator]]
+    zero_bias: ClassVar[Mapping[str, str]] = MappingProxyType({})
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if "estimator" in cls.__dict__:
+            cls.VARIABLES = estimator_variables(cls.estimator, cls.zero_bias)
+
+    def create_model(self, params: dict[str, Any]) -> EstimatorModel:
+        return EstimatorModel(self.estimator, params)

@@ -1,0 +1,213 @@
+"""modelDescription.xml decoration: what pythonfmu cannot write, added from the variable table.
+
+pythonfmu writes names, causality, variability, initial, start and description. This adds
+  <UnitDefinitions>  one <Unit> per unit used, with its SI <BaseUnit> exponents (a declared
+                     dimensionless unit "1" with an empty BaseUnit) and its <DisplayUnit>s with
+                     their factor (deg: 180/pi per power of rad);
+  <TypeDefinitions>  one Enumeration type per enumeration parameter;
+  per variable       unit, displayUnit, min and max (closed bounds of the allowed range; open
+                     bounds are stated in the description only, since min/max are inclusive).
+Unit strings use the Modelica syntax: "m/s2", "rad2/s3", "rad/(s.sqrt(Hz))", "1". FMI 2.0
+BaseUnit exponents are integers, so a unit whose SI exponents are not (a noise density such as
+rad/(s.sqrt(Hz)) = rad.s^-1/2) is declared without a BaseUnit.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from fractions import Fraction
+from xml.etree.ElementTree import Element, SubElement
+
+from .variables import Variable
+
+BASE_UNITS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+"""The SI base units an FMI 2.0 <BaseUnit> has exponents for, in schema order."""
+
+Dimension = dict[str, Fraction]
+
+_SYMBOLS: dict[str, tuple[Dimension, float]] = {
+    "m": ({"m": Fraction(1)}, 1.0),
+    "s": ({"s": Fraction(1)}, 1.0),
+    "kg": ({"kg": Fraction(1)}, 1.0),
+    "A": ({"A": Fraction(1)}, 1.0),
+    "K": ({"K": Fraction(1)}, 1.0),
+    "mol": ({"mol": Fraction(1)}, 1.0),
+    "cd": ({"cd": Fraction(1)}, 1.0),
+    "rad": ({"rad": Fraction(1)}, 1.0),
+    "deg": ({"rad": Fraction(1)}, math.pi / 180.0),
+    "Hz": ({"s": Fraction(-1)}, 1.0),
+    "N": ({"kg": Fraction(1), "m": Fraction(1), "s": Fraction(-2)}, 1.0),
+}
+"""Unit symbols: SI exponents and the value of one unit in SI (deg = pi/180 rad)."""
+
+_TOKEN = re.compile(r"\s*(sqrt\(|[A-Za-z]+-?\d*|1|\(|\)|/|\.)")
+
+
+class UnitError(ValueError):
+    """A unit string this module cannot read."""
+
+
+def parse_unit(unit: str) -> tuple[Dimension, float]:
+    """SI exponents and scale of a Modelica-style unit string ("1" is dimensionless)."""
+    tokens = _tokenize(unit)
+    dim, scale, rest = _expression(tokens, unit)
+    if rest:
+        raise UnitError(f"unit {unit!r}: unexpected {''.join(rest)!r}")
+    return {k: v for k, v in dim.items() if v != 0}, scale
+
+
+def _tokenize(unit: str) -> list[str]:
+    tokens, pos = [], 0
+    while pos < len(unit.rstrip()):
+        m = _TOKEN.match(unit, pos)
+        if m is None:
+            raise UnitError(f"unit {unit!r}: cannot read {unit[pos:]!r}")
+        tokens.append(m.group(1))
+        pos = m.end()
+    return tokens
+
+
+def _combine(a: Dimension, b: Dimension, sign: int) -> Dimension:
+    out = dict(a)
+    for k, v in b.items():
+        out[k] = out.get(k, Fraction(0)) + sign * v
+    return out
+
+
+def _expression(tokens: list[str], unit: str) -> tuple[Dimension, float, list[str]]:
+    """product ['/' factor]; a product is factors joined by '.'."""
+    dim, scale, tokens = _factor(tokens, unit)
+    while tokens and tokens[0] == ".":
+        d, s, tokens = _factor(tokens[1:], unit)
+        dim, scale = _combine(dim, d, 1), scale * s
+    if tokens and tokens[0] == "/":
+        d, s, tokens = _factor(tokens[1:], unit)
+        dim, scale = _combine(dim, d, -1), scale / s
+    return dim, scale, tokens
+
+
+def _factor(tokens: list[str], unit: str) -> tuple[Dimension, float, list[str]]:
+    if not tokens:
+        raise UnitError(f"unit {unit!r} ends too early")
+    head, tokens = tokens[0], tokens[1:]
+    if head in ("(", "sqrt("):
+        dim, scale, tokens = _expression(tokens, unit)
+        if not tokens or tokens[0] != ")":
+            raise UnitError(f"unit {unit!r}: missing ')'")
+        tokens = tokens[1:]
+        if head == "sqrt(":
+            dim, scale = {k: v / 2 for k, v in dim.items()}, math.sqrt(scale)
+        return dim, scale, tokens
+    if head == "1":
+        return {}, 1.0, tokens
+    m = re.fullmatch(r"([A-Za-z]+)(-?\d*)", head)
+    if m is None or m.group(1) not in _SYMBOLS:
+        raise UnitError(f"unit {unit!r}: unknown symbol {head!r}")
+    power = int(m.group(2)) if m.group(2) else 1
+    dim, scale = _SYMBOLS[m.group(1)]
+    return {k: v * power for k, v in dim.items()}, scale**power, tokens
+
+
+def base_unit_attributes(unit: str) -> dict[str, str] | None:
+    """The <BaseUnit> attributes of a unit, or None when an exponent is not an integer."""
+    dim, scale = parse_unit(unit)
+    if any(v.denominator != 1 for v in dim.values()):
+        return None
+    attrs = {k: str(int(dim[k])) for k in BASE_UNITS if k in dim}
+    if scale != 1.0:
+        attrs["factor"] = repr(scale)
+    return attrs
+
+
+def display_factor(unit: str, display_unit: str) -> float:
+    """FMI DisplayUnit factor: display value = factor * value (same dimension required)."""
+    dim, scale = parse_unit(unit)
+    ddim, dscale = parse_unit(display_unit)
+    if dim != ddim:
+        raise UnitError(f"display unit {display_unit!r} does not fit unit {unit!r}")
+    return scale / dscale
+
+
+def unit_definitions(variables: Sequence[Variable]) -> Element:
+    """<UnitDefinitions> for every unit and display unit the Real variables use."""
+    units: dict[str, list[str]] = {}
+    for v in variables:
+        if v.type == "Real" and v.unit:
+            displays = units.setdefault(v.unit, [])
+            if v.display_unit and v.display_unit not in displays:
+                displays.append(v.display_unit)
+    root = Element("UnitDefinitions")
+    for name in sorted(units):
+        node = SubElement(root, "Unit", {"name": name})
+        base = base_unit_attributes(name)
+        if base is not None:
+            SubElement(node, "BaseUnit", base)
+        for display in units[name]:
+            SubElement(
+                node, "DisplayUnit",
+                {"name": display, "factor": repr(display_factor(name, display))},
+            )
+    return root
+
+
+def type_definitions(variables: Sequence[Variable]) -> Element | None:
+    """<TypeDefinitions> with one Enumeration type per enumeration variable, or None."""
+    enums = [v for v in variables if v.type == "Enumeration"]
+    if not enums:
+        return None
+    root = Element("TypeDefinitions")
+    for v in enums:
+        simple = SubElement(root, "SimpleType", {"name": v.type_name or "", "description":
+                                                 f"Choices of {v.name}"})
+        enum = SubElement(simple, "Enumeration")
+        for value, item in enumerate(v.items or (), 1):
+            SubElement(enum, "Item", {"name": item, "value": str(value)})
+    return root
+
+
+def _number(x: float, kind: str) -> str:
+    return str(int(x)) if kind == "Integer" else repr(float(x))
+
+
+def decorate(root: Element, variables: Sequence[Variable]) -> None:
+    """Add units, types and ranges to pythonfmu's <fmiModelDescription> element, in place."""
+    by_name = {v.name: v for v in variables}
+    index = [child.tag for child in root].index("CoSimulation") + 1
+    blocks = [unit_definitions(variables), type_definitions(variables)]
+    for block in (b for b in blocks if b is not None):
+        root.insert(index, block)
+        index += 1
+    for sv in root.iter("ScalarVariable"):
+        v = by_name[sv.get("name", "")]
+        typed = sv[0]
+        start = typed.get("start")
+        attrs: dict[str, str] = {}
+        if v.type == "Enumeration":
+            typed.tag = "Enumeration"
+            attrs["declaredType"] = v.type_name or ""
+        if v.type == "Real":
+            attrs["unit"] = v.unit or "1"
+            if v.display_unit:
+                attrs["displayUnit"] = v.display_unit
+        if v.type in ("Real", "Integer"):
+            if v.low is not None and not v.low_open:
+                attrs["min"] = _number(v.low, v.type)
+            if v.high is not None and not v.high_open:
+                attrs["max"] = _number(v.high, v.type)
+        if start is not None:
+            # pythonfmu writes 16 significant digits, which does not round-trip every double.
+            attrs["start"] = repr(float(v.start)) if v.type == "Real" else start
+        typed.attrib.clear()
+        typed.attrib.update(attrs)
+
+
+def project_version() -> str:
+    """The installed project's version (the FMU's version attribute)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("imu-fusion-fmu")
+    except PackageNotFoundError:
+        return "0+unknown"

@@ -1,0 +1,21 @@
+"""ComplementaryFilter FMU: fusion_core.ComplementaryFilter as an FMI 2.0 co-simulation FMU.
+
+Implements W. Gui, Y. Tang, S. Mukhopadhyay (2015), complementary filter for tilt, eq. 1-2
+(angle = a (angle + gyro dt) + (1 - a) acc_angle, a = tau / (tau + dt)); the same filter as
+Das & Mary, eq. 1. The filter has no gyro-bias state: its bias outputs are always 0.
+"""
+
+import fusion_core
+from fmu_src.estimator import NO_BIAS_OUTPUTS, EstimatorSlave
+
+
+class ComplementaryFilter(EstimatorSlave):
+    """Complementary filter for roll and pitch (Gui, Tang, Mukhopadhyay 2015; Das & Mary)."""
+
+    estimator = fusion_core.ESTIMATORS["cf"]
+    description = (
+        "Complementary filter for roll and pitch from a 6-axis IMU: W. Gui, Y. Tang, "
+        "S. Mukhopadhyay (2015), eq. 1-2; Das & Mary, eq. 1. One IMU sample per doStep; "
+        "no gyro-bias state (bias outputs are 0)."
+    )
+    zero_bias = NO_BIAS_OUTPUTS

@@ -1,0 +1,309 @@
+"""FmuSlave: the pythonfmu slave base that every FMU of the project is built on.
+
+A concrete FMU declares VARIABLES (a table of `Variable`) and `create_model(params)`, which
+returns the Python object that does the work (the `Model` protocol: step, set_parameter,
+get_state, set_state). Everything FMI is done here, once:
+
+- registration: one pythonfmu variable per table row (nested=False, so names may hold dots);
+  outputs get initial="exact" and their start value (pythonfmu writes no InitialUnknowns);
+- modelDescription.xml: units, display units, ranges and enumeration types are added to what
+  pythonfmu writes (`to_xml`, see model_description.py), plus the capability flags;
+- no exception leaves a callback: pythonfmu turns one into fmi2Fatal, which ends the whole
+  simulation. A failing doStep is logged and returns fmi2Discard; anything else is logged and
+  the call does nothing;
+- parameters: every new value is checked against the table's range, then by building the
+  model with it (before exitInitializationMode) or by `model.set_parameter` (tunable ones,
+  while running), so the model's own checks (several parameters together) apply too. A refused
+  value is logged as an error naming the parameter and its allowed range, and the previous value
+  stays; a fixed parameter cannot change after initialisation;
+- FMU state: the values of every variable plus the model's own `get_state()`, as JSON-ready
+  data, so getFMUstate/setFMUstate and serialisation cover the whole filter state (pythonfmu's
+  default only stores the registered variables);
+- logging: `FmiLog` passes model warnings to the FMI logger (shown when the host switches debug
+  logging on, e.g. `fmpy simulate --debug-logging`).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import traceback
+from collections.abc import Mapping
+from functools import partial
+from types import MappingProxyType
+from typing import Any, ClassVar, Protocol
+
+from pythonfmu import Boolean, DefaultExperiment, Fmi2Slave, Integer, Real
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variability
+
+from .variables import Variable
+
+STATE_FORMAT = 1
+"""Version of the FMU state layout (stored in every state; a mismatch is refused)."""
+
+_PINNED_GLOBALS: list[dict[str, Any]] = []
+"""Extra references to slave-module globals (see FmuSlave.__init_subclass__): 8 bytes per
+instantiation, never released."""
+
+
+class FmiLog:
+    """What a model may log: warnings and errors, sent through the FMI logger callback."""
+
+    def __init__(self, slave: Fmi2Slave) -> None:
+        self._log = slave.log
+
+    def info(self, message: str) -> None:
+        self._log(_printf_safe(message), Fmi2Status.ok)
+
+    def warning(self, message: str) -> None:
+        self._log(_printf_safe(message), Fmi2Status.warning)
+
+    def error(self, message: str) -> None:
+        self._log(_printf_safe(message), Fmi2Status.error)
+
+
+def _printf_safe(message: str) -> str:
+    """The FMI logger callback takes the message as a printf format: escape '%'."""
+    return message.replace("%", "%%")
+
+
+class Model(Protocol):
+    """The Python object an FMU wraps (an estimator, later the plant and the sensor model)."""
+
+    def step(
+        self, t: float, h: float, values: Mapping[str, Any], log: FmiLog
+    ) -> Mapping[str, Any]:
+        """Advance over the communication step [t, t+h] with the inputs in `values` (a read-only
+        view of every variable by name); return the new output values by name."""
+        ...
+
+    def set_parameter(self, name: str, value: Any) -> None:
+        """Change a tunable parameter of the running model; ValueError if not allowed."""
+        ...
+
+    def get_state(self) -> dict[str, Any]:
+        """The whole internal state as JSON-ready data."""
+        ...
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """Restore a get_state() result; ValueError if it does not fit."""
+        ...
+
+
+class FmuSlave(Fmi2Slave):
+    """Base of every FMU: a variable table and a model object (see the module docstring)."""
+
+    VARIABLES: ClassVar[tuple[Variable, ...]] = ()
+    FMI_OPTIONS: ClassVar[dict[str, bool]] = {
+        "needsExecutionTool": True,  # a Python interpreter with numpy must be present
+        "canHandleVariableCommunicationStepSize": True,
+        "canGetAndSetFMUstate": True,
+        "canSerializeFMUstate": True,
+    }
+    author = "imu-fusion-fmu contributors"
+    license = "MIT"
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=10.0, step_size=0.01)
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        # pythonfmu 0.7's fmi2Instantiate re-executes the slave module's source to find the
+        # class, then Py_DECREFs the module's globals dict, a borrowed reference: every
+        # instantiation takes one reference too many, and the second or third instance of an
+        # FMU crashes the host when the dict is freed. The re-execution defines the class
+        # again, which runs this hook: one extra reference each time balances the books.
+        module = sys.modules.get(cls.__module__)
+        if module is not None:
+            _PINNED_GLOBALS.append(module.__dict__)
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self._fmi_log = FmiLog(self)
+        self._variables = {v.name: v for v in self.VARIABLES}
+        self._values: dict[str, Any] = {v.name: v.start for v in self.VARIABLES}
+        self._view = MappingProxyType(self._values)
+        self._running = False
+        for var in self.VARIABLES:
+            self.register_variable(self._scalar_variable(var), nested=False)
+        self._model: Model = self.create_model(self.model_parameters())
+
+    # ----- to be provided by a concrete FMU ---------------------------------------------------
+    def create_model(self, params: dict[str, Any]) -> Model:
+        """A new model with these parameter values; ValueError naming a refused parameter."""
+        raise NotImplementedError
+
+    # ----- variables ----------------------------------------------------------------------------
+    def _scalar_variable(self, var: Variable) -> Real | Integer | Boolean:
+        kind = {"Real": Real, "Integer": Integer, "Boolean": Boolean, "Enumeration": Integer}
+        return kind[var.type](
+            var.name,
+            causality=Fmi2Causality[var.causality],
+            variability=Fmi2Variability[var.variability or "continuous"],
+            initial=Fmi2Initial.exact if var.causality == "output" else None,
+            description=var.description,
+            getter=partial(self._values.__getitem__, var.name),
+            setter=partial(self._set_value, var),
+        )
+
+    def model_parameters(self) -> dict[str, Any]:
+        """The current parameter values in the form the model takes (enumerations as names)."""
+        return {
+            name: var.to_model(self._values[name])
+            for name, var in self._variables.items()
+            if var.causality == "parameter"
+        }
+
+    def _set_value(self, var: Variable, value: Any) -> None:
+        try:
+            value = var.coerce(value)
+            if var.causality == "input":
+                self._values[var.name] = value
+            elif var.causality == "parameter":
+                self._set_parameter(var, value)
+            else:
+                self._fmi_log.error(f"{var.name} is an output: it cannot be set (value {value!r})")
+        except Exception:
+            self._log_exception(f"setting {var.name} = {value!r}")
+
+    def _set_parameter(self, var: Variable, value: float | int | bool) -> None:
+        old = self._values[var.name]
+        if value == old:
+            return
+        try:
+            var.check(value)
+            model_value = var.to_model(value)
+            if not self._running:
+                # Nothing has been sampled yet: build the model anew with the new value, which
+                # validates it together with the others (and fixed parameters may still change).
+                params = self.model_parameters()
+                params[var.name] = model_value
+                self._model = self.create_model(params)
+            elif not var.tunable:
+                raise ValueError(
+                    f"parameter {var.name!r} is fixed after initialisation: set it before "
+                    f"exitInitializationMode (allowed {var.allowed()})"
+                )
+            else:
+                self._model.set_parameter(var.name, model_value)
+        except ValueError as err:
+            self._fmi_log.error(f"refused: {err}. {var.name} keeps its value {old!r}")
+            return
+        self._values[var.name] = value
+
+    # ----- life cycle ---------------------------------------------------------------------------
+    def exit_initialization_mode(self) -> None:
+        self._running = True
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        try:
+            outputs = self._model.step(current_time, step_size, self._view, self._fmi_log)
+            self._values.update(outputs)
+        except Exception:
+            self._log_exception(f"doStep(t={current_time!r}, h={step_size!r})")
+            return False  # fmi2Discard
+        return True
+
+    # ----- guarded pythonfmu entry points -------------------------------------------------------
+    def get_real(self, vrs: list[int]) -> list[float]:
+        try:
+            return super().get_real(vrs)
+        except Exception:
+            self._log_exception(f"fmi2GetReal{tuple(vrs)}")
+            return [float("nan")] * len(vrs)
+
+    def get_integer(self, vrs: list[int]) -> list[int]:
+        try:
+            return super().get_integer(vrs)
+        except Exception:
+            self._log_exception(f"fmi2GetInteger{tuple(vrs)}")
+            return [0] * len(vrs)
+
+    def get_boolean(self, vrs: list[int]) -> list[bool]:
+        try:
+            return super().get_boolean(vrs)
+        except Exception:
+            self._log_exception(f"fmi2GetBoolean{tuple(vrs)}")
+            return [False] * len(vrs)
+
+    def set_real(self, vrs: list[int], values: list[float]) -> None:
+        self._guard(super().set_real, "fmi2SetReal", vrs, values)
+
+    def set_integer(self, vrs: list[int], values: list[int]) -> None:
+        self._guard(super().set_integer, "fmi2SetInteger", vrs, values)
+
+    def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
+        self._guard(super().set_boolean, "fmi2SetBoolean", vrs, values)
+
+    def _guard(self, setter: Any, what: str, vrs: list[int], values: list[Any]) -> None:
+        try:
+            setter(vrs, values)
+        except Exception:
+            self._log_exception(f"{what}{tuple(vrs)}")
+
+    def _log_exception(self, what: str) -> None:
+        self._fmi_log.error(f"{what} failed, call ignored:\n{traceback.format_exc()}")
+
+    # ----- FMU state ----------------------------------------------------------------------------
+    def _get_fmu_state(self) -> dict[str, Any]:
+        try:
+            state = {
+                "fmu": type(self).__name__,
+                "format": STATE_FORMAT,
+                "running": self._running,
+                "values": dict(self._values),
+                "model": self._model.get_state(),
+            }
+            # A JSON round trip: the in-memory state is exactly what serialisation stores.
+            return json.loads(json.dumps(state))
+        except Exception:
+            self._log_exception("fmi2GetFMUstate")
+            return {"error": "fmi2GetFMUstate failed"}
+
+    def _set_fmu_state(self, state: dict[str, Any]) -> None:
+        try:
+            self._restore(state)
+        except Exception as err:
+            self._fmi_log.error(f"fmi2SetFMUstate refused, the FMU keeps its state: {err!r}")
+
+    def _restore(self, state: dict[str, Any]) -> None:
+        if "error" in state:
+            raise ValueError(state["error"])
+        if state.get("fmu") != type(self).__name__ or state.get("format") != STATE_FORMAT:
+            raise ValueError(
+                f"state of {state.get('fmu')!r} (format {state.get('format')!r}) does not fit "
+                f"{type(self).__name__} (format {STATE_FORMAT})"
+            )
+        values = state["values"]
+        if set(values) != set(self._values):
+            raise ValueError("state variables differ from this FMU's variables")
+        params = {
+            name: var.to_model(var.coerce(values[name]))
+            for name, var in self._variables.items()
+            if var.causality == "parameter"
+        }
+        model = self.create_model(params)
+        model.set_state(json.loads(json.dumps(state["model"])))  # never share the state's lists
+        self._model = model
+        self._values.update({n: var.coerce(values[n]) for n, var in self._variables.items()})
+        self._running = bool(state["running"])
+
+    @staticmethod
+    def _fmu_state_to_bytes(state: dict[str, Any]) -> bytes:
+        return json.dumps(state, separators=(",", ":")).encode("utf-8")
+
+    @staticmethod
+    def _fmu_state_from_bytes(state: bytes) -> dict[str, Any]:
+        try:
+            restored = json.loads(state.decode("utf-8"))
+        except Exception as err:
+            return {"error": f"serialized FMU state is not readable: {err!r}"}
+        return restored if isinstance(restored, dict) else {"error": "not an FMU state"}
+
+    # ----- modelDescription.xml -----------------------------------------------------------------
+    def to_xml(self, model_options: dict[str, Any] | None = None) -> Any:
+        """pythonfmu's model description plus units, ranges, types and capability flags."""
+        from .model_description import decorate, project_version
+
+        self.version = project_version()
+        root = super().to_xml({**self.FMI_OPTIONS, **(model_options or {})})
+        decorate(root, self.VARIABLES)
+        return root

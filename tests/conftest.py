@@ -1,0 +1,99 @@
+"""FMU test fixtures: the FMUs are built once per session, by the real command line.
+
+`python build_fmu.py --out <session tmp>` runs in a subprocess (the build imports the slave
+modules; the test process then loads them only from the FMUs). Any test with an `fmu_name`
+argument runs once per estimator FMU.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+ESTIMATOR_FMUS: dict[str, str] = {
+    "ComplementaryFilter": "cf",
+    "GainScheduledComplementaryFilter": "mgcf",
+    "AngleBiasKalmanFilter": "kf",
+    "UnscentedKalmanFilter": "ukf",
+    "PositionKalmanFilter": "poskf",
+}
+"""The estimator FMUs (issue 3) and the fusion_core.ESTIMATORS key each one packages."""
+
+
+@dataclass(frozen=True)
+class BuiltFmus:
+    """The outcome of the session's `python build_fmu.py` run."""
+
+    directory: Path
+    returncode: int
+    output: str
+
+    def path(self, name: str) -> Path:
+        """The FMU called name; the test fails (with the build table) if it was not built."""
+        path = self.directory / f"{name}.fmu"
+        if not path.is_file():
+            pytest.fail(f"{name}.fmu was not built; build_fmu.py said:\n{self.output}")
+        return path
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    if "fmu_name" in metafunc.fixturenames:
+        metafunc.parametrize("fmu_name", list(ESTIMATOR_FMUS))
+
+
+@pytest.fixture(scope="session")
+def built_fmus(tmp_path_factory: pytest.TempPathFactory) -> BuiltFmus:
+    """Every FMU, built once into a session temporary folder."""
+    out = tmp_path_factory.mktemp("fmus")
+    proc = subprocess.run(
+        [sys.executable, "build_fmu.py", "--out", str(out)],
+        cwd=REPO, capture_output=True, text=True, timeout=600,
+    )
+    return BuiltFmus(out, proc.returncode, proc.stdout + proc.stderr)
+
+
+@pytest.fixture
+def fmu_path(built_fmus: BuiltFmus, fmu_name: str) -> Path:
+    """The built FMU of the test's fmu_name."""
+    return built_fmus.path(fmu_name)
+
+
+@pytest.fixture
+def fmu_key(fmu_name: str) -> str:
+    """The fusion_core.ESTIMATORS key of the test's fmu_name."""
+    return ESTIMATOR_FMUS[fmu_name]
+
+
+@pytest.fixture(scope="session")
+def fmu_recording() -> dict:
+    """10 s at 100 Hz: at rest, a two-axis tilt with a yaw turn and a 1 m move, at rest again;
+    MPU-6050 noise and a constant gyro bias, so that every state of every filter is busy
+    (bias estimates, the position filter's stationary queue)."""
+    from fusion_core import synthetic
+
+    s = synthetic
+    trajectory = s.Trajectory(
+        roll=s.add(s.min_jerk(0.0, 0.6, 1.0, 1.5), s.min_jerk(0.0, -0.6, 4.0, 1.5)),
+        pitch=s.add(s.min_jerk(0.0, -0.4, 2.0, 1.5), s.min_jerk(0.0, 0.4, 5.0, 1.5)),
+        yaw=s.min_jerk(0.0, 0.8, 1.5, 3.0),
+        pos=(s.min_jerk(0.0, 1.0, 1.0, 3.0), s.min_jerk(0.0, -0.5, 2.0, 3.0), s.constant()),
+    )
+    noise = s.ImuNoise(gyro_bias=(0.01, -0.006, 0.004))
+    return s.record(trajectory, 9.99, 100.0, noise=noise, seed=7)
+
+
+@pytest.fixture(scope="session")
+def fusion_core_run():
+    """fusion_core's run() of an estimator: fusion_core_run(key, acc, gyro, dt, **params)."""
+    import fusion_core
+
+    def run(key: str, acc, gyro, dt, **params) -> dict:
+        return fusion_core.ESTIMATORS[key](**params).run(acc, gyro, dt)
+
+    return run

@@ -1,0 +1,221 @@
+"""The built FMUs: validation, variables, units, descriptions, resources, the build command."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import shutil
+import zipfile
+from pathlib import Path
+
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+import fusion_core
+from fmu_src.build import check
+
+REPO = Path(__file__).resolve().parents[1]
+DEG = 180.0 / math.pi
+
+INTERFACE = {
+    # name: (causality, type, unit, display unit); INTERFACE.md, estimator FMUs
+    "acc_x": ("input", "Real", "m/s2", None),
+    "acc_y": ("input", "Real", "m/s2", None),
+    "acc_z": ("input", "Real", "m/s2", None),
+    "gyro_x": ("input", "Real", "rad/s", "deg/s"),
+    "gyro_y": ("input", "Real", "rad/s", "deg/s"),
+    "gyro_z": ("input", "Real", "rad/s", "deg/s"),
+    "dt": ("input", "Real", "s", None),
+    "roll": ("output", "Real", "rad", "deg"),
+    "pitch": ("output", "Real", "rad", "deg"),
+    "bias_x": ("output", "Real", "rad/s", "deg/s"),
+    "bias_y": ("output", "Real", "rad/s", "deg/s"),
+    "bias_z": ("output", "Real", "rad/s", "deg/s"),
+    "invalid_samples": ("output", "Integer", None, None),
+}
+POSITION = {
+    **{f"pos_{a}": ("output", "Real", "m", None) for a in "xyz"},
+    **{f"vel_{a}": ("output", "Real", "m/s", None) for a in "xyz"},
+}
+BASE_UNITS = {
+    # unit: SI exponents of its <BaseUnit>
+    "m/s2": {"m": 1, "s": -2},
+    "rad/s": {"rad": 1, "s": -1},
+    "s": {"s": 1},
+    "rad": {"rad": 1},
+    "m": {"m": 1},
+    "m/s": {"m": 1, "s": -1},
+    "1": {},
+    "rad2/s": {"rad": 2, "s": -1},
+    "rad2/s3": {"rad": 2, "s": -3},
+    "rad2": {"rad": 2},
+    "m2/s5": {"m": 2, "s": -5},
+}
+NON_INTEGER_EXPONENTS = {"rad/(s.sqrt(Hz))", "rad/(s.sqrt(s))", "m/(s2.sqrt(Hz))"}
+"""Noise densities: SI exponents of 1/2, which an FMI 2.0 BaseUnit (integers) cannot hold."""
+PAPERS = {
+    "ComplementaryFilter": ("Gui, Y. Tang, S. Mukhopadhyay (2015)", "Das & Mary"),
+    "AngleBiasKalmanFilter": ("Gui, Y. Tang, S. Mukhopadhyay (2015)", "Das & Mary"),
+    "GainScheduledComplementaryFilter": ("Duong Quoc et al.",),
+    "UnscentedKalmanFilter": ("Duong Quoc et al.",),
+    "PositionKalmanFilter": ("Safitri, Cahyadi, Firmansyah",),
+}
+
+
+def test_build_command_builds_every_fmu_without_problems(built_fmus):
+    assert built_fmus.returncode == 0, built_fmus.output
+    lines = built_fmus.output.splitlines()
+    assert lines[0].split() == ["FMU", "size", "variables", "validation", "problems"]
+    for name in PAPERS:
+        row = next(line.split() for line in lines if line.startswith(name + " "))
+        assert row[-1] == "0", row  # validation problems
+        assert (built_fmus.directory / f"{name}.fmu").stat().st_size > 0
+
+
+def test_fmu_passes_fmpy_validation(fmu_path):
+    assert validate_fmu(str(fmu_path)) == []
+
+
+def test_every_variable_has_a_description(fmu_path):
+    md = read_model_description(str(fmu_path))
+    assert [v.name for v in md.modelVariables if not (v.description or "").strip()] == []
+
+
+def test_every_real_has_a_declared_unit_with_base_units(fmu_path):
+    md = read_model_description(str(fmu_path))
+    units = {u.name: u for u in md.unitDefinitions}
+    for v in md.modelVariables:
+        if v.type == "Real":
+            assert v.unit in units, v.name
+    for name, unit in units.items():
+        if name in NON_INTEGER_EXPONENTS:
+            assert unit.baseUnit is None, name
+            continue
+        assert name in BASE_UNITS, f"unexpected unit {name}"
+        assert unit.baseUnit is not None, name
+        got = {k: getattr(unit.baseUnit, k) for k in ("kg", "m", "s", "A", "K", "mol", "cd",
+                                                      "rad")}
+        assert {k: e for k, e in got.items() if e} == BASE_UNITS[name], name
+        assert unit.baseUnit.factor == 1.0 and unit.baseUnit.offset == 0.0
+
+
+def test_display_units_convert_radians_to_degrees(fmu_path):
+    md = read_model_description(str(fmu_path))
+    for unit in md.unitDefinitions:
+        for display in unit.displayUnits:
+            power = 2 if display.name.startswith("deg2") else 1
+            assert display.name.startswith("deg"), display.name
+            assert display.factor == pytest.approx(DEG**power, rel=1e-15)
+
+
+def test_variables_follow_the_interface(fmu_path, fmu_key):
+    md = read_model_description(str(fmu_path))
+    expected = dict(INTERFACE)
+    if fusion_core.ESTIMATORS[fmu_key].HAS_POSITION:
+        expected.update(POSITION)
+    got = {
+        v.name: (v.causality, v.type, v.unit, v.displayUnit)
+        for v in md.modelVariables if v.causality != "parameter"
+    }
+    assert got == expected
+    for v in md.modelVariables:
+        if v.causality == "output":
+            assert v.initial == "exact" and v.start is not None, v.name
+            assert v.variability == ("discrete" if v.type == "Integer" else "continuous")
+        if v.causality == "input":
+            assert v.start is not None
+    assert {u.variable.name for u in md.outputs} == {
+        n for n, row in expected.items() if row[0] == "output"
+    }
+
+
+def test_every_tuning_parameter_is_an_fmu_parameter(fmu_path, fmu_key):
+    md = read_model_description(str(fmu_path))
+    params = {v.name: v for v in md.modelVariables if v.causality == "parameter"}
+    specs = fusion_core.ESTIMATORS[fmu_key].param_specs()
+    assert list(params) == list(specs)
+    for name, spec in specs.items():
+        v = params[name]
+        assert v.variability == ("tunable" if spec.tunable else "fixed"), name
+        if spec.choices is not None:
+            items = [item.name for item in v.declaredType.items]
+            assert v.type == "Enumeration" and items == list(spec.choices), name
+            assert items[int(v.start) - 1] == spec.default
+        elif isinstance(spec.default, bool):
+            assert v.type == "Boolean" and v.start == str(spec.default).lower(), name
+        else:
+            assert v.type == "Real" and float(v.start) == spec.default, name  # exact
+            assert v.unit == spec.unit and v.displayUnit == spec.display_unit, name
+            if spec.low is not None and not spec.low_open:
+                assert float(v.min) == spec.low
+            if spec.high is not None and not spec.high_open:
+                assert float(v.max) == spec.high
+        assert spec.description.rstrip(".") in v.description
+
+
+def test_model_description_names_the_paper(fmu_path, fmu_name):
+    md = read_model_description(str(fmu_path))
+    for paper in PAPERS[fmu_name]:
+        assert paper in md.description
+
+
+def test_state_capabilities_are_declared(fmu_path):
+    cs = read_model_description(str(fmu_path)).coSimulation
+    assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
+    assert cs.needsExecutionTool and cs.canHandleVariableCommunicationStepSize
+
+
+def test_fmu_carries_fusion_core_and_requirements(fmu_path):
+    with zipfile.ZipFile(fmu_path) as z:
+        names = set(z.namelist())
+        requirements = z.read("resources/requirements.txt").decode().split()
+        module = z.read("resources/slavemodule.txt").decode().strip()
+    core = REPO / "fusion_core"
+    assert {f"resources/fusion_core/{p.name}" for p in core.glob("*.py")} <= names
+    assert "resources/fmu_src/slave.py" in names
+    assert f"resources/{module}.py" in names
+    assert "binaries/linux64/" + fmu_path.stem + ".so" in names
+    assert sorted(r.split(">=")[0] for r in requirements) == ["numpy", "scipy"]
+
+
+def test_slave_modules_have_unique_names(built_fmus):
+    modules = []
+    for name in PAPERS:
+        with zipfile.ZipFile(built_fmus.path(name)) as z:
+            modules.append(z.read("resources/slavemodule.txt").decode().strip())
+    assert len(set(modules)) == len(modules)
+    assert not {"fusion_core", "fmu_src", "pythonfmu"} & set(modules)
+
+
+def test_check_reports_a_real_without_unit(built_fmus, tmp_path):
+    broken = tmp_path / "ComplementaryFilter.fmu"
+    with zipfile.ZipFile(built_fmus.path("ComplementaryFilter")) as src, \
+            zipfile.ZipFile(broken, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "modelDescription.xml":
+                data = data.replace(b'<Real unit="s" start="0.01"/>', b'<Real start="0.01"/>')
+            dst.writestr(item, data)
+    assert check(broken) == ["Real variable 'dt' has no unit"]
+
+
+def test_build_command_exits_non_zero_on_a_validation_problem(
+    built_fmus, tmp_path, monkeypatch, capsys
+):
+    spec = importlib.util.spec_from_file_location("build_fmu_cli", REPO / "build_fmu.py")
+    cli = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(cli)
+
+    def build_copy(name: str, out_dir: Path) -> Path:  # the session's FMU, not a rebuild
+        out_dir.mkdir(parents=True, exist_ok=True)
+        return Path(shutil.copy(built_fmus.path(name), out_dir))
+
+    def one_problem(path: Path) -> list[str]:
+        return ["The unit \"x\" of variable \"dt\" is not defined."]
+
+    monkeypatch.setattr("fmu_src.build.build", build_copy)
+    assert cli.main(["--out", str(tmp_path), "--only", "ComplementaryFilter"]) == 0
+    monkeypatch.setattr("fmu_src.build.check", one_problem)
+    assert cli.main(["--out", str(tmp_path), "--only", "ComplementaryFilter"]) == 1
+    assert "1: The unit" in capsys.readouterr().out

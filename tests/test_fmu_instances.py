@@ -1,0 +1,100 @@
+"""Several FMU instances in one process stay independent; instantiate/free does not leak."""
+
+from __future__ import annotations
+
+import gc
+import os
+
+import numpy as np
+import pytest
+
+from fmu_src.host import FmuInstance
+from fusion_core import synthetic
+
+INSTANCES = (
+    ("ComplementaryFilter", "cf", {}, 1),
+    ("ComplementaryFilter", "cf", {"tau": 0.3}, 2),
+    ("GainScheduledComplementaryFilter", "mgcf", {}, 3),
+    ("AngleBiasKalmanFilter", "kf", {}, 4),
+    ("AngleBiasKalmanFilter", "kf", {"R_measure": 3e-5, "integration": "rectangle"}, 5),
+    ("UnscentedKalmanFilter", "ukf", {}, 6),
+    ("PositionKalmanFilter", "poskf", {}, 7),
+    ("PositionKalmanFilter", "poskf", {"qr_form": "diagonal"}, 8),
+)
+"""8 instances: all five kinds, three of them twice, each with its own parameters and seed."""
+N_SAMPLES = 500
+MEMORY_CYCLES = 200
+MEMORY_LIMIT = 5 * 2**20
+"""RSS growth allowed over MEMORY_CYCLES instantiate/free cycles [bytes] (the issue's figure)."""
+
+
+def record(seed: int) -> dict:
+    noise = synthetic.ImuNoise(gyro_bias=(0.01, -0.006, 0.004))
+    return synthetic.record(
+        synthetic.demo_motion(), (N_SAMPLES - 1) / 100.0, 100.0, noise=noise, seed=seed
+    )
+
+
+def test_eight_instances_in_one_process_match_separate_runs(built_fmus, fusion_core_run):
+    recordings = [record(seed) for *_, seed in INSTANCES]
+    # Separate runs: one instance alive at a time.
+    separate = []
+    for (name, _, params, seed), rec in zip(INSTANCES, recordings, strict=True):
+        with FmuInstance(built_fmus.path(name), f"alone{seed}", params) as fmu:
+            separate.append(fmu.run_samples(rec["acc_meas"], rec["gyro_meas"], rec["dt"]))
+    # Together: all eight alive, stepped in lockstep, sample by sample.
+    fmus = [
+        FmuInstance(built_fmus.path(name), f"together{seed}", params)
+        for name, _, params, seed in INSTANCES
+    ]
+    try:
+        rows = [[] for _ in fmus]
+        for i in range(N_SAMPLES):
+            for fmu, rec, out in zip(fmus, recordings, rows, strict=True):
+                out.append(fmu.run_samples(rec["acc_meas"][i:i + 1], rec["gyro_meas"][i:i + 1],
+                                           rec["dt"][i:i + 1]))
+    finally:
+        for fmu in fmus:
+            fmu.close()
+    for (name, key, params, seed), rec, alone, parts in zip(
+        INSTANCES, recordings, separate, rows, strict=True
+    ):
+        together = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+        for k in alone:
+            assert np.array_equal(together[k], alone[k]), f"{name} seed {seed}: {k}"
+        ref = fusion_core_run(key, rec["acc_meas"], rec["gyro_meas"], rec["dt"], **params)
+        assert np.array_equal(together["roll"], ref["roll"]), f"{name} seed {seed}"
+        assert np.array_equal(together["bias"], ref["bias"]), f"{name} seed {seed}"
+
+
+def resident_bytes() -> int:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/statm"), reason="needs Linux /proc")
+def test_instantiate_free_cycles_do_not_grow_memory(built_fmus, tmp_path):
+    from fmpy import extract
+
+    rec = record(1)
+    args = rec["acc_meas"][:10], rec["gyro_meas"][:10], rec["dt"][:10]
+    unzip = {
+        name: extract(str(built_fmus.path(name)), str(tmp_path / name))
+        for name in ("AngleBiasKalmanFilter", "UnscentedKalmanFilter")
+    }
+
+    def cycle(i: int) -> None:
+        name = "AngleBiasKalmanFilter" if i % 2 else "UnscentedKalmanFilter"
+        with FmuInstance(built_fmus.path(name), f"cycle{i}", unzip_dir=unzip[name]) as fmu:
+            fmu.run_samples(*args)
+
+    for i in range(10):  # warm-up: imports, first-time allocations
+        cycle(i)
+    gc.collect()
+    before = resident_bytes()
+    for i in range(MEMORY_CYCLES):
+        cycle(i)
+    gc.collect()
+    growth = resident_bytes() - before
+    print(f"RSS growth over {MEMORY_CYCLES} instantiate/free cycles: {growth / 2**20:.2f} MiB")
+    assert growth < MEMORY_LIMIT
