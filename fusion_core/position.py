@@ -91,7 +91,8 @@ class PositionKalmanFilter(Estimator):
     Per sample:
       1. stationary detector: the sample is quiet when the level-frame acceleration (computed
          with the previous tilt) is below zupt_acc and the bias-corrected rate below zupt_gyro;
-         the platform is stationary after zupt_window seconds of quiet samples;
+         the platform is stationary after zupt_window seconds of quiet samples, unless the
+         filter is sure it is gliding (see _slow_enough);
       2. tilt: an AngleBiasKalmanFilter (same samples) propagates roll and pitch. With
          tilt_update="stationary" (default) it uses only accelerometer samples confirmed
          stationary: a quiet sample waits zupt_window seconds in a queue and is applied (its
@@ -136,6 +137,16 @@ class PositionKalmanFilter(Estimator):
         Param(
             "zupt_window", 0.25, "Stationary detector: how long the sample must stay quiet",
             unit="s", low=0.0,
+        ),
+        Param(
+            "zupt_speed", 0.1,
+            "Zero-velocity update: estimated speeds above this (and above 5 sigma) are trusted "
+            "as motion at constant velocity, not reset", unit="m/s", low=0.0,
+        ),
+        Param(
+            "zupt_force_after", 2.0,
+            "Zero-velocity update: after this long quiet the platform is taken as stationary "
+            "whatever the estimated speed", unit="s", low=0.0,
         ),
         Param(
             "zupt_noise", 0.005, "Standard deviation of the zero-velocity pseudo-measurement",
@@ -218,6 +229,19 @@ class PositionKalmanFilter(Estimator):
         u2 = -sp * ax + cp * (sr * ay + cr * az)
         return cy * u0 - sy * u1, sy * u0 + cy * u1, u2 - G
 
+    def _slow_enough(self) -> bool:
+        """Whether the estimated speed allows a zero-velocity update.
+
+        An IMU cannot tell gliding at constant velocity from rest: in the middle of a smooth move
+        the acceleration passes through zero for longer than the detector window (0.36 s in a 1 m
+        move over 3 s). A speed the filter is sure of (above zupt_speed and above 5 standard
+        deviations) is not reset; after zupt_force_after seconds of quiet it is, whatever the
+        filter believes, so that a drifted velocity cannot lock the update out.
+        """
+        speed = math.sqrt(sum(x[1] * x[1] for x in self.states))
+        sigma = math.sqrt(self.P[1][1] + self._zupt_var)
+        return speed <= max(self._params["zupt_speed"], 5.0 * sigma)
+
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
@@ -231,7 +255,9 @@ class PositionKalmanFilter(Estimator):
             and math.sqrt(wx * wx + wy * wy + gz * gz) < p["zupt_gyro"]
         )
         self.quiet_time = self.quiet_time + dt if quiet else 0.0
-        self.stationary = quiet and self.quiet_time >= p["zupt_window"]
+        self.stationary = quiet and self.quiet_time >= p["zupt_window"] and (
+            self.quiet_time >= p["zupt_force_after"] or self._slow_enough()
+        )
         # 2. tilt stage; yaw from the gyro (Euler kinematics, Duong Quoc et al. eq. 2)
         tilt.gyro_prev = self.gyro_prev
         roll0, pitch0 = tilt.roll, tilt.pitch

@@ -79,19 +79,11 @@ class UnscentedKalmanFilter(Estimator):
         Param("alpha", 1.0, "Sigma-point spread (scaled unscented transform)", low=0.0,
               low_open=True, high=1.0),
         Param("beta", 2.0, "Prior-distribution parameter (2 is optimal for Gaussians)", low=0.0),
-        Param("kappa", 0.0, "Secondary scaling parameter; n + kappa must be > 0", low=-5.0,
-              low_open=True),
+        Param("kappa", 0.0, "Secondary scaling parameter (> -5 keeps n + lambda > 0 for n = 6)",
+              low=-5.0, low_open=True),
         INTEGRATION_PARAM,
     )
     STATE = ("x", "P")
-
-    def _check_params(self, values: dict) -> None:
-        lam = values["alpha"] ** 2 * (N_STATE + values["kappa"]) - N_STATE
-        if N_STATE + lam <= 0.0:
-            raise ValueError(
-                f"parameters alpha={values['alpha']!r}, kappa={values['kappa']!r} give "
-                f"n + lambda = {N_STATE + lam:.3g}: it must be > 0"
-            )
 
     def _configure(self) -> None:
         p = self._params
