@@ -89,8 +89,9 @@ class PositionKalmanFilter(Estimator):
     """Safitri et al. position Kalman filter with a zero-velocity update.
 
     Per sample:
-      1. stationary detector: the sample is quiet when the level-frame acceleration (computed
-         with the previous tilt) is below zupt_acc and the bias-corrected rate below zupt_gyro;
+      1. stationary detector: the sample is quiet when the specific force differs from its
+         running mean (time constant zupt_window) by less than zupt_acc, the level-frame
+         acceleration is below zupt_level_acc and the bias-corrected rate below zupt_gyro;
          the platform is stationary after zupt_window seconds of quiet samples, unless the
          filter is sure it is gliding (see _slow_enough);
       2. tilt: an AngleBiasKalmanFilter (same samples) propagates roll and pitch. With
@@ -127,7 +128,14 @@ class PositionKalmanFilter(Estimator):
         ),
         Param("zupt", True, "Zero-velocity update while the platform is stationary"),
         Param(
-            "zupt_acc", 0.2, "Stationary detector: level-frame acceleration threshold",
+            "zupt_acc", 0.2,
+            "Stationary detector: threshold on the specific force's change from its running mean",
+            unit="m/s2", low=0.0, low_open=True,
+        ),
+        Param(
+            "zupt_level_acc", 0.5,
+            "Stationary detector: level-frame acceleration threshold (coarse: it must tolerate "
+            "the tilt error it is there to let the filter correct, 0.5 m/s2 ~ 3 deg)",
             unit="m/s2", low=0.0, low_open=True,
         ),
         Param(
@@ -172,7 +180,8 @@ class PositionKalmanFilter(Estimator):
         ),
     )
     STATE = (
-        "yaw", "states", "P", "quiet_time", "stationary", "pending", "turned", "tilt_state"
+        "yaw", "states", "P", "quiet_time", "stationary", "pending", "turned", "f_mean",
+        "tilt_state",
     )
 
     def _configure(self) -> None:
@@ -208,10 +217,12 @@ class PositionKalmanFilter(Estimator):
         # acc pitch, `turned` when taken); `turned` sums the gyro propagation of roll and pitch.
         self.pending: list[tuple[float, float, float, float, float]] = []
         self.turned = (0.0, 0.0)
+        self.f_mean = (0.0, 0.0, 0.0)
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         # The first sample's dt is not used; pass one the tilt stage accepts.
         self.tilt.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
+        self.f_mean = (ax, ay, az)
         a = self._level_acceleration(ax, ay, az)
         r = self._acc_var_density * 100.0  # one sample's variance at a nominal 100 Hz
         self.P = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, r))
@@ -247,13 +258,20 @@ class PositionKalmanFilter(Estimator):
     ) -> None:
         p = self._params
         tilt = self.tilt
-        # 1. stationary detector, on the level-frame acceleration with the tilt so far
-        a_prev = self._level_acceleration(ax, ay, az)
+        # 1. stationary detector: the specific force against its own running mean (body frame:
+        # a tilt error cannot hide rest from the detector that corrects the tilt), a coarse
+        # level-frame acceleration test (a smooth move's acceleration plateau changes the
+        # specific force too slowly for the first test), and the bias-corrected rate
+        mx, my, mz = self.f_mean
         wx, wy = gx - tilt.bias_x, gy - tilt.bias_y
+        a_prev = self._level_acceleration(ax, ay, az)
         quiet = (
-            math.sqrt(a_prev[0] ** 2 + a_prev[1] ** 2 + a_prev[2] ** 2) < p["zupt_acc"]
+            math.sqrt((ax - mx) ** 2 + (ay - my) ** 2 + (az - mz) ** 2) < p["zupt_acc"]
+            and math.sqrt(a_prev[0] ** 2 + a_prev[1] ** 2 + a_prev[2] ** 2) < p["zupt_level_acc"]
             and math.sqrt(wx * wx + wy * wy + gz * gz) < p["zupt_gyro"]
         )
+        k = min(1.0, dt / p["zupt_window"]) if p["zupt_window"] > 0.0 else 1.0
+        self.f_mean = (mx + k * (ax - mx), my + k * (ay - my), mz + k * (az - mz))
         self.quiet_time = self.quiet_time + dt if quiet else 0.0
         self.stationary = quiet and self.quiet_time >= p["zupt_window"] and (
             self.quiet_time >= p["zupt_force_after"] or self._slow_enough()
