@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup run test test-slow lint fmus clean
+.PHONY: setup run demo test test-slow lint fmus clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -15,7 +15,14 @@ $(STAMP): pyproject.toml
 setup: $(STAMP)
 
 run: setup
+	$(BIN)/python build_fmu.py --out dist
+	$(BIN)/python -m testbenches run --out reports
+
+demo: setup
 	$(BIN)/python -m fusion_core.demo
+
+fmus: setup
+	$(BIN)/python build_fmu.py --out dist
 
 test: setup
 	$(BIN)/python -m pytest -q

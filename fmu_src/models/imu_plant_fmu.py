@@ -1,0 +1,88 @@
+"""ImuPlant FMU: the true motion of the testbench (fusion_core.scenarios) as an FMI 2.0
+co-simulation FMU.
+
+After doStep(t, h) the outputs are the truth at t+h of the scenario chosen by the Integer
+parameter `scenario`: Z-Y-X Euler angles, body rates consistent with them (inverse Euler-rate
+kinematics), the specific force R^T (a + g e_z) in the body frame, position and velocity.
+"""
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from fmu_src.slave import FmiLog, FmuSlave
+from fmu_src.variables import Variable, real_output
+from fusion_core.scenarios import SCENARIO_BY_ID, SCENARIOS, get_scenario
+
+_ENUM = ", ".join(f"{s.id} = {s.name} ({s.description})" for s in SCENARIOS.values())
+_AXIS = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
+_OUTPUTS = (
+    ("roll", "rad", "deg", "True roll phi (Z-Y-X Euler)"),
+    ("pitch", "rad", "deg", "True pitch theta (Z-Y-X Euler)"),
+    ("yaw", "rad", "deg", "True yaw psi (Z-Y-X Euler)"),
+    *((f"omega_{a}", "rad/s", "deg/s", f"True body angular rate about {_AXIS[a]}") for a in "xyz"),
+    *((f"f_{a}", "m/s2", None, f"True specific force along body {_AXIS[a]}") for a in "xyz"),
+    *((f"pos_{a}", "m", None, f"True position along world {a} (z up)") for a in "xyz"),
+    *((f"vel_{a}", "m/s", None, f"True velocity along world {a}") for a in "xyz"),
+)
+
+
+
+def _truth(scenario: int, t: float) -> dict[str, float]:
+    d = get_scenario(scenario).trajectory().truth(np.array([t]))
+    out = {"roll": float(d["roll"][0]), "pitch": float(d["pitch"][0]), "yaw": float(d["yaw"][0])}
+    for key in ("omega", "f", "pos", "vel"):
+        for i, a in enumerate("xyz"):
+            out[f"{key}_{a}"] = float(d[key][0, i])
+    return out
+
+
+class PlantModel:
+    """A scenario's truth, sampled at the end of each communication step."""
+
+    def __init__(self, params: dict[str, Any]) -> None:
+        self.scenario = get_scenario(int(params["scenario"]))
+        self.trajectory = self.scenario.trajectory()
+
+    def step(self, t: float, h: float, values: Mapping[str, Any], log: FmiLog) -> dict[str, Any]:
+        d = self.trajectory.truth(np.array([t + h]))
+        out = {"roll": float(d["roll"][0]), "pitch": float(d["pitch"][0]),
+               "yaw": float(d["yaw"][0])}
+        for key in ("omega", "f", "pos", "vel"):
+            row = d[key][0]
+            for i, a in enumerate("xyz"):
+                out[f"{key}_{a}"] = float(row[i])
+        return out
+
+    def set_parameter(self, name: str, value: Any) -> None:
+        raise ValueError(f"parameter {name!r} is fixed after initialisation")
+
+    def get_state(self) -> dict[str, Any]:
+        return {"scenario": self.scenario.id}  # the truth is a function of time only
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        self.__init__({"scenario": state["scenario"]})
+
+
+_START = _truth(0, 0.0)
+
+
+class ImuPlant(FmuSlave):
+    """True IMU motion of the testbench scenarios (fusion_core.scenarios)."""
+
+    description = (
+        "Testbench plant: analytic IMU motion with exact truth (Euler angles, body rates from "
+        "the Euler-rate kinematics, specific force, position, velocity). Scenarios after the "
+        "seed papers: Gui et al. and Duong Quoc et al. (tilt, two-axis, moderate dynamics), "
+        "Das & Mary (vibration), Safitri et al. (2 m translation)."
+    )
+    VARIABLES = (
+        Variable("scenario", "parameter", "Integer", f"Motion: {_ENUM}", 0,
+                 variability="fixed", low=min(SCENARIO_BY_ID), high=max(SCENARIO_BY_ID)),
+        *(real_output(name, unit, text + "; the value at the end of the last step", _START[name],
+                      display) for name, unit, display, text in _OUTPUTS),
+    )
+
+    def create_model(self, params: dict[str, Any]) -> PlantModel:
+        return PlantModel(params)

@@ -1,0 +1,154 @@
+"""The testbench scenarios: analytic motions with exact truth (plant model of the ImuPlant FMU).
+
+Each scenario has a fixed integer id (the ImuPlant FMU's `scenario` parameter), a name, a default
+duration and a Trajectory (fusion_core.synthetic). The ids never change meaning; new scenarios get
+new ids.
+
+| id | name              | motion                                                                  |
+|----|-------------------|-------------------------------------------------------------------------|
+| 0  | static_level      | at rest, level                                                          |
+| 1  | static_tilted     | at rest, roll 20 deg, pitch -10 deg                                     |
+| 2  | roll_sweep        | roll 45 deg sine at 0.35 Hz (peak rate 1.7 rad/s)                       |
+| 3  | pitch_sweep       | pitch 40 deg sine at 0.35 Hz (peak rate 1.5 rad/s)                      |
+| 4  | roll_pitch        | roll 30 deg at 0.3 Hz and pitch 20 deg at 0.2 Hz together, slow yaw     |
+| 5  | moderate_dynamics | roll/pitch 20-30 deg, rates up to 1.5 rad/s, linear acceleration       |
+|    |                   | swelling to 0.25/0.15/0.37 g (x/y/z) every 10 s: rho crosses 0.35      |
+| 6  | vibration         | slow tilt plus 61.3/122.6/183.9 Hz vibration of 0.3 g per tone (motor) |
+| 7  | high_dynamics     | tilt plus sustained 0.5 g accelerations lasting seconds                 |
+| 8  | translation_2m    | 2 m along x, minimum jerk over 3 s, 2 s at rest before and after        |
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from .synthetic import Signal, Trajectory, add, constant, min_jerk, sine
+from .types import DEG, G
+
+
+def swelling_sine(peak: float, freq: float, env_period: float, phase: float = 0.0) -> Signal:
+    """peak * e(t) * sin(2 pi freq t + phase), envelope e = (1 - cos(2 pi t / env_period)) / 2."""
+    w = 2.0 * math.pi * freq
+    we = 2.0 * math.pi / env_period
+
+    def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        ce, se = np.cos(we * t), np.sin(we * t)
+        e, de, dde = 0.5 * (1 - ce), 0.5 * we * se, 0.5 * we**2 * ce
+        c, s = np.cos(w * t + phase), np.sin(w * t + phase)
+        ds, dds = w * c, -w * w * s
+        return peak * e * s, peak * (de * s + e * ds), peak * (dde * s + 2 * de * ds + e * dds)
+
+    return f
+
+
+def _accel_sine(acc_amplitude: float, freq: float, phase: float = 0.0) -> Signal:
+    """A position sine whose acceleration amplitude is acc_amplitude [m/s^2]."""
+    return sine(acc_amplitude / (2.0 * math.pi * freq) ** 2, freq, phase)
+
+
+def _moderate() -> Trajectory:
+    # Two-axis tilt of 20-30 deg with rates to ~1.5 rad/s; linear acceleration whose envelope
+    # swells from 0 to its peak and back every 10 s: 0.25 g along x, 0.15 g along y and 0.37 g
+    # vertically, so rho = ||f|/g - 1| sweeps every band of Duong Quoc's table (0.01, 0.25, 0.35).
+    def lin(peak_g: float, freq: float, phase: float) -> Signal:
+        return swelling_sine(peak_g * G / (2 * math.pi * freq) ** 2, freq, 10.0, phase)
+
+    return Trajectory(
+        roll=add(sine(25 * DEG, 0.35), sine(5 * DEG, 0.13, 0.7)),
+        pitch=add(sine(20 * DEG, 0.45, 1.0), sine(8 * DEG, 0.11)),
+        yaw=sine(30 * DEG, 0.05),
+        pos=(lin(0.25, 0.9, 0.0), lin(0.15, 0.7, 1.1), lin(0.37, 1.1, 0.4)),
+    )
+
+
+def _vibration() -> Trajectory:
+    # Motor-like tones (rotor frequency and harmonics), not commensurate with the 100 Hz sample
+    # clock: tones at exact multiples of 20 Hz would alias to a pattern repeating every 10
+    # samples, which no real motor produces and which any accelerometer gate samples with bias.
+    vib = 0.3 * G
+    return Trajectory(
+        roll=sine(15 * DEG, 0.1),
+        pitch=sine(10 * DEG, 0.07, 0.5),
+        pos=(
+            add(_accel_sine(vib, 61.3), _accel_sine(vib, 183.9, 0.3)),
+            _accel_sine(vib, 122.6, 1.2),
+            add(_accel_sine(vib, 61.3, 2.0), _accel_sine(vib, 122.6, 0.8)),
+        ),
+    )
+
+
+def _high_dynamics() -> Trajectory:
+    # Moves of 20 m in 4 s (minimum jerk peak 0.73 g, above 0.5 g for about 1.5 s per move).
+    x = add(min_jerk(0.0, 20.0, 2.0, 4.0), min_jerk(0.0, -20.0, 10.0, 4.0))
+    y = add(min_jerk(0.0, 12.0, 5.0, 4.0), min_jerk(0.0, -12.0, 13.0, 4.0))
+    return Trajectory(
+        roll=sine(20 * DEG, 0.2), pitch=sine(15 * DEG, 0.15, 0.3), yaw=sine(20 * DEG, 0.03),
+        pos=(x, y, constant()),
+    )
+
+
+@dataclass(frozen=True)
+class Scenario:
+    id: int
+    name: str
+    duration: float
+    build: Callable[[], Trajectory]
+    description: str
+
+    def trajectory(self) -> Trajectory:
+        return self.build()
+
+
+SCENARIOS: dict[str, Scenario] = {
+    s.name: s
+    for s in (
+        Scenario(0, "static_level", 30.0, Trajectory, "at rest, level"),
+        Scenario(
+            1, "static_tilted", 30.0,
+            lambda: Trajectory(roll=constant(20 * DEG), pitch=constant(-10 * DEG)),
+            "at rest, roll 20 deg, pitch -10 deg",
+        ),
+        Scenario(
+            2, "roll_sweep", 30.0, lambda: Trajectory(roll=sine(45 * DEG, 0.35)),
+            "roll 45 deg sine at 0.35 Hz",
+        ),
+        Scenario(
+            3, "pitch_sweep", 30.0, lambda: Trajectory(pitch=sine(40 * DEG, 0.35)),
+            "pitch 40 deg sine at 0.35 Hz",
+        ),
+        Scenario(
+            4, "roll_pitch", 30.0,
+            lambda: Trajectory(
+                roll=sine(30 * DEG, 0.3), pitch=sine(20 * DEG, 0.2, 0.5), yaw=sine(20 * DEG, 0.05)
+            ),
+            "roll 30 deg at 0.3 Hz and pitch 20 deg at 0.2 Hz together",
+        ),
+        Scenario(
+            5, "moderate_dynamics", 60.0, _moderate,
+            "roll/pitch 20-30 deg, rates to 1.5 rad/s, linear acceleration swelling to 0.3 g",
+        ),
+        Scenario(6, "vibration", 30.0, _vibration, "slow tilt with 60-180 Hz vibration of 0.3 g"),
+        Scenario(
+            7, "high_dynamics", 20.0, _high_dynamics, "tilt with sustained 0.5 g accelerations"
+        ),
+        Scenario(
+            8, "translation_2m", 7.0,
+            lambda: Trajectory(pos=(min_jerk(0.0, 2.0, 2.0, 3.0), constant(), constant())),
+            "2 m along x, minimum jerk over 3 s, 2 s at rest before and after",
+        ),
+    )
+}
+SCENARIO_BY_ID: dict[int, Scenario] = {s.id: s for s in SCENARIOS.values()}
+
+
+def get_scenario(key: str | int) -> Scenario:
+    """A scenario by name or id; ValueError listing the allowed ones otherwise."""
+    found = SCENARIO_BY_ID.get(key) if isinstance(key, int) else SCENARIOS.get(key)
+    if found is None:
+        allowed = ", ".join(f"{s.id}={s.name}" for s in SCENARIOS.values())
+        raise ValueError(f"unknown scenario {key!r}: allowed {allowed}")
+    return found

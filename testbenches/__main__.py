@@ -1,0 +1,105 @@
+"""`python -m testbenches run ...`: the command line over testbenches' functions.
+
+  run   estimator x scenario x seed campaign with the contract checks; prints the contract table,
+        writes DIR/report.json, DIR/report.md and plots; exit status 1 on any FAIL.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from fusion_core.scenarios import SCENARIOS
+
+from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS
+
+
+def _choices(value: str, allowed: list[str], what: str) -> list[str]:
+    if value == "all":
+        return allowed
+    names = value.split(",")
+    bad = [n for n in names if n not in allowed]
+    if bad:
+        raise argparse.ArgumentTypeError(
+            f"unknown {what} {', '.join(bad)}: allowed all, {', '.join(allowed)}")
+    return names
+
+
+def parse_params(items: list[str]) -> dict[str, object]:
+    """NAME=VALUE strings to a dict: numbers as float or int, true/false, else the string."""
+    out: dict[str, object] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name:
+            raise ValueError(f"--param {item!r}: expected NAME=VALUE")
+        value: object = text
+        if text.lower() in ("true", "false"):
+            value = text.lower() == "true"
+        else:
+            for kind in (int, float):
+                try:
+                    value = kind(text)
+                    break
+                except ValueError:
+                    pass
+        out[name] = value
+    return out
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from .campaign import plan, run_campaign
+    from .report import contract_table, write_reports
+
+    estimators = _choices(args.estimator, list(ESTIMATOR_FMUS), "estimator")
+    scenarios = _choices(args.scenario, list(SCENARIOS), "scenario")
+    jobs = plan(estimators, scenarios, args.seeds, args.jitter, not args.no_contract)
+    with tqdm(total=len(jobs), unit="run", file=sys.stderr) as bar:
+        def progress(job: object) -> None:
+            bar.set_postfix_str(f"{job.estimator} {job.scenario}")  # type: ignore[attr-defined]
+            bar.update()
+
+        result = run_campaign(estimators, scenarios, args.seeds, args.jitter, args.fmu_dir,
+                              progress, not args.no_contract, parse_params(args.param),
+                              args.duration)
+    print(contract_table(result))
+    write_reports(result, args.out, plots=not args.no_plots)
+    print(f"\nreports: {args.out / 'report.md'}, {args.out / 'report.json'}")
+    return 0 if result.passed else 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m testbenches", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a testbench campaign and check the contract")
+    run.add_argument("--estimator", default="all",
+                     help=f"all or a comma list of {', '.join(ESTIMATOR_FMUS)}")
+    run.add_argument("--scenario", default="all",
+                     help=f"all or a comma list of {', '.join(SCENARIOS)}")
+    run.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                     help="estimator FMU parameter for every run (repeatable); an enumeration "
+                     "by item name, e.g. --param integration=rectangle")
+    run.add_argument("--seeds", type=int, default=1, help="seeds per estimator x scenario (1)")
+    run.add_argument("--jitter", type=float, default=0.0,
+                     help="communication-step jitter, fraction of the period (0)")
+    run.add_argument("--duration", type=float, default=None,
+                     help="seconds per run instead of each scenario's own duration")
+    run.add_argument("--out", type=Path, default=Path("reports"), help="report folder (reports)")
+    run.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
+    run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run.add_argument("--no-contract", action="store_true",
+                     help="only the runs, without the T1, T2, T4 and position extras")
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "run":
+            return cmd_run(args)
+    except (ValueError, FileNotFoundError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,98 @@
+"""A campaign: estimator x scenario x seed runs plus the contract's T1, T2, T4, position checks."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fusion_core.scenarios import SCENARIOS
+
+from . import contract
+from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS
+from .master import TestbenchResult, run_testbench
+
+
+@dataclass
+class CampaignResult:
+    runs: list[TestbenchResult] = field(default_factory=list)
+    checks: list[contract.Check] = field(default_factory=list)
+    """Campaign-level checks (T1, T2, T4, position); per-run checks live on each run."""
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks) and all(r.passed for r in self.runs)
+
+
+@dataclass(frozen=True)
+class Job:
+    kind: str  # "run"; contract extras: "t1", "t2_fixed", "t2_jitter", "t4"
+    estimator: str
+    scenario: str
+    seed: int
+    jitter: float = 0.0
+    sensor_params: tuple[tuple[str, Any], ...] = ()
+
+
+def plan(
+    estimators: Sequence[str], scenarios: Sequence[str], seeds: int, jitter: float,
+    contract_checks: bool = True,
+) -> list[Job]:
+    """The runs of a campaign: every estimator x scenario x seed, then the contract's extras."""
+    jobs = [Job("run", e, s, seed, jitter) for s in scenarios for e in estimators
+            for seed in range(seeds)]
+    if not contract_checks:
+        return jobs
+    noise_free = tuple(contract.NOISE_FREE.items())
+    for e in estimators:
+        jobs += [Job("t1", e, s, 0, 0.0, noise_free) for s in contract.T1_SCENARIOS]
+        jobs.append(Job("t2_fixed", e, contract.T2_SCENARIO, 0, 0.0, noise_free))
+        jobs.append(Job("t2_jitter", e, contract.T2_SCENARIO, 0, contract.T2_JITTER, noise_free))
+        jobs += [Job("t4", e, contract.T4_SCENARIO, 0)] * 2
+    if "poskf" in estimators:
+        done = {j.seed for j in jobs if j.kind == "run" and j.estimator == "poskf"
+                and j.scenario == "translation_2m" and j.jitter == 0.0}
+        jobs += [Job("position", "poskf", "translation_2m", seed)
+                 for seed in range(contract.POSITION_SEEDS) if seed not in done]
+    return jobs
+
+
+def run_campaign(
+    estimators: Sequence[str] = tuple(ESTIMATOR_FMUS),
+    scenarios: Sequence[str] = tuple(SCENARIOS),
+    seeds: int = 1,
+    jitter: float = 0.0,
+    fmu_dir: Path | str = DEFAULT_FMU_DIR,
+    progress: Callable[[Job], None] | None = None,
+    contract_checks: bool = True,
+    params: dict[str, Any] | None = None,
+    duration: float | None = None,
+) -> CampaignResult:
+    """Run a campaign and evaluate the contract; `progress` is called after each run; `params`
+    are estimator FMU parameters for every run (each estimator must have them); `duration`
+    replaces each scenario's own duration in the runs (not in the contract's extras)."""
+    out = CampaignResult()
+    extra: dict[tuple[str, str], list[TestbenchResult]] = {}
+    for job in plan(estimators, scenarios, seeds, jitter, contract_checks):
+        r = run_testbench(job.estimator, job.scenario, seed=job.seed, jitter=job.jitter,
+                          params=params, sensor_params=dict(job.sensor_params), fmu_dir=fmu_dir,
+                          duration=duration if job.kind == "run" else None)
+        if job.kind == "run":
+            out.runs.append(r)
+        else:
+            extra.setdefault((job.kind, job.estimator), []).append(r)
+        if progress:
+            progress(job)
+    if not contract_checks:
+        return out
+    for e in estimators:
+        out.checks.append(contract.check_t1(extra[("t1", e)]))
+        out.checks.append(contract.check_t2(extra[("t2_fixed", e)][0],
+                                            extra[("t2_jitter", e)][0]))
+        out.checks.append(contract.check_t4(*extra[("t4", e)]))
+    if "poskf" in estimators:
+        pos = [r for r in out.runs if r.estimator == "poskf" and r.scenario == "translation_2m"
+               and r.jitter == 0.0] + extra.get(("position", "poskf"), [])
+        out.checks += contract.check_position(pos)
+    return out

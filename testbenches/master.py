@@ -1,0 +1,160 @@
+"""The testbench master: plant -> sensor -> estimator FMUs, Gauss-Seidel, on fmpy's FMU2Slave.
+
+Per communication step [t, t+h] (INTERFACE.md, Timing):
+  1. plant.doStep(t, h): the plant's outputs are the truth at t+h;
+  2. sensor inputs := plant outputs; sensor.doStep(t, h): the IMU sample taken at t+h, dt = h;
+  3. estimator inputs := sensor outputs; estimator.doStep(t, h): the estimate at t+h.
+With jitter > 0 the communication steps are h_k = (1 + jitter u_k) / rate, u_k uniform in
+[-1, 1] from the run's seed, so dt follows. Every FMI call's status is checked (fmpy raises on
+anything but fmi2OK); the wall time of set-inputs + doStep + get-outputs of the estimator is
+recorded per step for contract check T3.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.scenarios import get_scenario
+
+from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, FmuHandle, fmu_path
+
+TRUTH = ("roll", "pitch", "yaw", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z",
+         "pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z")
+SENSOR_IN = ("omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z")
+SAMPLE = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt")
+ESTIMATE = ("roll", "pitch", "bias_x", "bias_y", "bias_z")
+POSITION = ("pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z")
+
+
+@dataclass
+class TestbenchResult:
+    """Traces of one run (arrays of length N, one row per communication point t_k > 0) and,
+    once contract.evaluate has run, its metrics and checks."""
+
+    estimator: str
+    scenario: str
+    seed: int
+    rate: float
+    jitter: float
+    params: dict[str, Any]
+    sensor_params: dict[str, Any]
+    t: np.ndarray
+    truth: dict[str, np.ndarray]
+    sample: dict[str, np.ndarray]
+    estimate: dict[str, np.ndarray]
+    invalid_samples: int
+    step_us: np.ndarray
+    true_gyro_bias: tuple[float, float, float]
+    metrics: dict[str, float] = field(default_factory=dict)
+    checks: list[Any] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+
+def communication_steps(duration: float, rate: float, jitter: float, seed: int) -> np.ndarray:
+    """Step sizes covering [0, duration]: 1/rate each, or jittered by +-jitter (uniform)."""
+    n = round(duration * rate)
+    h = np.full(n, 1.0 / rate)
+    if jitter > 0.0:
+        rng = np.random.default_rng([seed, 7919])  # a stream of its own, apart from the sensor's
+        h *= 1.0 + jitter * rng.uniform(-1.0, 1.0, n)
+    return h
+
+
+def run_testbench(
+    estimator: str,
+    scenario: str | int,
+    seed: int = 0,
+    duration: float | None = None,
+    rate: float = 100.0,
+    jitter: float = 0.0,
+    params: dict[str, Any] | None = None,
+    sensor_params: dict[str, Any] | None = None,
+    fmu_dir: Path | str = DEFAULT_FMU_DIR,
+    evaluate: bool = True,
+) -> TestbenchResult:
+    """Couple ImuPlant -> ImuSensor -> the estimator FMU and run one scenario.
+
+    estimator: a fusion_core.ESTIMATORS key; scenario: a name or id of fusion_core.scenarios;
+    params: estimator FMU parameters; sensor_params: ImuSensor parameters (seed is set from
+    `seed`). Returns the traces, and with evaluate=True the contract's metrics and checks.
+    """
+    if estimator not in ESTIMATOR_FMUS:
+        raise ValueError(f"unknown estimator {estimator!r}: allowed {', '.join(ESTIMATOR_FMUS)}")
+    sc = get_scenario(scenario)
+    duration = sc.duration if duration is None else float(duration)
+    if not rate > 0.0 or not 0.0 <= jitter < 1.0:
+        raise ValueError(f"rate={rate!r} must be > 0 and jitter={jitter!r} in [0, 1)")
+    params = dict(params or {})
+    sensor_params = {**(sensor_params or {}), "seed": seed}
+    steps = communication_steps(duration, rate, jitter, seed)
+    n = len(steps)
+    position = estimator == "poskf"
+
+    tag = f"{estimator}-{sc.name}-{seed}-{time.perf_counter_ns()}"
+    plant = FmuHandle(fmu_path(PLANT_FMU, fmu_dir), f"plant-{tag}")
+    sensor = FmuHandle(fmu_path(SENSOR_FMU, fmu_dir), f"sensor-{tag}")
+    est = FmuHandle(fmu_path(ESTIMATOR_FMUS[estimator], fmu_dir), f"est-{tag}")
+    try:
+        stop = float(np.sum(steps))
+        plant.start({"scenario": sc.id}, stop)
+        sensor.start(sensor_params, stop)
+        est.start(params, stop)
+        truth_vr = plant.vrs(TRUTH)
+        sensor_in_vr = sensor.vrs(SENSOR_IN)
+        sample_vr = sensor.vrs(SAMPLE)
+        est_in_vr = est.vrs(SAMPLE)
+        est_out_vr = est.vrs(ESTIMATE + (POSITION if position else ()))
+        invalid_vr = est.vrs(["invalid_samples"])
+        bias_vr = sensor.vrs([f"gyro_bias_{a}" for a in "xyz"])
+        true_bias = tuple(sensor.fmu.getReal(bias_vr))
+
+        truth = np.empty((n, len(TRUTH)))
+        sample = np.empty((n, len(SAMPLE)))
+        out = np.empty((n, len(est_out_vr)))
+        step_ns = np.empty(n, dtype=np.int64)
+        t_points = np.empty(n)
+        p_fmu, s_fmu, e_fmu = plant.fmu, sensor.fmu, est.fmu
+        perf = time.perf_counter_ns
+        t = 0.0
+        for k in range(n):
+            h = float(steps[k])
+            p_fmu.doStep(t, h)
+            tr = p_fmu.getReal(truth_vr)
+            s_fmu.setReal(sensor_in_vr, tr[3:9])
+            s_fmu.doStep(t, h)
+            smp = s_fmu.getReal(sample_vr)
+            t0 = perf()
+            e_fmu.setReal(est_in_vr, smp)
+            e_fmu.doStep(t, h)
+            o = e_fmu.getReal(est_out_vr)
+            step_ns[k] = perf() - t0
+            truth[k], sample[k], out[k] = tr, smp, o
+            t += h
+            t_points[k] = t
+        invalid = int(e_fmu.getInteger(invalid_vr)[0])
+    finally:
+        for handle in (est, sensor, plant):
+            handle.free()
+
+    names = ESTIMATE + (POSITION if position else ())
+    result = TestbenchResult(
+        estimator=estimator, scenario=sc.name, seed=seed, rate=rate, jitter=jitter,
+        params=params, sensor_params=sensor_params, t=t_points,
+        truth={name: truth[:, i] for i, name in enumerate(TRUTH)},
+        sample={name: sample[:, i] for i, name in enumerate(SAMPLE)},
+        estimate={name: out[:, i] for i, name in enumerate(names)},
+        invalid_samples=invalid, step_us=step_ns / 1e3, true_gyro_bias=true_bias,  # type: ignore[arg-type]
+    )
+    if evaluate:
+        from .contract import evaluate as evaluate_contract
+
+        evaluate_contract(result)
+    return result

@@ -1,0 +1,123 @@
+"""Reports of a campaign: a contract table for the terminal, report.json, report.md, PNG plots."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.types import DEG
+
+from . import contract
+from .campaign import CampaignResult
+from .master import TestbenchResult
+
+
+def _finite(x: float) -> float | None:
+    return x if math.isfinite(x) else None
+
+
+def run_record(r: TestbenchResult, plot: str | None = None) -> dict[str, Any]:
+    return {
+        "estimator": r.estimator,
+        "scenario": r.scenario,
+        "seed": r.seed,
+        "rate_hz": r.rate,
+        "jitter": r.jitter,
+        "params": r.params,
+        "metrics": {k: _finite(v) for k, v in r.metrics.items()},
+        "checks": [c.as_dict() for c in r.checks],
+        "passed": r.passed,
+        "plot": plot,
+    }
+
+
+def contract_table(result: CampaignResult) -> str:
+    """One line per run (RMSE roll/pitch against the limit, p99 step time, verdict) and the
+    campaign checks."""
+    head = (f"{'estimator':<9} {'scenario':<18} {'seed':>4} {'RMSE roll':>10} {'RMSE pitch':>10} "
+            f"{'limit':>11} {'max err':>8} {'p99 us':>7}  verdict")
+    lines = [f"contract v{contract.CONTRACT_VERSION}", head, "-" * len(head)]
+    for r in result.runs:
+        m = r.metrics
+        lim = contract.accuracy_limits(r.estimator, r.scenario)
+        failed = [c.name for c in r.checks if not c.passed]
+        verdict = "PASS" if not failed else "FAIL: " + ", ".join(failed)
+        lines.append(
+            f"{r.estimator:<9} {r.scenario:<18} {r.seed:>4} {m['rmse_roll_deg']:>10.3f} "
+            f"{m['rmse_pitch_deg']:>10.3f} {lim[0]:>5.2f}/{lim[1]:<5.2f} {m['max_err_deg']:>8.2f} "
+            f"{m['step_p99_us']:>7.0f}  {verdict}"
+        )
+    if result.checks:
+        lines.append("")
+        lines += [c.line() for c in result.checks]
+    n_fail = sum(not c.passed for r in result.runs for c in r.checks) + sum(
+        not c.passed for c in result.checks)
+    n_all = sum(len(r.checks) for r in result.runs) + len(result.checks)
+    lines.append("")
+    lines.append(f"{n_all - n_fail} of {n_all} checks PASS" + (
+        "" if not n_fail else f", {n_fail} FAIL"))
+    return "\n".join(lines)
+
+
+def plot_run(r: TestbenchResult, path: Path) -> None:
+    """Truth vs estimate, error, and gyro bias of one run."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    t = r.t
+    for name, color in (("roll", "C0"), ("pitch", "C1")):
+        ax[0].plot(t, r.truth[name] / DEG, color=color, lw=2.0, alpha=0.4, label=f"{name} truth")
+        ax[0].plot(t, r.estimate[name] / DEG, color=color, lw=0.8, label=f"{name} estimate")
+        err = np.remainder(r.estimate[name] - r.truth[name] + math.pi, 2 * math.pi) - math.pi
+        ax[1].plot(t, err / DEG, color=color, lw=0.8, label=f"{name} error")
+    for i, a in enumerate("xyz"):
+        ax[2].plot(t, r.estimate[f"bias_{a}"] / DEG, color=f"C{i + 2}", lw=0.8,
+                   label=f"bias_{a} estimate")
+        ax[2].axhline(r.true_gyro_bias[i] / DEG, color=f"C{i + 2}", ls="--", lw=0.8)
+    ax[0].set_ylabel("angle [deg]")
+    ax[1].set_ylabel("error [deg]")
+    ax[2].set_ylabel("gyro bias [deg/s]")
+    ax[2].set_xlabel("time [s]")
+    for a in ax:
+        a.grid(True, alpha=0.3)
+        a.legend(loc="upper right", fontsize=7, ncol=3)
+    m = r.metrics
+    fig.suptitle(f"{r.estimator} on {r.scenario} (seed {r.seed}): RMSE roll "
+                 f"{m['rmse_roll_deg']:.3f} deg, pitch {m['rmse_pitch_deg']:.3f} deg")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True) -> None:
+    """report.json, report.md and, with plots, a PNG per run under out_dir/plots."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    records = []
+    for r in result.runs:
+        name = None
+        if plots:
+            (out_dir / "plots").mkdir(exist_ok=True)
+            name = f"plots/{r.estimator}_{r.scenario}_{r.seed}.png"
+            plot_run(r, out_dir / name)
+        records.append(run_record(r, name))
+    report = {
+        "contract_version": contract.CONTRACT_VERSION,
+        "passed": result.passed,
+        "runs": records,
+        "checks": [c.as_dict() for c in result.checks],
+    }
+    (out_dir / "report.json").write_text(json.dumps(report, indent=1))
+    md = ["# Testbench report", "", f"Contract v{contract.CONTRACT_VERSION}: "
+          f"{'PASS' if result.passed else 'FAIL'}", "", "```", contract_table(result), "```", ""]
+    for rec in records:
+        if rec["plot"]:
+            md += [f"## {rec['estimator']} on {rec['scenario']} (seed {rec['seed']})", "",
+                   f"![{rec['estimator']} {rec['scenario']}]({rec['plot']})", ""]
+    (out_dir / "report.md").write_text("\n".join(md))

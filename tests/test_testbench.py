@@ -1,0 +1,266 @@
+"""The testbench (issue 4): master, plant and sensor models, contract checks, command line.
+
+The FMUs come from the session's build (conftest.built_fmus). Runs are short (5-15 s of motion)
+to keep the suite fast; the full campaign is `make run`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fusion_core import DEG, ESTIMATORS, G
+from fusion_core.kinematics import euler_rates
+from fusion_core.scenarios import SCENARIOS
+from fusion_core.sensor import ImuSensorModel
+from testbenches import contract, run_testbench
+
+REPO = Path(__file__).resolve().parent.parent
+KEYS = tuple(ESTIMATORS)
+
+
+@pytest.fixture(scope="module")
+def fmu_dir(built_fmus) -> Path:
+    assert built_fmus.returncode == 0, built_fmus.output
+    return built_fmus.directory
+
+
+# ----- master ------------------------------------------------------------------------------------
+@pytest.mark.parametrize("key", KEYS)
+def test_master_equals_a_direct_fusion_core_run_on_the_same_samples(
+    key: str, fmu_dir: Path
+) -> None:
+    """The estimator FMU inside the three-FMU loop gives exactly fusion_core's estimates for the
+    samples the sensor FMU produced (bit-identical: no extra delay, no lost sample)."""
+    r = run_testbench(key, "moderate_dynamics", duration=5.0, jitter=0.2, fmu_dir=fmu_dir)
+    s = r.sample
+    acc = np.column_stack([s["acc_x"], s["acc_y"], s["acc_z"]])
+    gyro = np.column_stack([s["gyro_x"], s["gyro_y"], s["gyro_z"]])
+    direct = ESTIMATORS[key]().run(acc, gyro, s["dt"])
+    assert np.array_equal(direct["roll"], r.estimate["roll"])
+    assert np.array_equal(direct["pitch"], r.estimate["pitch"])
+    assert np.array_equal(direct["bias"][:, 0], r.estimate["bias_x"])
+    if key == "poskf":
+        assert np.array_equal(direct["pos"][:, 0], r.estimate["pos_x"])
+
+
+def test_plant_outputs_are_the_truth_at_the_end_of_each_step(fmu_dir: Path) -> None:
+    """Step k of the master records the truth at t_k = (k + 1) h (Gauss-Seidel ordering)."""
+    r = run_testbench("cf", "roll_sweep", duration=2.0, fmu_dir=fmu_dir, evaluate=False)
+    truth = SCENARIOS["roll_sweep"].trajectory().truth(r.t)
+    assert r.t[0] == pytest.approx(0.01)
+    assert np.max(np.abs(truth["roll"] - r.truth["roll"])) < 1e-12
+
+
+# ----- contract checks T1-T4 on short scenarios ---------------------------------------------------
+def test_t1_alignment_passes_for_every_attitude_estimator(fmu_dir: Path) -> None:
+    """Noise-free roll sweep (peak rate 1.7 rad/s) at 100 Hz: error < 0.05 deg after 1 s."""
+    runs = [run_testbench(k, "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
+                          sensor_params=contract.NOISE_FREE) for k in KEYS]
+    check = contract.check_t1(runs)
+    print("\n" + check.line())
+    assert check.passed
+
+
+def test_t2_variable_step_passes(fmu_dir: Path) -> None:
+    """+-20 % jittered steps: RMSE within 10 % of the fixed-step run (cf, 15 s, noise-free)."""
+    kw = {"duration": 15.0, "fmu_dir": fmu_dir, "sensor_params": contract.NOISE_FREE}
+    fixed = run_testbench("mgcf", contract.T2_SCENARIO, **kw)
+    jittered = run_testbench("mgcf", contract.T2_SCENARIO, jitter=contract.T2_JITTER, **kw)
+    check = contract.check_t2(fixed, jittered)
+    print("\n" + check.line())
+    assert np.ptp(np.diff(jittered.t)) > 0.3 / 100.0  # the steps really varied
+    assert check.passed
+
+
+def test_t3_budget_is_measured_per_step_and_reported(fmu_dir: Path) -> None:
+    """T3 is a measurement (no wall-clock assertion here): p50 <= p99, one time per step."""
+    r = run_testbench("kf", "static_level", duration=2.0, fmu_dir=fmu_dir)
+    check = next(c for c in r.checks if c.name.startswith("T3"))
+    assert len(r.step_us) == len(r.t)
+    assert 0.0 < r.metrics["step_p50_us"] <= r.metrics["step_p99_us"] == check.measured
+    assert check.allowed == pytest.approx(1000.0)
+
+
+def test_t4_same_seed_gives_a_bit_identical_trace(fmu_dir: Path) -> None:
+    first = run_testbench("ukf", "roll_pitch", duration=3.0, seed=4, fmu_dir=fmu_dir)
+    again = run_testbench("ukf", "roll_pitch", duration=3.0, seed=4, fmu_dir=fmu_dir)
+    assert contract.check_t4(first, again).passed
+
+
+# ----- every check can fail ----------------------------------------------------------------------
+def test_a_one_sample_lag_fails_t1_by_about_omega_h(fmu_dir: Path) -> None:
+    """The estimate shifted by one sample (a hidden delay) fails T1 with ~|omega| h of error."""
+    r = run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
+                      sensor_params=contract.NOISE_FREE)
+    delayed = {k: np.r_[v[:1], v[:-1]] for k, v in r.estimate.items()}
+    lagged = dataclasses.replace(r, estimate=delayed)
+    contract.evaluate(lagged)
+    check = contract.check_t1([lagged])
+    peak_rate = np.max(np.abs(r.truth["omega_x"]))
+    print("\n" + check.line())
+    assert not check.passed
+    assert check.measured == pytest.approx(peak_rate * 0.01 / DEG, rel=0.1)
+
+
+def test_the_papers_rectangle_rule_fails_t1_and_accuracy(fmu_dir: Path) -> None:
+    """integration="rectangle" (the papers' rule) lags by half a step: 0.5 deg on the sweep."""
+    r = run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
+                      params={"integration": "rectangle"})
+    t1 = contract.check_t1([run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
+                                          params={"integration": "rectangle"},
+                                          sensor_params=contract.NOISE_FREE)])
+    assert not t1.passed
+    assert not next(c for c in r.checks if c.name == "accuracy roll RMSE").passed
+
+
+def test_a_mistuned_estimator_fails_accuracy(fmu_dir: Path) -> None:
+    """tau = 1000 s: the CF integrates a 1 deg/s gyro bias almost freely on the static tilt."""
+    r = run_testbench("cf", "static_tilted", duration=6.0, fmu_dir=fmu_dir,
+                      params={"tau": 1000.0}, sensor_params={"gyro_bias_x": 1.0 * DEG})
+    failed = [c.name for c in r.checks if not c.passed]
+    print(f"\nRMSE roll {r.metrics['rmse_roll_deg']:.2f} deg: failed {failed}")
+    assert "accuracy roll RMSE" in failed
+
+
+def test_t2_fails_when_the_jittered_rmse_differs(fmu_dir: Path) -> None:
+    fixed = run_testbench("cf", "roll_pitch", duration=3.0, fmu_dir=fmu_dir)
+    rmse = 1.2 * fixed.metrics["rmse_roll_deg"]
+    worse = dataclasses.replace(fixed, metrics={**fixed.metrics, "rmse_roll_deg": rmse})
+    assert not contract.check_t2(fixed, worse).passed
+
+
+def test_t4_fails_when_the_traces_differ(fmu_dir: Path) -> None:
+    a = run_testbench("cf", "roll_pitch", duration=2.0, seed=1, fmu_dir=fmu_dir)
+    b = run_testbench("cf", "roll_pitch", duration=2.0, seed=2, fmu_dir=fmu_dir)
+    assert not contract.check_t4(a, b).passed
+
+
+def test_position_check_fails_without_the_zero_velocity_update(fmu_dir: Path) -> None:
+    """zupt=False on the 2 m move (3 seeds): the final x error exceeds Safitri's 0.0385 m."""
+    runs = [run_testbench("poskf", "translation_2m", seed=s, fmu_dir=fmu_dir,
+                          params={"zupt": False, "zaru": False}) for s in range(3)]
+    checks = contract.check_position(runs)
+    print("\n" + "\n".join(c.line() for c in checks))
+    assert not checks[0].passed
+
+
+# ----- plant and sensor models -------------------------------------------------------------------
+@pytest.mark.parametrize("name", list(SCENARIOS))
+def test_plant_truth_is_consistent_with_finite_differences(name: str) -> None:
+    """Body rates reproduce the finite-difference Euler rates through the Euler kinematics, and
+    the specific force equals R^T (a + g e_z) with a from finite differences of the position."""
+    traj = SCENARIOS[name].trajectory()
+    h = 1e-5  # the vibration tones reach 184 Hz
+    t = np.linspace(1.0, 3.0, 41)
+    d = traj.truth(t)
+    up, down = traj.truth(t + h), traj.truth(t - h)
+    droll = (up["roll"] - down["roll"]) / (2 * h)
+    dpitch = (up["pitch"] - down["pitch"]) / (2 * h)
+    rates = np.array([euler_rates(p, q, *w) for p, q, w in zip(d["roll"], d["pitch"], d["omega"],
+                                                                strict=True)])
+    assert np.max(np.abs(rates[:, 0] - droll)) < 1e-5
+    assert np.max(np.abs(rates[:, 1] - dpitch)) < 1e-5
+    acc = (up["pos"] - 2 * d["pos"] + down["pos"]) / h**2
+    for i in range(len(t)):
+        cr, sr = math.cos(d["roll"][i]), math.sin(d["roll"][i])
+        cp, sp = math.cos(d["pitch"][i]), math.sin(d["pitch"][i])
+        cy, sy = math.cos(d["yaw"][i]), math.sin(d["yaw"][i])
+        rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+        ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+        rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+        f = (rz @ ry @ rx).T @ (acc[i] + [0.0, 0.0, G])
+        assert np.max(np.abs(f - d["f"][i])) < 2e-3 * max(1.0, np.abs(acc[i]).max())
+
+
+def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> None:
+    """40 000 samples at 100 Hz, no quantisation: sample std * sqrt(h) / density in [0.95, 1.05]
+    for every axis; the bias random walk's increments likewise."""
+    m = ImuSensorModel(bits=0, gyro_bias_walk=1e-3, acc_bias_walk=1e-2, seed=3)
+    h = 0.01
+    rows, gb, ab = [], [], []
+    for _ in range(40_000):
+        acc, gyro, _ = m.sample((0.0, 0.0, 0.0), (0.0, 0.0, G), h)
+        rows.append((*gyro, *acc))
+        gb.append(list(m.gyro_bias))
+        ab.append(list(m.acc_bias))
+    x = np.asarray(rows)
+    white = np.diff(x, axis=0).std(axis=0) / math.sqrt(2) * math.sqrt(h)
+    gyro_ratio = white[:3] / m.params["gyro_noise"]
+    acc_ratio = white[3:] / m.params["acc_noise"]
+    walk_g = np.diff(np.asarray(gb), axis=0).std(axis=0) / math.sqrt(h) / 1e-3
+    walk_a = np.diff(np.asarray(ab), axis=0).std(axis=0) / math.sqrt(h) / 1e-2
+    print(f"\ngyro {gyro_ratio}, acc {acc_ratio}, walks {walk_g} {walk_a}")
+    for ratio in (walk_g, walk_a):
+        assert np.all(np.abs(ratio - 1.0) < 0.05)
+    # The white noise rides on the slowly walking bias: difference it out (std of x_k - x_{k-1}
+    # is sqrt(2) sigma plus a walk increment 100x smaller than sigma here).
+    for ratio in (gyro_ratio, acc_ratio):
+        assert np.all(np.abs(ratio - 1.0) < 0.05)
+
+
+def test_sensor_saturates_and_quantises_like_a_16_bit_mpu6050() -> None:
+    m = ImuSensorModel(gyro_noise=0.0, acc_noise=0.0)
+    acc, gyro, _ = m.sample((50.0, 0.001, 0.0), (0.0, 0.0, 20 * G), 0.01)
+    lsb = 2 * 2000 * DEG / 2**16
+    assert gyro[0] == pytest.approx(round(2000 * DEG / lsb) * lsb)
+    assert gyro[1] == pytest.approx(round(0.001 / lsb) * lsb)
+    assert acc[2] == pytest.approx(16 * G)
+
+
+# ----- command line ------------------------------------------------------------------------------
+def _cli(*args: str, fmu_dir: Path, out: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "testbenches", "run", "--no-contract", "--no-plots",
+         "--fmu-dir", str(fmu_dir), "--out", str(out), *args],
+        cwd=REPO, capture_output=True, text=True, timeout=300,
+    )
+
+
+def test_cli_exits_0_when_every_check_passes(fmu_dir: Path, tmp_path: Path) -> None:
+    proc = _cli("--estimator", "cf,mgcf", "--scenario", "static_level", "--duration", "3",
+                fmu_dir=fmu_dir, out=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "PASS" in proc.stdout
+    import json
+
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert {r["estimator"] for r in report["runs"]} == {"cf", "mgcf"}
+    assert "rmse_roll_deg" in report["runs"][0]["metrics"]
+    assert (tmp_path / "report.md").is_file()
+
+
+def test_cli_exits_1_on_a_failed_check(fmu_dir: Path, tmp_path: Path) -> None:
+    proc = _cli("--estimator", "cf", "--scenario", "roll_sweep", "--duration", "5",
+                "--param", "integration=rectangle", fmu_dir=fmu_dir, out=tmp_path)
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "FAIL: accuracy roll RMSE" in proc.stdout
+
+
+def test_cli_exits_2_with_a_message_for_an_unknown_parameter(fmu_dir: Path, tmp_path: Path) -> None:
+    proc = _cli("--estimator", "cf", "--scenario", "static_level", "--duration", "1",
+                "--param", "nope=1", fmu_dir=fmu_dir, out=tmp_path)
+    assert proc.returncode == 2
+    assert "has no parameter 'nope'" in proc.stderr
+
+
+def test_reports_hold_a_plot_per_run_and_the_checks(fmu_dir: Path, tmp_path: Path) -> None:
+    import json
+
+    from testbenches.campaign import CampaignResult
+    from testbenches.report import write_reports
+
+    r = run_testbench("kf", "roll_pitch", duration=2.0, fmu_dir=fmu_dir)
+    write_reports(CampaignResult(runs=[r]), tmp_path, plots=True)
+    report = json.loads((tmp_path / "report.json").read_text())
+    png = tmp_path / report["runs"][0]["plot"]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    names = {c["name"] for c in report["runs"][0]["checks"]}
+    assert names >= {"accuracy roll RMSE", "T3 compute budget p99"}
+    assert "![kf roll_pitch]" in (tmp_path / "report.md").read_text()
