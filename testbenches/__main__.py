@@ -1,7 +1,8 @@
 """`python -m testbenches run ...`: the command line over testbenches' functions.
 
-  run   estimator x scenario x seed campaign with the contract checks; prints the contract table,
-        writes DIR/report.json, DIR/report.md and plots; exit status 1 on any FAIL.
+  run         estimator x scenario x seed campaign with the contract checks; prints the contract
+              table, writes DIR/report.json, DIR/report.md and plots; exit status 1 on any FAIL.
+  export-ssp  the plant, sensor and estimator FMUs and their connections as an SSP file.
 """
 
 from __future__ import annotations
@@ -91,10 +92,28 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--no-contract", action="store_true",
                      help="only the runs, without the T1, T2, T4 and position extras")
+    ssp = sub.add_parser("export-ssp", help="write a testbench as an SSP file")
+    ssp.add_argument("--estimator", required=True, choices=list(ESTIMATOR_FMUS))
+    ssp.add_argument("--scenario", required=True, choices=list(SCENARIOS))
+    ssp.add_argument("--seed", type=int, default=0, help="sensor noise seed (0)")
+    ssp.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                     help="estimator FMU parameter (repeatable)")
+    ssp.add_argument("--noise-free", action="store_true", help="a sensor without noise")
+    ssp.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
+    ssp.add_argument("out", type=Path, help="the SSP file to write")
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
             return cmd_run(args)
+        if args.command == "export-ssp":
+            from .contract import NOISE_FREE
+            from .ssp import export_ssp
+
+            path = export_ssp(args.estimator, args.scenario, args.out, args.seed,
+                              parse_params(args.param), NOISE_FREE if args.noise_free else None,
+                              args.fmu_dir)
+            print(f"wrote {path}")
+            return 0
     except (ValueError, FileNotFoundError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

@@ -264,3 +264,22 @@ def test_reports_hold_a_plot_per_run_and_the_checks(fmu_dir: Path, tmp_path: Pat
     names = {c["name"] for c in report["runs"][0]["checks"]}
     assert names >= {"accuracy roll RMSE", "T3 compute budget p99"}
     assert "![kf roll_pitch]" in (tmp_path / "report.md").read_text()
+
+
+def test_exported_ssp_runs_in_fmpy_and_matches_the_master_two_steps_later(
+    fmu_dir: Path, tmp_path: Path
+) -> None:
+    """fmpy's SSP master is Jacobi: the sensor sees the plant and the estimator the sensor one
+    step late, and the connectors start at 0 (two all-zero samples, rejected). With a noise-free
+    sensor the SSP's estimate in row k is bit-identical to the master's estimate of step k - 2."""
+    from testbenches.ssp import export_ssp, simulate
+
+    path = export_ssp("mgcf", "roll_pitch", tmp_path / "tb.ssp",
+                      sensor_params=contract.NOISE_FREE, fmu_dir=fmu_dir)
+    rows = simulate(path, stop_time=2.0, step_size=0.01)
+    master = run_testbench("mgcf", "roll_pitch", duration=2.0, fmu_dir=fmu_dir,
+                           sensor_params=contract.NOISE_FREE, evaluate=False)
+    n = len(rows) - 2
+    for name in ("roll", "pitch"):
+        assert np.array_equal(rows[f"estimator.{name}"][2:], master.estimate[name][:n])
+    assert rows["estimator.invalid_samples"][-1] == 2
