@@ -8,8 +8,8 @@ new ids.
 |----|-------------------|-------------------------------------------------------------------------|
 | 0  | static_level      | at rest, level                                                          |
 | 1  | static_tilted     | at rest, roll 20 deg, pitch -10 deg                                     |
-| 2  | roll_sweep        | roll 45 deg sine at 0.35 Hz (peak rate 1.7 rad/s)                       |
-| 3  | pitch_sweep       | pitch 40 deg sine at 0.35 Hz (peak rate 1.5 rad/s)                      |
+| 2  | roll_sweep        | roll 45 deg sine at 0.32 Hz (peak rate 1.58 rad/s, T1's 1.6 rad/s)      |
+| 3  | pitch_sweep       | pitch 40 deg sine at 0.36 Hz (peak rate 1.58 rad/s)                     |
 | 4  | roll_pitch        | roll 30 deg at 0.3 Hz and pitch 20 deg at 0.2 Hz together, slow yaw     |
 | 5  | moderate_dynamics | roll/pitch 20-30 deg, rates up to 1.5 rad/s, linear acceleration       |
 |    |                   | swelling to 0.25/0.15/0.37 g (x/y/z) every 10 s: rho crosses 0.35      |
@@ -113,12 +113,12 @@ SCENARIOS: dict[str, Scenario] = {
             "at rest, roll 20 deg, pitch -10 deg",
         ),
         Scenario(
-            2, "roll_sweep", 30.0, lambda: Trajectory(roll=sine(45 * DEG, 0.35)),
-            "roll 45 deg sine at 0.35 Hz",
+            2, "roll_sweep", 30.0, lambda: Trajectory(roll=sine(45 * DEG, 0.32)),
+            "roll 45 deg sine at 0.32 Hz (peak rate 1.58 rad/s)",
         ),
         Scenario(
-            3, "pitch_sweep", 30.0, lambda: Trajectory(pitch=sine(40 * DEG, 0.35)),
-            "pitch 40 deg sine at 0.35 Hz",
+            3, "pitch_sweep", 30.0, lambda: Trajectory(pitch=sine(40 * DEG, 0.36)),
+            "pitch 40 deg sine at 0.36 Hz (peak rate 1.58 rad/s)",
         ),
         Scenario(
             4, "roll_pitch", 30.0,

@@ -33,9 +33,13 @@ import numpy as np
 from fusion_core.types import DEG
 
 CONTRACT_VERSION = "1.0"
-SETTLE_S = 1.0
-"""Convergence period excluded from RMSE and max error [s]: every estimator starts from the
-accelerometer's attitude, so only its bias states are still settling after 1 s."""
+SETTLE_S = 5.0
+"""Convergence period excluded from RMSE and max error [s] ("after convergence"): the attitude
+starts from the accelerometer, but bias states and covariances settle over seconds (the UKF's
+RMSE on moderate_dynamics is 0.32/0.43 deg from 1 s, 0.20/0.37 deg from 5 s)."""
+SETTLE_BY_SCENARIO = {"translation_2m": 2.0}
+"""The 2 m move starts at 2 s, after the filters have converged at rest: scoring from 5 s would
+score only the recovery after the move."""
 CONVERGED_DEG = 1.0
 """Convergence time: first time after which the attitude error stays below this [deg]."""
 
@@ -78,11 +82,11 @@ HIGH_DYNAMICS = (5.0, 5.0)
 follows the apparent tilt (up to 35 deg). The norm hardly shows horizontal acceleration (0.5 g
 horizontal is 12 % on the norm), so a gate closes only near the peaks; 5 deg is what a filter
 keeps when it stops trusting the accelerometer for most of each move and re-converges after."""
-TRANSLATION = (0.5, 3.8)
+TRANSLATION = (0.5, 4.1)
 """The 2 m move (minimum jerk over 3 s): its acceleration along x, RMS 0.92 m/s^2 over the move
 and 1.28 m/s^2 at peak, reads as apparent pitch that barely changes the accelerometer's norm
-(0.8 %), so no norm gate sees it. Over the scored 6 s the raw accelerometer's pitch has an RMSE of
-3.8 deg: a fusion filter must do better than the accelerometer alone. Roll: no lateral motion,
+(0.8 %), so no norm gate sees it. Over the scored 5 s the raw accelerometer's pitch has an RMSE of
+4.1 deg: a fusion filter must do better than the accelerometer alone. Roll: no lateral motion,
 0.5 deg."""
 
 ACCURACY: dict[str, tuple[float, float]] = {
@@ -134,7 +138,7 @@ def compute_metrics(result: Any) -> dict[str, float]:
     t = result.t
     err_roll = _wrap(result.estimate["roll"] - result.truth["roll"]) / DEG
     err_pitch = (result.estimate["pitch"] - result.truth["pitch"]) / DEG
-    keep = t >= SETTLE_S
+    keep = t >= SETTLE_BY_SCENARIO.get(result.scenario, SETTLE_S)
     if not keep.any():
         keep = np.ones_like(t, dtype=bool)
     err = np.maximum(np.abs(err_roll), np.abs(err_pitch))
@@ -165,27 +169,30 @@ def compute_metrics(result: Any) -> dict[str, float]:
     return metrics
 
 
-def run_checks(result: Any) -> list[Check]:
-    """The per-run checks: accuracy (roll, pitch), no rejected samples, T3 budget."""
+def run_checks(result: Any, timing: bool = True) -> list[Check]:
+    """The per-run checks: accuracy (roll, pitch), no rejected samples and, with timing, the T3
+    budget (a wall-clock measurement: leave it out on a machine shared with other work)."""
     m = result.metrics
     lim_roll, lim_pitch = accuracy_limits(result.estimator, result.scenario)
     period_us = 1e6 / T3_RATE
     budget = T3_BUDGET_FRACTION * period_us
-    return [
+    checks = [
         Check("accuracy roll RMSE", m["rmse_roll_deg"] <= lim_roll, m["rmse_roll_deg"],
               lim_roll, "deg"),
         Check("accuracy pitch RMSE", m["rmse_pitch_deg"] <= lim_pitch, m["rmse_pitch_deg"],
               lim_pitch, "deg"),
         Check("no rejected samples", m["invalid_samples"] == 0, m["invalid_samples"], 0, ""),
-        Check("T3 compute budget p99", m["step_p99_us"] < budget, m["step_p99_us"], budget, "us",
-              f"p50 {m['step_p50_us']:.1f} us"),
     ]
+    if timing:
+        checks.append(Check("T3 compute budget p99", m["step_p99_us"] < budget, m["step_p99_us"],
+                            budget, "us", f"p50 {m['step_p50_us']:.1f} us"))
+    return checks
 
 
-def evaluate(result: Any) -> Any:
+def evaluate(result: Any, timing: bool = True) -> Any:
     """Fill result.metrics and result.checks; return the result."""
     result.metrics = compute_metrics(result)
-    result.checks = run_checks(result)
+    result.checks = run_checks(result, timing)
     return result
 
 

@@ -60,7 +60,7 @@ def test_plant_outputs_are_the_truth_at_the_end_of_each_step(fmu_dir: Path) -> N
 
 # ----- contract checks T1-T4 on short scenarios ---------------------------------------------------
 def test_t1_alignment_passes_for_every_attitude_estimator(fmu_dir: Path) -> None:
-    """Noise-free roll sweep (peak rate 1.7 rad/s) at 100 Hz: error < 0.05 deg after 1 s."""
+    """Noise-free roll sweep (peak rate 1.58 rad/s) at 100 Hz: error < 0.05 deg after 5 s."""
     runs = [run_testbench(k, "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
                           sensor_params=contract.NOISE_FREE) for k in KEYS]
     check = contract.check_t1(runs)
@@ -218,6 +218,7 @@ def test_sensor_saturates_and_quantises_like_a_16_bit_mpu6050() -> None:
 def _cli(*args: str, fmu_dir: Path, out: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-m", "testbenches", "run", "--no-contract", "--no-plots",
+         "--no-timing-check",
          "--fmu-dir", str(fmu_dir), "--out", str(out), *args],
         cwd=REPO, capture_output=True, text=True, timeout=300,
     )
