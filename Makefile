@@ -33,5 +33,10 @@ test-slow: setup
 lint: setup
 	$(BIN)/ruff check .
 
+.PHONY: bench
+bench: setup
+	$(BIN)/python -m pip install --quiet -e '.[test,bench]'
+	$(BIN)/python -m benchmarks --out reports
+
 clean:
 	rm -rf dist reports build *.egg-info

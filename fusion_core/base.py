@@ -29,6 +29,10 @@ INTEGRATION_PARAM = Param(
 )
 MIN_ACC_NORM = 0.1 * G
 """Accelerometer norm below which a sample is rejected (INTERFACE.md: 'norm near zero')."""
+RUN_CHUNK = 1024
+"""Samples that run() converts to Python floats and collects at a time."""
+_MIN_ACC_NORM2 = MIN_ACC_NORM * MIN_ACC_NORM
+_isfinite = math.isfinite
 
 
 def _plain(value: Any) -> Any:
@@ -165,7 +169,15 @@ class Estimator:
             raise InvalidSample(
                 f"sample is not three accelerations, three rates and dt: {err}"
             ) from None
-        self._check_values(ax, ay, az, gx, gy, gz, dt)
+        # Fast path of check_sample (written out here, the hot path): one finite test on the
+        # sum; _check_values says what is wrong only when this test fails.
+        norm2 = ax * ax + ay * ay + az * az
+        if not (
+            _isfinite(norm2 + gx + gy + gz + dt)
+            and norm2 >= _MIN_ACC_NORM2
+            and 0.0 < dt <= self._params["max_dt"]
+        ):
+            self._check_values(ax, ay, az, gx, gy, gz, dt)
         if self.initialized:
             self._update(ax, ay, az, gx, gy, gz, dt)
         else:
@@ -173,8 +185,8 @@ class Estimator:
             self.initialized = True
         self.gyro_prev = (gx, gy, gz)
         self.n_samples += 1
-        self.last = self._estimate()
-        return self.last
+        last = self.last = self._estimate()
+        return last
 
     def _check_values(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -182,8 +194,8 @@ class Estimator:
         # Fast path of check_sample: one finite test on the sum, details only on failure.
         norm2 = ax * ax + ay * ay + az * az
         if (
-            math.isfinite(norm2 + gx + gy + gz + dt)
-            and norm2 >= MIN_ACC_NORM * MIN_ACC_NORM
+            _isfinite(norm2 + gx + gy + gz + dt)
+            and norm2 >= _MIN_ACC_NORM2
             and 0.0 < dt <= self._params["max_dt"]
         ):
             return
@@ -218,23 +230,28 @@ class Estimator:
         if self.HAS_POSITION:
             out["pos"] = np.empty((n, 3))
             out["vel"] = np.empty((n, 3))
-        rows = []
         step = self.step
-        for i, (a, w, h) in enumerate(zip(acc.tolist(), gyro.tolist(), dts.tolist(), strict=True)):
-            try:
-                est = step(a, w, h)
-            except InvalidSample:
-                out["rejected"][i] = True
-                self.n_rejected += 1
-                est = self.last
-            rows.append(est)
-        if n:
-            out["roll"][:] = [e.roll for e in rows]
-            out["pitch"][:] = [e.pitch for e in rows]
-            out["bias"][:] = [e.bias for e in rows]
+        # Chunks of RUN_CHUNK samples: the Python lists of inputs and estimates never hold more
+        # than one chunk, so memory does not grow with N beyond the output arrays.
+        for lo in range(0, n, RUN_CHUNK):
+            hi = min(lo + RUN_CHUNK, n)
+            rows = []
+            append = rows.append
+            chunk = zip(acc[lo:hi].tolist(), gyro[lo:hi].tolist(), dts[lo:hi].tolist(), strict=True)
+            for i, (a, w, h) in enumerate(chunk, lo):
+                try:
+                    est = step(a, w, h)
+                except InvalidSample:
+                    out["rejected"][i] = True
+                    self.n_rejected += 1
+                    est = self.last
+                append(est)
+            out["roll"][lo:hi] = [e.roll for e in rows]
+            out["pitch"][lo:hi] = [e.pitch for e in rows]
+            out["bias"][lo:hi] = [e.bias for e in rows]
             if self.HAS_POSITION:
-                out["pos"][:] = [e.pos for e in rows]
-                out["vel"][:] = [e.vel for e in rows]
+                out["pos"][lo:hi] = [e.pos for e in rows]
+                out["vel"][lo:hi] = [e.vel for e in rows]
         return out
 
     # ----- state ------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ import math
 
 TWO_PI = 2.0 * math.pi
 _MIN_COS_PITCH = 1e-9  # keeps tan(pitch) finite at gimbal lock (pitch = +-pi/2)
+_HALF_PI = 0.5 * math.pi
 
 
 def wrap_angle(x: float) -> float:
@@ -38,7 +39,7 @@ def euler_rates(
     sp = math.sin(phi)
     cp = math.cos(phi)
     ct = math.cos(theta)
-    if abs(ct) < _MIN_COS_PITCH:
+    if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:  # abs(ct) < _MIN_COS_PITCH
         ct = math.copysign(_MIN_COS_PITCH, ct)
     return p + (q * sp + r * cp) * math.sin(theta) / ct, q * cp - r * sp
 
@@ -55,8 +56,19 @@ def heun_euler_step(
     w0 is the (bias-corrected) body rate at the start of the interval, w1 at its end: the rate
     is linear over the interval (trapezoid rule), so the local error is O(dt^3).
     """
-    d1p, d1t = euler_rates(phi, theta, w0[0], w0[1], w0[2])
-    d2p, d2t = euler_rates(phi + dt * d1p, theta + dt * d1t, w1[0], w1[1], w1[2])
+    # euler_rates at both ends, written out (this runs once per sample in cf, kf and poskf)
+    sin, cos = math.sin, math.cos
+    p, q, r = w0
+    sp, cp, ct = sin(phi), cos(phi), cos(theta)
+    if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:
+        ct = math.copysign(_MIN_COS_PITCH, ct)
+    d1p, d1t = p + (q * sp + r * cp) * sin(theta) / ct, q * cp - r * sp
+    phi1, theta1 = phi + dt * d1p, theta + dt * d1t
+    p, q, r = w1
+    sp, cp, ct = sin(phi1), cos(phi1), cos(theta1)
+    if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:
+        ct = math.copysign(_MIN_COS_PITCH, ct)
+    d2p, d2t = p + (q * sp + r * cp) * sin(theta1) / ct, q * cp - r * sp
     return phi + 0.5 * dt * (d1p + d2p), theta + 0.5 * dt * (d1t + d2t)
 
 
@@ -70,7 +82,9 @@ def euler_step(
 
 def clamp_pitch(theta: float) -> float:
     """Pitch limited to [-pi/2, pi/2] (INTERFACE.md range)."""
-    return max(-0.5 * math.pi, min(0.5 * math.pi, theta))
+    # max(-pi/2, min(pi/2, theta)), without the two builtin calls
+    theta = theta if theta < _HALF_PI else _HALF_PI
+    return theta if theta > -_HALF_PI else -_HALF_PI
 
 
 def quat_from_roll_pitch_yaw(

@@ -12,6 +12,7 @@ Reference:
 
 from __future__ import annotations
 
+import functools
 import math
 
 from .base import Estimator
@@ -25,6 +26,7 @@ TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "integ
 Mat3 = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
 
+@functools.lru_cache(maxsize=16)  # one entry per (form, q, dt): dt is constant in most runs
 def process_noise(form: str, q: float, dt: float) -> Mat3:
     """Q of one axis for the named form (Safitri et al.'s three Q/R forms, our reading):
 
@@ -82,7 +84,14 @@ def scalar_update(
         x[0] += K[0] * y
         x[1] += K[1] * y
         x[2] += K[2] * y
-    return tuple(tuple(P[a][b] - K[a] * col[b] for b in range(3)) for a in range(3))  # type: ignore[return-value]
+    (p00, p01, p02), (p10, p11, p12), (p20, p21, p22) = P
+    k0, k1, k2 = K
+    c0, c1, c2 = col
+    return (
+        (p00 - k0 * c0, p01 - k0 * c1, p02 - k0 * c2),
+        (p10 - k1 * c0, p11 - k1 * c1, p12 - k1 * c2),
+        (p20 - k2 * c0, p21 - k2 * c1, p22 - k2 * c2),
+    )
 
 
 class PositionKalmanFilter(Estimator):

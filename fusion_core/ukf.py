@@ -14,6 +14,29 @@ X = R^T e_z with R body-to-world. Since R_dot = R [omega]x, d(R^T)/dt = -[omega]
 (The paper writes the same equation for a z-down frame; the sign is the one above for the
 specific-force direction with z up.) Over one interval the body turns by the rotation vector
 phi (trapezoid rate plus coning correction), so X_{k+1} = exp(-[phi]x) X_k exactly (Rodrigues).
+
+Implementation: plain floats, no matrices. It computes the same unscented transform as a
+textbook implementation (13 sigma points, every one through the exact process model; the
+tests compare it with the numpy version to 1e-9), using identities that hold exactly:
+  - sigma points x +- gamma s_j, s_j the columns of the Cholesky factor of P (n = 6);
+  - phi is affine in the bias: with w0 = g0 - b, w1 = g1 - b,
+      phi(b) = (w0 + w1) dt/2 + (w0 dt x w1 dt)/12 = c - M b,
+      c = (g0 + g1) dt/2 + (dt^2/12) g0 x g1,  M v = dt v - (dt^2/12) (g1 - g0) x v,
+    so the pair x +- gamma s_j turns by phi(b) -+ M s_j^b (one M product per pair);
+  - the bias part of each sigma point is not transformed: its mean is b and its covariance
+    P_bb (2 wc gamma^2 = 1 and wm0 + 2n wm = 1), and the X-b cross covariance is
+    wc sum_j (Y_j+ - Y_j-) (s_j^b)^T (Y: rotated X parts; the mean cancels);
+  - with e_i = Y_i - Y_0 (deviations from the rotated central point, small numbers) and
+    mu = wm sum e_i, the mean is Y_0 + mu and
+      P_XX = wc sum e_i e_i^T + (beta - alpha^2) mu mu^T
+    (the weights wm_i = wc_i for i >= 1 and sum wc_i = 2 - alpha^2 + beta);
+  - a rotation keeps the norm, so the pseudo-measurement |Y_i|^2 = |X_i|^2 is known before the
+    rotation: |X +- s|^2 - |X|^2 = +-2 X.s + |s|^2;
+  - the measurement prediction of the X part is the state's X part, so S[:3, :3] and
+    P_xz[:, :3] are the predicted covariance (before Q) plus R, and K S K^T = P_xz S^-1 P_xz^T
+    = Y^T Y with Y = L_S^-1 P_xz^T (L_S the Cholesky factor of S).
+P is kept as its lower triangle (21 floats, row by row); the `P` attribute shows it as a full
+6x6 list of lists.
 """
 
 from __future__ import annotations
@@ -26,6 +49,7 @@ from .base import INTEGRATION_PARAM, Estimator
 from .types import DEG, Estimate, G, Param
 
 N_STATE = 6  # X (3), gyro bias b (3)
+_SMALL_ANGLE = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
 
 
 class UnscentedKalmanFilter(Estimator):
@@ -93,22 +117,24 @@ class UnscentedKalmanFilter(Estimator):
     def _configure(self) -> None:
         p = self._params
         n = N_STATE
-        lam = p["alpha"] ** 2 * (n + p["kappa"]) - n
+        alpha2 = p["alpha"] ** 2
+        lam = alpha2 * (n + p["kappa"]) - n
         self._gamma = math.sqrt(n + lam)
-        wm = np.full(2 * n + 1, 0.5 / (n + lam))
-        wc = wm.copy()
-        wm[0] = lam / (n + lam)
-        wc[0] = wm[0] + 1.0 - p["alpha"] ** 2 + p["beta"]
-        self._wm, self._wc = wm, wc
+        # Weights (Wan & van der Merwe): wm_0 = lam/(n+lam), wc_0 = wm_0 + 1 - alpha^2 + beta,
+        # wm_i = wc_i = 1/(2(n+lam)) for i = 1..2n. Deviations are taken from the central
+        # point, so only wm_i and (sum of wc) - 2 = beta - alpha^2 appear (module docstring).
+        self._w = 0.5 / (n + lam)
+        self._w_mu = p["beta"] - alpha2
         self._q_gyro = p["gyro_noise"] ** 2
         self._q_bias = p["bias_noise"] ** 2
-        self._R = np.diag([p["acc_noise"] ** 2] * 3 + [p["norm_noise"] ** 2])
+        self._r_acc = p["acc_noise"] ** 2
+        self._r_norm = p["norm_noise"] ** 2
         self._gate = p["acc_gate"]
         self._trapezoid = p["integration"] == "trapezoid"
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
-        self.P = np.zeros((N_STATE, N_STATE)).tolist()
+        self._P = (0.0,) * 21
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         n = math.sqrt(ax * ax + ay * ay + az * az)
@@ -116,72 +142,379 @@ class UnscentedKalmanFilter(Estimator):
         # X from one accelerometer sample: its noise, per axis; b: the prior on the bias.
         p_x = self._params["acc_noise"] ** 2
         p_b = self._params["init_bias_std"] ** 2
-        self.P = np.diag([p_x] * 3 + [p_b] * 3).tolist()
+        self._P = _packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
 
-    def _sigma_points(self, x: np.ndarray, P: np.ndarray) -> np.ndarray:
-        """2n+1 sigma points x, x +- gamma * columns of sqrt(P) (rows of the result)."""
-        S = _sqrt_psd(P) * self._gamma
-        return np.vstack([x, x + S.T, x - S.T])
+    @property
+    def P(self) -> list[list[float]]:
+        """The 6x6 state covariance as a list of lists (a copy; x = [X (3), b (3)])."""
+        t = self._P
+        return [[t[_packed_index(i, j)] for j in range(N_STATE)] for i in range(N_STATE)]
+
+    @P.setter
+    def P(self, value: list[list[float]]) -> None:
+        self._P = tuple(float(value[i][j]) for i in range(N_STATE) for j in range(i + 1))
 
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
-        x = np.asarray(self.x)
-        P = np.asarray(self.P)
-        # ---- predict (eq. 14-15): sigma points through X_{k+1} = exp(-[phi]x) X_k
-        chi = self._sigma_points(x, P)
-        b = chi[:, 3:]
-        w1 = np.array([gx, gy, gz]) - b
+        X0, X1, X2, b0, b1, b2 = self.x
+        P = self._P
+        offsets = _sigma_offsets(P, self._gamma)  # gamma s_j, j = 1..6
+        # ---- predict (eq. 14-15): every sigma point through X_{k+1} = exp(-[phi]x) X_k.
+        # phi(b) = c - M b, M v = dt v - k (g1 - g0) x v (module docstring).
         if self._trapezoid:
-            w0 = np.asarray(self.gyro_prev) - b
-            phi = 0.5 * (w0 + w1) * dt + np.cross(w0 * dt, w1 * dt) / 12.0
-        else:
-            phi = w1 * dt
-        chi[:, :3] = _rotate_back(chi[:, :3], phi)
-        x_pred = self._wm @ chi
-        d = chi - x_pred
-        P_pred = (d.T * self._wc) @ d
-        X = x_pred[:3] / np.linalg.norm(x_pred[:3])
-        P_pred[:3, :3] += self._q_gyro * dt * (np.eye(3) - np.outer(X, X))
-        P_pred[3:, 3:] += self._q_bias * dt * np.eye(3)
-        # ---- update (eq. 16-17): z = [acc/g; 1], h = [X; |X|^2]
+            h0, h1, h2 = self.gyro_prev
+            k = dt * dt / 12.0
+            c0 = 0.5 * dt * (h0 + gx) + k * (h1 * gz - h2 * gy)
+            c1 = 0.5 * dt * (h1 + gy) + k * (h2 * gx - h0 * gz)
+            c2 = 0.5 * dt * (h2 + gz) + k * (h0 * gy - h1 * gx)
+            d0, d1, d2 = k * (gx - h0), k * (gy - h1), k * (gz - h2)
+        else:  # the papers' rule: phi = (g1 - b) dt
+            c0, c1, c2 = gx * dt, gy * dt, gz * dt
+            d0 = d1 = d2 = 0.0
+        f0 = c0 - (dt * b0 - (d1 * b2 - d2 * b1))
+        f1 = c1 - (dt * b1 - (d2 * b0 - d0 * b2))
+        f2 = c2 - (dt * b2 - (d0 * b1 - d1 * b0))
+        Y0, Y1, Y2 = _rotate(X0, X1, X2, f0, f1, f2)  # the central point
         rho = abs(math.sqrt(ax * ax + ay * ay + az * az) / G - 1.0)
-        if rho < self._gate:
-            Z = np.column_stack([chi[:, :3], np.einsum("ij,ij->i", chi[:, :3], chi[:, :3])])
-            z_pred = self._wm @ Z
-            dz = Z - z_pred
-            S = (dz.T * self._wc) @ dz + self._R
-            Pxz = (d.T * self._wc) @ dz
-            K = np.linalg.solve(S, Pxz.T).T
-            z = np.array([ax / G, ay / G, az / G, 1.0])
-            x_pred = x_pred + K @ (z - z_pred)
-            P_pred = P_pred - K @ S @ K.T
-        x_pred[:3] /= np.linalg.norm(x_pred[:3])
-        self.x = x_pred.tolist()
-        self.P = (0.5 * (P_pred + P_pred.T)).tolist()
+        update = rho < self._gate
+        # Sums over the outer points, e = Y_i - Y_0: sum e (m), sum e e^T (e..),
+        # sum_j (e_j+ - e_j-) (s_j^b)^T (x..), and for the pseudo-measurement
+        # nu = |X_i|^2 - |X_0|^2 = +-2 X_0.s + |s|^2: sum nu, sum nu^2, sum e nu,
+        # sum_j (nu_j+ - nu_j-) s_j^b (nu = 0 for the Cholesky columns 4-6, whose X part is 0).
+        m0 = m1 = m2 = 0.0
+        e00 = e10 = e11 = e20 = e21 = e22 = 0.0
+        x00 = x01 = x02 = x10 = x11 = x12 = x20 = x21 = x22 = 0.0
+        v_sum = vv = ev0 = ev1 = ev2 = bv0 = bv1 = bv2 = 0.0
+        sqrt, sin, cos, small = math.sqrt, math.sin, math.cos, _SMALL_ANGLE
+        for s0, s1, s2, s3, s4, s5 in offsets:
+            t0 = dt * s3 - (d1 * s5 - d2 * s4)  # M s^b
+            t1 = dt * s4 - (d2 * s3 - d0 * s5)
+            t2 = dt * s5 - (d0 * s4 - d1 * s3)
+            # x + s through the process model (_rotate written out: this loop is the hot path)
+            z0, z1, z2 = X0 + s0, X1 + s1, X2 + s2
+            p0, p1, p2 = f0 - t0, f1 - t1, f2 - t2
+            a2 = p0 * p0 + p1 * p1 + p2 * p2
+            a = sqrt(a2)
+            if a < small:
+                sa, ca = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
+            else:
+                sa, ca = sin(a) / a, (1.0 - cos(a)) / a2
+            u0 = p1 * z2 - p2 * z1
+            u1 = p2 * z0 - p0 * z2
+            u2 = p0 * z1 - p1 * z0
+            ep0 = z0 - sa * u0 + ca * (p1 * u2 - p2 * u1) - Y0
+            ep1 = z1 - sa * u1 + ca * (p2 * u0 - p0 * u2) - Y1
+            ep2 = z2 - sa * u2 + ca * (p0 * u1 - p1 * u0) - Y2
+            # x - s
+            z0, z1, z2 = X0 - s0, X1 - s1, X2 - s2
+            p0, p1, p2 = f0 + t0, f1 + t1, f2 + t2
+            a2 = p0 * p0 + p1 * p1 + p2 * p2
+            a = sqrt(a2)
+            if a < small:
+                sa, ca = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
+            else:
+                sa, ca = sin(a) / a, (1.0 - cos(a)) / a2
+            u0 = p1 * z2 - p2 * z1
+            u1 = p2 * z0 - p0 * z2
+            u2 = p0 * z1 - p1 * z0
+            em0 = z0 - sa * u0 + ca * (p1 * u2 - p2 * u1) - Y0
+            em1 = z1 - sa * u1 + ca * (p2 * u0 - p0 * u2) - Y1
+            em2 = z2 - sa * u2 + ca * (p0 * u1 - p1 * u0) - Y2
+            m0 += ep0 + em0
+            m1 += ep1 + em1
+            m2 += ep2 + em2
+            e00 += ep0 * ep0 + em0 * em0
+            e10 += ep1 * ep0 + em1 * em0
+            e11 += ep1 * ep1 + em1 * em1
+            e20 += ep2 * ep0 + em2 * em0
+            e21 += ep2 * ep1 + em2 * em1
+            e22 += ep2 * ep2 + em2 * em2
+            u0, u1, u2 = ep0 - em0, ep1 - em1, ep2 - em2
+            x00 += u0 * s3
+            x01 += u0 * s4
+            x02 += u0 * s5
+            x10 += u1 * s3
+            x11 += u1 * s4
+            x12 += u1 * s5
+            x20 += u2 * s3
+            x21 += u2 * s4
+            x22 += u2 * s5
+            if update and (s0 or s1 or s2):
+                a = 2.0 * (X0 * s0 + X1 * s1 + X2 * s2)
+                q = s0 * s0 + s1 * s1 + s2 * s2
+                vp, vm = q + a, q - a
+                v_sum += vp + vm
+                vv += vp * vp + vm * vm
+                ev0 += ep0 * vp + em0 * vm
+                ev1 += ep1 * vp + em1 * vm
+                ev2 += ep2 * vp + em2 * vm
+                a = vp - vm
+                bv0 += a * s3
+                bv1 += a * s4
+                bv2 += a * s5
+        w = self._w
+        w_mu = self._w_mu
+        mu0, mu1, mu2 = w * m0, w * m1, w * m2
+        v_prior = X0 * X0 + X1 * X1 + X2 * X2  # |X_0|^2 (1 but for rounding)
+        X0, X1, X2 = Y0 + mu0, Y1 + mu1, Y2 + mu2  # the predicted mean of X; b is unchanged
+        # Unscented covariance of X (A) and of b with X (C), before the process noise
+        a00 = w * e00 + w_mu * mu0 * mu0
+        a10 = w * e10 + w_mu * mu1 * mu0
+        a11 = w * e11 + w_mu * mu1 * mu1
+        a20 = w * e20 + w_mu * mu2 * mu0
+        a21 = w * e21 + w_mu * mu2 * mu1
+        a22 = w * e22 + w_mu * mu2 * mu2
+        x00, x01, x02 = w * x00, w * x01, w * x02
+        x10, x11, x12 = w * x10, w * x11, w * x12
+        x20, x21, x22 = w * x20, w * x21, w * x22
+        # Q = gyro_noise^2 dt (I - X X^T) for X, bias_noise^2 dt I for b (X normalised)
+        inv = 1.0 / math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
+        h0, h1, h2 = X0 * inv, X1 * inv, X2 * inv
+        qg = self._q_gyro * dt
+        qb = self._q_bias * dt
+        P = (
+            a00 + qg * (1.0 - h0 * h0),
+            a10 - qg * (h1 * h0), a11 + qg * (1.0 - h1 * h1),
+            a20 - qg * (h2 * h0), a21 - qg * (h2 * h1), a22 + qg * (1.0 - h2 * h2),
+            x00, x10, x20, P[9] + qb,
+            x01, x11, x21, P[13], P[14] + qb,
+            x02, x12, x22, P[18], P[19], P[20] + qb,
+        )
+        if update:
+            # ---- update (eq. 16-17): z = [acc/g; 1], h = [X; |X|^2], R diagonal.
+            # S = [[A + r I, s_v], [s_v^T, s_vv + r_norm]], P_xz = [[A, s_v], [C, c_v]].
+            mu_v = w * v_sum
+            sv0 = w * ev0 + w_mu * mu0 * mu_v
+            sv1 = w * ev1 + w_mu * mu1 * mu_v
+            sv2 = w * ev2 + w_mu * mu2 * mu_v
+            r = self._r_acc
+            S = (
+                a00 + r, a10, a11 + r, a20, a21, a22 + r,
+                sv0, sv1, sv2, w * vv + w_mu * mu_v * mu_v + self._r_norm,
+            )
+            rows = (
+                (a00, a10, a20, sv0), (a10, a11, a21, sv1), (a20, a21, a22, sv2),
+                (x00, x10, x20, w * bv0), (x01, x11, x21, w * bv1), (x02, x12, x22, w * bv2),
+            )
+            innovation = (ax / G - X0, ay / G - X1, az / G - X2, 1.0 - (v_prior + mu_v))
+            X0, X1, X2, b0, b1, b2, P = _kalman_update(
+                (X0, X1, X2, b0, b1, b2), P, S, rows, innovation
+            )
+        n = math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
+        self.x = [X0 / n, X1 / n, X2 / n, b0, b1, b2]
+        self._P = P
 
     def _estimate(self) -> Estimate:
         X1, X2, X3, bx, by, bz = self.x
         return Estimate(math.atan2(X2, X3), math.atan2(-X1, math.hypot(X2, X3)), (bx, by, bz))
 
 
-def _rotate_back(X: np.ndarray, phi: np.ndarray) -> np.ndarray:
-    """Rows X_i rotated by exp(-[phi_i]x) (Rodrigues): a world-fixed vector seen from a body that
-    turned by phi_i."""
-    angle = np.linalg.norm(phi, axis=1)
-    small = angle < 1e-8
-    safe = np.where(small, 1.0, angle)
-    sin_a = np.where(small, 1.0 - angle**2 / 6.0, np.sin(angle) / safe)  # sin(a)/a
-    cos_a = np.where(small, 0.5 - angle**2 / 24.0, (1.0 - np.cos(angle)) / safe**2)  # (1-cos)/a^2
-    cross = np.cross(phi, X)
-    return X - sin_a[:, None] * cross + cos_a[:, None] * np.cross(phi, cross)
+def _rotate(
+    x0: float, x1: float, x2: float, p0: float, p1: float, p2: float
+) -> tuple[float, float, float]:
+    """X rotated by exp(-[phi]x) (Rodrigues): a world-fixed vector seen from a body that turned
+    by phi. X - sin(a)/a (phi x X) + (1 - cos a)/a^2 phi x (phi x X), a = |phi|."""
+    a2 = p0 * p0 + p1 * p1 + p2 * p2
+    a = math.sqrt(a2)
+    if a < _SMALL_ANGLE:
+        sa = 1.0 - a2 / 6.0
+        ca = 0.5 - a2 / 24.0
+    else:
+        sa = math.sin(a) / a
+        ca = (1.0 - math.cos(a)) / a2
+    u0 = p1 * x2 - p2 * x1  # phi x X
+    u1 = p2 * x0 - p0 * x2
+    u2 = p0 * x1 - p1 * x0
+    return (
+        x0 - sa * u0 + ca * (p1 * u2 - p2 * u1),
+        x1 - sa * u1 + ca * (p2 * u0 - p0 * u2),
+        x2 - sa * u2 + ca * (p0 * u1 - p1 * u0),
+    )
 
 
-def _sqrt_psd(P: np.ndarray) -> np.ndarray:
-    """Lower Cholesky factor of P; for a P that rounding made indefinite, the symmetric square
+def _packed_index(i: int, j: int) -> int:
+    """Position of P[i][j] in the row-by-row lower triangle."""
+    if j > i:
+        i, j = j, i
+    return i * (i + 1) // 2 + j
+
+
+def _packed_diagonal(d: tuple[float, ...]) -> tuple[float, ...]:
+    """The packed lower triangle of diag(d)."""
+    return tuple(d[i] if i == j else 0.0 for i in range(len(d)) for j in range(i + 1))
+
+
+def _sigma_offsets(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]]:
+    """The columns of gamma L, L the lower Cholesky factor of the packed 6x6 P (P = L L^T);
+    Cholesky-Banachiewicz, row by row, written out. For a P that rounding made indefinite,
+    those of _psd_sqrt_columns."""
+    (p00, p10, p11, p20, p21, p22, p30, p31, p32, p33,
+     p40, p41, p42, p43, p44, p50, p51, p52, p53, p54, p55) = P
+    sqrt = math.sqrt
+    if not p00 > 0.0:
+        return _psd_sqrt_columns(P, gamma)
+    l00 = sqrt(p00)
+    i0 = 1.0 / l00
+    l10 = p10 * i0
+    d = p11 - l10 * l10
+    if not d > 0.0:
+        return _psd_sqrt_columns(P, gamma)
+    l11 = sqrt(d)
+    i1 = 1.0 / l11
+    l20 = p20 * i0
+    l21 = (p21 - l20 * l10) * i1
+    d = p22 - l20 * l20 - l21 * l21
+    if not d > 0.0:
+        return _psd_sqrt_columns(P, gamma)
+    l22 = sqrt(d)
+    i2 = 1.0 / l22
+    l30 = p30 * i0
+    l31 = (p31 - l30 * l10) * i1
+    l32 = (p32 - l30 * l20 - l31 * l21) * i2
+    d = p33 - l30 * l30 - l31 * l31 - l32 * l32
+    if not d > 0.0:
+        return _psd_sqrt_columns(P, gamma)
+    l33 = sqrt(d)
+    i3 = 1.0 / l33
+    l40 = p40 * i0
+    l41 = (p41 - l40 * l10) * i1
+    l42 = (p42 - l40 * l20 - l41 * l21) * i2
+    l43 = (p43 - l40 * l30 - l41 * l31 - l42 * l32) * i3
+    d = p44 - l40 * l40 - l41 * l41 - l42 * l42 - l43 * l43
+    if not d > 0.0:
+        return _psd_sqrt_columns(P, gamma)
+    l44 = sqrt(d)
+    l50 = p50 * i0
+    l51 = (p51 - l50 * l10) * i1
+    l52 = (p52 - l50 * l20 - l51 * l21) * i2
+    l53 = (p53 - l50 * l30 - l51 * l31 - l52 * l32) * i3
+    l54 = (p54 - l50 * l40 - l51 * l41 - l52 * l42 - l53 * l43) / l44
+    d = p55 - l50 * l50 - l51 * l51 - l52 * l52 - l53 * l53 - l54 * l54
+    if not d > 0.0:
+        return _psd_sqrt_columns(P, gamma)
+    g = gamma
+    return [
+        (g * l00, g * l10, g * l20, g * l30, g * l40, g * l50),
+        (0.0, g * l11, g * l21, g * l31, g * l41, g * l51),
+        (0.0, 0.0, g * l22, g * l32, g * l42, g * l52),
+        (0.0, 0.0, 0.0, g * l33, g * l43, g * l53),
+        (0.0, 0.0, 0.0, 0.0, g * l44, g * l54),
+        (0.0, 0.0, 0.0, 0.0, 0.0, g * sqrt(d)),
+    ]
+
+
+def _psd_sqrt_columns(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]]:
+    """For a P that rounding made indefinite: the columns of gamma times the symmetric square
     root with negative eigenvalues clipped to zero (never raises for a finite P)."""
-    try:
-        return np.linalg.cholesky(P)
-    except np.linalg.LinAlgError:
-        w, V = np.linalg.eigh(0.5 * (P + P.T))
-        return V * np.sqrt(np.clip(w, 0.0, None))
+    full = np.array([[P[_packed_index(i, j)] for j in range(N_STATE)] for i in range(N_STATE)])
+    w, V = np.linalg.eigh(full)
+    return [tuple(c) for c in (gamma * (V * np.sqrt(np.clip(w, 0.0, None)))).T.tolist()]
+
+
+def _kalman_update(
+    x: tuple[float, ...],
+    P: tuple[float, ...],
+    S: tuple[float, ...],
+    rows: tuple[tuple[float, float, float, float], ...],
+    y: tuple[float, float, float, float],
+) -> tuple[float, ...]:
+    """(*(x + K y), P - K S K^T) with K = P_xz S^-1 (eq. 17): x (6), P packed (21), S the packed
+    4x4 innovation covariance, rows the rows of the 6x4 P_xz, y the innovation. With
+    S = L L^T and Y = L^-1 P_xz^T: K y = Y^T (L^-1 y) and K S K^T = Y^T Y."""
+    s00, s10, s11, s20, s21, s22, s30, s31, s32, s33 = S
+    L = _cholesky4(s00, s10, s11, s20, s21, s22, s30, s31, s32, s33)
+    if L is None:
+        return _general_update(x, P, S, rows, y)
+    l00, l10, l11, l20, l21, l22, l30, l31, l32, l33 = L
+    i0, i1, i2, i3 = 1.0 / l00, 1.0 / l11, 1.0 / l22, 1.0 / l33
+    Y = []
+    for r0, r1, r2, r3 in (*rows, y):  # forward substitution, L^-1 r
+        y0 = r0 * i0
+        y1 = (r1 - l10 * y0) * i1
+        y2 = (r2 - l20 * y0 - l21 * y1) * i2
+        Y.append((y0, y1, y2, (r3 - l30 * y0 - l31 * y1 - l32 * y2) * i3))
+    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3), \
+        (e0, e1, e2, e3), (f0, f1, f2, f3), (z0, z1, z2, z3) = Y
+    x0, x1, x2, x3, x4, x5 = x
+    return (
+        x0 + (a0 * z0 + a1 * z1 + a2 * z2 + a3 * z3),
+        x1 + (b0 * z0 + b1 * z1 + b2 * z2 + b3 * z3),
+        x2 + (c0 * z0 + c1 * z1 + c2 * z2 + c3 * z3),
+        x3 + (d0 * z0 + d1 * z1 + d2 * z2 + d3 * z3),
+        x4 + (e0 * z0 + e1 * z1 + e2 * z2 + e3 * z3),
+        x5 + (f0 * z0 + f1 * z1 + f2 * z2 + f3 * z3),
+        (
+            P[0] - (a0 * a0 + a1 * a1 + a2 * a2 + a3 * a3),
+            P[1] - (b0 * a0 + b1 * a1 + b2 * a2 + b3 * a3),
+            P[2] - (b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3),
+            P[3] - (c0 * a0 + c1 * a1 + c2 * a2 + c3 * a3),
+            P[4] - (c0 * b0 + c1 * b1 + c2 * b2 + c3 * b3),
+            P[5] - (c0 * c0 + c1 * c1 + c2 * c2 + c3 * c3),
+            P[6] - (d0 * a0 + d1 * a1 + d2 * a2 + d3 * a3),
+            P[7] - (d0 * b0 + d1 * b1 + d2 * b2 + d3 * b3),
+            P[8] - (d0 * c0 + d1 * c1 + d2 * c2 + d3 * c3),
+            P[9] - (d0 * d0 + d1 * d1 + d2 * d2 + d3 * d3),
+            P[10] - (e0 * a0 + e1 * a1 + e2 * a2 + e3 * a3),
+            P[11] - (e0 * b0 + e1 * b1 + e2 * b2 + e3 * b3),
+            P[12] - (e0 * c0 + e1 * c1 + e2 * c2 + e3 * c3),
+            P[13] - (e0 * d0 + e1 * d1 + e2 * d2 + e3 * d3),
+            P[14] - (e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3),
+            P[15] - (f0 * a0 + f1 * a1 + f2 * a2 + f3 * a3),
+            P[16] - (f0 * b0 + f1 * b1 + f2 * b2 + f3 * b3),
+            P[17] - (f0 * c0 + f1 * c1 + f2 * c2 + f3 * c3),
+            P[18] - (f0 * d0 + f1 * d1 + f2 * d2 + f3 * d3),
+            P[19] - (f0 * e0 + f1 * e1 + f2 * e2 + f3 * e3),
+            P[20] - (f0 * f0 + f1 * f1 + f2 * f2 + f3 * f3),
+        ),
+    )
+
+
+def _cholesky4(
+    s00: float, s10: float, s11: float, s20: float, s21: float, s22: float,
+    s30: float, s31: float, s32: float, s33: float,
+) -> tuple[float, ...] | None:
+    """The packed lower Cholesky factor of a packed 4x4 S, or None when S is not positive
+    definite."""
+    if not s00 > 0.0:
+        return None
+    l00 = math.sqrt(s00)
+    l10 = s10 / l00
+    d = s11 - l10 * l10
+    if not d > 0.0:
+        return None
+    l11 = math.sqrt(d)
+    l20 = s20 / l00
+    l21 = (s21 - l20 * l10) / l11
+    d = s22 - l20 * l20 - l21 * l21
+    if not d > 0.0:
+        return None
+    l22 = math.sqrt(d)
+    l30 = s30 / l00
+    l31 = (s31 - l30 * l10) / l11
+    l32 = (s32 - l30 * l20 - l31 * l21) / l22
+    d = s33 - l30 * l30 - l31 * l31 - l32 * l32
+    if not d > 0.0:
+        return None
+    return l00, l10, l11, l20, l21, l22, l30, l31, l32, math.sqrt(d)
+
+
+def _general_update(
+    x: tuple[float, ...],
+    P: tuple[float, ...],
+    S: tuple[float, ...],
+    rows: tuple[tuple[float, float, float, float], ...],
+    y: tuple[float, float, float, float],
+) -> tuple[float, ...]:
+    """_kalman_update for an S that is not positive definite (possible only with beta < alpha^2,
+    which gives the central point a negative covariance weight): a general solve."""
+    S_full = np.array([[S[_packed_index(i, j)] for j in range(4)] for i in range(4)])
+    Pxz = np.array(rows)
+    K = np.linalg.solve(S_full, Pxz.T).T
+    x_new = (np.asarray(x) + K @ np.asarray(y)).tolist()
+    KSK = K @ S_full @ K.T
+    KSK = 0.5 * (KSK + KSK.T)
+    n = N_STATE
+    return (
+        *x_new, tuple(P[_packed_index(i, j)] - KSK[i, j] for i in range(n) for j in range(i + 1))
+    )

@@ -1,0 +1,38 @@
+"""`python -m benchmarks [--quick] [--out DIR] [--fmu-dir DIR]`: run the speed benchmarks, print
+the table (every target beside its measurement) and write DIR/bench.json."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from .config import BenchConfig
+from .report import format_table, write_json
+from .suite import run_benchmarks
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; return the exit status (0: the benchmark ran, whatever it found)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__)
+    parser.add_argument("--quick", action="store_true",
+                        help="shorter recording, fewer repeats, scaling to 1e5 (under 2 minutes)")
+    parser.add_argument("--out", type=Path, default=Path("reports"),
+                        help="folder for bench.json (default: reports)")
+    parser.add_argument("--fmu-dir", type=Path, default=None,
+                        help="use the FMUs in this folder instead of building them")
+    args = parser.parse_args(argv)
+    config = BenchConfig.quick_config(args.fmu_dir) if args.quick else BenchConfig(
+        fmu_dir=args.fmu_dir)
+    t0 = time.perf_counter()
+    results = run_benchmarks(config, log=lambda msg: print(f"... {msg}", file=sys.stderr))
+    results["wall_s"] = round(time.perf_counter() - t0, 1)
+    print(format_table(results))
+    path = write_json(results, args.out)
+    print(f"\nwrote {path} ({results['wall_s']} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,47 @@
+"""What a benchmark run measures and how long it may take: the full and the --quick settings."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ESTIMATOR_KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
+"""Our estimators, by fusion_core.ESTIMATORS key."""
+
+
+@dataclass(frozen=True)
+class BenchConfig:
+    """Sizes and repeats of one run.
+
+    duration_s: length of the 100 Hz recording the per-sample and FMU timings loop over;
+    repeats: timed passes over it (the medians are reported); fmu_dir: prebuilt FMUs (None:
+    build them into a temporary folder with build_fmu.py); testbench_s: simulated seconds per
+    testbench rate, for each of testbench_estimators; scaling_sizes: sample counts of the `run`
+    scaling test; peers: time the peer filters too; sections: which parts to run (all).
+    """
+
+    duration_s: float = 60.0
+    repeats: int = 7
+    fmu_dir: Path | None = None
+    testbench_s: dict[float, float] = field(default_factory=lambda: {100.0: 20.0, 1000.0: 5.0})
+    testbench_repeats: int = 3
+    testbench_estimators: tuple[str, ...] = ESTIMATOR_KEYS
+    scaling_sizes: tuple[int, ...] = (1_000, 10_000, 100_000, 1_000_000)
+    scaling_estimators: tuple[str, ...] = ESTIMATOR_KEYS
+    peers: bool = True
+    sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "scaling")
+    quick: bool = False
+
+    @classmethod
+    def quick_config(cls, fmu_dir: Path | None = None) -> BenchConfig:
+        """The --quick run: shorter recording, fewer repeats, scaling to 1e5 samples (under
+        2 minutes on a 2-core machine)."""
+        return cls(
+            duration_s=20.0,
+            repeats=3,
+            fmu_dir=fmu_dir,
+            testbench_s={100.0: 5.0, 1000.0: 1.0},
+            testbench_repeats=1,
+            scaling_sizes=(1_000, 10_000, 100_000),
+            quick=True,
+        )

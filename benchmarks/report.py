@@ -1,0 +1,193 @@
+"""Targets of issue 6 beside the measurements, the terminal table and bench.json."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+PER_SAMPLE_TARGETS_US = {"cf": 1.0, "kf": 2.0, "mgcf": 5.0, "ukf": 25.0, "poskf": 10.0}
+UKF_VS_FILTERPY = 10.0
+"""Our UKF must be at least this many times faster than filterpy's UKF in the same run."""
+FMU_OVERHEAD_TARGET_US = 10.0
+TESTBENCH_RTF_TARGET = 50.0
+TESTBENCH_TARGET_RATE = "1000Hz"
+
+
+def _target(name: str, measured: float | None, target: str, met: bool | None,
+            limit: str = "") -> dict[str, Any]:
+    return {"name": name, "measured": measured, "target": target, "met": met,
+            "limited_by": "" if met else limit}
+
+
+def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
+    """Every target the measurements of r allow to judge: met or not, and what limits it."""
+    out: list[dict[str, Any]] = []
+    ps = r.get("per_sample_us")
+    if ps:
+        floor = r.get("step_floor_us")
+        floor_text = (
+            f"the step API alone (input conversion, checks, Estimate) costs {floor:.2f} us "
+            "per call in this interpreter" if floor is not None else ""
+        )
+        for key, limit in PER_SAMPLE_TARGETS_US.items():
+            v = ps.get(key)
+            out.append(_target(
+                f"per_sample_us.{key}", v, f"<= {limit:g} us",
+                None if v is None else v <= limit,
+                f"CPython float arithmetic in the filter's own work; {floor_text}",
+            ))
+        ukf, peer = ps.get("ukf"), ps.get("filterpy_ukf")
+        if ukf is not None and peer is not None:
+            out.append(_target(
+                "per_sample_us.ukf vs filterpy_ukf", peer / ukf,
+                f">= {UKF_VS_FILTERPY:g}x faster", peer / ukf >= UKF_VS_FILTERPY,
+                "13 sigma points through the exact rotation, 6x6 covariance in Python floats",
+            ))
+    overhead = r.get("fmu_overhead_us")
+    if overhead:
+        low = r.get("fmu_overhead_lowlevel_us", {})
+        for key, v in overhead.items():
+            lv = low.get(key)
+            out.append(_target(
+                f"fmu_overhead_us.{key}", v, f"<= {FMU_OVERHEAD_TARGET_US:g} us",
+                v <= FMU_OVERHEAD_TARGET_US,
+                "fmpy's list-to-ctypes conversion per call, pythonfmu's C++ wrapper and the "
+                "slave's Python setters/getters"
+                + (f" (with preallocated ctypes arrays the overhead is {lv:.1f} us)"
+                   if lv is not None else ""),
+            ))
+    tb = r.get("testbench")
+    if tb:
+        for key, rates in tb.items():
+            at = rates.get(TESTBENCH_TARGET_RATE)
+            if at is None:
+                continue
+            est = at["estimator_fmu_us_per_step"]
+            out.append(_target(
+                f"testbench.{key}.{TESTBENCH_TARGET_RATE}.real_time_factor",
+                at["real_time_factor"], f">= {TESTBENCH_RTF_TARGET:g}",
+                at["real_time_factor"] >= TESTBENCH_RTF_TARGET,
+                f"{at['us_per_step']:.0f} us per testbench step, of which the estimator FMU "
+                f"{est:.0f} us; the rest is the ImuPlant and ImuSensor FMUs and the master",
+            ))
+    sc = r.get("scaling")
+    if sc:
+        for key, s in sc.items():
+            if s.get("flat") is None:
+                continue
+            out.append(_target(
+                f"scaling.{key}.flat", s["excess_growth_bytes_per_sample"],
+                f"growth beyond the outputs <= {s['allowed_growth_bytes_per_sample']:.1f} B "
+                "per extra sample", s["flat"],
+                "run() keeps Python objects per sample",
+            ))
+    return out
+
+
+def _fmt(v: float | None, digits: int = 2) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    return f"{v:.{digits}f}"
+
+
+def _verdict(t: dict[str, Any] | None) -> str:
+    if t is None or t["met"] is None:
+        return ""
+    return "met" if t["met"] else "NOT MET"
+
+
+def format_table(r: dict[str, Any]) -> str:
+    """The results as a terminal table, every target beside its measurement."""
+    targets = {t["name"]: t for t in r.get("targets", [])}
+    lines: list[str] = []
+    rec = r["recording"]
+    m = r["machine"]
+    lines.append(
+        f"Machine: {m['cpu']} ({m['usable_cpus']} usable of {m['cpu_count']} CPUs), "
+        f"Python {m['python']} (PGO/LTO build: {'yes' if m['python_pgo_lto'] else 'no'}); "
+        f"load average {m.get('load_average_start')} -> {m.get('load_average_end')}"
+    )
+    lines.append(
+        f"Recording: {rec['scenario']} at {rec['rate_hz']:g} Hz, {rec['samples']} samples; "
+        f"medians of {r['repeats']} passes{' (--quick)' if r['quick'] else ''}"
+    )
+    if "per_sample_us" in r:
+        lines += ["", "Per sample: one step/update call in a Python loop [us]",
+                  f"  {'filter':<15}{'median':>10}{'min':>10}   {'target':<22}verdict"]
+        detail = r["per_sample_detail"]
+        for key, v in r["per_sample_us"].items():
+            t = targets.get(f"per_sample_us.{key}")
+            if v is None:
+                reason = r["peers_unavailable"].get(key, "not measured")
+                lines.append(f"  {key:<15}{'-':>10}{'':>10}   unavailable: {reason}")
+                continue
+            lines.append(
+                f"  {key:<15}{_fmt(v):>10}{_fmt(detail[key]['min_us']):>10}   "
+                f"{(t['target'] if t else ''):<22}{_verdict(t)}"
+            )
+        t = targets.get("per_sample_us.ukf vs filterpy_ukf")
+        if t:
+            lines.append(f"  ukf speed-up over filterpy_ukf: {_fmt(t['measured'], 1)}x "
+                         f"(target {t['target']}): {_verdict(t)}")
+        lines.append(f"  step API floor (an estimator that does nothing): "
+                     f"{_fmt(r.get('step_floor_us'))} us")
+    if "fmu_step_us" in r:
+        lines += ["", "FMU step: set inputs + doStep + get outputs through fmpy [us]; overhead = "
+                  "FMU less fusion_core's step, timed in turn",
+                  f"  {'estimator':<11}{'core':>8}{'fmpy API':>10}{'overhead':>10}"
+                  f"{'low-level':>11}{'overhead':>10}   {'target':<18}verdict"]
+        ov = r.get("fmu_overhead_us", {})
+        lov = r.get("fmu_overhead_lowlevel_us", {})
+        core = r.get("fmu_core_us", {})
+        for key, v in r["fmu_step_us"].items():
+            t = targets.get(f"fmu_overhead_us.{key}")
+            lines.append(
+                f"  {key:<11}{_fmt(core.get(key), 1):>8}{_fmt(v, 1):>10}{_fmt(ov.get(key), 1):>10}"
+                f"{_fmt(r['fmu_step_lowlevel_us'][key], 1):>11}{_fmt(lov.get(key), 1):>10}   "
+                f"{('overhead ' + t['target']) if t else '':<18}{_verdict(t)}"
+            )
+    if "testbench" in r:
+        lines += ["", "Testbench: ImuPlant -> ImuSensor -> estimator FMU (testbenches.master)",
+                  f"  {'estimator':<11}{'rate':>8}{'steps/s':>10}{'RTF':>8}{'us/step':>9}"
+                  f"{'est. us':>9}   {'target':<10}verdict"]
+        for key, rates in r["testbench"].items():
+            for rate, x in rates.items():
+                t = targets.get(f"testbench.{key}.{rate}.real_time_factor")
+                lines.append(
+                    f"  {key:<11}{rate:>8}{_fmt(x['steps_per_s'], 0):>10}"
+                    f"{_fmt(x['real_time_factor'], 1):>8}{_fmt(x['us_per_step'], 0):>9}"
+                    f"{_fmt(x['estimator_fmu_us_per_step'], 0):>9}   "
+                    f"{(t['target'] if t else ''):<10}{_verdict(t)}"
+                )
+    if "scaling" in r:
+        lines += ["", "Scaling of run(): time per sample and peak memory growth",
+                  f"  {'estimator':<11}{'N':>9}{'us/sample':>11}{'peak MB':>9}"
+                  f"{'outputs MB':>12}{'excess MB':>11}"]
+        for key, s in r["scaling"].items():
+            for run in s["runs"]:
+                lines.append(
+                    f"  {key:<11}{run['n']:>9}{_fmt(run['us_per_sample']):>11}"
+                    f"{run['peak_bytes'] / 1e6:>9.2f}{run['output_bytes'] / 1e6:>12.2f}"
+                    f"{run['excess_bytes'] / 1e6:>11.2f}"
+                )
+            t = targets.get(f"scaling.{key}.flat")
+            if t:
+                lines.append(f"  {key:<11}memory growth beyond the outputs "
+                             f"{_fmt(t['measured'], 2)} B per extra sample (target "
+                             f"{t['target'].split('<= ')[1]}): {_verdict(t)}")
+    missed = [t for t in r.get("targets", []) if t["met"] is False]
+    if missed:
+        lines += ["", "Targets not met, and what limits them:"]
+        lines += [f"  {t['name']}: {_fmt(t['measured'])} (target {t['target']}): "
+                  f"{t['limited_by']}" for t in missed]
+    return "\n".join(lines)
+
+
+def write_json(r: dict[str, Any], out_dir: Path) -> Path:
+    """DIR/bench.json."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    path = out_dir / "bench.json"
+    path.write_text(json.dumps(r, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    return path

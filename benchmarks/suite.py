@@ -1,0 +1,129 @@
+"""run_benchmarks: every section of the benchmark, in one process, into one JSON-ready dict."""
+
+from __future__ import annotations
+
+import datetime
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.base import Estimator
+from fusion_core.types import Estimate
+
+from .common import (
+    RATE_HZ,
+    SCENARIO,
+    load_average,
+    machine_info,
+    recording,
+    samples,
+    time_interleaved,
+)
+from .config import ESTIMATOR_KEYS, BenchConfig
+from .estimators import step_factories
+from .fmu import build_fmus, fmu_steps
+from .peers import PEERS, available_peers
+from .report import evaluate_targets
+from .scaling import scaling
+from .testbench import testbench_throughput
+
+SCHEMA = 1
+
+
+FLOOR = "(step API floor)"
+
+
+class _NoOpEstimator(Estimator):
+    """An estimator whose update does nothing: what the step API itself costs."""
+
+    def _reset(self) -> None:
+        pass
+
+    def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
+        pass
+
+    def _update(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> None:
+        pass
+
+    def _estimate(self) -> Estimate:
+        return Estimate(0.0, 0.0, (0.0, 0.0, 0.0))
+
+
+def _noop_pass(data: list[tuple[list[float], list[float], float]]) -> Any:
+    step = _NoOpEstimator().step
+
+    def run() -> int:
+        for acc, gyro, dt in data:
+            step(acc, gyro, dt)
+        return len(data)
+
+    return run
+
+
+def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
+    """Run the sections named in config.sections; return the results (see benchmarks/__init__)."""
+    rec = recording(config.duration_s)
+    data = samples(rec)
+    n = len(data)
+    results: dict[str, Any] = {
+        "schema": SCHEMA,
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "quick": config.quick,
+        "repeats": config.repeats,
+        "recording": {"scenario": SCENARIO, "rate_hz": RATE_HZ, "samples": n,
+                      "noise": "MPU-6050", "seed": 0},
+        "machine": machine_info(),
+    }
+    if "per_sample" in config.sections:
+        log(f"per-sample timing: {len(ESTIMATOR_KEYS)} estimators and the peers, {n} samples x "
+            f"{config.repeats} passes, in turn")
+        factories = step_factories(ESTIMATOR_KEYS, data)
+        unavailable = {name: "not run (peers switched off)" for name in PEERS}
+        if config.peers:
+            peer_factories, unavailable = available_peers(rec)
+            factories.update(peer_factories)
+        factories[FLOOR] = lambda: _noop_pass(data)
+        detail = time_interleaved(factories, config.repeats)
+        floor = detail.pop(FLOOR)
+        results["per_sample_us"] = {
+            key: (detail[key]["median_us"] if key in detail else None)
+            for key in (*ESTIMATOR_KEYS, *PEERS)
+        }
+        results["per_sample_detail"] = detail
+        results["peers_unavailable"] = unavailable
+        results["step_floor_us"] = floor["median_us"]
+    if {"fmu", "testbench"} & set(config.sections):
+        with tempfile.TemporaryDirectory(prefix="bench_fmus_") as tmp:
+            fmu_dir = config.fmu_dir
+            if fmu_dir is None:
+                log("building the FMUs (build_fmu.py)")
+                fmu_dir = build_fmus(Path(tmp))
+            results["fmu_dir"] = str(config.fmu_dir) if config.fmu_dir else "(built, temporary)"
+            if "fmu" in config.sections:
+                log("FMU step timing (fusion_core, fmpy API and low-level host in turn)")
+                fmu_data = np.column_stack(
+                    [rec["acc_meas"], rec["gyro_meas"], rec["dt"]]).tolist()
+                timings = fmu_steps(ESTIMATOR_KEYS, fmu_dir, fmu_data, data, config.repeats)
+                results["fmu_step_detail"] = timings
+                med = {k: {h: v[h]["median_us"] for h in v} for k, v in timings.items()}
+                results["fmu_step_us"] = {k: m["api"] for k, m in med.items()}
+                results["fmu_step_lowlevel_us"] = {k: m["lowlevel"] for k, m in med.items()}
+                results["fmu_core_us"] = {k: m["core"] for k, m in med.items()}
+                results["fmu_overhead_us"] = {k: m["api"] - m["core"] for k, m in med.items()}
+                results["fmu_overhead_lowlevel_us"] = {
+                    k: m["lowlevel"] - m["core"] for k, m in med.items()}
+            if "testbench" in config.sections:
+                log("testbench throughput")
+                results["testbench"] = testbench_throughput(
+                    config.testbench_estimators, config.testbench_s, fmu_dir,
+                    config.testbench_repeats)
+    if "scaling" in config.sections:
+        log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
+        results["scaling"] = scaling(config.scaling_estimators, config.scaling_sizes, rec)
+    results["machine"]["load_average_end"] = load_average()
+    results["targets"] = evaluate_targets(results)
+    return results

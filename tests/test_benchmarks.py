@@ -1,0 +1,146 @@
+"""The benchmark suite's code paths on tiny sizes (no timing is asserted), and the memory
+behaviour of run() that its scaling section measures."""
+
+from __future__ import annotations
+
+import json
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import benchmarks.__main__ as cli
+from benchmarks import BenchConfig, peers, report, scaling
+from benchmarks.common import recording
+from benchmarks.config import ESTIMATOR_KEYS
+from fusion_core import ComplementaryFilter
+
+TINY = dict(
+    duration_s=0.5,
+    repeats=1,
+    testbench_s={100.0: 0.05, 1000.0: 0.01},
+    testbench_repeats=1,
+    testbench_estimators=("kf",),
+    scaling_sizes=(300, 600),
+    scaling_estimators=("cf",),
+)
+
+
+@pytest.fixture(scope="module")
+def bench_json(built_fmus, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """`python -m benchmarks --quick` with the quick settings shrunk to TINY, through main()."""
+    out = tmp_path_factory.mktemp("bench")
+    original = BenchConfig.quick_config
+    BenchConfig.quick_config = classmethod(  # type: ignore[method-assign]
+        lambda cls, fmu_dir=None: cls(fmu_dir=fmu_dir, quick=True, **TINY))
+    try:
+        assert cli.main(["--quick", "--out", str(out), "--fmu-dir", str(built_fmus.directory)]) == 0
+    finally:
+        BenchConfig.quick_config = original  # type: ignore[method-assign]
+    return json.loads((out / "bench.json").read_text())
+
+
+def test_json_holds_every_section_of_the_issue(bench_json: dict) -> None:
+    for key in ("per_sample_us", "fmu_step_us", "fmu_overhead_us", "testbench", "scaling",
+                "machine", "repeats", "targets"):
+        assert key in bench_json, key
+    assert bench_json["repeats"] == 1
+    assert bench_json["machine"]["cpu_count"] >= 1
+
+
+def test_per_sample_has_every_estimator_and_every_peer_or_its_reason(bench_json: dict) -> None:
+    ps = bench_json["per_sample_us"]
+    assert set(ps) == {*ESTIMATOR_KEYS, *peers.PEERS}
+    assert all(ps[k] > 0.0 for k in ESTIMATOR_KEYS)
+    for name in peers.PEERS:
+        assert (ps[name] is not None and ps[name] > 0.0) or name in bench_json["peers_unavailable"]
+
+
+def test_fmu_step_and_overhead_per_estimator(bench_json: dict) -> None:
+    for key in ESTIMATOR_KEYS:
+        step = bench_json["fmu_step_us"][key]
+        assert step > 0.0
+        assert bench_json["fmu_overhead_us"][key] == pytest.approx(
+            step - bench_json["fmu_core_us"][key])
+
+
+def test_testbench_at_100_hz_and_1_khz(bench_json: dict) -> None:
+    for rate, hz in (("100Hz", 100.0), ("1000Hz", 1000.0)):
+        x = bench_json["testbench"]["kf"][rate]
+        assert x["steps_per_s"] > 0.0
+        assert x["real_time_factor"] == pytest.approx(x["steps_per_s"] / hz)
+
+
+def test_scaling_reports_time_and_memory_per_size(bench_json: dict) -> None:
+    runs = bench_json["scaling"]["cf"]["runs"]
+    assert [r["n"] for r in runs] == [300, 600]
+    for r in runs:
+        assert r["us_per_sample"] > 0.0
+        assert r["output_bytes"] == r["n"] * (8 + 8 + 24 + 1)  # roll, pitch, bias, rejected
+        assert r["peak_bytes"] >= 0
+
+
+def test_every_target_is_judged_beside_its_measurement(bench_json: dict) -> None:
+    names = {t["name"] for t in bench_json["targets"]}
+    expected = {f"per_sample_us.{k}" for k in ("cf", "kf", "mgcf", "ukf", "poskf")}
+    expected |= {f"fmu_overhead_us.{k}" for k in ESTIMATOR_KEYS}
+    expected |= {"testbench.kf.1000Hz.real_time_factor"}
+    expected |= {"scaling.cf.flat"}
+    assert expected <= names
+    for t in bench_json["targets"]:
+        assert isinstance(t["met"], bool)
+        assert t["met"] or t["limited_by"], t["name"]
+
+
+def test_ukf_target_needs_ten_times_filterpys_speed() -> None:
+    results = {"per_sample_us": {"ukf": 20.0, "filterpy_ukf": 150.0}}
+    t = {x["name"]: x for x in report.evaluate_targets(results)}
+    assert t["per_sample_us.ukf"]["met"] is True
+    assert t["per_sample_us.ukf vs filterpy_ukf"]["measured"] == pytest.approx(7.5)
+    assert t["per_sample_us.ukf vs filterpy_ukf"]["met"] is False
+
+
+def test_an_unavailable_peer_is_reported_with_its_reason(monkeypatch: pytest.MonkeyPatch) -> None:
+    def missing(name: str, rec: dict) -> None:
+        raise ImportError(f"No module named {name!r}")
+
+    monkeypatch.setattr(peers, "peer_pass_factory", missing)
+    timings, unavailable = peers.per_sample_peers(recording(0.1), 1, ("vqf",))
+    assert timings == {}
+    assert unavailable == {"vqf": "ImportError: No module named 'vqf'"}
+
+
+def test_table_names_every_estimator_and_verdict(bench_json: dict) -> None:
+    table = report.format_table(bench_json)
+    for key in ESTIMATOR_KEYS:
+        assert f"\n  {key} " in table
+    assert "met" in table
+
+
+def test_flatness_tells_a_chunked_run_from_one_that_keeps_every_sample() -> None:
+    def runs(excess_per_sample: float) -> list[dict]:
+        return [{"n": n, "us_per_sample": 1.0, "output_bytes": 41 * n,
+                 "excess_bytes": 2_000_000 + excess_per_sample * n} for n in (10_000, 100_000)]
+
+    assert scaling.flatness(runs(0.0))["flat"] is True
+    assert scaling.flatness(runs(500.0))["flat"] is False
+
+
+def test_run_memory_beyond_the_outputs_does_not_grow_with_n(tmp_path: Path) -> None:
+    rec = recording(10.0)
+
+    def peak_beyond_outputs(n: int) -> int:
+        idx = np.arange(n) % len(rec["dt"])
+        acc, gyro, dt = rec["acc_meas"][idx], rec["gyro_meas"][idx], rec["dt"][idx]
+        tracemalloc.start()
+        try:
+            out = ComplementaryFilter().run(acc, gyro, dt)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        return peak - sum(v.nbytes for v in out.values())
+
+    small, large = peak_beyond_outputs(2_000), peak_beyond_outputs(8_000)
+    # Keeping one Python object per sample grows by about 12 times the extra outputs' bytes.
+    assert large - small < 0.25 * 41 * 6_000
