@@ -38,10 +38,16 @@ Z_BIAS_UNOBSERVABLE = (
     "always 0: a bias about z does not change the accelerometer's tilt, so it is unobservable "
     "in this filter"
 )
-"""zero_bias reason for bias_z of the per-axis [angle, bias] Kalman filters."""
+"""zero_bias reason for bias_z of the position filter's tilt stage."""
+Z_BIAS_REST_ONLY = (
+    "always 0 while rest detection is off (rest_time = 0, the default): a bias about z does not "
+    "change the accelerometer's tilt, so only the zero-rate update at rest observes it"
+)
+"""zero_bias reason for bias_z of the [angle, bias] Kalman filter."""
 NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STATE for a in AXES})
 """zero_bias of a filter without a bias state: all three bias outputs are 0."""
 NO_Z_BIAS_OUTPUT: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_UNOBSERVABLE})
+Z_BIAS_AT_REST_ONLY: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_REST_ONLY})
 """zero_bias of the per-axis [angle, bias] Kalman filters: bias_z is 0."""
 
 

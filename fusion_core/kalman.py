@@ -18,8 +18,27 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 from __future__ import annotations
 
 from .base import INTEGRATION_PARAM, Estimator
-from .complementary import ACC_GATE_PARAMS
-from .kinematics import accel_roll_pitch, clamp_pitch, euler_step, heun_euler_step, wrap_angle
+from .complementary import (
+    ACC_GATE_PARAMS,
+    ACC_LOWPASS_PARAM,
+    PROPAGATION_PARAM,
+    REST_PARAMS,
+    Vec3,
+    body_rotation,
+    lowpass_specific_force,
+    quat_with_roll_pitch,
+    rest_step,
+)
+from .kinematics import (
+    accel_roll_pitch,
+    clamp_pitch,
+    euler_step,
+    heun_euler_step,
+    quat_from_roll_pitch_yaw,
+    quat_mul_rotvec,
+    quat_roll_pitch,
+    wrap_angle,
+)
 from .types import DEG, Estimate, G, Param
 
 DEG2 = DEG * DEG
@@ -92,11 +111,27 @@ class AngleBiasKalmanFilter(Estimator):
     only predicts). The innovation is wrapped to [-pi, pi].
 
     Initialisation: the first valid sample sets the angles from the accelerometer, biases 0 and
-    P = 0, like the papers' reference code.
+    P = 0, like the papers' reference code (init_bias_std > 0 starts the bias variances there
+    instead: with a small, physical Q_bias a zero prior would keep the bias from ever moving).
+
+    Options for real sensors, all off by default (then the filter is exactly the papers'):
+    - acc_lowpass > 0: the accelerometer is low-passed in a frame that turns with the gyro
+      (complementary.ACC_LOWPASS_PARAM, after Laidig & Seel 2023) before the gate and the
+      measurement, so linear acceleration averages out instead of reading as tilt;
+    - rest_time > 0: while a rest detector (complementary.REST_PARAMS) says the sensor is still,
+      a zero-angular-rate update: the gyro measures the bias directly (H = [0, 1], variance
+      gyro_noise^2 / dt; the standard Kalman update, bias_update). The z-axis bias, which the
+      accelerometer's tilt cannot observe, then gets a state of its own, bias_z (a random walk
+      with Q_bias, observed only at rest), used in the propagation and output as bias_z; with
+      rest detection off bias_z stays 0 as before;
+    - propagation="quaternion": roll and pitch are carried by an attitude quaternion with a free
+      yaw instead of the Euler rates (complementary.PROPAGATION_PARAM), so that pitch +-90 deg is
+      no singularity; the covariance and the measurement update are the papers'.
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2] (papers' 0.001, 0.003,
     0.03 deg-based values converted, see the module docstring); gate_low, gate_high;
-    integration; max_dt [s].
+    acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_noise
+    [rad/s/sqrt(Hz)]; init_bias_std [rad/s]; propagation; integration; max_dt [s].
     """
 
     PARAMS = (
@@ -116,9 +151,27 @@ class AngleBiasKalmanFilter(Estimator):
             unit="rad2", low=0.0, low_open=True, display_unit="deg2",
         ),
         *ACC_GATE_PARAMS,
+        ACC_LOWPASS_PARAM,
+        *REST_PARAMS,
+        Param(
+            "gyro_noise", 0.005 * DEG,
+            "Gyro white-noise density, the variance of the zero-angular-rate update at rest "
+            "(MPU-6050: 0.005 deg/s/sqrt(Hz))",
+            unit="rad/(s.sqrt(Hz))", low=0.0, low_open=True,
+        ),
+        Param(
+            "init_bias_std", 0.0,
+            "Initial standard deviation of the gyro-bias states (0: P = 0 at the first sample, "
+            "the papers' code)",
+            unit="rad/s", low=0.0, tunable=False, display_unit="deg/s",
+        ),
+        PROPAGATION_PARAM,
         INTEGRATION_PARAM,
     )
-    STATE = ("roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch")
+    STATE = (
+        "roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch", "bias_z", "P_z", "acc_f", "rest",
+        "q_att",
+    )
 
     def _configure(self) -> None:
         p = self._params
@@ -128,6 +181,12 @@ class AngleBiasKalmanFilter(Estimator):
         self._gate_low2 = (p["gate_low"] * G) ** 2
         self._gate_high2 = (p["gate_high"] * G) ** 2
         self._trapezoid = p["integration"] == "trapezoid"
+        self._acc_tau = p["acc_lowpass"]
+        self._rest_time = p["rest_time"]
+        self._rest_gyro = p["rest_gyro"]
+        self._rest_acc = p["rest_acc"]
+        self._gyro_var = p["gyro_noise"] ** 2
+        self._quaternion = p["propagation"] == "quaternion"
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -136,27 +195,78 @@ class AngleBiasKalmanFilter(Estimator):
         self.bias_y = 0.0
         self.P_roll = (0.0, 0.0, 0.0, 0.0)
         self.P_pitch = (0.0, 0.0, 0.0, 0.0)
+        self.bias_z = 0.0  # only with rest detection (rest_time > 0); else 0: unobservable
+        self.P_z = 0.0
+        self.acc_f = (0.0, 0.0, 0.0)  # pre-filtered specific force (acc_lowpass > 0)
+        self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
+        self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
+        self.acc_f = (ax, ay, az)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
+        self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
+        p_b = self._params["init_bias_std"] ** 2
+        if p_b > 0.0:
+            self.P_roll = (0.0, 0.0, 0.0, p_b)
+            self.P_pitch = (0.0, 0.0, 0.0, p_b)
+            self.P_z = p_b
 
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
-        self.propagate(gx, gy, gz, dt)
+        phi = None
+        if self._quaternion or self._acc_tau > 0.0:
+            bias = (self.bias_x, self.bias_y, self.bias_z)
+            phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
+        self.propagate(gx, gy, gz, dt, phi)
+        predicted = (self.roll, self.pitch)
+        if self._rest_time > 0.0:
+            self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
+        if self._acc_tau > 0.0:
+            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
+            ax, ay, az = self.acc_f
         norm2 = ax * ax + ay * ay + az * az
         if self._gate_low2 <= norm2 <= self._gate_high2:
             self.correct(ax, ay, az)
+        if self._quaternion and (self.roll, self.pitch) != predicted:
+            self.q_att = quat_with_roll_pitch(self.q_att, self.roll, self.pitch)
 
-    def propagate(self, gx: float, gy: float, gz: float, dt: float) -> None:
-        """Time update: angles by the Euler-rate kinematics, P by the papers' F and Q."""
-        bx, by = self.bias_x, self.bias_y
-        w1 = (gx - bx, gy - by, gz)
-        if self._trapezoid:
+    def _zero_rate_update(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> None:
+        """Rest detection; at rest the gyro sample measures the bias (variance gyro_noise^2/dt):
+        the x and y biases through the [angle, bias] filters, bias_z through its own state."""
+        self.rest = rest_step(
+            self.rest, gx, gy, gz, ax, ay, az, dt, self._rest_gyro, self._rest_acc
+        )
+        self.P_z += self._q_bias * dt
+        if self.rest[6] >= self._rest_time:
+            r = self._gyro_var / dt
+            self.correct_bias(gx, gy, r)
+            k = self.P_z / (self.P_z + r)
+            self.bias_z += k * (gz - self.bias_z)
+            self.P_z -= k * self.P_z
+
+    def propagate(
+        self, gx: float, gy: float, gz: float, dt: float, phi: Vec3 | None = None
+    ) -> None:
+        """Time update: angles by the Euler-rate kinematics (or, with propagation="quaternion",
+        by the attitude quaternion turned by the rotation vector phi of the interval, computed
+        here when not given), P by the papers' F and Q."""
+        bx, by, bz = self.bias_x, self.bias_y, self.bias_z
+        w1 = (gx - bx, gy - by, gz - bz)
+        if self._quaternion:
+            if phi is None:
+                phi = body_rotation(self.gyro_prev, (gx, gy, gz), (bx, by, bz), dt,
+                                    self._trapezoid)
+            self.q_att = quat_mul_rotvec(self.q_att, *phi)
+            roll, pitch = quat_roll_pitch(*self.q_att)
+        elif self._trapezoid:
             g0 = self.gyro_prev
-            w0 = (g0[0] - bx, g0[1] - by, g0[2])
+            w0 = (g0[0] - bx, g0[1] - by, g0[2] - bz)
             roll, pitch = heun_euler_step(self.roll, self.pitch, w0, w1, dt)
         else:
             roll, pitch = euler_step(self.roll, self.pitch, w1, dt)
@@ -194,4 +304,4 @@ class AngleBiasKalmanFilter(Estimator):
         )
 
     def _estimate(self) -> Estimate:
-        return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0))
+        return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z))

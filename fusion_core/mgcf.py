@@ -17,6 +17,13 @@ from __future__ import annotations
 import math
 
 from .base import INTEGRATION_PARAM, Estimator
+from .complementary import (
+    ACC_LOWPASS_PARAM,
+    REST_PARAMS,
+    body_rotation,
+    lowpass_specific_force,
+    rest_step,
+)
 from .kinematics import (
     accel_roll_pitch,
     quat_from_roll_pitch_yaw,
@@ -61,8 +68,19 @@ class GainScheduledComplementaryFilter(Estimator):
       advanced with the current rate by first-order quaternion integration (the papers' rule).
     Roll and pitch come from the quaternion; yaw is carried along but unobservable.
 
+    Options for real sensors, both off by default (then the filter is exactly the paper's):
+    - acc_lowpass > 0: a is first low-passed in a frame that turns with the bias-corrected gyro
+      (complementary.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and e and rho use that
+      vector: linear acceleration averages out instead of reading as tilt, and the schedule sees
+      the norm of what the correction uses;
+    - rest_time > 0: while a rest detector (complementary.REST_PARAMS) says the sensor is still,
+      the gyro reads its own bias, and b follows the gyro with time constant rest_time (a
+      zero-angular-rate update of the integral term; Mahony's integral alone needs minutes, and
+      cannot see the bias about the vertical at all).
+
     Parameters: schedule ("simulation" default, "experimental", "fixed"), w0 [rad/s] (used when
-    schedule="fixed"; 0.1), zeta (2), integration, max_dt [s].
+    schedule="fixed"; 0.1), zeta (2), acc_lowpass [s], rest_time [s], rest_gyro [rad/s],
+    rest_acc [m/s^2], integration, max_dt [s].
     """
 
     PARAMS = (
@@ -77,9 +95,11 @@ class GainScheduledComplementaryFilter(Estimator):
             unit="rad/s", low=0.0,
         ),
         Param("zeta", 2.0, "Damping ratio of the PI correction (Kp = 2 zeta w0)", low=0.0),
+        ACC_LOWPASS_PARAM,
+        *REST_PARAMS,
         INTEGRATION_PARAM,
     )
-    STATE = ("q", "bias", "w0_now")
+    STATE = ("q", "bias", "w0_now", "acc_f", "rest")
 
     def _configure(self) -> None:
         p = self._params
@@ -87,19 +107,48 @@ class GainScheduledComplementaryFilter(Estimator):
         self._w0_fixed = p["w0"]
         self._two_zeta = 2.0 * p["zeta"]
         self._trapezoid = p["integration"] == "trapezoid"
+        self._acc_tau = p["acc_lowpass"]
+        self._rest_time = p["rest_time"]
+        self._rest_gyro = p["rest_gyro"]
+        self._rest_acc = p["rest_acc"]
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)
         self.bias = (0.0, 0.0, 0.0)
         self.w0_now = 0.0
+        self.acc_f = (0.0, 0.0, 0.0)  # pre-filtered specific force (acc_lowpass > 0)
+        self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         roll, pitch = accel_roll_pitch(ax, ay, az)
         self.q = quat_from_roll_pitch_yaw(roll, pitch, 0.0)
+        self.acc_f = (ax, ay, az)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
+
+    def _real_sensor_options(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> tuple[float, float, float]:
+        """The zero-angular-rate update at rest and the accelerometer pre-filter (see the class
+        docstring); returns the specific force the correction is to use."""
+        if self._rest_time > 0.0:
+            self.rest = rest_step(
+                self.rest, gx, gy, gz, ax, ay, az, dt, self._rest_gyro, self._rest_acc
+            )
+            if self.rest[6] >= self._rest_time:
+                k = dt / (self._rest_time + dt)
+                bx, by, bz = self.bias
+                self.bias = (bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz))
+        if self._acc_tau > 0.0:
+            phi = body_rotation(self.gyro_prev, (gx, gy, gz), self.bias, dt, self._trapezoid)
+            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
+            return self.acc_f
+        return ax, ay, az
 
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
+        if self._rest_time > 0.0 or self._acc_tau > 0.0:
+            ax, ay, az = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         rho = abs(norm / G - 1.0)
         w0 = self._w0_fixed if self._table is None else scheduled_w0(rho, self._table)

@@ -3,6 +3,7 @@
   run         estimator x scenario x seed campaign with the contract checks; prints the contract
               table, writes DIR/report.json, DIR/report.md and plots; exit status 1 on any FAIL.
   export-ssp  the plant, sensor and estimator FMUs and their connections as an SSP file.
+  broad       accuracy on BROAD's real recordings beside VQF, Madgwick, Mahony (broad_cli).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from pathlib import Path
 
 from fusion_core.scenarios import SCENARIOS
 
+from .broad_cli import add_broad_parser
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS
 
 
@@ -104,6 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     ssp.add_argument("--noise-free", action="store_true", help="a sensor without noise")
     ssp.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
     ssp.add_argument("out", type=Path, help="the SSP file to write")
+    add_broad_parser(sub)
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
@@ -117,6 +120,10 @@ def main(argv: list[str] | None = None) -> int:
                               args.fmu_dir)
             print(f"wrote {path}")
             return 0
+        if args.command == "broad":
+            from .broad_cli import cmd_broad
+
+            return cmd_broad(args)
     except (ValueError, FileNotFoundError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

@@ -3,11 +3,11 @@
 Implements the two-state [angle, gyro bias] Kalman filter of W. Gui, Y. Tang, S. Mukhopadhyay
 (2015), eq. 5-26, written scalar by scalar in Das & Mary, eq. 16-27: one filter for roll
 (estimating the x gyro bias) and one for pitch (the y gyro bias). bias_z is unobservable from
-the accelerometer's tilt and is always 0.
+the accelerometer's tilt: it is 0 unless rest detection (rest_time > 0) estimates it at rest.
 """
 
 import fusion_core
-from fmu_src.estimator import NO_Z_BIAS_OUTPUT, EstimatorSlave
+from fmu_src.estimator import Z_BIAS_AT_REST_ONLY, EstimatorSlave
 
 
 class AngleBiasKalmanFilter(EstimatorSlave):
@@ -18,4 +18,4 @@ class AngleBiasKalmanFilter(EstimatorSlave):
         "Two-state [angle, gyro bias] Kalman filter for roll and pitch: W. Gui, Y. Tang, "
         "S. Mukhopadhyay (2015), eq. 5-26; Das & Mary, eq. 16-27. One IMU sample per doStep."
     )
-    zero_bias = NO_Z_BIAS_OUTPUT
+    zero_bias = Z_BIAS_AT_REST_ONLY

@@ -1,0 +1,103 @@
+"""`python -m testbenches broad PATH...`: the command line of the BROAD evaluation.
+
+Kept apart from testbenches/__main__.py, which only registers the subcommand and dispatches to
+`cmd_broad`; everything it does is callable from Python (`testbenches.broad.evaluate`,
+`testbenches.broad_report.write_reports`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .fmus import DEFAULT_FMU_DIR
+
+HELP = """\
+Evaluate the estimators on BROAD trials (Laidig et al., Data 2021): inclination RMSE over each
+trial's movement samples, a trial x estimator table with means per BROAD group, and
+DIR/report.json, DIR/report.md and a bar chart. PATH: trial files (.hdf5 or MATLAB v5 .mat) or
+folders holding them. Peers (--peers) need the bench extra: pip install -e '.[bench]'."""
+
+
+def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
+    """Register the `broad` subcommand on the subparsers of `python -m testbenches`."""
+    p = sub.add_parser("broad", help="accuracy on BROAD's real recordings (inclination RMSE)",
+                       description=HELP)
+    p.add_argument("paths", nargs="+", type=Path, metavar="PATH",
+                   help="BROAD trial files (.hdf5, .mat) or folders of them")
+    p.add_argument("--estimator", default="all",
+                   help="all or a comma list of cf, mgcf, kf, ukf, poskf (all)")
+    p.add_argument("--preset", default="default",
+                   help="default (the papers' parameters), broad (tuned for real sensors, see "
+                   "fusion_core/presets.py), all, or a comma list (default)")
+    p.add_argument("--peers", action="store_true",
+                   help="also run VQF (6D), Madgwick and Mahony (ahrs) on the same trials")
+    p.add_argument("--fmu", action="store_true",
+                   help="run the estimators as the built FMUs through fmpy instead of fusion_core")
+    p.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR,
+                   help="folder of the built FMUs, for --fmu (dist)")
+    p.add_argument("--trials-json", type=Path, default=None,
+                   help="BROAD's trials.json for the groups (default: the one beside the files; "
+                   "else the groups in the trial names)")
+    p.add_argument("--head", type=float, default=None, metavar="SECONDS",
+                   help="use only the first SECONDS of every trial (a quick look)")
+    p.add_argument("--out", type=Path, default=Path("reports/broad"),
+                   help="report folder (reports/broad)")
+    p.add_argument("--no-plot", action="store_true", help="skip the bar chart")
+    return p
+
+
+def _names(value: str, allowed: list[str], what: str) -> list[str]:
+    if value == "all":
+        return allowed
+    names = [v for v in value.split(",") if v]
+    bad = [n for n in names if n not in allowed]
+    if bad or not names:
+        raise ValueError(f"unknown {what} {', '.join(bad) or value!r}: allowed all, "
+                         f"{', '.join(allowed)}")
+    return names
+
+
+def cmd_broad(args: argparse.Namespace) -> int:
+    """Run the evaluation, print the table, write the reports. Exit status 0, or 2 on bad input
+    (the message says what was wrong)."""
+    from tqdm import tqdm
+
+    from fusion_core import ESTIMATORS
+    from fusion_core.presets import PRESETS
+
+    from .broad import collect_paths, evaluate, plan_columns
+    from .broad_data import load_trial
+    from .broad_peers import PEERS, PeerUnavailable, check_peers
+    from .broad_report import table, write_reports
+
+    estimators = _names(args.estimator, list(ESTIMATORS), "estimator")
+    presets = _names(args.preset, list(PRESETS), "preset")
+    peers = list(PEERS) if args.peers else []
+    try:
+        check_peers(peers)
+    except PeerUnavailable as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    columns = plan_columns(estimators, presets, peers, fmu=args.fmu)
+    files = collect_paths(args.paths)
+    if not files:
+        raise ValueError(f"no trial files in {', '.join(map(str, args.paths))}")
+    trials = [load_trial(f) for f in files]  # refuses a non-trial before any long run
+    with tqdm(total=len(files) * len(columns), unit="run", file=sys.stderr) as bar:
+        def progress(trial: str, column: str) -> None:
+            bar.set_postfix_str(f"{trial[:28]} {column}")
+            bar.update()
+
+        result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
+                          progress=progress, head_seconds=args.head)
+    print(table(result))
+    paths = write_reports(result, args.out, plot=not args.no_plot)
+    print("\nmean_inclination_rmse_deg: " + ", ".join(
+        f"{k} {v:.3f}" for k, v in result.means().items()))
+    print("reports: " + ", ".join(str(p) for p in paths.values()))
+    return 0
+
+
+__all__ = ["add_broad_parser", "cmd_broad"]

@@ -1,0 +1,93 @@
+"""Public 6D orientation filters run beside ours on BROAD (the `bench` extra): VQF, Madgwick,
+Mahony. Each returns the estimated up direction in the sensor frame, [N, 3], for the metric.
+
+- VQF: D. Laidig, T. Seel. "VQF: Highly Accurate IMU Orientation Estimation with Bias Estimation
+  and Magnetic Disturbance Rejection". Information Fusion 91:187-204, 2023. The `vqf` package's
+  causal filter (`VQF.updateBatch`, its defaults), 6D quaternion `quat6D`. Not `offlineVQF`,
+  which also looks at future samples.
+- Madgwick: S. Madgwick, A. Harrison, R. Vaidyanathan. "Estimation of IMU and MARG orientation
+  using a gradient descent algorithm". ICORR 2011. `ahrs.filters.Madgwick`, IMU form, its default
+  gain 0.033.
+- Mahony: R. Mahony, T. Hamel, J.-M. Pflimlin. "Nonlinear complementary filters on the special
+  orthogonal group". IEEE TAC 53(5), 2008. `ahrs.filters.Mahony`, IMU form, its defaults
+  k_P = 1, k_I = 0.3.
+
+Conventions, checked against the packages' code: all three take gyro in rad/s and the
+accelerometer in m/s^2 (only its direction is used) and expect a resting accelerometer to read
++g along the sensor's up axis, as BROAD and we do; their quaternion (w first) rotates sensor
+coordinates into a z-up earth frame, so the up direction in the sensor frame is R(q)^T e_z, the
+same formula as for BROAD's reference (ahrs's NED option concerns only its magnetometer forms).
+The filters' heading is arbitrary, which the inclination metric ignores. Madgwick and Mahony
+start from the first accelerometer sample (ahrs's `acc2q`), VQF from its own first sample.
+
+The packages are imported only when a peer runs; a missing one raises PeerUnavailable with the
+pip command.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from types import ModuleType
+
+import numpy as np
+
+from .broad_metric import gravity_from_quat
+
+PEER_INSTALL = "pip install 'vqf>=2.0' 'ahrs>=0.3.1'  (or: pip install -e '.[bench]')"
+
+
+class PeerUnavailable(RuntimeError):
+    """A peer's package is not installed."""
+
+
+def _import(module: str, what: str) -> ModuleType:
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as err:
+        raise PeerUnavailable(
+            f"{what} needs the Python package {module.split('.')[0]!r}, which is not installed "
+            f"({err}); install the peers with: {PEER_INSTALL}"
+        ) from None
+
+
+def run_vqf(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
+    """VQF 6D with the package's defaults: up direction [N, 3]."""
+    vqf = _import("vqf", "the VQF peer")
+    f = vqf.VQF(1.0 / rate)
+    out = f.updateBatch(np.ascontiguousarray(gyro, dtype=float),
+                        np.ascontiguousarray(acc, dtype=float))
+    return gravity_from_quat(out["quat6D"])
+
+
+def run_madgwick(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
+    """ahrs Madgwick (IMU) with its default gain: up direction [N, 3]."""
+    filters = _import("ahrs.filters", "the Madgwick peer")
+    f = filters.Madgwick(gyr=np.asarray(gyro, float), acc=np.asarray(acc, float), frequency=rate)
+    return gravity_from_quat(f.Q)
+
+
+def run_mahony(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
+    """ahrs Mahony (IMU) with its default gains: up direction [N, 3]."""
+    filters = _import("ahrs.filters", "the Mahony peer")
+    f = filters.Mahony(gyr=np.asarray(gyro, float), acc=np.asarray(acc, float), frequency=rate)
+    return gravity_from_quat(f.Q)
+
+
+PEERS: dict[str, Callable[[np.ndarray, np.ndarray, float], np.ndarray]] = {
+    "vqf": run_vqf,
+    "madgwick": run_madgwick,
+    "mahony": run_mahony,
+}
+"""Peer name -> run(acc [N, 3], gyro [N, 3], rate [Hz]) -> up direction [N, 3]."""
+
+
+def check_peers(names: list[str]) -> None:
+    """Raise PeerUnavailable (with the pip command) unless every named peer can be imported."""
+    modules = {"vqf": "vqf", "madgwick": "ahrs.filters", "mahony": "ahrs.filters"}
+    for name in names:
+        _import(modules[name], f"the {name} peer")
+
+
+__all__ = ["PEERS", "PEER_INSTALL", "PeerUnavailable", "check_peers"]

@@ -1,0 +1,208 @@
+"""BROAD evaluation (issue 5): the trial loader (both formats), the inclination metric, the
+`broad` command line and the FMU path. Runs on the shared trials in ../shared/data/broad, cut to
+a 45 s slice where a whole trial would be slow."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fusion_core import DEG, ESTIMATORS
+from fusion_core.kinematics import quat_from_roll_pitch_yaw
+from fusion_core.presets import PRESETS, preset_params
+from testbenches.__main__ import main
+from testbenches.broad import Column, evaluate, plan_columns, run_fmu, run_fusion_core
+from testbenches.broad_data import NotABroadTrial, load_trial, trial_groups
+from testbenches.broad_metric import (
+    gravity_from_quat,
+    gravity_from_roll_pitch,
+    inclination_error,
+    inclination_rmse_deg,
+)
+
+h5py = pytest.importorskip("h5py")
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"
+HDF5_TRIAL = DATA / "10_undisturbed_slow_translation_A.hdf5"
+MAT_TRIAL = DATA / "01_undisturbed_slow_rotation_A.mat"
+RATE = 285.7142857142857
+
+pytestmark = pytest.mark.skipif(not HDF5_TRIAL.is_file() or not MAT_TRIAL.is_file(),
+                                reason=f"the shared BROAD trials are not in {DATA}")
+
+
+def write_slice(path: Path, seconds: float = 45.0, source: Path = HDF5_TRIAL) -> Path:
+    """The first `seconds` of a shared trial as a BROAD HDF5 file (rest, then movement from
+    36.8 s on for trial 10)."""
+    trial = load_trial(source)
+    k = round(seconds * trial.rate)
+    with h5py.File(path, "w") as f:
+        f["imu_acc"] = trial.acc[:k]
+        f["imu_gyr"] = trial.gyro[:k]
+        f["opt_quat"] = trial.opt_quat[:k]
+        f["movement"] = trial.movement[:k]
+        f.attrs["sampling_rate"] = trial.rate
+    return path
+
+
+# ----- loader --------------------------------------------------------------------------------
+@pytest.mark.parametrize("path", [HDF5_TRIAL, MAT_TRIAL], ids=["hdf5", "mat"])
+def test_loader_reads_both_formats_into_the_same_fields(path: Path) -> None:
+    trial = load_trial(path)
+    assert trial.name == path.stem
+    assert trial.rate == pytest.approx(RATE, rel=1e-12)
+    assert trial.acc.shape == trial.gyro.shape == (trial.n, 3)
+    assert trial.opt_quat.shape == (trial.n, 4)
+    assert trial.movement.shape == (trial.n,) and trial.movement.dtype == bool
+    assert 0.3 < trial.movement.mean() < 0.8
+    # at rest the accelerometer reads +g along up: about (0, 0, 9.8) for a level sensor
+    assert np.linalg.norm(trial.acc[:100], axis=1).mean() == pytest.approx(9.81, abs=0.2)
+
+
+def test_loader_finds_the_format_from_the_content_not_the_file_name(tmp_path: Path) -> None:
+    renamed = write_slice(tmp_path / "trial_without_suffix", seconds=5.0)
+    trial = load_trial(renamed)
+    assert trial.n == round(5.0 * RATE)
+    assert trial.duration == pytest.approx(5.0, abs=1.0 / RATE)
+
+
+def test_loader_refuses_a_file_that_is_neither_hdf5_nor_mat(tmp_path: Path) -> None:
+    path = tmp_path / "notes.mat"
+    path.write_text("imu_acc, imu_gyr\n1, 2\n")
+    with pytest.raises(NotABroadTrial, match="neither HDF5 nor a MATLAB v5"):
+        load_trial(path)
+
+
+def test_loader_refuses_an_hdf5_file_without_the_trial_fields_naming_them(tmp_path: Path) -> None:
+    path = tmp_path / "other.hdf5"
+    with h5py.File(path, "w") as f:
+        f["imu_acc"] = np.zeros((10, 3))
+        f["imu_gyr"] = np.zeros((10, 3))
+    with pytest.raises(NotABroadTrial, match=r"missing field.*opt_quat, movement, sampling_rate"):
+        load_trial(path)
+
+
+def test_loader_refuses_fields_of_the_wrong_shape(tmp_path: Path) -> None:
+    path = tmp_path / "bad.hdf5"
+    with h5py.File(path, "w") as f:
+        f["imu_acc"] = np.zeros((10, 3))
+        f["imu_gyr"] = np.zeros((10, 3))
+        f["opt_quat"] = np.zeros((9, 4))
+        f["movement"] = np.zeros(10, dtype=bool)
+        f.attrs["sampling_rate"] = 100.0
+    with pytest.raises(NotABroadTrial, match=r"opt_quat has shape \(9, 4\)"):
+        load_trial(path)
+
+
+def test_groups_come_from_the_trial_name_when_trials_json_does_not_list_it() -> None:
+    assert trial_groups("99_undisturbed_fast_rotation_with_breaks_C") == [
+        "undisturbed", "rotation", "fast", "with_breaks"]
+    assert trial_groups("98_disturbed_phone_vibration_C") == ["disturbed", "vibration"]
+
+
+# ----- metric --------------------------------------------------------------------------------
+def test_a_constant_one_degree_tilt_error_gives_one_degree() -> None:
+    n = 2000
+    t = np.linspace(0.0, 20.0, n)
+    roll, pitch, yaw = 0.6 * np.sin(0.7 * t), 0.4 * np.cos(0.3 * t), 2.0 * t
+    ref = np.array([quat_from_roll_pitch_yaw(r, p, y) for r, p, y in zip(roll, pitch, yaw,
+                                                                            strict=True)])
+    # 1 deg more pitch turns the up direction by exactly 1 deg, whatever the roll
+    est = gravity_from_roll_pitch(roll, pitch + 1.0 * DEG)
+    movement = np.ones(n, dtype=bool)
+    assert inclination_rmse_deg(est, gravity_from_quat(ref), movement) == pytest.approx(
+        1.0, abs=1e-9)
+
+
+def test_the_metric_ignores_heading_nan_references_and_samples_outside_movement() -> None:
+    q = np.array([quat_from_roll_pitch_yaw(0.2, -0.1, y) for y in (0.0, 1.0, 2.0, 3.0)])
+    g_ref = gravity_from_quat(q)
+    g_est = gravity_from_roll_pitch(np.full(4, 0.2), np.full(4, -0.1 + 2.0 * DEG))
+    g_ref[1] = np.nan  # markers not visible
+    g_est[3] = (1.0, 0.0, 0.0)  # way off, but not a movement sample
+    movement = np.array([True, True, True, False])
+    assert inclination_rmse_deg(g_est, g_ref, movement) == pytest.approx(2.0, abs=1e-9)
+
+
+def test_reference_and_accelerometer_agree_at_rest_so_the_frames_match() -> None:
+    """BROAD's opt_quat and our frame convention: at rest the normalised accelerometer and
+    R(q)^T e_z agree to a few tenths of a degree (sensor misalignment), not 180 or 90 deg."""
+    trial = load_trial(HDF5_TRIAL)
+    rest = ~trial.movement & np.all(np.isfinite(trial.opt_quat), axis=1)
+    err = inclination_error(trial.acc[rest], gravity_from_quat(trial.opt_quat[rest]))
+    assert np.median(err) < 1.0 * DEG
+
+
+# ----- evaluation and command line ------------------------------------------------------------
+def test_presets_name_every_estimator_with_valid_parameters() -> None:
+    for preset in PRESETS:
+        for key, cls in ESTIMATORS.items():
+            cls(**preset_params(preset, key))  # raises on an unknown or out-of-range value
+
+
+def test_the_broad_presets_beat_the_defaults_on_a_slice_with_motion(tmp_path: Path) -> None:
+    path = write_slice(tmp_path / "slice.hdf5")
+    result = evaluate([path], plan_columns(["cf", "mgcf", "kf"], ["default", "broad"]))
+    means = result.means()
+    for key in ("cf", "mgcf", "kf"):
+        assert means[f"{key}-broad"] < means[key], means
+    assert means["mgcf-broad"] < 1.0, means
+
+
+def test_cli_on_one_trial_slice_prints_the_table_and_writes_the_reports(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
+    out = tmp_path / "report"
+    status = main(["broad", str(path), "--estimator", "cf,kf", "--preset", "all",
+                   "--out", str(out)])
+    assert status == 0
+    text = capsys.readouterr().out
+    assert "10_undisturbed_slow_translation_A" in text and "kf-broad" in text
+    report = json.loads((out / "report.json").read_text())
+    means = report["mean_inclination_rmse_deg"]
+    assert set(means) == {"cf", "cf-broad", "kf", "kf-broad"}
+    assert all(math.isfinite(v) and 0.0 < v < 30.0 for v in means.values()), means
+    (trial,) = report["trials"]
+    assert trial["inclination_rmse_deg"] == means
+    assert trial["groups"] == ["undisturbed", "translation", "slow", "no_breaks"]
+    assert "undisturbed" in report["groups"]
+    assert (out / "report.md").is_file() and (out / "broad_inclination_rmse.png").is_file()
+
+
+def test_cli_refuses_a_file_that_is_not_a_broad_trial(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "not_a_trial.hdf5"
+    with h5py.File(path, "w") as f:
+        f["something"] = np.zeros(3)
+    assert main(["broad", str(path), "--out", str(tmp_path / "r")]) == 2
+    assert "not a BROAD trial" in capsys.readouterr().err
+
+
+def test_cli_runs_the_peers_on_the_same_trial(tmp_path: Path) -> None:
+    pytest.importorskip("vqf")
+    pytest.importorskip("ahrs")
+    path = write_slice(tmp_path / "slice.hdf5")
+    out = tmp_path / "report"
+    assert main(["broad", str(path), "--estimator", "mgcf", "--peers", "--no-plot",
+                 "--out", str(out)]) == 0
+    means = json.loads((out / "report.json").read_text())["mean_inclination_rmse_deg"]
+    assert set(means) == {"mgcf", "vqf", "madgwick", "mahony"}
+    assert means["vqf"] < 2.0, means  # VQF on an undisturbed slow trial
+
+
+@pytest.mark.parametrize("key", ["cf", "kf", "mgcf"])
+def test_fmu_gives_the_fusion_core_numbers_with_the_broad_preset(built_fmus, key: str) -> None:
+    assert built_fmus.returncode == 0, built_fmus.output
+    trial = load_trial(HDF5_TRIAL).head(8.0)
+    params = preset_params("broad", key)
+    core = run_fusion_core(key, params, trial)
+    fmu = run_fmu(key, params, trial, built_fmus.directory)
+    np.testing.assert_array_equal(fmu["roll"], core["roll"])
+    np.testing.assert_array_equal(fmu["pitch"], core["pitch"])
+    assert Column(key, "fmu", key).kind == "fmu"
