@@ -66,7 +66,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         result = run_campaign(estimators, scenarios, args.seeds, args.jitter, args.fmu_dir,
                               progress, not args.no_contract, parse_params(args.param),
-                              args.duration, not args.no_timing_check)
+                              args.duration, not args.no_timing_check, args.jobs)
     print(contract_table(result))
     write_reports(result, args.out, plots=not args.no_plots)
     print(f"\nreports: {args.out / 'report.md'}, {args.out / 'report.json'}")
@@ -92,6 +92,8 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--out", type=Path, default=Path("reports"), help="report folder (reports)")
     run.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run.add_argument("--jobs", type=int, default=2,
+                     help="worker processes (2: the campaign on two cores; 1: all in this one)")
     run.add_argument("--no-timing-check", action="store_true",
                      help="report T3 (wall-clock budget) but leave it out of the verdict, e.g. on "
                      "a machine busy with other work")

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import tempfile
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -10,7 +14,7 @@ from typing import Any
 from fusion_core.scenarios import SCENARIOS
 
 from . import contract
-from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS
+from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, extract_under
 from .master import TestbenchResult, run_testbench
 
 
@@ -69,24 +73,30 @@ def run_campaign(
     params: dict[str, Any] | None = None,
     duration: float | None = None,
     timing: bool = True,
+    jobs: int = 1,
 ) -> CampaignResult:
     """Run a campaign and evaluate the contract; `progress` is called after each run; `params`
     are estimator FMU parameters for every run (each estimator must have them); `duration`
     replaces each scenario's own duration in the runs (not in the contract's extras); timing=False
-    leaves the wall-clock check T3 out of the verdict (its figures are still reported)."""
+    leaves the wall-clock check T3 out of the verdict (its figures are still reported); jobs > 1
+    runs that many worker processes (one run per process at a time, so T3 stays per core)."""
     out = CampaignResult()
     extra: dict[tuple[str, str], list[TestbenchResult]] = {}
-    for job in plan(estimators, scenarios, seeds, jitter, contract_checks):
-        r = run_testbench(job.estimator, job.scenario, seed=job.seed, jitter=job.jitter,
-                          params=params, sensor_params=dict(job.sensor_params), fmu_dir=fmu_dir,
-                          duration=duration if job.kind == "run" else None, evaluate=False)
-        contract.evaluate(r, timing)
-        if job.kind == "run":
-            out.runs.append(r)
+    jobs_list = plan(estimators, scenarios, seeds, jitter, contract_checks)
+    run_one = functools.partial(_run_job, params=params, fmu_dir=fmu_dir, duration=duration,
+                                timing=timing)
+    with contextlib.ExitStack() as stack:
+        if jobs > 1:
+            root = stack.enter_context(tempfile.TemporaryDirectory(prefix="campaign_"))
+            pool = stack.enter_context(ProcessPoolExecutor(
+                jobs, initializer=extract_under, initargs=(root,)))
+            results = pool.map(run_one, jobs_list)
         else:
-            extra.setdefault((job.kind, job.estimator), []).append(r)
-        if progress:
-            progress(job)
+            results = map(run_one, jobs_list)
+        for job, r in zip(jobs_list, results, strict=True):
+            _collect(out, extra, job, r)
+            if progress:
+                progress(job)
     if not contract_checks:
         return out
     for e in estimators:
@@ -99,3 +109,20 @@ def run_campaign(
                and r.jitter == 0.0] + extra.get(("position", "poskf"), [])
         out.checks += contract.check_position(pos)
     return out
+
+
+def _run_job(job: Job, params: dict[str, Any] | None, fmu_dir: Path | str,
+             duration: float | None, timing: bool) -> TestbenchResult:
+    r = run_testbench(job.estimator, job.scenario, seed=job.seed, jitter=job.jitter,
+                      params=params, sensor_params=dict(job.sensor_params), fmu_dir=fmu_dir,
+                      duration=duration if job.kind == "run" else None, evaluate=False)
+    return contract.evaluate(r, timing)
+
+
+def _collect(out: CampaignResult, extra: dict[tuple[str, str], list[TestbenchResult]],
+             job: Job, r: TestbenchResult) -> None:
+    """File a finished run: a campaign run, or one of the contract's extras."""
+    if job.kind == "run":
+        out.runs.append(r)
+    else:
+        extra.setdefault((job.kind, job.estimator), []).append(r)

@@ -43,6 +43,13 @@ _TMP = Path(tempfile.mkdtemp(prefix="testbench_fmus_"))
 atexit.register(shutil.rmtree, _TMP, ignore_errors=True)
 
 
+def extract_under(root: str) -> None:
+    """Extract FMUs under root (a folder its creator removes): for worker processes, which end
+    without running atexit handlers."""
+    global _TMP
+    _TMP = Path(tempfile.mkdtemp(prefix="worker_", dir=root))
+
+
 def fmu_path(name: str, fmu_dir: Path | str = DEFAULT_FMU_DIR) -> Path:
     path = Path(fmu_dir) / f"{name}.fmu"
     if not path.is_file():
