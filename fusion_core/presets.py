@@ -102,22 +102,24 @@ motion with a time constant of seconds; 1e-8 leaves the bias to the rest updates
 
 BROAD_UKF: dict[str, Any] = {
     "integration": "rectangle",
-    "gyro_noise": 0.05 * DEG,
-    "acc_noise": 0.06,
-    "acc_gate": 0.05,
-    "bias_noise": 0.0005 * DEG,
+    "gyro_noise": 0.008 * DEG,
+    "bias_noise": 1e-4 * DEG,
+    "acc_noise": 0.005,
+    "acc_gate": 1.0,
+    "acc_lowpass": 1.0,
+    "rest_time": 1.5,
+    "zaru_noise": 0.008 * DEG,
 }
-"""Unscented Kalman filter (Duong Quoc et al. eq. 14-17), existing parameters only (the UKF has
-no pre-filter and no rest update; testbenches/broad_proposals.py measures them as a proposal).
-integration: physics (2). Without the pre-filter every accelerometer sample that passes the gate
-acts in full, so the gate is the only defence against linear acceleration: scan (3) of
-acc_gate 0.1 / 0.05 / 0.03 with gyro_noise 0.05 deg/s/sqrt(Hz) and acc_noise 0.06 (the
-defaults' ratio: a 4 s correction time constant) gave 3.9 / 3.8 / 4.8 deg (the 0.1 run with the
-default bias_noise); a narrower gate also shuts out the sensor at rest, whose norm reads up to
-1.01 g. The measured noise densities themselves (gyro 0.008 deg/s/sqrt(Hz), accelerometer
-0.006) give a 2 s time constant and 5.9 deg: without a pre-filter the raw accelerometer must be
-trusted less than its white noise says. bias_noise 0.0005 deg/s/sqrt(s): about the gyro's drift
-between the rests of a trial. Not met here: the UKF stays at 3.8 deg, behind Madgwick."""
+"""Unscented Kalman filter (Duong Quoc et al. eq. 14-17) with the same real-sensor options as cf,
+kf and mgcf: the accelerometer pre-filter (acc_lowpass 1 s, as for them) and the zero-rate update
+at rest (rest_time 1.5 s, VQF's thresholds). integration: physics (2). Noise (1): gyro_noise
+and zaru_noise = the measured gyro density 0.008 deg/s/sqrt(Hz); acc_noise 0.005 = the
+measured accelerometer density over g: with the pre-filter the measurement is the filtered vector,
+so no allowance for linear acceleration is added, and no gate is needed (acc_gate 1.0: off).
+bias_noise 1e-4 deg/s/sqrt(s): the gyro's drift over a trial, the rest updates doing the rest.
+With the existing parameters only (no pre-filter, no rest update) the best scan point was
+3.8 deg (gate 0.05, gyro_noise 0.05, acc_noise 0.06): the raw accelerometer had to be gated and
+trusted less than its white noise says."""
 
 BROAD_POSKF: dict[str, Any] = {
     "gyro_noise": 0.008 * DEG,

@@ -46,6 +46,13 @@ import math
 import numpy as np
 
 from .base import INTEGRATION_PARAM, Estimator
+from .complementary import (
+    ACC_LOWPASS_PARAM,
+    REST_PARAMS,
+    body_rotation,
+    lowpass_specific_force,
+    rest_step,
+)
 from .types import DEG, Estimate, G, Param
 
 N_STATE = 6  # X (3), gyro bias b (3)
@@ -111,8 +118,15 @@ class UnscentedKalmanFilter(Estimator):
         Param("kappa", 0.0, "Secondary scaling parameter (> -5 keeps n + lambda > 0 for n = 6)",
               low=-5.0, low_open=True),
         INTEGRATION_PARAM,
+        ACC_LOWPASS_PARAM,
+        *REST_PARAMS,
+        Param(
+            "zaru_noise", 0.005 * DEG,
+            "Gyro white-noise density of the zero-rate update at rest (rest_time > 0)",
+            unit="rad/(s.sqrt(Hz))", low=0.0, low_open=True, display_unit="deg/(s.sqrt(Hz))",
+        ),
     )
-    STATE = ("x", "P")
+    STATE = ("x", "P", "acc_f", "rest")
 
     def _configure(self) -> None:
         p = self._params
@@ -135,6 +149,8 @@ class UnscentedKalmanFilter(Estimator):
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
         self._P = (0.0,) * 21
+        self.acc_f = (0.0, 0.0, 0.0)  # the pre-filtered specific force (acc_lowpass > 0)
+        self.rest = (0.0,) * 7  # the rest detector's means and quiet time (rest_time > 0)
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         n = math.sqrt(ax * ax + ay * ay + az * az)
@@ -143,6 +159,8 @@ class UnscentedKalmanFilter(Estimator):
         p_x = self._params["acc_noise"] ** 2
         p_b = self._params["init_bias_std"] ** 2
         self._P = _packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
+        self.acc_f = (ax, ay, az)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
 
     @property
     def P(self) -> list[list[float]]:
@@ -157,6 +175,41 @@ class UnscentedKalmanFilter(Estimator):
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
+        """Real-sensor options around the paper's filter (all off by default): the accelerometer
+        pre-filter (acc_lowpass, complementary.ACC_LOWPASS_PARAM: the filter then measures the
+        low-passed specific force) and, at rest, a zero-rate update of the bias states."""
+        p = self._params
+        if p["acc_lowpass"] > 0.0:
+            phi = body_rotation(self.gyro_prev, (gx, gy, gz), (self.x[3], self.x[4], self.x[5]),
+                                dt, self._trapezoid)
+            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
+                                                p["acc_lowpass"])
+            self._filter_update(*self.acc_f, gx, gy, gz, dt)
+        else:
+            self._filter_update(ax, ay, az, gx, gy, gz, dt)
+        if p["rest_time"] > 0.0:
+            self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, p["rest_gyro"],
+                                  p["rest_acc"])
+            if self.rest[6] >= p["rest_time"]:
+                self._zero_rate_update((gx, gy, gz), p["zaru_noise"] ** 2 / dt)
+
+    def _zero_rate_update(self, z: tuple[float, float, float], r: float) -> None:
+        """At rest the gyro reads its bias: a linear Kalman update with z = gyro, h(x) = b
+        (variance r per axis), then X renormalised. Runs only at rest, so numpy is fine here."""
+        x = np.asarray(self.x)
+        P = np.asarray(self.P)
+        S = P[3:, 3:] + r * np.eye(3)
+        K = np.linalg.solve(S, P[3:, :]).T
+        x = x + K @ (np.asarray(z) - x[3:])
+        P = P - K @ P[3:, :]
+        x[:3] /= np.linalg.norm(x[:3])
+        self.x = x.tolist()
+        self.P = (0.5 * (P + P.T)).tolist()
+
+    def _filter_update(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> None:
+        """One sample of the paper's UKF (eq. 14-17): predict, then update with acc/g."""
         X0, X1, X2, b0, b1, b2 = self.x
         P = self._P
         offsets = _sigma_offsets(P, self._gamma)  # gamma s_j, j = 1..6
