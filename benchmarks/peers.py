@@ -108,16 +108,24 @@ def _imufusion(rec: dict[str, np.ndarray]) -> Callable[[], Callable[[], int]]:
     def make() -> Callable[[], int]:
         ahrs = imufusion.Ahrs()
         ahrs.set_sample_period(dt)
-        update = ahrs.update_no_magnetometer
-
-        def run() -> int:
-            for g, a in zip(gyro, acc, strict=True):
-                update(g, a)
-            return len(acc)
-
-        return run
+        return _sample_loop(ahrs.update_no_magnetometer, gyro, acc)
 
     return make
+
+
+
+def _sample_loop(
+    update: Callable[[np.ndarray, np.ndarray], object], gyro: list, acc: list
+) -> Callable[[], int]:
+    """One timed pass: update(gyro, acc) per sample, in a loop of its own (no extra call per
+    sample); returns the number of samples."""
+
+    def run() -> int:
+        for g, a in zip(gyro, acc, strict=True):
+            update(g, a)
+        return len(acc)
+
+    return run
 
 
 def _vqf(rec: dict[str, np.ndarray]) -> Callable[[], Callable[[], int]]:
@@ -128,14 +136,7 @@ def _vqf(rec: dict[str, np.ndarray]) -> Callable[[], Callable[[], int]]:
     dt = float(rec["dt"][0])
 
     def make() -> Callable[[], int]:
-        update = VQF(dt).update
-
-        def run() -> int:
-            for g, a in zip(gyro, acc, strict=True):
-                update(g, a)
-            return len(acc)
-
-        return run
+        return _sample_loop(VQF(dt).update, gyro, acc)
 
     return make
 

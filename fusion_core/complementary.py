@@ -20,6 +20,7 @@ from .kinematics import (
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
     quat_roll_pitch,
+    rotate_back,
     rotation_increment,
     wrap_angle,
 )
@@ -130,22 +131,10 @@ def quat_with_roll_pitch(
     return quat_from_roll_pitch_yaw(roll, pitch, quat_yaw(*q))
 
 
-def rotate_back(v: Vec3, phi: Vec3) -> Vec3:
-    """v as seen from a body that turned by the rotation vector phi: exp(-[phi]x) v (Rodrigues)."""
-    p0, p1, p2 = phi
-    a2 = p0 * p0 + p1 * p1 + p2 * p2
-    if a2 < 1e-16:  # series of sin(a)/a and (1 - cos a)/a^2
-        s, c = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
-    else:
-        a = math.sqrt(a2)
-        s, c = math.sin(a) / a, (1.0 - math.cos(a)) / a2
-    v0, v1, v2 = v
-    u0, u1, u2 = p1 * v2 - p2 * v1, p2 * v0 - p0 * v2, p0 * v1 - p1 * v0
-    return (
-        v0 - s * u0 + c * (p1 * u2 - p2 * u1),
-        v1 - s * u1 + c * (p2 * u0 - p0 * u2),
-        v2 - s * u2 + c * (p0 * u1 - p1 * u0),
-    )
+def gate_bounds2(params: dict) -> tuple[float, float]:
+    """The accelerometer gate (ACC_GATE_PARAMS) as bounds on the squared norm |acc|^2 [m^2/s^4],
+    so that the per-sample test needs no square root."""
+    return (params["gate_low"] * G) ** 2, (params["gate_high"] * G) ** 2
 
 
 def body_rotation(g0: Vec3, g1: Vec3, bias: Vec3, dt: float, trapezoid: bool) -> Vec3:
@@ -230,8 +219,7 @@ class ComplementaryFilter(Estimator):
     def _configure(self) -> None:
         p = self._params
         self._tau = p["tau"]
-        self._gate_low2 = (p["gate_low"] * G) ** 2
-        self._gate_high2 = (p["gate_high"] * G) ** 2
+        self._gate_low2, self._gate_high2 = gate_bounds2(p)
         self._trapezoid = p["integration"] == "trapezoid"
         self._acc_tau = p["acc_lowpass"]
         self._quaternion = p["propagation"] == "quaternion"
@@ -285,9 +273,9 @@ __all__ = [
     "REST_PARAMS",
     "ComplementaryFilter",
     "body_rotation",
+    "gate_bounds2",
     "lowpass_specific_force",
     "quat_with_roll_pitch",
     "quat_yaw",
     "rest_step",
-    "rotate_back",
 ]

@@ -25,6 +25,7 @@ from .complementary import (
     REST_PARAMS,
     Vec3,
     body_rotation,
+    gate_bounds2,
     lowpass_specific_force,
     quat_with_roll_pitch,
     rest_step,
@@ -39,7 +40,7 @@ from .kinematics import (
     quat_roll_pitch,
     wrap_angle,
 )
-from .types import DEG, Estimate, G, Param
+from .types import DEG, Estimate, Param
 
 DEG2 = DEG * DEG
 
@@ -178,8 +179,7 @@ class AngleBiasKalmanFilter(Estimator):
         self._q_angle = p["Q_angle"]
         self._q_bias = p["Q_bias"]
         self._r = p["R_measure"]
-        self._gate_low2 = (p["gate_low"] * G) ** 2
-        self._gate_high2 = (p["gate_high"] * G) ** 2
+        self._gate_low2, self._gate_high2 = gate_bounds2(p)
         self._trapezoid = p["integration"] == "trapezoid"
         self._acc_tau = p["acc_lowpass"]
         self._rest_time = p["rest_time"]
@@ -229,7 +229,7 @@ class AngleBiasKalmanFilter(Estimator):
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
             ax, ay, az = self.acc_f
         norm2 = ax * ax + ay * ay + az * az
-        if self._gate_low2 <= norm2 <= self._gate_high2:
+        if self.accel_trusted(norm2):
             self.correct(ax, ay, az)
         if self._quaternion and (self.roll, self.pitch) != predicted:
             self.q_att = quat_with_roll_pitch(self.q_att, self.roll, self.pitch)
@@ -274,6 +274,10 @@ class AngleBiasKalmanFilter(Estimator):
         self.pitch = clamp_pitch(pitch)
         self.P_roll = predict_covariance(self.P_roll, dt, self._q_angle, self._q_bias)
         self.P_pitch = predict_covariance(self.P_pitch, dt, self._q_angle, self._q_bias)
+
+    def accel_trusted(self, norm2: float) -> bool:
+        """Whether the accelerometer gate is open for a sample of squared norm norm2."""
+        return self._gate_low2 <= norm2 <= self._gate_high2
 
     def correct(self, ax: float, ay: float, az: float) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch."""

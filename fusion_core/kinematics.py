@@ -11,6 +11,7 @@ import math
 TWO_PI = 2.0 * math.pi
 _MIN_COS_PITCH = 1e-9  # keeps tan(pitch) finite at gimbal lock (pitch = +-pi/2)
 _HALF_PI = 0.5 * math.pi
+_SMALL_ANGLE = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
 
 
 def wrap_angle(x: float) -> float:
@@ -155,4 +156,24 @@ def rotation_increment(
         0.5 * (a0 + b0) + k * (a1 * b2 - a2 * b1),
         0.5 * (a1 + b1) + k * (a2 * b0 - a0 * b2),
         0.5 * (a2 + b2) + k * (a0 * b1 - a1 * b0),
+    )
+
+
+def rotate_back(v: tuple[float, float, float], phi: tuple[float, float, float]
+                ) -> tuple[float, float, float]:
+    """v as seen from a body that turned by the rotation vector phi: exp(-[phi]x) v (Rodrigues),
+    v - sin(a)/a (phi x v) + (1 - cos a)/a^2 phi x (phi x v), a = |phi|."""
+    p0, p1, p2 = phi
+    a2 = p0 * p0 + p1 * p1 + p2 * p2
+    a = math.sqrt(a2)
+    if a < _SMALL_ANGLE:  # series of sin(a)/a and (1 - cos a)/a^2
+        s, c = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
+    else:
+        s, c = math.sin(a) / a, (1.0 - math.cos(a)) / a2
+    v0, v1, v2 = v
+    u0, u1, u2 = p1 * v2 - p2 * v1, p2 * v0 - p0 * v2, p0 * v1 - p1 * v0  # phi x v
+    return (
+        v0 - s * u0 + c * (p1 * u2 - p2 * u1),
+        v1 - s * u1 + c * (p2 * u0 - p0 * u2),
+        v2 - s * u2 + c * (p0 * u1 - p1 * u0),
     )

@@ -295,7 +295,7 @@ class PositionKalmanFilter(Estimator):
         )
         self.turned = turned
         norm2 = ax * ax + ay * ay + az * az
-        acc_ok = tilt._gate_low2 <= norm2 <= tilt._gate_high2
+        acc_ok = tilt.accel_trusted(norm2)
         if p["tilt_update"] == "always":
             if acc_ok:
                 tilt.correct(ax, ay, az)

@@ -53,6 +53,7 @@ from .complementary import (
     lowpass_specific_force,
     rest_step,
 )
+from .kinematics import rotate_back
 from .types import DEG, Estimate, G, Param
 
 N_STATE = 6  # X (3), gyro bias b (3)
@@ -228,7 +229,7 @@ class UnscentedKalmanFilter(Estimator):
         f0 = c0 - (dt * b0 - (d1 * b2 - d2 * b1))
         f1 = c1 - (dt * b1 - (d2 * b0 - d0 * b2))
         f2 = c2 - (dt * b2 - (d0 * b1 - d1 * b0))
-        Y0, Y1, Y2 = _rotate(X0, X1, X2, f0, f1, f2)  # the central point
+        Y0, Y1, Y2 = rotate_back((X0, X1, X2), (f0, f1, f2))  # the central point
         rho = abs(math.sqrt(ax * ax + ay * ay + az * az) / G - 1.0)
         update = rho < self._gate
         # Sums over the outer points, e = Y_i - Y_0: sum e (m), sum e e^T (e..),
@@ -244,7 +245,7 @@ class UnscentedKalmanFilter(Estimator):
             t0 = dt * s3 - (d1 * s5 - d2 * s4)  # M s^b
             t1 = dt * s4 - (d2 * s3 - d0 * s5)
             t2 = dt * s5 - (d0 * s4 - d1 * s3)
-            # x + s through the process model (_rotate written out: this loop is the hot path)
+            # x + s through the process model (kinematics.rotate_back written out: the hot path)
             z0, z1, z2 = X0 + s0, X1 + s1, X2 + s2
             p0, p1, p2 = f0 - t0, f1 - t1, f2 - t2
             a2 = p0 * p0 + p1 * p1 + p2 * p2
@@ -361,29 +362,6 @@ class UnscentedKalmanFilter(Estimator):
     def _estimate(self) -> Estimate:
         X1, X2, X3, bx, by, bz = self.x
         return Estimate(math.atan2(X2, X3), math.atan2(-X1, math.hypot(X2, X3)), (bx, by, bz))
-
-
-def _rotate(
-    x0: float, x1: float, x2: float, p0: float, p1: float, p2: float
-) -> tuple[float, float, float]:
-    """X rotated by exp(-[phi]x) (Rodrigues): a world-fixed vector seen from a body that turned
-    by phi. X - sin(a)/a (phi x X) + (1 - cos a)/a^2 phi x (phi x X), a = |phi|."""
-    a2 = p0 * p0 + p1 * p1 + p2 * p2
-    a = math.sqrt(a2)
-    if a < _SMALL_ANGLE:
-        sa = 1.0 - a2 / 6.0
-        ca = 0.5 - a2 / 24.0
-    else:
-        sa = math.sin(a) / a
-        ca = (1.0 - math.cos(a)) / a2
-    u0 = p1 * x2 - p2 * x1  # phi x X
-    u1 = p2 * x0 - p0 * x2
-    u2 = p0 * x1 - p1 * x0
-    return (
-        x0 - sa * u0 + ca * (p1 * u2 - p2 * u1),
-        x1 - sa * u1 + ca * (p2 * u0 - p0 * u2),
-        x2 - sa * u2 + ca * (p0 * u1 - p1 * u0),
-    )
 
 
 def _packed_index(i: int, j: int) -> int:

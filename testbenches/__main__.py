@@ -16,17 +16,7 @@ from fusion_core.scenarios import SCENARIOS
 
 from .broad_cli import add_broad_parser
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS
-
-
-def _choices(value: str, allowed: list[str], what: str) -> list[str]:
-    if value == "all":
-        return allowed
-    names = value.split(",")
-    bad = [n for n in names if n not in allowed]
-    if bad:
-        raise argparse.ArgumentTypeError(
-            f"unknown {what} {', '.join(bad)}: allowed all, {', '.join(allowed)}")
-    return names
+from .options import choose
 
 
 def parse_params(items: list[str]) -> dict[str, object]:
@@ -56,8 +46,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .campaign import plan, run_campaign
     from .report import contract_table, write_reports
 
-    estimators = _choices(args.estimator, list(ESTIMATOR_FMUS), "estimator")
-    scenarios = _choices(args.scenario, list(SCENARIOS), "scenario")
+    estimators = choose(args.estimator, list(ESTIMATOR_FMUS), "estimator")
+    scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
     jobs = plan(estimators, scenarios, args.seeds, args.jitter, not args.no_contract)
     with tqdm(total=len(jobs), unit="run", file=sys.stderr) as bar:
         def progress(job: object) -> None:

@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from .fmus import DEFAULT_FMU_DIR
+from .options import choose
 
 HELP = """\
 Evaluate the estimators on BROAD trials (Laidig et al., Data 2021): inclination RMSE over each
@@ -48,17 +49,6 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     return p
 
 
-def _names(value: str, allowed: list[str], what: str) -> list[str]:
-    if value == "all":
-        return allowed
-    names = [v for v in value.split(",") if v]
-    bad = [n for n in names if n not in allowed]
-    if bad or not names:
-        raise ValueError(f"unknown {what} {', '.join(bad) or value!r}: allowed all, "
-                         f"{', '.join(allowed)}")
-    return names
-
-
 def cmd_broad(args: argparse.Namespace) -> int:
     """Run the evaluation, print the table, write the reports. Exit status 0, or 2 on bad input
     (the message says what was wrong)."""
@@ -72,8 +62,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from .broad_peers import PEERS, PeerUnavailable, check_peers
     from .broad_report import table, write_reports
 
-    estimators = _names(args.estimator, list(ESTIMATORS), "estimator")
-    presets = _names(args.preset, list(PRESETS), "preset")
+    estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
+    presets = choose(args.preset, list(PRESETS), "preset")
     peers = list(PEERS) if args.peers else []
     try:
         check_peers(peers)

@@ -284,3 +284,10 @@ def test_exported_ssp_runs_in_fmpy_and_matches_the_master_two_steps_later(
     for name in ("roll", "pitch"):
         assert np.array_equal(rows[f"estimator.{name}"][2:], master.estimate[name][:n])
     assert rows["estimator.invalid_samples"][-1] == 2
+
+
+def test_cli_exits_2_with_a_message_for_an_unknown_estimator(fmu_dir: Path, tmp_path: Path) -> None:
+    proc = _cli("--estimator", "cf,nope", "--scenario", "static_level", fmu_dir=fmu_dir,
+                out=tmp_path)
+    assert proc.returncode == 2
+    assert "unknown estimator 'nope': allowed all, cf" in proc.stderr

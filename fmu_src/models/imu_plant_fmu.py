@@ -14,6 +14,7 @@ import numpy as np
 from fmu_src.slave import FmiLog, FmuSlave
 from fmu_src.variables import Variable, real_output
 from fusion_core.scenarios import SCENARIO_BY_ID, SCENARIOS, get_scenario
+from fusion_core.synthetic import Trajectory
 
 _ENUM = ", ".join(f"{s.id} = {s.name} ({s.description})" for s in SCENARIOS.values())
 _AXIS = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
@@ -28,13 +29,14 @@ _OUTPUTS = (
 )
 
 
-
-def _truth(scenario: int, t: float) -> dict[str, float]:
-    d = get_scenario(scenario).trajectory().truth(np.array([t]))
+def _truth(trajectory: Trajectory, t: float) -> dict[str, float]:
+    """The output values: the trajectory's truth at time t, by variable name."""
+    d = trajectory.truth(np.array([t]))
     out = {"roll": float(d["roll"][0]), "pitch": float(d["pitch"][0]), "yaw": float(d["yaw"][0])}
     for key in ("omega", "f", "pos", "vel"):
+        row = d[key][0]
         for i, a in enumerate("xyz"):
-            out[f"{key}_{a}"] = float(d[key][0, i])
+            out[f"{key}_{a}"] = float(row[i])
     return out
 
 
@@ -46,14 +48,7 @@ class PlantModel:
         self.trajectory = self.scenario.trajectory()
 
     def step(self, t: float, h: float, values: Mapping[str, Any], log: FmiLog) -> dict[str, Any]:
-        d = self.trajectory.truth(np.array([t + h]))
-        out = {"roll": float(d["roll"][0]), "pitch": float(d["pitch"][0]),
-               "yaw": float(d["yaw"][0])}
-        for key in ("omega", "f", "pos", "vel"):
-            row = d[key][0]
-            for i, a in enumerate("xyz"):
-                out[f"{key}_{a}"] = float(row[i])
-        return out
+        return _truth(self.trajectory, t + h)
 
     def set_parameter(self, name: str, value: Any) -> None:
         raise ValueError(f"parameter {name!r} is fixed after initialisation")
@@ -65,7 +60,7 @@ class PlantModel:
         self.__init__({"scenario": state["scenario"]})
 
 
-_START = _truth(0, 0.0)
+_START = _truth(get_scenario(0).trajectory(), 0.0)
 
 
 class ImuPlant(FmuSlave):
