@@ -7,9 +7,10 @@ pythonfmu writes names, causality, variability, initial, start and description. 
   <TypeDefinitions>  one Enumeration type per enumeration parameter;
   per variable       unit, displayUnit, min and max (closed bounds of the allowed range; open
                      bounds are stated in the description only, since min/max are inclusive).
-Unit strings use the Modelica syntax: "m/s2", "rad2/s3", "rad/(s.sqrt(Hz))", "1". FMI 2.0
-BaseUnit exponents are integers, so a unit whose SI exponents are not (a noise density such as
-rad/(s.sqrt(Hz)) = rad.s^-1/2) is declared without a BaseUnit.
+Unit strings use the Modelica syntax: "m/s2", "rad2/s3", "1". FMI 2.0 BaseUnit exponents are
+integers, so every unit must have integer SI exponents: a noise density such as
+rad/(s.sqrt(Hz)) = rad.s^-1/2 is refused at build time, and the parameters are declared as
+power spectral densities instead (rad2/s, the density squared).
 """
 
 from __future__ import annotations
@@ -110,11 +111,16 @@ def _factor(tokens: list[str], unit: str) -> tuple[Dimension, float, list[str]]:
     return {k: v * power for k, v in dim.items()}, scale**power, tokens
 
 
-def base_unit_attributes(unit: str) -> dict[str, str] | None:
-    """The <BaseUnit> attributes of a unit, or None when an exponent is not an integer."""
+def base_unit_attributes(unit: str) -> dict[str, str]:
+    """The <BaseUnit> attributes of a unit; UnitError when an exponent is not an integer."""
     dim, scale = parse_unit(unit)
-    if any(v.denominator != 1 for v in dim.values()):
-        return None
+    halves = {k: str(v) for k, v in dim.items() if v.denominator != 1}
+    if halves:
+        raise UnitError(
+            f"unit {unit!r} has non-integer SI exponents {halves}, which an FMI 2.0 <BaseUnit> "
+            "cannot hold: declare the power spectral density (the density squared, e.g. rad2/s "
+            "for rad/(s.sqrt(Hz))) instead"
+        )
     attrs = {k: str(int(dim[k])) for k in BASE_UNITS if k in dim}
     if scale != 1.0:
         attrs["factor"] = repr(scale)
@@ -141,9 +147,7 @@ def unit_definitions(variables: Sequence[Variable]) -> Element:
     root = Element("UnitDefinitions")
     for name in sorted(units):
         node = SubElement(root, "Unit", {"name": name})
-        base = base_unit_attributes(name)
-        if base is not None:
-            SubElement(node, "BaseUnit", base)
+        SubElement(node, "BaseUnit", base_unit_attributes(name))
         for display in units[name]:
             SubElement(
                 node, "DisplayUnit",

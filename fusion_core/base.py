@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from .types import Estimate, G, InvalidSample, Param
+from .types import Estimate, G, InvalidSample, Param, check_param_names
 
 COMMON_PARAMS: tuple[Param, ...] = (
     Param(
@@ -65,12 +65,7 @@ class Estimator:
 
     def __init__(self, **params: Any) -> None:
         specs = self.param_specs()
-        unknown = sorted(set(params) - set(specs))
-        if unknown:
-            raise ValueError(
-                f"unknown parameter(s) {', '.join(unknown)} for {type(self).__name__}: "
-                f"allowed {', '.join(specs)}"
-            )
+        check_param_names(params, specs, type(self).__name__)
         values = {name: spec.default for name, spec in specs.items()}
         values.update({name: specs[name].validate(v) for name, v in params.items()})
         self._check_params(values)
@@ -92,8 +87,7 @@ class Estimator:
     def set_param(self, name: str, value: Any) -> None:
         """Change one tunable parameter of a running filter (the state is kept)."""
         specs = self.param_specs()
-        if name not in specs:
-            raise ValueError(f"unknown parameter {name!r}: allowed {', '.join(specs)}")
+        check_param_names((name,), specs, type(self).__name__)
         if not specs[name].tunable:
             raise ValueError(f"parameter {name!r} is fixed after construction: use a new instance")
         values = dict(self._params)

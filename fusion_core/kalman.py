@@ -121,7 +121,7 @@ class AngleBiasKalmanFilter(Estimator):
       measurement, so linear acceleration averages out instead of reading as tilt;
     - rest_time > 0: while a rest detector (complementary.REST_PARAMS) says the sensor is still,
       a zero-angular-rate update: the gyro measures the bias directly (H = [0, 1], variance
-      gyro_noise^2 / dt; the standard Kalman update, bias_update). The z-axis bias, which the
+      gyro_psd / dt; the standard Kalman update, bias_update). The z-axis bias, which the
       accelerometer's tilt cannot observe, then gets a state of its own, bias_z (a random walk
       with Q_bias, observed only at rest), used in the propagation and output as bias_z; with
       rest detection off bias_z stays 0 as before;
@@ -131,8 +131,8 @@ class AngleBiasKalmanFilter(Estimator):
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2] (papers' 0.001, 0.003,
     0.03 deg-based values converted, see the module docstring); gate_low, gate_high;
-    acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_noise
-    [rad/s/sqrt(Hz)]; init_bias_std [rad/s]; propagation; integration; max_dt [s].
+    acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_psd
+    [rad^2/s]; init_bias_std [rad/s]; propagation; integration; max_dt [s].
     """
 
     PARAMS = (
@@ -155,10 +155,10 @@ class AngleBiasKalmanFilter(Estimator):
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         Param(
-            "gyro_noise", 0.005 * DEG,
-            "Gyro white-noise density, the variance of the zero-angular-rate update at rest "
-            "(MPU-6050: 0.005 deg/s/sqrt(Hz))",
-            unit="rad/(s.sqrt(Hz))", low=0.0, low_open=True,
+            "gyro_psd", (0.005 * DEG) ** 2,
+            "Gyro white-noise power spectral density; gyro_psd/dt is the variance of the "
+            "zero-angular-rate update at rest (MPU-6050: (0.005 deg/s/sqrt(Hz))^2)",
+            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
         ),
         Param(
             "init_bias_std", 0.0,
@@ -185,7 +185,7 @@ class AngleBiasKalmanFilter(Estimator):
         self._rest_time = p["rest_time"]
         self._rest_gyro = p["rest_gyro"]
         self._rest_acc = p["rest_acc"]
-        self._gyro_var = p["gyro_noise"] ** 2
+        self._gyro_var = p["gyro_psd"]
         self._quaternion = p["propagation"] == "quaternion"
 
     def _reset(self) -> None:
@@ -237,7 +237,7 @@ class AngleBiasKalmanFilter(Estimator):
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
-        """Rest detection; at rest the gyro sample measures the bias (variance gyro_noise^2/dt):
+        """Rest detection; at rest the gyro sample measures the bias (variance gyro_psd/dt):
         the x and y biases through the [angle, bias] filters, bias_z through its own state."""
         self.rest = rest_step(
             self.rest, gx, gy, gz, ax, ay, az, dt, self._rest_gyro, self._rest_acc

@@ -112,7 +112,7 @@ class PositionKalmanFilter(Estimator):
          Yaw is the gyro's integral (unobservable: positions are in the start-heading frame);
       3. level-frame acceleration a = R(roll, pitch, yaw) f - g e_z;
       4. per axis [p, v, a]: predict (F eq. 23, Q of the chosen form), update with a
-         (H = [0 0 1], R = acc_noise^2 / dt), and while stationary a zero-velocity update
+         (H = [0 0 1], R = acc_psd / dt), and while stationary a zero-velocity update
          (H = [0 1 0], z = 0, variance zupt_noise^2) so that velocity does not drift at rest;
          while stationary the gyro also updates the tilt stage's biases (zero-angular-rate
          update, zaru), so the tilt does not drift during the next move.
@@ -129,11 +129,13 @@ class PositionKalmanFilter(Estimator):
             "'piecewise_jerk', 'diagonal'",
             choices=("white_jerk", "piecewise_jerk", "diagonal"),
         ),
-        Param("q", 1.0, "Jerk noise density per axis", unit="m2/s5", low=0.0, low_open=True),
+        Param("q", 1.0, "Jerk noise power spectral density per axis", unit="m2/s5", low=0.0,
+              low_open=True),
         Param(
-            "acc_noise", 400e-6 * G,
-            "Accelerometer white-noise density (MPU-6050: 400 ug/sqrt(Hz)); R = acc_noise^2/dt",
-            unit="m/(s2.sqrt(Hz))", low=0.0, low_open=True,
+            "acc_psd", (400e-6 * G) ** 2,
+            "Accelerometer white-noise power spectral density, R = acc_psd/dt (MPU-6050: "
+            "(400 ug/sqrt(Hz))^2)",
+            unit="m2/s3", low=0.0, low_open=True,
         ),
         Param("zupt", True, "Zero-velocity update while the platform is stationary"),
         Param(
@@ -174,9 +176,10 @@ class PositionKalmanFilter(Estimator):
             "Zero-angular-rate update of the tilt stage's gyro biases while stationary",
         ),
         Param(
-            "gyro_noise", 0.005 * DEG,
-            "Gyro white-noise density (MPU-6050: 0.005 deg/s/sqrt(Hz)), for the zero-rate update",
-            unit="rad/(s.sqrt(Hz))", low=0.0, low_open=True,
+            "gyro_psd", (0.005 * DEG) ** 2,
+            "Gyro white-noise power spectral density, for the zero-rate update (MPU-6050: "
+            "(0.005 deg/s/sqrt(Hz))^2)",
+            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
         ),
         Param(
             "tilt_update", "stationary",
@@ -203,9 +206,9 @@ class PositionKalmanFilter(Estimator):
                 if k != "integration":
                     self.tilt.set_param(k, v)
             self.tilt.set_param("max_dt", p["max_dt"])
-        self._acc_var_density = p["acc_noise"] ** 2
+        self._acc_var_density = p["acc_psd"]
         self._zupt_var = p["zupt_noise"] ** 2
-        self._gyro_var_density = p["gyro_noise"] ** 2
+        self._gyro_var_density = p["gyro_psd"]
 
     @property
     def tilt_state(self) -> dict:

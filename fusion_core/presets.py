@@ -83,58 +83,58 @@ BROAD_KF: dict[str, Any] = {
     "rest_time": 1.5,
     "Q_angle": 6.4e-5 * DEG2,
     "R_measure": 0.085 * DEG2,
-    "gyro_noise": 0.008 * DEG,
+    "gyro_psd": (0.008 * DEG) ** 2,
     "init_bias_std": 1.0 * DEG,
     "Q_bias": 1e-8 * DEG2,
 }
-"""Angle/bias Kalman filter (Gui et al. eq. 5-26; Das & Mary eq. 16-27). integration,
-propagation, acc_lowpass, rest_time: physics (2); gate: as for cf. Noise (1): Q_angle = gyro
-density^2 = (0.008 deg/s/sqrt(Hz))^2; R_measure = the variance of one accelerometer sample's
-tilt, (0.05 m/s^2 / g)^2 = (0.29 deg)^2; gyro_noise (the zero-rate update) = 0.008 deg/s/sqrt(Hz).
-Together they give a correction time constant sqrt(R dt / Q_angle) = 2.2 s at 285.7 Hz (the
-papers' numbers, tuned at 30 Hz, give 0.3 s here). init_bias_std = 1 deg/s: an uncalibrated
-MEMS gyro's turn-on bias (this one: up to 0.5 deg/s), as in the UKF; with the papers' P = 0 the
-bias could not move. Q_bias: scan (3): 1e-6 / 1e-8 / 1e-10 deg^2/s^3 gave 1.16 / 0.95 /
-0.94 deg. The filter's accelerometer error is not white (the residual linear acceleration
-after the pre-filter is coloured), so a bias random walk sized from the gyro's real drift
-(about 0.02 deg/s over a 150 s trial, 3e-6 deg^2/s^3) lets the accelerometer steer the bias in
-motion with a time constant of seconds; 1e-8 leaves the bias to the rest updates."""
+"""Angle/bias Kalman filter (Gui et al. eq. 5-26; Das & Mary eq. 16-27). integration, propagation,
+acc_lowpass, rest_time: physics (2); gate: as for cf. Noise (1): Q_angle = gyro density^2 = (0.008
+deg/s/sqrt(Hz))^2; R_measure = the variance of one accelerometer sample's tilt, (0.05 m/s^2 / g)^2 =
+(0.29 deg)^2; gyro_psd (the zero-rate update) = the same (0.008 deg/s/sqrt(Hz))^2. Together they
+give a correction time constant sqrt(R dt / Q_angle) = 2.2 s at 285.7 Hz (the papers' numbers, tuned
+at 30 Hz, give 0.3 s here). init_bias_std = 1 deg/s: an uncalibrated MEMS gyro's turn-on bias (this
+one: up to 0.5 deg/s), as in the UKF; with the papers' P = 0 the bias could not move. Q_bias: scan
+(3): 1e-6 / 1e-8 / 1e-10 deg^2/s^3 gave 1.16 / 0.95 / 0.94 deg. The filter's accelerometer error is
+not white (the residual linear acceleration after the pre-filter is coloured), so a bias random walk
+sized from the gyro's real drift (about 0.02 deg/s over a 150 s trial, 3e-6 deg^2/s^3) lets the
+accelerometer steer the bias in motion with a time constant of seconds; 1e-8 leaves the bias to the
+rest updates."""
 
 BROAD_UKF: dict[str, Any] = {
     "integration": "rectangle",
-    "gyro_noise": 0.008 * DEG,
-    "bias_noise": 1e-4 * DEG,
+    "gyro_psd": (0.008 * DEG) ** 2,
+    "bias_psd": (1e-4 * DEG) ** 2,
     "acc_noise": 0.005,
     "acc_gate": 1.0,
     "acc_lowpass": 1.0,
     "rest_time": 1.5,
-    "zaru_noise": 0.008 * DEG,
+    "zaru_psd": (0.008 * DEG) ** 2,
 }
-"""Unscented Kalman filter (Duong Quoc et al. eq. 14-17) with the same real-sensor options as cf,
-kf and mgcf: the accelerometer pre-filter (acc_lowpass 1 s, as for them) and the zero-rate update
-at rest (rest_time 1.5 s, VQF's thresholds). integration: physics (2). Noise (1): gyro_noise
-and zaru_noise = the measured gyro density 0.008 deg/s/sqrt(Hz); acc_noise 0.005 = the
-measured accelerometer density over g: with the pre-filter the measurement is the filtered vector,
-so no allowance for linear acceleration is added, and no gate is needed (acc_gate 1.0: off).
-bias_noise 1e-4 deg/s/sqrt(s): the gyro's drift over a trial, the rest updates doing the rest.
-With the existing parameters only (no pre-filter, no rest update) the best scan point was
-3.8 deg (gate 0.05, gyro_noise 0.05, acc_noise 0.06): the raw accelerometer had to be gated and
-trusted less than its white noise says."""
+"""Unscented Kalman filter (Duong Quoc et al. eq. 14-17) with the same real-sensor options as cf, kf
+and mgcf: the accelerometer pre-filter (acc_lowpass 1 s, as for them) and the zero-rate update at
+rest (rest_time 1.5 s, VQF's thresholds). integration: physics (2). Noise (1): gyro_psd and zaru_psd
+= the measured gyro density squared, (0.008 deg/s/sqrt(Hz))^2; acc_noise 0.005 = the measured
+accelerometer density over g: with the pre-filter the measurement is the filtered vector, so no
+allowance for linear acceleration is added, and no gate is needed (acc_gate 1.0: off). bias_psd
+(1e-4 deg/s/sqrt(s))^2: the gyro's drift over a trial, the rest updates doing the rest. With the
+existing parameters only (no pre-filter, no rest update) the best scan point was 3.8 deg (gate 0.05,
+gyro_psd (0.05 deg/s/sqrt(Hz))^2, acc_noise 0.06): the raw accelerometer had to be gated and trusted
+less than its white noise says."""
 
 BROAD_POSKF: dict[str, Any] = {
-    "gyro_noise": 0.008 * DEG,
-    "acc_noise": 0.005,
+    "gyro_psd": (0.008 * DEG) ** 2,
+    "acc_psd": 0.005**2,
 }
 """Position Kalman filter (Safitri et al. eq. 20-29) and its kf tilt stage: the measured noise
-densities (1) only, gyro 0.008 deg/s/sqrt(Hz) (its zero-rate update) and accelerometer
-0.005 m/s^2/sqrt(Hz) (its R). Its design stays: the tilt stage takes the accelerometer only at
-confirmed rest, so in motion its attitude is gyro-only integration of the Euler rates, and the
-new kf options (pre-filter, quaternion propagation, bias prior) do not reach it
+densities (1) only, squared into PSDs: gyro (0.008 deg/s/sqrt(Hz))^2 (its zero-rate update) and
+accelerometer (0.005 m/s^2/sqrt(Hz))^2 (its R). Its design stays: the tilt stage takes the
+accelerometer only at confirmed rest, so in motion its attitude is gyro-only integration of the
+Euler rates, and the new kf options (pre-filter, quaternion propagation, bias prior) do not reach it
 (position.TILT_PARAMS). Tried and left out: tilt_update="always" (the papers') lowers the mean
 inclination error from 9.7 to 8.7 deg, but only through the rotation trials, while the
 fast-translation trials, where a position filter matters, go from 7 to 54 deg;
-integration="rectangle" makes the gyro-only Euler integration through pitch +-90 deg worse
-(13.5 deg). For attitude in continuous motion use kf."""
+integration="rectangle" makes the gyro-only Euler integration through pitch +-90 deg worse (13.5
+deg). For attitude in continuous motion use kf."""
 
 PRESETS: dict[str, dict[str, dict[str, Any]]] = {
     "default": {"cf": {}, "mgcf": {}, "kf": {}, "ukf": {}, "poskf": {}},

@@ -4,9 +4,11 @@ quantisation and timestamp jitter, seeded and reproducible.
 Defaults are the MPU-6050 datasheet's: gyro rate-noise density 0.005 deg/s/sqrt(Hz), accelerometer
 noise density 400 ug/sqrt(Hz), full-scale ranges +-2000 deg/s and +-16 g, 16-bit converters.
 
-Noise convention: a continuous white noise of density n sampled over an interval h has standard
-deviation n / sqrt(h) (the density is one-sided per sqrt(Hz), as datasheets state it). A bias
-random walk of density k moves the bias by k sqrt(h) (one standard deviation) per interval.
+Noise convention: the parameters are power spectral densities S, the squares of the datasheets'
+densities n (S = n^2; FMI 2.0 base units have integer exponents, so n's unit rad/(s.sqrt(Hz))
+cannot be declared, S's rad2/s can). A continuous white noise of PSD S sampled over an interval h
+has standard deviation sqrt(S / h) (n / sqrt(h); one-sided, per Hz, as datasheets state it). A
+bias random walk of PSD K moves the bias by sqrt(K h) (one standard deviation) per interval.
 """
 
 from __future__ import annotations
@@ -16,22 +18,27 @@ from typing import Any
 
 import numpy as np
 
-from .types import DEG, G, Param
+from .types import DEG, G, Param, check_param_names
 
 SENSOR_PARAMS: tuple[Param, ...] = (
     Param("seed", 0, "Seed of the noise generator (same seed, same samples)", low=0, high=2**31 - 1,
           tunable=False),
-    Param("gyro_noise", 0.005 * DEG, "Gyro white-noise density", unit="rad/(s.sqrt(Hz))",
-          low=0.0, display_unit="deg/(s.sqrt(Hz))"),
-    Param("acc_noise", 400e-6 * G, "Accelerometer white-noise density", unit="m/(s2.sqrt(Hz))",
-          low=0.0),
+    Param("gyro_psd", (0.005 * DEG) ** 2,
+          "Gyro white-noise power spectral density (the rate-noise density squared; MPU-6050: "
+          "(0.005 deg/s/sqrt(Hz))^2)", unit="rad2/s", low=0.0, display_unit="deg2/s"),
+    Param("acc_psd", (400e-6 * G) ** 2,
+          "Accelerometer white-noise power spectral density (the noise density squared; "
+          "MPU-6050: (400 ug/sqrt(Hz))^2)", unit="m2/s3", low=0.0),
     *(Param(f"gyro_bias_{a}", 0.0, f"Constant gyro bias, {a} axis", unit="rad/s",
             display_unit="deg/s") for a in "xyz"),
     *(Param(f"acc_bias_{a}", 0.0, f"Constant accelerometer bias, {a} axis", unit="m/s2")
       for a in "xyz"),
-    Param("gyro_bias_walk", 0.0, "Gyro bias random-walk density", unit="rad/(s.sqrt(s))", low=0.0),
-    Param("acc_bias_walk", 0.0, "Accelerometer bias random-walk density", unit="m/(s2.sqrt(s))",
-          low=0.0),
+    Param("gyro_bias_psd", 0.0,
+          "Gyro bias random-walk power spectral density (the random-walk density squared)",
+          unit="rad2/s3", low=0.0, display_unit="deg2/s3"),
+    Param("acc_bias_psd", 0.0,
+          "Accelerometer bias random-walk power spectral density (the random-walk density "
+          "squared)", unit="m2/s5", low=0.0),
     Param("gyro_range", 2000.0 * DEG, "Gyro full-scale range (outputs saturate at +-range)",
           unit="rad/s", low=0.0, low_open=True, display_unit="deg/s"),
     Param("acc_range", 16.0 * G, "Accelerometer full-scale range (outputs saturate at +-range)",
@@ -50,10 +57,7 @@ class ImuSensorModel:
 
     def __init__(self, **params: Any) -> None:
         specs = {p.name: p for p in SENSOR_PARAMS}
-        unknown = sorted(set(params) - set(specs))
-        if unknown:
-            raise ValueError(f"unknown sensor parameter(s) {', '.join(unknown)}: allowed "
-                             f"{', '.join(specs)}")
+        check_param_names(params, specs, "the IMU sensor model")
         self.params = {name: spec.default for name, spec in specs.items()}
         self.params.update({k: specs[k].validate(v) for k, v in params.items()})
         self.reset()
@@ -73,11 +77,11 @@ class ImuSensorModel:
         if not h > 0.0:
             raise ValueError(f"interval h={h!r} s must be > 0")
         z = self.rng.standard_normal(13).tolist()
-        sq = math.sqrt(h)
+        gw, aw = math.sqrt(p["gyro_bias_psd"] * h), math.sqrt(p["acc_bias_psd"] * h)
         for i in range(3):
-            self.gyro_bias[i] += p["gyro_bias_walk"] * sq * z[6 + i]
-            self.acc_bias[i] += p["acc_bias_walk"] * sq * z[9 + i]
-        gn, an = p["gyro_noise"] / sq, p["acc_noise"] / sq
+            self.gyro_bias[i] += gw * z[6 + i]
+            self.acc_bias[i] += aw * z[9 + i]
+        gn, an = math.sqrt(p["gyro_psd"] / h), math.sqrt(p["acc_psd"] / h)
         gyro = [omega[i] + self.gyro_bias[i] + gn * z[i] for i in range(3)]
         acc = [f[i] + self.acc_bias[i] + an * z[3 + i] for i in range(3)]
         gyro = _convert(gyro, p["gyro_range"], p["bits"])
@@ -91,9 +95,9 @@ class ImuSensorModel:
 
     def set_param(self, name: str, value: Any) -> None:
         """Change a tunable parameter between samples (a bias takes its new value now)."""
-        spec = next((p for p in SENSOR_PARAMS if p.name == name), None)
-        if spec is None:
-            raise ValueError(f"unknown sensor parameter {name!r}")
+        specs = {p.name: p for p in SENSOR_PARAMS}
+        check_param_names((name,), specs, "the IMU sensor model")
+        spec = specs[name]
         if not spec.tunable:
             raise ValueError(f"sensor parameter {name!r} is fixed after the start")
         self.params[name] = spec.validate(value)

@@ -8,6 +8,7 @@ y left, z up; the accelerometer measures specific force, so a sensor lying still
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -98,3 +99,31 @@ class Param:
         if not ok:
             raise ValueError(f"{where} is out of range: allowed {self.allowed()} {self.unit}")
         return int(v) if self.kind is int else v
+
+
+RENAMED_PARAMS: dict[str, str] = {
+    "gyro_noise": "gyro_psd",
+    "bias_noise": "bias_psd",
+    "zaru_noise": "zaru_psd",
+    "acc_noise": "acc_psd",
+    "gyro_bias_walk": "gyro_bias_psd",
+    "acc_bias_walk": "acc_bias_psd",
+}
+"""Noise parameters renamed in 0.2.0, when the noise densities n [rad/(s.sqrt(Hz)), ...] became
+power spectral densities n^2 [rad2/s, ...]: FMI 2.0 base units have integer exponents only."""
+
+
+def check_param_names(given: Iterable[str], specs: dict[str, Param], owner: str) -> None:
+    """ValueError listing the names in `given` that `owner` does not have, what it allows, and
+    the new name of a renamed noise parameter (whose value must now be squared)."""
+    unknown = sorted(set(given) - set(specs))
+    if not unknown:
+        return
+    hints = [
+        f"{name} is now {RENAMED_PARAMS[name]}, the density squared (a power spectral density)"
+        for name in unknown if RENAMED_PARAMS.get(name) in specs
+    ]
+    raise ValueError(
+        f"unknown parameter(s) {', '.join(unknown)} for {owner}: allowed {', '.join(specs)}"
+        + "".join(f"; {h}" for h in hints)
+    )

@@ -65,34 +65,37 @@ class UnscentedKalmanFilter(Estimator):
 
     State x = [X (3), b (3)]; covariance P (6x6).
     Predict: each sigma point is rotated by its own bias-corrected rotation increment
-      (exp(-[phi_i]x) X_i), b_i unchanged; Q = gyro_noise^2 dt (I - X X^T) for X (the gyro noise
-      turns X only perpendicular to itself) and bias_noise^2 dt I for b.
+      (exp(-[phi_i]x) X_i), b_i unchanged; Q = gyro_psd dt (I - X X^T) for X (the gyro noise
+      turns X only perpendicular to itself) and bias_psd dt I for b.
     Update: z = [acc/g; 1], h(x) = [X; |X|^2], R = diag(acc_noise^2 I3, norm_noise^2); the
       accelerometer update is skipped while rho = ||acc|/g - 1| >= acc_gate (the accelerometer
       then measures more than gravity). After the update X is renormalised to unit length.
-    Defaults (ours; the paper's values are not in our sources): gyro_noise 10x the MPU-6050
-    density (it also absorbs integration and model error), acc_noise 0.06 (white noise plus an
+    Defaults (ours; the paper's values are not in our sources): gyro_psd (10x the MPU-6050
+    density)^2 (it also absorbs integration and model error), acc_noise 0.06 (white noise plus an
     allowance for unmodelled linear acceleration), acc_gate 0.1 (10 % of g along gravity is
     certainly not gravity; 3 % scale-factor error of an uncalibrated sensor still passes).
     Measured on moderate_dynamics: RMSE 0.21/0.37 deg (0.43/0.63 with acc_noise 0.03 and the
     gate at Duong Quoc's 0.35).
     Output: roll = atan2(X2, X3), pitch = atan2(-X1, sqrt(X2^2 + X3^2)); bias = b.
 
-    Parameters: gyro_noise [rad/s/sqrt(Hz)], bias_noise [rad/s/sqrt(s)], acc_noise [1]
+    Parameters: gyro_psd [rad^2/s] (the gyro's noise density squared), bias_psd [rad^2/s^3]
+    (the bias random-walk density squared), acc_noise [1]
     (standard deviation of acc/g, white noise and unmodelled acceleration), norm_noise [1],
     acc_gate [1], init_bias_std [rad/s], alpha, beta, kappa, integration, max_dt [s].
     """
 
     PARAMS = (
         Param(
-            "gyro_noise", 0.05 * DEG,
-            "Gyro white-noise density driving the gravity direction (process noise)",
-            unit="rad/(s.sqrt(Hz))", low=0.0, low_open=True,
+            "gyro_psd", (0.05 * DEG) ** 2,
+            "Gyro white-noise power spectral density driving the gravity direction (process "
+            "noise; the datasheet's rate-noise density squared)",
+            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
         ),
         Param(
-            "bias_noise", 0.002 * DEG,
-            "Gyro bias random-walk density (process noise of the bias states)",
-            unit="rad/(s.sqrt(s))", low=0.0,
+            "bias_psd", (0.002 * DEG) ** 2,
+            "Gyro bias random-walk power spectral density (process noise of the bias states; "
+            "the random-walk density squared)",
+            unit="rad2/s3", low=0.0, display_unit="deg2/s3",
         ),
         Param(
             "acc_noise", 0.06,
@@ -122,9 +125,10 @@ class UnscentedKalmanFilter(Estimator):
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         Param(
-            "zaru_noise", 0.005 * DEG,
-            "Gyro white-noise density of the zero-rate update at rest (rest_time > 0)",
-            unit="rad/(s.sqrt(Hz))", low=0.0, low_open=True, display_unit="deg/(s.sqrt(Hz))",
+            "zaru_psd", (0.005 * DEG) ** 2,
+            "Gyro white-noise power spectral density of the zero-rate update at rest "
+            "(rest_time > 0; the rate-noise density squared)",
+            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
         ),
     )
     STATE = ("x", "P", "acc_f", "rest")
@@ -140,8 +144,8 @@ class UnscentedKalmanFilter(Estimator):
         # point, so only wm_i and (sum of wc) - 2 = beta - alpha^2 appear (module docstring).
         self._w = 0.5 / (n + lam)
         self._w_mu = p["beta"] - alpha2
-        self._q_gyro = p["gyro_noise"] ** 2
-        self._q_bias = p["bias_noise"] ** 2
+        self._q_gyro = p["gyro_psd"]
+        self._q_bias = p["bias_psd"]
         self._r_acc = p["acc_noise"] ** 2
         self._r_norm = p["norm_noise"] ** 2
         self._gate = p["acc_gate"]
@@ -192,7 +196,7 @@ class UnscentedKalmanFilter(Estimator):
             self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, p["rest_gyro"],
                                   p["rest_acc"])
             if self.rest[6] >= p["rest_time"]:
-                self._zero_rate_update((gx, gy, gz), p["zaru_noise"] ** 2 / dt)
+                self._zero_rate_update((gx, gy, gz), p["zaru_psd"] / dt)
 
     def _zero_rate_update(self, z: tuple[float, float, float], r: float) -> None:
         """At rest the gyro reads its bias: a linear Kalman update with z = gyro, h(x) = b
@@ -322,7 +326,7 @@ class UnscentedKalmanFilter(Estimator):
         x00, x01, x02 = w * x00, w * x01, w * x02
         x10, x11, x12 = w * x10, w * x11, w * x12
         x20, x21, x22 = w * x20, w * x21, w * x22
-        # Q = gyro_noise^2 dt (I - X X^T) for X, bias_noise^2 dt I for b (X normalised)
+        # Q = gyro_psd dt (I - X X^T) for X, bias_psd dt I for b (X normalised)
         inv = 1.0 / math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
         h0, h1, h2 = X0 * inv, X1 * inv, X2 * inv
         qg = self._q_gyro * dt

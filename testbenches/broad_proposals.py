@@ -7,7 +7,7 @@ measured with the same metric (`python -m testbenches.broad_proposals PATH...`).
    Measured: 1.62 deg mean against 0.91 without it (the de-weighting inflates the covariance and
    the next sample that passes gets too large a gain), so it is not adopted. The UKF's pre-filter
    and zero-rate update, first measured here, are now the UKF's own parameters (acc_lowpass,
-   rest_time, zaru_noise) and its broad preset.
+   rest_time, zaru_psd) and its broad preset.
 2. `low_acc_gyro_only`: INTERFACE.md rejects a whole sample whose accelerometer norm is below
    0.1 g, gyro included. On BROAD's fast trials the sensor reads below 0.1 g for tens of samples
    at a time while it turns at 400 deg/s, so every estimator loses those rotations. The mixin
@@ -78,7 +78,7 @@ PROPOSED_UKF: dict[str, Any] = dict(BROAD_UKF)
 
 VARIANTS: dict[str, tuple[type[Estimator], dict[str, Any]]] = {
     "ukf-broad+lowpass": (UkfProposal, {k: v for k, v in PROPOSED_UKF.items()
-                                        if k not in ("rest_time", "zaru_noise")}),
+                                        if k not in ("rest_time", "zaru_psd")}),
     "ukf-broad+lowpass+rest": (UkfProposal, PROPOSED_UKF),
     "ukf-broad+lowpass+rest+adaptiveR": (UkfProposal, {**PROPOSED_UKF, "acc_adaptive": True}),
 }

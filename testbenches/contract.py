@@ -55,7 +55,7 @@ POSITION_SEEDS = 10
 POSITION_LIMIT_M = {"x": 0.0385, "y": 0.21}
 
 ATTITUDE = ("cf", "mgcf", "kf", "ukf", "poskf")
-NOISE_FREE = {"gyro_noise": 0.0, "acc_noise": 0.0, "bits": 0}
+NOISE_FREE = {"gyro_psd": 0.0, "acc_psd": 0.0, "bits": 0}
 """ImuSensor parameters of a noise-free sensor (contract check T1)."""
 
 PAPER_MODERATE = {"cf": (1.84, 2.03), "mgcf": (1.07, 1.32), "ukf": (0.35, 0.41),

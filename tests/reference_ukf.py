@@ -34,8 +34,8 @@ class ReferenceUnscentedKalmanFilter(Estimator):
         wm[0] = lam / (n + lam)
         wc[0] = wm[0] + 1.0 - p["alpha"] ** 2 + p["beta"]
         self._wm, self._wc = wm, wc
-        self._q_gyro = p["gyro_noise"] ** 2
-        self._q_bias = p["bias_noise"] ** 2
+        self._q_gyro = p["gyro_psd"]
+        self._q_bias = p["bias_psd"]
         self._R = np.diag([p["acc_noise"] ** 2] * 3 + [p["norm_noise"] ** 2])
         self._gate = p["acc_gate"]
         self._trapezoid = p["integration"] == "trapezoid"

@@ -181,8 +181,9 @@ def test_plant_truth_is_consistent_with_finite_differences(name: str) -> None:
 
 def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> None:
     """40 000 samples at 100 Hz, no quantisation: sample std * sqrt(h) / density in [0.95, 1.05]
-    for every axis; the bias random walk's increments likewise."""
-    m = ImuSensorModel(bits=0, gyro_bias_walk=1e-3, acc_bias_walk=1e-2, seed=3)
+    for every axis, the density being sqrt of the configured PSD; the bias random walk's
+    increments likewise."""
+    m = ImuSensorModel(bits=0, gyro_bias_psd=1e-3**2, acc_bias_psd=1e-2**2, seed=3)
     h = 0.01
     rows, gb, ab = [], [], []
     for _ in range(40_000):
@@ -192,8 +193,8 @@ def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> Non
         ab.append(list(m.acc_bias))
     x = np.asarray(rows)
     white = np.diff(x, axis=0).std(axis=0) / math.sqrt(2) * math.sqrt(h)
-    gyro_ratio = white[:3] / m.params["gyro_noise"]
-    acc_ratio = white[3:] / m.params["acc_noise"]
+    gyro_ratio = white[:3] / math.sqrt(m.params["gyro_psd"])
+    acc_ratio = white[3:] / math.sqrt(m.params["acc_psd"])
     walk_g = np.diff(np.asarray(gb), axis=0).std(axis=0) / math.sqrt(h) / 1e-3
     walk_a = np.diff(np.asarray(ab), axis=0).std(axis=0) / math.sqrt(h) / 1e-2
     print(f"\ngyro {gyro_ratio}, acc {acc_ratio}, walks {walk_g} {walk_a}")
@@ -206,7 +207,7 @@ def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> Non
 
 
 def test_sensor_saturates_and_quantises_like_a_16_bit_mpu6050() -> None:
-    m = ImuSensorModel(gyro_noise=0.0, acc_noise=0.0)
+    m = ImuSensorModel(gyro_psd=0.0, acc_psd=0.0)
     acc, gyro, _ = m.sample((50.0, 0.001, 0.0), (0.0, 0.0, 20 * G), 0.01)
     lsb = 2 * 2000 * DEG / 2**16
     assert gyro[0] == pytest.approx(round(2000 * DEG / lsb) * lsb)
