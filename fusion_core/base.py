@@ -1,8 +1,11 @@
 """The step API that every estimator shares: parameters, input checks, run, state.
 
 A subclass declares PARAMS (its tuning parameters) and STATE (the names of the attributes that
-make up its internal state), and implements `_reset()` and `_update(ax, ay, az, gx, gy, gz, dt)`.
-Everything else (validation, the first-sample rule, batch runs, json state) is written once here.
+make up its internal state), and implements `_reset()`, `_init(...)`, `_estimate()` and
+`_update(ax, ay, az, gx, gy, gz, dt)`, or instead of `_update` the hot-path form
+`_advance(ax, ay, az, gx, gy, gz, dt)`, which also returns the estimate (one call less per
+sample). Everything else (validation, the first-sample rule, batch runs, json state) is written
+once here.
 """
 
 from __future__ import annotations
@@ -33,6 +36,9 @@ RUN_CHUNK = 1024
 """Samples that run() converts to Python floats and collects at a time."""
 _MIN_ACC_NORM2 = MIN_ACC_NORM * MIN_ACC_NORM
 _isfinite = math.isfinite
+tuple_new = tuple.__new__
+"""`tuple_new(Estimate, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
+without the NamedTuple's Python-level __new__: the hot paths build their estimate this way."""
 
 
 def _plain(value: Any) -> Any:
@@ -69,8 +75,7 @@ class Estimator:
         values = {name: spec.default for name, spec in specs.items()}
         values.update({name: specs[name].validate(v) for name, v in params.items()})
         self._check_params(values)
-        self._params = values
-        self._configure()
+        self._set_params(values)
         self.reset()
 
     # ----- parameters -------------------------------------------------------------------------
@@ -93,7 +98,12 @@ class Estimator:
         values = dict(self._params)
         values[name] = specs[name].validate(value)
         self._check_params(values)
+        self._set_params(values)
+
+    def _set_params(self, values: dict[str, Any]) -> None:
+        """Take checked parameter values and derive the hot path's constants from them."""
         self._params = values
+        self._max_dt = values["max_dt"]
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:
@@ -169,18 +179,28 @@ class Estimator:
         if not (
             _isfinite(norm2 + gx + gy + gz + dt)
             and norm2 >= _MIN_ACC_NORM2
-            and 0.0 < dt <= self._params["max_dt"]
+            and 0.0 < dt <= self._max_dt
         ):
             self._check_values(ax, ay, az, gx, gy, gz, dt)
         if self.initialized:
-            self._update(ax, ay, az, gx, gy, gz, dt)
+            last = self._advance(ax, ay, az, gx, gy, gz, dt)
         else:
             self._init(ax, ay, az, gx, gy, gz)
             self.initialized = True
+            last = self._estimate()
+        self.last = last
         self.gyro_prev = (gx, gy, gz)
         self.n_samples += 1
-        last = self.last = self._estimate()
         return last
+
+    def _advance(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> Estimate:
+        """Process one valid sample after the first and return the new estimate: _update, then
+        _estimate. An estimator may override it with one method doing both (the hot path);
+        self.gyro_prev is still the previous sample's rate here."""
+        self._update(ax, ay, az, gx, gy, gz, dt)
+        return self._estimate()
 
     def _check_values(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -190,7 +210,7 @@ class Estimator:
         if (
             _isfinite(norm2 + gx + gy + gz + dt)
             and norm2 >= _MIN_ACC_NORM2
-            and 0.0 < dt <= self._params["max_dt"]
+            and 0.0 < dt <= self._max_dt
         ):
             return
         self.check_sample((ax, ay, az), (gx, gy, gz), dt)
@@ -271,8 +291,7 @@ class Estimator:
         specs = self.param_specs()
         params = {k: specs[k].validate(v) for k, v in snapshot["params"].items()}
         self._check_params(params)
-        self._params = params
-        self._configure()
+        self._set_params(params)
         for name in names:
             setattr(self, name, _restore(getattr(self, name), state[name]))
         self._restored()

@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import math
 
-from .base import INTEGRATION_PARAM, Estimator
+from .base import INTEGRATION_PARAM, Estimator, tuple_new
 from .kinematics import (
+    HALF_PI,
+    PI,
     accel_roll_pitch,
     clamp_pitch,
     euler_step,
@@ -27,6 +29,7 @@ from .kinematics import (
 from .types import DEG, Estimate, G, Param
 
 Vec3 = tuple[float, float, float]
+ZERO3: Vec3 = (0.0, 0.0, 0.0)
 
 ACC_GATE_PARAMS: tuple[Param, ...] = (
     Param(
@@ -143,7 +146,7 @@ def body_rotation(g0: Vec3, g1: Vec3, bias: Vec3, dt: float, trapezoid: bool) ->
     b0, b1, b2 = bias
     if trapezoid:
         return rotation_increment(
-            (g0[0] - b0, g0[1] - b1, g0[2] - b2), (g1[0] - b0, g1[1] - b1, g1[2] - b2), dt
+            g0[0] - b0, g0[1] - b1, g0[2] - b2, g1[0] - b0, g1[1] - b1, g1[2] - b2, dt
         )
     return (g1[0] - b0) * dt, (g1[1] - b1) * dt, (g1[2] - b2) * dt
 
@@ -223,11 +226,13 @@ class ComplementaryFilter(Estimator):
         self._trapezoid = p["integration"] == "trapezoid"
         self._acc_tau = p["acc_lowpass"]
         self._quaternion = p["propagation"] == "quaternion"
+        # both options need the rotation vector of each interval; the papers' filter does not
+        self._rotating = self._quaternion or self._acc_tau > 0.0
 
     def _reset(self) -> None:
         self.roll = 0.0
         self.pitch = 0.0
-        self.acc_f = (0.0, 0.0, 0.0)  # the pre-filtered specific force (acc_lowpass > 0)
+        self.acc_f = ZERO3  # the pre-filtered specific force (acc_lowpass > 0)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
@@ -235,35 +240,37 @@ class ComplementaryFilter(Estimator):
         self.acc_f = (ax, ay, az)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
 
-    def _update(
+    def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> None:
-        phi = (0.0, 0.0, 0.0)
-        if self._quaternion or self._acc_tau > 0.0:
-            phi = body_rotation(self.gyro_prev, (gx, gy, gz), (0.0, 0.0, 0.0), dt, self._trapezoid)
-        if self._quaternion:
+    ) -> Estimate:
+        if self._rotating:
+            phi = body_rotation(self.gyro_prev, (gx, gy, gz), ZERO3, dt, self._trapezoid)
+            if self._acc_tau > 0.0:  # the filter and its gate use the pre-filtered vector
+                self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
+                                                    self._acc_tau)
+                ax, ay, az = self.acc_f
+        if self._quaternion:  # (then self._rotating: phi is this interval's rotation)
             self.q_att = quat_mul_rotvec(self.q_att, *phi)
             roll, pitch = quat_roll_pitch(*self.q_att)
         elif self._trapezoid:
-            roll, pitch = heun_euler_step(self.roll, self.pitch, self.gyro_prev, (gx, gy, gz), dt)
+            p0, q0, r0 = self.gyro_prev
+            roll, pitch = heun_euler_step(self.roll, self.pitch, p0, q0, r0, gx, gy, gz, dt)
         else:
-            roll, pitch = euler_step(self.roll, self.pitch, (gx, gy, gz), dt)
-        if self._acc_tau > 0.0:
-            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
-            ax, ay, az = self.acc_f
-        norm2 = ax * ax + ay * ay + az * az
-        if self._gate_low2 <= norm2 <= self._gate_high2:
+            roll, pitch = euler_step(self.roll, self.pitch, gx, gy, gz, dt)
+        if self._gate_low2 <= ax * ax + ay * ay + az * az <= self._gate_high2:
             acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
             k = dt / (self._tau + dt)  # 1 - a, Gui et al. eq. 2
-            roll += k * wrap_angle(acc_roll - roll)
+            y = acc_roll - roll
+            roll += k * (y if -PI <= y <= PI else wrap_angle(y))
             pitch += k * (acc_pitch - pitch)
             if self._quaternion:
                 self.q_att = quat_with_roll_pitch(self.q_att, roll, pitch)
-        self.roll = wrap_angle(roll)
-        self.pitch = clamp_pitch(pitch)
+        self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
+        self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
+        return tuple_new(Estimate, (roll, pitch, ZERO3, None, None))
 
     def _estimate(self) -> Estimate:
-        return Estimate(self.roll, self.pitch, (0.0, 0.0, 0.0))
+        return Estimate(self.roll, self.pitch, ZERO3)
 
 
 __all__ = [

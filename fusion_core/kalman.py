@@ -17,12 +17,13 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 
 from __future__ import annotations
 
-from .base import INTEGRATION_PARAM, Estimator
+from .base import INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
     PROPAGATION_PARAM,
     REST_PARAMS,
+    ZERO3,
     Vec3,
     body_rotation,
     gate_bounds2,
@@ -31,6 +32,8 @@ from .complementary import (
     rest_step,
 )
 from .kinematics import (
+    HALF_PI,
+    PI,
     accel_roll_pitch,
     clamp_pitch,
     euler_step,
@@ -58,25 +61,20 @@ def predict_covariance(
     )
 
 
-def measurement_update(
-    angle: float, bias: float, P: tuple[float, float, float, float], y: float, r: float
-) -> tuple[float, float, tuple[float, float, float, float], float, float]:
-    """Update with the innovation y = acc_angle - angle (Das & Mary eq. 23-27).
+def measurement_gain(
+    P: tuple[float, float, float, float], r: float
+) -> tuple[tuple[float, float], tuple[float, float, float, float]]:
+    """Gain and covariance of the update with an angle measurement (Das & Mary eq. 23-27).
 
-    S = P00 + R; K = [P00, P10] / S; x += K y; P <- (I - K H) P using the old P values (the
-    papers' temporaries), not values already overwritten. Returns angle, bias, P, K0, K1.
+    S = P00 + R; K = [P00, P10] / S; P <- (I - K H) P using the old P values (the papers'
+    temporaries), not values already overwritten. Returns K = (K0, K1) and the new P; the state
+    update is angle += K0 y, bias += K1 y with the innovation y = acc_angle - angle.
     """
     P00, P01, P10, P11 = P
     S = P00 + r
     K0 = P00 / S
     K1 = P10 / S
-    return (
-        angle + K0 * y,
-        bias + K1 * y,
-        (P00 - K0 * P00, P01 - K0 * P01, P10 - K1 * P00, P11 - K1 * P01),
-        K0,
-        K1,
-    )
+    return (K0, K1), (P00 - K0 * P00, P01 - K0 * P01, P10 - K1 * P00, P11 - K1 * P01)
 
 
 def bias_update(
@@ -179,14 +177,15 @@ class AngleBiasKalmanFilter(Estimator):
         self._q_angle = p["Q_angle"]
         self._q_bias = p["Q_bias"]
         self._r = p["R_measure"]
-        self._gate_low2, self._gate_high2 = gate_bounds2(p)
+        self._gate2 = gate_bounds2(p)
         self._trapezoid = p["integration"] == "trapezoid"
         self._acc_tau = p["acc_lowpass"]
-        self._rest_time = p["rest_time"]
-        self._rest_gyro = p["rest_gyro"]
-        self._rest_acc = p["rest_acc"]
-        self._gyro_var = p["gyro_psd"]
+        # the zero-rate update's constants in one attribute: CPython 3.11 gives an instance of at
+        # most 29 attributes its faster shared-key dict, and this class is at 29
+        self._rest_cfg = (p["rest_time"], p["rest_gyro"], p["rest_acc"], p["gyro_psd"])
         self._quaternion = p["propagation"] == "quaternion"
+        # any real-sensor option on (else the papers' filter: the short path of _advance)
+        self._options = self._quaternion or self._acc_tau > 0.0 or p["rest_time"] > 0.0
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -194,10 +193,10 @@ class AngleBiasKalmanFilter(Estimator):
         self.bias_x = 0.0
         self.bias_y = 0.0
         self.P_roll = (0.0, 0.0, 0.0, 0.0)
-        self.P_pitch = (0.0, 0.0, 0.0, 0.0)
+        self.P_pitch = self.P_roll  # one covariance for both axes (see propagate)
         self.bias_z = 0.0  # only with rest detection (rest_time > 0); else 0: unobservable
         self.P_z = 0.0
-        self.acc_f = (0.0, 0.0, 0.0)  # pre-filtered specific force (acc_lowpass > 0)
+        self.acc_f = ZERO3  # pre-filtered specific force (acc_lowpass > 0)
         self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
         self.gain_roll = (0.0, 0.0)
@@ -210,26 +209,39 @@ class AngleBiasKalmanFilter(Estimator):
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         p_b = self._params["init_bias_std"] ** 2
         if p_b > 0.0:
-            self.P_roll = (0.0, 0.0, 0.0, p_b)
-            self.P_pitch = (0.0, 0.0, 0.0, p_b)
+            self.P_roll = self.P_pitch = (0.0, 0.0, 0.0, p_b)
             self.P_z = p_b
 
-    def _update(
+    def _advance(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> Estimate:
+        if self._options:
+            self._update_with_options(ax, ay, az, gx, gy, gz, dt)
+        else:
+            self.propagate(gx, gy, gz, dt)
+            low2, high2 = self._gate2
+            if low2 <= ax * ax + ay * ay + az * az <= high2:  # accel_trusted, written out
+                self.correct(ax, ay, az)
+        return tuple_new(
+            Estimate, (self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z), None, None)
+        )
+
+    def _update_with_options(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
+        """One sample with the real-sensor options (see the class docstring)."""
         phi = None
         if self._quaternion or self._acc_tau > 0.0:
             bias = (self.bias_x, self.bias_y, self.bias_z)
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
         self.propagate(gx, gy, gz, dt, phi)
         predicted = (self.roll, self.pitch)
-        if self._rest_time > 0.0:
+        if self._rest_cfg[0] > 0.0:  # rest_time
             self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
         if self._acc_tau > 0.0:
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
             ax, ay, az = self.acc_f
-        norm2 = ax * ax + ay * ay + az * az
-        if self.accel_trusted(norm2):
+        if self.accel_trusted(ax * ax + ay * ay + az * az):
             self.correct(ax, ay, az)
         if self._quaternion and (self.roll, self.pitch) != predicted:
             self.q_att = quat_with_roll_pitch(self.q_att, self.roll, self.pitch)
@@ -239,12 +251,11 @@ class AngleBiasKalmanFilter(Estimator):
     ) -> None:
         """Rest detection; at rest the gyro sample measures the bias (variance gyro_psd/dt):
         the x and y biases through the [angle, bias] filters, bias_z through its own state."""
-        self.rest = rest_step(
-            self.rest, gx, gy, gz, ax, ay, az, dt, self._rest_gyro, self._rest_acc
-        )
+        rest_time, rest_gyro, rest_acc, gyro_var = self._rest_cfg
+        self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, rest_gyro, rest_acc)
         self.P_z += self._q_bias * dt
-        if self.rest[6] >= self._rest_time:
-            r = self._gyro_var / dt
+        if self.rest[6] >= rest_time:
+            r = gyro_var / dt
             self.correct_bias(gx, gy, r)
             k = self.P_z / (self.P_z + r)
             self.bias_z += k * (gz - self.bias_z)
@@ -255,9 +266,8 @@ class AngleBiasKalmanFilter(Estimator):
     ) -> None:
         """Time update: angles by the Euler-rate kinematics (or, with propagation="quaternion",
         by the attitude quaternion turned by the rotation vector phi of the interval, computed
-        here when not given), P by the papers' F and Q."""
+        here when not given), P by the papers' F and Q (predict_covariance)."""
         bx, by, bz = self.bias_x, self.bias_y, self.bias_z
-        w1 = (gx - bx, gy - by, gz - bz)
         if self._quaternion:
             if phi is None:
                 phi = body_rotation(self.gyro_prev, (gx, gy, gz), (bx, by, bz), dt,
@@ -265,35 +275,53 @@ class AngleBiasKalmanFilter(Estimator):
             self.q_att = quat_mul_rotvec(self.q_att, *phi)
             roll, pitch = quat_roll_pitch(*self.q_att)
         elif self._trapezoid:
-            g0 = self.gyro_prev
-            w0 = (g0[0] - bx, g0[1] - by, g0[2] - bz)
-            roll, pitch = heun_euler_step(self.roll, self.pitch, w0, w1, dt)
+            p0, q0, r0 = self.gyro_prev
+            roll, pitch = heun_euler_step(
+                self.roll, self.pitch, p0 - bx, q0 - by, r0 - bz, gx - bx, gy - by, gz - bz, dt
+            )
         else:
-            roll, pitch = euler_step(self.roll, self.pitch, w1, dt)
-        self.roll = wrap_angle(roll)
-        self.pitch = clamp_pitch(pitch)
-        self.P_roll = predict_covariance(self.P_roll, dt, self._q_angle, self._q_bias)
-        self.P_pitch = predict_covariance(self.P_pitch, dt, self._q_angle, self._q_bias)
+            roll, pitch = euler_step(self.roll, self.pitch, gx - bx, gy - by, gz - bz, dt)
+        self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
+        self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
+        # The roll and the pitch filter have the same F, Q and R and every update treats both,
+        # so P_roll == P_pitch: one covariance, computed once (the same numbers as twice). A
+        # state snapshot with two different ones is still followed axis by axis.
+        P, P_pitch = self.P_roll, self.P_pitch
+        self.P_roll = predict_covariance(P, dt, self._q_angle, self._q_bias)
+        if P_pitch is P or P_pitch == P:
+            self.P_pitch = self.P_roll
+        else:
+            self.P_pitch = predict_covariance(P_pitch, dt, self._q_angle, self._q_bias)
 
     def accel_trusted(self, norm2: float) -> bool:
         """Whether the accelerometer gate is open for a sample of squared norm norm2."""
-        return self._gate_low2 <= norm2 <= self._gate_high2
+        low2, high2 = self._gate2
+        return low2 <= norm2 <= high2
 
     def correct(self, ax: float, ay: float, az: float) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch."""
         acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
-        self.correct_innovation(wrap_angle(acc_roll - self.roll), acc_pitch - self.pitch)
+        y_roll = acc_roll - self.roll
+        self.correct_innovation(
+            y_roll if -PI <= y_roll <= PI else wrap_angle(y_roll), acc_pitch - self.pitch
+        )
 
     def correct_innovation(self, y_roll: float, y_pitch: float) -> None:
         """Measurement update with given innovations (accelerometer angle - predicted angle)."""
-        roll, self.bias_x, self.P_roll, *self.gain_roll = measurement_update(
-            self.roll, self.bias_x, self.P_roll, y_roll, self._r
-        )
-        pitch, self.bias_y, self.P_pitch, *self.gain_pitch = measurement_update(
-            self.pitch, self.bias_y, self.P_pitch, y_pitch, self._r
-        )
-        self.roll = wrap_angle(roll)
-        self.pitch = clamp_pitch(pitch)
+        P, P_pitch = self.P_roll, self.P_pitch
+        self.gain_roll, self.P_roll = measurement_gain(P, self._r)
+        if P_pitch is P or P_pitch == P:  # one covariance (see propagate)
+            self.gain_pitch, self.P_pitch = self.gain_roll, self.P_roll
+        else:
+            self.gain_pitch, self.P_pitch = measurement_gain(P_pitch, self._r)
+        K0, K1 = self.gain_roll
+        roll = self.roll + K0 * y_roll
+        self.bias_x += K1 * y_roll
+        K0, K1 = self.gain_pitch
+        pitch = self.pitch + K0 * y_pitch
+        self.bias_y += K1 * y_pitch
+        self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
+        self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
 
     def correct_bias(self, z_x: float, z_y: float, r: float) -> None:
         """Update with direct measurements z of the x and y gyro bias (variance r each).

@@ -1,22 +1,29 @@
 """Attitude kinematics shared by the estimators, in this project's frame (x fwd, y left, z up).
 
-Plain-float functions: the estimators call them once or twice per sample, where numpy's per-call
-overhead on 3-vectors would dominate.
+Plain-float functions taking and returning scalars (tuples only where a value is one): the
+estimators call them once or twice per sample, where numpy's per-call overhead on 3-vectors would
+dominate, and so would building a tuple only to unpack it again.
+
+Hot paths skip the call of wrap_angle and clamp_pitch when the value is already in range, where
+both return it unchanged: `x if -PI <= x <= PI else wrap_angle(x)` and
+`x if -HALF_PI <= x <= HALF_PI else clamp_pitch(x)` are the same numbers without a call.
 """
 
 from __future__ import annotations
 
 import math
+from math import asin, atan2, copysign, cos, remainder, sin, sqrt
 
+PI = math.pi
 TWO_PI = 2.0 * math.pi
+HALF_PI = 0.5 * math.pi
 _MIN_COS_PITCH = 1e-9  # keeps tan(pitch) finite at gimbal lock (pitch = +-pi/2)
-_HALF_PI = 0.5 * math.pi
 _SMALL_ANGLE = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
 
 
 def wrap_angle(x: float) -> float:
     """x wrapped to [-pi, pi]; exact (x itself) when |x| <= pi."""
-    return math.remainder(x, TWO_PI)
+    return remainder(x, TWO_PI)
 
 
 def accel_roll_pitch(ax: float, ay: float, az: float) -> tuple[float, float]:
@@ -26,7 +33,7 @@ def accel_roll_pitch(ax: float, ay: float, az: float) -> tuple[float, float]:
     roll = atan2(ay, az) (Gui et al. eq. 3), pitch = atan2(-ax, sqrt(ay^2 + az^2)) (eq. 4,
     written with atan2 so that it is defined for every direction).
     """
-    return math.atan2(ay, az), math.atan2(-ax, math.sqrt(ay * ay + az * az))
+    return atan2(ay, az), atan2(-ax, sqrt(ay * ay + az * az))
 
 
 def euler_rates(
@@ -37,64 +44,59 @@ def euler_rates(
     phi_dot   = p + (q sin(phi) + r cos(phi)) tan(theta)
     theta_dot = q cos(phi) - r sin(phi)
     """
-    sp = math.sin(phi)
-    cp = math.cos(phi)
-    ct = math.cos(theta)
+    sp = sin(phi)
+    cp = cos(phi)
+    ct = cos(theta)
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:  # abs(ct) < _MIN_COS_PITCH
-        ct = math.copysign(_MIN_COS_PITCH, ct)
-    return p + (q * sp + r * cp) * math.sin(theta) / ct, q * cp - r * sp
+        ct = copysign(_MIN_COS_PITCH, ct)
+    return p + (q * sp + r * cp) * sin(theta) / ct, q * cp - r * sp
 
 
 def heun_euler_step(
-    phi: float,
-    theta: float,
-    w0: tuple[float, float, float],
-    w1: tuple[float, float, float],
-    dt: float,
+    phi: float, theta: float,
+    p0: float, q0: float, r0: float, p1: float, q1: float, r1: float, dt: float,
 ) -> tuple[float, float]:
     """Propagate roll and pitch over dt with Heun's method on the Euler-rate kinematics.
 
-    w0 is the (bias-corrected) body rate at the start of the interval, w1 at its end: the rate
-    is linear over the interval (trapezoid rule), so the local error is O(dt^3).
+    (p0, q0, r0) is the (bias-corrected) body rate at the start of the interval, (p1, q1, r1) at
+    its end: the rate is linear over the interval (trapezoid rule), so the local error is O(dt^3).
     """
     # euler_rates at both ends, written out (this runs once per sample in cf, kf and poskf)
-    sin, cos = math.sin, math.cos
-    p, q, r = w0
     sp, cp, ct = sin(phi), cos(phi), cos(theta)
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:
-        ct = math.copysign(_MIN_COS_PITCH, ct)
-    d1p, d1t = p + (q * sp + r * cp) * sin(theta) / ct, q * cp - r * sp
+        ct = copysign(_MIN_COS_PITCH, ct)
+    d1p, d1t = p0 + (q0 * sp + r0 * cp) * sin(theta) / ct, q0 * cp - r0 * sp
     phi1, theta1 = phi + dt * d1p, theta + dt * d1t
-    p, q, r = w1
     sp, cp, ct = sin(phi1), cos(phi1), cos(theta1)
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:
-        ct = math.copysign(_MIN_COS_PITCH, ct)
-    d2p, d2t = p + (q * sp + r * cp) * sin(theta1) / ct, q * cp - r * sp
+        ct = copysign(_MIN_COS_PITCH, ct)
+    d2p, d2t = p1 + (q1 * sp + r1 * cp) * sin(theta1) / ct, q1 * cp - r1 * sp
     return phi + 0.5 * dt * (d1p + d2p), theta + 0.5 * dt * (d1t + d2t)
 
 
 def euler_step(
-    phi: float, theta: float, w1: tuple[float, float, float], dt: float
+    phi: float, theta: float, p: float, q: float, r: float, dt: float
 ) -> tuple[float, float]:
-    """Propagate roll and pitch with the papers' rectangle rule: end-of-interval rate times dt."""
-    dp, dtheta = euler_rates(phi, theta, w1[0], w1[1], w1[2])
+    """Propagate roll and pitch with the papers' rectangle rule: the end-of-interval body rate
+    (p, q, r) times dt."""
+    dp, dtheta = euler_rates(phi, theta, p, q, r)
     return phi + dt * dp, theta + dt * dtheta
 
 
 def clamp_pitch(theta: float) -> float:
     """Pitch limited to [-pi/2, pi/2] (INTERFACE.md range)."""
     # max(-pi/2, min(pi/2, theta)), without the two builtin calls
-    theta = theta if theta < _HALF_PI else _HALF_PI
-    return theta if theta > -_HALF_PI else -_HALF_PI
+    theta = theta if theta < HALF_PI else HALF_PI
+    return theta if theta > -HALF_PI else -HALF_PI
 
 
 def quat_from_roll_pitch_yaw(
     phi: float, theta: float, psi: float = 0.0
 ) -> tuple[float, float, float, float]:
     """Quaternion (w, x, y, z), body to world, of the Z-Y-X Euler angles (yaw psi, pitch, roll)."""
-    cr, sr = math.cos(0.5 * phi), math.sin(0.5 * phi)
-    cp, sp = math.cos(0.5 * theta), math.sin(0.5 * theta)
-    cy, sy = math.cos(0.5 * psi), math.sin(0.5 * psi)
+    cr, sr = cos(0.5 * phi), sin(0.5 * phi)
+    cp, sp = cos(0.5 * theta), sin(0.5 * theta)
+    cy, sy = cos(0.5 * psi), sin(0.5 * psi)
     return (
         cr * cp * cy + sr * sp * sy,
         sr * cp * cy - cr * sp * sy,
@@ -105,9 +107,10 @@ def quat_from_roll_pitch_yaw(
 
 def quat_roll_pitch(w: float, x: float, y: float, z: float) -> tuple[float, float]:
     """Roll and pitch of a unit quaternion (body to world, Z-Y-X Euler)."""
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    roll = atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     s = 2.0 * (w * y - x * z)
-    return roll, math.asin(max(-1.0, min(1.0, s)))
+    # max(-1, min(1, s)) (rounding can put |s| a little above 1), the builtins called only then
+    return roll, asin(s if -1.0 <= s <= 1.0 else max(-1.0, min(1.0, s)))
 
 
 def quat_gravity_body(w: float, x: float, y: float, z: float) -> tuple[float, float, float]:
@@ -124,33 +127,34 @@ def quat_mul_rotvec(
 ) -> tuple[float, float, float, float]:
     """q (x) exp(v/2): rotate the body frame by the rotation vector v (body axes), renormalised."""
     w, x, y, z = q
-    angle = math.sqrt(vx * vx + vy * vy + vz * vz)
+    angle = sqrt(vx * vx + vy * vy + vz * vz)
     if angle < 1e-8:  # series of sin(a/2)/a and cos(a/2), exact to double precision here
         c = 1.0 - angle * angle / 8.0
         s = 0.5 - angle * angle / 48.0
     else:
-        c = math.cos(0.5 * angle)
-        s = math.sin(0.5 * angle) / angle
+        c = cos(0.5 * angle)
+        s = sin(0.5 * angle) / angle
     bx, by, bz = s * vx, s * vy, s * vz
     rw = w * c - x * bx - y * by - z * bz
     rx = w * bx + x * c + y * bz - z * by
     ry = w * by - x * bz + y * c + z * bx
     rz = w * bz + x * by - y * bx + z * c
-    n = 1.0 / math.sqrt(rw * rw + rx * rx + ry * ry + rz * rz)
+    n = 1.0 / sqrt(rw * rw + rx * rx + ry * ry + rz * rz)
     return rw * n, rx * n, ry * n, rz * n
 
 
 def rotation_increment(
-    w0: tuple[float, float, float], w1: tuple[float, float, float], dt: float
+    p0: float, q0: float, r0: float, p1: float, q1: float, r1: float, dt: float
 ) -> tuple[float, float, float]:
-    """Body rotation vector over one interval from the rates at its ends (trapezoid + coning).
+    """Body rotation vector over one interval from the rates w0 = (p0, q0, r0) and
+    w1 = (p1, q1, r1) at its ends (trapezoid + coning).
 
     phi = (w0 + w1)/2 dt + (w0 dt x w1 dt)/12: the two-sample coning correction for a rate that is
     linear over the interval (Bortz 1971; Savage, Strapdown Analytics, eq. 7.1.1.1-11), so
     simultaneous rotation about several axes integrates without an O(dt^3) drift.
     """
-    a0, a1, a2 = w0[0] * dt, w0[1] * dt, w0[2] * dt
-    b0, b1, b2 = w1[0] * dt, w1[1] * dt, w1[2] * dt
+    a0, a1, a2 = p0 * dt, q0 * dt, r0 * dt
+    b0, b1, b2 = p1 * dt, q1 * dt, r1 * dt
     k = 1.0 / 12.0
     return (
         0.5 * (a0 + b0) + k * (a1 * b2 - a2 * b1),
@@ -165,11 +169,11 @@ def rotate_back(v: tuple[float, float, float], phi: tuple[float, float, float]
     v - sin(a)/a (phi x v) + (1 - cos a)/a^2 phi x (phi x v), a = |phi|."""
     p0, p1, p2 = phi
     a2 = p0 * p0 + p1 * p1 + p2 * p2
-    a = math.sqrt(a2)
+    a = sqrt(a2)
     if a < _SMALL_ANGLE:  # series of sin(a)/a and (1 - cos a)/a^2
         s, c = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
     else:
-        s, c = math.sin(a) / a, (1.0 - math.cos(a)) / a2
+        s, c = sin(a) / a, (1.0 - cos(a)) / a2
     v0, v1, v2 = v
     u0, u1, u2 = p1 * v2 - p2 * v1, p2 * v0 - p0 * v2, p0 * v1 - p1 * v0  # phi x v
     return (

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import math
 
-from .base import INTEGRATION_PARAM, Estimator
+from .base import INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_LOWPASS_PARAM,
     REST_PARAMS,
+    ZERO3,
     body_rotation,
     lowpass_specific_force,
     rest_step,
@@ -111,12 +112,13 @@ class GainScheduledComplementaryFilter(Estimator):
         self._rest_time = p["rest_time"]
         self._rest_gyro = p["rest_gyro"]
         self._rest_acc = p["rest_acc"]
+        self._options = self._rest_time > 0.0 or self._acc_tau > 0.0
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)
-        self.bias = (0.0, 0.0, 0.0)
+        self.bias = ZERO3
         self.w0_now = 0.0
-        self.acc_f = (0.0, 0.0, 0.0)  # pre-filtered specific force (acc_lowpass > 0)
+        self.acc_f = ZERO3  # pre-filtered specific force (acc_lowpass > 0)
         self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
@@ -144,59 +146,46 @@ class GainScheduledComplementaryFilter(Estimator):
             return self.acc_f
         return ax, ay, az
 
-    def _update(
+    def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> None:
-        if self._rest_time > 0.0 or self._acc_tau > 0.0:
+    ) -> Estimate:
+        if self._options:
             ax, ay, az = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
-        rho = abs(norm / G - 1.0)
-        w0 = self._w0_fixed if self._table is None else scheduled_w0(rho, self._table)
+        table = self._table
+        w0 = self._w0_fixed if table is None else scheduled_w0(abs(norm / G - 1.0), table)
         self.w0_now = w0
         bx, by, bz = self.bias
-        if not self._trapezoid:
-            # Mahony's reference order: error from the previous attitude, then one Euler step.
-            ex, ey, ez = self._error(self.q, ax, ay, az, norm, w0)
-            bx, by, bz = self._integrate_bias(ex, ey, ez, w0, dt)
-            kp = self._two_zeta * w0
-            w1 = (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz)
-            self.q = _quat_first_order(self.q, w1, dt)
-            return
-        # Predict with the gyro over the interval, then correct with this sample's accelerometer
-        # against the attitude at this sample's time: the same continuous-time PI filter without
-        # the one-sample lag of comparing a_k with q_{k-1} (which shows as |omega| dt of error).
-        g0 = self.gyro_prev
-        rotvec = rotation_increment(
-            (g0[0] - bx, g0[1] - by, g0[2] - bz), (gx - bx, gy - by, gz - bz), dt
-        )
-        q = quat_mul_rotvec(self.q, *rotvec)
-        ex, ey, ez = self._error(q, ax, ay, az, norm, w0)
-        self._integrate_bias(ex, ey, ez, w0, dt)
-        kp_dt = self._two_zeta * w0 * dt
-        self.q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez) if w0 > 0.0 else q
-
-    @staticmethod
-    def _error(
-        q: tuple[float, float, float, float], ax: float, ay: float, az: float, norm: float,
-        w0: float,
-    ) -> tuple[float, float, float]:
-        """Mahony's error e = a/|a| x v, v = R(q)^T e_z; zero when the correction is off."""
-        if w0 <= 0.0:
-            return 0.0, 0.0, 0.0
-        vx, vy, vz = quat_gravity_body(*q)
-        inv = 1.0 / norm
-        nx, ny, nz = ax * inv, ay * inv, az * inv
-        return ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
-
-    def _integrate_bias(
-        self, ex: float, ey: float, ez: float, w0: float, dt: float
-    ) -> tuple[float, float, float]:
-        """b <- b - Ki e dt, Ki = w0^2: the integral term, whose negative is the gyro bias."""
+        if self._trapezoid:
+            # Predict with the gyro over the interval, then correct with this sample's
+            # accelerometer against the attitude at this sample's time: the same continuous-time
+            # PI filter without the one-sample lag of comparing a_k with q_{k-1} (which shows as
+            # |omega| dt of error).
+            p0, q0, r0 = self.gyro_prev
+            q = quat_mul_rotvec(self.q, *rotation_increment(
+                p0 - bx, q0 - by, r0 - bz, gx - bx, gy - by, gz - bz, dt
+            ))
+        else:
+            q = self.q  # Mahony's reference order: error from the previous attitude
+        ex = ey = ez = 0.0  # Mahony's error, zero while the correction is off
         if w0 > 0.0:
+            # e = a/|a| x v, v = R(q)^T e_z the estimated gravity direction in the body frame
+            vx, vy, vz = quat_gravity_body(*q)
+            inv = 1.0 / norm
+            nx, ny, nz = ax * inv, ay * inv, az * inv
+            ex, ey, ez = ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
+            # b <- b - Ki e dt, Ki = w0^2: the integral term, whose negative is the gyro bias
             ki_dt = w0 * w0 * dt
-            bx, by, bz = self.bias
-            self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
-        return self.bias
+            bx, by, bz = self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
+        if not self._trapezoid:  # then one Euler step with the PI-corrected rate
+            kp = self._two_zeta * w0
+            q = _quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
+        elif w0 > 0.0:
+            kp_dt = self._two_zeta * w0 * dt
+            q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
+        self.q = q
+        roll, pitch = quat_roll_pitch(*q)
+        return tuple_new(Estimate, (roll, pitch, self.bias, None, None))
 
     def _estimate(self) -> Estimate:
         roll, pitch = quat_roll_pitch(*self.q)

@@ -8,26 +8,33 @@ Reference:
   They compare three Q/R forms; their best final error on a 2 m move is 0.0385 m in x.
   The tilt that turns the body specific force into the level frame comes from the
   AngleBiasKalmanFilter (Gui et al. / Das & Mary) run on the same samples.
+
+Implementation: plain floats. The three axes share F, Q, R and their updates, so they share one
+covariance P (and one gain per update), kept as its upper triangle
+(p00, p01, p02, p11, p12, p22); the `P` attribute shows it as a 3x3 tuple of tuples and the
+`states` attribute the per-axis [p, v, a] as lists.
 """
 
 from __future__ import annotations
 
-import functools
-import math
+from math import cos, sin, sqrt
 
-from .base import Estimator
+from .base import Estimator, tuple_new
 from .kalman import AngleBiasKalmanFilter
-from .kinematics import accel_roll_pitch, wrap_angle
+from .kinematics import PI, accel_roll_pitch, wrap_angle
 from .types import DEG, Estimate, G, Param
 
 TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "integration")
 """Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
 
+Sym3 = tuple[float, float, float, float, float, float]
+"""A symmetric 3x3 matrix as its upper triangle (m00, m01, m02, m11, m12, m22)."""
 Mat3 = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+AxisStates = tuple[float, float, float, float, float, float, float, float, float]
+"""[p, v, a] of the x, y and z axes, one after the other."""
 
 
-@functools.lru_cache(maxsize=16)  # one entry per (form, q, dt): dt is constant in most runs
-def process_noise(form: str, q: float, dt: float) -> Mat3:
+def process_noise(form: str, q: float, dt: float) -> Sym3:
     """Q of one axis for the named form (Safitri et al.'s three Q/R forms, our reading):
 
     white_jerk      continuous white jerk of density q, discretised exactly (eq. 29);
@@ -37,61 +44,102 @@ def process_noise(form: str, q: float, dt: float) -> Mat3:
     """
     d2, d3, d4, d5 = dt * dt, dt**3, dt**4, dt**5
     if form == "piecewise_jerk":
-        g = (d3 / 6.0, d2 / 2.0, dt)
+        g0, g1, g2 = d3 / 6.0, d2 / 2.0, dt
         s = q / dt
-        return tuple(tuple(s * gi * gj for gj in g) for gi in g)  # type: ignore[return-value]
-    full = (
-        (q * d5 / 20.0, q * d4 / 8.0, q * d3 / 6.0),
-        (q * d4 / 8.0, q * d3 / 3.0, q * d2 / 2.0),
-        (q * d3 / 6.0, q * d2 / 2.0, q * dt),
-    )
+        return (s * g0 * g0, s * g0 * g1, s * g0 * g2, s * g1 * g1, s * g1 * g2, s * g2 * g2)
+    q00, q11, q22 = q * d5 / 20.0, q * d3 / 3.0, q * dt
     if form == "diagonal":
-        return ((full[0][0], 0.0, 0.0), (0.0, full[1][1], 0.0), (0.0, 0.0, full[2][2]))
-    return full
+        return (q00, 0.0, 0.0, q11, 0.0, q22)
+    return (q00, q * d4 / 8.0, q * d3 / 6.0, q11, q * d2 / 2.0, q22)
 
 
-def predict(P: Mat3, Q: Mat3, dt: float) -> Mat3:
-    """F P F^T + Q for F of eq. 23, written out (P symmetric)."""
-    h = 0.5 * dt * dt
-    (p00, p01, p02), (_, p11, p12), (_, _, p22) = P
-    r00 = p00 + dt * p01 + h * p02
-    r01 = p01 + dt * p11 + h * p12
-    r02 = p02 + dt * p12 + h * p22
-    r11 = p11 + dt * p12
-    r12 = p12 + dt * p22
-    n00 = r00 + dt * r01 + h * r02 + Q[0][0]
-    n01 = r01 + dt * r02 + Q[0][1]
-    n02 = r02 + Q[0][2]
-    n11 = r11 + dt * r12 + Q[1][1]
-    n12 = r12 + Q[1][2]
-    n22 = p22 + Q[2][2]
-    return ((n00, n01, n02), (n01, n11, n12), (n02, n12, n22))
+def axis_filters(
+    x: AxisStates, P: Sym3, Q: Sym3, dt: float, acc: tuple[float, float, float], r: float,
+    zupt_r: float | None,
+) -> tuple[AxisStates, Sym3]:
+    """One sample of the three [p, v, a] filters (eq. 20-29), written out; returns (x, P).
 
-
-def scalar_update(
-    P: Mat3, states: list[list[float]], j: int, z: tuple[float, float, float], r: float
-) -> Mat3:
-    """Update every axis with a measurement of its state j (value z[axis], variance r).
-
-    The three axes share F, Q, R and P, so they share the gain K = P[:, j] / (P[j][j] + r).
-    Updates `states` (per axis [p, v, a]) in place and returns the new P = P - K P[j, :].
+    Predict: x <- F x, P <- F P F^T + Q (F of eq. 23). Update with the level-frame acceleration
+    acc (H = [0 0 1], variance r per axis) and, unless zupt_r is None, with velocity 0
+    (H = [0 1 0], variance zupt_r). Each update is the standard scalar one, shared by the axes:
+    c = P H^T, K = c / (H c + r), x += K (z - H x), P <- P - K c^T.
     """
-    col = (P[0][j], P[1][j], P[2][j])
-    s = col[j] + r
-    K = (col[0] / s, col[1] / s, col[2] / s)
-    for axis, x in enumerate(states):
-        y = z[axis] - x[j]
-        x[0] += K[0] * y
-        x[1] += K[1] * y
-        x[2] += K[2] * y
-    (p00, p01, p02), (p10, p11, p12), (p20, p21, p22) = P
-    k0, k1, k2 = K
-    c0, c1, c2 = col
-    return (
-        (p00 - k0 * c0, p01 - k0 * c1, p02 - k0 * c2),
-        (p10 - k1 * c0, p11 - k1 * c1, p12 - k1 * c2),
-        (p20 - k2 * c0, p21 - k2 * c1, p22 - k2 * c2),
-    )
+    p0, v0, a0, p1, v1, a1, p2, v2, a2 = x
+    h = 0.5 * dt * dt
+    p0 += dt * v0 + h * a0
+    v0 += dt * a0
+    p1 += dt * v1 + h * a1
+    v1 += dt * a1
+    p2 += dt * v2 + h * a2
+    v2 += dt * a2
+    # F P F^T + Q: first R = F P (rows of F times P), then R F^T
+    m00, m01, m02, m11, m12, m22 = P
+    r00 = m00 + dt * m01 + h * m02
+    r01 = m01 + dt * m11 + h * m12
+    r02 = m02 + dt * m12 + h * m22
+    r11 = m11 + dt * m12
+    r12 = m12 + dt * m22
+    q00, q01, q02, q11, q12, q22 = Q
+    m00 = r00 + dt * r01 + h * r02 + q00
+    m01 = r01 + dt * r02 + q01
+    m02 = r02 + q02
+    m11 = r11 + dt * r12 + q11
+    m12 = r12 + q12
+    m22 = m22 + q22
+    # acceleration update: c = (m02, m12, m22)
+    s = m22 + r
+    k0, k1, k2 = m02 / s, m12 / s, m22 / s
+    y = acc[0] - a0
+    p0 += k0 * y
+    v0 += k1 * y
+    a0 += k2 * y
+    y = acc[1] - a1
+    p1 += k0 * y
+    v1 += k1 * y
+    a1 += k2 * y
+    y = acc[2] - a2
+    p2 += k0 * y
+    v2 += k1 * y
+    a2 += k2 * y
+    # P - K c^T; its column 1 (the zero-velocity update's c) has the entry m12 - k2 m12 below
+    # the diagonal (= m12 - k1 m22 above it, but for rounding)
+    c2 = m12 - k2 * m12
+    m00, m01, m02 = m00 - k0 * m02, m01 - k0 * m12, m02 - k0 * m22
+    m11, m12, m22 = m11 - k1 * m12, m12 - k1 * m22, m22 - k2 * m22
+    if zupt_r is not None:
+        # zero-velocity update: c = (m01, m11, c2), z = 0
+        s = m11 + zupt_r
+        k0, k1, k2 = m01 / s, m11 / s, c2 / s
+        y = 0.0 - v0
+        p0 += k0 * y
+        v0 += k1 * y
+        a0 += k2 * y
+        y = 0.0 - v1
+        p1 += k0 * y
+        v1 += k1 * y
+        a1 += k2 * y
+        y = 0.0 - v2
+        p2 += k0 * y
+        v2 += k1 * y
+        a2 += k2 * y
+        c0, c1 = m01, m11
+        m00, m01, m02 = m00 - k0 * c0, m01 - k0 * c1, m02 - k0 * c2
+        m11, m12, m22 = m11 - k1 * c1, m12 - k1 * c2, m22 - k2 * c2
+    return (p0, v0, a0, p1, v1, a1, p2, v2, a2), (m00, m01, m02, m11, m12, m22)
+
+
+def level_acceleration(
+    ax: float, ay: float, az: float,
+    sr: float, cr: float, sp: float, cp: float, sy: float, cy: float,
+) -> tuple[float, float, float]:
+    """R f - g e_z, R = Rz Ry Rx (body to level frame), for the specific force f; sr, cr, sp, cp,
+    sy, cy are the sines and cosines of roll, pitch and yaw."""
+    # Ry Rx f
+    w = sr * ay + cr * az
+    u0 = cp * ax + sp * w
+    u1 = cr * ay - sr * az
+    u2 = -sp * ax + cp * w
+    return cy * u0 - sy * u1, sy * u0 + cy * u1, u2 - G
 
 
 class PositionKalmanFilter(Estimator):
@@ -209,6 +257,16 @@ class PositionKalmanFilter(Estimator):
         self._acc_var_density = p["acc_psd"]
         self._zupt_var = p["zupt_noise"] ** 2
         self._gyro_var_density = p["gyro_psd"]
+        # the hot path's constants
+        self._zupt_acc = p["zupt_acc"]
+        self._zupt_level_acc = p["zupt_level_acc"]
+        self._zupt_gyro = p["zupt_gyro"]
+        self._window = p["zupt_window"]
+        self._force_after = p["zupt_force_after"]
+        self._zupt = p["zupt"]
+        self._zaru = p["zaru"]
+        self._always = p["tilt_update"] == "always"
+        self._Q_dt = None  # the dt of Q = process_noise(qr_form, q, dt) and R = acc_psd / dt
 
     @property
     def tilt_state(self) -> dict:
@@ -218,11 +276,31 @@ class PositionKalmanFilter(Estimator):
     def tilt_state(self, value: dict) -> None:
         self.tilt.set_state(value)
 
+    @property
+    def states(self) -> list[list[float]]:
+        """[p, v, a] of the x, y and z axes (a copy)."""
+        x = self._x
+        return [list(x[0:3]), list(x[3:6]), list(x[6:9])]
+
+    @states.setter
+    def states(self, value: list[list[float]]) -> None:
+        self._x = tuple(float(v) for axis in value for v in axis)
+
+    @property
+    def P(self) -> Mat3:
+        """The covariance shared by the three axes, 3x3 (of [p, v, a])."""
+        m00, m01, m02, m11, m12, m22 = self._P
+        return ((m00, m01, m02), (m01, m11, m12), (m02, m12, m22))
+
+    @P.setter
+    def P(self, value: Mat3) -> None:
+        self._P = tuple(float(value[i][j]) for i in range(3) for j in range(i, 3))
+
     def _reset(self) -> None:
         self.tilt.reset()
         self.yaw = 0.0
-        self.states = [[0.0, 0.0, 0.0] for _ in range(3)]
-        self.P = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        self._x = (0.0,) * 9
+        self._P = (0.0,) * 6
         self.quiet_time = 0.0
         self.stationary = False
         # Accelerometer samples waiting for confirmation: (quiet_time when taken, acc roll,
@@ -233,24 +311,16 @@ class PositionKalmanFilter(Estimator):
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         # The first sample's dt is not used; pass one the tilt stage accepts.
-        self.tilt.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
+        tilt = self.tilt
+        tilt.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
         self.f_mean = (ax, ay, az)
-        a = self._level_acceleration(ax, ay, az)
+        roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
+        lx, ly, lz = level_acceleration(
+            ax, ay, az, sin(roll), cos(roll), sin(pitch), cos(pitch), sin(yaw), cos(yaw)
+        )
         r = self._acc_var_density * 100.0  # one sample's variance at a nominal 100 Hz
-        self.P = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, r))
-        for axis in range(3):
-            self.states[axis][2] = a[axis]
-
-    def _level_acceleration(self, ax: float, ay: float, az: float) -> tuple[float, float, float]:
-        """R(roll, pitch, yaw) f - g e_z, R = Rz Ry Rx (body to level frame)."""
-        sr, cr = math.sin(self.tilt.roll), math.cos(self.tilt.roll)
-        sp, cp = math.sin(self.tilt.pitch), math.cos(self.tilt.pitch)
-        sy, cy = math.sin(self.yaw), math.cos(self.yaw)
-        # Ry Rx f
-        u0 = cp * ax + sp * (sr * ay + cr * az)
-        u1 = cr * ay - sr * az
-        u2 = -sp * ax + cp * (sr * ay + cr * az)
-        return cy * u0 - sy * u1, sy * u0 + cy * u1, u2 - G
+        self._P = (0.0, 0.0, 0.0, 0.0, 0.0, r)
+        self._x = (0.0, 0.0, lx, 0.0, 0.0, ly, 0.0, 0.0, lz)
 
     def _slow_enough(self) -> bool:
         """Whether the estimated speed allows a zero-velocity update.
@@ -261,87 +331,98 @@ class PositionKalmanFilter(Estimator):
         deviations) is not reset; after zupt_force_after seconds of quiet it is, whatever the
         filter believes, so that a drifted velocity cannot lock the update out.
         """
-        speed = math.sqrt(sum(x[1] * x[1] for x in self.states))
-        sigma = math.sqrt(self.P[1][1] + self._zupt_var)
+        x = self._x
+        speed = sqrt(x[1] * x[1] + x[4] * x[4] + x[7] * x[7])
+        sigma = sqrt(self._P[3] + self._zupt_var)
         return speed <= max(self._params["zupt_speed"], 5.0 * sigma)
 
-    def _update(
+    def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> None:
-        p = self._params
+    ) -> Estimate:
         tilt = self.tilt
         # 1. stationary detector: the specific force against its own running mean (body frame:
         # a tilt error cannot hide rest from the detector that corrects the tilt), a coarse
         # level-frame acceleration test (a smooth move's acceleration plateau changes the
         # specific force too slowly for the first test), and the bias-corrected rate
         mx, my, mz = self.f_mean
+        dx, dy, dz = ax - mx, ay - my, az - mz
         wx, wy = gx - tilt.bias_x, gy - tilt.bias_y
-        a_prev = self._level_acceleration(ax, ay, az)
-        quiet = (
-            math.sqrt((ax - mx) ** 2 + (ay - my) ** 2 + (az - mz) ** 2) < p["zupt_acc"]
-            and math.sqrt(a_prev[0] ** 2 + a_prev[1] ** 2 + a_prev[2] ** 2) < p["zupt_level_acc"]
-            and math.sqrt(wx * wx + wy * wy + gz * gz) < p["zupt_gyro"]
+        roll, pitch = tilt.roll, tilt.pitch
+        # the level-frame acceleration with yaw 0 (the yaw turns it about the vertical, which
+        # leaves its norm as it is)
+        lx, ly, lz = level_acceleration(
+            ax, ay, az, sin(roll), cos(roll), sin(pitch), cos(pitch), 0.0, 1.0
         )
-        k = min(1.0, dt / p["zupt_window"]) if p["zupt_window"] > 0.0 else 1.0
-        self.f_mean = (mx + k * (ax - mx), my + k * (ay - my), mz + k * (az - mz))
-        self.quiet_time = self.quiet_time + dt if quiet else 0.0
-        self.stationary = quiet and self.quiet_time >= p["zupt_window"] and (
-            self.quiet_time >= p["zupt_force_after"] or self._slow_enough()
+        quiet = (
+            sqrt(dx * dx + dy * dy + dz * dz) < self._zupt_acc
+            and sqrt(lx * lx + ly * ly + lz * lz) < self._zupt_level_acc
+            and sqrt(wx * wx + wy * wy + gz * gz) < self._zupt_gyro
+        )
+        window = self._window
+        k = dt / window if window > 0.0 else 1.0
+        if k > 1.0:
+            k = 1.0
+        self.f_mean = (mx + k * dx, my + k * dy, mz + k * dz)
+        quiet_time = self.quiet_time = self.quiet_time + dt if quiet else 0.0
+        stationary = self.stationary = quiet and quiet_time >= window and (
+            quiet_time >= self._force_after or self._slow_enough()
         )
         # 2. tilt stage; yaw from the gyro (Euler kinematics, Duong Quoc et al. eq. 2)
         tilt.gyro_prev = self.gyro_prev
-        roll0, pitch0 = tilt.roll, tilt.pitch
         tilt.propagate(gx, gy, gz, dt)
-        turned = (
-            self.turned[0] + wrap_angle(tilt.roll - roll0),
-            self.turned[1] + tilt.pitch - pitch0,
-        )
-        self.turned = turned
-        norm2 = ax * ax + ay * ay + az * az
-        acc_ok = tilt.accel_trusted(norm2)
-        if p["tilt_update"] == "always":
-            if acc_ok:
+        d_roll = tilt.roll - roll
+        turned_roll, turned_pitch = self.turned
+        turned_roll += d_roll if -PI <= d_roll <= PI else wrap_angle(d_roll)
+        turned_pitch = turned_pitch + tilt.pitch - pitch
+        self.turned = (turned_roll, turned_pitch)
+        if self._always:
+            if tilt.accel_trusted(ax * ax + ay * ay + az * az):
                 tilt.correct(ax, ay, az)
         elif not quiet:
-            self.pending = []
+            if self.pending:
+                self.pending = []
         else:
-            if acc_ok and self.stationary:
+            pending = self.pending
+            if stationary and tilt.accel_trusted(ax * ax + ay * ay + az * az):
                 # Only samples that are themselves inside a stationary period (quiet for
                 # zupt_window before), so the tail of a deceleration is never taken for tilt.
-                self.pending.append((self.quiet_time, *accel_roll_pitch(ax, ay, az), *turned))
-            while self.pending and self.quiet_time - self.pending[0][0] >= p["zupt_window"]:
+                pending.append((quiet_time, *accel_roll_pitch(ax, ay, az),
+                                turned_roll, turned_pitch))
+            while pending and quiet_time - pending[0][0] >= window:
                 # Confirmed stationary: its innovation against the tilt of its own time, i.e. the
                 # current tilt less the gyro propagation since (Safitri's tilt stage, delayed).
-                _, acc_roll, acc_pitch, turned_roll, turned_pitch = self.pending.pop(0)
+                _, acc_roll, acc_pitch, then_roll, then_pitch = pending.pop(0)
                 tilt.correct_innovation(
-                    wrap_angle(acc_roll - tilt.roll + turned[0] - turned_roll),
-                    acc_pitch - tilt.pitch + turned[1] - turned_pitch,
+                    wrap_angle(acc_roll - tilt.roll + turned_roll - then_roll),
+                    acc_pitch - tilt.pitch + turned_pitch - then_pitch,
                 )
-        if self.stationary and p["zaru"]:
+        if stationary and self._zaru:
             tilt.correct_bias(gx, gy, self._gyro_var_density / dt)
         tilt.gyro_prev = (gx, gy, gz)
         tilt.n_samples += 1
-        cp = math.cos(tilt.pitch)
-        if abs(cp) > 1e-6:
-            sr, cr = math.sin(tilt.roll), math.cos(tilt.roll)
-            self.yaw = wrap_angle(self.yaw + dt * (wy * sr + gz * cr) / cp)
+        roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
+        sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
+        if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
+            yaw += dt * (wy * sr + gz * cr) / cp
+            yaw = self.yaw = yaw if -PI <= yaw <= PI else wrap_angle(yaw)
         # 3. level-frame acceleration with the new attitude
-        a = self._level_acceleration(ax, ay, az)
+        acc = level_acceleration(ax, ay, az, sr, cr, sp, cp, sin(yaw), cos(yaw))
         # 4. [p, v, a] filter per axis (eq. 20-29)
-        h = 0.5 * dt * dt
-        for x in self.states:
-            x[0] += dt * x[1] + h * x[2]
-            x[1] += dt * x[2]
-        P = predict(self.P, process_noise(p["qr_form"], p["q"], dt), dt)
-        P = scalar_update(P, self.states, 2, a, self._acc_var_density / dt)
-        if self.stationary and p["zupt"]:
-            P = scalar_update(P, self.states, 1, (0.0, 0.0, 0.0), self._zupt_var)
-        self.P = P
+        if dt != self._Q_dt:
+            p = self._params
+            self._Q = process_noise(p["qr_form"], p["q"], dt)
+            self._R = self._acc_var_density / dt
+            self._Q_dt = dt
+        x, self._P = axis_filters(
+            self._x, self._P, self._Q, dt, acc, self._R,
+            self._zupt_var if stationary and self._zupt else None,
+        )
+        self._x = x
+        return self._estimate()
 
     def _estimate(self) -> Estimate:
         t = self.tilt
-        s = self.states
-        return Estimate(
-            t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0),
-            (s[0][0], s[1][0], s[2][0]), (s[0][1], s[1][1], s[2][1]),
-        )
+        x = self._x
+        return tuple_new(Estimate, (
+            t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0), (x[0], x[3], x[6]), (x[1], x[4], x[7])
+        ))

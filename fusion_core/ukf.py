@@ -42,10 +42,11 @@ P is kept as its lower triangle (21 floats, row by row); the `P` attribute shows
 from __future__ import annotations
 
 import math
+from math import atan2, hypot
 
 import numpy as np
 
-from .base import INTEGRATION_PARAM, Estimator
+from .base import INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_LOWPASS_PARAM,
     REST_PARAMS,
@@ -150,6 +151,8 @@ class UnscentedKalmanFilter(Estimator):
         self._r_norm = p["norm_noise"] ** 2
         self._gate = p["acc_gate"]
         self._trapezoid = p["integration"] == "trapezoid"
+        # any real-sensor option on (else the paper's filter alone: the short path of _advance)
+        self._options = p["acc_lowpass"] > 0.0 or p["rest_time"] > 0.0
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -176,6 +179,15 @@ class UnscentedKalmanFilter(Estimator):
     @P.setter
     def P(self, value: list[list[float]]) -> None:
         self._P = tuple(float(value[i][j]) for i in range(N_STATE) for j in range(i + 1))
+
+    def _advance(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> Estimate:
+        if self._options:
+            self._update(ax, ay, az, gx, gy, gz, dt)
+        else:
+            self._filter_update(ax, ay, az, gx, gy, gz, dt)
+        return self._estimate()
 
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -223,9 +235,10 @@ class UnscentedKalmanFilter(Estimator):
         if self._trapezoid:
             h0, h1, h2 = self.gyro_prev
             k = dt * dt / 12.0
-            c0 = 0.5 * dt * (h0 + gx) + k * (h1 * gz - h2 * gy)
-            c1 = 0.5 * dt * (h1 + gy) + k * (h2 * gx - h0 * gz)
-            c2 = 0.5 * dt * (h2 + gz) + k * (h0 * gy - h1 * gx)
+            hdt = 0.5 * dt
+            c0 = hdt * (h0 + gx) + k * (h1 * gz - h2 * gy)
+            c1 = hdt * (h1 + gy) + k * (h2 * gx - h0 * gz)
+            c2 = hdt * (h2 + gz) + k * (h0 * gy - h1 * gx)
             d0, d1, d2 = k * (gx - h0), k * (gy - h1), k * (gz - h2)
         else:  # the papers' rule: phi = (g1 - b) dt
             c0, c1, c2 = gx * dt, gy * dt, gz * dt
@@ -327,7 +340,8 @@ class UnscentedKalmanFilter(Estimator):
         x10, x11, x12 = w * x10, w * x11, w * x12
         x20, x21, x22 = w * x20, w * x21, w * x22
         # Q = gyro_psd dt (I - X X^T) for X, bias_psd dt I for b (X normalised)
-        inv = 1.0 / math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
+        n = math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
+        inv = 1.0 / n
         h0, h1, h2 = X0 * inv, X1 * inv, X2 * inv
         qg = self._q_gyro * dt
         qb = self._q_bias * dt
@@ -359,13 +373,15 @@ class UnscentedKalmanFilter(Estimator):
             X0, X1, X2, b0, b1, b2, P = _kalman_update(
                 (X0, X1, X2, b0, b1, b2), P, S, rows, innovation
             )
-        n = math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
+            n = math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
         self.x = [X0 / n, X1 / n, X2 / n, b0, b1, b2]
         self._P = P
 
     def _estimate(self) -> Estimate:
         X1, X2, X3, bx, by, bz = self.x
-        return Estimate(math.atan2(X2, X3), math.atan2(-X1, math.hypot(X2, X3)), (bx, by, bz))
+        return tuple_new(
+            Estimate, (atan2(X2, X3), atan2(-X1, hypot(X2, X3)), (bx, by, bz), None, None)
+        )
 
 
 def _packed_index(i: int, j: int) -> int:
