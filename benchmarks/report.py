@@ -48,15 +48,21 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
     overhead = r.get("fmu_overhead_us")
     if overhead:
         low = r.get("fmu_overhead_lowlevel_us", {})
+        floors = r.get("fmu_floor_us", {})
         for key, v in overhead.items():
             lv = low.get(key)
+            floor = floors.get(key, {})
             out.append(_target(
                 f"fmu_overhead_us.{key}", v, f"<= {FMU_OVERHEAD_TARGET_US:g} us",
                 v <= FMU_OVERHEAD_TARGET_US,
                 "fmpy's list-to-ctypes conversion per call, pythonfmu's C++ wrapper and the "
                 "slave's Python setters/getters"
                 + (f" (with preallocated ctypes arrays the overhead is {lv:.1f} us)"
-                   if lv is not None else ""),
+                   if lv is not None else "")
+                + (f"; an FMU whose calls return at once already costs "
+                   f"{floor['api']:.1f} us (fmpy API) / {floor['lowlevel']:.1f} us (low-level) "
+                   "per step" if floor.get("api") is not None
+                   and floor.get("lowlevel") is not None else ""),
             ))
     tb = r.get("testbench")
     if tb:
@@ -148,6 +154,12 @@ def format_table(r: dict[str, Any]) -> str:
                 f"{_fmt(r['fmu_step_lowlevel_us'][key], 1):>11}{_fmt(lov.get(key), 1):>10}   "
                 f"{('overhead ' + t['target']) if t else '':<18}{_verdict(t)}"
             )
+        floors = r.get("fmu_floor_us", {})
+        for key, f in floors.items():
+            if f.get("api") is not None and f.get("lowlevel") is not None:
+                lines.append(f"  floor beside {key}: an FMU whose calls return at once: "
+                             f"{_fmt(f['api'], 1)} us (fmpy API), {_fmt(f['lowlevel'], 1)} us "
+                             "(low-level)")
     if "testbench" in r:
         lines += ["", "Testbench: ImuPlant -> ImuSensor -> estimator FMU (testbenches.master)",
                   f"  {'estimator':<11}{'rate':>8}{'steps/s':>10}{'RTF':>8}{'us/step':>9}"

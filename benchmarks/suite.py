@@ -50,7 +50,15 @@ class _NoOpEstimator(Estimator):
         pass
 
     def _estimate(self) -> Estimate:
-        return Estimate(0.0, 0.0, (0.0, 0.0, 0.0))
+        return _ZERO
+
+    def _advance(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> Estimate:
+        return _ZERO  # the one hook the step API calls per sample, as every estimator has it
+
+
+_ZERO = Estimate(0.0, 0.0, (0.0, 0.0, 0.0))
 
 
 def _noop_pass(data: list[tuple[list[float], list[float], float]]) -> Any:
@@ -116,6 +124,11 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
                 results["fmu_overhead_us"] = {k: m["api"] - m["core"] for k, m in med.items()}
                 results["fmu_overhead_lowlevel_us"] = {
                     k: m["lowlevel"] - m["core"] for k, m in med.items()}
+                # The floor FMU (benchmarks/fmu.py) timed beside each estimator: what fmpy and
+                # pythonfmu's wrapper cost per step with no slave work behind them.
+                results["fmu_floor_us"] = {
+                    k: {"api": m.get("floor_api"), "lowlevel": m.get("floor_lowlevel")}
+                    for k, m in med.items()}
             if "testbench" in config.sections:
                 log("testbench throughput")
                 results["testbench"] = testbench_throughput(

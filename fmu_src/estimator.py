@@ -15,6 +15,7 @@ state exactly as it was, counts in invalid_samples, logs a warning and the step 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from operator import itemgetter
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -133,24 +134,37 @@ def estimator_variables(
     return table
 
 
+ACC_INPUTS = tuple(f"acc_{a}" for a in AXES)
+GYRO_INPUTS = tuple(f"gyro_{a}" for a in AXES)
+_ZERO3 = (0.0, 0.0, 0.0)
+
+
 class EstimatorModel:
-    """A fusion_core estimator as an FmuSlave model: one sample per doStep."""
+    """A fusion_core estimator as an FmuSlave model: one sample per doStep.
+
+    This runs on every doStep, so what can be prepared is prepared once: the readers of the
+    acc and gyro triples (`operator.itemgetter`, one C call for three values) and the output
+    dict, which each step refills in place (cheaper than building a new dict: FmuSlave copies
+    the returned values into its table at once and keeps no reference to the dict).
+    """
 
     def __init__(self, cls: type[Estimator], params: dict[str, Any]) -> None:
         self.estimator = cls(**params)
         self.invalid_samples = 0
         self._position = cls.HAS_POSITION
+        self._acc = itemgetter(*ACC_INPUTS)
+        self._gyro = itemgetter(*GYRO_INPUTS)
+        self._out: dict[str, Any] = {}
+        self.outputs(self.estimator.last)  # every output key, in a fixed order
 
     def step(
         self, t: float, h: float, values: Mapping[str, Any], log: FmiLog
     ) -> dict[str, Any]:
         est = self.estimator
         try:
-            estimate = est.step(
-                (values["acc_x"], values["acc_y"], values["acc_z"]),
-                (values["gyro_x"], values["gyro_y"], values["gyro_z"]),
-                values["dt"],
-            )
+            # Every sample goes to the estimator, which checks it (fusion_core's step): a bad
+            # one raises InvalidSample and leaves the filter state as it was.
+            estimate = est.step(self._acc(values), self._gyro(values), values["dt"])
         except InvalidSample as err:
             self.invalid_samples += 1
             log.warning(
@@ -161,15 +175,16 @@ class EstimatorModel:
         return self.outputs(estimate)
 
     def outputs(self, e: Estimate) -> dict[str, Any]:
-        """The output values for an estimate."""
-        bx, by, bz = e.bias
-        out: dict[str, Any] = {
-            "roll": e.roll, "pitch": e.pitch, "bias_x": bx, "bias_y": by, "bias_z": bz,
-            "invalid_samples": self.invalid_samples,
-        }
+        """The output values for an estimate, in the model's output dict (refilled on every
+        call: copy it to keep the values)."""
+        out = self._out
+        out["roll"] = e.roll
+        out["pitch"] = e.pitch
+        out["bias_x"], out["bias_y"], out["bias_z"] = e.bias
+        out["invalid_samples"] = self.invalid_samples
         if self._position:
-            out["pos_x"], out["pos_y"], out["pos_z"] = e.pos or (0.0, 0.0, 0.0)
-            out["vel_x"], out["vel_y"], out["vel_z"] = e.vel or (0.0, 0.0, 0.0)
+            out["pos_x"], out["pos_y"], out["pos_z"] = e.pos or _ZERO3
+            out["vel_x"], out["vel_y"], out["vel_z"] = e.vel or _ZERO3
         return out
 
     def set_parameter(self, name: str, value: Any) -> None:

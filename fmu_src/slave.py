@@ -11,6 +11,11 @@ get_state, set_state). Everything FMI is done here, once:
 - no exception leaves a callback: pythonfmu turns one into fmi2Fatal, which ends the whole
   simulation. A failing doStep is logged and returns fmi2Discard; anything else is logged and
   the call does nothing;
+- fast paths for what a host does every step (set the inputs, get the outputs): fmi2SetReal on
+  Real inputs and fmi2GetReal/fmi2GetInteger write and read the value table directly through
+  value-reference tables built once, instead of pythonfmu's per-variable setter and getter
+  objects. Every other call (parameters, outputs, unknown references, a value that does not
+  convert) takes the full guarded path, so the two give the same values, logs and results;
 - parameters: every new value is checked against the table's range, then by building the
   model with it (before exitInitializationMode) or by `model.set_parameter` (tunable ones,
   while running), so the model's own checks (several parameters together) apply too. A refused
@@ -74,7 +79,8 @@ class Model(Protocol):
         self, t: float, h: float, values: Mapping[str, Any], log: FmiLog
     ) -> Mapping[str, Any]:
         """Advance over the communication step [t, t+h] with the inputs in `values` (a read-only
-        view of every variable by name); return the new output values by name."""
+        view of every variable by name); return the new output values by name. FmuSlave copies
+        them into its table at once, so a model may refill and return the same dict each step."""
         ...
 
     def set_parameter(self, name: str, value: Any) -> None:
@@ -124,6 +130,7 @@ class FmuSlave(Fmi2Slave):
         self._running = False
         for var in self.VARIABLES:
             self.register_variable(self._scalar_variable(var), nested=False)
+        self._fast_inputs, self._fast_reals, self._fast_integers = self._fast_tables()
         self._model: Model = self.create_model(self.model_parameters())
 
     # ----- to be provided by a concrete FMU ---------------------------------------------------
@@ -143,6 +150,29 @@ class FmuSlave(Fmi2Slave):
             getter=partial(self._values.__getitem__, var.name),
             setter=partial(self._set_value, var),
         )
+
+    def _fast_tables(self) -> tuple[dict[int, str], dict[int, str], dict[int, str]]:
+        """Value reference -> variable name, for the fast paths of set_real, get_real and
+        get_integer: the Real inputs (setting one is `_values[name] = float(value)`, all that
+        `_set_value` does for an input, as Variable.coerce of a Real is float()), every Real and
+        every Integer (an Enumeration is an FMI Integer) variable (getting one is
+        `float(_values[name])` / `int(_values[name])`, what pythonfmu's get_real/get_integer do
+        with the getters registered in `_scalar_variable`).
+
+        A subclass that overrides `_set_value` gets no fast inputs, so its own setter always
+        runs."""
+        by_name = {sv.name: vr for vr, sv in self.vars.items()}
+        own_setter = type(self)._set_value is not FmuSlave._set_value
+        inputs, reals, integers = {}, {}, {}
+        for var in self.VARIABLES:
+            vr = by_name[var.name]
+            if var.type == "Real":
+                reals[vr] = var.name
+                if var.causality == "input" and not own_setter:
+                    inputs[vr] = var.name
+            elif var.type in ("Integer", "Enumeration"):
+                integers[vr] = var.name
+        return inputs, reals, integers
 
     def model_parameters(self) -> dict[str, Any]:
         """The current parameter values in the form the model takes (enumerations as names)."""
@@ -202,8 +232,22 @@ class FmuSlave(Fmi2Slave):
             return False  # fmi2Discard
         return True
 
-    # ----- guarded pythonfmu entry points -------------------------------------------------------
+    # ----- pythonfmu entry points: fast paths, then the full guarded path -----------------------
+    # pythonfmu's C++ wrapper calls these once per fmi2SetReal/fmi2GetReal/... with lists of
+    # value references (and values); their Python cost is paid on every step of every host.
+    # A fast path handles the calls a host makes every step with one dict operation per value;
+    # any exception in it (a reference it does not handle, a value that does not convert) sends
+    # the whole call to the full path, which logs exactly as before. The full path repeats the
+    # call from the start: the inputs the fast path may already have written are written again
+    # with the same values, and the fast getters write nothing.
     def get_real(self, vrs: list[int]) -> list[float]:
+        try:
+            values, names = self._values, self._fast_reals
+            return [float(values[names[vr]]) for vr in vrs]
+        except Exception:
+            return self._get_real_guarded(vrs)
+
+    def _get_real_guarded(self, vrs: list[int]) -> list[float]:
         try:
             return super().get_real(vrs)
         except Exception:
@@ -211,6 +255,13 @@ class FmuSlave(Fmi2Slave):
             return [float("nan")] * len(vrs)
 
     def get_integer(self, vrs: list[int]) -> list[int]:
+        try:
+            values, names = self._values, self._fast_integers
+            return [int(values[names[vr]]) for vr in vrs]
+        except Exception:
+            return self._get_integer_guarded(vrs)
+
+    def _get_integer_guarded(self, vrs: list[int]) -> list[int]:
         try:
             return super().get_integer(vrs)
         except Exception:
@@ -225,7 +276,15 @@ class FmuSlave(Fmi2Slave):
             return [False] * len(vrs)
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
-        self._guard(super().set_real, "fmi2SetReal", vrs, values)
+        # Fast path: only Real inputs (a host's every step). Inputs are stored, never checked
+        # here: a bad sample is the model's to reject at doStep (invalid_samples counts it).
+        # zip stops at the shorter list, as in pythonfmu's set_real.
+        try:
+            table, names = self._values, self._fast_inputs
+            for vr, value in zip(vrs, values, strict=False):
+                table[names[vr]] = float(value)
+        except Exception:
+            self._guard(super().set_real, "fmi2SetReal", vrs, values)
 
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
         self._guard(super().set_integer, "fmi2SetInteger", vrs, values)

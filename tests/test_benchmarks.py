@@ -65,6 +65,17 @@ def test_fmu_step_and_overhead_per_estimator(bench_json: dict) -> None:
             step - bench_json["fmu_core_us"][key])
 
 
+def test_fmu_floor_is_timed_beside_every_estimator(bench_json: dict) -> None:
+    """The floor FMU (FMI calls that return at once) is timed in turn with each estimator FMU,
+    through both hosts."""
+    for key in ESTIMATOR_KEYS:
+        detail = bench_json["fmu_step_detail"][key]
+        for host in ("api", "lowlevel"):
+            assert detail[f"floor_{host}"]["median_us"] > 0.0
+            assert len(detail[f"floor_{host}"]["passes_us"]) == len(detail[host]["passes_us"])
+            assert bench_json["fmu_floor_us"][key][host] == detail[f"floor_{host}"]["median_us"]
+
+
 def test_testbench_at_100_hz_and_1_khz(bench_json: dict) -> None:
     for rate, hz in (("100Hz", 100.0), ("1000Hz", 1000.0)):
         x = bench_json["testbench"]["kf"][rate]
