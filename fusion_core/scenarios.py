@@ -23,10 +23,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
-import numpy as np
-
-from .synthetic import Signal, Trajectory, add, constant, min_jerk, sine
+from .synthetic import VECTOR, Ops, Signal, Trajectory, add, constant, min_jerk, sine
 from .types import DEG, G
 
 
@@ -35,10 +34,11 @@ def swelling_sine(peak: float, freq: float, env_period: float, phase: float = 0.
     w = 2.0 * math.pi * freq
     we = 2.0 * math.pi / env_period
 
-    def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        ce, se = np.cos(we * t), np.sin(we * t)
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        env, arg = we * t, w * t + phase
+        ce, se = ops.cos(env), ops.sin(env)
         e, de, dde = 0.5 * (1 - ce), 0.5 * we * se, 0.5 * we**2 * ce
-        c, s = np.cos(w * t + phase), np.sin(w * t + phase)
+        c, s = ops.cos(arg), ops.sin(arg)
         ds, dds = w * c, -w * w * s
         return peak * e * s, peak * (de * s + e * ds), peak * (dde * s + 2 * de * ds + e * dds)
 

@@ -77,15 +77,20 @@ class ImuSensorModel:
         if not h > 0.0:
             raise ValueError(f"interval h={h!r} s must be > 0")
         z = self.rng.standard_normal(13).tolist()
+        # Written out per axis: this runs once per testbench step (the ImuSensor FMU's doStep).
+        gb, ab = self.gyro_bias, self.acc_bias
         gw, aw = math.sqrt(p["gyro_bias_psd"] * h), math.sqrt(p["acc_bias_psd"] * h)
-        for i in range(3):
-            self.gyro_bias[i] += gw * z[6 + i]
-            self.acc_bias[i] += aw * z[9 + i]
+        gb[0] += gw * z[6]
+        gb[1] += gw * z[7]
+        gb[2] += gw * z[8]
+        ab[0] += aw * z[9]
+        ab[1] += aw * z[10]
+        ab[2] += aw * z[11]
         gn, an = math.sqrt(p["gyro_psd"] / h), math.sqrt(p["acc_psd"] / h)
-        gyro = [omega[i] + self.gyro_bias[i] + gn * z[i] for i in range(3)]
-        acc = [f[i] + self.acc_bias[i] + an * z[3 + i] for i in range(3)]
-        gyro = _convert(gyro, p["gyro_range"], p["bits"])
-        acc = _convert(acc, p["acc_range"], p["bits"])
+        gyro = _convert(omega[0] + gb[0] + gn * z[0], omega[1] + gb[1] + gn * z[1],
+                        omega[2] + gb[2] + gn * z[2], p["gyro_range"], p["bits"])
+        acc = _convert(f[0] + ab[0] + an * z[3], f[1] + ab[1] + an * z[4],
+                       f[2] + ab[2] + an * z[5], p["acc_range"], p["bits"])
         dt = h
         if p["jitter"] > 0.0:
             new_error = p["jitter"] * z[12]
@@ -123,10 +128,18 @@ class ImuSensorModel:
         self.time_error = float(state["time_error"])
 
 
-def _convert(values: list[float], full_scale: float, bits: int) -> tuple[float, float, float]:
+def _saturate(v: float, full_scale: float) -> float:
+    """v clipped to [-full_scale, full_scale] (a NaN stays NaN)."""
+    v = v if v > -full_scale else -full_scale
+    return v if full_scale > v else full_scale
+
+
+def _convert(
+    x: float, y: float, z: float, full_scale: float, bits: int
+) -> tuple[float, float, float]:
     """Saturate at +-full_scale, then round to the converter's step 2 full_scale / 2^bits."""
-    out = [min(full_scale, max(-full_scale, v)) for v in values]
+    x, y, z = _saturate(x, full_scale), _saturate(y, full_scale), _saturate(z, full_scale)
     if bits:
         lsb = 2.0 * full_scale / 2.0**bits
-        out = [round(v / lsb) * lsb for v in out]
-    return out[0], out[1], out[2]
+        return round(x / lsb) * lsb, round(y / lsb) * lsb, round(z / lsb) * lsb
+    return x, y, z

@@ -8,6 +8,16 @@ differences:
     q = theta_dot cos(phi) + psi_dot sin(phi) cos(theta)
     r = psi_dot cos(phi) cos(theta) - theta_dot sin(phi)
   specific force  f = R^T (a + g e_z), R = Rz(psi) Ry(theta) Rx(phi) (body to world, z up).
+
+Every formula is written once and evaluated two ways: on an array of times with numpy
+(`Trajectory.truth`, recordings and tests) and on one float time with plain math
+(`Trajectory.truth_at`, the plant FMU's one evaluation per step, where numpy's per-call overhead
+on one-element arrays made it some 30 times slower). A formula sees the difference only through
+`Ops` (sin, cos, clip, where, zeros_like); + - * / are IEEE operations in both, and no formula
+raises a time-dependent value to a power (on CPUs with AVX-512 numpy computes array powers with
+a vectorised pow whose last bit differs from libm's). So both paths give the same floats wherever
+numpy's sin and cos are libm's (bit-identical with the numpy builds tested here; within an ulp
+otherwise).
 """
 
 from __future__ import annotations
@@ -15,18 +25,44 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
 from .types import DEG, G
 
-Signal = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
-"""t -> (value, first derivative, second derivative)."""
+
+class Ops(NamedTuple):
+    """What a signal's formula uses besides + - * /: numpy's functions for an array of times
+    (VECTOR) or plain math for one float time (SCALAR)."""
+
+    sin: Callable[[Any], Any]
+    cos: Callable[[Any], Any]
+    clip: Callable[[Any, float, float], Any]
+    where: Callable[[Any, Any, Any], Any]
+    zeros_like: Callable[[Any], Any]
+
+
+VECTOR = Ops(np.sin, np.cos, np.clip, np.where, np.zeros_like)
+SCALAR = Ops(
+    math.sin,
+    math.cos,
+    lambda x, low, high: min(max(x, low), high),  # np.clip of one value
+    lambda condition, a, b: a if condition else b,  # np.where of one value
+    lambda t: 0.0,
+)
+
+
+class Signal(Protocol):
+    """t -> (value, first derivative, second derivative): `s(t)` on an array of times (numpy),
+    `s(t, SCALAR)` on one float time (plain floats)."""
+
+    def __call__(self, t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]: ...
 
 
 def constant(value: float = 0.0) -> Signal:
-    def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        z = np.zeros_like(t)
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        z = ops.zeros_like(t)
         return z + value, z, z
 
     return f
@@ -36,34 +72,49 @@ def sine(amplitude: float, freq: float, phase: float = 0.0, offset: float = 0.0)
     """offset + amplitude sin(2 pi freq t + phase)."""
     w = 2.0 * math.pi * freq
 
-    def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s, c = np.sin(w * t + phase), np.cos(w * t + phase)
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        arg = w * t + phase
+        s, c = ops.sin(arg), ops.cos(arg)
         return offset + amplitude * s, amplitude * w * c, -amplitude * w * w * s
 
     return f
 
 
 def add(*signals: Signal) -> Signal:
-    def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        parts = [s(t) for s in signals]
-        return tuple(sum(p[i] for p in parts) for i in range(3))  # type: ignore[return-value]
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        # 0 + s1 + s2 + ... from left to right, as sum() did in Python < 3.12 (from 3.12 on,
+        # sum() of floats compensates rounding errors, which numpy's + does not)
+        v, dv, ddv = 0.0, 0.0, 0.0
+        for s in signals:
+            a, da, dda = s(t, ops)
+            v, dv, ddv = v + a, dv + da, ddv + dda
+        return v, dv, ddv
 
     return f
 
 
 def min_jerk(start: float, end: float, t0: float, duration: float) -> Signal:
-    """Minimum-jerk move from start to end over [t0, t0 + duration], at rest before and after."""
+    """Minimum-jerk move from start to end over [t0, t0 + duration], at rest before and after:
+    start + d (10 s^3 - 15 s^4 + 6 s^5), s = (t - t0) / duration, d = end - start."""
     d = end - start
 
-    def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s = np.clip((t - t0) / duration, 0.0, 1.0)
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        s = ops.clip((t - t0) / duration, 0.0, 1.0)
         inside = (t > t0) & (t < t0 + duration)
-        pos = start + d * (10 * s**3 - 15 * s**4 + 6 * s**5)
-        vel = np.where(inside, d * (30 * s**2 - 60 * s**3 + 30 * s**4) / duration, 0.0)
-        acc = np.where(inside, d * (60 * s - 180 * s**2 + 120 * s**3) / duration**2, 0.0)
+        # the polynomial and its derivatives in s, in Horner form (products and sums only)
+        pos = start + d * (s * s * s * (10.0 + s * (-15.0 + 6.0 * s)))
+        vel = ops.where(inside, d * (s * s * (30.0 + s * (-60.0 + 30.0 * s))) / duration, 0.0)
+        acc = ops.where(inside, d * (s * (60.0 + s * (-180.0 + 120.0 * s))) / duration**2, 0.0)
         return pos, vel, acc
 
     return f
+
+
+TRUTH_NAMES = (
+    "roll", "pitch", "yaw", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z",
+    "pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z",
+)
+"""The truth at one time as `Trajectory.truth_at` returns it (the plant FMU's outputs)."""
 
 
 @dataclass
@@ -80,24 +131,39 @@ class Trajectory:
     def truth(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Truth at times t: angles, body rates omega [N,3], specific force f [N,3], pos, vel."""
         t = np.asarray(t, dtype=float)
-        phi, dphi, _ = self.roll(t)
-        theta, dtheta, _ = self.pitch(t)
-        psi, dpsi, _ = self.yaw(t)
-        sphi, cphi = np.sin(phi), np.cos(phi)
-        sth, cth = np.sin(theta), np.cos(theta)
-        spsi, cpsi = np.sin(psi), np.cos(psi)
-        omega = np.stack(
-            [
-                dphi - dpsi * sth,
-                dtheta * cphi + dpsi * sphi * cth,
-                dpsi * cphi * cth - dtheta * sphi,
-            ],
-            axis=-1,
+        x, acc = self._evaluate(t, VECTOR)
+        acc_world = np.stack(acc, axis=-1)
+
+        def vector(i: int) -> np.ndarray:
+            return np.stack(x[i:i + 3], axis=-1)
+
+        return {
+            "t": t, "roll": x[0], "pitch": x[1], "yaw": x[2], "omega": vector(3), "f": vector(6),
+            "pos": vector(9), "vel": vector(12), "acc": acc_world - np.array([0.0, 0.0, G]),
+        }
+
+    def truth_at(self, t: float) -> tuple[float, ...]:
+        """Truth at one time t, in plain floats, named by TRUTH_NAMES: the same values as
+        truth() at that time, without numpy (the plant FMU calls it once per step)."""
+        return self._evaluate(float(t), SCALAR)[0]
+
+    def _evaluate(self, t: Any, ops: Ops) -> tuple[tuple[Any, ...], tuple[Any, Any, Any]]:
+        """The truth's components in the order of TRUTH_NAMES, and a + g e_z (world frame)."""
+        sin, cos = ops.sin, ops.cos
+        phi, dphi, _ = self.roll(t, ops)
+        theta, dtheta, _ = self.pitch(t, ops)
+        psi, dpsi, _ = self.yaw(t, ops)
+        sphi, cphi = sin(phi), cos(phi)
+        sth, cth = sin(theta), cos(theta)
+        spsi, cpsi = sin(psi), cos(psi)
+        omega = (
+            dphi - dpsi * sth,
+            dtheta * cphi + dpsi * sphi * cth,
+            dpsi * cphi * cth - dtheta * sphi,
         )
-        px, py, pz = (s(t) for s in self.pos)
-        pos = np.stack([px[0], py[0], pz[0]], axis=-1)
-        vel = np.stack([px[1], py[1], pz[1]], axis=-1)
-        acc_world = np.stack([px[2], py[2], pz[2] + G], axis=-1)  # a + g e_z
+        pos_x, pos_y, pos_z = self.pos
+        px, py, pz = pos_x(t, ops), pos_y(t, ops), pos_z(t, ops)
+        ax, ay, az = px[2], py[2], pz[2] + G  # a + g e_z
         # R = Rz Ry Rx; f = R^T (a + g e_z), written out row by row of R^T.
         r00, r01, r02 = cpsi * cth, spsi * cth, -sth
         r10 = cpsi * sth * sphi - spsi * cphi
@@ -106,16 +172,12 @@ class Trajectory:
         r20 = cpsi * sth * cphi + spsi * sphi
         r21 = spsi * sth * cphi - cpsi * sphi
         r22 = cth * cphi
-        ax, ay, az = acc_world[..., 0], acc_world[..., 1], acc_world[..., 2]
-        f = np.stack(
-            [r00 * ax + r01 * ay + r02 * az, r10 * ax + r11 * ay + r12 * az,
-             r20 * ax + r21 * ay + r22 * az],
-            axis=-1,
+        f = (
+            r00 * ax + r01 * ay + r02 * az,
+            r10 * ax + r11 * ay + r12 * az,
+            r20 * ax + r21 * ay + r22 * az,
         )
-        return {
-            "t": t, "roll": phi, "pitch": theta, "yaw": psi, "omega": omega, "f": f,
-            "pos": pos, "vel": vel, "acc": acc_world - np.array([0.0, 0.0, G]),
-        }
+        return (phi, theta, psi, *omega, *f, px[0], py[0], pz[0], px[1], py[1], pz[1]), (ax, ay, az)
 
 
 @dataclass(frozen=True)

@@ -5,30 +5,55 @@ Per communication step [t, t+h] (INTERFACE.md, Timing):
   2. sensor inputs := plant outputs; sensor.doStep(t, h): the IMU sample taken at t+h, dt = h;
   3. estimator inputs := sensor outputs; estimator.doStep(t, h): the estimate at t+h.
 With jitter > 0 the communication steps are h_k = (1 + jitter u_k) / rate, u_k uniform in
-[-1, 1] from the run's seed, so dt follows. Every FMI call's status is checked (fmpy raises on
-anything but fmi2OK); the wall time of set-inputs + doStep + get-outputs of the estimator is
-recorded per step for contract check T3.
+[-1, 1] from the run's seed, so dt follows. Every FMI call's status is checked (fmpy's wrapped
+FMI functions raise FMICallException on fmi2Discard, fmi2Error and fmi2Fatal); the wall time of
+set-inputs + doStep + get-outputs of the estimator is recorded per step for contract check T3.
+
+The step loop is the hot path of every campaign (at 1 kHz the FMUs are called 9000 times per
+simulated second), so it calls fmpy's low-level fmi2SetReal/fmi2DoStep/fmi2GetReal on ctypes
+arrays allocated once, instead of setReal/getReal, which build new arrays from Python lists on
+every call. The arrays are views of one row of doubles laid out like the recording (truth,
+sample, estimate): the plant writes the truth into it, the sensor reads its inputs from the
+truth part and writes the sample, the estimator reads the sample and writes the estimate, and
+each step ends with one copy of the row into the preallocated record. The values are the same
+doubles the list-based calls passed on.
 """
 
 from __future__ import annotations
 
 import time
+from ctypes import sizeof
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from fmpy.fmi2 import fmi2Real, fmi2True, fmi2ValueReference
 
 from fusion_core.scenarios import get_scenario
+from fusion_core.synthetic import TRUTH_NAMES
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, FmuHandle, fmu_path
 
-TRUTH = ("roll", "pitch", "yaw", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z",
-         "pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z")
+TRUTH = TRUTH_NAMES
+"""The plant's outputs, recorded in this order."""
 SENSOR_IN = ("omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z")
 SAMPLE = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt")
 ESTIMATE = ("roll", "pitch", "bias_x", "bias_y", "bias_z")
 POSITION = ("pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z")
+_SENSOR_IN_AT = TRUTH.index(SENSOR_IN[0])
+"""Where the sensor's inputs start among the plant outputs (they are consecutive there)."""
+assert TRUTH[_SENSOR_IN_AT:_SENSOR_IN_AT + len(SENSOR_IN)] == SENSOR_IN
+
+
+def _refs(value_references: list[int]) -> Any:
+    """The value references as a ctypes array (made once per run, passed on every call)."""
+    return (fmi2ValueReference * len(value_references))(*value_references)
+
+
+def _view(row: Any, start: int, count: int) -> Any:
+    """count doubles of the ctypes array row from index start on, sharing its memory."""
+    return (fmi2Real * count).from_buffer(row, start * sizeof(fmi2Real))
 
 
 @dataclass
@@ -116,27 +141,40 @@ def run_testbench(
         bias_vr = sensor.vrs([f"gyro_bias_{a}" for a in "xyz"])
         true_bias = tuple(sensor.fmu.getReal(bias_vr))
 
-        truth = np.empty((n, len(TRUTH)))
-        sample = np.empty((n, len(SAMPLE)))
-        out = np.empty((n, len(est_out_vr)))
+        # The row (see the module docstring): truth | sample | estimate, and views of its parts.
+        n_truth, n_in, n_sample, n_out = len(TRUTH), len(SENSOR_IN), len(SAMPLE), len(est_out_vr)
+        row = (fmi2Real * (n_truth + n_sample + n_out))()
+        truth_buf = _view(row, 0, n_truth)
+        sensor_in_buf = _view(row, _SENSOR_IN_AT, n_in)
+        sample_buf = _view(row, n_truth, n_sample)
+        out_buf = _view(row, n_truth + n_sample, n_out)
+        row_np = np.frombuffer(row, dtype=np.float64)  # the same memory, for the record
+        record = np.empty((n, len(row)))
         step_ns = np.empty(n, dtype=np.int64)
         t_points = np.empty(n)
+
         p_fmu, s_fmu, e_fmu = plant.fmu, sensor.fmu, est.fmu
+        p_c, s_c, e_c = p_fmu.component, s_fmu.component, e_fmu.component
+        p_step, p_get = p_fmu.fmi2DoStep, p_fmu.fmi2GetReal
+        s_set, s_step, s_get = s_fmu.fmi2SetReal, s_fmu.fmi2DoStep, s_fmu.fmi2GetReal
+        e_set, e_step, e_get = e_fmu.fmi2SetReal, e_fmu.fmi2DoStep, e_fmu.fmi2GetReal
+        truth_refs, sample_refs = _refs(truth_vr), _refs(sample_vr)
+        sensor_in_refs, est_in_refs = _refs(sensor_in_vr), _refs(est_in_vr)
+        est_out_refs = _refs(est_out_vr)
         perf = time.perf_counter_ns
         t = 0.0
-        for k in range(n):
-            h = float(steps[k])
-            p_fmu.doStep(t, h)
-            tr = p_fmu.getReal(truth_vr)
-            s_fmu.setReal(sensor_in_vr, tr[3:9])
-            s_fmu.doStep(t, h)
-            smp = s_fmu.getReal(sample_vr)
+        for k, h in enumerate(steps.tolist()):
+            p_step(p_c, t, h, fmi2True)
+            p_get(p_c, truth_refs, n_truth, truth_buf)
+            s_set(s_c, sensor_in_refs, n_in, sensor_in_buf)
+            s_step(s_c, t, h, fmi2True)
+            s_get(s_c, sample_refs, n_sample, sample_buf)
             t0 = perf()
-            e_fmu.setReal(est_in_vr, smp)
-            e_fmu.doStep(t, h)
-            o = e_fmu.getReal(est_out_vr)
+            e_set(e_c, est_in_refs, n_sample, sample_buf)
+            e_step(e_c, t, h, fmi2True)
+            e_get(e_c, est_out_refs, n_out, out_buf)
             step_ns[k] = perf() - t0
-            truth[k], sample[k], out[k] = tr, smp, o
+            record[k] = row_np
             t += h
             t_points[k] = t
         invalid = int(e_fmu.getInteger(invalid_vr)[0])
@@ -144,6 +182,10 @@ def run_testbench(
         for handle in (est, sensor, plant):
             handle.free()
 
+    # Each part as its own C-ordered array, the layout the traces always had.
+    truth = record[:, :n_truth].copy()
+    sample = record[:, n_truth:n_truth + n_sample].copy()
+    out = record[:, n_truth + n_sample:].copy()
     names = ESTIMATE + (POSITION if position else ())
     result = TestbenchResult(
         estimator=estimator, scenario=sc.name, seed=seed, rate=rate, jitter=jitter,

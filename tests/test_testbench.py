@@ -14,12 +14,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from fmpy.fmi1 import FMICallException
 
 from fusion_core import DEG, ESTIMATORS, G
 from fusion_core.kinematics import euler_rates
 from fusion_core.scenarios import SCENARIOS
 from fusion_core.sensor import ImuSensorModel
-from testbenches import contract, run_testbench
+from testbenches import contract, master, run_testbench
 
 REPO = Path(__file__).resolve().parent.parent
 KEYS = tuple(ESTIMATORS)
@@ -56,6 +57,35 @@ def test_plant_outputs_are_the_truth_at_the_end_of_each_step(fmu_dir: Path) -> N
     truth = SCENARIOS["roll_sweep"].trajectory().truth(r.t)
     assert r.t[0] == pytest.approx(0.01)
     assert np.max(np.abs(truth["roll"] - r.truth["roll"])) < 1e-12
+
+
+def test_every_plant_output_is_the_truth_and_the_sensor_samples_that_step(fmu_dir: Path) -> None:
+    """At 1 kHz with jittered steps, on rotation plus linear acceleration (high_dynamics: its
+    first move starts at 2 s), all 15 plant outputs are Trajectory.truth at t_k; a noise-free
+    sensor without quantisation passes that step's omega and f on unchanged, with dt = h_k (the
+    master wires each step's plant outputs to the sensor and the sample to the estimator)."""
+    r = run_testbench("kf", "high_dynamics", duration=3.0, rate=1000.0, jitter=0.2, seed=5,
+                      fmu_dir=fmu_dir, sensor_params=contract.NOISE_FREE, evaluate=False)
+    truth = SCENARIOS["high_dynamics"].trajectory().truth(r.t)
+    for name in ("roll", "pitch", "yaw"):
+        np.testing.assert_allclose(r.truth[name], truth[name], rtol=0.0, atol=1e-12)
+    for key in ("omega", "f", "pos", "vel"):
+        for i, a in enumerate("xyz"):
+            np.testing.assert_allclose(r.truth[f"{key}_{a}"], truth[key][:, i], rtol=0.0,
+                                       atol=1e-12)
+    for a in "xyz":
+        assert np.array_equal(r.sample[f"gyro_{a}"], r.truth[f"omega_{a}"])
+        assert np.array_equal(r.sample[f"acc_{a}"], r.truth[f"f_{a}"])
+    assert np.array_equal(r.sample["dt"], master.communication_steps(3.0, 1000.0, 0.2, 5))
+    assert np.ptp(r.truth["vel_x"]) > 1.0  # the move really happened
+
+
+def test_a_failed_fmi_call_stops_the_master(fmu_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every FMI status is checked: a communication step h = 0 makes the sensor's doStep fail
+    (fmi2Discard), and the run raises instead of recording the step."""
+    monkeypatch.setattr(master, "communication_steps", lambda *args: np.array([0.01, 0.0, 0.01]))
+    with pytest.raises(FMICallException, match="fmi2DoStep"):
+        run_testbench("cf", "roll_sweep", duration=0.03, fmu_dir=fmu_dir, evaluate=False)
 
 
 # ----- contract checks T1-T4 on short scenarios ---------------------------------------------------

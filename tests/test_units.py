@@ -29,7 +29,7 @@ def test_power_spectral_density_units_have_integer_base_units(unit, expected):
 
 @pytest.mark.parametrize("unit", ["rad/(s.sqrt(Hz))", "rad/(s.sqrt(s))", "m/(s2.sqrt(Hz))"])
 def test_a_half_power_unit_is_refused_with_the_way_out(unit):
-    with pytest.raises(UnitError, match="non-integer SI exponents.*power spectral density"):
+    with pytest.raises(UnitError, match=r"non-integer SI exponents.*power spectral density"):
         base_unit_attributes(unit)
 
 

@@ -9,12 +9,10 @@ kinematics), the specific force R^T (a + g e_z) in the body frame, position and 
 from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
-
 from fmu_src.slave import FmiLog, FmuSlave
 from fmu_src.variables import Variable, real_output
 from fusion_core.scenarios import SCENARIO_BY_ID, SCENARIOS, get_scenario
-from fusion_core.synthetic import Trajectory
+from fusion_core.synthetic import TRUTH_NAMES, Trajectory
 
 _ENUM = ", ".join(f"{s.id} = {s.name} ({s.description})" for s in SCENARIOS.values())
 _AXIS = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
@@ -30,14 +28,9 @@ _OUTPUTS = (
 
 
 def _truth(trajectory: Trajectory, t: float) -> dict[str, float]:
-    """The output values: the trajectory's truth at time t, by variable name."""
-    d = trajectory.truth(np.array([t]))
-    out = {"roll": float(d["roll"][0]), "pitch": float(d["pitch"][0]), "yaw": float(d["yaw"][0])}
-    for key in ("omega", "f", "pos", "vel"):
-        row = d[key][0]
-        for i, a in enumerate("xyz"):
-            out[f"{key}_{a}"] = float(row[i])
-    return out
+    """The output values: the trajectory's truth at time t, by variable name (plain-float
+    evaluation: the same values as Trajectory.truth, without numpy's per-call cost)."""
+    return dict(zip(TRUTH_NAMES, trajectory.truth_at(t), strict=True))
 
 
 class PlantModel:
