@@ -44,11 +44,6 @@ class _NoOpEstimator(Estimator):
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         pass
 
-    def _update(
-        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> None:
-        pass
-
     def _estimate(self) -> Estimate:
         return _ZERO
 

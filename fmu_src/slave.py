@@ -245,35 +245,17 @@ class FmuSlave(Fmi2Slave):
             values, names = self._values, self._fast_reals
             return [float(values[names[vr]]) for vr in vrs]
         except Exception:
-            return self._get_real_guarded(vrs)
-
-    def _get_real_guarded(self, vrs: list[int]) -> list[float]:
-        try:
-            return super().get_real(vrs)
-        except Exception:
-            self._log_exception(f"fmi2GetReal{tuple(vrs)}")
-            return [float("nan")] * len(vrs)
+            return self._guard_get(super().get_real, "fmi2GetReal", vrs, float("nan"))
 
     def get_integer(self, vrs: list[int]) -> list[int]:
         try:
             values, names = self._values, self._fast_integers
             return [int(values[names[vr]]) for vr in vrs]
         except Exception:
-            return self._get_integer_guarded(vrs)
-
-    def _get_integer_guarded(self, vrs: list[int]) -> list[int]:
-        try:
-            return super().get_integer(vrs)
-        except Exception:
-            self._log_exception(f"fmi2GetInteger{tuple(vrs)}")
-            return [0] * len(vrs)
+            return self._guard_get(super().get_integer, "fmi2GetInteger", vrs, 0)
 
     def get_boolean(self, vrs: list[int]) -> list[bool]:
-        try:
-            return super().get_boolean(vrs)
-        except Exception:
-            self._log_exception(f"fmi2GetBoolean{tuple(vrs)}")
-            return [False] * len(vrs)
+        return self._guard_get(super().get_boolean, "fmi2GetBoolean", vrs, False)
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
         # Fast path: only Real inputs (a host's every step). Inputs are stored, never checked
@@ -297,6 +279,14 @@ class FmuSlave(Fmi2Slave):
             setter(vrs, values)
         except Exception:
             self._log_exception(f"{what}{tuple(vrs)}")
+
+    def _guard_get(self, getter: Any, what: str, vrs: list[int], default: Any) -> list[Any]:
+        """getter(vrs), or `default` for every reference when it raises (logged)."""
+        try:
+            return getter(vrs)
+        except Exception:
+            self._log_exception(f"{what}{tuple(vrs)}")
+            return [default] * len(vrs)
 
     def _log_exception(self, what: str) -> None:
         self._fmi_log.error(f"{what} failed, call ignored:\n{traceback.format_exc()}")

@@ -48,6 +48,8 @@ SENSOR_PARAMS: tuple[Param, ...] = (
           "Standard deviation of the sample-time error: the reported dt is the interval plus the "
           "difference of two successive timestamp errors", unit="s", low=0.0),
 )
+_SPECS = {p.name: p for p in SENSOR_PARAMS}
+"""SENSOR_PARAMS by name."""
 
 
 class ImuSensorModel:
@@ -56,10 +58,9 @@ class ImuSensorModel:
     PARAMS = SENSOR_PARAMS
 
     def __init__(self, **params: Any) -> None:
-        specs = {p.name: p for p in SENSOR_PARAMS}
-        check_param_names(params, specs, "the IMU sensor model")
-        self.params = {name: spec.default for name, spec in specs.items()}
-        self.params.update({k: specs[k].validate(v) for k, v in params.items()})
+        check_param_names(params, _SPECS, "the IMU sensor model")
+        self.params = {name: spec.default for name, spec in _SPECS.items()}
+        self.params.update({k: _SPECS[k].validate(v) for k, v in params.items()})
         self.reset()
 
     def reset(self) -> None:
@@ -100,9 +101,8 @@ class ImuSensorModel:
 
     def set_param(self, name: str, value: Any) -> None:
         """Change a tunable parameter between samples (a bias takes its new value now)."""
-        specs = {p.name: p for p in SENSOR_PARAMS}
-        check_param_names((name,), specs, "the IMU sensor model")
-        spec = specs[name]
+        check_param_names((name,), _SPECS, "the IMU sensor model")
+        spec = _SPECS[name]
         if not spec.tunable:
             raise ValueError(f"sensor parameter {name!r} is fixed after the start")
         self.params[name] = spec.validate(value)
