@@ -26,7 +26,7 @@ from .kinematics import (
     rotation_increment,
     wrap_angle,
 )
-from .types import DEG, Estimate, G, Param
+from .types import DEG, MPU6050_GYRO_DENSITY, Estimate, G, Param
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
@@ -119,6 +119,19 @@ not observable from the accelerometer at all while the sensor is level. The dete
 (Laidig & Seel 2023): the rate and the specific force must stay within the thresholds of their
 running means (time constant REST_MEAN_TAU) for rest_time; its defaults (2 deg/s, 0.5 m/s^2)
 are VQF's restThGyr and restThAcc."""
+
+
+def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
+    """The gyro white-noise PSD of the zero-angular-rate update at rest (REST_PARAMS), whose
+    measurement variance is PSD / dt; default the MPU-6050's. The UKF names it zaru_psd, since
+    its gyro_psd is its process noise."""
+    return Param(
+        name, MPU6050_GYRO_DENSITY**2,
+        "Gyro white-noise power spectral density of the zero-angular-rate update at rest: its "
+        "variance is this / dt (the rate-noise density squared; MPU-6050: "
+        "(0.005 deg/s/sqrt(Hz))^2)",
+        unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
+    )
 
 
 def quat_yaw(w: float, x: float, y: float, z: float) -> float:

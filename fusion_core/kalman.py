@@ -30,6 +30,7 @@ from .complementary import (
     lowpass_specific_force,
     quat_with_roll_pitch,
     rest_step,
+    zero_rate_psd_param,
 )
 from .kinematics import (
     HALF_PI,
@@ -152,12 +153,7 @@ class AngleBiasKalmanFilter(Estimator):
         *ACC_GATE_PARAMS,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
-        Param(
-            "gyro_psd", (0.005 * DEG) ** 2,
-            "Gyro white-noise power spectral density; gyro_psd/dt is the variance of the "
-            "zero-angular-rate update at rest (MPU-6050: (0.005 deg/s/sqrt(Hz))^2)",
-            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
-        ),
+        zero_rate_psd_param(),
         Param(
             "init_bias_std", 0.0,
             "Initial standard deviation of the gyro-bias states (0: P = 0 at the first sample, "

@@ -20,9 +20,10 @@ from __future__ import annotations
 from math import cos, sin, sqrt
 
 from .base import Estimator, tuple_new
+from .complementary import zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
-from .types import DEG, Estimate, G, Param
+from .types import DEG, MPU6050_ACC_DENSITY, Estimate, G, Param
 
 TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "integration")
 """Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
@@ -180,7 +181,7 @@ class PositionKalmanFilter(Estimator):
         Param("q", 1.0, "Jerk noise power spectral density per axis", unit="m2/s5", low=0.0,
               low_open=True),
         Param(
-            "acc_psd", (400e-6 * G) ** 2,
+            "acc_psd", MPU6050_ACC_DENSITY**2,
             "Accelerometer white-noise power spectral density, R = acc_psd/dt (MPU-6050: "
             "(400 ug/sqrt(Hz))^2)",
             unit="m2/s3", low=0.0, low_open=True,
@@ -223,12 +224,7 @@ class PositionKalmanFilter(Estimator):
             "zaru", True,
             "Zero-angular-rate update of the tilt stage's gyro biases while stationary",
         ),
-        Param(
-            "gyro_psd", (0.005 * DEG) ** 2,
-            "Gyro white-noise power spectral density, for the zero-rate update (MPU-6050: "
-            "(0.005 deg/s/sqrt(Hz))^2)",
-            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
-        ),
+        zero_rate_psd_param(),
         Param(
             "tilt_update", "stationary",
             "When the tilt filter uses the accelerometer: 'stationary' or 'always' (the papers')",

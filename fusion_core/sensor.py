@@ -18,15 +18,22 @@ from typing import Any
 
 import numpy as np
 
-from .types import DEG, G, Param, check_param_names
+from .types import (
+    DEG,
+    MPU6050_ACC_DENSITY,
+    MPU6050_GYRO_DENSITY,
+    G,
+    Param,
+    check_param_names,
+)
 
 SENSOR_PARAMS: tuple[Param, ...] = (
     Param("seed", 0, "Seed of the noise generator (same seed, same samples)", low=0, high=2**31 - 1,
           tunable=False),
-    Param("gyro_psd", (0.005 * DEG) ** 2,
+    Param("gyro_psd", MPU6050_GYRO_DENSITY**2,
           "Gyro white-noise power spectral density (the rate-noise density squared; MPU-6050: "
           "(0.005 deg/s/sqrt(Hz))^2)", unit="rad2/s", low=0.0, display_unit="deg2/s"),
-    Param("acc_psd", (400e-6 * G) ** 2,
+    Param("acc_psd", MPU6050_ACC_DENSITY**2,
           "Accelerometer white-noise power spectral density (the noise density squared; "
           "MPU-6050: (400 ug/sqrt(Hz))^2)", unit="m2/s3", low=0.0),
     *(Param(f"gyro_bias_{a}", 0.0, f"Constant gyro bias, {a} axis", unit="rad/s",

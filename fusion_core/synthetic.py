@@ -29,7 +29,7 @@ from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
-from .types import DEG, G
+from .types import MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
 
 
 class Ops(NamedTuple):
@@ -187,8 +187,8 @@ class ImuNoise:
     A continuous white noise of density n sampled every dt has standard deviation n / sqrt(dt).
     """
 
-    gyro_density: float = 0.005 * DEG  # rad/s/sqrt(Hz)
-    acc_density: float = 400e-6 * G  # m/s^2/sqrt(Hz)
+    gyro_density: float = MPU6050_GYRO_DENSITY  # rad/s/sqrt(Hz)
+    acc_density: float = MPU6050_ACC_DENSITY  # m/s^2/sqrt(Hz)
     gyro_bias: tuple[float, float, float] = (0.0, 0.0, 0.0)  # rad/s
     acc_bias: tuple[float, float, float] = (0.0, 0.0, 0.0)  # m/s^2
 

@@ -18,6 +18,11 @@ G = 9.80665
 DEG = math.pi / 180.0
 """One degree in radians."""
 
+MPU6050_GYRO_DENSITY = 0.005 * DEG
+"""MPU-6050 datasheet gyro rate-noise density [rad/s/sqrt(Hz)]; its square is the PSD [rad2/s]."""
+MPU6050_ACC_DENSITY = 400e-6 * G
+"""MPU-6050 datasheet accelerometer noise density, 400 ug/sqrt(Hz) [m/s^2/sqrt(Hz)]."""
+
 
 class Estimate(NamedTuple):
     """One estimator output: the estimate at the time of the sample just processed.

@@ -53,6 +53,7 @@ from .complementary import (
     body_rotation,
     lowpass_specific_force,
     rest_step,
+    zero_rate_psd_param,
 )
 from .kinematics import rotate_back
 from .types import DEG, Estimate, G, Param
@@ -125,12 +126,7 @@ class UnscentedKalmanFilter(Estimator):
         INTEGRATION_PARAM,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
-        Param(
-            "zaru_psd", (0.005 * DEG) ** 2,
-            "Gyro white-noise power spectral density of the zero-rate update at rest "
-            "(rest_time > 0; the rate-noise density squared)",
-            unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
-        ),
+        zero_rate_psd_param("zaru_psd"),
     )
     STATE = ("x", "P", "acc_f", "rest")
 
