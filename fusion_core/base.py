@@ -11,12 +11,20 @@ once here.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import Any, ClassVar
+from collections.abc import Callable, Sequence
+from typing import Any, ClassVar, Final
 
 import numpy as np
 
 from .types import Estimate, G, InvalidSample, Param, check_param_names
+
+try:  # class options for the mypyc-compiled core (fmu_src/compiled_core.py); else a no-op
+    from mypy_extensions import mypyc_attr
+except ImportError:  # a host without mypy_extensions runs the pure-Python modules
+
+    def mypyc_attr(*attrs: str, **kwattrs: object) -> Callable[[type], type]:  # type: ignore[misc]
+        return lambda cls: cls
+
 
 COMMON_PARAMS: tuple[Param, ...] = (
     Param(
@@ -30,12 +38,11 @@ INTEGRATION_PARAM = Param(
     "method on the Euler-rate kinematics) or 'rectangle' (the papers' rule: current rate times dt)",
     choices=("trapezoid", "rectangle"), tunable=False,
 )
-MIN_ACC_NORM = 0.1 * G
+MIN_ACC_NORM: Final = 0.1 * G
 """Accelerometer norm below which a sample is rejected (INTERFACE.md: 'norm near zero')."""
-RUN_CHUNK = 1024
+RUN_CHUNK: Final = 1024
 """Samples that run() converts to Python floats and collects at a time."""
-_MIN_ACC_NORM2 = MIN_ACC_NORM * MIN_ACC_NORM
-_isfinite = math.isfinite
+_MIN_ACC_NORM2: Final = MIN_ACC_NORM * MIN_ACC_NORM
 tuple_new = tuple.__new__
 """`tuple_new(Estimate, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
 without the NamedTuple's Python-level __new__: the hot paths build their estimate this way."""
@@ -62,6 +69,7 @@ def _restore(template: Any, value: Any) -> Any:
     return value
 
 
+@mypyc_attr(allow_interpreted_subclasses=True)  # reference filters and benchmarks subclass it
 class Estimator:
     """Base class of the five estimators. See the module docstring."""
 
@@ -177,7 +185,7 @@ class Estimator:
         # sum; _check_values says what is wrong only when this test fails.
         norm2 = ax * ax + ay * ay + az * az
         if not (
-            _isfinite(norm2 + gx + gy + gz + dt)
+            math.isfinite(norm2 + gx + gy + gz + dt)
             and norm2 >= _MIN_ACC_NORM2
             and 0.0 < dt <= self._max_dt
         ):
@@ -208,7 +216,7 @@ class Estimator:
         # Fast path of check_sample: one finite test on the sum, details only on failure.
         norm2 = ax * ax + ay * ay + az * az
         if (
-            _isfinite(norm2 + gx + gy + gz + dt)
+            math.isfinite(norm2 + gx + gy + gz + dt)
             and norm2 >= _MIN_ACC_NORM2
             and 0.0 < dt <= self._max_dt
         ):
@@ -249,7 +257,7 @@ class Estimator:
         # than one chunk, so memory does not grow with N beyond the output arrays.
         for lo in range(0, n, RUN_CHUNK):
             hi = min(lo + RUN_CHUNK, n)
-            rows = []
+            rows: list[Estimate] = []
             append = rows.append
             chunk = zip(acc[lo:hi].tolist(), gyro[lo:hi].tolist(), dts[lo:hi].tolist(), strict=True)
             for i, (a, w, h) in enumerate(chunk, lo):

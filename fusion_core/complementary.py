@@ -10,6 +10,7 @@ References:
 from __future__ import annotations
 
 import math
+from typing import Final
 
 from .base import INTEGRATION_PARAM, Estimator, tuple_new
 from .kinematics import (
@@ -89,7 +90,10 @@ quaternion filters, kinematics.rotation_increment), takes roll and pitch from it
 paper's correction to roll and pitch, and rebuilds q from the corrected roll and pitch and q's own
 yaw. The correction law, its gains and its covariance are the paper's."""
 
-REST_MEAN_TAU = 0.5
+RestState = tuple[float, float, float, float, float, float, float]
+"""The rest detector's state: running means of the rate (3) and of the specific force (3), and
+the quiet time [s]."""
+REST_MEAN_TAU: Final = 0.5
 """Time constant [s] of the running means the rest detector compares each sample with (VQF's
 restFilterTau)."""
 
@@ -173,9 +177,9 @@ def lowpass_specific_force(f: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float) -
 
 
 def rest_step(
-    rest: tuple[float, ...], gx: float, gy: float, gz: float, ax: float, ay: float, az: float,
+    rest: RestState, gx: float, gy: float, gz: float, ax: float, ay: float, az: float,
     dt: float, th_gyro: float, th_acc: float,
-) -> tuple[float, ...]:
+) -> RestState:
     """One step of the rest detector (REST_PARAMS). rest = (running mean of the rate (3), of the
     specific force (3), quiet time [s]); returns the new tuple. The caller compares the quiet time
     (the last element) with rest_time."""

@@ -17,6 +17,8 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 
 from __future__ import annotations
 
+from typing import Final
+
 from .base import INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_GATE_PARAMS,
@@ -46,7 +48,7 @@ from .kinematics import (
 )
 from .types import DEG, Estimate, Param
 
-DEG2 = DEG * DEG
+DEG2: Final = DEG * DEG
 
 
 def predict_covariance(
@@ -235,6 +237,7 @@ class AngleBiasKalmanFilter(Estimator):
         if self._rest_cfg[0] > 0.0:  # rest_time
             self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
         if self._acc_tau > 0.0:
+            assert phi is not None  # computed above whenever acc_tau > 0
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
             ax, ay, az = self.acc_f
         if self.accel_trusted(ax * ax + ay * ay + az * az):

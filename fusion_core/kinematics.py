@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import math
 from math import asin, atan2, copysign, cos, remainder, sin, sqrt
+from typing import Final
 
-PI = math.pi
-TWO_PI = 2.0 * math.pi
-HALF_PI = 0.5 * math.pi
-_MIN_COS_PITCH = 1e-9  # keeps tan(pitch) finite at gimbal lock (pitch = +-pi/2)
-_SMALL_ANGLE = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
+PI: Final = math.pi
+TWO_PI: Final = 2.0 * math.pi
+HALF_PI: Final = 0.5 * math.pi
+_MIN_COS_PITCH: Final = 1e-9  # keeps tan(pitch) finite at gimbal lock (pitch = +-pi/2)
+_SMALL_ANGLE: Final = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
 
 
 def wrap_angle(x: float) -> float:

@@ -18,6 +18,7 @@ covariance P (and one gain per update), kept as its upper triangle
 from __future__ import annotations
 
 from math import cos, sin, sqrt
+from typing import Any
 
 from .base import Estimator, tuple_new
 from .complementary import zero_rate_psd_param
@@ -239,6 +240,8 @@ class PositionKalmanFilter(Estimator):
         "yaw", "states", "P", "quiet_time", "stationary", "pending", "turned", "f_mean",
         "tilt_state",
     )
+    _x: AxisStates  # [p, v, a] of x, y, z
+    _P: Sym3  # the covariance the three axes share, packed
 
     def _configure(self) -> None:
         p = self._params
@@ -262,7 +265,9 @@ class PositionKalmanFilter(Estimator):
         self._zupt = p["zupt"]
         self._zaru = p["zaru"]
         self._always = p["tilt_update"] == "always"
-        self._Q_dt = None  # the dt of Q = process_noise(qr_form, q, dt) and R = acc_psd / dt
+        # the dt of Q = process_noise(qr_form, q, dt) and R = acc_psd / dt (0: none yet, since
+        # every accepted dt is > 0)
+        self._Q_dt = 0.0
 
     @property
     def tilt_state(self) -> dict:
@@ -280,7 +285,11 @@ class PositionKalmanFilter(Estimator):
 
     @states.setter
     def states(self, value: list[list[float]]) -> None:
-        self._x = tuple(float(v) for axis in value for v in axis)
+        (p0, v0, a0), (p1, v1, a1), (p2, v2, a2) = value
+        self._x = (
+            float(p0), float(v0), float(a0), float(p1), float(v1), float(a1),
+            float(p2), float(v2), float(a2),
+        )
 
     @property
     def P(self) -> Mat3:
@@ -290,7 +299,8 @@ class PositionKalmanFilter(Estimator):
 
     @P.setter
     def P(self, value: Mat3) -> None:
-        self._P = tuple(float(value[i][j]) for i in range(3) for j in range(i, 3))
+        (m00, m01, m02), (_, m11, m12), (_, _, m22) = value
+        self._P = (float(m00), float(m01), float(m02), float(m11), float(m12), float(m22))
 
     def _reset(self) -> None:
         self.tilt.reset()
@@ -304,6 +314,13 @@ class PositionKalmanFilter(Estimator):
         self.pending: list[tuple[float, float, float, float, float]] = []
         self.turned = (0.0, 0.0)
         self.f_mean = (0.0, 0.0, 0.0)
+
+    def _restored(self) -> None:
+        # a json snapshot holds the queue's entries as lists: make them tuples again
+        entries: list[Any] = self.pending
+        self.pending = [
+            (float(t), float(r), float(p), float(r0), float(p0)) for t, r, p, r0, p0 in entries
+        ]
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         # The first sample's dt is not used; pass one the tilt stage accepts.

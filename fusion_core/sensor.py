@@ -66,7 +66,7 @@ class ImuSensorModel:
 
     def __init__(self, **params: Any) -> None:
         check_param_names(params, _SPECS, "the IMU sensor model")
-        self.params = {name: spec.default for name, spec in _SPECS.items()}
+        self.params: dict[str, Any] = {name: spec.default for name, spec in _SPECS.items()}
         self.params.update({k: _SPECS[k].validate(v) for k, v in params.items()})
         self.reset()
 

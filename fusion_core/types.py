@@ -10,17 +10,17 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Final, NamedTuple
 
-G = 9.80665
+G: Final = 9.80665
 """Standard gravity [m/s^2]; the accelerometer norm of a sensor at rest."""
 
-DEG = math.pi / 180.0
+DEG: Final = math.pi / 180.0
 """One degree in radians."""
 
-MPU6050_GYRO_DENSITY = 0.005 * DEG
+MPU6050_GYRO_DENSITY: Final = 0.005 * DEG
 """MPU-6050 datasheet gyro rate-noise density [rad/s/sqrt(Hz)]; its square is the PSD [rad2/s]."""
-MPU6050_ACC_DENSITY = 400e-6 * G
+MPU6050_ACC_DENSITY: Final = 400e-6 * G
 """MPU-6050 datasheet accelerometer noise density, 400 ug/sqrt(Hz) [m/s^2/sqrt(Hz)]."""
 
 

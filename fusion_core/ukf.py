@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from math import atan2, hypot
+from typing import Final
 
 import numpy as np
 
@@ -58,8 +59,10 @@ from .complementary import (
 from .kinematics import rotate_back
 from .types import DEG, Estimate, G, Param
 
-N_STATE = 6  # X (3), gyro bias b (3)
-_SMALL_ANGLE = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
+N_STATE: Final = 6  # X (3), gyro bias b (3)
+UpdateResult = tuple[float, float, float, float, float, float, tuple[float, ...]]
+"""The updated state x (6 floats) and the packed covariance P (21 floats)."""
+_SMALL_ANGLE: Final = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
 
 
 class UnscentedKalmanFilter(Estimator):
@@ -152,7 +155,7 @@ class UnscentedKalmanFilter(Estimator):
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
-        self._P = (0.0,) * 21
+        self._P: tuple[float, ...] = (0.0,) * 21  # packed lower triangle of the 6x6 P
         self.acc_f = (0.0, 0.0, 0.0)  # the pre-filtered specific force (acc_lowpass > 0)
         self.rest = (0.0,) * 7  # the rest detector's means and quiet time (rest_time > 0)
 
@@ -465,7 +468,7 @@ def _kalman_update(
     S: tuple[float, ...],
     rows: tuple[tuple[float, float, float, float], ...],
     y: tuple[float, float, float, float],
-) -> tuple[float, ...]:
+) -> UpdateResult:
     """(*(x + K y), P - K S K^T) with K = P_xz S^-1 (eq. 17): x (6), P packed (21), S the packed
     4x4 innovation covariance, rows the rows of the 6x4 P_xz, y the innovation. With
     S = L L^T and Y = L^-1 P_xz^T: K y = Y^T (L^-1 y) and K S K^T = Y^T Y."""
@@ -552,16 +555,17 @@ def _general_update(
     S: tuple[float, ...],
     rows: tuple[tuple[float, float, float, float], ...],
     y: tuple[float, float, float, float],
-) -> tuple[float, ...]:
+) -> UpdateResult:
     """_kalman_update for an S that is not positive definite (possible only with beta < alpha^2,
     which gives the central point a negative covariance weight): a general solve."""
     S_full = np.array([[S[_packed_index(i, j)] for j in range(4)] for i in range(4)])
     Pxz = np.array(rows)
     K = np.linalg.solve(S_full, Pxz.T).T
-    x_new = (np.asarray(x) + K @ np.asarray(y)).tolist()
+    x0, x1, x2, x3, x4, x5 = (np.asarray(x) + K @ np.asarray(y)).tolist()
     KSK = K @ S_full @ K.T
     KSK = 0.5 * (KSK + KSK.T)
     n = N_STATE
     return (
-        *x_new, tuple(P[_packed_index(i, j)] - KSK[i, j] for i in range(n) for j in range(i + 1))
+        x0, x1, x2, x3, x4, x5,
+        tuple(float(P[_packed_index(i, j)] - KSK[i, j]) for i in range(n) for j in range(i + 1)),
     )
