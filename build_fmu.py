@@ -1,9 +1,11 @@
-"""Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...]`.
+"""Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--core C]`.
 
-Builds every FMU (or the named ones) into dist/ (or DIR), validates each with
+Builds every FMU (or the named ones) into dist/ (or DIR), with fusion_core compiled by mypyc
+(--core auto, the default, falls back to the pure-Python sources where mypyc or a C compiler is
+missing; --core compiled insists; --core python ships only the sources), validates each with
 fmpy.validation.validate_fmu plus the project's checks (every variable described, every Real
-with a unit), prints a table (FMU, size, variables, validation problems) and exits with status 1
-if any FMU failed to build or has a problem. A thin layer over fmu_src.build.
+with a unit), prints a table (FMU, core, size, variables, validation problems) and exits with
+status 1 if any FMU failed to build or has a problem. A thin layer over fmu_src.build.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ import sys
 from pathlib import Path
 
 from fmu_src.build import build_all, format_table, model_names
+from fmu_src.compiled_core import CORES, CompiledCoreError
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -23,8 +26,17 @@ def main(argv: list[str] | None = None) -> int:
         "--only", nargs="+", metavar="NAME", choices=model_names(),
         help=f"build only these FMUs (of {', '.join(model_names())})",
     )
+    parser.add_argument(
+        "--core", choices=CORES, default="auto",
+        help="fusion_core to ship: compiled by mypyc (built once, cached in build/), the "
+        "pure-Python sources, or auto = compiled where it can be built (default)",
+    )
     args = parser.parse_args(argv)
-    results = build_all(args.only or model_names(), args.out)
+    try:
+        results = build_all(args.only or model_names(), args.out, args.core)
+    except CompiledCoreError as err:
+        print(f"error: --core compiled: {err}", file=sys.stderr)
+        return 2
     print(format_table(results))
     return 1 if any(r.problems for r in results) else 0
 

@@ -3,18 +3,22 @@
 Every module fmu_src/models/<snake_name>_fmu.py is one FMU; its model name (and file name) is
 the CamelCase of <snake_name>. An FMU carries in resources/ its slave module, fusion_core, the
 runtime part of fmu_src, pythonfmu (added by pythonfmu's builder) and a requirements.txt with
-what the host interpreter must provide (numpy, scipy).
+what the host interpreter must provide (numpy, scipy). With the compiled core (core="compiled",
+or "auto" where it builds; fmu_src/compiled_core.py) resources/ also holds fusion_core's
+extension modules for the builder's CPython and mypyc's shared runtime module; other hosts run
+the .py sources beside them.
 """
 
 from __future__ import annotations
 
-import importlib.util
 import shutil
 import tempfile
 import traceback
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from .compiled_core import fusion_core_dir, resolve_core, shipped_files
 
 HERE = Path(__file__).resolve().parent
 MODELS_DIR = HERE / "models"
@@ -45,36 +49,44 @@ def script_path(name: str) -> Path:
     return path
 
 
-def _stage(root: Path) -> list[Path]:
-    """Copy what goes into resources/ besides the slave module; return the paths."""
-    spec = importlib.util.find_spec("fusion_core")
-    if spec is None or not spec.submodule_search_locations:
-        raise RuntimeError("fusion_core is not importable: run from the repository root")
-    core = Path(next(iter(spec.submodule_search_locations)))
-    shutil.copytree(core, root / "fusion_core", ignore=shutil.ignore_patterns("__pycache__"))
+def _stage(root: Path, compiled: Path | None = None) -> list[Path]:
+    """Copy what goes into resources/ besides the slave module; return the paths. compiled: a
+    compiled-core folder (compiled_core.build_compiled_core) to ship instead of the sources."""
+    staged = []
+    if compiled is None:
+        core = fusion_core_dir()
+        shutil.copytree(core, root / "fusion_core", ignore=shutil.ignore_patterns("__pycache__"))
+        staged.append(root / "fusion_core")
+    else:
+        for entry in shipped_files(compiled):
+            copy = shutil.copytree if entry.is_dir() else shutil.copy2
+            copy(entry, root / entry.name)
+            staged.append(root / entry.name)
     (root / "fmu_src").mkdir()
     for name in RUNTIME_FILES:
         shutil.copy2(HERE / name, root / "fmu_src" / name)
     (root / "requirements.txt").write_text(REQUIREMENTS)
-    return [root / "fusion_core", root / "fmu_src", root / "requirements.txt"]
+    return [*staged, root / "fmu_src", root / "requirements.txt"]
 
 
-def build(name: str, out_dir: Path) -> Path:
-    """Build the FMU called name into out_dir/<name>.fmu and return its path."""
-    path = build_script(script_path(name), out_dir)
+def build(name: str, out_dir: Path, compiled: Path | None = None) -> Path:
+    """Build the FMU called name into out_dir/<name>.fmu and return its path (with the
+    compiled core of the folder `compiled`, or the pure-Python one)."""
+    path = build_script(script_path(name), out_dir, compiled)
     if path.name != f"{name}.fmu":
         raise RuntimeError(f"{script_path(name).name} built {path.name}: its class must be {name}")
     return path
 
 
-def build_script(script: Path, out_dir: Path) -> Path:
+def build_script(script: Path, out_dir: Path, compiled: Path | None = None) -> Path:
     """Build the FMU of one slave module (any FmuSlave subclass) into out_dir; the FMU is
     named after the class. The module name must be unique among the FMUs of a process."""
     from pythonfmu import FmuBuilder
 
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fmu_stage_") as tmp:
-        path = FmuBuilder.build_FMU(script, dest=out_dir, project_files=_stage(Path(tmp)))
+        files = _stage(Path(tmp), compiled)
+        path = FmuBuilder.build_FMU(script, dest=out_dir, project_files=files)
     return Path(path)
 
 
@@ -103,21 +115,27 @@ class BuildResult:
     """One row of the build table."""
 
     name: str
+    core: str = "python"  # the fusion_core it ships: "compiled" or "python"
     path: Path | None = None
     size: int = 0
     variables: int = 0
     problems: list[str] = field(default_factory=list)
 
 
-def build_all(names: Iterable[str], out_dir: Path) -> list[BuildResult]:
-    """Build and check each FMU; a failed build is a problem of its row, not an exception."""
+def build_all(
+    names: Iterable[str], out_dir: Path, core: str = "auto"
+) -> list[BuildResult]:
+    """Build and check each FMU; a failed build is a problem of its row, not an exception.
+    core: "auto" (the compiled fusion_core where it can be built, else the pure-Python one),
+    "compiled" or "python" (compiled_core.CORES)."""
     from fmpy import read_model_description
 
+    compiled = resolve_core(core)
     results = []
     for name in names:
-        result = BuildResult(name)
+        result = BuildResult(name, core="python" if compiled is None else "compiled")
         try:
-            result.path = build(name, out_dir)
+            result.path = build(name, out_dir, compiled)
             result.size = result.path.stat().st_size
             result.variables = len(read_model_description(str(result.path)).modelVariables)
             result.problems = check(result.path)
@@ -129,20 +147,22 @@ def build_all(names: Iterable[str], out_dir: Path) -> list[BuildResult]:
 
 
 def format_table(results: Sequence[BuildResult]) -> str:
-    """The build table: FMU, size, number of variables, validation problems."""
-    rows = [("FMU", "size", "variables", "validation problems")]
+    """The build table: FMU, fusion_core it ships, size, number of variables, validation
+    problems."""
+    rows = [("FMU", "core", "size", "variables", "validation problems")]
     for r in results:
         first = r.problems[0] if r.problems else ""
         count = f"{len(r.problems)}" + (f": {first}" if first else "")
         size = f"{r.size / 1024:.0f} kB" if r.path else "-"
-        rows.append((r.name, size, str(r.variables) if r.path else "-", count))
-    widths = [max(len(row[i]) for row in rows) for i in range(3)]
+        rows.append((r.name, r.core, size, str(r.variables) if r.path else "-", count))
+    widths = [max(len(row[i]) for row in rows) for i in range(4)]
     lines = []
     for i, row in enumerate(rows):
-        cells = [row[0].ljust(widths[0]), row[1].rjust(widths[1]), row[2].rjust(widths[2]), row[3]]
+        cells = [row[0].ljust(widths[0]), row[1].ljust(widths[1]), row[2].rjust(widths[2]),
+                 row[3].rjust(widths[3]), row[4]]
         lines.append("  ".join(cells).rstrip())
         if i == 0:
-            lines.append("  ".join("-" * w for w in (*widths, len(rows[0][3]))))
+            lines.append("  ".join("-" * w for w in (*widths, len(rows[0][4]))))
     for r in results:
         lines += [f"{r.name}: {p}" for p in r.problems[1:]]
     return "\n".join(lines)

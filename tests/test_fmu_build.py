@@ -14,6 +14,7 @@ from fmpy.validation import validate_fmu
 
 import fusion_core
 from fmu_src.build import check
+from fmu_src.compiled_core import COMPILED_MODULES, EXT_SUFFIX
 
 REPO = Path(__file__).resolve().parents[1]
 DEG = 180.0 / math.pi
@@ -65,11 +66,23 @@ PAPERS = {
 def test_build_command_builds_every_fmu_without_problems(built_fmus):
     assert built_fmus.returncode == 0, built_fmus.output
     lines = built_fmus.output.splitlines()
-    assert lines[0].split() == ["FMU", "size", "variables", "validation", "problems"]
+    assert lines[0].split() == ["FMU", "core", "size", "variables", "validation", "problems"]
     for name in PAPERS:
         row = next(line.split() for line in lines if line.startswith(name + " "))
+        assert row[1] == "compiled", row  # mypy (mypyc) is a dependency: no silent fallback
         assert row[-1] == "0", row  # validation problems
         assert (built_fmus.directory / f"{name}.fmu").stat().st_size > 0
+
+
+def test_each_fmu_ships_the_compiled_core_beside_its_sources(fmu_path):
+    """resources/ holds every fusion_core source and, for the compiled modules, the extension
+    module of the builder's CPython, plus mypyc's shared runtime module."""
+    with zipfile.ZipFile(fmu_path) as z:
+        names = set(z.namelist())
+    for module in COMPILED_MODULES:
+        assert f"resources/fusion_core/{module}.py" in names
+        assert f"resources/fusion_core/{module}{EXT_SUFFIX}" in names
+    assert any(n.startswith("resources/") and n.endswith(f"__mypyc{EXT_SUFFIX}") for n in names)
 
 
 def test_fmu_passes_fmpy_validation(fmu_path):
@@ -203,7 +216,7 @@ def test_build_command_exits_non_zero_on_a_validation_problem(
     cli = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cli)
 
-    def build_copy(name: str, out_dir: Path) -> Path:  # the session's FMU, not a rebuild
+    def build_copy(name: str, out_dir: Path, compiled: Path | None) -> Path:  # no rebuild
         out_dir.mkdir(parents=True, exist_ok=True)
         return Path(shutil.copy(built_fmus.path(name), out_dir))
 
