@@ -84,10 +84,11 @@ class {FLOOR_NAME}(FmuSlave):
 """Source of the floor FMU's slave module (built by build_floor_fmu)."""
 
 
-def build_fmus(out: Path) -> Path:
-    """Build every FMU with the project's command line (python build_fmu.py --out out)."""
+def build_fmus(out: Path, core: str = "auto") -> Path:
+    """Build every FMU with the project's command line (python build_fmu.py --out out --core
+    core)."""
     proc = subprocess.run(
-        [sys.executable, "build_fmu.py", "--out", str(out)],
+        [sys.executable, "build_fmu.py", "--out", str(out), "--core", core],
         cwd=REPO, capture_output=True, text=True, timeout=600,
     )
     if proc.returncode != 0:

@@ -119,6 +119,13 @@ def format_table(r: dict[str, Any]) -> str:
         f"Recording: {rec['scenario']} at {rec['rate_hz']:g} Hz, {rec['samples']} samples; "
         f"medians of {r['repeats']} passes{' (--quick)' if r['quick'] else ''}"
     )
+    if "core" in r:
+        kind = r["core"]["kind"]
+        lines.append(
+            "fusion_core: " + ("compiled by mypyc (the core the FMUs ship; --core python times "
+                               "the sources)" if kind == "compiled" else
+                               "pure Python (--core python, or mypyc unavailable)")
+        )
     if "per_sample_us" in r:
         lines += ["", "Per sample: one step/update call in a Python loop [us]",
                   f"  {'filter':<15}{'median':>10}{'min':>10}   {'target':<22}verdict"]

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from fmu_src.compiled_core import is_compiled
 from fusion_core.base import Estimator
 from fusion_core.types import Estimate
 
@@ -67,6 +68,14 @@ def _noop_pass(data: list[tuple[list[float], list[float], float]]) -> Any:
     return run
 
 
+def core_info() -> dict[str, Any]:
+    """Which fusion_core this process runs: "compiled" (mypyc extension modules) or "python"."""
+    import fusion_core.base
+
+    compiled = is_compiled(fusion_core.base)
+    return {"kind": "compiled" if compiled else "python", "base_module": fusion_core.base.__file__}
+
+
 def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
     """Run the sections named in config.sections; return the results (see benchmarks/__init__)."""
     rec = recording(config.duration_s)
@@ -80,6 +89,7 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         "recording": {"scenario": SCENARIO, "rate_hz": RATE_HZ, "samples": n,
                       "noise": "MPU-6050", "seed": 0},
         "machine": machine_info(),
+        "core": core_info(),
     }
     if "per_sample" in config.sections:
         log(f"per-sample timing: {len(ESTIMATOR_KEYS)} estimators and the peers, {n} samples x "
@@ -104,7 +114,7 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
             fmu_dir = config.fmu_dir
             if fmu_dir is None:
                 log("building the FMUs (build_fmu.py)")
-                fmu_dir = build_fmus(Path(tmp))
+                fmu_dir = build_fmus(Path(tmp), config.core)
             results["fmu_dir"] = str(config.fmu_dir) if config.fmu_dir else "(built, temporary)"
             if "fmu" in config.sections:
                 log("FMU step timing (fusion_core, fmpy API and low-level host in turn)")

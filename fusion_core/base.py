@@ -184,8 +184,9 @@ class Estimator:
         # Fast path of check_sample (written out here, the hot path): one finite test on the
         # sum; _check_values says what is wrong only when this test fails.
         norm2 = ax * ax + ay * ay + az * az
+        total = norm2 + gx + gy + gz + dt  # not finite if an input is NaN or inf (or huge)
         if not (
-            math.isfinite(norm2 + gx + gy + gz + dt)
+            total - total == 0.0  # isfinite(total) without a call: inf - inf, NaN - NaN are NaN
             and norm2 >= _MIN_ACC_NORM2
             and 0.0 < dt <= self._max_dt
         ):
