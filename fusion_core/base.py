@@ -43,9 +43,11 @@ MIN_ACC_NORM: Final = 0.1 * G
 RUN_CHUNK: Final = 1024
 """Samples that run() converts to Python floats and collects at a time."""
 _MIN_ACC_NORM2: Final = MIN_ACC_NORM * MIN_ACC_NORM
-tuple_new = tuple.__new__
-"""`tuple_new(Estimate, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
-without the NamedTuple's Python-level __new__: the hot paths build their estimate this way."""
+tuple_new: Final = tuple.__new__
+ESTIMATE: Final = Estimate
+"""`tuple_new(ESTIMATE, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
+without the NamedTuple's Python-level __new__: the hot paths build their estimate this way. The
+Final names spare the compiled core (fmu_src/compiled_core.py) two module-dict look-ups."""
 
 
 def _plain(value: Any) -> Any:
@@ -111,7 +113,7 @@ class Estimator:
     def _set_params(self, values: dict[str, Any]) -> None:
         """Take checked parameter values and derive the hot path's constants from them."""
         self._params = values
-        self._max_dt = values["max_dt"]
+        self._max_dt = float(values["max_dt"])
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:

@@ -9,14 +9,14 @@ References:
 
 from __future__ import annotations
 
-import math
 from typing import Final
 
-from .base import INTEGRATION_PARAM, Estimator, tuple_new
+from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
 from .kinematics import (
     HALF_PI,
     PI,
     accel_roll_pitch,
+    atan2,
     clamp_pitch,
     euler_step,
     heun_euler_step,
@@ -31,6 +31,8 @@ from .types import DEG, MPU6050_GYRO_DENSITY, Estimate, G, Param
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
+NO_BIAS: Final[tuple[float, ...]] = ZERO3
+"""ZERO3 as the compiled core's constant (no module-dict look-up): the CF's bias output."""
 
 ACC_GATE_PARAMS: tuple[Param, ...] = (
     Param(
@@ -141,7 +143,7 @@ def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
 def quat_yaw(w: float, x: float, y: float, z: float) -> float:
     """Yaw of a unit quaternion (body to world, Z-Y-X Euler), the companion of
     kinematics.quat_roll_pitch."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def quat_with_roll_pitch(
@@ -238,11 +240,11 @@ class ComplementaryFilter(Estimator):
 
     def _configure(self) -> None:
         p = self._params
-        self._tau = p["tau"]
+        self._tau = float(p["tau"])
         self._gate_low2, self._gate_high2 = gate_bounds2(p)
-        self._trapezoid = p["integration"] == "trapezoid"
-        self._acc_tau = p["acc_lowpass"]
-        self._quaternion = p["propagation"] == "quaternion"
+        self._trapezoid: bool = p["integration"] == "trapezoid"
+        self._acc_tau = float(p["acc_lowpass"])
+        self._quaternion: bool = p["propagation"] == "quaternion"
         # both options need the rotation vector of each interval; the papers' filter does not
         self._rotating = self._quaternion or self._acc_tau > 0.0
 
@@ -284,7 +286,7 @@ class ComplementaryFilter(Estimator):
                 self.q_att = quat_with_roll_pitch(self.q_att, roll, pitch)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-        return tuple_new(Estimate, (roll, pitch, ZERO3, None, None))
+        return tuple_new(ESTIMATE, (roll, pitch, NO_BIAS, None, None))
 
     def _estimate(self) -> Estimate:
         return Estimate(self.roll, self.pitch, ZERO3)

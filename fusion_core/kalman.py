@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from .base import INTEGRATION_PARAM, Estimator, tuple_new
+from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
@@ -172,18 +172,21 @@ class AngleBiasKalmanFilter(Estimator):
 
     def _configure(self) -> None:
         p = self._params
-        self._q_angle = p["Q_angle"]
-        self._q_bias = p["Q_bias"]
-        self._r = p["R_measure"]
+        self._q_angle = float(p["Q_angle"])
+        self._q_bias = float(p["Q_bias"])
+        self._r = float(p["R_measure"])
         self._gate2 = gate_bounds2(p)
-        self._trapezoid = p["integration"] == "trapezoid"
-        self._acc_tau = p["acc_lowpass"]
+        self._trapezoid: bool = p["integration"] == "trapezoid"
+        self._acc_tau = float(p["acc_lowpass"])
         # the zero-rate update's constants in one attribute: CPython 3.11 gives an instance of at
         # most 29 attributes its faster shared-key dict, and this class is at 29
-        self._rest_cfg = (p["rest_time"], p["rest_gyro"], p["rest_acc"], p["gyro_psd"])
-        self._quaternion = p["propagation"] == "quaternion"
+        self._rest_cfg = (
+            float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]),
+            float(p["gyro_psd"]),
+        )
+        self._quaternion: bool = p["propagation"] == "quaternion"
         # any real-sensor option on (else the papers' filter: the short path of _advance)
-        self._options = self._quaternion or self._acc_tau > 0.0 or p["rest_time"] > 0.0
+        self._options = self._quaternion or self._acc_tau > 0.0 or float(p["rest_time"]) > 0.0
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -221,7 +224,7 @@ class AngleBiasKalmanFilter(Estimator):
             if low2 <= ax * ax + ay * ay + az * az <= high2:  # accel_trusted, written out
                 self.correct(ax, ay, az)
         return tuple_new(
-            Estimate, (self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z), None, None)
+            ESTIMATE, (self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z), None, None)
         )
 
     def _update_with_options(
@@ -284,10 +287,11 @@ class AngleBiasKalmanFilter(Estimator):
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         # The roll and the pitch filter have the same F, Q and R and every update treats both,
         # so P_roll == P_pitch: one covariance, computed once (the same numbers as twice). A
-        # state snapshot with two different ones is still followed axis by axis.
+        # state snapshot with two different ones is still followed axis by axis. (== and not
+        # `is`: the compiled core keeps these tuples unboxed, where == compares four doubles.)
         P, P_pitch = self.P_roll, self.P_pitch
         self.P_roll = predict_covariance(P, dt, self._q_angle, self._q_bias)
-        if P_pitch is P or P_pitch == P:
+        if P_pitch == P:
             self.P_pitch = self.P_roll
         else:
             self.P_pitch = predict_covariance(P_pitch, dt, self._q_angle, self._q_bias)
@@ -309,7 +313,7 @@ class AngleBiasKalmanFilter(Estimator):
         """Measurement update with given innovations (accelerometer angle - predicted angle)."""
         P, P_pitch = self.P_roll, self.P_pitch
         self.gain_roll, self.P_roll = measurement_gain(P, self._r)
-        if P_pitch is P or P_pitch == P:  # one covariance (see propagate)
+        if P_pitch == P:  # one covariance (see propagate)
             self.gain_pitch, self.P_pitch = self.gain_roll, self.P_roll
         else:
             self.gain_pitch, self.P_pitch = measurement_gain(P_pitch, self._r)

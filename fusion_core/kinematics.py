@@ -12,8 +12,15 @@ both return it unchanged: `x if -PI <= x <= PI else wrap_angle(x)` and
 from __future__ import annotations
 
 import math
-from math import asin, atan2, copysign, cos, remainder, sin, sqrt
+from math import copysign, cos, sin, sqrt
 from typing import Final
+
+# mypyc compiles math's sin, cos, tan, sqrt and copysign to C calls, not these; as Final names
+# the compiled core (fmu_src/compiled_core.py) calls them without a module-dict look-up.
+atan2: Final = math.atan2
+asin: Final = math.asin
+hypot: Final = math.hypot
+remainder: Final = math.remainder
 
 PI: Final = math.pi
 TWO_PI: Final = 2.0 * math.pi

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from .base import INTEGRATION_PARAM, Estimator, tuple_new
+from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_LOWPASS_PARAM,
     REST_PARAMS,
@@ -105,13 +105,13 @@ class GainScheduledComplementaryFilter(Estimator):
     def _configure(self) -> None:
         p = self._params
         self._table = SCHEDULES.get(p["schedule"])
-        self._w0_fixed = p["w0"]
-        self._two_zeta = 2.0 * p["zeta"]
-        self._trapezoid = p["integration"] == "trapezoid"
-        self._acc_tau = p["acc_lowpass"]
-        self._rest_time = p["rest_time"]
-        self._rest_gyro = p["rest_gyro"]
-        self._rest_acc = p["rest_acc"]
+        self._w0_fixed = float(p["w0"])
+        self._two_zeta = 2.0 * float(p["zeta"])
+        self._trapezoid: bool = p["integration"] == "trapezoid"
+        self._acc_tau = float(p["acc_lowpass"])
+        self._rest_time = float(p["rest_time"])
+        self._rest_gyro = float(p["rest_gyro"])
+        self._rest_acc = float(p["rest_acc"])
         self._options = self._rest_time > 0.0 or self._acc_tau > 0.0
 
     def _reset(self) -> None:
@@ -185,7 +185,7 @@ class GainScheduledComplementaryFilter(Estimator):
             q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)
-        return tuple_new(Estimate, (roll, pitch, self.bias, None, None))
+        return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
 
     def _estimate(self) -> Estimate:
         roll, pitch = quat_roll_pitch(*self.q)

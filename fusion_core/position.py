@@ -20,7 +20,7 @@ from __future__ import annotations
 from math import cos, sin, sqrt
 from typing import Any
 
-from .base import Estimator, tuple_new
+from .base import ESTIMATE, Estimator, tuple_new
 from .complementary import zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
@@ -253,18 +253,18 @@ class PositionKalmanFilter(Estimator):
                 if k != "integration":
                     self.tilt.set_param(k, v)
             self.tilt.set_param("max_dt", p["max_dt"])
-        self._acc_var_density = p["acc_psd"]
-        self._zupt_var = p["zupt_noise"] ** 2
-        self._gyro_var_density = p["gyro_psd"]
+        self._acc_var_density = float(p["acc_psd"])
+        self._zupt_var = float(p["zupt_noise"]) ** 2
+        self._gyro_var_density = float(p["gyro_psd"])
         # the hot path's constants
-        self._zupt_acc = p["zupt_acc"]
-        self._zupt_level_acc = p["zupt_level_acc"]
-        self._zupt_gyro = p["zupt_gyro"]
-        self._window = p["zupt_window"]
-        self._force_after = p["zupt_force_after"]
-        self._zupt = p["zupt"]
-        self._zaru = p["zaru"]
-        self._always = p["tilt_update"] == "always"
+        self._zupt_acc = float(p["zupt_acc"])
+        self._zupt_level_acc = float(p["zupt_level_acc"])
+        self._zupt_gyro = float(p["zupt_gyro"])
+        self._window = float(p["zupt_window"])
+        self._force_after = float(p["zupt_force_after"])
+        self._zupt = bool(p["zupt"])
+        self._zaru = bool(p["zaru"])
+        self._always: bool = p["tilt_update"] == "always"
         # the dt of Q = process_noise(qr_form, q, dt) and R = acc_psd / dt (0: none yet, since
         # every accepted dt is > 0)
         self._Q_dt = 0.0
@@ -436,6 +436,6 @@ class PositionKalmanFilter(Estimator):
     def _estimate(self) -> Estimate:
         t = self.tilt
         x = self._x
-        return tuple_new(Estimate, (
+        return tuple_new(ESTIMATE, (
             t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0), (x[0], x[3], x[6]), (x[1], x[4], x[7])
         ))

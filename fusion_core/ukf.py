@@ -42,12 +42,11 @@ P is kept as its lower triangle (21 floats, row by row); the `P` attribute shows
 from __future__ import annotations
 
 import math
-from math import atan2, hypot
 from typing import Final
 
 import numpy as np
 
-from .base import INTEGRATION_PARAM, Estimator, tuple_new
+from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
 from .complementary import (
     ACC_LOWPASS_PARAM,
     REST_PARAMS,
@@ -56,7 +55,7 @@ from .complementary import (
     rest_step,
     zero_rate_psd_param,
 )
-from .kinematics import rotate_back
+from .kinematics import atan2, hypot, rotate_back
 from .types import DEG, Estimate, G, Param
 
 N_STATE: Final = 6  # X (3), gyro bias b (3)
@@ -136,22 +135,22 @@ class UnscentedKalmanFilter(Estimator):
     def _configure(self) -> None:
         p = self._params
         n = N_STATE
-        alpha2 = p["alpha"] ** 2
-        lam = alpha2 * (n + p["kappa"]) - n
+        alpha2 = float(p["alpha"]) ** 2
+        lam = alpha2 * (n + float(p["kappa"])) - n
         self._gamma = math.sqrt(n + lam)
         # Weights (Wan & van der Merwe): wm_0 = lam/(n+lam), wc_0 = wm_0 + 1 - alpha^2 + beta,
         # wm_i = wc_i = 1/(2(n+lam)) for i = 1..2n. Deviations are taken from the central
         # point, so only wm_i and (sum of wc) - 2 = beta - alpha^2 appear (module docstring).
         self._w = 0.5 / (n + lam)
-        self._w_mu = p["beta"] - alpha2
-        self._q_gyro = p["gyro_psd"]
-        self._q_bias = p["bias_psd"]
-        self._r_acc = p["acc_noise"] ** 2
-        self._r_norm = p["norm_noise"] ** 2
-        self._gate = p["acc_gate"]
-        self._trapezoid = p["integration"] == "trapezoid"
+        self._w_mu = float(p["beta"]) - alpha2
+        self._q_gyro = float(p["gyro_psd"])
+        self._q_bias = float(p["bias_psd"])
+        self._r_acc = float(p["acc_noise"]) ** 2
+        self._r_norm = float(p["norm_noise"]) ** 2
+        self._gate = float(p["acc_gate"])
+        self._trapezoid: bool = p["integration"] == "trapezoid"
         # any real-sensor option on (else the paper's filter alone: the short path of _advance)
-        self._options = p["acc_lowpass"] > 0.0 or p["rest_time"] > 0.0
+        self._options = float(p["acc_lowpass"]) > 0.0 or float(p["rest_time"]) > 0.0
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -379,7 +378,7 @@ class UnscentedKalmanFilter(Estimator):
     def _estimate(self) -> Estimate:
         X1, X2, X3, bx, by, bz = self.x
         return tuple_new(
-            Estimate, (atan2(X2, X3), atan2(-X1, hypot(X2, X3)), (bx, by, bz), None, None)
+            ESTIMATE, (atan2(X2, X3), atan2(-X1, hypot(X2, X3)), (bx, by, bz), None, None)
         )
 
 
