@@ -18,7 +18,18 @@ command line and the tests call. Timings are medians of several repeats with the
 collector off (like timeit); nothing here asserts a timing.
 """
 
+from typing import Any
+
 from .config import BenchConfig
-from .suite import run_benchmarks
 
 __all__ = ["BenchConfig", "run_benchmarks"]
+
+
+def __getattr__(name: str) -> Any:
+    # run_benchmarks on first use: importing the package must not import fusion_core, whose
+    # compiled or pure-Python build `python -m benchmarks --core` chooses first
+    if name == "run_benchmarks":
+        from .suite import run_benchmarks
+
+        return run_benchmarks
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

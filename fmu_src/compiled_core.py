@@ -104,7 +104,17 @@ def build_compiled_core(cache: Path = DEFAULT_CACHE) -> Path:
                 raise
     finally:
         shutil.rmtree(work, ignore_errors=True)
+    _prune(cache, keep=target)
     return target
+
+
+def _prune(cache: Path, keep: Path, n: int = 3) -> None:
+    """Remove all but the n newest builds of the cache (each source change makes a new one)."""
+    builds = sorted((d for d in cache.iterdir() if (d / "COMPLETE").is_file()),
+                    key=lambda d: d.stat().st_mtime, reverse=True)
+    for old in builds[n:]:
+        if old != keep:
+            shutil.rmtree(old, ignore_errors=True)
 
 
 def shipped_files(root: Path) -> list[Path]:

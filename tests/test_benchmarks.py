@@ -4,6 +4,8 @@ behaviour of run() that its scaling section measures."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 import tracemalloc
 from pathlib import Path
 
@@ -15,6 +17,8 @@ from benchmarks import BenchConfig, peers, report, scaling
 from benchmarks.common import recording
 from benchmarks.config import ESTIMATOR_KEYS
 from fusion_core import ComplementaryFilter
+
+REPO = Path(__file__).resolve().parents[1]
 
 TINY = dict(
     duration_s=0.5,
@@ -155,3 +159,20 @@ def test_run_memory_beyond_the_outputs_does_not_grow_with_n(tmp_path: Path) -> N
     small, large = peak_beyond_outputs(2_000), peak_beyond_outputs(8_000)
     # Keeping one Python object per sample grows by about 12 times the extra outputs' bytes.
     assert large - small < 0.25 * 41 * 6_000
+
+
+def test_the_command_line_chooses_its_core_before_fusion_core_is_imported() -> None:
+    """`python -m benchmarks` must be able to put the compiled core first on sys.path: importing
+    the package and its command line imports no fusion_core module."""
+    code = ("import sys, benchmarks, benchmarks.__main__; "
+            "print([m for m in sys.modules if m.split('.')[0] == 'fusion_core'])")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True,
+                          text=True, timeout=120, check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
+
+
+def test_bench_json_says_which_core_ran(bench_json: dict) -> None:
+    """In-process (this test) the benchmark times the fusion_core already imported: the sources."""
+    assert bench_json["core"]["kind"] == "python"
+    assert bench_json["core"]["base_module"].endswith("base.py")
