@@ -47,6 +47,20 @@ class CompiledCoreError(RuntimeError):
     """The compiled core could not be built here (no mypyc, no C compiler, a mypyc error)."""
 
 
+def toolchain_missing() -> str | None:
+    """Why the compiled core cannot be built here (no C compiler, no Python headers, no mypyc),
+    or None when it can be tried."""
+    cc = os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc"
+    if shutil.which(cc.split()[0]) is None:
+        return f"no C compiler ({cc.split()[0]!r} not found)"
+    include = Path(sysconfig.get_paths()["include"])
+    if not (include / "Python.h").is_file():
+        return f"no Python headers ({include / 'Python.h'} not found)"
+    if importlib.util.find_spec("mypyc") is None:
+        return "mypyc is not installed (it comes with mypy: pip install 'mypy>=1.11')"
+    return None
+
+
 def fusion_core_dir() -> Path:
     """The fusion_core package the build compiles (the importable one, without importing it)."""
     spec = importlib.util.find_spec("fusion_core")
@@ -74,6 +88,9 @@ def build_compiled_core(cache: Path = DEFAULT_CACHE) -> Path:
     .py source plus the extension modules of COMPILED_MODULES) and mypyc's shared runtime module.
     Put it first on sys.path to import the compiled core. Raises CompiledCoreError saying why it
     cannot be built."""
+    missing = toolchain_missing()
+    if missing:
+        raise CompiledCoreError(missing)
     core = fusion_core_dir()
     target = cache / cache_key(core)
     if (target / "COMPLETE").is_file():

@@ -14,7 +14,7 @@ from fmpy.validation import validate_fmu
 
 import fusion_core
 from fmu_src.build import check
-from fmu_src.compiled_core import COMPILED_MODULES, EXT_SUFFIX
+from fmu_src.compiled_core import COMPILED_MODULES, EXT_SUFFIX, toolchain_missing
 
 REPO = Path(__file__).resolve().parents[1]
 DEG = 180.0 / math.pi
@@ -63,17 +63,25 @@ PAPERS = {
 }
 
 
+EXPECTED_CORE = "python" if toolchain_missing() else "compiled"
+"""What build_fmu.py --core auto ships here: the compiled core wherever it can be built (mypy,
+which brings mypyc, is a dependency; a machine with only Python and pip has no C compiler)."""
+
+
 def test_build_command_builds_every_fmu_without_problems(built_fmus):
     assert built_fmus.returncode == 0, built_fmus.output
     lines = built_fmus.output.splitlines()
     assert lines[0].split() == ["FMU", "core", "size", "variables", "validation", "problems"]
     for name in PAPERS:
         row = next(line.split() for line in lines if line.startswith(name + " "))
-        assert row[1] == "compiled", row  # mypy (mypyc) is a dependency: no silent fallback
+        assert row[1] == EXPECTED_CORE, row  # no silent fallback where a compiler exists
         assert row[-1] == "0", row  # validation problems
         assert (built_fmus.directory / f"{name}.fmu").stat().st_size > 0
 
 
+@pytest.mark.skipif(
+    EXPECTED_CORE == "python", reason=f"{toolchain_missing()}: the FMUs ship the sources"
+)
 def test_each_fmu_ships_the_compiled_core_beside_its_sources(fmu_path):
     """resources/ holds every fusion_core source and, for the compiled modules, the extension
     module of the builder's CPython, plus mypyc's shared runtime module."""
