@@ -32,6 +32,7 @@ test-slow: setup
 
 lint: setup
 	$(BIN)/ruff check .
+	$(BIN)/mypy fusion_core  # mypy-clean: what mypyc compiles (fmu_src/compiled_core.py)
 
 .PHONY: bench
 bench: setup

@@ -4,7 +4,7 @@ fusion_core is plain, typed Python (mypy-clean). mypyc (the compiler that ships 
 compiles mypy itself and black) turns its estimator modules into C extensions in which the
 floats of the hot paths are C doubles. The math stays in one place, the Python source; the
 compiled modules compute the same IEEE operations in the same order, so their outputs are bit
-for bit those of the pure-Python modules (tests/test_compiled_core.py checks it), at 2-3x the
+for bit those of the pure-Python modules (tests/test_compiled_core.py checks it), at 3-7x the
 speed (`make bench`).
 
 Each FMU ships both: resources/fusion_core holds the .py sources and, beside them, the extension
