@@ -70,13 +70,10 @@ def fusion_core_dir() -> Path:
 
 
 def cache_key(core: Path) -> str:
-    """A hash of the fusion_core sources, the compiler version and the interpreter's ABI tag."""
-    try:
-        from mypy.version import __version__ as mypy_version
-    except ImportError as err:
-        raise CompiledCoreError(
-            "mypyc is not installed (it comes with mypy: pip install 'mypy>=1.11')"
-        ) from err
+    """A hash of the fusion_core sources, the compiler version and the interpreter's ABI tag
+    (call it once toolchain_missing() has found mypyc)."""
+    from mypy.version import __version__ as mypy_version
+
     digest = hashlib.sha256(f"{mypy_version}|{EXT_SUFFIX}|{sys.version}".encode())
     for path in sorted(core.glob("*.py")):
         digest.update(path.name.encode() + b"\0" + path.read_bytes())

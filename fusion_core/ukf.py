@@ -61,7 +61,6 @@ from .types import DEG, Estimate, G, Param
 N_STATE: Final = 6  # X (3), gyro bias b (3)
 UpdateResult = tuple[float, float, float, float, float, float, tuple[float, ...]]
 """The updated state x (6 floats) and the packed covariance P (21 floats)."""
-_SMALL_ANGLE: Final = 1e-8  # below it, series for sin(a)/a and (1 - cos a)/a^2
 
 
 class UnscentedKalmanFilter(Estimator):
@@ -255,41 +254,15 @@ class UnscentedKalmanFilter(Estimator):
         e00 = e10 = e11 = e20 = e21 = e22 = 0.0
         x00 = x01 = x02 = x10 = x11 = x12 = x20 = x21 = x22 = 0.0
         v_sum = vv = ev0 = ev1 = ev2 = bv0 = bv1 = bv2 = 0.0
-        sqrt, sin, cos, small = math.sqrt, math.sin, math.cos, _SMALL_ANGLE
         for s0, s1, s2, s3, s4, s5 in offsets:
             t0 = dt * s3 - (d1 * s5 - d2 * s4)  # M s^b
             t1 = dt * s4 - (d2 * s3 - d0 * s5)
             t2 = dt * s5 - (d0 * s4 - d1 * s3)
-            # x + s through the process model (kinematics.rotate_back written out: the hot path)
-            z0, z1, z2 = X0 + s0, X1 + s1, X2 + s2
-            p0, p1, p2 = f0 - t0, f1 - t1, f2 - t2
-            a2 = p0 * p0 + p1 * p1 + p2 * p2
-            a = sqrt(a2)
-            if a < small:
-                sa, ca = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
-            else:
-                sa, ca = sin(a) / a, (1.0 - cos(a)) / a2
-            u0 = p1 * z2 - p2 * z1
-            u1 = p2 * z0 - p0 * z2
-            u2 = p0 * z1 - p1 * z0
-            ep0 = z0 - sa * u0 + ca * (p1 * u2 - p2 * u1) - Y0
-            ep1 = z1 - sa * u1 + ca * (p2 * u0 - p0 * u2) - Y1
-            ep2 = z2 - sa * u2 + ca * (p0 * u1 - p1 * u0) - Y2
-            # x - s
-            z0, z1, z2 = X0 - s0, X1 - s1, X2 - s2
-            p0, p1, p2 = f0 + t0, f1 + t1, f2 + t2
-            a2 = p0 * p0 + p1 * p1 + p2 * p2
-            a = sqrt(a2)
-            if a < small:
-                sa, ca = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
-            else:
-                sa, ca = sin(a) / a, (1.0 - cos(a)) / a2
-            u0 = p1 * z2 - p2 * z1
-            u1 = p2 * z0 - p0 * z2
-            u2 = p0 * z1 - p1 * z0
-            em0 = z0 - sa * u0 + ca * (p1 * u2 - p2 * u1) - Y0
-            em1 = z1 - sa * u1 + ca * (p2 * u0 - p0 * u2) - Y1
-            em2 = z2 - sa * u2 + ca * (p0 * u1 - p1 * u0) - Y2
+            # x + s and x - s through the process model, as deviations from the central point
+            r0, r1, r2 = rotate_back((X0 + s0, X1 + s1, X2 + s2), (f0 - t0, f1 - t1, f2 - t2))
+            ep0, ep1, ep2 = r0 - Y0, r1 - Y1, r2 - Y2
+            r0, r1, r2 = rotate_back((X0 - s0, X1 - s1, X2 - s2), (f0 + t0, f1 + t1, f2 + t2))
+            em0, em1, em2 = r0 - Y0, r1 - Y1, r2 - Y2
             m0 += ep0 + em0
             m1 += ep1 + em1
             m2 += ep2 + em2
@@ -400,23 +373,22 @@ def _sigma_offsets(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]
     those of _psd_sqrt_columns."""
     (p00, p10, p11, p20, p21, p22, p30, p31, p32, p33,
      p40, p41, p42, p43, p44, p50, p51, p52, p53, p54, p55) = P
-    sqrt = math.sqrt
     if not p00 > 0.0:
         return _psd_sqrt_columns(P, gamma)
-    l00 = sqrt(p00)
+    l00 = math.sqrt(p00)
     i0 = 1.0 / l00
     l10 = p10 * i0
     d = p11 - l10 * l10
     if not d > 0.0:
         return _psd_sqrt_columns(P, gamma)
-    l11 = sqrt(d)
+    l11 = math.sqrt(d)
     i1 = 1.0 / l11
     l20 = p20 * i0
     l21 = (p21 - l20 * l10) * i1
     d = p22 - l20 * l20 - l21 * l21
     if not d > 0.0:
         return _psd_sqrt_columns(P, gamma)
-    l22 = sqrt(d)
+    l22 = math.sqrt(d)
     i2 = 1.0 / l22
     l30 = p30 * i0
     l31 = (p31 - l30 * l10) * i1
@@ -424,7 +396,7 @@ def _sigma_offsets(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]
     d = p33 - l30 * l30 - l31 * l31 - l32 * l32
     if not d > 0.0:
         return _psd_sqrt_columns(P, gamma)
-    l33 = sqrt(d)
+    l33 = math.sqrt(d)
     i3 = 1.0 / l33
     l40 = p40 * i0
     l41 = (p41 - l40 * l10) * i1
@@ -433,7 +405,7 @@ def _sigma_offsets(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]
     d = p44 - l40 * l40 - l41 * l41 - l42 * l42 - l43 * l43
     if not d > 0.0:
         return _psd_sqrt_columns(P, gamma)
-    l44 = sqrt(d)
+    l44 = math.sqrt(d)
     l50 = p50 * i0
     l51 = (p51 - l50 * l10) * i1
     l52 = (p52 - l50 * l20 - l51 * l21) * i2
@@ -449,7 +421,7 @@ def _sigma_offsets(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]
         (0.0, 0.0, g * l22, g * l32, g * l42, g * l52),
         (0.0, 0.0, 0.0, g * l33, g * l43, g * l53),
         (0.0, 0.0, 0.0, 0.0, g * l44, g * l54),
-        (0.0, 0.0, 0.0, 0.0, 0.0, g * sqrt(d)),
+        (0.0, 0.0, 0.0, 0.0, 0.0, g * math.sqrt(d)),
     ]
 
 
