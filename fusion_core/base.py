@@ -26,23 +26,35 @@ except ImportError:  # a host without mypy_extensions runs the pure-Python modul
         return lambda cls: cls
 
 
+MAX_RATE_DEFAULT: Final = 1000.0
+"""Default max_rate [rad/s] (57,300 deg/s): about three times the widest full-scale range of any
+MEMS gyro we know of (Analog Devices ADXRS649, +-20,000 deg/s; consumer parts such as the
+MPU-6050 end at +-2000 deg/s). A larger reading is no measurement."""
 COMMON_PARAMS: tuple[Param, ...] = (
     Param(
         "max_dt", 1.0, "Longest accepted time between samples; a longer dt is rejected",
         unit="s", low=0.0, low_open=True, tunable=True,
     ),
+    Param(
+        "max_rate", MAX_RATE_DEFAULT,
+        "Largest accepted gyro reading (norm of the rate vector); a larger one is rejected: no "
+        "sensor delivers it (default about 3x the widest MEMS gyro range, +-20,000 deg/s)",
+        unit="rad/s", low=0.0, low_open=True, display_unit="deg/s",
+    ),
 )
-INTEGRATION_PARAM = Param(
-    "integration", "trapezoid",
-    "Gyro integration rule: 'trapezoid' (average of the previous and current sample; Heun's "
-    "method on the Euler-rate kinematics) or 'rectangle' (the papers' rule: current rate times dt)",
-    choices=("trapezoid", "rectangle"), tunable=False,
-)
-MIN_ACC_NORM: Final = 0.1 * G
-"""Accelerometer norm below which a sample is rejected (INTERFACE.md: 'norm near zero')."""
+MIN_INIT_NORM: Final = 0.1 * G
+"""Accelerometer norm [m/s^2] a sample needs to initialise roll and pitch: below it (free fall,
+a thrown body) there is no gravity direction to start from, and the filter waits for the next
+sample (skipped, not rejected: nothing has been estimated yet)."""
+MAX_ACC_NORM: Final = 1000.0 * G
+"""Accelerometer norm [m/s^2] beyond which a reading is taken as no reading at all, (0, 0, 0),
+like a sample in free fall: far beyond any MEMS accelerometer's range (+-16 g for the MPU-6050,
++-200 g for high-g parts such as the ADXL375), and too large to filter without overflow. The
+gyro of such a sample is still integrated."""
 RUN_CHUNK: Final = 1024
 """Samples that run() converts to Python floats and collects at a time."""
-_MIN_ACC_NORM2: Final = MIN_ACC_NORM * MIN_ACC_NORM
+_MIN_INIT_NORM2: Final = MIN_INIT_NORM * MIN_INIT_NORM
+_MAX_ACC_NORM2: Final = MAX_ACC_NORM * MAX_ACC_NORM
 tuple_new: Final = tuple.__new__
 ESTIMATE: Final = Estimate
 """`tuple_new(ESTIMATE, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
@@ -114,6 +126,7 @@ class Estimator:
         """Take checked parameter values and derive the hot path's constants from them."""
         self._params = values
         self._max_dt = float(values["max_dt"])
+        self._max_rate2 = float(values["max_rate"]) ** 2
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:
@@ -150,7 +163,12 @@ class Estimator:
 
     # ----- samples ----------------------------------------------------------------------------
     def check_sample(self, acc: Sequence[float], gyro: Sequence[float], dt: float) -> None:
-        """Raise InvalidSample saying what is wrong with a sample; return None for a good one."""
+        """Raise InvalidSample saying what is wrong with a sample; return None for a good one.
+
+        Rejected: a NaN or infinite value, dt outside (0, max_dt], a gyro reading above
+        max_rate. Not rejected: any finite accelerometer reading (one near zero or far from g
+        is not trusted by the filters' corrections, but the gyro is still integrated).
+        """
         ax, ay, az = acc
         gx, gy, gz = gyro
         for name, values in (("acc", (ax, ay, az)), ("gyro", (gx, gy, gz)), ("dt", (dt,))):
@@ -161,11 +179,11 @@ class Estimator:
             raise InvalidSample(
                 f"dt={dt!r} s is outside the allowed range (0, max_dt={self._params['max_dt']!r}] s"
             )
-        norm = math.sqrt(ax * ax + ay * ay + az * az)
-        if norm < MIN_ACC_NORM:
+        rate = math.hypot(gx, gy, gz)
+        if not rate <= self._params["max_rate"]:
             raise InvalidSample(
-                f"accelerometer norm {norm:.4g} m/s^2 is below {MIN_ACC_NORM:.4g} m/s^2 (0.1 g): "
-                "no gravity direction"
+                f"gyro rate {rate:.4g} rad/s is above max_rate={self._params['max_rate']!r} rad/s: "
+                "no sensor delivers it"
             )
 
     def step(self, acc: Sequence[float], gyro: Sequence[float], dt: float) -> Estimate:
@@ -185,20 +203,25 @@ class Estimator:
             ) from None
         # Fast path of check_sample (written out here, the hot path): one finite test on the
         # sum; _check_values says what is wrong only when this test fails.
-        norm2 = ax * ax + ay * ay + az * az
-        total = norm2 + gx + gy + gz + dt  # not finite if an input is NaN or inf (or huge)
+        w2 = gx * gx + gy * gy + gz * gz
+        total = ax + ay + az + w2 + dt  # not finite if an input is NaN or inf (or huge)
         if not (
             total - total == 0.0  # isfinite(total) without a call: inf - inf, NaN - NaN are NaN
-            and norm2 >= _MIN_ACC_NORM2
+            and w2 <= self._max_rate2
             and 0.0 < dt <= self._max_dt
         ):
             self._check_values(ax, ay, az, gx, gy, gz, dt)
+        norm2 = ax * ax + ay * ay + az * az
+        if not norm2 <= _MAX_ACC_NORM2:  # (also an overflow to inf) no reading at all
+            ax = ay = az = norm2 = 0.0
         if self.initialized:
             last = self._advance(ax, ay, az, gx, gy, gz, dt)
-        else:
+        elif norm2 >= _MIN_INIT_NORM2:
             self._init(ax, ay, az, gx, gy, gz)
             self.initialized = True
             last = self._estimate()
+        else:  # no gravity direction to start from yet (MIN_INIT_NORM)
+            return self.last
         self.last = last
         self.gyro_prev = (gx, gy, gz)
         self.n_samples += 1
@@ -216,16 +239,9 @@ class Estimator:
     def _check_values(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
-        # Fast path of check_sample: one finite test on the sum, details only on failure.
-        norm2 = ax * ax + ay * ay + az * az
-        if (
-            math.isfinite(norm2 + gx + gy + gz + dt)
-            and norm2 >= _MIN_ACC_NORM2
-            and 0.0 < dt <= self._max_dt
-        ):
-            return
+        # The details of the fast test in step(): raises InvalidSample saying what is wrong.
+        # (a finite sample whose sum merely overflowed, e.g. acc = 1e308, passes)
         self.check_sample((ax, ay, az), (gx, gy, gz), dt)
-        raise InvalidSample("sample rejected")  # not reached: check_sample raised
 
     def run(
         self,

@@ -19,10 +19,11 @@ from __future__ import annotations
 
 from typing import Final
 
-from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
-from .complementary import (
+from .base import ESTIMATE, Estimator, tuple_new
+from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
+    GYRO_SAMPLING_PARAM,
     PROPAGATION_PARAM,
     REST_PARAMS,
     ZERO3,
@@ -104,7 +105,7 @@ class AngleBiasKalmanFilter(Estimator):
 
     Propagation: the bias-corrected body rate (gx - bias_x, gy - bias_y, gz) drives the full Z-Y-X
     Euler-rate kinematics (Heun's method with the previous and current sample, or the papers'
-    rectangle rule with integration="rectangle"), so roll and pitch do not couple when they move
+    rectangle rule with gyro_sampling="mean"), so roll and pitch do not couple when they move
     together; the covariance follows the papers' F (their model, with the per-axis bias entering
     with -dt). For roll-only motion this is exactly the papers' algorithm.
 
@@ -163,7 +164,7 @@ class AngleBiasKalmanFilter(Estimator):
             unit="rad/s", low=0.0, tunable=False, display_unit="deg/s",
         ),
         PROPAGATION_PARAM,
-        INTEGRATION_PARAM,
+        GYRO_SAMPLING_PARAM,
     )
     STATE = (
         "roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch", "bias_z", "P_z", "acc_f", "rest",
@@ -176,7 +177,7 @@ class AngleBiasKalmanFilter(Estimator):
         self._q_bias = float(p["Q_bias"])
         self._r = float(p["R_measure"])
         self._gate2 = gate_bounds2(p)
-        self._trapezoid: bool = p["integration"] == "trapezoid"
+        self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
         # the zero-rate update's constants in one attribute: CPython 3.11 gives an instance of at
         # most 29 attributes its faster shared-key dict, and this class is at 29

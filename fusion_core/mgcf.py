@@ -6,8 +6,10 @@ Reference:
   gravity direction in the body frame); Kp = 2 zeta w0, Ki = w0^2 (the PI loop as a second-order
   system with natural frequency w0 and damping zeta = 2); w0 is switched by
   rho = | |a|/g - 1 | so that the accelerometer is trusted less the further its norm is from g.
-  Their simulation table: rho < 0.01 -> w0 = 0.1 rad/s, < 0.25 -> 0.07, < 0.35 -> 0.035,
-  else 0 (gyro only). With a fixed w0 the filter is their conventional CF (CCF).
+  Their simulation table (section 4.1): rho < 0.01 -> w0 = 0.1 rad/s, < 0.25 -> 0.07,
+  < 0.35 -> 0.035, else 0 (gyro only); their experimental table for the MPU-6050 (section 4.2):
+  rho < 0.025 -> 0.1, < 0.035 -> 0.07, < 0.05 -> 0.05, else 0. With a fixed w0 the filter is
+  their conventional CF (CCF): w0 = 0.05 rad/s in their experiment.
   Mahony, Hamel, Pflimlin (2008), "Nonlinear complementary filters on the special orthogonal
   group", give the PI law this filter uses: omega = gyro - b + Kp e, b_dot = -Ki e.
 """
@@ -16,9 +18,10 @@ from __future__ import annotations
 
 import math
 
-from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
-from .complementary import (
+from .base import ESTIMATE, Estimator, tuple_new
+from .building_blocks import (
     ACC_LOWPASS_PARAM,
+    GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     ZERO3,
     body_rotation,
@@ -37,11 +40,11 @@ from .types import Estimate, G, Param
 
 SCHEDULES: dict[str, tuple[tuple[float, float], ...]] = {
     # (rho upper bound, w0 [rad/s]); rho at or above the last bound gives w0 = 0.
+    # Duong Quoc et al. section 4.1 (simulated data, zeta = 2).
     "simulation": ((0.01, 0.1), (0.25, 0.07), (0.35, 0.035)),
-    # Our reading of the experimental schedule: the simulation table's bands widened for a real
-    # MEMS accelerometer, whose noise alone puts rho around 0.005-0.02 at rest. The source text we
-    # work from quotes only the simulation table; check these bands against the paper's table.
-    "experimental": ((0.03, 0.1), (0.25, 0.07), (0.35, 0.035)),
+    # Duong Quoc et al. section 4.2 (their MPU-6050, low and medium dynamics, zeta = 2); their
+    # conventional CF (CCF) in that experiment is schedule="fixed" with w0 = 0.05 rad/s.
+    "experimental": ((0.025, 0.1), (0.035, 0.07), (0.05, 0.05)),
 }
 
 
@@ -63,7 +66,7 @@ class GainScheduledComplementaryFilter(Estimator):
       rho = | |a|/g - 1 |; w0 = schedule(rho) (or the parameter w0 with schedule="fixed");
       Kp  = 2 zeta w0, Ki = w0^2;
       b  <- b - Ki e dt (the integral term; b is the gyro-bias estimate, output as bias_*);
-      the body rate gyro - b + Kp e rotates q over dt. With integration="trapezoid" the rate is
+      the body rate gyro - b + Kp e rotates q over dt. With gyro_sampling="point" the rate is
       taken linear between the previous and the current gyro sample and integrated with the
       two-sample coning correction (kinematics.rotation_increment); with "rectangle" q is
       advanced with the current rate by first-order quaternion integration (the papers' rule).
@@ -98,7 +101,7 @@ class GainScheduledComplementaryFilter(Estimator):
         Param("zeta", 2.0, "Damping ratio of the PI correction (Kp = 2 zeta w0)", low=0.0),
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
-        INTEGRATION_PARAM,
+        GYRO_SAMPLING_PARAM,
     )
     STATE = ("q", "bias", "w0_now", "acc_f", "rest")
 
@@ -107,7 +110,7 @@ class GainScheduledComplementaryFilter(Estimator):
         self._table = SCHEDULES.get(p["schedule"])
         self._w0_fixed = float(p["w0"])
         self._two_zeta = 2.0 * float(p["zeta"])
-        self._trapezoid: bool = p["integration"] == "trapezoid"
+        self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
         self._rest_time = float(p["rest_time"])
         self._rest_gyro = float(p["rest_gyro"])
@@ -154,6 +157,8 @@ class GainScheduledComplementaryFilter(Estimator):
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         table = self._table
         w0 = self._w0_fixed if table is None else scheduled_w0(abs(norm / G - 1.0), table)
+        if not norm > 0.0:  # no gravity direction in this sample: gyro only
+            w0 = 0.0
         self.w0_now = w0
         bx, by, bz = self.bias
         if self._trapezoid:

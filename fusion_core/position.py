@@ -21,12 +21,12 @@ from math import cos, sin, sqrt
 from typing import Any
 
 from .base import ESTIMATE, Estimator, tuple_new
-from .complementary import zero_rate_psd_param
+from .building_blocks import zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
 from .types import DEG, MPU6050_ACC_DENSITY, Estimate, G, Param
 
-TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "integration")
+TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "gyro_sampling")
 """Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
 
 Sym3 = tuple[float, float, float, float, float, float]
@@ -250,7 +250,7 @@ class PositionKalmanFilter(Estimator):
             self.tilt = AngleBiasKalmanFilter(max_dt=p["max_dt"], **tilt_params)
         else:
             for k, v in tilt_params.items():
-                if k != "integration":
+                if k != "gyro_sampling":
                     self.tilt.set_param(k, v)
             self.tilt.set_param("max_dt", p["max_dt"])
         self._acc_var_density = float(p["acc_psd"])

@@ -118,6 +118,13 @@ RENAMED_PARAMS: dict[str, str] = {
 power spectral densities n^2 [rad2/s, ...]: FMI 2.0 base units have integer exponents only."""
 
 
+REPLACED_PARAMS: dict[str, str] = {
+    "integration": "integration is now gyro_sampling, a property of the sensor: 'trapezoid' -> "
+    "'point', 'rectangle' -> 'mean'",
+}
+"""Parameters replaced by one of another meaning, with what to write instead."""
+
+
 def check_param_names(given: Iterable[str], specs: dict[str, Param], owner: str) -> None:
     """ValueError listing the names in `given` that `owner` does not have, what it allows, and
     the new name of a renamed noise parameter (whose value must now be squared)."""
@@ -127,7 +134,7 @@ def check_param_names(given: Iterable[str], specs: dict[str, Param], owner: str)
     hints = [
         f"{name} is now {RENAMED_PARAMS[name]}, the density squared (a power spectral density)"
         for name in unknown if RENAMED_PARAMS.get(name) in specs
-    ]
+    ] + [REPLACED_PARAMS[name] for name in unknown if name in REPLACED_PARAMS]
     raise ValueError(
         f"unknown parameter(s) {', '.join(unknown)} for {owner}: allowed {', '.join(specs)}"
         + "".join(f"; {h}" for h in hints)

@@ -46,9 +46,10 @@ from typing import Final
 
 import numpy as np
 
-from .base import ESTIMATE, INTEGRATION_PARAM, Estimator, tuple_new
-from .complementary import (
+from .base import ESTIMATE, Estimator, tuple_new
+from .building_blocks import (
     ACC_LOWPASS_PARAM,
+    GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     body_rotation,
     lowpass_specific_force,
@@ -124,7 +125,7 @@ class UnscentedKalmanFilter(Estimator):
         Param("beta", 2.0, "Prior-distribution parameter (2 is optimal for Gaussians)", low=0.0),
         Param("kappa", 0.0, "Secondary scaling parameter (> -5 keeps n + lambda > 0 for n = 6)",
               low=-5.0, low_open=True),
-        INTEGRATION_PARAM,
+        GYRO_SAMPLING_PARAM,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
@@ -147,7 +148,7 @@ class UnscentedKalmanFilter(Estimator):
         self._r_acc = float(p["acc_noise"]) ** 2
         self._r_norm = float(p["norm_noise"]) ** 2
         self._gate = float(p["acc_gate"])
-        self._trapezoid: bool = p["integration"] == "trapezoid"
+        self._trapezoid: bool = p["gyro_sampling"] == "point"
         # any real-sensor option on (else the paper's filter alone: the short path of _advance)
         self._options = float(p["acc_lowpass"]) > 0.0 or float(p["rest_time"]) > 0.0
 
@@ -244,8 +245,8 @@ class UnscentedKalmanFilter(Estimator):
         f1 = c1 - (dt * b1 - (d2 * b0 - d0 * b2))
         f2 = c2 - (dt * b2 - (d0 * b1 - d1 * b0))
         Y0, Y1, Y2 = rotate_back((X0, X1, X2), (f0, f1, f2))  # the central point
-        rho = abs(math.sqrt(ax * ax + ay * ay + az * az) / G - 1.0)
-        update = rho < self._gate
+        norm = math.sqrt(ax * ax + ay * ay + az * az)
+        update = abs(norm / G - 1.0) < self._gate and norm > 0.0  # rho < acc_gate
         # Sums over the outer points, e = Y_i - Y_0: sum e (m), sum e e^T (e..),
         # sum_j (e_j+ - e_j-) (s_j^b)^T (x..), and for the pseudo-measurement
         # nu = |X_i|^2 - |X_0|^2 = +-2 X_0.s + |s|^2: sum nu, sum nu^2, sum e nu,

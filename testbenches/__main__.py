@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
                      help=f"all or a comma list of {', '.join(SCENARIOS)}")
     run.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                      help="estimator FMU parameter for every run (repeatable); an enumeration "
-                     "by item name, e.g. --param integration=rectangle")
+                     "by item name, e.g. --param gyro_sampling=mean")
     run.add_argument("--seeds", type=int, default=1, help="seeds per estimator x scenario (1)")
     run.add_argument("--jitter", type=float, default=0.0,
                      help="communication-step jitter, fraction of the period (0)")

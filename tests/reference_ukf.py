@@ -38,7 +38,7 @@ class ReferenceUnscentedKalmanFilter(Estimator):
         self._q_bias = p["bias_psd"]
         self._R = np.diag([p["acc_noise"] ** 2] * 3 + [p["norm_noise"] ** 2])
         self._gate = p["acc_gate"]
-        self._trapezoid = p["integration"] == "trapezoid"
+        self._trapezoid = p["gyro_sampling"] == "point"
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]

@@ -33,13 +33,13 @@ from fusion_core.presets import preset_params
 REPO = Path(__file__).resolve().parents[1]
 
 PARAM_SETS: dict[str, list[dict]] = {
-    "cf": [{}, {"integration": "rectangle"}, {"propagation": "quaternion"},
+    "cf": [{}, {"gyro_sampling": "mean"}, {"propagation": "quaternion"},
            {"acc_lowpass": 0.5}],
-    "kf": [{}, {"integration": "rectangle"}, {"propagation": "quaternion"},
+    "kf": [{}, {"gyro_sampling": "mean"}, {"propagation": "quaternion"},
            {"acc_lowpass": 0.5}, {"rest_time": 0.3}],
-    "mgcf": [{}, {"integration": "rectangle"}, {"schedule": "experimental"},
+    "mgcf": [{}, {"gyro_sampling": "mean"}, {"schedule": "experimental"},
              {"schedule": "fixed", "w0": 0.0}, {"acc_lowpass": 0.5}, {"rest_time": 0.3}],
-    "ukf": [{}, {"integration": "rectangle"}, {"acc_gate": 0.1}, {"acc_lowpass": 0.5},
+    "ukf": [{}, {"gyro_sampling": "mean"}, {"acc_gate": 0.1}, {"acc_lowpass": 0.5},
             {"rest_time": 0.3}, {"alpha": 0.5, "beta": 0.0}],
     "poskf": [{}, {"qr_form": "piecewise_jerk"}, {"qr_form": "diagonal"}, {"zupt": False}],
 }

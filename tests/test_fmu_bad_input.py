@@ -110,11 +110,11 @@ def test_tunable_parameter_change_while_running_takes_effect_at_that_sample(
 
 def test_fixed_parameter_is_refused_after_initialisation(built_fmus):
     with FmuInstance(built_fmus.path("UnscentedKalmanFilter")) as fmu:
-        fmu.set({"integration": "rectangle", "init_bias_std": 0.1})
+        fmu.set({"gyro_sampling": "mean", "init_bias_std": 0.1})
         errors = [m.message for m in fmu.messages if m.status == "ERROR"]
-        assert fmu.get("integration") == 1 and fmu.get("init_bias_std") == math.radians(1.0)
+        assert fmu.get("gyro_sampling") == 1 and fmu.get("init_bias_std") == math.radians(1.0)
     assert len(errors) == 2
-    assert "'integration' is fixed after initialisation" in errors[0]
+    assert "'gyro_sampling' is fixed after initialisation" in errors[0]
     assert "'init_bias_std' is fixed after initialisation" in errors[1]
 
 
@@ -122,10 +122,10 @@ def test_fixed_parameter_is_accepted_before_initialisation(
     built_fmus, fmu_recording, fusion_core_run
 ):
     acc, gyro, dt = (fmu_recording[k][:100] for k in IMU)
-    params = {"integration": "rectangle", "init_bias_std": 0.1}
+    params = {"gyro_sampling": "mean", "init_bias_std": 0.1}
     with FmuInstance(built_fmus.path("UnscentedKalmanFilter"), parameters=params) as fmu:
         out = fmu.run_samples(acc, gyro, dt)
-        assert fmu.get("integration") == 2
+        assert fmu.get("gyro_sampling") == 2
     assert np.array_equal(out["bias"], fusion_core_run("ukf", acc, gyro, dt, **params)["bias"])
 
 

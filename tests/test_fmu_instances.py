@@ -16,7 +16,7 @@ INSTANCES = (
     ("ComplementaryFilter", "cf", {"tau": 0.3}, 2),
     ("GainScheduledComplementaryFilter", "mgcf", {}, 3),
     ("AngleBiasKalmanFilter", "kf", {}, 4),
-    ("AngleBiasKalmanFilter", "kf", {"R_measure": 3e-5, "integration": "rectangle"}, 5),
+    ("AngleBiasKalmanFilter", "kf", {"R_measure": 3e-5, "gyro_sampling": "mean"}, 5),
     ("UnscentedKalmanFilter", "ukf", {}, 6),
     ("PositionKalmanFilter", "poskf", {}, 7),
     ("PositionKalmanFilter", "poskf", {"qr_form": "diagonal"}, 8),

@@ -80,7 +80,7 @@ def roll_only_sequence(seed: int = 1) -> dict[str, np.ndarray]:
 def test_rectangle_rule_roll_equals_papers_scalar_filter_to_1e_9_deg() -> None:
     seq = roll_only_sequence()
     assert np.abs(seq["roll"]).max() < 60 * DEG
-    out = AngleBiasKalmanFilter(integration="rectangle").run(seq["acc"], seq["gyro"], seq["dt"])
+    out = AngleBiasKalmanFilter(gyro_sampling="mean").run(seq["acc"], seq["gyro"], seq["dt"])
 
     new_angle = np.degrees(np.arctan2(seq["acc"][:, 1], seq["acc"][:, 2]))
     ref_angle, ref_bias = papers_kalman_deg(new_angle, np.degrees(seq["gyro"][:, 0]), seq["dt"])

@@ -20,11 +20,11 @@ LEVEL = (0.0, 0.0, G)
 STILL = (0.0, 0.0, 0.0)
 
 OPTION_SETS: dict[str, list[dict]] = {
-    "cf": [{}, {"integration": "rectangle"}, {"propagation": "quaternion"},
+    "cf": [{}, {"gyro_sampling": "mean"}, {"propagation": "quaternion"},
            {"acc_lowpass": 0.5}],
-    "kf": [{}, {"integration": "rectangle"}, {"propagation": "quaternion"},
+    "kf": [{}, {"gyro_sampling": "mean"}, {"propagation": "quaternion"},
            {"acc_lowpass": 0.5}, {"rest_time": 0.3}],
-    "mgcf": [{}, {"integration": "rectangle"}, {"schedule": "fixed", "w0": 0.0},
+    "mgcf": [{}, {"gyro_sampling": "mean"}, {"schedule": "fixed", "w0": 0.0},
              {"acc_lowpass": 0.5}, {"rest_time": 0.3}],
 }
 """Each filter's default (the short path) and every option that takes the general path."""
@@ -54,7 +54,7 @@ def test_messages_say_what_was_wrong(key: str) -> None:
         "gyro=": (LEVEL, (0.0, math.inf, 0.0), DT),
         "dt=": (LEVEL, STILL, -DT),
         "max_dt": (LEVEL, STILL, 2.0),
-        "accelerometer norm": ((0.0, 0.0, 0.05 * G), STILL, DT),
+        "max_rate": (LEVEL, (0.0, 0.0, 2000.0), DT),
         "three accelerations": ((0.0, G), STILL, DT),
     }
     for expected, (acc, gyro, dt) in cases.items():
@@ -78,7 +78,7 @@ def test_max_dt_follows_set_param_and_set_state(key: str) -> None:
     other.step(LEVEL, STILL, 0.05)
 
 
-@pytest.mark.parametrize("params", [{}, {"rest_time": 0.3}, {"integration": "rectangle"}])
+@pytest.mark.parametrize("params", [{}, {"rest_time": 0.3}, {"gyro_sampling": "mean"}])
 def test_kalman_snapshot_with_two_covariances_follows_each_axis(params: dict) -> None:
     """The roll and pitch filters share one covariance; a snapshot holding two different ones
     (no filter makes one, but set_state takes it) is followed axis by axis: each covariance and

@@ -140,11 +140,11 @@ def test_a_one_sample_lag_fails_t1_by_about_omega_h(fmu_dir: Path) -> None:
 
 
 def test_the_papers_rectangle_rule_fails_t1_and_accuracy(fmu_dir: Path) -> None:
-    """integration="rectangle" (the papers' rule) lags by half a step: 0.5 deg on the sweep."""
+    """gyro_sampling="mean" (the papers' rule) lags by half a step: 0.5 deg on the sweep."""
     r = run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
-                      params={"integration": "rectangle"})
+                      params={"gyro_sampling": "mean"})
     t1 = contract.check_t1([run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
-                                          params={"integration": "rectangle"},
+                                          params={"gyro_sampling": "mean"},
                                           sensor_params=contract.NOISE_FREE)])
     assert not t1.passed
     assert not next(c for c in r.checks if c.name == "accuracy roll RMSE").passed
@@ -270,7 +270,7 @@ def test_cli_exits_0_when_every_check_passes(fmu_dir: Path, tmp_path: Path) -> N
 
 def test_cli_exits_1_on_a_failed_check(fmu_dir: Path, tmp_path: Path) -> None:
     proc = _cli("--estimator", "cf", "--scenario", "roll_sweep", "--duration", "5",
-                "--param", "integration=rectangle", fmu_dir=fmu_dir, out=tmp_path)
+                "--param", "gyro_sampling=mean", fmu_dir=fmu_dir, out=tmp_path)
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert "FAIL: accuracy roll RMSE" in proc.stdout
 

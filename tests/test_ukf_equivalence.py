@@ -64,7 +64,7 @@ def test_defaults_match_the_numpy_reference_at_every_sample() -> None:
 @pytest.mark.parametrize(
     "params",
     [
-        {"integration": "rectangle"},
+        {"gyro_sampling": "mean"},
         {"alpha": 0.5, "beta": 0.0, "kappa": 1.0},
         {"acc_gate": 10.0, "acc_noise": 0.01},
     ],
