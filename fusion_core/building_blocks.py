@@ -27,7 +27,12 @@ from .kinematics import (
     rotate_back,
     rotation_increment,
 )
-from .types import DEG, MPU6050_GYRO_DENSITY, G, Param
+from .types import DEG, G, Param
+
+REAL_GYRO_DENSITY: Final = 0.008 * DEG
+"""Gyro white-noise density [rad/s/sqrt(Hz)] of the recommended zero-rate updates: measured on a
+real MEMS IMU at rest (BROAD's myon aktos-t, the first 20 s of 13 trials, median), 1.6 times the
+MPU-6050 datasheet's typical 0.005 deg/s/sqrt(Hz): a datasheet's typical figure is a good part's."""
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
@@ -52,32 +57,36 @@ seed papers integrate with the rectangle rule on every sensor: their preset take
 
 ACC_GATE_PARAMS: tuple[Param, ...] = (
     Param(
-        "gate_low", 0.9,
+        "gate_low", 0.5,
         "Accelerometer gate, lower bound of |acc|/g: below it the accelerometer correction is "
         "skipped (free fall, strong deceleration)",
         low=0.0, low_open=True, high=1.0,
     ),
     Param(
-        "gate_high", 1.1,
+        "gate_high", 2.0,
         "Accelerometer gate, upper bound of |acc|/g: above it the accelerometer correction is "
         "skipped (strong linear acceleration)",
         low=1.0,
     ),
 )
-"""Gui et al.'s accelerometer-magnitude gate. The papers give no bounds; ours, 0.9 g to 1.1 g, skip
-the accelerometer where at least 0.1 g of linear acceleration acts along gravity, yet stay open at
-rest for an uncalibrated MEMS accelerometer (scale-factor error up to about 3 %). Measured on the
-moderate_dynamics scenario: CF RMSE 0.40/0.46 deg with these bounds, 1.33/1.58 deg with the wide
-0.5 g to 2 g of common MPU-6050 sketches. Both bounds are parameters."""
+"""Gui et al.'s accelerometer-magnitude gate. The papers give no bounds. Recommended, 0.5 g to
+2 g: with the pre-filter on (ACC_LOWPASS_PARAM) the gate sees the filtered vector, whose norm
+stays near g while the raw one swings, so only gross disturbances need closing it; a narrow gate
+then only adds rejections (BROAD, kf: 1.35 deg mean with 0.5-2 g, 1.46 deg with 0.9-1.1 g). The
+paper preset's 0.9-1.1 g is our reading for the raw accelerometer: it skips samples with 0.1 g
+or more of linear acceleration along gravity, yet stays open at rest for an uncalibrated MEMS
+accelerometer (scale error up to about 3 %)."""
 
 ACC_LOWPASS_PARAM = Param(
-    "acc_lowpass", 0.0,
+    "acc_lowpass", 1.0,
     "Accelerometer pre-filter time constant: the specific force is low-passed in a frame that "
     "turns with the gyro, so linear acceleration averages out and gravity does not lag the "
     "rotation (Laidig & Seel 2023, VQF); the filter and its gate then use the filtered vector. "
     "0 = off: each raw sample (the papers)",
     unit="s", low=0.0,
 )
+"""Recommended: 1 s. Together with a correction time constant of 1-2.5 s it is a second-order
+low-pass of about VQF's tau_acc = 3 s (Laidig & Seel 2023, their tuning on BROAD)."""
 """The accelerometer pre-filter. Laidig & Seel (VQF: Highly accurate IMU orientation estimation
 with bias estimation and magnetic disturbance rejection, Information Fusion 91, 2023) low-pass
 filter the accelerometer in an almost inertial frame given by the gyro strapdown integration:
@@ -91,7 +100,7 @@ real recordings (testbenches/broad.py): the fast-translation trials, whose raw a
 swings between 0.02 g and 5 g, drop from tens of degrees to below 1 deg of inclination error."""
 
 PROPAGATION_PARAM = Param(
-    "propagation", "euler",
+    "propagation", "quaternion",
     "How the gyro carries roll and pitch between samples: 'euler' (the Z-Y-X Euler-rate "
     "kinematics, singular at pitch +-90 deg) or 'quaternion' (an attitude quaternion with a free "
     "yaw, turned by each interval's rotation vector: exact in every orientation)",
@@ -105,7 +114,8 @@ back. With 'quaternion' the filter keeps an attitude quaternion q (yaw free, uno
 it by the bias-corrected rotation vector of each interval (the same integration rule as the
 quaternion filters, kinematics.rotation_increment), takes roll and pitch from it, applies its
 paper's correction to roll and pitch, and rebuilds q from the corrected roll and pitch and q's own
-yaw. The correction law, its gains and its covariance are the paper's."""
+yaw. The correction law, its gains and its covariance are the paper's. Recommended: 'quaternion'
+(no orientation is singular for it); 'euler' is the papers'."""
 
 RestState = tuple[float, float, float, float, float, float, float]
 """The rest detector's state: running means of the rate (3) and of the specific force (3), and
@@ -116,7 +126,7 @@ restFilterTau)."""
 
 REST_PARAMS: tuple[Param, ...] = (
     Param(
-        "rest_time", 0.0,
+        "rest_time", 1.5,
         "Rest detection: after this long with the gyro and accelerometer within rest_gyro and "
         "rest_acc of their running means (and the mean rate below rest_gyro) the sensor is at "
         "rest, and the gyro, which then reads its own bias, updates the bias estimate. "
@@ -138,19 +148,20 @@ uncalibrated MEMS gyro's turn-on bias (0.1-0.5 deg/s on BROAD's IMU, 0.5 deg/s a
 correction time constant of seconds is a tilt error of tenths of a degree, and about z the bias is
 not observable from the accelerometer at all while the sensor is level. The detector is VQF's
 (Laidig & Seel 2023): the rate and the specific force must stay within the thresholds of their
-running means (time constant REST_MEAN_TAU) for rest_time; its defaults (2 deg/s, 0.5 m/s^2)
-are VQF's restThGyr and restThAcc."""
+running means (time constant REST_MEAN_TAU) for rest_time; its defaults (2 deg/s, 0.5 m/s^2,
+1.5 s) are VQF's restThGyr, restThAcc and restMinT. The papers have no rest detection
+(rest_time = 0)."""
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
     """The gyro white-noise PSD of the zero-angular-rate update at rest (REST_PARAMS), whose
-    measurement variance is PSD / dt; default the MPU-6050's. The UKF names it zaru_psd, since
-    its gyro_psd is its process noise."""
+    measurement variance is PSD / dt; default REAL_GYRO_DENSITY squared. The UKF names it
+    zaru_psd, since its gyro_psd is its process noise."""
     return Param(
-        name, MPU6050_GYRO_DENSITY**2,
+        name, REAL_GYRO_DENSITY**2,
         "Gyro white-noise power spectral density of the zero-angular-rate update at rest: its "
-        "variance is this / dt (the rate-noise density squared; MPU-6050: "
-        "(0.005 deg/s/sqrt(Hz))^2)",
+        "variance is this / dt (the rate-noise density squared; measured on a real MEMS IMU: "
+        "(0.008 deg/s/sqrt(Hz))^2)",
         unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
     )
 

@@ -25,6 +25,7 @@ from .building_blocks import (
     ACC_LOWPASS_PARAM,
     GYRO_SAMPLING_PARAM,
     PROPAGATION_PARAM,
+    REAL_GYRO_DENSITY,
     REST_PARAMS,
     ZERO3,
     Vec3,
@@ -47,9 +48,13 @@ from .kinematics import (
     quat_roll_pitch,
     wrap_angle,
 )
-from .types import DEG, Estimate, Param
+from .types import DEG, Estimate, G, Param
 
 DEG2: Final = DEG * DEG
+RECOMMENDED_R: Final = (0.05 / G) ** 2
+"""Recommended R_measure [rad^2]: the variance of one accelerometer sample's tilt, (0.05 m/s^2 /
+g)^2 = (0.29 deg)^2, from the accelerometer's noise measured at rest on a real MEMS IMU
+(0.045-0.07 m/s^2 per sample on BROAD's)."""
 
 
 def predict_covariance(
@@ -113,11 +118,14 @@ class AngleBiasKalmanFilter(Estimator):
     gate_low <= |acc|/g <= gate_high (the accelerometer-magnitude gate; outside it the filter
     only predicts). The innovation is wrapped to [-pi, pi].
 
-    Initialisation: the first valid sample sets the angles from the accelerometer, biases 0 and
-    P = 0, like the papers' reference code (init_bias_std > 0 starts the bias variances there
-    instead: with a small, physical Q_bias a zero prior would keep the bias from ever moving).
+    Initialisation: the first valid sample sets the angles from the accelerometer and the biases
+    to 0. With init_bias_std > 0 (recommended) P starts as diag(R_measure, init_bias_std^2): the
+    angles as sure as one accelerometer sample, the bias as its prior (with a small, physical
+    Q_bias a zero prior would keep the bias from ever moving); with init_bias_std = 0, P = 0
+    like the papers' reference code.
 
-    Options for real sensors, all off by default (then the filter is exactly the papers'):
+    Options for real sensors, all on by default (the `paper` preset turns them off, and then the
+    filter is exactly the papers'):
     - acc_lowpass > 0: the accelerometer is low-passed in a frame that turns with the gyro
       (complementary.ACC_LOWPASS_PARAM, after Laidig & Seel 2023) before the gate and the
       measurement, so linear acceleration averages out instead of reading as tilt;
@@ -131,26 +139,40 @@ class AngleBiasKalmanFilter(Estimator):
       yaw instead of the Euler rates (complementary.PROPAGATION_PARAM), so that pitch +-90 deg is
       no singularity; the covariance and the measurement update are the papers'.
 
-    Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2] (papers' 0.001, 0.003,
-    0.03 deg-based values converted, see the module docstring); gate_low, gate_high;
+    Recommended values (the defaults), from sensor physics: Q_angle = the gyro's noise PSD and
+    R_measure = the variance of one accelerometer sample's tilt (RECOMMENDED_R), which together
+    give a correction time constant sqrt(R dt / Q_angle) of 2.2 s at 285.7 Hz and 3.7 s at 100
+    Hz (the papers' numbers, tuned at 30 Hz, give 0.3 s at 285.7 Hz); gyro_psd (the zero-rate
+    update) the same PSD; init_bias_std = 1 deg/s, an uncalibrated MEMS gyro's turn-on bias
+    (BROAD's: up to 0.5 deg/s), with the angles' first variance R (one sample's); the
+    pre-filter, rest detection and quaternion propagation as building_blocks recommends.
+    Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 1.16 / 0.95 / 0.94 deg):
+    the accelerometer's error after the pre-filter is coloured (residual linear acceleration),
+    so a bias random walk sized from the gyro's real drift (3e-6 deg^2/s^3) lets it steer the
+    bias in motion with a time constant of seconds; 1e-8 leaves the bias to the rest updates.
+    The papers' values (Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees, P = 0 at the start) are
+    presets.PAPER_KF.
+
+    Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2]; gate_low, gate_high;
     acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_psd
-    [rad^2/s]; init_bias_std [rad/s]; propagation; integration; max_dt [s].
+    [rad^2/s]; init_bias_std [rad/s]; propagation; gyro_sampling; max_dt [s], max_rate [rad/s].
     """
 
     PARAMS = (
         Param(
-            "Q_angle", 0.001 * DEG2,
-            "Process noise of the angle per second of integration (papers' 0.001 deg^2/s)",
+            "Q_angle", REAL_GYRO_DENSITY**2,
+            "Process noise of the angle per second of integration: the gyro's noise PSD "
+            "((0.008 deg/s/sqrt(Hz))^2; papers' 0.001 deg^2/s)",
             unit="rad2/s", low=0.0, display_unit="deg2/s",
         ),
         Param(
-            "Q_bias", 0.003 * DEG2,
-            "Process noise of the gyro bias per second (papers' 0.003 (deg/s)^2/s)",
+            "Q_bias", 1e-8 * DEG2,
+            "Process noise of the gyro bias per second (1e-8 (deg/s)^2/s; papers' 0.003)",
             unit="rad2/s3", low=0.0, display_unit="deg2/s3",
         ),
         Param(
-            "R_measure", 0.03 * DEG2,
-            "Variance of the accelerometer angle measurement (papers' 0.03 deg^2)",
+            "R_measure", RECOMMENDED_R,
+            "Variance of the accelerometer angle measurement ((0.29 deg)^2; papers' 0.03 deg^2)",
             unit="rad2", low=0.0, low_open=True, display_unit="deg2",
         ),
         *ACC_GATE_PARAMS,
@@ -158,7 +180,7 @@ class AngleBiasKalmanFilter(Estimator):
         *REST_PARAMS,
         zero_rate_psd_param(),
         Param(
-            "init_bias_std", 0.0,
+            "init_bias_std", 1.0 * DEG,
             "Initial standard deviation of the gyro-bias states (0: P = 0 at the first sample, "
             "the papers' code)",
             unit="rad/s", low=0.0, tunable=False, display_unit="deg/s",
@@ -211,7 +233,10 @@ class AngleBiasKalmanFilter(Estimator):
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         p_b = self._params["init_bias_std"] ** 2
         if p_b > 0.0:
-            self.P_roll = self.P_pitch = (0.0, 0.0, 0.0, p_b)
+            # one accelerometer sample's variance for the angles it set (the posterior of that
+            # one measurement): with P00 = 0 the filter would be sure of a first sample taken
+            # in motion and explain the innovations that follow by a gyro bias
+            self.P_roll = self.P_pitch = (self._r, 0.0, 0.0, p_b)
             self.P_z = p_b
 
     def _advance(

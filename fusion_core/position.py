@@ -17,6 +17,7 @@ covariance P (and one gain per update), kept as its upper triangle
 
 from __future__ import annotations
 
+import dataclasses
 from math import cos, sin, sqrt
 from typing import Any
 
@@ -24,10 +25,24 @@ from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
-from .types import DEG, MPU6050_ACC_DENSITY, Estimate, G, Param
+from .presets import PAPER_KF
+from .types import DEG, Estimate, G, Param
+
+REAL_ACC_DENSITY = 0.005
+"""Accelerometer white-noise density [m/s^2/sqrt(Hz)] measured on a real MEMS IMU at rest
+(BROAD's myon aktos-t: 0.004-0.006), the recommended acc_psd's root."""
 
 TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "gyro_sampling")
 """Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
+TILT_DEFAULTS = {k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "gate_low",
+                                          "gate_high")}
+"""The tilt stage's defaults: the papers' values. It sees the accelerometer only at confirmed
+rest, where the specific force is gravity alone, so it may trust each sample as the papers do
+(R 0.03 deg^2: it converges within a rest of a fraction of a second); the recommended kf's
+values are for a filter that must trust the accelerometer in motion too."""
+TILT_FIXED = {"propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0}
+"""The tilt stage's other kf options: off. This filter drives the stage step by step (propagate,
+correct_innovation, correct_bias) and does its own rest detection and bias updates."""
 
 Sym3 = tuple[float, float, float, float, float, float]
 """A symmetric 3x3 matrix as its upper triangle (m00, m01, m02, m11, m12, m22)."""
@@ -168,7 +183,13 @@ class PositionKalmanFilter(Estimator):
          update, zaru), so the tilt does not drift during the next move.
     The filter starts at position 0 and velocity 0 (the platform at rest, as in the paper).
 
-    Outputs pos, vel [m, m/s] plus the tilt stage's roll, pitch, bias (bias_z = 0).
+    Outputs pos, vel [m, m/s] plus roll, pitch and bias. With attitude="kf" (recommended) they
+    come from an AngleBiasKalmanFilter with its recommended values run on the same samples: the
+    tilt stage above is right for levelling the accelerometer between rests (it never takes
+    linear acceleration for tilt), but in continuous motion it is gyro-only integration, and an
+    attitude output must be as good as the best attitude filter here. With "tilt_stage" (the
+    papers') they are the tilt stage's (bias_z = 0). The recommended acc_psd and gyro_psd are
+    the noise densities measured on a real MEMS IMU, squared.
     """
 
     HAS_POSITION = True
@@ -182,9 +203,9 @@ class PositionKalmanFilter(Estimator):
         Param("q", 1.0, "Jerk noise power spectral density per axis", unit="m2/s5", low=0.0,
               low_open=True),
         Param(
-            "acc_psd", MPU6050_ACC_DENSITY**2,
-            "Accelerometer white-noise power spectral density, R = acc_psd/dt (MPU-6050: "
-            "(400 ug/sqrt(Hz))^2)",
+            "acc_psd", REAL_ACC_DENSITY**2,
+            "Accelerometer white-noise power spectral density, R = acc_psd/dt (measured on a real "
+            "MEMS IMU: (0.005 m/s2/sqrt(Hz))^2; MPU-6050 datasheet (400 ug/sqrt(Hz))^2)",
             unit="m2/s3", low=0.0, low_open=True,
         ),
         Param("zupt", True, "Zero-velocity update while the platform is stationary"),
@@ -231,14 +252,22 @@ class PositionKalmanFilter(Estimator):
             "When the tilt filter uses the accelerometer: 'stationary' or 'always' (the papers')",
             choices=("stationary", "always"),
         ),
+        Param(
+            "attitude", "kf",
+            "Where the roll, pitch and bias outputs come from: 'kf' (an AngleBiasKalmanFilter with "
+            "its recommended values on the same samples: accurate in continuous motion) or "
+            "'tilt_stage' (the tilt that levels the accelerometer for the position filter; the "
+            "papers')",
+            choices=("kf", "tilt_stage"), tunable=False,
+        ),
         *(
-            p for p in AngleBiasKalmanFilter.PARAMS
-            if p.name in TILT_PARAMS
+            dataclasses.replace(p, default=TILT_DEFAULTS.get(p.name, p.default))
+            for p in AngleBiasKalmanFilter.PARAMS if p.name in TILT_PARAMS
         ),
     )
     STATE = (
         "yaw", "states", "P", "quiet_time", "stationary", "pending", "turned", "f_mean",
-        "tilt_state",
+        "tilt_state", "attitude_state",
     )
     _x: AxisStates  # [p, v, a] of x, y, z
     _P: Sym3  # the covariance the three axes share, packed
@@ -247,12 +276,19 @@ class PositionKalmanFilter(Estimator):
         p = self._params
         tilt_params = {k: p[k] for k in TILT_PARAMS}
         if not hasattr(self, "tilt"):
-            self.tilt = AngleBiasKalmanFilter(max_dt=p["max_dt"], **tilt_params)
+            self.tilt = AngleBiasKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
+                                              **TILT_FIXED, **tilt_params)
+            # the attitude output (attitude="kf"): the recommended kf on the same samples
+            self.att = AngleBiasKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
+                                             gyro_sampling=p["gyro_sampling"])
         else:
             for k, v in tilt_params.items():
                 if k != "gyro_sampling":
                     self.tilt.set_param(k, v)
-            self.tilt.set_param("max_dt", p["max_dt"])
+            for f in (self.tilt, self.att):
+                f.set_param("max_dt", p["max_dt"])
+                f.set_param("max_rate", p["max_rate"])
+        self._own_attitude: bool = p["attitude"] == "kf"
         self._acc_var_density = float(p["acc_psd"])
         self._zupt_var = float(p["zupt_noise"]) ** 2
         self._gyro_var_density = float(p["gyro_psd"])
@@ -268,6 +304,14 @@ class PositionKalmanFilter(Estimator):
         # the dt of Q = process_noise(qr_form, q, dt) and R = acc_psd / dt (0: none yet, since
         # every accepted dt is > 0)
         self._Q_dt = 0.0
+
+    @property
+    def attitude_state(self) -> dict:
+        return self.att.get_state()
+
+    @attitude_state.setter
+    def attitude_state(self, value: dict) -> None:
+        self.att.set_state(value)
 
     @property
     def tilt_state(self) -> dict:
@@ -304,6 +348,7 @@ class PositionKalmanFilter(Estimator):
 
     def _reset(self) -> None:
         self.tilt.reset()
+        self.att.reset()
         self.yaw = 0.0
         self._x = (0.0,) * 9
         self._P = (0.0,) * 6
@@ -326,6 +371,8 @@ class PositionKalmanFilter(Estimator):
         # The first sample's dt is not used; pass one the tilt stage accepts.
         tilt = self.tilt
         tilt.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
+        if self._own_attitude:
+            self.att.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
         self.f_mean = (ax, ay, az)
         roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
         lx, ly, lz = level_acceleration(
@@ -413,6 +460,8 @@ class PositionKalmanFilter(Estimator):
             tilt.correct_bias(gx, gy, self._gyro_var_density / dt)
         tilt.gyro_prev = (gx, gy, gz)
         tilt.n_samples += 1
+        if self._own_attitude:
+            self.att.step((ax, ay, az), (gx, gy, gz), dt)
         roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
         sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
         if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
@@ -434,7 +483,7 @@ class PositionKalmanFilter(Estimator):
         return self._estimate()
 
     def _estimate(self) -> Estimate:
-        t = self.tilt
+        t = self.att if self._own_attitude else self.tilt
         x = self._x
         return tuple_new(ESTIMATE, (
             t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0), (x[0], x[3], x[6]), (x[1], x[4], x[7])

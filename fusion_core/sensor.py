@@ -1,14 +1,42 @@
-"""MEMS IMU error model (the ImuSensor FMU's math): noise, bias, bias random walk, range,
-quantisation and timestamp jitter, seeded and reproducible.
+"""MEMS IMU error model (the ImuSensor FMU's math), seeded and reproducible.
 
-Defaults are the MPU-6050 datasheet's: gyro rate-noise density 0.005 deg/s/sqrt(Hz), accelerometer
-noise density 400 ug/sqrt(Hz), full-scale ranges +-2000 deg/s and +-16 g, 16-bit converters.
+The default is a realistic MPU-6050-class IMU: every error a user of such a part meets, each
+value from the InvenSense MPU-6000/6050 product specification (PS-MPU-6000A-00, rev. 3.4; "DS"
+below) or stated as our reading where the datasheet gives a bound, not a distribution:
+
+- white noise density: gyro 0.005 deg/s/sqrt(Hz), accelerometer 400 ug/sqrt(Hz) (DS: rate
+  noise spectral density; power spectral density);
+- bias left after the usual calibration (calibration="startup"): gyro 0.16 deg/s, accelerometer
+  0.5 mg (1 sigma): the DS temperature coefficients (ZRO +-20 deg/s over 125 K, zero-g +-35 mg
+  over 70 K) times 1 K of warm-up after the calibration;
+- scale and cross-axis errors: gyro 1 % and 0.67 % (DS +-3 % and +-2 % taken as 3 sigma; users
+  calibrate a gyro's bias at start-up, not its scale, which needs a turntable); accelerometer
+  0.1 % and 0.1 % (our reading of what a six-position calibration, PX4's and ArduPilot's set-up
+  step, leaves);
+- uncalibrated (calibration="none"): gyro bias 6.7 deg/s, accelerometer 17 mg (x, y), 27 mg (z),
+  1 %, 0.67 % (DS initial tolerances +-20 deg/s, +-50/+-80 mg, +-3 %, +-2 % as 3 sigma);
+- bias instability, a Gauss-Markov process of 100 s: gyro 0.003 deg/s (about 10 deg/h),
+  accelerometer 0.1 mg (the order that Allan-variance studies of the MPU-6050 report; the DS
+  gives none);
+- digital low-pass filter: DLPF_CFG 0, gyro 256 Hz and 0.98 ms, accelerometer 260 Hz and 0 ms
+  (DS register 26; 0 is the register's reset value);
+- full-scale range +-2000 deg/s and +-16 g at 16 bits (DS FS_SEL = 3, AFS_SEL = 3);
+- gyro sample: a point value (the DLPF's output read at the output rate).
+
+The per-run errors (bias left after calibration, scale factor, cross-axis) are drawn once
+from the seed, so every seed is another sensor off the same production line; the noise and the
+bias instability are drawn per sample. SENSOR_PRESETS["ideal"] switches everything off but the
+white noise (the papers' comparisons, and the contract's noise-free runs with the noise off too).
 
 Noise convention: the parameters are power spectral densities S, the squares of the datasheets'
 densities n (S = n^2; FMI 2.0 base units have integer exponents, so n's unit rad/(s.sqrt(Hz))
 cannot be declared, S's rad2/s can). A continuous white noise of PSD S sampled over an interval h
 has standard deviation sqrt(S / h) (n / sqrt(h); one-sided, per Hz, as datasheets state it). A
 bias random walk of PSD K moves the bias by sqrt(K h) (one standard deviation) per interval.
+
+Order of the errors within one sample, as in the part: true rate (its interval mean with
+gyro_sampling="mean") -> scale factor and cross-axis -> bias -> white noise -> digital low-pass
+filter -> saturation -> quantisation.
 """
 
 from __future__ import annotations
@@ -27,25 +55,81 @@ from .types import (
     check_param_names,
 )
 
+MG = 1e-3 * G
+"""One milli-g [m/s^2]."""
+
+DLPF_TABLE: dict[int, tuple[float, float, float, float]] = {
+    0: (260.0, 0.0, 256.0, 0.98e-3),
+    1: (184.0, 2.0e-3, 188.0, 1.9e-3),
+    2: (94.0, 3.0e-3, 98.0, 2.8e-3),
+    3: (44.0, 4.9e-3, 42.0, 4.8e-3),
+    4: (21.0, 8.5e-3, 20.0, 8.3e-3),
+    5: (10.0, 13.8e-3, 10.0, 13.4e-3),
+    6: (5.0, 19.0e-3, 5.0, 18.6e-3),
+}
+"""MPU-6050 DLPF_CFG -> (accelerometer bandwidth [Hz], delay [s], gyro bandwidth [Hz], delay [s])
+(DS register 26, CONFIG). 7 (reserved in the DS) is not offered; -1 turns the filter off."""
+
+Calibrated = tuple[tuple[float, float, float], tuple[float, float, float], float, float]
+CALIBRATION: dict[str, Calibrated] = {
+    "startup": ((0.16 * DEG,) * 3, (0.5 * MG,) * 3, 0.001, 0.001),
+    "none": ((20.0 / 3.0 * DEG,) * 3, (50.0 / 3.0 * MG, 50.0 / 3.0 * MG, 80.0 / 3.0 * MG),
+             0.01, 0.02 / 3.0),
+    "perfect": ((0.0,) * 3, (0.0,) * 3, 0.0, 0.0),
+}
+"""calibration -> per-axis standard deviations of the per-run errors it leaves: gyro bias
+[rad/s], accelerometer bias [m/s^2], accelerometer scale-factor error, accelerometer cross-axis
+sensitivity (see the module docstring for the sources). The gyro's scale and cross-axis errors
+are parameters of their own: users do not calibrate them."""
+
 SENSOR_PARAMS: tuple[Param, ...] = (
-    Param("seed", 0, "Seed of the noise generator (same seed, same samples)", low=0, high=2**31 - 1,
-          tunable=False),
+    Param("seed", 0, "Seed of the noise generator and of the per-run errors (same seed, same "
+          "sensor and samples)", low=0, high=2**31 - 1, tunable=False),
+    Param("gyro_sampling", "point",
+          "What the gyro sample is: 'point' (the rate at the sample instant) or 'mean' (the mean "
+          "rate over the interval ending at the sample, as integrating IMUs deliver); an "
+          "estimator's gyro_sampling must match it", choices=("point", "mean"), tunable=False),
     Param("gyro_psd", MPU6050_GYRO_DENSITY**2,
           "Gyro white-noise power spectral density (the rate-noise density squared; MPU-6050: "
           "(0.005 deg/s/sqrt(Hz))^2)", unit="rad2/s", low=0.0, display_unit="deg2/s"),
     Param("acc_psd", MPU6050_ACC_DENSITY**2,
           "Accelerometer white-noise power spectral density (the noise density squared; "
           "MPU-6050: (400 ug/sqrt(Hz))^2)", unit="m2/s3", low=0.0),
-    *(Param(f"gyro_bias_{a}", 0.0, f"Constant gyro bias, {a} axis", unit="rad/s",
-            display_unit="deg/s") for a in "xyz"),
-    *(Param(f"acc_bias_{a}", 0.0, f"Constant accelerometer bias, {a} axis", unit="m/s2")
-      for a in "xyz"),
+    Param("calibration", "startup",
+          "Per-run errors drawn from the seed: 'startup' (what the usual calibration leaves: "
+          "gyro bias 0.16 deg/s after averaging at rest at start-up, accelerometer bias 0.5 mg, "
+          "scale and cross-axis 0.1 % after a six-position calibration), 'none' (the MPU-6050 "
+          "datasheet's tolerances as 3 sigma: 6.7 deg/s, 17-27 mg, 1 %, 0.67 %) or 'perfect'",
+          choices=tuple(CALIBRATION), tunable=False),
+    *(Param(f"gyro_bias_{a}", 0.0, f"Constant gyro bias added to the per-run one, {a} axis",
+            unit="rad/s", display_unit="deg/s") for a in "xyz"),
+    *(Param(f"acc_bias_{a}", 0.0, f"Constant accelerometer bias added to the per-run one, {a} axis",
+            unit="m/s2") for a in "xyz"),
+    Param("gyro_bias_instability", 0.003 * DEG,
+          "Gyro bias instability: standard deviation of a first-order Gauss-Markov bias "
+          "(time constant bias_time_constant); 0.003 deg/s, about 10 deg/h",
+          unit="rad/s", low=0.0, display_unit="deg/s"),
+    Param("acc_bias_instability", 0.1 * MG,
+          "Accelerometer bias instability: standard deviation of a first-order Gauss-Markov bias "
+          "(time constant bias_time_constant); 0.1 mg", unit="m/s2", low=0.0),
+    Param("bias_time_constant", 100.0, "Correlation time of the Gauss-Markov bias instability",
+          unit="s", low=0.0, low_open=True),
     Param("gyro_bias_psd", 0.0,
           "Gyro bias random-walk power spectral density (the random-walk density squared)",
           unit="rad2/s3", low=0.0, display_unit="deg2/s3"),
     Param("acc_bias_psd", 0.0,
           "Accelerometer bias random-walk power spectral density (the random-walk density "
           "squared)", unit="m2/s5", low=0.0),
+    Param("gyro_scale_std", 0.01,
+          "Per-run scale-factor error of each gyro axis, standard deviation (MPU-6050 "
+          "datasheet +-3 % as 3 sigma)", low=0.0, high=0.5, tunable=False),
+    Param("gyro_cross_axis_std", 0.02 / 3.0,
+          "Per-run cross-axis sensitivity of every gyro axis pair, standard deviation (MPU-6050 "
+          "datasheet +-2 % as 3 sigma)", low=0.0, high=0.5, tunable=False),
+    Param("dlpf_cfg", 0,
+          "MPU-6050 digital low-pass filter setting DLPF_CFG 0..6 (bandwidth 260/184/94/44/21/10/"
+          "5 Hz, delay 0-19 ms; 0 is the register's reset value), or -1 for no filter",
+          low=-1, high=6, tunable=False),
     Param("gyro_range", 2000.0 * DEG, "Gyro full-scale range (outputs saturate at +-range)",
           unit="rad/s", low=0.0, low_open=True, display_unit="deg/s"),
     Param("acc_range", 16.0 * G, "Accelerometer full-scale range (outputs saturate at +-range)",
@@ -57,6 +141,72 @@ SENSOR_PARAMS: tuple[Param, ...] = (
 )
 _SPECS = {p.name: p for p in SENSOR_PARAMS}
 """SENSOR_PARAMS by name."""
+
+SENSOR_PRESETS: dict[str, dict[str, Any]] = {
+    "realistic": {},
+    "ideal": {"calibration": "perfect", "gyro_bias_instability": 0.0,
+              "acc_bias_instability": 0.0, "gyro_scale_std": 0.0, "gyro_cross_axis_std": 0.0,
+              "dlpf_cfg": -1},
+}
+"""Sensor parameter sets: 'realistic' (the defaults: an MPU-6050-class IMU as a user meets it)
+and 'ideal' (white noise, range and quantisation only: the sensor of the papers' simulations)."""
+
+N_NORMALS = 19
+"""Standard normals drawn per sample: white noise (6), bias random walk (6), Gauss-Markov bias
+instability (6), timestamp jitter (1)."""
+
+
+def sensor_preset(name: str) -> dict[str, Any]:
+    """A copy of a named sensor parameter set (ValueError naming the allowed ones)."""
+    if name not in SENSOR_PRESETS:
+        raise ValueError(f"unknown sensor {name!r}: allowed {', '.join(SENSOR_PRESETS)}")
+    return dict(SENSOR_PRESETS[name])
+
+
+class LowPass2:
+    """A 2nd-order Butterworth low-pass (bilinear transform, pre-warped) on three channels, or a
+    pure delay where the corner is beyond what the sample rate can show.
+
+    Stands for the MPU-6050's DLPF at the output rate 1/h: below 0.45/h the datasheet bandwidth
+    is the -3 dB corner (whose group delay is then close to the datasheet's delay); above it the
+    samples cannot show the magnitude response, and only the datasheet delay is kept, as a
+    linear interpolation back by delay/h samples.
+    """
+
+    def __init__(self, bandwidth: float, delay: float) -> None:
+        self.bandwidth = bandwidth
+        self.delay = delay
+        self.h = 0.0
+        self.coef: tuple[float, ...] = ()
+        self.state: list[list[float]] | None = None  # per channel: x1, x2, y1, y2
+
+    def _design(self, h: float) -> None:
+        self.h = h
+        if self.bandwidth >= 0.45 / h:
+            self.coef = (min(self.delay / h, 1.0),)
+            return
+        k = math.tan(math.pi * self.bandwidth * h)
+        norm = 1.0 / (1.0 + math.sqrt(2.0) * k + k * k)
+        b0 = k * k * norm
+        a1 = 2.0 * (k * k - 1.0) * norm
+        a2 = (1.0 - math.sqrt(2.0) * k + k * k) * norm
+        self.coef = (b0, 2.0 * b0, b0, a1, a2)
+
+    def __call__(self, x: list[float], h: float) -> list[float]:
+        if h != self.h:
+            self._design(h)
+        if self.state is None:  # start at rest at the first value (no transient)
+            self.state = [[v, v, v, v] for v in x]
+        out = []
+        for v, s in zip(x, self.state, strict=True):
+            if len(self.coef) == 1:
+                y = v - self.coef[0] * (v - s[0])
+            else:
+                b0, b1, b2, a1, a2 = self.coef
+                y = b0 * v + b1 * s[0] + b2 * s[1] - a1 * s[2] - a2 * s[3]
+            s[1], s[0], s[3], s[2] = s[0], v, s[2], y
+            out.append(y)
+        return out
 
 
 class ImuSensorModel:
@@ -73,9 +223,42 @@ class ImuSensorModel:
     def reset(self) -> None:
         p = self.params
         self.rng = np.random.Generator(np.random.PCG64(p["seed"]))
-        self.gyro_bias = [p[f"gyro_bias_{a}"] for a in "xyz"]
-        self.acc_bias = [p[f"acc_bias_{a}"] for a in "xyz"]
+        # The per-run errors from a stream of their own, so that they do not shift the noise.
+        run = np.random.Generator(np.random.PCG64([p["seed"], 1]))
+        gyro_std, acc_std, acc_scale, acc_cross = CALIBRATION[p["calibration"]]
+        self.gyro_turn_on = (run.standard_normal(3) * gyro_std).tolist()
+        self.acc_turn_on = (run.standard_normal(3) * acc_std).tolist()
+        self.gyro_matrix = _error_matrix(run, p["gyro_scale_std"], p["gyro_cross_axis_std"])
+        self.acc_matrix = _error_matrix(run, acc_scale, acc_cross)
+        self.gyro_walk = [0.0, 0.0, 0.0]  # random walk (gyro_bias_psd)
+        self.acc_walk = [0.0, 0.0, 0.0]
+        # Gauss-Markov bias instability, started from its stationary distribution
+        self.gyro_gm = (run.standard_normal(3) * p["gyro_bias_instability"]).tolist()
+        self.acc_gm = (run.standard_normal(3) * p["acc_bias_instability"]).tolist()
+        self.omega_prev: list[float] | None = None
         self.time_error = 0.0
+        cfg = int(p["dlpf_cfg"])
+        if cfg < 0:
+            self.acc_filter: LowPass2 | None = None
+            self.gyro_filter: LowPass2 | None = None
+        else:
+            acc_bw, acc_delay, gyro_bw, gyro_delay = DLPF_TABLE[cfg]
+            self.acc_filter = LowPass2(acc_bw, acc_delay)
+            self.gyro_filter = LowPass2(gyro_bw, gyro_delay)
+
+    @property
+    def gyro_bias(self) -> list[float]:
+        """The gyro bias now [rad/s]: constant + per-run + random walk + bias instability."""
+        p = self.params
+        return [p[f"gyro_bias_{a}"] + self.gyro_turn_on[i] + self.gyro_walk[i] + self.gyro_gm[i]
+                for i, a in enumerate("xyz")]
+
+    @property
+    def acc_bias(self) -> list[float]:
+        """The accelerometer bias now [m/s^2]."""
+        p = self.params
+        return [p[f"acc_bias_{a}"] + self.acc_turn_on[i] + self.acc_walk[i] + self.acc_gm[i]
+                for i, a in enumerate("xyz")]
 
     def sample(
         self, omega: tuple[float, float, float], f: tuple[float, float, float], h: float
@@ -84,55 +267,85 @@ class ImuSensorModel:
         p = self.params
         if not h > 0.0:
             raise ValueError(f"interval h={h!r} s must be > 0")
-        z = self.rng.standard_normal(13).tolist()
-        # Written out per axis: this runs once per testbench step (the ImuSensor FMU's doStep).
-        gb, ab = self.gyro_bias, self.acc_bias
+        z = self.rng.standard_normal(N_NORMALS).tolist()
+        rate = list(omega)
+        if p["gyro_sampling"] == "mean":
+            # the rate's mean over the interval, the rate taken linear between its ends
+            prev = self.omega_prev if self.omega_prev is not None else rate
+            self.omega_prev = rate
+            rate = [0.5 * (a + b) for a, b in zip(prev, rate, strict=True)]
         gw, aw = math.sqrt(p["gyro_bias_psd"] * h), math.sqrt(p["acc_bias_psd"] * h)
-        gb[0] += gw * z[6]
-        gb[1] += gw * z[7]
-        gb[2] += gw * z[8]
-        ab[0] += aw * z[9]
-        ab[1] += aw * z[10]
-        ab[2] += aw * z[11]
+        decay = math.exp(-h / p["bias_time_constant"])
+        drive = math.sqrt(1.0 - decay * decay)
+        g_gm, a_gm = drive * p["gyro_bias_instability"], drive * p["acc_bias_instability"]
+        for i in range(3):
+            self.gyro_walk[i] += gw * z[6 + i]
+            self.acc_walk[i] += aw * z[9 + i]
+            self.gyro_gm[i] = decay * self.gyro_gm[i] + g_gm * z[12 + i]
+            self.acc_gm[i] = decay * self.acc_gm[i] + a_gm * z[15 + i]
         gn, an = math.sqrt(p["gyro_psd"] / h), math.sqrt(p["acc_psd"] / h)
-        gyro = _convert(omega[0] + gb[0] + gn * z[0], omega[1] + gb[1] + gn * z[1],
-                        omega[2] + gb[2] + gn * z[2], p["gyro_range"], p["bits"])
-        acc = _convert(f[0] + ab[0] + an * z[3], f[1] + ab[1] + an * z[4],
-                       f[2] + ab[2] + an * z[5], p["acc_range"], p["bits"])
+        gb, ab = self.gyro_bias, self.acc_bias
+        gyro = [v + gb[i] + gn * z[i] for i, v in enumerate(_apply(self.gyro_matrix, rate))]
+        acc = [v + ab[i] + an * z[3 + i] for i, v in enumerate(_apply(self.acc_matrix, f))]
+        if self.gyro_filter is not None and self.acc_filter is not None:
+            gyro = self.gyro_filter(gyro, h)
+            acc = self.acc_filter(acc, h)
         dt = h
         if p["jitter"] > 0.0:
-            new_error = p["jitter"] * z[12]
+            new_error = p["jitter"] * z[18]
             dt = max(h + new_error - self.time_error, 1e-6 * h)
             self.time_error = new_error
-        return acc, gyro, dt
+        return (_convert(acc, p["acc_range"], p["bits"]),
+                _convert(gyro, p["gyro_range"], p["bits"]), dt)
 
     def set_param(self, name: str, value: Any) -> None:
-        """Change a tunable parameter between samples (a bias takes its new value now)."""
+        """Change a tunable parameter between samples (a constant bias takes its value now)."""
         check_param_names((name,), _SPECS, "the IMU sensor model")
         spec = _SPECS[name]
         if not spec.tunable:
             raise ValueError(f"sensor parameter {name!r} is fixed after the start")
         self.params[name] = spec.validate(value)
-        for prefix, bias in (("gyro_bias_", self.gyro_bias), ("acc_bias_", self.acc_bias)):
-            if name.startswith(prefix):
-                bias["xyz".index(name[-1])] = self.params[name]
+
+    _STATE = ("gyro_turn_on", "acc_turn_on", "gyro_matrix", "acc_matrix", "gyro_walk",
+              "acc_walk", "gyro_gm", "acc_gm", "omega_prev", "time_error")
 
     def get_state(self) -> dict[str, Any]:
-        return {
-            "params": dict(self.params),
-            "rng": self.rng.bit_generator.state,
-            "gyro_bias": list(self.gyro_bias),
-            "acc_bias": list(self.acc_bias),
-            "time_error": self.time_error,
-        }
+        state = {name: _copy(getattr(self, name)) for name in self._STATE}
+        for name in ("gyro_filter", "acc_filter"):
+            filt = getattr(self, name)
+            state[name] = None if filt is None or filt.state is None else _copy(filt.state)
+        return {"params": dict(self.params), "rng": self.rng.bit_generator.state, **state}
 
     def set_state(self, state: dict[str, Any]) -> None:
         self.params = dict(state["params"])
-        self.rng = np.random.Generator(np.random.PCG64())
+        self.reset()
         self.rng.bit_generator.state = state["rng"]
-        self.gyro_bias = [float(v) for v in state["gyro_bias"]]
-        self.acc_bias = [float(v) for v in state["acc_bias"]]
-        self.time_error = float(state["time_error"])
+        for name in self._STATE:
+            setattr(self, name, _copy(state[name]))
+        for name in ("gyro_filter", "acc_filter"):
+            filt = getattr(self, name)
+            if filt is not None:
+                filt.state = _copy(state[name])
+
+
+def _copy(value: Any) -> Any:
+    """A plain copy of a list of floats, a list of lists, a float or None."""
+    if isinstance(value, (list, tuple)):
+        return [_copy(v) for v in value]
+    return value
+
+
+def _error_matrix(rng: np.random.Generator, scale_std: float, cross_std: float
+                  ) -> list[list[float]]:
+    """I + diag(scale errors) + cross-axis terms off the diagonal: measured = M true."""
+    scale = rng.standard_normal(3) * scale_std
+    cross = rng.standard_normal(6) * cross_std
+    it = iter(cross.tolist())
+    return [[1.0 + scale[i] if i == j else next(it) for j in range(3)] for i in range(3)]
+
+
+def _apply(m: list[list[float]], v: Any) -> list[float]:
+    return [m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2] for i in range(3)]
 
 
 def _saturate(v: float, full_scale: float) -> float:
@@ -141,11 +354,9 @@ def _saturate(v: float, full_scale: float) -> float:
     return v if full_scale > v else full_scale
 
 
-def _convert(
-    x: float, y: float, z: float, full_scale: float, bits: int
-) -> tuple[float, float, float]:
+def _convert(v: list[float], full_scale: float, bits: int) -> tuple[float, float, float]:
     """Saturate at +-full_scale, then round to the converter's step 2 full_scale / 2^bits."""
-    x, y, z = _saturate(x, full_scale), _saturate(y, full_scale), _saturate(z, full_scale)
+    x, y, z = (_saturate(c, full_scale) for c in v)
     if bits:
         lsb = 2.0 * full_scale / 2.0**bits
         return round(x / lsb) * lsb, round(y / lsb) * lsb, round(z / lsb) * lsb

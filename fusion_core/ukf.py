@@ -50,6 +50,7 @@ from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
     GYRO_SAMPLING_PARAM,
+    REAL_GYRO_DENSITY,
     REST_PARAMS,
     body_rotation,
     lowpass_specific_force,
@@ -74,35 +75,40 @@ class UnscentedKalmanFilter(Estimator):
     Update: z = [acc/g; 1], h(x) = [X; |X|^2], R = diag(acc_noise^2 I3, norm_noise^2); the
       accelerometer update is skipped while rho = ||acc|/g - 1| >= acc_gate (the accelerometer
       then measures more than gravity). After the update X is renormalised to unit length.
-    Defaults (ours; the paper's values are not in our sources): gyro_psd (10x the MPU-6050
-    density)^2 (it also absorbs integration and model error), acc_noise 0.06 (white noise plus an
-    allowance for unmodelled linear acceleration), acc_gate 0.1 (10 % of g along gravity is
-    certainly not gravity; 3 % scale-factor error of an uncalibrated sensor still passes).
-    Measured on moderate_dynamics: RMSE 0.21/0.37 deg (0.43/0.63 with acc_noise 0.03 and the
-    gate at Duong Quoc's 0.35).
+    Recommended values (the defaults), with the real-sensor options of building_blocks on (the
+    accelerometer pre-filter, 1 s, and the zero-rate update at rest, VQF's thresholds): from
+    sensor physics, gyro_psd and zaru_psd = the gyro's measured noise PSD,
+    (0.008 deg/s/sqrt(Hz))^2, and acc_noise 0.005 = the accelerometer's measured density over g:
+    the measurement is the pre-filtered vector, so no allowance for linear acceleration is added,
+    and no gate is needed (acc_gate 1.0: off); bias_psd (1e-4 deg/s/sqrt(s))^2, the gyro's drift
+    over a 150 s recording, the rest updates doing the rest. The paper gives no values; the ones
+    we used to reproduce its Table 1 (10x the MPU-6050 gyro density, acc_noise 0.06 with an
+    allowance for linear acceleration, gate at rho 0.1) are presets.PAPER_UKF.
     Output: roll = atan2(X2, X3), pitch = atan2(-X1, sqrt(X2^2 + X3^2)); bias = b.
 
     Parameters: gyro_psd [rad^2/s] (the gyro's noise density squared), bias_psd [rad^2/s^3]
     (the bias random-walk density squared), acc_noise [1]
     (standard deviation of acc/g, white noise and unmodelled acceleration), norm_noise [1],
-    acc_gate [1], init_bias_std [rad/s], alpha, beta, kappa, integration, max_dt [s].
+    acc_gate [1], init_bias_std [rad/s], alpha, beta, kappa, gyro_sampling, acc_lowpass [s],
+    rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], zaru_psd [rad^2/s], max_dt [s],
+    max_rate [rad/s].
     """
 
     PARAMS = (
         Param(
-            "gyro_psd", (0.05 * DEG) ** 2,
+            "gyro_psd", REAL_GYRO_DENSITY**2,
             "Gyro white-noise power spectral density driving the gravity direction (process "
             "noise; the datasheet's rate-noise density squared)",
             unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
         ),
         Param(
-            "bias_psd", (0.002 * DEG) ** 2,
+            "bias_psd", (1e-4 * DEG) ** 2,
             "Gyro bias random-walk power spectral density (process noise of the bias states; "
             "the random-walk density squared)",
             unit="rad2/s3", low=0.0, display_unit="deg2/s3",
         ),
         Param(
-            "acc_noise", 0.06,
+            "acc_noise", 0.005,
             "Standard deviation of one accelerometer sample divided by g (noise and unmodelled "
             "linear acceleration)",
             low=0.0, low_open=True,
@@ -112,7 +118,7 @@ class UnscentedKalmanFilter(Estimator):
             low=0.0, low_open=True,
         ),
         Param(
-            "acc_gate", 0.1,
+            "acc_gate", 1.0,
             "Skip the accelerometer update while ||acc|/g - 1| is at or above this value",
             low=0.0, low_open=True,
         ),

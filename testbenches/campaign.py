@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import json
 import tempfile
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -74,17 +75,21 @@ def run_campaign(
     duration: float | None = None,
     timing: bool = True,
     jobs: int = 1,
+    preset: dict[str, dict[str, Any]] | None = None,
+    sensor: dict[str, Any] | None = None,
 ) -> CampaignResult:
     """Run a campaign and evaluate the contract; `progress` is called after each run; `params`
     are estimator FMU parameters for every run (each estimator must have them); `duration`
     replaces each scenario's own duration in the runs (not in the contract's extras); timing=False
     leaves the wall-clock check T3 out of the verdict (its figures are still reported); jobs > 1
-    runs that many worker processes (one run per process at a time, so T3 stays per core)."""
+    runs that many worker processes (one run per process at a time, so T3 stays per core);
+    `preset` holds each estimator's parameters (presets.load_preset; `params` go on top) and
+    `sensor` the ImuSensor parameters of every run but the contract's noise-free ones."""
     out = CampaignResult()
     extra: dict[tuple[str, str], list[TestbenchResult]] = {}
     jobs_list = plan(estimators, scenarios, seeds, jitter, contract_checks)
     run_one = functools.partial(_run_job, params=params, fmu_dir=fmu_dir, duration=duration,
-                                timing=timing)
+                                timing=timing, preset=preset or {}, sensor=sensor or {})
     with contextlib.ExitStack() as stack:
         if jobs > 1:
             root = stack.enter_context(tempfile.TemporaryDirectory(prefix="campaign_"))
@@ -111,10 +116,29 @@ def run_campaign(
     return out
 
 
+def load_sensor(spec: str | Path) -> dict[str, Any]:
+    """ImuSensor parameters by name (fusion_core.sensor.SENSOR_PRESETS: realistic, ideal) or
+    from a JSON file of parameters; each is checked by building the sensor model."""
+    from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel, sensor_preset
+
+    text = str(spec)
+    if text in SENSOR_PRESETS or not text.endswith(".json"):
+        return sensor_preset(text)
+    try:
+        params = json.loads(Path(text).read_text())
+        ImuSensorModel(**params)
+    except (OSError, json.JSONDecodeError, TypeError, ValueError) as err:
+        raise ValueError(f"sensor file {text}: {err}") from None
+    return dict(params)
+
+
 def _run_job(job: Job, params: dict[str, Any] | None, fmu_dir: Path | str,
-             duration: float | None, timing: bool) -> TestbenchResult:
+             duration: float | None, timing: bool, preset: dict[str, dict[str, Any]],
+             sensor: dict[str, Any]) -> TestbenchResult:
+    sensor_params = dict(job.sensor_params) if job.sensor_params else dict(sensor)
+    run_params = {**preset.get(job.estimator, {}), **(params or {})}
     r = run_testbench(job.estimator, job.scenario, seed=job.seed, jitter=job.jitter,
-                      params=params, sensor_params=dict(job.sensor_params), fmu_dir=fmu_dir,
+                      params=run_params, sensor_params=sensor_params, fmu_dir=fmu_dir,
                       duration=duration if job.kind == "run" else None, evaluate=False)
     return contract.evaluate(r, timing)
 

@@ -25,6 +25,15 @@ def estimator_class(key: str) -> type[Estimator]:
     return cls
 
 
+def paper(key: str, **params: object) -> dict:
+    """The paper preset of estimator key with the point-sample rule (gyro_sampling="point", the
+    rule for the synthetic recordings' point samples) and the given parameters on top: the tests
+    of the papers' equations run the papers' filters on exact samples."""
+    from fusion_core.presets import PAPER
+
+    return {**PAPER[key], "gyro_sampling": "point", **params}
+
+
 def make(key: str, **params: object) -> Estimator:
     """A new estimator of kind key."""
     return estimator_class(key)(**params)

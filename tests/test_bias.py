@@ -15,7 +15,7 @@ import functools
 
 import numpy as np
 import pytest
-from helpers import RATE, make, run_recording
+from helpers import RATE, make, paper, run_recording
 
 from fusion_core import DEG, synthetic
 
@@ -62,7 +62,7 @@ CASES = {
 def final_bias(key: str) -> np.ndarray:
     """The estimator's bias estimate at the last sample [rad/s]."""
     motion, params = CASES[key]
-    out = run_recording(make(key, **params), biased_recording(motion))
+    out = run_recording(make(key, **paper(key, **params)), biased_recording(motion))
     assert not out["rejected"].any()
     return out["bias"][-1]
 
@@ -91,7 +91,7 @@ def test_final_bias_estimate_within_0p05_deg_per_s_after_60_s(key: str, axis: st
 
 def test_ukf_estimates_every_bias_on_the_small_tilt_motion_too() -> None:
     """UKF defaults on two_axis_motion (tilts to 30 deg): x, y within 0.05 deg/s, z within 0.05."""
-    out = run_recording(make("ukf"), biased_recording("two_axis"))
+    out = run_recording(make("ukf", **paper("ukf")), biased_recording("two_axis"))
     error = (out["bias"][-1] - TRUE_BIAS) / DEG
     print(f"\nukf two_axis bias error {error} deg/s")
     assert np.all(np.abs(error) < 0.05)
@@ -100,7 +100,7 @@ def test_ukf_estimates_every_bias_on_the_small_tilt_motion_too() -> None:
 def test_mgcf_paper_gains_learn_the_bias_in_300_s() -> None:
     """Default (simulation-table) gains, noise-free, wide tilts: after 300 s, eight of the 37 s
     time constants, the x and y biases are within 0.05 deg/s."""
-    out = run_recording(make("mgcf"), biased_recording("wide", 300.0, noisy=False))
+    out = run_recording(make("mgcf", **paper("mgcf")), biased_recording("wide", 300.0, noisy=False))
     error = (out["bias"][-1] - TRUE_BIAS) / DEG
     print(f"\nmgcf paper gains, 300 s, bias error {error} deg/s")
     assert np.all(np.abs(error[:2]) < 0.05)
@@ -108,5 +108,5 @@ def test_mgcf_paper_gains_learn_the_bias_in_300_s() -> None:
 
 def test_kalman_z_bias_output_is_always_zero() -> None:
     """The 2-state filter cannot see a z bias (it does not change the tilt): it outputs 0."""
-    out = run_recording(make("kf"), biased_recording("two_axis"))
+    out = run_recording(make("kf", **paper("kf")), biased_recording("two_axis"))
     assert np.all(out["bias"][:, 2] == 0.0)

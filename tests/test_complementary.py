@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from helpers import paper
 
 from fusion_core import DEG
 from fusion_core.complementary import ComplementaryFilter
@@ -25,7 +26,7 @@ def test_static_tilt_with_gyro_bias_settles_at_bias_times_tau(
     """angle = a (angle + (w + b) dt) + (1 - a) acc_angle, a = tau / (tau + dt), settles at
     e = a b dt / (1 - a) = b tau exactly: 0.75 deg for b = 1 deg/s and the default tau = 0.75 s.
     30 s is 40 tau, so the transient is gone (e^-40)."""
-    cf = ComplementaryFilter()
+    cf = ComplementaryFilter(**paper("cf"))
     noise = ImuNoise(gyro_density=0.0, acc_density=0.0, gyro_bias=gyro_bias)
     rec = record(trajectory, 30.0, 100.0, noise=noise)
     out = cf.run(rec["acc_meas"], rec["gyro_meas"], rec["dt"])

@@ -6,9 +6,11 @@ import math
 
 import numpy as np
 import scipy.linalg
+from helpers import paper
 
 from fusion_core import DEG, G
 from fusion_core.kalman import AngleBiasKalmanFilter
+from fusion_core.presets import PAPER_KF
 from fusion_core.synthetic import Trajectory, add, sine
 
 N_SAMPLES = 6000
@@ -80,7 +82,7 @@ def roll_only_sequence(seed: int = 1) -> dict[str, np.ndarray]:
 def test_rectangle_rule_roll_equals_papers_scalar_filter_to_1e_9_deg() -> None:
     seq = roll_only_sequence()
     assert np.abs(seq["roll"]).max() < 60 * DEG
-    out = AngleBiasKalmanFilter(gyro_sampling="mean").run(seq["acc"], seq["gyro"], seq["dt"])
+    out = AngleBiasKalmanFilter(**PAPER_KF).run(seq["acc"], seq["gyro"], seq["dt"])
 
     new_angle = np.degrees(np.arctan2(seq["acc"][:, 1], seq["acc"][:, 2]))
     ref_angle, ref_bias = papers_kalman_deg(new_angle, np.degrees(seq["gyro"][:, 0]), seq["dt"])
@@ -116,7 +118,7 @@ def steady_state_solution(dt: float, q_angle: float, q_bias: float, r: float) ->
 
 def test_converged_covariance_and_gain_equal_the_dare_solution_to_1e_6() -> None:
     dt = 0.01
-    kf = AngleBiasKalmanFilter()
+    kf = AngleBiasKalmanFilter(**paper("kf"))
     p = kf.params
     ss = steady_state_solution(dt, p["Q_angle"], p["Q_bias"], p["R_measure"])
     phi, theta = 0.3, 0.2

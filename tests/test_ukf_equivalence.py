@@ -12,6 +12,7 @@ import functools
 
 import numpy as np
 import pytest
+from helpers import paper
 from reference_ukf import ReferenceUnscentedKalmanFilter
 
 from fusion_core import synthetic
@@ -34,7 +35,7 @@ def default_runs() -> tuple[UnscentedKalmanFilter, ReferenceUnscentedKalmanFilte
     """Both filters with default parameters after the whole recording, and their outputs."""
     rec = moderate_dynamics_recording()
     args = (rec["acc_meas"], rec["gyro_meas"], rec["dt"])
-    new, ref = UnscentedKalmanFilter(), ReferenceUnscentedKalmanFilter()
+    new, ref = UnscentedKalmanFilter(**paper("ukf")), ReferenceUnscentedKalmanFilter(**paper("ukf"))
     return new, ref, new.run(*args), ref.run(*args)
 
 
@@ -49,7 +50,7 @@ def test_reference_is_a_busy_recording() -> None:
     # skipped (gate), and the bias must move, for the comparison to cover every branch.
     rec = moderate_dynamics_recording()
     rho = np.abs(np.linalg.norm(rec["acc_meas"], axis=1) / 9.80665 - 1.0)
-    gate = UnscentedKalmanFilter.param_specs()["acc_gate"].default
+    gate = paper("ukf")["acc_gate"]
     assert 0.1 < np.mean(rho < gate) < 0.95
     assert np.max(np.abs(default_runs()[3]["bias"])) > 1e-4
 
@@ -74,8 +75,8 @@ def test_other_parameters_match_the_numpy_reference(params: dict[str, object]) -
     rec = moderate_dynamics_recording()
     args = (rec["acc_meas"][:2001], rec["gyro_meas"][:2001], rec["dt"][:2001])  # first 20 s
     diff = differences(
-        UnscentedKalmanFilter(**params).run(*args),
-        ReferenceUnscentedKalmanFilter(**params).run(*args),
+        UnscentedKalmanFilter(**paper("ukf", **params)).run(*args),
+        ReferenceUnscentedKalmanFilter(**paper("ukf", **params)).run(*args),
     )
     assert diff["roll"] < ANGLE_TOL
     assert diff["pitch"] < ANGLE_TOL
@@ -92,7 +93,7 @@ def test_covariance_matches_the_numpy_reference_after_60_s() -> None:
 def test_a_covariance_made_indefinite_by_rounding_takes_the_references_square_root() -> None:
     rec = moderate_dynamics_recording()
     acc, gyro, dt = rec["acc_meas"][:200], rec["gyro_meas"][:200], rec["dt"][:200]
-    new, ref = UnscentedKalmanFilter(), ReferenceUnscentedKalmanFilter()
+    new, ref = UnscentedKalmanFilter(**paper("ukf")), ReferenceUnscentedKalmanFilter(**paper("ukf"))
     new.run(acc, gyro, dt)
     ref.run(acc, gyro, dt)
     # Push the smallest eigenvalue just below zero: Cholesky fails, both fall back to the

@@ -2,7 +2,9 @@
 
 Inputs: the plant's true body rates omega_* [rad/s] and specific force f_* [m/s2], set before
 doStep(t, h). Outputs after doStep(t, h): the IMU sample taken at t+h, acc_* [m/s2], gyro_* [rad/s]
-and dt [s] (h, or h with timestamp jitter). MPU-6050 datasheet defaults; seeded and reproducible.
+and dt [s] (h, or h with timestamp jitter), and the gyro's true bias at that sample
+(true_bias_*, the truth for the estimators' bias outputs). A realistic MPU-6050-class IMU by
+default (fusion_core.sensor); seeded and reproducible.
 """
 
 from collections.abc import Mapping
@@ -28,8 +30,10 @@ class SensorModel:
             (values["f_x"], values["f_y"], values["f_z"]),
             h,
         )
+        bias = self.model.gyro_bias
         return {"acc_x": acc[0], "acc_y": acc[1], "acc_z": acc[2],
-                "gyro_x": gyro[0], "gyro_y": gyro[1], "gyro_z": gyro[2], "dt": dt}
+                "gyro_x": gyro[0], "gyro_y": gyro[1], "gyro_z": gyro[2], "dt": dt,
+                "true_bias_x": bias[0], "true_bias_y": bias[1], "true_bias_z": bias[2]}
 
     def set_parameter(self, name: str, value: Any) -> None:
         self.model.set_param(name, value)
@@ -42,12 +46,15 @@ class SensorModel:
 
 
 class ImuSensor(FmuSlave):
-    """MEMS IMU error model: noise, bias, bias random walk, saturation, quantisation, jitter."""
+    """MEMS IMU error model: noise, per-run bias, bias instability and random walk, scale and
+    cross-axis errors, digital low-pass filter, saturation, quantisation, jitter."""
 
     description = (
-        "Testbench sensor: a 6-axis MEMS IMU error model with MPU-6050 datasheet defaults "
-        "(0.005 deg/s/sqrt(Hz), 400 ug/sqrt(Hz), +-2000 deg/s, +-16 g, 16 bit), constant bias "
-        "plus random walk, optional timestamp jitter; seeded. One sample per doStep."
+        "Testbench sensor: a 6-axis MEMS IMU error model, by default a realistic MPU-6050 "
+        "(0.005 deg/s/sqrt(Hz), 400 ug/sqrt(Hz), the errors a start-up calibration leaves, bias "
+        "instability, gyro scale and cross-axis errors, DLPF, +-2000 deg/s, +-16 g, 16 bit); "
+        "seeded. One sample per doStep; gyro_sampling says whether the gyro sample is a point "
+        "value or an interval mean."
     )
     VARIABLES = (
         *(real_input(f"omega_{a}", "rad/s", f"True body angular rate about {_AXIS[a]}",
@@ -60,6 +67,9 @@ class ImuSensor(FmuSlave):
                       "end of the last step", 0.0, "deg/s") for a in "xyz"),
         real_output("dt", "s", "Time since the previous sample as the sensor reports it (the "
                     "step size, plus timestamp jitter if any)", 0.01),
+        *(real_output(f"true_bias_{a}", "rad/s", f"The gyro's true total bias about {_AXIS[a]} "
+                      "at the last sample (truth for the estimators' bias outputs)", 0.0,
+                      "deg/s") for a in "xyz"),
         *(parameter_variable(p) for p in SENSOR_PARAMS),
     )
 

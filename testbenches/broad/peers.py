@@ -31,7 +31,7 @@ from types import ModuleType
 
 import numpy as np
 
-from .broad_metric import gravity_from_quat
+from .metric import gravity_from_quat
 
 PEER_INSTALL = "pip install 'vqf>=2.0' 'ahrs>=0.3.1'  (or: pip install -e '.[bench]')"
 

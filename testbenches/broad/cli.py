@@ -2,7 +2,7 @@
 
 Kept apart from testbenches/__main__.py, which only registers the subcommand and dispatches to
 `cmd_broad`; everything it does is callable from Python (`testbenches.broad.evaluate`,
-`testbenches.broad_report.write_reports`).
+`testbenches.broad.report.write_reports`).
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from .fmus import DEFAULT_FMU_DIR
-from .options import choose
+from ..fmus import DEFAULT_FMU_DIR
+from ..options import choose
 
 HELP = """\
 Evaluate the estimators on BROAD trials (Laidig et al., Data 2021): inclination RMSE over each
@@ -29,9 +29,10 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="BROAD trial files (.hdf5, .mat) or folders of them")
     p.add_argument("--estimator", default="all",
                    help="all or a comma list of cf, mgcf, kf, ukf, poskf (all)")
-    p.add_argument("--preset", default="default",
-                   help="default (the papers' parameters), broad (tuned for real sensors, see "
-                   "fusion_core/presets.py), all, or a comma list (default)")
+    p.add_argument("--preset", default="recommended",
+                   help="recommended (the defaults, for real MEMS sensors), paper (the seed "
+                   "papers' values), a JSON file of parameters per estimator, all (both named "
+                   "ones), or a comma list (recommended)")
     p.add_argument("--peers", action="store_true",
                    help="also run VQF (6D), Madgwick and Mahony (ahrs) on the same trials")
     p.add_argument("--fmu", action="store_true",
@@ -57,13 +58,13 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from fusion_core import ESTIMATORS
     from fusion_core.presets import PRESETS
 
-    from .broad import collect_paths, evaluate, plan_columns
-    from .broad_data import load_trial
-    from .broad_peers import PEERS, PeerUnavailable, check_peers
-    from .broad_report import table, write_reports
+    from .data import load_trial
+    from .peers import PEERS, PeerUnavailable, check_peers
+    from .report import table, write_reports
+    from .run import collect_paths, evaluate, plan_columns
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
-    presets = choose(args.preset, list(PRESETS), "preset")
+    presets = list(PRESETS) if args.preset == "all" else [p for p in args.preset.split(",") if p]
     peers = list(PEERS) if args.peers else []
     try:
         check_peers(peers)

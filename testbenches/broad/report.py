@@ -7,9 +7,9 @@ import math
 from pathlib import Path
 from typing import Any
 
-from fusion_core.presets import PRESETS
+from fusion_core.presets import load_preset
 
-from .broad import BroadResult
+from .run import BroadResult
 
 METRIC = (
     "BROAD inclination error (Laidig et al., Data 2021): angle between the estimated and the "
@@ -55,7 +55,7 @@ def report_dict(result: BroadResult) -> dict[str, Any]:
         "mean_inclination_rmse_deg": {k: _finite(v) for k, v in result.means().items()},
         "trial_count": len(result.trials),
         "columns": [c.as_dict() for c in result.columns],
-        "presets": {p: PRESETS[p] for p in presets},
+        "presets": {p: load_preset(p) for p in presets},
         "fmu_dir": result.fmu_dir,
         "groups": {
             g: {

@@ -1,16 +1,16 @@
 """Accuracy on real recordings: every estimator on BROAD trials, beside public 6D filters.
 
 `python -m testbenches broad PATH...` is a thin layer over `plan_columns`, `evaluate` and
-`broad_report.write_reports`:
+`report.write_reports`:
 
-- each trial file (HDF5 or MATLAB v5, `broad_data.load_trial`) is run through every selected
+- each trial file (HDF5 or MATLAB v5, `data.load_trial`) is run through every selected
   estimator with every selected preset (`fusion_core.presets`), on `imu_acc`, `imu_gyr` and
   dt = 1/sampling_rate, either in fusion_core (`Estimator.run`) or, with `fmu=True`, through the
   built FMUs in fmpy, one doStep per sample (the same numbers: the FMUs are bit-identical to
   fusion_core);
-- with peers, VQF, Madgwick and Mahony run on the same samples (`broad_peers`);
+- with peers, VQF, Madgwick and Mahony run on the same samples (`peers`);
 - every run is scored by BROAD's inclination RMSE over the `movement` samples
-  (`broad_metric`), and the per-trial numbers are averaged over the given trials and over
+  (`metric`), and the per-trial numbers are averaged over the given trials and over
   BROAD's groups (trials.json beside the files, or the groups in the trial names).
 
 A column is one (estimator or peer, preset) pair; its name is the estimator key for the default
@@ -28,9 +28,10 @@ from typing import Any
 import numpy as np
 
 from fusion_core import ESTIMATORS
-from fusion_core.presets import PRESETS, preset_params
+from fusion_core.presets import load_preset
 
-from .broad_data import (
+from ..fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, FmuHandle, fmu_path
+from .data import (
     GROUP_ORDER,
     BroadTrial,
     find_trials_json,
@@ -38,9 +39,8 @@ from .broad_data import (
     load_trials_json,
     trial_groups,
 )
-from .broad_metric import gravity_from_quat, gravity_from_roll_pitch, inclination_rmse_deg
-from .broad_peers import PEERS
-from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, FmuHandle, fmu_path
+from .metric import gravity_from_quat, gravity_from_roll_pitch, inclination_rmse_deg
+from .peers import PEERS
 
 TRIAL_SUFFIXES = (".hdf5", ".h5", ".mat")
 """File endings collected from a directory given as PATH."""
@@ -56,7 +56,7 @@ class Column:
     kind: str
     """'fusion_core', 'fmu' or 'peer'."""
     key: str
-    """fusion_core.ESTIMATORS key, or broad_peers.PEERS name."""
+    """fusion_core.ESTIMATORS key, or peers.PEERS name."""
     preset: str | None = None
     params: dict[str, Any] = field(default_factory=dict)
 
@@ -113,7 +113,10 @@ def _mean(values: Iterable[float]) -> float:
 
 # ----- what to run -------------------------------------------------------------------------------
 def column_name(key: str, preset: str) -> str:
-    return key if preset == "default" else f"{key}-{preset}"
+    """kf for the recommended preset, kf-paper for another, kf-NAME for a file NAME.json."""
+    if preset == "recommended":
+        return key
+    return f"{key}-{Path(preset).stem if preset.endswith('.json') else preset}"
 
 
 def plan_columns(
@@ -124,14 +127,12 @@ def plan_columns(
     bad = [k for k in estimators if k not in ESTIMATORS]
     if bad:
         raise ValueError(f"unknown estimator(s) {', '.join(bad)}: allowed {', '.join(ESTIMATORS)}")
-    bad = [p for p in presets if p not in PRESETS]
-    if bad:
-        raise ValueError(f"unknown preset(s) {', '.join(bad)}: allowed {', '.join(PRESETS)}")
+    loaded = {p: load_preset(p) for p in presets}  # ValueError for an unknown one
     bad = [p for p in peers if p not in PEERS]
     if bad:
         raise ValueError(f"unknown peer(s) {', '.join(bad)}: allowed {', '.join(PEERS)}")
     cols = [
-        Column(column_name(k, p), "fmu" if fmu else "fusion_core", k, p, preset_params(p, k))
+        Column(column_name(k, p), "fmu" if fmu else "fusion_core", k, p, loaded[p][k])
         for k in estimators for p in presets
     ]
     return cols + [Column(p, "peer", p) for p in peers]
@@ -150,7 +151,9 @@ def collect_paths(paths: Iterable[str | Path]) -> list[Path]:
 
 # ----- running one column on one trial ------------------------------------------------------------
 def run_fusion_core(key: str, params: dict[str, Any], trial: BroadTrial) -> dict[str, np.ndarray]:
-    """roll, pitch [N] (and rejected) of fusion_core's estimator on the trial."""
+    """roll, pitch [N] (and rejected) of fusion_core's estimator on the trial (integrating the
+    gyro by the trial's sampling property unless params say otherwise)."""
+    params = {"gyro_sampling": trial.gyro_sampling, **params}
     return ESTIMATORS[key](**params).run(trial.acc, trial.gyro, trial.dt)
 
 
@@ -160,6 +163,7 @@ def run_fmu(
     """roll, pitch [N] (and rejected) of the estimator's FMU on the trial, in fmpy: one
     set-inputs / doStep / get-outputs per sample, communication step = dt (INTERFACE.md)."""
     path = fmu_path(ESTIMATOR_FMUS[key], fmu_dir)
+    params = {"gyro_sampling": trial.gyro_sampling, **params}
     fmu = FmuHandle(path, f"broad-{key}-{time.perf_counter_ns()}")
     n, h = trial.n, trial.dt
     out = np.empty((n, 2))
