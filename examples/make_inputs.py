@@ -11,7 +11,7 @@ move_2m.csv / move_2m_truth.csv
 Both with MPU-6050 white noise and a constant gyro bias GYRO_BIAS.
 
 Timing: fmpy applies the CSV row of time t at the start of the communication step [t, t+h], and
-INTERFACE.md says the inputs set before doStep(t, h) are the sample taken at t+h. So the row
+docs/interface.md says the inputs set before doStep(t, h) are the sample taken at t+h. So the row
 of time t holds the sample taken at t + 0.01 s, and the FMU's output at time t+h is the estimate
 at the sample's time, aligned with the truth file's row of the same time.
 """

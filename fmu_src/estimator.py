@@ -41,8 +41,9 @@ Z_BIAS_UNOBSERVABLE = (
 )
 """zero_bias reason for bias_z of the position filter's tilt stage."""
 Z_BIAS_REST_ONLY = (
-    "always 0 while rest detection is off (rest_time = 0, the default): a bias about z does not "
-    "change the accelerometer's tilt, so only the zero-rate update at rest observes it"
+    "0 until rest detection (rest_time > 0, the default) has seen the sensor at rest, and 0 "
+    "throughout with rest_time = 0: a bias about z does not change the accelerometer's tilt, so "
+    "only the zero-rate update at rest observes it"
 )
 """zero_bias reason for bias_z of the [angle, bias] Kalman filter."""
 NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STATE for a in AXES})

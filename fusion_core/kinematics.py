@@ -37,7 +37,7 @@ def wrap_angle(x: float) -> float:
 def accel_roll_pitch(ax: float, ay: float, az: float) -> tuple[float, float]:
     """Roll and pitch from a specific-force sample of a sensor at rest.
 
-    Inverts INTERFACE.md's  acc = g (-sin(theta), sin(phi) cos(theta), cos(phi) cos(theta)):
+    Inverts docs/interface.md's  acc = g (-sin(theta), sin(phi) cos(theta), cos(phi) cos(theta)):
     roll = atan2(ay, az) (Gui et al. eq. 3), pitch = atan2(-ax, sqrt(ay^2 + az^2)) (eq. 4,
     written with atan2 so that it is defined for every direction).
     """
@@ -92,7 +92,7 @@ def euler_step(
 
 
 def clamp_pitch(theta: float) -> float:
-    """Pitch limited to [-pi/2, pi/2] (INTERFACE.md range)."""
+    """Pitch limited to [-pi/2, pi/2] (docs/interface.md range)."""
     # max(-pi/2, min(pi/2, theta)), without the two builtin calls
     theta = theta if theta < HALF_PI else HALF_PI
     return theta if theta > -HALF_PI else -HALF_PI

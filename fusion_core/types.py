@@ -1,6 +1,6 @@
 """Shared types and constants of fusion_core: the estimate, the bad-sample error, parameter specs.
 
-Conventions (../shared/INTERFACE.md, restated in README.md): SI units; body frame x forward,
+Conventions (docs/interface.md): SI units; body frame x forward,
 y left, z up; the accelerometer measures specific force, so a sensor lying still and level reads
 (0, 0, +G); attitude is Z-Y-X Euler (yaw, pitch, roll), roll in (-pi, pi], pitch in [-pi/2, pi/2].
 """

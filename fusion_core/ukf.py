@@ -3,7 +3,7 @@
 Reference:
   Duong Quoc et al., eq. 14-17: the state is the gravity direction in the body frame,
   X = [-sin(theta), sin(phi) cos(theta), cos(phi) cos(theta)] (the accelerometer reading of a
-  sensor at rest divided by g, INTERFACE.md), propagated by the gyro and observed through the
+  sensor at rest divided by g, docs/interface.md), propagated by the gyro and observed through the
   measurement [acc/g; |X|^2 = 1]; roll and pitch follow from X as from a resting accelerometer.
   Scaled sigma points: Wan & van der Merwe (2000), "The unscented Kalman filter for nonlinear
   estimation" (alpha, beta, kappa).

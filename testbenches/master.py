@@ -1,6 +1,6 @@
 """The testbench master: plant -> sensor -> estimator FMUs, Gauss-Seidel, on fmpy's FMU2Slave.
 
-Per communication step [t, t+h] (INTERFACE.md, Timing):
+Per communication step [t, t+h] (docs/interface.md, Timing):
   1. plant.doStep(t, h): the plant's outputs are the truth at t+h;
   2. sensor inputs := plant outputs; sensor.doStep(t, h): the IMU sample taken at t+h, dt = h;
   3. estimator inputs := sensor outputs; estimator.doStep(t, h): the estimate at t+h.

@@ -7,7 +7,7 @@ component.variable). `simulate` runs it with fmpy.ssp.simulation.simulate_ssp.
 
 Alignment. fmpy's SSP master is Jacobi: every FMU steps on the values the connections carried at
 the previous communication point, and connectors start at 0. So, against our Gauss-Seidel master
-(INTERFACE.md), the sensor sees the plant one step late and the estimator the sensor one step
+(docs/interface.md), the sensor sees the plant one step late and the estimator the sensor one step
 late: the estimator's output in row k (labelled with the step's start time) is the master's
 estimate of step k - 2. The first two samples reaching the estimator are all-zero (the connectors'
 start values): the estimator rejects them (|acc| < 0.1 g) and counts 2 invalid samples. With a
@@ -28,7 +28,9 @@ from xml.sax.saxutils import quoteattr
 
 from fmpy import read_model_description
 
+from fusion_core import ESTIMATORS
 from fusion_core.scenarios import get_scenario
+from fusion_core.sensor import SENSOR_PARAMS
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, fmu_path
 from .master import SAMPLE, SENSOR_IN
@@ -69,6 +71,12 @@ def _ssv(params: dict[str, Any]) -> str:
             "</ssv:ParameterSet>\n")
 
 
+def _item(choices: dict[str, tuple[str, ...] | None], name: str, value: Any) -> Any:
+    """An enumeration parameter's item name as its value 1..n; other values as they are."""
+    items = choices.get(name)
+    return items.index(value) + 1 if items and isinstance(value, str) else value
+
+
 def export_ssp(
     estimator: str,
     scenario: str | int,
@@ -97,8 +105,13 @@ def export_ssp(
         f'endConnector="{d}"/>' for a, b, c, d in wires
     )
     values: dict[str, Any] = {"plant.scenario": sc.id, "sensor.seed": seed}
-    values.update({f"sensor.{k}": v for k, v in (sensor_params or {}).items()})
-    values.update({f"estimator.{k}": v for k, v in (params or {}).items()})
+    # an enumeration's item name as its value 1..n, the form an SSV parameter takes
+    sensor_choices = {p.name: p.choices for p in SENSOR_PARAMS if p.choices}
+    est_choices = {p.name: p.choices for p in ESTIMATORS[estimator].param_specs().values()
+                   if p.choices}
+    values.update({f"sensor.{k}": _item(sensor_choices, k, v)
+                   for k, v in (sensor_params or {}).items()})
+    values.update({f"estimator.{k}": _item(est_choices, k, v) for k, v in (params or {}).items()})
     ssd = f"""<?xml version="1.0" encoding="UTF-8"?>
 <ssd:SystemStructureDescription {NS} version="1.0" name="{names['estimator']}_{sc.name}">
   <ssd:System name="testbench">

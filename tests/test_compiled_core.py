@@ -1,6 +1,6 @@
 """The mypyc-compiled fusion_core (fmu_src/compiled_core.py, issue 6): every listed module is an
 extension module, and its outputs and states are bit for bit those of the pure-Python sources,
-for every estimator with its defaults, its real-sensor options and the BROAD presets, over a
+for every estimator with its defaults, its real-sensor options and the paper presets, over a
 noisy recording with bad samples in it.
 
 The compiled core runs in a subprocess (a process holds one fusion_core); this process runs the
@@ -45,7 +45,7 @@ PARAM_SETS: dict[str, list[dict]] = {
 }
 """Defaults, each option that takes another code path, and (added below) the BROAD preset."""
 CASES = [(key, params) for key in KEYS for params in [*PARAM_SETS[key],
-                                                      preset_params("broad", key)]]
+                                                      preset_params("paper", key)]]
 
 _SCRIPT = """
 import json, sys
@@ -82,7 +82,7 @@ def _recording_with_bad_samples(tmp_path: Path) -> Path:
     acc[50] = np.nan
     gyro[120, 1] = np.inf
     dt[200] = 0.0
-    acc[300] = 0.0
+    gyro[300] = 2000.0  # above max_rate
     dt[400] = 5.0  # above max_dt
     path = tmp_path / "rec.npz"
     np.savez(path, acc=acc, gyro=gyro, dt=dt)

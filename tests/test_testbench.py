@@ -19,7 +19,7 @@ from fmpy.fmi1 import FMICallException
 from fusion_core import DEG, ESTIMATORS, G
 from fusion_core.kinematics import euler_rates
 from fusion_core.scenarios import SCENARIOS
-from fusion_core.sensor import ImuSensorModel
+from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel
 from testbenches import contract, master, run_testbench
 
 REPO = Path(__file__).resolve().parent.parent
@@ -213,7 +213,8 @@ def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> Non
     """40 000 samples at 100 Hz, no quantisation: sample std * sqrt(h) / density in [0.95, 1.05]
     for every axis, the density being sqrt of the configured PSD; the bias random walk's
     increments likewise."""
-    m = ImuSensorModel(bits=0, gyro_bias_psd=1e-3**2, acc_bias_psd=1e-2**2, seed=3)
+    m = ImuSensorModel(**{**SENSOR_PRESETS["ideal"], "bits": 0}, gyro_bias_psd=1e-3**2,
+                       acc_bias_psd=1e-2**2, seed=3)
     h = 0.01
     rows, gb, ab = [], [], []
     for _ in range(40_000):
@@ -237,7 +238,7 @@ def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> Non
 
 
 def test_sensor_saturates_and_quantises_like_a_16_bit_mpu6050() -> None:
-    m = ImuSensorModel(gyro_psd=0.0, acc_psd=0.0)
+    m = ImuSensorModel(**SENSOR_PRESETS["ideal"], gyro_psd=0.0, acc_psd=0.0)
     acc, gyro, _ = m.sample((50.0, 0.001, 0.0), (0.0, 0.0, 20 * G), 0.01)
     lsb = 2 * 2000 * DEG / 2**16
     assert gyro[0] == pytest.approx(round(2000 * DEG / lsb) * lsb)
@@ -257,7 +258,7 @@ def _cli(*args: str, fmu_dir: Path, out: Path) -> subprocess.CompletedProcess:
 
 def test_cli_exits_0_when_every_check_passes(fmu_dir: Path, tmp_path: Path) -> None:
     proc = _cli("--estimator", "cf,mgcf", "--scenario", "static_level", "--duration", "3",
-                fmu_dir=fmu_dir, out=tmp_path)
+                "--sensor", "ideal", fmu_dir=fmu_dir, out=tmp_path)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "PASS" in proc.stdout
     import json
@@ -302,8 +303,9 @@ def test_exported_ssp_runs_in_fmpy_and_matches_the_master_two_steps_later(
     fmu_dir: Path, tmp_path: Path
 ) -> None:
     """fmpy's SSP master is Jacobi: the sensor sees the plant and the estimator the sensor one
-    step late, and the connectors start at 0 (two all-zero samples, rejected). With a noise-free
-    sensor the SSP's estimate in row k is bit-identical to the master's estimate of step k - 2."""
+    step late, and the connectors start at 0: two all-zero samples, the first rejected (dt = 0),
+    the second skipped (no gravity to start from). With a noise-free sensor the SSP's estimate in
+    row k is bit-identical to the master's estimate of step k - 2."""
     from testbenches.ssp import export_ssp, simulate
 
     path = export_ssp("mgcf", "roll_pitch", tmp_path / "tb.ssp",
@@ -314,7 +316,7 @@ def test_exported_ssp_runs_in_fmpy_and_matches_the_master_two_steps_later(
     n = len(rows) - 2
     for name in ("roll", "pitch"):
         assert np.array_equal(rows[f"estimator.{name}"][2:], master.estimate[name][:n])
-    assert rows["estimator.invalid_samples"][-1] == 2
+    assert rows["estimator.invalid_samples"][-1] == 1
 
 
 def test_cli_exits_2_with_a_message_for_an_unknown_estimator(fmu_dir: Path, tmp_path: Path) -> None:

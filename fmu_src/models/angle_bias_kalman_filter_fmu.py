@@ -3,7 +3,7 @@
 Implements the two-state [angle, gyro bias] Kalman filter of W. Gui, Y. Tang, S. Mukhopadhyay
 (2015), eq. 5-26, written scalar by scalar in Das & Mary, eq. 16-27: one filter for roll
 (estimating the x gyro bias) and one for pitch (the y gyro bias). bias_z is unobservable from
-the accelerometer's tilt: it is 0 unless rest detection (rest_time > 0) estimates it at rest.
+the accelerometer's tilt: it is 0 until rest detection (on by default) estimates it at rest.
 """
 
 import fusion_core

@@ -9,7 +9,7 @@ reference (NaN in `opt_quat`) are left out.
 
 Frames. A quaternion q (w first) that rotates sensor coordinates into a global frame whose z axis
 points up has the world up axis, seen from the sensor, as R(q)^T e_z. With our convention (body
-x forward, y left, z up; the accelerometer reads +g along up, INTERFACE.md) the estimate's
+x forward, y left, z up; the accelerometer reads +g along up, docs/interface.md) the estimate's
 direction from roll phi and pitch theta is (-sin theta, sin phi cos theta, cos phi cos theta).
 At rest the normalised accelerometer agrees with both (tests/test_broad.py checks it on a trial).
 """
@@ -32,7 +32,7 @@ def gravity_from_quat(q: np.ndarray) -> np.ndarray:
 
 
 def gravity_from_roll_pitch(roll: np.ndarray, pitch: np.ndarray) -> np.ndarray:
-    """Up direction in the sensor frame from Z-Y-X roll and pitch [rad] (INTERFACE.md):
+    """Up direction in the sensor frame from Z-Y-X roll and pitch [rad] (docs/interface.md):
     (-sin pitch, sin roll cos pitch, cos roll cos pitch)."""
     roll = np.asarray(roll, dtype=float)
     pitch = np.asarray(pitch, dtype=float)

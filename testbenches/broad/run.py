@@ -161,7 +161,7 @@ def run_fmu(
     key: str, params: dict[str, Any], trial: BroadTrial, fmu_dir: Path | str = DEFAULT_FMU_DIR
 ) -> dict[str, np.ndarray]:
     """roll, pitch [N] (and rejected) of the estimator's FMU on the trial, in fmpy: one
-    set-inputs / doStep / get-outputs per sample, communication step = dt (INTERFACE.md)."""
+    set-inputs / doStep / get-outputs per sample, communication step = dt (docs/interface.md)."""
     path = fmu_path(ESTIMATOR_FMUS[key], fmu_dir)
     params = {"gyro_sampling": trial.gyro_sampling, **params}
     fmu = FmuHandle(path, f"broad-{key}-{time.perf_counter_ns()}")
