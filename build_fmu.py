@@ -1,8 +1,10 @@
-"""Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--core C]`.
+"""Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--core C]
+[--preset P]`.
 
 Builds every FMU (or the named ones) into dist/ (or DIR), with fusion_core compiled by mypyc
 (--core auto, the default, falls back to the pure-Python sources where mypyc or a C compiler is
-missing; --core compiled insists; --core python ships only the sources), validates each with
+missing; --core compiled insists; --core python ships only the sources), with the estimators'
+start values of --preset (recommended, the defaults; paper; or a JSON file), validates each with
 fmpy.validation.validate_fmu plus the project's checks (every variable described, every Real
 with a unit), prints a table (FMU, core, size, variables, validation problems) and exits with
 status 1 if any FMU failed to build or has a problem. A thin layer over fmu_src.build.
@@ -31,11 +33,19 @@ def main(argv: list[str] | None = None) -> int:
         help="fusion_core to ship: compiled by mypyc (built once, cached in build/), the "
         "pure-Python sources, or auto = compiled where it can be built (default)",
     )
+    parser.add_argument(
+        "--preset", default="recommended",
+        help="the estimators' start values: recommended (the defaults), paper, or a JSON file "
+        "of parameters per estimator",
+    )
     args = parser.parse_args(argv)
     try:
-        results = build_all(args.only or model_names(), args.out, args.core)
+        results = build_all(args.only or model_names(), args.out, args.core, args.preset)
     except CompiledCoreError as err:
         print(f"error: --core compiled: {err}", file=sys.stderr)
+        return 2
+    except ValueError as err:
+        print(f"error: --preset: {err}", file=sys.stderr)
         return 2
     print(format_table(results))
     return 1 if any(r.problems for r in results) else 0

@@ -11,14 +11,19 @@ the .py sources beside them.
 
 from __future__ import annotations
 
+import contextlib
+import json
+import os
 import shutil
 import tempfile
 import traceback
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from .compiled_core import fusion_core_dir, resolve_core, shipped_files
+from .estimator import PRESET_ENV
 
 HERE = Path(__file__).resolve().parent
 MODELS_DIR = HERE / "models"
@@ -66,7 +71,12 @@ def _stage(root: Path, compiled: Path | None = None) -> list[Path]:
     for name in RUNTIME_FILES:
         shutil.copy2(HERE / name, root / "fmu_src" / name)
     (root / "requirements.txt").write_text(REQUIREMENTS)
-    return [*staged, root / "fmu_src", root / "requirements.txt"]
+    staged += [root / "fmu_src", root / "requirements.txt"]
+    preset = os.environ.get(PRESET_ENV)
+    if preset:  # the start values it was built with, read by the slave when it runs
+        shutil.copy2(preset, root / "preset.json")
+        staged.append(root / "preset.json")
+    return staged
 
 
 def build(name: str, out_dir: Path, compiled: Path | None = None) -> Path:
@@ -123,27 +133,54 @@ class BuildResult:
 
 
 def build_all(
-    names: Iterable[str], out_dir: Path, core: str = "auto"
+    names: Iterable[str], out_dir: Path, core: str = "auto", preset: str = "recommended"
 ) -> list[BuildResult]:
     """Build and check each FMU; a failed build is a problem of its row, not an exception.
     core: "auto" (the compiled fusion_core where it can be built, else the pure-Python one),
-    "compiled" or "python" (compiled_core.CORES)."""
+    "compiled" or "python" (compiled_core.CORES); preset: the estimators' start values, a name
+    or a JSON file (fusion_core.presets.load_preset; ValueError for a bad one)."""
     from fmpy import read_model_description
 
+    from fusion_core.presets import load_preset
+
+    starts = load_preset(preset)
     compiled = resolve_core(core)
     results = []
-    for name in names:
-        result = BuildResult(name, core="python" if compiled is None else "compiled")
-        try:
-            result.path = build(name, out_dir, compiled)
-            result.size = result.path.stat().st_size
-            result.variables = len(read_model_description(str(result.path)).modelVariables)
-            result.problems = check(result.path)
-        except Exception as err:
-            last = traceback.format_exception_only(type(err), err)[-1].strip()
-            result.problems = [f"build failed: {last}"]
-        results.append(result)
+    with contextlib.ExitStack() as stack:
+        if any(starts.values()):  # the recommended values need no file: they are the defaults
+            tmp = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="preset_")))
+            (tmp / "preset.json").write_text(json.dumps(starts, indent=1))
+            stack.enter_context(_environ(PRESET_ENV, str(tmp / "preset.json")))
+        results = [_build_and_check(name, out_dir, compiled, read_model_description)
+                   for name in names]
     return results
+
+
+@contextlib.contextmanager
+def _environ(name: str, value: str) -> Iterator[None]:
+    old = os.environ.get(name)
+    os.environ[name] = value
+    try:
+        yield
+    finally:
+        if old is None:
+            del os.environ[name]
+        else:
+            os.environ[name] = old
+
+
+def _build_and_check(name: str, out_dir: Path, compiled: Path | None,
+                     read_model_description: Any) -> BuildResult:
+    result = BuildResult(name, core="python" if compiled is None else "compiled")
+    try:
+        result.path = build(name, out_dir, compiled)
+        result.size = result.path.stat().st_size
+        result.variables = len(read_model_description(str(result.path)).modelVariables)
+        result.problems = check(result.path)
+    except Exception as err:
+        last = traceback.format_exception_only(type(err), err)[-1].strip()
+        result.problems = [f"build failed: {last}"]
+    return result
 
 
 def format_table(results: Sequence[BuildResult]) -> str:

@@ -14,8 +14,12 @@ state exactly as it was, counts in invalid_samples, logs a warning and the step 
 
 from __future__ import annotations
 
+import dataclasses
+import json
+import os
 from collections.abc import Mapping
 from operator import itemgetter
+from pathlib import Path
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -51,6 +55,29 @@ NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STAT
 NO_Z_BIAS_OUTPUT: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_UNOBSERVABLE})
 Z_BIAS_AT_REST_ONLY: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_REST_ONLY})
 """zero_bias of the per-axis [angle, bias] Kalman filters: bias_z is 0."""
+
+
+PRESET_ENV = "FUSION_FMU_PRESET"
+"""Environment variable naming the preset file while build_fmu.py builds (the FMU then carries
+it as resources/preset.json, PRESET_FILE, which the slave reads when it runs)."""
+PRESET_FILE = "preset.json"
+"""The preset an FMU was built with, in its resources folder."""
+
+
+def preset_starts(cls: type[Estimator], resources: str | None = None) -> dict[str, Any]:
+    """The start values an FMU of estimator class cls was built with (its entry of the preset
+    file, checked when the file was written; {} for the recommended values, the defaults): from
+    the FMU's resources folder when it runs, from PRESET_ENV while it is built."""
+    path = Path(resources) / PRESET_FILE if resources else None
+    if path is None or not path.is_file():
+        env = os.environ.get(PRESET_ENV)
+        if not env:
+            return {}
+        path = Path(env)
+    from fusion_core import ESTIMATORS
+
+    key = next(k for k, c in ESTIMATORS.items() if c is cls)
+    return dict(json.loads(path.read_text()).get(key, {}))
 
 
 def estimator_variables(
@@ -126,7 +153,11 @@ def estimator_variables(
             real_output(f"vel_{a}", "m/s", f"Velocity estimate along level-frame {a}", v)
             for a, v in zip(AXES, vel, strict=True)
         ]
-    params = tuple(parameter_variable(p) for p in cls.param_specs().values())
+    starts = preset_starts(cls)
+    params = tuple(
+        parameter_variable(dataclasses.replace(p, default=starts.get(p.name, p.default)))
+        for p in cls.param_specs().values()
+    )
     table = (*inputs, *outputs, *params)
     names = [v.name for v in table]
     clash = sorted({n for n in names if names.count(n) > 1})
@@ -214,6 +245,17 @@ class EstimatorSlave(FmuSlave):
         super().__init_subclass__(**kwargs)
         if "estimator" in cls.__dict__:
             cls.VARIABLES = estimator_variables(cls.estimator, cls.zero_bias)
+
+    def start_values(self) -> dict[str, Any]:
+        """The preset this FMU was built with (preset_starts), in FMI form: read per instance
+        from the FMU's own resources, so that it holds even where another FMU's fmu_src was
+        imported first in the same process."""
+        out = {}
+        for name, value in preset_starts(self.estimator, self.resources).items():
+            var = self._variables[name]
+            out[name] = var.items.index(value) + 1 if var.items and isinstance(value, str) \
+                else value
+        return out
 
     def create_model(self, params: dict[str, Any]) -> EstimatorModel:
         return EstimatorModel(self.estimator, params)

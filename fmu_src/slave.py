@@ -126,6 +126,7 @@ class FmuSlave(Fmi2Slave):
         self._fmi_log = FmiLog(self)
         self._variables = {v.name: v for v in self.VARIABLES}
         self._values: dict[str, Any] = {v.name: v.start for v in self.VARIABLES}
+        self._values.update(self.start_values())
         self._view = MappingProxyType(self._values)
         self._running = False
         for var in self.VARIABLES:
@@ -134,6 +135,11 @@ class FmuSlave(Fmi2Slave):
         self._model: Model = self.create_model(self.model_parameters())
 
     # ----- to be provided by a concrete FMU ---------------------------------------------------
+    def start_values(self) -> dict[str, Any]:
+        """Start values that differ from the VARIABLES table's for this FMU (by name, in FMI
+        form); none by default."""
+        return {}
+
     def create_model(self, params: dict[str, Any]) -> Model:
         """A new model with these parameter values; ValueError naming a refused parameter."""
         raise NotImplementedError

@@ -236,3 +236,31 @@ def test_build_command_exits_non_zero_on_a_validation_problem(
     monkeypatch.setattr("fmu_src.build.check", one_problem)
     assert cli.main(["--out", str(tmp_path), "--only", "ComplementaryFilter"]) == 1
     assert "1: The unit" in capsys.readouterr().out
+
+
+def test_build_with_the_paper_preset_starts_from_the_papers_values(tmp_path, fmu_recording):
+    """build_fmu.py --preset paper: the FMU's start values are the paper preset's, and the FMU
+    run with its own start values gives fusion_core's outputs with that preset."""
+    import subprocess
+    import sys
+
+    import numpy as np
+
+    from fmu_src.host import FmuInstance
+    from fusion_core.presets import preset_params
+
+    repo = Path(__file__).resolve().parents[1]
+    proc = subprocess.run(
+        [sys.executable, "build_fmu.py", "--out", str(tmp_path), "--only",
+         "ComplementaryFilter", "--preset", "paper"],
+        cwd=repo, capture_output=True, text=True, timeout=600,
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    fmu = tmp_path / "ComplementaryFilter.fmu"
+    starts = {v.name: v.start for v in read_model_description(str(fmu)).modelVariables}
+    assert float(starts["tau"]) == 0.75 and float(starts["acc_lowpass"]) == 0.0
+    acc, gyro, dt = (fmu_recording[k][:300] for k in ("acc_meas", "gyro_meas", "dt"))
+    with FmuInstance(fmu) as instance:
+        out = instance.run_samples(acc, gyro, dt)
+    want = fusion_core.ComplementaryFilter(**preset_params("paper", "cf")).run(acc, gyro, dt)
+    assert np.array_equal(out["roll"], want["roll"])
