@@ -17,6 +17,7 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 
 from __future__ import annotations
 
+import math
 from typing import Final
 
 from .base import ESTIMATE, Estimator, tuple_new
@@ -51,6 +52,13 @@ from .kinematics import (
 from .types import DEG, Estimate, G, Param
 
 DEG2: Final = DEG * DEG
+BIAS_GATE: Final = 0.05
+"""Recommended bias_gate: Duong Quoc et al.'s experimental table for their MPU-6050 (section
+4.2) stops trusting the accelerometer at rho = 0.05; here only the bias stops learning from it.
+The accelerometer sees a gyro bias only as a slow drift of the tilt it measures; a sample whose
+norm is 5 % off g carries linear acceleration (or vibration) whose apparent tilt would be taken
+for that drift, and with a small Q_bias a bias learned wrong stays wrong for minutes. A resting
+MEMS accelerometer (scale error up to 3 % uncalibrated) passes."""
 RECOMMENDED_R: Final = (0.05 / G) ** 2
 """Recommended R_measure [rad^2]: the variance of one accelerometer sample's tilt, (0.05 m/s^2 /
 g)^2 = (0.29 deg)^2, from the accelerometer's noise measured at rest on a real MEMS IMU
@@ -84,6 +92,17 @@ def measurement_gain(
     K0 = P00 / S
     K1 = P10 / S
     return (K0, K1), (P00 - K0 * P00, P01 - K0 * P01, P10 - K1 * P00, P11 - K1 * P01)
+
+
+def angle_only_gain(
+    P: tuple[float, float, float, float], r: float
+) -> tuple[tuple[float, float], tuple[float, float, float, float]]:
+    """The update of measurement_gain with the bias left out (K1 = 0, the bias a "consider"
+    state: Schmidt 1966): K0 = P00 / S as before, and P <- (I - K H) P (I - K H)^T + K R K^T,
+    which for this K is P00 - K0 P00, P01 - K0 P01, P10 - K0 P10, P11."""
+    P00, P01, P10, P11 = P
+    K0 = P00 / (P00 + r)
+    return (K0, 0.0), (P00 - K0 * P00, P01 - K0 * P01, P10 - K0 * P10, P11)
 
 
 def bias_update(
@@ -145,7 +164,9 @@ class AngleBiasKalmanFilter(Estimator):
     Hz (the papers' numbers, tuned at 30 Hz, give 0.3 s at 285.7 Hz); gyro_psd (the zero-rate
     update) the same PSD; init_bias_std = 1 deg/s, an uncalibrated MEMS gyro's turn-on bias
     (BROAD's: up to 0.5 deg/s), with the angles' first variance R (one sample's); the
-    pre-filter, rest detection and quaternion propagation as building_blocks recommends.
+    pre-filter, rest detection and quaternion propagation as building_blocks recommends; the
+    bias learns from the accelerometer only while the raw sample's norm is within 5 % of g
+    (bias_gate, BIAS_GATE: Duong Quoc et al.'s real-sensor cutoff).
     Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 1.16 / 0.95 / 0.94 deg):
     the accelerometer's error after the pre-filter is coloured (residual linear acceleration),
     so a bias random walk sized from the gyro's real drift (3e-6 deg^2/s^3) lets it steer the
@@ -155,7 +176,8 @@ class AngleBiasKalmanFilter(Estimator):
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2]; gate_low, gate_high;
     acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_psd
-    [rad^2/s]; init_bias_std [rad/s]; propagation; gyro_sampling; max_dt [s], max_rate [rad/s].
+    [rad^2/s]; init_bias_std [rad/s]; bias_gate; propagation; gyro_sampling; max_dt [s],
+    max_rate [rad/s].
     """
 
     PARAMS = (
@@ -185,6 +207,14 @@ class AngleBiasKalmanFilter(Estimator):
             "the papers' code)",
             unit="rad/s", low=0.0, tunable=False, display_unit="deg/s",
         ),
+        Param(
+            "bias_gate", BIAS_GATE,
+            "Bias learning gate on rho = ||a|/g - 1| of the raw accelerometer sample: at or "
+            "above it the accelerometer update leaves the gyro bias alone (the sample measures "
+            "linear acceleration, not the drift of the tilt); 0 = off, every update moves the "
+            "bias (the papers)",
+            low=0.0,
+        ),
         PROPAGATION_PARAM,
         GYRO_SAMPLING_PARAM,
     )
@@ -208,6 +238,12 @@ class AngleBiasKalmanFilter(Estimator):
             float(p["gyro_psd"]),
         )
         self._quaternion: bool = p["propagation"] == "quaternion"
+        bias_gate = float(p["bias_gate"])
+        # the gate on |a|^2: ((1 - gate) g)^2 <= |a|^2 < ((1 + gate) g)^2 learns the bias
+        self._bias_band2 = (
+            (max(1.0 - bias_gate, 0.0) * G) ** 2 if bias_gate > 0.0 else -1.0,
+            ((1.0 + bias_gate) * G) ** 2 if bias_gate > 0.0 else math.inf,
+        )
         # any real-sensor option on (else the papers' filter: the short path of _advance)
         self._options = self._quaternion or self._acc_tau > 0.0 or float(p["rest_time"]) > 0.0
 
@@ -247,8 +283,10 @@ class AngleBiasKalmanFilter(Estimator):
         else:
             self.propagate(gx, gy, gz, dt)
             low2, high2 = self._gate2
-            if low2 <= ax * ax + ay * ay + az * az <= high2:  # accel_trusted, written out
-                self.correct(ax, ay, az)
+            norm2 = ax * ax + ay * ay + az * az
+            if low2 <= norm2 <= high2:  # accel_trusted, written out
+                lo, hi = self._bias_band2
+                self.correct(ax, ay, az, lo < norm2 < hi)
         return tuple_new(
             ESTIMATE, (self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z), None, None)
         )
@@ -263,6 +301,9 @@ class AngleBiasKalmanFilter(Estimator):
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
         self.propagate(gx, gy, gz, dt, phi)
         predicted = (self.roll, self.pitch)
+        raw2 = ax * ax + ay * ay + az * az
+        lo, hi = self._bias_band2
+        learn_bias = lo < raw2 < hi  # the raw sample, before the pre-filter (bias_gate)
         if self._rest_cfg[0] > 0.0:  # rest_time
             self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
         if self._acc_tau > 0.0:
@@ -270,7 +311,7 @@ class AngleBiasKalmanFilter(Estimator):
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
             ax, ay, az = self.acc_f
         if self.accel_trusted(ax * ax + ay * ay + az * az):
-            self.correct(ax, ay, az)
+            self.correct(ax, ay, az, learn_bias)
         if self._quaternion and (self.roll, self.pitch) != predicted:
             self.q_att = quat_with_roll_pitch(self.q_att, self.roll, self.pitch)
 
@@ -327,22 +368,26 @@ class AngleBiasKalmanFilter(Estimator):
         low2, high2 = self._gate2
         return low2 <= norm2 <= high2
 
-    def correct(self, ax: float, ay: float, az: float) -> None:
-        """Measurement update of both axes with the accelerometer's roll and pitch."""
+    def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True) -> None:
+        """Measurement update of both axes with the accelerometer's roll and pitch (the biases
+        left alone unless learn_bias: bias_gate)."""
         acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
         y_roll = acc_roll - self.roll
         self.correct_innovation(
-            y_roll if -PI <= y_roll <= PI else wrap_angle(y_roll), acc_pitch - self.pitch
+            y_roll if -PI <= y_roll <= PI else wrap_angle(y_roll), acc_pitch - self.pitch,
+            learn_bias,
         )
 
-    def correct_innovation(self, y_roll: float, y_pitch: float) -> None:
-        """Measurement update with given innovations (accelerometer angle - predicted angle)."""
+    def correct_innovation(self, y_roll: float, y_pitch: float, learn_bias: bool = True) -> None:
+        """Measurement update with given innovations (accelerometer angle - predicted angle);
+        with learn_bias False the biases are consider states (angle_only_gain)."""
+        gain = measurement_gain if learn_bias else angle_only_gain
         P, P_pitch = self.P_roll, self.P_pitch
-        self.gain_roll, self.P_roll = measurement_gain(P, self._r)
+        self.gain_roll, self.P_roll = gain(P, self._r)
         if P_pitch == P:  # one covariance (see propagate)
             self.gain_pitch, self.P_pitch = self.gain_roll, self.P_roll
         else:
-            self.gain_pitch, self.P_pitch = measurement_gain(P_pitch, self._r)
+            self.gain_pitch, self.P_pitch = gain(P_pitch, self._r)
         K0, K1 = self.gain_roll
         roll = self.roll + K0 * y_roll
         self.bias_x += K1 * y_roll
