@@ -141,3 +141,21 @@ def test_converged_covariance_and_gain_equal_the_dare_solution_to_1e_6() -> None
     }
     print("\nKF vs DARE relative error:", {k: f"{v:.2g}" for k, v in errors.items()})
     assert max(errors.values()) < 1e-6, errors
+
+
+def test_bias_gate_keeps_the_bias_while_the_raw_norm_is_off_g() -> None:
+    """A sample 10 % off g (linear acceleration) with an apparent tilt: the angle is updated, the
+    bias is not (a consider state); the same sample within 5 % of g moves the bias, and so does
+    any sample with the gate off (the papers)."""
+    def bias_after(norm: float, gate: float) -> tuple[float, float]:
+        kf = AngleBiasKalmanFilter(acc_lowpass=0.0, rest_time=0.0, bias_gate=gate)
+        kf.step((0.0, 0.0, G), (0.0, 0.0, 0.0), 0.01)
+        tilt = 0.05  # rad of apparent roll
+        for _ in range(50):
+            kf.step((0.0, norm * math.sin(tilt), norm * math.cos(tilt)), (0.0, 0.0, 0.0), 0.01)
+        return kf.bias_x, kf.roll
+
+    bias, roll = bias_after(1.1 * G, 0.05)
+    assert bias == 0.0 and roll > 0.0
+    assert bias_after(1.02 * G, 0.05)[0] != 0.0
+    assert bias_after(1.1 * G, 0.0)[0] != 0.0
