@@ -226,3 +226,13 @@ def rest_step(
         and (ax - fx) ** 2 + (ay - fy) ** 2 + (az - fz) ** 2 < th_acc * th_acc
     )
     return wx, wy, wz, fx, fy, fz, (quiet + dt if still else 0.0)
+
+
+def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_time: float
+                 ) -> Vec3:
+    """One step of a gyro-bias estimate that follows the gyro while the sensor is at rest
+    (rest_step said so for rest_time): a first-order low-pass with time constant rest_time, the
+    zero-angular-rate update of the filters without a bias covariance (cf, mgcf)."""
+    k = dt / (rest_time + dt)
+    bx, by, bz = bias
+    return bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz)

@@ -9,19 +9,20 @@ References:
 
 from __future__ import annotations
 
-from typing import Final
-
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
     GYRO_SAMPLING_PARAM,
     PROPAGATION_PARAM,
+    REST_PARAMS,
     ZERO3,
+    bias_at_rest,
     body_rotation,
     gate_bounds2,
     lowpass_specific_force,
     quat_with_roll_pitch,
+    rest_step,
 )
 from .kinematics import (
     HALF_PI,
@@ -37,9 +38,6 @@ from .kinematics import (
 )
 from .types import Estimate, Param
 
-NO_BIAS: Final[tuple[float, ...]] = ZERO3
-"""ZERO3 as the compiled core's constant (no module-dict look-up): the CF's bias output."""
-
 
 class ComplementaryFilter(Estimator):
     """Complementary filter (Gui et al. 2015 eq. 1-2; Das & Mary eq. 1) for roll and pitch.
@@ -53,24 +51,30 @@ class ComplementaryFilter(Estimator):
     angle_pred + (1-a)*wrap(acc_angle - angle_pred), the same number, so roll does not jump at
     +-180 deg).
 
-    A constant gyro bias b leaves a steady-state error b*tau: this filter has no bias state, and
-    its bias outputs are always 0.
+    A constant gyro bias b leaves a steady-state error b*tau: the papers' filter has no bias
+    state. Options for real sensors, on by default (the `paper` preset turns them off, and then
+    the filter is exactly the papers'):
+    - acc_lowpass > 0: the accelerometer is first low-passed in a frame that turns with the gyro
+      (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and the gate and the blend
+      use that vector;
+    - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
+      still, the gyro reads its own bias, and a bias estimate b follows it with time constant
+      rest_time; the filter integrates gyro - b and outputs b (BROAD: 1.03 -> 0.85 deg mean, the
+      uncalibrated gyro's b tau gone);
+    - propagation="quaternion" carries roll and pitch through an attitude quaternion instead of
+      the Euler rates (building_blocks.PROPAGATION_PARAM), so that pitch +-90 deg is no
+      singularity.
 
-    Options for real sensors, on by default (the `paper` preset turns them off, and then the
-    filter is exactly the papers'): the accelerometer is first low-passed in a frame that turns
-    with the gyro (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and the gate
-    and the blend use that vector; propagation="quaternion" carries roll and pitch through an
-    attitude quaternion instead of the Euler rates (building_blocks.PROPAGATION_PARAM), so that
-    pitch +-90 deg is no singularity.
-
-    Recommended tau = 1 s: with no bias state a gyro bias b leaves an error b tau (0.5 deg/s x
-    1 s = 0.5 deg on an uncalibrated MEMS gyro), while a shorter tau lets the pre-filtered
-    accelerometer's residual acceleration through; physics fixes no single value, and a coarse
+    Recommended tau = 1 s: a gyro bias b the rest updates have not seen leaves an error b tau
+    (0.5 deg/s x 1 s = 0.5 deg on an uncalibrated MEMS gyro), while a shorter tau lets the
+    pre-filtered accelerometer's residual acceleration through; physics fixes no single value,
+    and a coarse
     scan on BROAD (0.75 / 1 / 1.5 / 2 s: 1.20 / 1.16 / 1.18 / 1.26 deg) has its plateau's middle
     at 1 s. The papers' values are presets.PAPER_CF.
 
     Parameters: tau [s] time constant (1; papers 0.75); gate_low, gate_high accelerometer gate
-    (|acc|/g); acc_lowpass [s] (0: off); propagation; gyro_sampling; max_dt, max_rate.
+    (|acc|/g); acc_lowpass [s] (0: off); rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2];
+    propagation; gyro_sampling; max_dt, max_rate.
     """
 
     PARAMS = (
@@ -81,10 +85,11 @@ class ComplementaryFilter(Estimator):
         ),
         *ACC_GATE_PARAMS,
         ACC_LOWPASS_PARAM,
+        *REST_PARAMS,
         PROPAGATION_PARAM,
         GYRO_SAMPLING_PARAM,
     )
-    STATE = ("roll", "pitch", "acc_f", "q_att")
+    STATE = ("roll", "pitch", "acc_f", "q_att", "bias", "rest")
 
     def _configure(self) -> None:
         p = self._params
@@ -95,23 +100,35 @@ class ComplementaryFilter(Estimator):
         self._quaternion: bool = p["propagation"] == "quaternion"
         # both options need the rotation vector of each interval; the papers' filter does not
         self._rotating = self._quaternion or self._acc_tau > 0.0
+        self._rest = (float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]))
 
     def _reset(self) -> None:
         self.roll = 0.0
         self.pitch = 0.0
         self.acc_f = ZERO3  # the pre-filtered specific force (acc_lowpass > 0)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
+        self.bias = ZERO3  # gyro bias measured at rest (rest_time > 0)
+        self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
         self.acc_f = (ax, ay, az)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
 
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
+        rest_time = self._rest[0]
+        if rest_time > 0.0:  # at rest the gyro reads its bias: follow it (time constant rest_time)
+            self.rest = rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, self._rest[1],
+                                         self._rest[2])
+            if rest[6] >= rest_time:
+                self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, rest_time)
+        bias = self.bias
+        bx, by, bz = bias
         if self._rotating:
-            phi = body_rotation(self.gyro_prev, (gx, gy, gz), ZERO3, dt, self._trapezoid)
+            phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
             if self._acc_tau > 0.0:  # the filter and its gate use the pre-filtered vector
                 self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
                                                     self._acc_tau)
@@ -121,9 +138,10 @@ class ComplementaryFilter(Estimator):
             roll, pitch = quat_roll_pitch(*self.q_att)
         elif self._trapezoid:
             p0, q0, r0 = self.gyro_prev
-            roll, pitch = heun_euler_step(self.roll, self.pitch, p0, q0, r0, gx, gy, gz, dt)
+            roll, pitch = heun_euler_step(self.roll, self.pitch, p0 - bx, q0 - by, r0 - bz,
+                                          gx - bx, gy - by, gz - bz, dt)
         else:
-            roll, pitch = euler_step(self.roll, self.pitch, gx, gy, gz, dt)
+            roll, pitch = euler_step(self.roll, self.pitch, gx - bx, gy - by, gz - bz, dt)
         if self._gate_low2 <= ax * ax + ay * ay + az * az <= self._gate_high2:
             acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
             k = dt / (self._tau + dt)  # 1 - a, Gui et al. eq. 2
@@ -134,10 +152,10 @@ class ComplementaryFilter(Estimator):
                 self.q_att = quat_with_roll_pitch(self.q_att, roll, pitch)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-        return tuple_new(ESTIMATE, (roll, pitch, NO_BIAS, None, None))
+        return tuple_new(ESTIMATE, (roll, pitch, bias, None, None))
 
     def _estimate(self) -> Estimate:
-        return Estimate(self.roll, self.pitch, ZERO3)
+        return Estimate(self.roll, self.pitch, self.bias)
 
 
 __all__ = ["ComplementaryFilter"]

@@ -24,6 +24,7 @@ from .building_blocks import (
     GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     ZERO3,
+    bias_at_rest,
     body_rotation,
     lowpass_specific_force,
     rest_step,
@@ -152,9 +153,7 @@ class GainScheduledComplementaryFilter(Estimator):
                 self.rest, gx, gy, gz, ax, ay, az, dt, self._rest_gyro, self._rest_acc
             )
             if self.rest[6] >= self._rest_time:
-                k = dt / (self._rest_time + dt)
-                bx, by, bz = self.bias
-                self.bias = (bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz))
+                self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, self._rest_time)
         if self._acc_tau > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), self.bias, dt, self._trapezoid)
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)

@@ -28,7 +28,7 @@ DEG2 = DEG * DEG
 KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
 
 PAPER_CF: dict[str, Any] = {
-    "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0,
+    "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
     "propagation": "euler", "gyro_sampling": "mean",
 }
 """Gui et al. eq. 1-2: tau = 0.75 s (a = 0.96 at their 30 ms loop), the Euler rates, the

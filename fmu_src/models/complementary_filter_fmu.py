@@ -2,11 +2,12 @@
 
 Implements W. Gui, Y. Tang, S. Mukhopadhyay (2015), complementary filter for tilt, eq. 1-2
 (angle = a (angle + gyro dt) + (1 - a) acc_angle, a = tau / (tau + dt)); the same filter as
-Das & Mary, eq. 1. The filter has no gyro-bias state: its bias outputs are always 0.
+Das & Mary, eq. 1. The papers' filter has no gyro-bias state; with rest detection (on by
+default) the bias outputs are the gyro's reading at rest, which the filter subtracts.
 """
 
 import fusion_core
-from fmu_src.estimator import NO_BIAS_OUTPUTS, EstimatorSlave
+from fmu_src.estimator import EstimatorSlave
 
 
 class ComplementaryFilter(EstimatorSlave):
@@ -16,6 +17,5 @@ class ComplementaryFilter(EstimatorSlave):
     description = (
         "Complementary filter for roll and pitch from a 6-axis IMU: W. Gui, Y. Tang, "
         "S. Mukhopadhyay (2015), eq. 1-2; Das & Mary, eq. 1. One IMU sample per doStep; "
-        "no gyro-bias state (bias outputs are 0)."
+        "the gyro bias measured at rest (rest_time > 0) is subtracted and output."
     )
-    zero_bias = NO_BIAS_OUTPUTS
