@@ -3,8 +3,9 @@
     python examples/make_inputs.py
 
 tilt_motion.csv / tilt_motion_truth.csv
-    fusion_core.synthetic.two_axis_motion() (roll 0.5 rad at 0.5 Hz and pitch 0.35 rad at
-    0.35 Hz together, about a fixed point) for 10 s at 100 Hz.
+    at rest for 3 s (as a session starts: the rest detection measures the gyro bias), then
+    roll 0.5 rad at 0.5 Hz and pitch 0.35 rad at 0.35 Hz together, about a fixed point, faded in
+    over 1 s by a minimum-jerk ramp, to 10 s, at 100 Hz.
 move_2m.csv / move_2m_truth.csv
     at rest for 2 s, a 2 m minimum-jerk move along x in 3 s, at rest again (for the position
     filter).
@@ -38,11 +39,19 @@ def move_2m() -> synthetic.Trajectory:
     return s.Trajectory(pos=(s.min_jerk(0.0, 2.0, 2.0, 3.0), s.constant(), s.constant()))
 
 
+def tilt_motion() -> synthetic.Trajectory:
+    """At rest for 3 s, then two-axis motion faded in over 1 s (module docstring)."""
+    s = synthetic
+    ramp = s.min_jerk(0.0, 1.0, 3.0, 1.0)
+    return s.Trajectory(roll=s.product(ramp, s.sine(0.5, 0.5)),
+                        pitch=s.product(ramp, s.sine(0.35, 0.35)))
+
+
 def recordings() -> dict[str, dict[str, np.ndarray]]:
     """The example recordings by file stem."""
     noise = synthetic.ImuNoise(gyro_bias=GYRO_BIAS)
     return {
-        "tilt_motion": synthetic.record(synthetic.two_axis_motion(), 10.0, RATE, noise, seed=2026),
+        "tilt_motion": synthetic.record(tilt_motion(), 10.0, RATE, noise, seed=2026),
         "move_2m": synthetic.record(move_2m(), 10.0, RATE, noise, seed=2026),
     }
 

@@ -223,6 +223,16 @@ def record(
     return out
 
 
+def product(u: Signal, v: Signal) -> Signal:
+    """u v, with its derivatives by the product rule."""
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        a, da, dda = u(t, ops)
+        b, db, ddb = v(t, ops)
+        return a * b, da * b + a * db, dda * b + 2 * da * db + a * ddb
+
+    return f
+
+
 def two_axis_motion() -> Trajectory:
     """Simultaneous roll and pitch (roll 0.5 rad at 0.5 Hz, pitch 0.35 rad at 0.35 Hz)."""
     return Trajectory(roll=sine(0.5, 0.5), pitch=sine(0.35, 0.35))
