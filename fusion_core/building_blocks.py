@@ -19,6 +19,7 @@ carries no gravity direction: every block below skips it, and so does every corr
 
 from __future__ import annotations
 
+import math
 from typing import Final
 
 from .kinematics import (
@@ -236,3 +237,27 @@ def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_ti
     k = dt / (rest_time + dt)
     bx, by, bz = bias
     return bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz)
+
+
+BIAS_GATE: Final = 0.05
+"""Recommended bias_gate: Duong Quoc et al.'s experimental table for their MPU-6050 (section
+4.2) stops trusting the accelerometer at rho = 0.05; here only the bias stops learning from it.
+The accelerometer sees a gyro bias only as a slow drift of the tilt it measures; a sample whose
+norm is 5 % off g carries linear acceleration (or vibration) whose apparent tilt would be taken
+for that drift, and with a small Q_bias a bias learned wrong stays wrong for minutes. A resting
+MEMS accelerometer (scale error up to 3 % uncalibrated) passes."""
+BIAS_GATE_PARAM = Param(
+    "bias_gate", BIAS_GATE,
+    "Bias learning gate on rho = ||a|/g - 1| of the raw accelerometer sample: at or above it "
+    "the accelerometer update leaves the gyro bias alone (the sample measures linear "
+    "acceleration, not the drift of the tilt); 0 = off, every update moves the bias (the papers)",
+    low=0.0,
+)
+
+
+def bias_band2(gate: float) -> tuple[float, float]:
+    """BIAS_GATE_PARAM as bounds on the raw sample's squared norm: the bias learns while
+    lo < |a|^2 < hi (any sample when the gate is 0, off)."""
+    if not gate > 0.0:
+        return -1.0, math.inf
+    return (max(1.0 - gate, 0.0) * G) ** 2, ((1.0 + gate) * G) ** 2

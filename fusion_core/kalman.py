@@ -17,19 +17,20 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 
 from __future__ import annotations
 
-import math
 from typing import Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
+    BIAS_GATE_PARAM,
     GYRO_SAMPLING_PARAM,
     PROPAGATION_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
     ZERO3,
     Vec3,
+    bias_band2,
     body_rotation,
     gate_bounds2,
     lowpass_specific_force,
@@ -52,13 +53,6 @@ from .kinematics import (
 from .types import DEG, Estimate, G, Param
 
 DEG2: Final = DEG * DEG
-BIAS_GATE: Final = 0.05
-"""Recommended bias_gate: Duong Quoc et al.'s experimental table for their MPU-6050 (section
-4.2) stops trusting the accelerometer at rho = 0.05; here only the bias stops learning from it.
-The accelerometer sees a gyro bias only as a slow drift of the tilt it measures; a sample whose
-norm is 5 % off g carries linear acceleration (or vibration) whose apparent tilt would be taken
-for that drift, and with a small Q_bias a bias learned wrong stays wrong for minutes. A resting
-MEMS accelerometer (scale error up to 3 % uncalibrated) passes."""
 RECOMMENDED_R: Final = (0.05 / G) ** 2
 """Recommended R_measure [rad^2]: the variance of one accelerometer sample's tilt, (0.05 m/s^2 /
 g)^2 = (0.29 deg)^2, from the accelerometer's noise measured at rest on a real MEMS IMU
@@ -166,7 +160,7 @@ class AngleBiasKalmanFilter(Estimator):
     (BROAD's: up to 0.5 deg/s), with the angles' first variance R (one sample's); the
     pre-filter, rest detection and quaternion propagation as building_blocks recommends; the
     bias learns from the accelerometer only while the raw sample's norm is within 5 % of g
-    (bias_gate, BIAS_GATE: Duong Quoc et al.'s real-sensor cutoff).
+    (bias_gate, building_blocks.BIAS_GATE_PARAM: Duong Quoc et al.'s real-sensor cutoff).
     Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 1.16 / 0.95 / 0.94 deg):
     the accelerometer's error after the pre-filter is coloured (residual linear acceleration),
     so a bias random walk sized from the gyro's real drift (3e-6 deg^2/s^3) lets it steer the
@@ -207,14 +201,7 @@ class AngleBiasKalmanFilter(Estimator):
             "the papers' code)",
             unit="rad/s", low=0.0, tunable=False, display_unit="deg/s",
         ),
-        Param(
-            "bias_gate", BIAS_GATE,
-            "Bias learning gate on rho = ||a|/g - 1| of the raw accelerometer sample: at or "
-            "above it the accelerometer update leaves the gyro bias alone (the sample measures "
-            "linear acceleration, not the drift of the tilt); 0 = off, every update moves the "
-            "bias (the papers)",
-            low=0.0,
-        ),
+        BIAS_GATE_PARAM,
         PROPAGATION_PARAM,
         GYRO_SAMPLING_PARAM,
     )
@@ -238,12 +225,7 @@ class AngleBiasKalmanFilter(Estimator):
             float(p["gyro_psd"]),
         )
         self._quaternion: bool = p["propagation"] == "quaternion"
-        bias_gate = float(p["bias_gate"])
-        # the gate on |a|^2: ((1 - gate) g)^2 <= |a|^2 < ((1 + gate) g)^2 learns the bias
-        self._bias_band2 = (
-            (max(1.0 - bias_gate, 0.0) * G) ** 2 if bias_gate > 0.0 else -1.0,
-            ((1.0 + bias_gate) * G) ** 2 if bias_gate > 0.0 else math.inf,
-        )
+        self._bias_band2 = bias_band2(float(p["bias_gate"]))
         # any real-sensor option on (else the papers' filter: the short path of _advance)
         self._options = self._quaternion or self._acc_tau > 0.0 or float(p["rest_time"]) > 0.0
 

@@ -55,7 +55,7 @@ PAPER_KF: dict[str, Any] = {
 PAPER_UKF: dict[str, Any] = {
     "gyro_psd": (0.05 * DEG) ** 2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
-    "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "gyro_sampling": "mean",
+    "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0, "gyro_sampling": "mean",
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
 simulated MPU-6050 at 100 Hz (gyro 10x the datasheet density, acc_noise 0.06 with an allowance

@@ -49,9 +49,11 @@ import numpy as np
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
+    BIAS_GATE_PARAM,
     GYRO_SAMPLING_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
+    bias_band2,
     body_rotation,
     lowpass_specific_force,
     rest_step,
@@ -135,6 +137,7 @@ class UnscentedKalmanFilter(Estimator):
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
+        BIAS_GATE_PARAM,
     )
     STATE = ("x", "P", "acc_f", "rest")
 
@@ -157,6 +160,7 @@ class UnscentedKalmanFilter(Estimator):
         self._trapezoid: bool = p["gyro_sampling"] == "point"
         # any real-sensor option on (else the paper's filter alone: the short path of _advance)
         self._options = float(p["acc_lowpass"]) > 0.0 or float(p["rest_time"]) > 0.0
+        self._bias_band2 = bias_band2(float(p["bias_gate"]))
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -190,7 +194,9 @@ class UnscentedKalmanFilter(Estimator):
         if self._options:
             self._update(ax, ay, az, gx, gy, gz, dt)
         else:
-            self._filter_update(ax, ay, az, gx, gy, gz, dt)
+            lo, hi = self._bias_band2
+            self._filter_update(ax, ay, az, gx, gy, gz, dt,
+                                lo < ax * ax + ay * ay + az * az < hi)
         return self._estimate()
 
     def _update(
@@ -200,14 +206,16 @@ class UnscentedKalmanFilter(Estimator):
         pre-filter (acc_lowpass, complementary.ACC_LOWPASS_PARAM: the filter then measures the
         low-passed specific force) and, at rest, a zero-rate update of the bias states."""
         p = self._params
+        lo, hi = self._bias_band2
+        learn_bias = lo < ax * ax + ay * ay + az * az < hi  # the raw sample (bias_gate)
         if p["acc_lowpass"] > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), (self.x[3], self.x[4], self.x[5]),
                                 dt, self._trapezoid)
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
                                                 p["acc_lowpass"])
-            self._filter_update(*self.acc_f, gx, gy, gz, dt)
+            self._filter_update(*self.acc_f, gx, gy, gz, dt, learn_bias)
         else:
-            self._filter_update(ax, ay, az, gx, gy, gz, dt)
+            self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
         if p["rest_time"] > 0.0:
             self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, p["rest_gyro"],
                                   p["rest_acc"])
@@ -228,9 +236,11 @@ class UnscentedKalmanFilter(Estimator):
         self.P = (0.5 * (P + P.T)).tolist()
 
     def _filter_update(
-        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float,
+        learn_bias: bool = True,
     ) -> None:
-        """One sample of the paper's UKF (eq. 14-17): predict, then update with acc/g."""
+        """One sample of the paper's UKF (eq. 14-17): predict, then update with acc/g (the bias
+        states as consider states, unchanged, unless learn_bias: bias_gate)."""
         X0, X1, X2, b0, b1, b2 = self.x
         P = self._P
         offsets = _sigma_offsets(P, self._gamma)  # gamma s_j, j = 1..6
@@ -349,7 +359,7 @@ class UnscentedKalmanFilter(Estimator):
             )
             innovation = (ax / G - X0, ay / G - X1, az / G - X2, 1.0 - (v_prior + mu_v))
             X0, X1, X2, b0, b1, b2, P = _kalman_update(
-                (X0, X1, X2, b0, b1, b2), P, S, rows, innovation
+                (X0, X1, X2, b0, b1, b2), P, S, rows, innovation, learn_bias
             )
             n = math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
         self.x = [X0 / n, X1 / n, X2 / n, b0, b1, b2]
@@ -446,14 +456,17 @@ def _kalman_update(
     S: tuple[float, ...],
     rows: tuple[tuple[float, float, float, float], ...],
     y: tuple[float, float, float, float],
+    learn_bias: bool = True,
 ) -> UpdateResult:
     """(*(x + K y), P - K S K^T) with K = P_xz S^-1 (eq. 17): x (6), P packed (21), S the packed
     4x4 innovation covariance, rows the rows of the 6x4 P_xz, y the innovation. With
-    S = L L^T and Y = L^-1 P_xz^T: K y = Y^T (L^-1 y) and K S K^T = Y^T Y."""
+    S = L L^T and Y = L^-1 P_xz^T: K y = Y^T (L^-1 y) and K S K^T = Y^T Y. With learn_bias
+    False the bias rows of K are 0 (the biases are consider states, Schmidt 1966): b and its
+    own covariance block stay, the rest is the same update."""
     s00, s10, s11, s20, s21, s22, s30, s31, s32, s33 = S
     L = _cholesky4(s00, s10, s11, s20, s21, s22, s30, s31, s32, s33)
     if L is None:
-        return _general_update(x, P, S, rows, y)
+        return _consider_bias(_general_update(x, P, S, rows, y), x, P, learn_bias)
     l00, l10, l11, l20, l21, l22, l30, l31, l32, l33 = L
     i0, i1, i2, i3 = 1.0 / l00, 1.0 / l11, 1.0 / l22, 1.0 / l33
     Y = []
@@ -465,7 +478,7 @@ def _kalman_update(
     (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), (d0, d1, d2, d3), \
         (e0, e1, e2, e3), (f0, f1, f2, f3), (z0, z1, z2, z3) = Y
     x0, x1, x2, x3, x4, x5 = x
-    return (
+    return _consider_bias((
         x0 + (a0 * z0 + a1 * z1 + a2 * z2 + a3 * z3),
         x1 + (b0 * z0 + b1 * z1 + b2 * z2 + b3 * z3),
         x2 + (c0 * z0 + c1 * z1 + c2 * z2 + c3 * z3),
@@ -495,7 +508,19 @@ def _kalman_update(
             P[19] - (f0 * e0 + f1 * e1 + f2 * e2 + f3 * e3),
             P[20] - (f0 * f0 + f1 * f1 + f2 * f2 + f3 * f3),
         ),
-    )
+    ), x, P, learn_bias)
+
+
+def _consider_bias(result: UpdateResult, x: tuple[float, ...], P: tuple[float, ...],
+                   learn_bias: bool) -> UpdateResult:
+    """result as it is, or with the bias states x[3:] and their covariance block P_bb as before
+    the update (learn_bias False: _kalman_update)."""
+    if learn_bias:
+        return result
+    x0, x1, x2, _, _, _, Pn = result
+    bb = (9, 13, 14, 18, 19, 20)  # the packed indices of P_bb
+    return (x0, x1, x2, x[3], x[4], x[5],
+            tuple(P[i] if i in bb else v for i, v in enumerate(Pn)))
 
 
 def _cholesky4(
