@@ -36,7 +36,8 @@ import numpy as np
 from fusion_core.sensor import SENSOR_PRESETS
 from fusion_core.types import DEG
 
-CONTRACT_VERSION = "1.0"
+CONTRACT_VERSION = "2.0"
+"""2.0: interface v2 (bad input, presets, the realistic sensor by default), T3 in CPU time."""
 SETTLE_S = 5.0
 """Convergence period excluded from RMSE and max error [s] ("after convergence"): the attitude
 starts from the accelerometer, but bias states and covariances settle over seconds (the UKF's
