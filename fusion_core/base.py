@@ -30,6 +30,19 @@ MAX_RATE_DEFAULT: Final = 1000.0
 """Default max_rate [rad/s] (57,300 deg/s): about three times the widest full-scale range of any
 MEMS gyro we know of (Analog Devices ADXRS649, +-20,000 deg/s; consumer parts such as the
 MPU-6050 end at +-2000 deg/s). A larger reading is no measurement."""
+MOUNTING_PARAMS: tuple[Param, ...] = tuple(
+    Param(
+        f"mount_{axis}", 0.0,
+        f"Mounting: {axis} angle of the rotation from the sensor frame to the filter frame "
+        "(Z-Y-X: yaw, then pitch, then roll), applied to every sample at the input, as flight "
+        "stacks' board-rotation setting; all three 0: the sensor's axes are the filter's",
+        unit="rad", low=-math.pi, high=math.pi, display_unit="deg", tunable=False,
+    )
+    for axis in ("roll", "pitch", "yaw")
+)
+"""The mounting rotation (interface v2): a sensor resting in any orientation (x up, upside
+down, turned on its side) is given as the rotation that takes its axes to the filter's, so that
+every estimator sees the body frame of docs/interface.md."""
 COMMON_PARAMS: tuple[Param, ...] = (
     Param(
         "max_dt", 1.0, "Longest accepted time between samples; a longer dt is rejected",
@@ -41,6 +54,7 @@ COMMON_PARAMS: tuple[Param, ...] = (
         "sensor delivers it (default about 3x the widest MEMS gyro range, +-20,000 deg/s)",
         unit="rad/s", low=0.0, low_open=True, display_unit="deg/s",
     ),
+    *MOUNTING_PARAMS,
 )
 MIN_INIT_NORM: Final = 0.1 * G
 """Accelerometer norm [m/s^2] a sample needs to initialise roll and pitch: below it (free fall,
@@ -60,6 +74,32 @@ ESTIMATE: Final = Estimate
 """`tuple_new(ESTIMATE, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
 without the NamedTuple's Python-level __new__: the hot paths build their estimate this way. The
 Final names spare the compiled core (fmu_src/compiled_core.py) two module-dict look-ups."""
+
+
+Mat9 = tuple[float, float, float, float, float, float, float, float, float]
+IDENTITY: Final[Mat9] = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+
+
+def mounting_matrix(roll: float, pitch: float, yaw: float) -> Mat9:
+    """The rotation matrix Rz(yaw) Ry(pitch) Rx(roll), row by row, that takes a vector from
+    the sensor frame to the filter frame; exactly the identity for zero angles, and with
+    exact zeros and ones for right angles (cosines and sines of multiples of pi/2 rounded), so
+    that a right-angle mounting permutes the axes without rounding."""
+    def cs(a: float) -> tuple[float, float]:
+        c, s = math.cos(a), math.sin(a)
+        quarter = a / (0.5 * math.pi)
+        if abs(quarter - round(quarter)) < 1e-12:
+            c, s = float(round(c)), float(round(s))
+        return c, s
+
+    cr, sr = cs(roll)
+    cp, sp = cs(pitch)
+    cy, sy = cs(yaw)
+    return (
+        cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
+        sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
+        -sp, cp * sr, cp * cr,
+    )
 
 
 def _plain(value: Any) -> Any:
@@ -127,6 +167,9 @@ class Estimator:
         self._params = values
         self._max_dt = float(values["max_dt"])
         self._max_rate2 = float(values["max_rate"]) ** 2
+        self._mounting = mounting_matrix(float(values["mount_roll"]), float(values["mount_pitch"]),
+                                         float(values["mount_yaw"]))
+        self._mounted: bool = self._mounting != IDENTITY
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:
@@ -211,6 +254,12 @@ class Estimator:
             and 0.0 < dt <= self._max_dt
         ):
             self._check_values(ax, ay, az, gx, gy, gz, dt)
+        if self._mounted:  # into the filter frame (MOUNTING_PARAMS)
+            m00, m01, m02, m10, m11, m12, m20, m21, m22 = self._mounting
+            ax, ay, az = (m00 * ax + m01 * ay + m02 * az, m10 * ax + m11 * ay + m12 * az,
+                          m20 * ax + m21 * ay + m22 * az)
+            gx, gy, gz = (m00 * gx + m01 * gy + m02 * gz, m10 * gx + m11 * gy + m12 * gz,
+                          m20 * gx + m21 * gy + m22 * gz)
         norm2 = ax * ax + ay * ay + az * az
         if not norm2 <= _MAX_ACC_NORM2:  # (also an overflow to inf) no reading at all
             ax = ay = az = norm2 = 0.0
