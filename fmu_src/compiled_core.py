@@ -34,7 +34,8 @@ from types import ModuleType
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_CACHE = REPO / "build" / "compiled_core"
 COMPILED_MODULES = (
-    "types", "kinematics", "base", "complementary", "kalman", "mgcf", "ukf", "position",
+    "types", "kinematics", "base", "building_blocks", "complementary", "kalman", "mgcf", "ukf",
+    "position",
 )
 """The fusion_core modules that mypyc compiles: the estimators and what their hot paths call.
 The rest (presets, scenarios, the sensor model, the synthetic recordings) stays Python."""
@@ -70,11 +71,12 @@ def fusion_core_dir() -> Path:
 
 
 def cache_key(core: Path) -> str:
-    """A hash of the fusion_core sources, the compiler version and the interpreter's ABI tag
-    (call it once toolchain_missing() has found mypyc)."""
+    """A hash of the fusion_core sources, the modules compiled, the compiler version and the
+    interpreter's ABI tag (call it once toolchain_missing() has found mypyc)."""
     from mypy.version import __version__ as mypy_version
 
-    digest = hashlib.sha256(f"{mypy_version}|{EXT_SUFFIX}|{sys.version}".encode())
+    modules = ",".join(COMPILED_MODULES)
+    digest = hashlib.sha256(f"{mypy_version}|{EXT_SUFFIX}|{sys.version}|{modules}".encode())
     for path in sorted(core.glob("*.py")):
         digest.update(path.name.encode() + b"\0" + path.read_bytes())
     return digest.hexdigest()[:16]
