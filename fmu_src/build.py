@@ -17,10 +17,10 @@ import os
 import shutil
 import tempfile
 import traceback
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from unittest import mock
 
 from .compiled_core import fusion_core_dir, resolve_core, shipped_files
 from .estimator import PRESET_ENV
@@ -139,38 +139,22 @@ def build_all(
     core: "auto" (the compiled fusion_core where it can be built, else the pure-Python one),
     "compiled" or "python" (compiled_core.CORES); preset: the estimators' start values, a name
     or a JSON file (fusion_core.presets.load_preset; ValueError for a bad one)."""
-    from fmpy import read_model_description
-
     from fusion_core.presets import load_preset
 
     starts = load_preset(preset)
     compiled = resolve_core(core)
-    results = []
     with contextlib.ExitStack() as stack:
         if any(starts.values()):  # the recommended values need no file: they are the defaults
             tmp = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="preset_")))
             (tmp / "preset.json").write_text(json.dumps(starts, indent=1))
-            stack.enter_context(_environ(PRESET_ENV, str(tmp / "preset.json")))
-        results = [_build_and_check(name, out_dir, compiled, read_model_description)
-                   for name in names]
-    return results
+            stack.enter_context(mock.patch.dict(os.environ, {PRESET_ENV: str(tmp / "preset.json")}))
+        return [_build_and_check(name, out_dir, compiled) for name in names]
 
 
-@contextlib.contextmanager
-def _environ(name: str, value: str) -> Iterator[None]:
-    old = os.environ.get(name)
-    os.environ[name] = value
-    try:
-        yield
-    finally:
-        if old is None:
-            del os.environ[name]
-        else:
-            os.environ[name] = old
+def _build_and_check(name: str, out_dir: Path, compiled: Path | None) -> BuildResult:
+    """One row of the build table: build the FMU, then check it."""
+    from fmpy import read_model_description
 
-
-def _build_and_check(name: str, out_dir: Path, compiled: Path | None,
-                     read_model_description: Any) -> BuildResult:
     result = BuildResult(name, core="python" if compiled is None else "compiled")
     try:
         result.path = build(name, out_dir, compiled)

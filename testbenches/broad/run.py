@@ -150,11 +150,15 @@ def collect_paths(paths: Iterable[str | Path]) -> list[Path]:
 
 
 # ----- running one column on one trial ------------------------------------------------------------
+def with_sampling(params: dict[str, Any], trial: BroadTrial) -> dict[str, Any]:
+    """params with the trial's gyro_sampling unless they set one themselves."""
+    return {"gyro_sampling": trial.gyro_sampling, **params}
+
+
 def run_fusion_core(key: str, params: dict[str, Any], trial: BroadTrial) -> dict[str, np.ndarray]:
     """roll, pitch [N] (and rejected) of fusion_core's estimator on the trial (integrating the
     gyro by the trial's sampling property unless params say otherwise)."""
-    params = {"gyro_sampling": trial.gyro_sampling, **params}
-    return ESTIMATORS[key](**params).run(trial.acc, trial.gyro, trial.dt)
+    return ESTIMATORS[key](**with_sampling(params, trial)).run(trial.acc, trial.gyro, trial.dt)
 
 
 def run_fmu(
@@ -163,7 +167,7 @@ def run_fmu(
     """roll, pitch [N] (and rejected) of the estimator's FMU on the trial, in fmpy: one
     set-inputs / doStep / get-outputs per sample, communication step = dt (docs/interface.md)."""
     path = fmu_path(ESTIMATOR_FMUS[key], fmu_dir)
-    params = {"gyro_sampling": trial.gyro_sampling, **params}
+    params = with_sampling(params, trial)
     fmu = FmuHandle(path, f"broad-{key}-{time.perf_counter_ns()}")
     n, h = trial.n, trial.dt
     out = np.empty((n, 2))
