@@ -39,22 +39,18 @@ from .variables import (
 AXES = ("x", "y", "z")
 NO_BIAS_STATE = "always 0: this filter has no gyro-bias state"
 """zero_bias reason for a filter without any bias state."""
-Z_BIAS_UNOBSERVABLE = (
-    "always 0: a bias about z does not change the accelerometer's tilt, so it is unobservable "
-    "in this filter"
-)
-"""zero_bias reason for bias_z of the position filter's tilt stage."""
 Z_BIAS_REST_ONLY = (
-    "0 until rest detection (rest_time > 0, the default) has seen the sensor at rest, and 0 "
-    "throughout with rest_time = 0: a bias about z does not change the accelerometer's tilt, so "
-    "only the zero-rate update at rest observes it"
+    "while z is the axis nearest to up, a bias about it does not change the accelerometer's "
+    "tilt, so only the zero-rate update at rest (rest_time > 0, the default) observes it: 0 "
+    "until the sensor has rested or lain on another face (tilt_axes='nearest_face', the "
+    "default), and 0 throughout with neither"
 )
-"""zero_bias reason for bias_z of the [angle, bias] Kalman filter."""
+"""zero_bias reason for bias_z of the [angle, bias] Kalman filter (and of the position filter,
+whose attitude is that filter's)."""
 NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STATE for a in AXES})
 """zero_bias of a filter without a bias state: all three bias outputs are 0."""
-NO_Z_BIAS_OUTPUT: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_UNOBSERVABLE})
 Z_BIAS_AT_REST_ONLY: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_REST_ONLY})
-"""zero_bias of the per-axis [angle, bias] Kalman filters: bias_z is 0."""
+"""zero_bias of the per-axis [angle, bias] Kalman filters: bias_z can stay 0."""
 
 
 PRESET_ENV = "FUSION_FMU_PRESET"

@@ -17,13 +17,16 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 
 from __future__ import annotations
 
-from typing import Final
+from math import cos, sin
+from typing import Any, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
     BIAS_GATE_PARAM,
+    FACE_SWITCH_COS,
+    FACES,
     GYRO_SAMPLING_PARAM,
     PROPAGATION_PARAM,
     REAL_GYRO_DENSITY,
@@ -34,6 +37,9 @@ from .building_blocks import (
     body_rotation,
     gate_bounds2,
     lowpass_specific_force,
+    mat_t_vec,
+    mat_vec,
+    nearest_face,
     quat_with_roll_pitch,
     rest_step,
     zero_rate_psd_param,
@@ -140,17 +146,26 @@ class AngleBiasKalmanFilter(Estimator):
     Options for real sensors, all on by default (the `paper` preset turns them off, and then the
     filter is exactly the papers'):
     - acc_lowpass > 0: the accelerometer is low-passed in a frame that turns with the gyro
-      (complementary.ACC_LOWPASS_PARAM, after Laidig & Seel 2023) before the gate and the
+      (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023) before the gate and the
       measurement, so linear acceleration averages out instead of reading as tilt;
-    - rest_time > 0: while a rest detector (complementary.REST_PARAMS) says the sensor is still,
+    - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is still,
       a zero-angular-rate update: the gyro measures the bias directly (H = [0, 1], variance
       gyro_psd / dt; the standard Kalman update, bias_update). The z-axis bias, which the
       accelerometer's tilt cannot observe, then gets a state of its own, bias_z (a random walk
       with Q_bias, observed only at rest), used in the propagation and output as bias_z; with
       rest detection off bias_z stays 0 as before;
     - propagation="quaternion": roll and pitch are carried by an attitude quaternion with a free
-      yaw instead of the Euler rates (complementary.PROPAGATION_PARAM), so that pitch +-90 deg is
-      no singularity; the covariance and the measurement update are the papers'.
+      yaw instead of the Euler rates (building_blocks.PROPAGATION_PARAM), so that pitch +-90 deg
+      is no singularity; the covariance and the measurement update are the papers';
+    - tilt_axes="nearest_face": the roll and the pitch filter run on the axes of the face the
+      sensor rests on nearest to up (building_blocks.FACES), not on the sensor's own x and y.
+      The papers' filters are made for a sensor near level: their accelerometer roll
+      atan2(ay, az) is noise at pitch +-90 deg (a sensor resting x-up), where R_measure still
+      trusts it, and the accelerometer can only teach them the bias of the x and y gyro axes,
+      while it is the horizontal axes whose bias tilts the estimate (x-up: y and z). On the
+      nearest face every resting orientation is the level case; the filters move to a new face
+      once up is 60 deg from the old one (_switch_face), carrying every state across exactly.
+      The outputs (roll, pitch, biases) are always in the sensor's frame.
 
     Recommended values (the defaults), from sensor physics: Q_angle = the gyro's noise PSD and
     R_measure = the variance of one accelerometer sample's tilt (RECOMMENDED_R), which together
@@ -158,9 +173,10 @@ class AngleBiasKalmanFilter(Estimator):
     Hz (the papers' numbers, tuned at 30 Hz, give 0.3 s at 285.7 Hz); gyro_psd (the zero-rate
     update) the same PSD; init_bias_std = 1 deg/s, an uncalibrated MEMS gyro's turn-on bias
     (BROAD's: up to 0.5 deg/s), with the angles' first variance R (one sample's); the
-    pre-filter, rest detection and quaternion propagation as building_blocks recommends; the
-    bias learns from the accelerometer only while the raw sample's norm is within 5 % of g
-    (bias_gate, building_blocks.BIAS_GATE_PARAM: Duong Quoc et al.'s real-sensor cutoff).
+    pre-filter, rest detection and quaternion propagation as building_blocks recommends, on the
+    nearest face; the bias learns from the accelerometer only while the raw sample's norm is
+    within 5 % of g (bias_gate, building_blocks.BIAS_GATE_PARAM: Duong Quoc et al.'s real-sensor
+    cutoff).
     Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 1.16 / 0.95 / 0.94 deg):
     the accelerometer's error after the pre-filter is coloured (residual linear acceleration),
     so a bias random walk sized from the gyro's real drift (3e-6 deg^2/s^3) lets it steer the
@@ -170,8 +186,8 @@ class AngleBiasKalmanFilter(Estimator):
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2]; gate_low, gate_high;
     acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_psd
-    [rad^2/s]; init_bias_std [rad/s]; bias_gate; propagation; gyro_sampling; max_dt [s],
-    max_rate [rad/s].
+    [rad^2/s]; init_bias_std [rad/s]; bias_gate; propagation; tilt_axes; gyro_sampling;
+    max_dt [s], max_rate [rad/s].
     """
 
     PARAMS = (
@@ -203,12 +219,30 @@ class AngleBiasKalmanFilter(Estimator):
         ),
         BIAS_GATE_PARAM,
         PROPAGATION_PARAM,
+        Param(
+            "tilt_axes", "nearest_face",
+            "The axes of the roll and the pitch filter: 'body' (the sensor's x and y, the "
+            "papers'; on a sensor resting on another face they lose the tilt near pitch +-90 deg "
+            "and cannot learn the bias of the horizontal z axis) or 'nearest_face' (the sensor "
+            "frame turned by the right-angle rotation that brings the axis nearest to up onto z, "
+            "chosen again past 60 deg: every resting face is the level case; needs "
+            "propagation='quaternion')",
+            choices=("body", "nearest_face"), tunable=False,
+        ),
         GYRO_SAMPLING_PARAM,
     )
     STATE = (
         "roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch", "bias_z", "P_z", "acc_f", "rest",
-        "q_att",
+        "q_att", "face",
     )
+
+    def _check_params(self, values: dict[str, Any]) -> None:
+        if values["tilt_axes"] == "nearest_face" and values["propagation"] != "quaternion":
+            raise ValueError(
+                "tilt_axes='nearest_face' needs propagation='quaternion' (the attitude is carried "
+                f"from face to face as a quaternion); got propagation={values['propagation']!r}: "
+                "set tilt_axes='body' for the Euler-rate propagation"
+            )
 
     def _configure(self) -> None:
         p = self._params
@@ -225,6 +259,7 @@ class AngleBiasKalmanFilter(Estimator):
             float(p["gyro_psd"]),
         )
         self._quaternion: bool = p["propagation"] == "quaternion"
+        self._faces: bool = p["tilt_axes"] == "nearest_face"
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
         # any real-sensor option on (else the papers' filter: the short path of _advance)
         self._options = self._quaternion or self._acc_tau > 0.0 or float(p["rest_time"]) > 0.0
@@ -243,8 +278,15 @@ class AngleBiasKalmanFilter(Estimator):
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
+        self.face = 0  # index into FACES of the filters' frame (tilt_axes); 0: the sensor's own
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
+        if self._faces:
+            self.face = nearest_face(ax, ay, az)
+            if self.face:
+                C = FACES[self.face]
+                ax, ay, az = mat_vec(C, (ax, ay, az))
+                gx, gy, gz = mat_vec(C, (gx, gy, gz))
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
         self.acc_f = (ax, ay, az)
         self.rest = (gx, gy, gz, ax, ay, az, 0.0)
@@ -261,7 +303,18 @@ class AngleBiasKalmanFilter(Estimator):
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
         if self._options:
-            self._update_with_options(ax, ay, az, gx, gy, gz, dt)
+            face = self.face
+            prev = self.gyro_prev
+            if face:  # into the face frame (tilt_axes)
+                C = FACES[face]
+                ax, ay, az = mat_vec(C, (ax, ay, az))
+                gx, gy, gz = mat_vec(C, (gx, gy, gz))
+                prev = mat_vec(C, prev)
+            self._update_with_options(ax, ay, az, gx, gy, gz, dt, prev)
+            if self._faces and cos(self.roll) * cos(self.pitch) < FACE_SWITCH_COS:
+                self._switch_face()
+            if self.face:
+                return self._estimate()
         else:
             self.propagate(gx, gy, gz, dt)
             low2, high2 = self._gate2
@@ -274,13 +327,15 @@ class AngleBiasKalmanFilter(Estimator):
         )
 
     def _update_with_options(
-        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float,
+        prev: Vec3,
     ) -> None:
-        """One sample with the real-sensor options (see the class docstring)."""
+        """One sample with the real-sensor options (see the class docstring), in the filters'
+        frame; prev is the previous gyro sample in that frame."""
         phi = None
         if self._quaternion or self._acc_tau > 0.0:
             bias = (self.bias_x, self.bias_y, self.bias_z)
-            phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
+            phi = body_rotation(prev, (gx, gy, gz), bias, dt, self._trapezoid)
         self.propagate(gx, gy, gz, dt, phi)
         predicted = (self.roll, self.pitch)
         raw2 = ax * ax + ay * ay + az * az
@@ -391,5 +446,52 @@ class AngleBiasKalmanFilter(Estimator):
             self.pitch, self.bias_y, self.P_pitch, z_y - self.bias_y, r
         )
 
+    def _switch_face(self) -> None:
+        """Move the filters to the face nearest to up (tilt_axes="nearest_face"), once up is more
+        than 60 deg from the current face's z axis (FACE_SWITCH_COS).
+
+        Every state is turned by D = C_new C_old^T, a signed permutation: the attitude (its yaw
+        is free, so it restarts at 0), the biases, the pre-filtered specific force and the rest
+        detector's means. The [angle, bias] covariance of an axis that stays horizontal goes with
+        it; the axis that was vertical brings only its bias variance P_z, with the larger of the
+        two angle variances (no accelerometer update had measured a tilt about it)."""
+        roll, pitch = self.roll, self.pitch
+        cp = cos(pitch)
+        C = FACES[self.face]
+        up = (-sin(pitch), sin(roll) * cp, cos(roll) * cp)
+        new = nearest_face(*mat_t_vec(C, up))
+        if new == self.face:
+            return
+        C2 = FACES[new]
+
+        def turn(v: Vec3) -> Vec3:
+            return mat_vec(C2, mat_t_vec(C, v))
+
+        self.roll, self.pitch = accel_roll_pitch(*turn(up))
+        self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
+        self.bias_x, self.bias_y, self.bias_z = turn((self.bias_x, self.bias_y, self.bias_z))
+        self.acc_f = turn(self.acc_f)
+        r = self.rest
+        self.rest = (*turn((r[0], r[1], r[2])), *turn((r[3], r[4], r[5])), r[6])
+        P_roll, P_pitch, P_z = self.P_roll, self.P_pitch, self.P_z
+        vertical = (max(P_roll[0], P_pitch[0]), 0.0, 0.0, P_z)
+        old = (P_roll, P_pitch, vertical)
+        # the old axis that each new axis is: the nonzero of row k of D
+        source = [j for k in range(3) for j in range(3) if turn_axis(C2, C, k, j) != 0.0]
+        self.P_roll, self.P_pitch = old[source[0]], old[source[1]]
+        self.P_z = old[source[2]][3]
+        self.face = new
+
     def _estimate(self) -> Estimate:
+        if self.face:  # from the face frame back to the sensor's (tilt_axes)
+            C = FACES[self.face]
+            cp = cos(self.pitch)
+            up = mat_t_vec(C, (-sin(self.pitch), sin(self.roll) * cp, cos(self.roll) * cp))
+            roll, pitch = accel_roll_pitch(*up)
+            return Estimate(roll, pitch, mat_t_vec(C, (self.bias_x, self.bias_y, self.bias_z)))
         return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z))
+
+
+def turn_axis(C2: tuple[float, ...], C: tuple[float, ...], k: int, j: int) -> float:
+    """Entry (k, j) of C2 C^T for 3x3 matrices given row by row."""
+    return C2[3 * k] * C[3 * j] + C2[3 * k + 1] * C[3 * j + 1] + C2[3 * k + 2] * C[3 * j + 2]

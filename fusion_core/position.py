@@ -40,7 +40,10 @@ TILT_DEFAULTS = {k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "gat
 rest, where the specific force is gravity alone, so it may trust each sample as the papers do
 (R 0.03 deg^2: it converges within a rest of a fraction of a second); the recommended kf's
 values are for a filter that must trust the accelerometer in motion too."""
-TILT_FIXED = {"propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0}
+TILT_FIXED = {
+    "propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0,
+    "tilt_axes": "body",
+}
 """The tilt stage's other kf options: off. This filter drives the stage step by step (propagate,
 correct_innovation, correct_bias) and does its own rest detection and bias updates."""
 
@@ -483,8 +486,11 @@ class PositionKalmanFilter(Estimator):
         return self._estimate()
 
     def _estimate(self) -> Estimate:
-        t = self.att if self._own_attitude else self.tilt
         x = self._x
-        return tuple_new(ESTIMATE, (
-            t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0), (x[0], x[3], x[6]), (x[1], x[4], x[7])
-        ))
+        if self._own_attitude:  # the attitude kf's own output (in the sensor frame)
+            a = self.att.last
+            roll, pitch, bias = a[0], a[1], a[2]
+        else:
+            t = self.tilt
+            roll, pitch, bias = t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0)
+        return tuple_new(ESTIMATE, (roll, pitch, bias, (x[0], x[3], x[6]), (x[1], x[4], x[7])))

@@ -47,7 +47,8 @@ w0 = 0.05."""
 PAPER_KF: dict[str, Any] = {
     "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
     "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "init_bias_std": 0.0, "bias_gate": 0.0, "propagation": "euler", "gyro_sampling": "mean",
+    "init_bias_std": 0.0, "bias_gate": 0.0, "propagation": "euler", "tilt_axes": "body",
+    "gyro_sampling": "mean",
 }
 """Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
 (times (pi/180)^2 here), P = 0 at the start, the Euler rates, the rectangle rule."""

@@ -203,7 +203,7 @@ class UnscentedKalmanFilter(Estimator):
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
         """Real-sensor options around the paper's filter (all off by default): the accelerometer
-        pre-filter (acc_lowpass, complementary.ACC_LOWPASS_PARAM: the filter then measures the
+        pre-filter (acc_lowpass, building_blocks.ACC_LOWPASS_PARAM: the filter then measures the
         low-passed specific force) and, at rest, a zero-rate update of the bias states."""
         p = self._params
         lo, hi = self._bias_band2

@@ -82,9 +82,11 @@ def test_max_dt_follows_set_param_and_set_state(key: str) -> None:
 def test_kalman_snapshot_with_two_covariances_follows_each_axis(params: dict) -> None:
     """The roll and pitch filters share one covariance; a snapshot holding two different ones
     (no filter makes one, but set_state takes it) is followed axis by axis: each covariance and
-    gain as a filter whose two axes both started from it."""
+    gain as a filter whose two axes both started from it (on the sensor's own axes, tilt_axes
+    'body': a change of face, which depends on both angles, would mix them)."""
     rec = noisy_two_axis_recording(3.0)
     acc, gyro, dt = rec["acc_meas"], rec["gyro_meas"], rec["dt"]
+    params = {**params, "tilt_axes": "body"}
     base = make("kf", **params)
     base.run(acc[:100], gyro[:100], dt[:100])
     snapshot = base.get_state()

@@ -3,11 +3,12 @@
 Implements the position Kalman filter of Safitri, Cahyadi, Firmansyah, eq. 20-29 (per axis a
 [p, v, a] state with white-jerk process noise, the accelerometer observing a), with the tilt
 from the [angle, bias] Kalman filter of Gui, Tang, Mukhopadhyay (2015) and a zero-velocity
-update at rest. Outputs pos_x..z and vel_x..z besides the attitude; bias_z is always 0.
+update at rest. Outputs pos_x..z and vel_x..z besides the attitude and the gyro bias, which
+are the [angle, bias] Kalman filter's.
 """
 
 import fusion_core
-from fmu_src.estimator import NO_Z_BIAS_OUTPUT, EstimatorSlave
+from fmu_src.estimator import Z_BIAS_AT_REST_ONLY, EstimatorSlave
 
 
 class PositionKalmanFilter(EstimatorSlave):
@@ -19,4 +20,4 @@ class PositionKalmanFilter(EstimatorSlave):
         "Firmansyah, eq. 20-29; tilt from the Gui, Tang, Mukhopadhyay (2015) [angle, bias] "
         "Kalman filter. One IMU sample per doStep."
     )
-    zero_bias = NO_Z_BIAS_OUTPUT
+    zero_bias = Z_BIAS_AT_REST_ONLY
