@@ -18,6 +18,7 @@ import dataclasses
 import json
 import os
 from collections.abc import Mapping
+from functools import partial
 from operator import itemgetter
 from pathlib import Path
 from types import MappingProxyType
@@ -34,6 +35,7 @@ from .variables import (
     parameter_variable,
     real_input,
     real_output,
+    variable_table,
 )
 
 AXES = ("x", "y", "z")
@@ -240,7 +242,9 @@ class EstimatorSlave(FmuSlave):
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         if "estimator" in cls.__dict__:
-            cls.VARIABLES = estimator_variables(cls.estimator, cls.zero_bias)
+            cls.VARIABLES = variable_table(
+                cls.estimator.__name__, partial(estimator_variables, cls.estimator, cls.zero_bias)
+            )
 
     def start_values(self) -> dict[str, Any]:
         """The preset this FMU was built with (preset_starts), in FMI form: read per instance

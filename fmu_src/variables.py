@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -174,3 +175,19 @@ def parameter_variable(param: Any) -> Variable:
     how = "tunable while running" if param.tunable else "fixed after initialisation"
     text = f"{param.description.rstrip('.')}. Allowed: {var.allowed()}; default {default!r}; {how}"
     return dataclasses.replace(var, description=text)
+
+
+_TABLES: dict[str, tuple[Variable, ...]] = {}
+
+
+def variable_table(key: str, build: Callable[[], tuple[Variable, ...]]) -> tuple[Variable, ...]:
+    """The variable table of the FMU model `key`, built by build() the first time only.
+
+    pythonfmu re-executes a slave module's source for every instantiation, and the slave's
+    globals are kept alive (slave.FmuSlave.__init_subclass__): a table built in the class body
+    would be built, and kept, once per instance (about 20 kB each). This module is imported
+    once, so the table is built once per process and every re-executed class shares it."""
+    table = _TABLES.get(key)
+    if table is None:
+        table = _TABLES[key] = build()
+    return table

@@ -7,6 +7,7 @@ import os
 
 import numpy as np
 import pytest
+from conftest import ESTIMATOR_FMUS
 
 from fmu_src.host import FmuInstance
 from fusion_core import synthetic
@@ -97,4 +98,32 @@ def test_instantiate_free_cycles_do_not_grow_memory(built_fmus, tmp_path):
     gc.collect()
     growth = resident_bytes() - before
     print(f"RSS growth over {MEMORY_CYCLES} instantiate/free cycles: {growth / 2**20:.2f} MiB")
+    assert growth < MEMORY_LIMIT
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [*ESTIMATOR_FMUS, "ImuPlant", "ImuSensor"])
+def test_200_instantiate_free_cycles_of_each_fmu_grow_its_memory_by_less_than_5_mb(
+    built_fmus, tmp_path, name: str
+) -> None:
+    """Each FMU on its own: MEMORY_CYCLES instantiate / initialise / 10 doSteps / terminate /
+    free cycles in one process (the FMU extracted once, as an importer caches it)."""
+    from fmpy import extract
+
+    unzip = extract(str(built_fmus.path(name)), str(tmp_path / name))
+
+    def cycle(i: int) -> None:
+        with FmuInstance(built_fmus.path(name), f"cycle{i}", unzip_dir=unzip) as fmu:
+            for k in range(10):
+                fmu.fmu.doStep(k * 0.01, 0.01)
+
+    for i in range(10):  # warm-up: imports, first-time allocations
+        cycle(i)
+    gc.collect()
+    before = resident_bytes()
+    for i in range(MEMORY_CYCLES):
+        cycle(i)
+    gc.collect()
+    growth = resident_bytes() - before
+    print(f"{name}: RSS growth over {MEMORY_CYCLES} cycles: {growth / 2**20:.2f} MiB")
     assert growth < MEMORY_LIMIT

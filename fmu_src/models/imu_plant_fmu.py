@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from fmu_src.slave import FmiLog, FmuSlave
-from fmu_src.variables import Variable, real_output
+from fmu_src.variables import Variable, real_output, variable_table
 from fusion_core.scenarios import SCENARIO_BY_ID, SCENARIOS, get_scenario
 from fusion_core.synthetic import TRUTH_NAMES, Trajectory
 
@@ -65,12 +65,12 @@ class ImuPlant(FmuSlave):
         "seed papers: Gui et al. and Duong Quoc et al. (tilt, two-axis, moderate dynamics), "
         "Das & Mary (vibration), Safitri et al. (2 m translation)."
     )
-    VARIABLES = (
+    VARIABLES = variable_table("ImuPlant", lambda: (
         Variable("scenario", "parameter", "Integer", f"Motion: {_ENUM}", 0,
                  variability="fixed", low=min(SCENARIO_BY_ID), high=max(SCENARIO_BY_ID)),
         *(real_output(name, unit, text + "; the value at the end of the last step", _START[name],
                       display) for name, unit, display, text in _OUTPUTS),
-    )
+    ))
 
     def create_model(self, params: dict[str, Any]) -> PlantModel:
         return PlantModel(params)

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from fmu_src.slave import FmiLog, FmuSlave
-from fmu_src.variables import parameter_variable, real_input, real_output
+from fmu_src.variables import parameter_variable, real_input, real_output, variable_table
 from fusion_core import G
 from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
 
@@ -56,7 +56,7 @@ class ImuSensor(FmuSlave):
         "seeded. One sample per doStep; gyro_sampling says whether the gyro sample is a point "
         "value or an interval mean."
     )
-    VARIABLES = (
+    VARIABLES = variable_table("ImuSensor", lambda: (
         *(real_input(f"omega_{a}", "rad/s", f"True body angular rate about {_AXIS[a]}",
                      display_unit="deg/s") for a in "xyz"),
         *(real_input(f"f_{a}", "m/s2", f"True specific force along body {_AXIS[a]}",
@@ -71,7 +71,7 @@ class ImuSensor(FmuSlave):
                       "at the last sample (truth for the estimators' bias outputs)", 0.0,
                       "deg/s") for a in "xyz"),
         *(parameter_variable(p) for p in SENSOR_PARAMS),
-    )
+    ))
 
     def create_model(self, params: dict[str, Any]) -> SensorModel:
         return SensorModel(params)
