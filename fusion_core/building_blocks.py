@@ -224,10 +224,12 @@ def rest_step(
     fy += k * (ay - fy)
     fz += k * (az - fz)
     th_g2 = th_gyro * th_gyro
+    dx, dy, dz = gx - wx, gy - wy, gz - wz
+    ex, ey, ez = ax - fx, ay - fy, az - fz
     still = (
-        (gx - wx) ** 2 + (gy - wy) ** 2 + (gz - wz) ** 2 < th_g2
+        dx * dx + dy * dy + dz * dz < th_g2
         and wx * wx + wy * wy + wz * wz < th_g2
-        and (ax - fx) ** 2 + (ay - fy) ** 2 + (az - fz) ** 2 < th_acc * th_acc
+        and ex * ex + ey * ey + ez * ez < th_acc * th_acc
     )
     return wx, wy, wz, fx, fy, fz, (quiet + dt if still else 0.0)
 
