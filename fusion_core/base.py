@@ -65,6 +65,8 @@ MAX_ACC_NORM: Final = 1000.0 * G
 like a sample in free fall: far beyond any MEMS accelerometer's range (+-16 g for the MPU-6050,
 +-200 g for high-g parts such as the ADXL375), and too large to filter without overflow. The
 gyro of such a sample is still integrated."""
+BACKENDS: Final = ("auto", "python", "native")
+"""Estimator.run's backends."""
 RUN_CHUNK: Final = 1024
 """Samples that run() converts to Python floats and collects at a time."""
 _MIN_INIT_NORM2: Final = MIN_INIT_NORM * MIN_INIT_NORM
@@ -297,12 +299,21 @@ class Estimator:
         acc: np.ndarray,
         gyro: np.ndarray,
         dt: np.ndarray | float,
+        backend: str = "auto",
     ) -> dict[str, np.ndarray]:
         """Run over N samples: acc, gyro [N, 3], dt [N] or a scalar.
 
         Returns numpy arrays roll, pitch [N], bias [N, 3], rejected [N] (bool) and, for the
         position filter, pos and vel [N, 3]. A rejected sample repeats the last estimate.
+
+        backend: "python" (this class), "native" (its C twin, fusion_core.native; ValueError
+        where there is none or it is not available, saying why) or "auto" (the C twin where
+        there is one and it is available, else Python). Either way the outputs and the state
+        the filter is left in are the same (to 1e-12), so a run may continue with step().
         """
+        if backend not in BACKENDS:
+            raise ValueError(f"backend={backend!r} is not allowed: expected one of "
+                             f"{', '.join(repr(b) for b in BACKENDS)}")
         acc = np.asarray(acc, dtype=float)
         gyro = np.asarray(gyro, dtype=float)
         if acc.ndim != 2 or acc.shape[1] != 3 or gyro.shape != acc.shape:
@@ -311,6 +322,16 @@ class Estimator:
             )
         n = acc.shape[0]
         dts = np.broadcast_to(np.asarray(dt, dtype=float), (n,))
+        if backend != "python":
+            from . import native
+
+            if native.has_twin(self) and native.available():
+                return native.run(self, acc, gyro, dts)
+            if backend == "native":
+                why = (f"{type(self).__name__} has no C twin (twins: "
+                       f"{', '.join(native.TWINS)})" if not native.has_twin(self)
+                       else f"the C twin is unavailable: {native.reason()}")
+                raise ValueError(f"backend='native': {why}")
         out = {
             "roll": np.empty(n),
             "pitch": np.empty(n),

@@ -1,0 +1,258 @@
+"""fusion_core's C twin: the same estimators in C99, and their Python binding.
+
+The C sources beside this file (fc_core.c, fc_cf.c, ...) are the twins of the Python modules:
+the same names, the same state fields, the same floating-point operations in the same order, libm
+where Python calls math, compiled without fused multiply-add or fast-math, so that a run through
+either gives the same numbers (tests/test_native.py: within 1e-12, in practice bit for bit). They
+need libc and libm only, so the very same files go into the native FMUs and onto a
+microcontroller.
+
+This module builds them into a shared library with the C compiler it finds (CC, else cc; cached
+under build/native/ in a source checkout, else ~/.cache/imu-fusion-fmu/native, keyed on the
+sources and the flags) and binds it with cffi. `available()` says whether that worked and
+`reason()` why not; where it did not, every estimator still runs in Python. `Estimator.run(...,
+backend="auto")` uses the native twin where there is one and it is available.
+
+By hand, the library is one command:
+
+    cc -std=c99 -O2 -fPIC -shared -ffp-contract=off -fno-fast-math \\
+        -o libfusion_core.so fusion_core/native/*.c -lm
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+SOURCES = ("fc_core.c", "fc_cf.c", "fc_kf.c")
+"""The C sources, in link order."""
+HEADERS = ("fc_core.h", "fc_params.h", "fc_cf.h", "fc_kf.h")
+"""The headers, in the order the binding declares them."""
+CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
+"""No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
+Python's does, which is what makes the twins equal."""
+TWINS = {"ComplementaryFilter": "fc_cf", "AngleBiasKalmanFilter": "fc_kf"}
+"""The estimators that have a C twin, by class name, and the twin's C prefix."""
+ESTIMATE_FIELDS = 11
+"""Doubles per fc_estimate: roll, pitch, bias[3], pos[3], vel[3]."""
+BASE_STATE = ("initialized", "n_samples", "n_rejected", "gyro_prev")
+RUN_CHUNK = 1024
+"""Samples per call of the C batch run (base.RUN_CHUNK)."""
+"""Estimator._BASE_STATE: these live in the twin's `base` member."""
+
+_lib: Any = None
+_ffi: Any = None
+_reason: str | None = "not loaded yet"
+_tried = False
+
+
+def cache_dir() -> Path:
+    """Where the built library is kept: FUSION_CORE_NATIVE_CACHE, else build/native in a source
+    checkout, else the user's cache folder."""
+    env = os.environ.get("FUSION_CORE_NATIVE_CACHE")
+    if env:
+        return Path(env)
+    repo = HERE.parents[1]
+    if (repo / "pyproject.toml").is_file():
+        return repo / "build" / "native"
+    return Path.home() / ".cache" / "imu-fusion-fmu" / "native"
+
+
+def compiler() -> str | None:
+    """The C compiler to build with: $CC, else cc, gcc or clang on the PATH."""
+    cc = os.environ.get("CC")
+    if cc:
+        return shutil.which(cc)
+    for name in ("cc", "gcc", "clang"):
+        found = shutil.which(name)
+        if found:
+            return found
+    return None
+
+
+def _key(cc: str) -> str:
+    h = hashlib.sha256()
+    for name in (*SOURCES, *HEADERS):
+        h.update(name.encode() + b"\0" + (HERE / name).read_bytes())
+    h.update(" ".join((cc, *CFLAGS)).encode())
+    return h.hexdigest()[:16]
+
+
+def build(force: bool = False) -> Path:
+    """Compile the library (unless cached) and return its path; RuntimeError saying why not."""
+    cc = compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler found (set CC, or install cc, gcc or clang)")
+    target = cache_dir() / _key(cc) / "libfusion_core.so"
+    if target.is_file() and not force:
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
+    os.close(fd)
+    cmd = [cc, *CFLAGS, "-o", tmp, *(str(HERE / s) for s in SOURCES), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        os.unlink(tmp)
+        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-10:])
+        raise RuntimeError(f"building the C twin failed ({' '.join(cmd)}):\n{tail}")
+    os.replace(tmp, target)  # atomic: a parallel build never sees half a library
+    return target
+
+
+def cdef() -> str:
+    """The headers as cffi declarations: comments, include guards, #includes and the static
+    inline default functions left out; integer #defines kept."""
+    out = []
+    for name in HEADERS:
+        text = re.sub(r"/\*.*?\*/", "", (HERE / name).read_text(), flags=re.S)
+        text = re.sub(r"static inline[^{]*\{.*?\n\}\n", "", text, flags=re.S)
+        for line in text.splitlines():
+            if line.startswith("#") and not re.match(r"#define \w+ -?\d+$", line):
+                continue
+            out.append(line)
+    return "\n".join(out)
+
+
+def _load() -> None:
+    global _lib, _ffi, _reason, _tried
+    _tried = True
+    try:
+        import cffi  # type: ignore[import-untyped]
+    except ImportError as err:
+        _reason = f"cffi is not installed ({err})"
+        return
+    try:
+        path = build()
+        ffi = cffi.FFI()
+        ffi.cdef(cdef())
+        _lib = ffi.dlopen(str(path))
+        _ffi = ffi
+        _reason = None
+    except (RuntimeError, OSError, cffi.CDefError, cffi.FFIError) as err:
+        _reason = str(err)
+
+
+def available() -> bool:
+    """Whether the C twin is built and loaded (building it on first use)."""
+    if not _tried:
+        _load()
+    return _lib is not None
+
+
+def reason() -> str | None:
+    """Why the C twin is not available (no compiler, build failed, ...); None when it is."""
+    available()
+    return _reason
+
+
+def lib_and_ffi() -> tuple[Any, Any]:
+    """The loaded library and its cffi FFI; RuntimeError with the reason where unavailable."""
+    if not available():
+        raise RuntimeError(f"the native backend is unavailable: {reason()}")
+    return _lib, _ffi
+
+
+def has_twin(estimator: object) -> bool:
+    """Whether this estimator's exact class has a C twin (a subclass may change its Python
+    methods, so it never runs natively)."""
+    return type(estimator).__name__ in TWINS and type(estimator).__module__.startswith(
+        "fusion_core.")
+
+
+# ----- an estimator's state and parameters, both ways ------------------------------------------
+def _field_value(cdata: Any, name: str, template: Any) -> Any:
+    value = getattr(cdata, name)
+    if isinstance(template, tuple):
+        return tuple(float(value[i]) for i in range(len(template)))
+    if isinstance(template, bool):
+        return bool(value)
+    if isinstance(template, int):
+        return int(value)
+    return float(value)
+
+
+def _set_field(cdata: Any, name: str, value: Any) -> None:
+    if isinstance(value, tuple):
+        arr = getattr(cdata, name)
+        for i, v in enumerate(value):
+            arr[i] = v
+    else:
+        setattr(cdata, name, value)
+
+
+def new_twin(estimator: Any) -> Any:
+    """A C twin holding the estimator's parameters and its whole state."""
+    lib, ffi = lib_and_ffi()
+    prefix = TWINS[type(estimator).__name__]
+    twin = ffi.new(f"{prefix} *")
+    params = ffi.new(f"{prefix}_params *")
+    specs = estimator.param_specs()
+    for name, value in estimator.params.items():
+        choices = specs[name].choices
+        setattr(params, name, choices.index(value) if choices is not None else value)
+    getattr(lib, f"{prefix}_init")(twin, params)
+    for name in BASE_STATE:
+        _set_field(twin.base, name, getattr(estimator, name))
+    for name in estimator.STATE:
+        _set_field(twin, name, getattr(estimator, name))
+    twin.last = getattr(lib, f"{prefix}_estimate")(twin)
+    return twin
+
+
+def take_state(estimator: Any, twin: Any) -> None:
+    """Copy the twin's state into the Python estimator (which continues from it exactly)."""
+    for name in BASE_STATE:
+        setattr(estimator, name, _field_value(twin.base, name, getattr(estimator, name)))
+    for name in estimator.STATE:
+        setattr(estimator, name, _field_value(twin, name, getattr(estimator, name)))
+    estimator.last = estimator._estimate()
+
+
+def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
+        ) -> dict[str, np.ndarray]:
+    """Estimator.run through the C twin: the same outputs, and the estimator's state afterwards
+    is the one the Python run would leave. The samples go through in chunks of RUN_CHUNK, so
+    that, as in the Python run, memory beyond the outputs does not grow with N."""
+    lib, ffi = lib_and_ffi()
+    twin = new_twin(estimator)
+    run_twin = getattr(lib, f"{TWINS[type(estimator).__name__]}_run")
+    n = acc.shape[0]
+    out = {"roll": np.empty(n), "pitch": np.empty(n), "bias": np.empty((n, 3)),
+           "rejected": np.zeros(n, dtype=bool)}
+    if estimator.HAS_POSITION:
+        out["pos"] = np.empty((n, 3))
+        out["vel"] = np.empty((n, 3))
+    est = np.zeros((RUN_CHUNK, ESTIMATE_FIELDS))
+    rejected = np.zeros(RUN_CHUNK, dtype=np.uint8)
+    est_p = ffi.cast("fc_estimate *", ffi.from_buffer(est, require_writable=True))
+    rejected_p = ffi.cast("unsigned char *", ffi.from_buffer(rejected, require_writable=True))
+    for lo in range(0, n, RUN_CHUNK):
+        hi = min(lo + RUN_CHUNK, n)
+        a = np.ascontiguousarray(acc[lo:hi], dtype=np.float64)
+        g = np.ascontiguousarray(gyro[lo:hi], dtype=np.float64)
+        h = np.ascontiguousarray(dt[lo:hi], dtype=np.float64)
+        run_twin(twin, hi - lo, ffi.cast("double *", ffi.from_buffer(a)),
+                 ffi.cast("double *", ffi.from_buffer(g)),
+                 ffi.cast("double *", ffi.from_buffer(h)), est_p, rejected_p)
+        k = hi - lo
+        out["roll"][lo:hi] = est[:k, 0]
+        out["pitch"][lo:hi] = est[:k, 1]
+        out["bias"][lo:hi] = est[:k, 2:5]
+        out["rejected"][lo:hi] = rejected[:k] != 0
+        if estimator.HAS_POSITION:
+            out["pos"][lo:hi] = est[:k, 5:8]
+            out["vel"][lo:hi] = est[:k, 8:11]
+    take_state(estimator, twin)
+    return out
+
+
+__all__ = ["available", "build", "cache_dir", "compiler", "has_twin", "reason", "run"]

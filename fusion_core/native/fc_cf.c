@@ -1,0 +1,155 @@
+/* fc_cf.c: see fc_cf.h; the twin of fusion_core/complementary.py line by line. */
+#include "fc_cf.h"
+
+#include <string.h>
+
+void fc_cf_configure(fc_cf *f)
+{
+    const fc_cf_params *p = &f->params;
+    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
+                      p->mount_yaw);
+    f->tau = p->tau;
+    fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
+    f->trapezoid = p->gyro_sampling == FC_CF_GYRO_SAMPLING_POINT;
+    f->acc_tau = p->acc_lowpass;
+    f->quaternion = p->propagation == FC_CF_PROPAGATION_QUATERNION;
+    f->rotating = f->quaternion || f->acc_tau > 0.0;
+}
+
+fc_estimate fc_cf_estimate(const fc_cf *f)
+{
+    fc_estimate e;
+    memset(&e, 0, sizeof e);
+    e.roll = f->roll;
+    e.pitch = f->pitch;
+    memcpy(e.bias, f->bias, sizeof e.bias);
+    return e;
+}
+
+void fc_cf_reset(fc_cf *f)
+{
+    fc_base_reset(&f->base);
+    f->roll = f->pitch = 0.0;
+    memset(f->acc_f, 0, sizeof f->acc_f);
+    f->q_att[0] = 1.0;
+    f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
+    memset(f->bias, 0, sizeof f->bias);
+    memset(f->rest, 0, sizeof f->rest);
+    f->last = fc_cf_estimate(f);
+}
+
+void fc_cf_init(fc_cf *f, const fc_cf_params *params)
+{
+    if (params) {
+        f->params = *params;
+    } else {
+        fc_cf_params_default(&f->params);
+    }
+    fc_cf_configure(f);
+    fc_cf_reset(f);
+}
+
+static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _init */
+{
+    fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
+    memcpy(f->acc_f, a, sizeof f->acc_f);
+    fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
+    f->rest[0] = g[0];
+    f->rest[1] = g[1];
+    f->rest[2] = g[2];
+    f->rest[3] = a[0];
+    f->rest[4] = a[1];
+    f->rest[5] = a[2];
+    f->rest[6] = 0.0;
+}
+
+static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt)  /* _advance */
+{
+    const fc_cf_params *p = &f->params;
+    double a[3] = {a_in[0], a_in[1], a_in[2]};
+    double rest_time = p->rest_time;
+    double roll, pitch, phi[3];
+    if (rest_time > 0.0) {
+        fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, p->rest_gyro,
+                     p->rest_acc);
+        if (f->rest[6] >= rest_time) {
+            fc_bias_at_rest(f->bias, g[0], g[1], g[2], dt, rest_time);
+        }
+    }
+    double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
+    if (f->rotating) {
+        fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+        if (f->acc_tau > 0.0) {
+            fc_lowpass_specific_force(f->acc_f, phi, a, dt, f->acc_tau);
+            memcpy(a, f->acc_f, sizeof a);
+        }
+    }
+    if (f->quaternion) {
+        fc_quat_mul_rotvec(f->q_att, phi[0], phi[1], phi[2]);
+        fc_quat_roll_pitch(f->q_att, &roll, &pitch);
+    } else if (f->trapezoid) {
+        const double *w0 = f->base.gyro_prev;
+        fc_heun_euler_step(f->roll, f->pitch, w0[0] - bx, w0[1] - by, w0[2] - bz, g[0] - bx,
+                           g[1] - by, g[2] - bz, dt, &roll, &pitch);
+    } else {
+        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2] - bz, dt, &roll, &pitch);
+    }
+    double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
+        double acc_roll, acc_pitch;
+        fc_accel_roll_pitch(a[0], a[1], a[2], &acc_roll, &acc_pitch);
+        double k = dt / (f->tau + dt);  /* 1 - a, Gui et al. eq. 2 */
+        double y = acc_roll - roll;
+        roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
+        pitch += k * (acc_pitch - pitch);
+        if (f->quaternion) {
+            fc_quat_with_roll_pitch(f->q_att, roll, pitch);
+        }
+    }
+    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+}
+
+fc_status fc_cf_step(fc_cf *f, const double acc[3], const double gyro[3], double dt,
+                     fc_estimate *out)
+{
+    double a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
+    fc_status status = fc_base_prepare(&f->base, a, g, dt);
+    if (status != FC_OK) {
+        return status;
+    }
+    if (f->base.initialized) {
+        advance(f, a, g, dt);
+    } else if (fc_base_can_init(a)) {
+        first_sample(f, a, g);
+        f->base.initialized = 1;
+    } else {
+        if (out) {
+            *out = f->last;
+        }
+        return FC_SKIPPED;
+    }
+    f->last = fc_cf_estimate(f);
+    memcpy(f->base.gyro_prev, g, sizeof g);
+    f->base.n_samples += 1;
+    if (out) {
+        *out = f->last;
+    }
+    return FC_OK;
+}
+
+long fc_cf_run(fc_cf *f, long n, const double *acc, const double *gyro, const double *dt,
+               fc_estimate *out, unsigned char *rejected)
+{
+    long bad = 0;
+    for (long i = 0; i < n; i++) {
+        fc_status s = fc_cf_step(f, acc + 3 * i, gyro + 3 * i, dt[i], out + i);
+        rejected[i] = s > FC_SKIPPED;
+        if (rejected[i]) {
+            f->base.n_rejected += 1;
+            out[i] = f->last;
+            bad++;
+        }
+    }
+    return bad;
+}

@@ -1,0 +1,42 @@
+/* fc_cf.h: the complementary filter (fusion_core/complementary.py, ComplementaryFilter), the
+ * C twin. Gui et al. 2015 eq. 1-2, Das & Mary eq. 1; the options for real sensors as in the
+ * Python class's docstring. */
+#ifndef FC_CF_H
+#define FC_CF_H
+
+#include "fc_core.h"
+#include "fc_params.h"
+
+typedef struct fc_cf {
+    fc_cf_params params;
+    fc_base base;
+    /* ComplementaryFilter.STATE */
+    double roll, pitch;
+    double acc_f[3];
+    double q_att[4];
+    double bias[3];
+    double rest[7];
+    fc_estimate last;
+    /* derived from params (ComplementaryFilter._configure) */
+    double tau, gate_low2, gate_high2, acc_tau;
+    int trapezoid, quaternion, rotating;
+} fc_cf;
+
+/* params (NULL: the defaults) in, a filter waiting for its first sample out. */
+void fc_cf_init(fc_cf *f, const fc_cf_params *params);
+/* Take a change of f->params (the state is kept). */
+void fc_cf_configure(fc_cf *f);
+/* Forget every sample. */
+void fc_cf_reset(fc_cf *f);
+/* One sample: acc [m/s^2], gyro [rad/s], dt [s]. FC_OK or FC_SKIPPED: *out is the estimate
+ * (the last one when skipped); a rejection leaves the filter and *out as they were. */
+fc_status fc_cf_step(fc_cf *f, const double acc[3], const double gyro[3], double dt,
+                     fc_estimate *out);
+/* n samples (acc, gyro row-major [n][3], dt [n]): out[i] the estimate after sample i (the last
+ * one for a rejected sample, rejected[i] = 1, counted in n_rejected). Returns the number of
+ * rejected samples. */
+long fc_cf_run(fc_cf *f, long n, const double *acc, const double *gyro, const double *dt,
+               fc_estimate *out, unsigned char *rejected);
+fc_estimate fc_cf_estimate(const fc_cf *f);
+
+#endif /* FC_CF_H */

@@ -1,0 +1,360 @@
+/* fc_core.c: see fc_core.h. Each function names its Python twin; the operations are the
+ * twin's, in its order. */
+#include "fc_core.h"
+
+#include <math.h>
+
+#define MIN_COS_PITCH 1e-9   /* kinematics._MIN_COS_PITCH */
+#define SMALL_ANGLE 1e-8     /* kinematics._SMALL_ANGLE */
+
+/* ----- kinematics.py ----------------------------------------------------------------------- */
+
+double fc_wrap_angle(double x)  /* wrap_angle */
+{
+    return remainder(x, FC_TWO_PI);
+}
+
+double fc_clamp_pitch(double theta)  /* clamp_pitch */
+{
+    theta = theta < FC_HALF_PI ? theta : FC_HALF_PI;
+    return theta > -FC_HALF_PI ? theta : -FC_HALF_PI;
+}
+
+void fc_accel_roll_pitch(double ax, double ay, double az, double *roll, double *pitch)
+{
+    *roll = atan2(ay, az);
+    *pitch = atan2(-ax, sqrt(ay * ay + az * az));
+}
+
+/* euler_rates (with the cos(pitch) guard of heun_euler_step) */
+static void euler_rates(double phi, double theta, double p, double q, double r, double *dphi,
+                        double *dtheta)
+{
+    double sp = sin(phi), cp = cos(phi), ct = cos(theta);
+    if (-MIN_COS_PITCH < ct && ct < MIN_COS_PITCH) {
+        ct = copysign(MIN_COS_PITCH, ct);
+    }
+    *dphi = p + (q * sp + r * cp) * sin(theta) / ct;
+    *dtheta = q * cp - r * sp;
+}
+
+void fc_euler_step(double phi, double theta, double p, double q, double r, double dt,
+                   double *phi_out, double *theta_out)
+{
+    double dp, dtheta;
+    euler_rates(phi, theta, p, q, r, &dp, &dtheta);
+    *phi_out = phi + dt * dp;
+    *theta_out = theta + dt * dtheta;
+}
+
+void fc_heun_euler_step(double phi, double theta, double p0, double q0, double r0, double p1,
+                        double q1, double r1, double dt, double *phi_out, double *theta_out)
+{
+    double d1p, d1t, d2p, d2t;
+    euler_rates(phi, theta, p0, q0, r0, &d1p, &d1t);
+    double phi1 = phi + dt * d1p, theta1 = theta + dt * d1t;
+    euler_rates(phi1, theta1, p1, q1, r1, &d2p, &d2t);
+    *phi_out = phi + 0.5 * dt * (d1p + d2p);
+    *theta_out = theta + 0.5 * dt * (d1t + d2t);
+}
+
+void fc_quat_from_roll_pitch_yaw(double phi, double theta, double psi, double q[4])
+{
+    double cr = cos(0.5 * phi), sr = sin(0.5 * phi);
+    double cp = cos(0.5 * theta), sp = sin(0.5 * theta);
+    double cy = cos(0.5 * psi), sy = sin(0.5 * psi);
+    q[0] = cr * cp * cy + sr * sp * sy;
+    q[1] = sr * cp * cy - cr * sp * sy;
+    q[2] = cr * sp * cy + sr * cp * sy;
+    q[3] = cr * cp * sy - sr * sp * cy;
+}
+
+void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch)
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    *roll = atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+    double s = 2.0 * (w * y - x * z);
+    if (!(-1.0 <= s && s <= 1.0)) {
+        s = s < 1.0 ? s : 1.0;     /* max(-1, min(1, s)) */
+        s = -1.0 > s ? -1.0 : s;
+    }
+    *pitch = asin(s);
+}
+
+void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    double angle = sqrt(vx * vx + vy * vy + vz * vz);
+    double c, s;
+    if (angle < 1e-8) {
+        c = 1.0 - angle * angle / 8.0;
+        s = 0.5 - angle * angle / 48.0;
+    } else {
+        c = cos(0.5 * angle);
+        s = sin(0.5 * angle) / angle;
+    }
+    double bx = s * vx, by = s * vy, bz = s * vz;
+    double rw = w * c - x * bx - y * by - z * bz;
+    double rx = w * bx + x * c + y * bz - z * by;
+    double ry = w * by - x * bz + y * c + z * bx;
+    double rz = w * bz + x * by - y * bx + z * c;
+    double n = 1.0 / sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
+    q[0] = rw * n;
+    q[1] = rx * n;
+    q[2] = ry * n;
+    q[3] = rz * n;
+}
+
+void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
+                           double dt, double phi[3])
+{
+    double a0 = p0 * dt, a1 = q0 * dt, a2 = r0 * dt;
+    double b0 = p1 * dt, b1 = q1 * dt, b2 = r1 * dt;
+    double k = 1.0 / 12.0;
+    phi[0] = 0.5 * (a0 + b0) + k * (a1 * b2 - a2 * b1);
+    phi[1] = 0.5 * (a1 + b1) + k * (a2 * b0 - a0 * b2);
+    phi[2] = 0.5 * (a2 + b2) + k * (a0 * b1 - a1 * b0);
+}
+
+void fc_rotate_back(const double v[3], const double phi[3], double out[3])
+{
+    double p0 = phi[0], p1 = phi[1], p2 = phi[2];
+    double a2 = p0 * p0 + p1 * p1 + p2 * p2;
+    double a = sqrt(a2);
+    double s, c;
+    if (a < SMALL_ANGLE) {
+        s = 1.0 - a2 / 6.0;
+        c = 0.5 - a2 / 24.0;
+    } else {
+        s = sin(a) / a;
+        c = (1.0 - cos(a)) / a2;
+    }
+    double v0 = v[0], v1 = v[1], v2 = v[2];
+    double u0 = p1 * v2 - p2 * v1, u1 = p2 * v0 - p0 * v2, u2 = p0 * v1 - p1 * v0;
+    out[0] = v0 - s * u0 + c * (p1 * u2 - p2 * u1);
+    out[1] = v1 - s * u1 + c * (p2 * u0 - p0 * u2);
+    out[2] = v2 - s * u2 + c * (p0 * u1 - p1 * u0);
+}
+
+/* ----- building_blocks.py ------------------------------------------------------------------ */
+
+const double FC_FACES[6][9] = {
+    {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0},
+    {1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0},
+    {0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0},
+    {0.0, 1.0, 0.0, 0.0, 0.0, -1.0, -1.0, 0.0, 0.0},
+    {0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0},
+    {0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0},
+};
+
+double fc_quat_yaw(const double q[4])
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+}
+
+void fc_quat_with_roll_pitch(double q[4], double roll, double pitch)
+{
+    fc_quat_from_roll_pitch_yaw(roll, pitch, fc_quat_yaw(q), q);
+}
+
+void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2)
+{
+    *low2 = pow(gate_low * FC_G, 2.0);
+    *high2 = pow(gate_high * FC_G, 2.0);
+}
+
+void fc_body_rotation(const double g0[3], const double g1[3], const double bias[3], double dt,
+                      int trapezoid, double phi[3])
+{
+    double b0 = bias[0], b1 = bias[1], b2 = bias[2];
+    if (trapezoid) {
+        fc_rotation_increment(g0[0] - b0, g0[1] - b1, g0[2] - b2, g1[0] - b0, g1[1] - b1,
+                              g1[2] - b2, dt, phi);
+        return;
+    }
+    phi[0] = (g1[0] - b0) * dt;
+    phi[1] = (g1[1] - b1) * dt;
+    phi[2] = (g1[2] - b2) * dt;
+}
+
+void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
+                               double tau)
+{
+    double t[3];
+    fc_rotate_back(f, phi, t);
+    double k = dt / (tau + dt);
+    f[0] = t[0] + k * (a[0] - t[0]);
+    f[1] = t[1] + k * (a[1] - t[1]);
+    f[2] = t[2] + k * (a[2] - t[2]);
+}
+
+void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,
+                  double az, double dt, double th_gyro, double th_acc)
+{
+    double wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
+    double k = dt / (FC_REST_MEAN_TAU + dt);
+    wx += k * (gx - wx);
+    wy += k * (gy - wy);
+    wz += k * (gz - wz);
+    fx += k * (ax - fx);
+    fy += k * (ay - fy);
+    fz += k * (az - fz);
+    double th_g2 = th_gyro * th_gyro;
+    double dx = gx - wx, dy = gy - wy, dz = gz - wz;
+    double ex = ax - fx, ey = ay - fy, ez = az - fz;
+    int still = dx * dx + dy * dy + dz * dz < th_g2
+        && wx * wx + wy * wy + wz * wz < th_g2
+        && ex * ex + ey * ey + ez * ez < th_acc * th_acc;
+    rest[0] = wx;
+    rest[1] = wy;
+    rest[2] = wz;
+    rest[3] = fx;
+    rest[4] = fy;
+    rest[5] = fz;
+    rest[6] = still ? rest[6] + dt : 0.0;
+}
+
+void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
+                     double rest_time)
+{
+    double k = dt / (rest_time + dt);
+    bias[0] = bias[0] + k * (gx - bias[0]);
+    bias[1] = bias[1] + k * (gy - bias[1]);
+    bias[2] = bias[2] + k * (gz - bias[2]);
+}
+
+void fc_bias_band2(double gate, double *lo, double *hi)
+{
+    if (!(gate > 0.0)) {
+        *lo = -1.0;
+        *hi = HUGE_VAL;
+        return;
+    }
+    double low = 1.0 - gate;
+    *lo = pow((low >= 0.0 ? low : 0.0) * FC_G, 2.0);
+    *hi = pow((1.0 + gate) * FC_G, 2.0);
+}
+
+int fc_nearest_face(double ux, double uy, double uz)
+{
+    double ax = fabs(ux), ay = fabs(uy), az = fabs(uz);
+    if (az >= ax && az >= ay) {
+        return uz >= 0.0 ? 0 : 1;
+    }
+    if (ax >= ay) {
+        return ux > 0.0 ? 2 : 3;
+    }
+    return uy > 0.0 ? 4 : 5;
+}
+
+void fc_mat_vec(const double m[9], const double v[3], double out[3])
+{
+    double x = v[0], y = v[1], z = v[2];
+    out[0] = m[0] * x + m[1] * y + m[2] * z;
+    out[1] = m[3] * x + m[4] * y + m[5] * z;
+    out[2] = m[6] * x + m[7] * y + m[8] * z;
+}
+
+void fc_mat_t_vec(const double m[9], const double v[3], double out[3])
+{
+    double x = v[0], y = v[1], z = v[2];
+    out[0] = m[0] * x + m[3] * y + m[6] * z;
+    out[1] = m[1] * x + m[4] * y + m[7] * z;
+    out[2] = m[2] * x + m[5] * y + m[8] * z;
+}
+
+/* ----- base.py ----------------------------------------------------------------------------- */
+
+#define MAX_ACC_NORM (1000.0 * FC_G)   /* base.MAX_ACC_NORM */
+#define MIN_INIT_NORM (0.1 * FC_G)     /* base.MIN_INIT_NORM */
+
+/* cos and sin of a, exact 0 and +-1 at multiples of pi/2 (mounting_matrix's cs) */
+static void right_angle_cs(double a, double *c, double *s)
+{
+    *c = cos(a);
+    *s = sin(a);
+    double quarter = a / (0.5 * FC_PI);
+    if (fabs(quarter - nearbyint(quarter)) < 1e-12) {
+        *c = nearbyint(*c);
+        *s = nearbyint(*s);
+    }
+}
+
+void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9])
+{
+    double cr, sr, cp, sp, cy, sy;
+    right_angle_cs(roll, &cr, &sr);
+    right_angle_cs(pitch, &cp, &sp);
+    right_angle_cs(yaw, &cy, &sy);
+    m[0] = cy * cp;
+    m[1] = cy * sp * sr - sy * cr;
+    m[2] = cy * sp * cr + sy * sr;
+    m[3] = sy * cp;
+    m[4] = sy * sp * sr + cy * cr;
+    m[5] = sy * sp * cr - cy * sr;
+    m[6] = -sp;
+    m[7] = cp * sr;
+    m[8] = cp * cr;
+}
+
+void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
+                       double mount_pitch, double mount_yaw)
+{
+    static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    b->max_dt = max_dt;
+    b->max_rate = max_rate;
+    b->max_rate2 = pow(max_rate, 2.0);
+    fc_mounting_matrix(mount_roll, mount_pitch, mount_yaw, b->mounting);
+    b->mounted = 0;
+    for (int i = 0; i < 9; i++) {
+        if (b->mounting[i] != identity[i]) {
+            b->mounted = 1;
+        }
+    }
+}
+
+void fc_base_reset(fc_base *b)
+{
+    b->initialized = 0;
+    b->n_samples = 0;
+    b->n_rejected = 0;
+    b->gyro_prev[0] = b->gyro_prev[1] = b->gyro_prev[2] = 0.0;
+}
+
+fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], double dt)
+{
+    double ax = acc[0], ay = acc[1], az = acc[2], gx = gyro[0], gy = gyro[1], gz = gyro[2];
+    double w2 = gx * gx + gy * gy + gz * gz;
+    double total = ax + ay + az + w2 + dt;
+    if (!(total - total == 0.0 && w2 <= b->max_rate2 && 0.0 < dt && dt <= b->max_dt)) {
+        /* Estimator.check_sample: what is wrong (a finite sample whose sum overflowed passes) */
+        if (!isfinite(ax) || !isfinite(ay) || !isfinite(az)) {
+            return FC_BAD_ACC;
+        }
+        if (!isfinite(gx) || !isfinite(gy) || !isfinite(gz)) {
+            return FC_BAD_GYRO;
+        }
+        if (!isfinite(dt) || !(0.0 < dt && dt <= b->max_dt)) {
+            return FC_BAD_DT;
+        }
+        if (!(hypot(hypot(gx, gy), gz) <= b->max_rate)) {
+            return FC_BAD_RATE;
+        }
+    }
+    if (b->mounted) {
+        fc_mat_vec(b->mounting, acc, acc);
+        fc_mat_vec(b->mounting, gyro, gyro);
+    }
+    double norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+    if (!(norm2 <= MAX_ACC_NORM * MAX_ACC_NORM)) {
+        acc[0] = acc[1] = acc[2] = 0.0;
+    }
+    return FC_OK;
+}
+
+int fc_base_can_init(const double acc[3])
+{
+    double norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+    return norm2 >= MIN_INIT_NORM * MIN_INIT_NORM;
+}

@@ -1,0 +1,99 @@
+/* fc_core.h: what every estimator of fusion_core's C twin shares.
+ *
+ * The twin of fusion_core/kinematics.py, fusion_core/building_blocks.py and the sample rules of
+ * fusion_core/base.py (Estimator.step): the same names, the same floating-point operations in
+ * the same order, libm where Python calls math. Compiled without fused multiply-add
+ * (-ffp-contract=off) and without fast-math, every result equals the Python reference's.
+ *
+ * C99, libc and libm only; no globals, no allocation: the same file builds into the Python
+ * binding, the native FMUs and a microcontroller's firmware.
+ */
+#ifndef FC_CORE_H
+#define FC_CORE_H
+
+#include <stddef.h>
+
+#define FC_G 9.80665            /* standard gravity [m/s^2] (fusion_core.types.G) */
+#define FC_PI 3.141592653589793
+#define FC_TWO_PI (2.0 * FC_PI)
+#define FC_HALF_PI (0.5 * FC_PI)
+
+/* What a step did with its sample (fusion_core.base.Estimator.step). */
+typedef enum fc_status {
+    FC_OK = 0,              /* processed */
+    FC_SKIPPED = 1,         /* before the first sample with a gravity direction: waiting */
+    FC_BAD_ACC = 2,         /* rejected: an accelerometer value is NaN or infinite */
+    FC_BAD_GYRO = 3,        /* rejected: a gyro value is NaN or infinite */
+    FC_BAD_DT = 4,          /* rejected: dt is NaN, infinite or outside (0, max_dt] */
+    FC_BAD_RATE = 5         /* rejected: the gyro reading is above max_rate */
+} fc_status;
+
+/* An estimate: roll and pitch [rad], gyro bias [rad/s]; position [m] and velocity [m/s] for the
+ * position filter (0 elsewhere). */
+typedef struct fc_estimate {
+    double roll, pitch;
+    double bias[3];
+    double pos[3];
+    double vel[3];
+} fc_estimate;
+
+/* The state every estimator has (Estimator._BASE_STATE) and the sample rules' constants. */
+typedef struct fc_base {
+    int initialized;
+    long n_samples;
+    long n_rejected;
+    double gyro_prev[3];
+    /* derived from the parameters (Estimator._set_params) */
+    double max_dt, max_rate, max_rate2;
+    double mounting[9];
+    int mounted;
+} fc_base;
+
+/* ----- kinematics.py ----------------------------------------------------------------------- */
+double fc_wrap_angle(double x);
+double fc_clamp_pitch(double theta);
+void fc_accel_roll_pitch(double ax, double ay, double az, double *roll, double *pitch);
+void fc_euler_step(double phi, double theta, double p, double q, double r, double dt,
+                   double *phi_out, double *theta_out);
+void fc_heun_euler_step(double phi, double theta, double p0, double q0, double r0, double p1,
+                        double q1, double r1, double dt, double *phi_out, double *theta_out);
+void fc_quat_from_roll_pitch_yaw(double phi, double theta, double psi, double q[4]);
+void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch);
+void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz);
+void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
+                           double dt, double phi[3]);
+void fc_rotate_back(const double v[3], const double phi[3], double out[3]);
+
+/* ----- building_blocks.py ------------------------------------------------------------------ */
+#define FC_REST_MEAN_TAU 0.5
+#define FC_FACE_SWITCH_COS 0.5
+extern const double FC_FACES[6][9];
+double fc_quat_yaw(const double q[4]);
+void fc_quat_with_roll_pitch(double q[4], double roll, double pitch);
+void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2);
+void fc_body_rotation(const double g0[3], const double g1[3], const double bias[3], double dt,
+                      int trapezoid, double phi[3]);
+void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
+                               double tau);
+void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,
+                  double az, double dt, double th_gyro, double th_acc);
+void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
+                     double rest_time);
+void fc_bias_band2(double gate, double *lo, double *hi);
+int fc_nearest_face(double ux, double uy, double uz);
+void fc_mat_vec(const double m[9], const double v[3], double out[3]);
+void fc_mat_t_vec(const double m[9], const double v[3], double out[3]);
+
+/* ----- base.py ----------------------------------------------------------------------------- */
+void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9]);
+void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
+                       double mount_pitch, double mount_yaw);
+void fc_base_reset(fc_base *b);
+/* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
+ * was), turns it into the filter frame (mounting) and takes an absurd accelerometer reading as
+ * none. Returns FC_OK with acc and gyro rewritten in place, or the rejection. */
+fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], double dt);
+/* Whether a prepared sample may initialise the filter (its accelerometer norm >= 0.1 g). */
+int fc_base_can_init(const double acc[3]);
+
+#endif /* FC_CORE_H */

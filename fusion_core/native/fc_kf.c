@@ -1,0 +1,397 @@
+/* fc_kf.c: see fc_kf.h; the twin of fusion_core/kalman.py line by line. */
+#include "fc_kf.h"
+
+#include <math.h>
+#include <string.h>
+
+/* predict_covariance: F P F' + Q (Das & Mary eq. 19-22) */
+static void predict_covariance(const double P[4], double dt, double q_angle, double q_bias,
+                               double out[4])
+{
+    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    out[0] = P00 + dt * (dt * P11 - P01 - P10 + q_angle);
+    out[1] = P01 - dt * P11;
+    out[2] = P10 - dt * P11;
+    out[3] = P11 + q_bias * dt;
+}
+
+/* measurement_gain (Das & Mary eq. 23-27) and angle_only_gain (the bias a consider state) */
+static void gain(const double P[4], double r, int learn_bias, double K[2], double out[4])
+{
+    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    if (learn_bias) {
+        double S = P00 + r;
+        double K0 = P00 / S, K1 = P10 / S;
+        K[0] = K0;
+        K[1] = K1;
+        out[0] = P00 - K0 * P00;
+        out[1] = P01 - K0 * P01;
+        out[2] = P10 - K1 * P00;
+        out[3] = P11 - K1 * P01;
+    } else {
+        double K0 = P00 / (P00 + r);
+        K[0] = K0;
+        K[1] = 0.0;
+        out[0] = P00 - K0 * P00;
+        out[1] = P01 - K0 * P01;
+        out[2] = P10 - K0 * P10;
+        out[3] = P11;
+    }
+}
+
+/* bias_update: a direct bias measurement, H = [0, 1] */
+static void bias_update(double *angle, double *bias, double P[4], double y, double r)
+{
+    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    double S = P11 + r;
+    double K0 = P01 / S, K1 = P11 / S;
+    *angle = *angle + K0 * y;
+    *bias = *bias + K1 * y;
+    P[0] = P00 - K0 * P10;
+    P[1] = P01 - K0 * P11;
+    P[2] = P10 - K1 * P10;
+    P[3] = P11 - K1 * P11;
+}
+
+static int same4(const double a[4], const double b[4])
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] && a[3] == b[3];
+}
+
+void fc_kf_configure(fc_kf *f)
+{
+    const fc_kf_params *p = &f->params;
+    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
+                      p->mount_yaw);
+    f->q_angle = p->Q_angle;
+    f->q_bias = p->Q_bias;
+    f->r = p->R_measure;
+    fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
+    f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
+    f->acc_tau = p->acc_lowpass;
+    f->rest_time = p->rest_time;
+    f->rest_gyro = p->rest_gyro;
+    f->rest_acc = p->rest_acc;
+    f->gyro_var = p->gyro_psd;
+    f->quaternion = p->propagation == FC_KF_PROPAGATION_QUATERNION;
+    f->faces = p->tilt_axes == FC_KF_TILT_AXES_NEAREST_FACE;
+    fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
+    f->options = f->quaternion || f->acc_tau > 0.0 || p->rest_time > 0.0;
+}
+
+fc_estimate fc_kf_estimate(const fc_kf *f)  /* _estimate */
+{
+    fc_estimate e;
+    memset(&e, 0, sizeof e);
+    double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    if (f->face) {  /* from the face frame back to the sensor's (tilt_axes) */
+        const double *C = FC_FACES[f->face];
+        double cp = cos(f->pitch);
+        double v[3] = {-sin(f->pitch), sin(f->roll) * cp, cos(f->roll) * cp}, up[3];
+        fc_mat_t_vec(C, v, up);
+        fc_accel_roll_pitch(up[0], up[1], up[2], &e.roll, &e.pitch);
+        fc_mat_t_vec(C, b, e.bias);
+        return e;
+    }
+    e.roll = f->roll;
+    e.pitch = f->pitch;
+    memcpy(e.bias, b, sizeof b);
+    return e;
+}
+
+void fc_kf_reset(fc_kf *f)
+{
+    fc_base_reset(&f->base);
+    f->roll = f->pitch = f->bias_x = f->bias_y = 0.0;
+    memset(f->P_roll, 0, sizeof f->P_roll);
+    memset(f->P_pitch, 0, sizeof f->P_pitch);
+    f->bias_z = f->P_z = 0.0;
+    memset(f->acc_f, 0, sizeof f->acc_f);
+    memset(f->rest, 0, sizeof f->rest);
+    f->q_att[0] = 1.0;
+    f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
+    f->gain_roll[0] = f->gain_roll[1] = f->gain_pitch[0] = f->gain_pitch[1] = 0.0;
+    f->face = 0;
+    f->last = fc_kf_estimate(f);
+}
+
+void fc_kf_init(fc_kf *f, const fc_kf_params *params)
+{
+    if (params) {
+        f->params = *params;
+    } else {
+        fc_kf_params_default(&f->params);
+    }
+    fc_kf_configure(f);
+    fc_kf_reset(f);
+}
+
+static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  /* _init */
+{
+    double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
+    if (f->faces) {
+        f->face = fc_nearest_face(a[0], a[1], a[2]);
+        if (f->face) {
+            fc_mat_vec(FC_FACES[f->face], a, a);
+            fc_mat_vec(FC_FACES[f->face], g, g);
+        }
+    }
+    fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
+    memcpy(f->acc_f, a, sizeof a);
+    f->rest[0] = g[0];
+    f->rest[1] = g[1];
+    f->rest[2] = g[2];
+    f->rest[3] = a[0];
+    f->rest[4] = a[1];
+    f->rest[5] = a[2];
+    f->rest[6] = 0.0;
+    fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
+    double p_b = pow(f->params.init_bias_std, 2.0);
+    if (p_b > 0.0) {
+        f->P_roll[0] = f->r;
+        f->P_roll[1] = f->P_roll[2] = 0.0;
+        f->P_roll[3] = p_b;
+        memcpy(f->P_pitch, f->P_roll, sizeof f->P_roll);
+        f->P_z = p_b;
+    }
+}
+
+/* propagate: the angles by the Euler rates or the quaternion, P by the papers' F and Q */
+static void propagate(fc_kf *f, const double g[3], double dt, const double *phi_in)
+{
+    double bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
+    if (f->quaternion) {
+        double phi[3];
+        if (phi_in) {
+            memcpy(phi, phi_in, sizeof phi);
+        } else {
+            double b[3] = {bx, by, bz};
+            fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
+        }
+        fc_quat_mul_rotvec(f->q_att, phi[0], phi[1], phi[2]);
+        fc_quat_roll_pitch(f->q_att, &roll, &pitch);
+    } else if (f->trapezoid) {
+        const double *w0 = f->base.gyro_prev;
+        fc_heun_euler_step(f->roll, f->pitch, w0[0] - bx, w0[1] - by, w0[2] - bz, g[0] - bx,
+                           g[1] - by, g[2] - bz, dt, &roll, &pitch);
+    } else {
+        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2] - bz, dt, &roll, &pitch);
+    }
+    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+    double P[4];
+    memcpy(P, f->P_roll, sizeof P);
+    predict_covariance(P, dt, f->q_angle, f->q_bias, f->P_roll);
+    if (same4(f->P_pitch, P)) {
+        memcpy(f->P_pitch, f->P_roll, sizeof P);
+    } else {
+        double Pp[4];
+        memcpy(Pp, f->P_pitch, sizeof Pp);
+        predict_covariance(Pp, dt, f->q_angle, f->q_bias, f->P_pitch);
+    }
+}
+
+/* correct_innovation */
+static void correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
+{
+    double P[4];
+    memcpy(P, f->P_roll, sizeof P);
+    int shared = same4(f->P_pitch, P);
+    gain(P, f->r, learn_bias, f->gain_roll, f->P_roll);
+    if (shared) {
+        memcpy(f->gain_pitch, f->gain_roll, sizeof f->gain_roll);
+        memcpy(f->P_pitch, f->P_roll, sizeof P);
+    } else {
+        double Pp[4];
+        memcpy(Pp, f->P_pitch, sizeof Pp);
+        gain(Pp, f->r, learn_bias, f->gain_pitch, f->P_pitch);
+    }
+    double roll = f->roll + f->gain_roll[0] * y_roll;
+    f->bias_x += f->gain_roll[1] * y_roll;
+    double pitch = f->pitch + f->gain_pitch[0] * y_pitch;
+    f->bias_y += f->gain_pitch[1] * y_pitch;
+    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+}
+
+/* correct: the accelerometer's roll and pitch */
+static void correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
+{
+    double acc_roll, acc_pitch;
+    fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
+    double y_roll = acc_roll - f->roll;
+    correct_innovation(f, -FC_PI <= y_roll && y_roll <= FC_PI ? y_roll : fc_wrap_angle(y_roll),
+                       acc_pitch - f->pitch, learn_bias);
+}
+
+/* _zero_rate_update: at rest the gyro measures the bias */
+static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], double dt)
+{
+    fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, f->rest_gyro, f->rest_acc);
+    f->P_z += f->q_bias * dt;
+    if (f->rest[6] >= f->rest_time) {
+        double r = f->gyro_var / dt;
+        bias_update(&f->roll, &f->bias_x, f->P_roll, g[0] - f->bias_x, r);
+        bias_update(&f->pitch, &f->bias_y, f->P_pitch, g[1] - f->bias_y, r);
+        double k = f->P_z / (f->P_z + r);
+        f->bias_z += k * (g[2] - f->bias_z);
+        f->P_z -= k * f->P_z;
+    }
+}
+
+/* _update_with_options, in the filters' frame; prev: the previous gyro sample there */
+static void update_with_options(fc_kf *f, const double a_in[3], const double g[3], double dt,
+                                const double prev[3])
+{
+    double a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3];
+    int have_phi = 0;
+    if (f->quaternion || f->acc_tau > 0.0) {
+        double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+        fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
+        have_phi = 1;
+    }
+    propagate(f, g, dt, have_phi ? phi : NULL);
+    double pred_roll = f->roll, pred_pitch = f->pitch;
+    double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2;
+    if (f->rest_time > 0.0) {
+        zero_rate_update(f, a, g, dt);
+    }
+    if (f->acc_tau > 0.0) {
+        fc_lowpass_specific_force(f->acc_f, phi, a, dt, f->acc_tau);
+        memcpy(a, f->acc_f, sizeof a);
+    }
+    double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
+        correct(f, a[0], a[1], a[2], learn_bias);
+    }
+    if (f->quaternion && (f->roll != pred_roll || f->pitch != pred_pitch)) {
+        fc_quat_with_roll_pitch(f->q_att, f->roll, f->pitch);
+    }
+}
+
+/* _switch_face: to the face nearest to up, every state turned by C_new C_old^T */
+static void switch_face(fc_kf *f)
+{
+    double roll = f->roll, pitch = f->pitch, cp = cos(pitch);
+    const double *C = FC_FACES[f->face];
+    double up[3] = {-sin(pitch), sin(roll) * cp, cos(roll) * cp}, t[3];
+    fc_mat_t_vec(C, up, t);
+    int next = fc_nearest_face(t[0], t[1], t[2]);
+    if (next == f->face) {
+        return;
+    }
+    const double *C2 = FC_FACES[next];
+#define TURN(v, out) do { double tmp_[3]; fc_mat_t_vec(C, (v), tmp_); fc_mat_vec(C2, tmp_, (out)); } while (0)
+    double u2[3];
+    TURN(up, u2);
+    fc_accel_roll_pitch(u2[0], u2[1], u2[2], &f->roll, &f->pitch);
+    fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
+    double b[3] = {f->bias_x, f->bias_y, f->bias_z}, b2[3];
+    TURN(b, b2);
+    f->bias_x = b2[0];
+    f->bias_y = b2[1];
+    f->bias_z = b2[2];
+    double acc_f[3];
+    TURN(f->acc_f, acc_f);
+    memcpy(f->acc_f, acc_f, sizeof acc_f);
+    double w[3] = {f->rest[0], f->rest[1], f->rest[2]}, sf[3] = {f->rest[3], f->rest[4], f->rest[5]};
+    double w2[3], sf2[3];
+    TURN(w, w2);
+    TURN(sf, sf2);
+    f->rest[0] = w2[0];
+    f->rest[1] = w2[1];
+    f->rest[2] = w2[2];
+    f->rest[3] = sf2[0];
+    f->rest[4] = sf2[1];
+    f->rest[5] = sf2[2];
+#undef TURN
+    double old[3][4];
+    memcpy(old[0], f->P_roll, sizeof old[0]);
+    memcpy(old[1], f->P_pitch, sizeof old[1]);
+    old[2][0] = f->P_pitch[0] > f->P_roll[0] ? f->P_pitch[0] : f->P_roll[0];  /* max(...) */
+    old[2][1] = old[2][2] = 0.0;
+    old[2][3] = f->P_z;
+    int source[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++) {  /* the old axis that new axis k is: row k of C2 C^T */
+        for (int j = 0; j < 3; j++) {
+            double d = C2[3 * k] * C[3 * j] + C2[3 * k + 1] * C[3 * j + 1]
+                + C2[3 * k + 2] * C[3 * j + 2];
+            if (d != 0.0) {
+                source[k] = j;
+            }
+        }
+    }
+    memcpy(f->P_roll, old[source[0]], sizeof f->P_roll);
+    memcpy(f->P_pitch, old[source[1]], sizeof f->P_pitch);
+    f->P_z = old[source[2]][3];
+    f->face = next;
+}
+
+static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double dt)
+{
+    if (f->options) {
+        double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
+        double prev[3] = {f->base.gyro_prev[0], f->base.gyro_prev[1], f->base.gyro_prev[2]};
+        if (f->face) {  /* into the face frame (tilt_axes) */
+            const double *C = FC_FACES[f->face];
+            fc_mat_vec(C, a, a);
+            fc_mat_vec(C, g, g);
+            fc_mat_vec(C, prev, prev);
+        }
+        update_with_options(f, a, g, dt, prev);
+        if (f->faces && cos(f->roll) * cos(f->pitch) < FC_FACE_SWITCH_COS) {
+            switch_face(f);
+        }
+    } else {
+        propagate(f, g_in, dt, NULL);
+        double n2 = a_in[0] * a_in[0] + a_in[1] * a_in[1] + a_in[2] * a_in[2];
+        if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
+            correct(f, a_in[0], a_in[1], a_in[2], f->bias_lo2 < n2 && n2 < f->bias_hi2);
+        }
+    }
+}
+
+fc_status fc_kf_step(fc_kf *f, const double acc[3], const double gyro[3], double dt,
+                     fc_estimate *out)
+{
+    double a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
+    fc_status status = fc_base_prepare(&f->base, a, g, dt);
+    if (status != FC_OK) {
+        return status;
+    }
+    if (f->base.initialized) {
+        advance(f, a, g, dt);
+    } else if (fc_base_can_init(a)) {
+        first_sample(f, a, g);
+        f->base.initialized = 1;
+    } else {
+        if (out) {
+            *out = f->last;
+        }
+        return FC_SKIPPED;
+    }
+    f->last = fc_kf_estimate(f);
+    memcpy(f->base.gyro_prev, g, sizeof g);
+    f->base.n_samples += 1;
+    if (out) {
+        *out = f->last;
+    }
+    return FC_OK;
+}
+
+long fc_kf_run(fc_kf *f, long n, const double *acc, const double *gyro, const double *dt,
+               fc_estimate *out, unsigned char *rejected)
+{
+    long bad = 0;
+    for (long i = 0; i < n; i++) {
+        fc_status s = fc_kf_step(f, acc + 3 * i, gyro + 3 * i, dt[i], out + i);
+        rejected[i] = s > FC_SKIPPED;
+        if (rejected[i]) {
+            f->base.n_rejected += 1;
+            out[i] = f->last;
+            bad++;
+        }
+    }
+    return bad;
+}

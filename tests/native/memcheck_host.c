@@ -1,0 +1,94 @@
+/* A C host of the twins for memory checkers (tests/test_native.py runs it under valgrind):
+ * each twin with its defaults and with the papers' Euler propagation, over a recording of
+ * motion, rest, a near-zero accelerometer stretch, NaN, inf, huge values and bad dt, step by step
+ * and in one batch. Exit status 0 when every output is finite. */
+#include <math.h>
+#include <stdio.h>
+
+#include "fc_cf.h"
+#include "fc_kf.h"
+
+#define N 4000
+
+static void sample(int i, double acc[3], double gyro[3], double *dt)
+{
+    double t = i * 0.01;
+    double roll = 0.6 * sin(0.7 * t), pitch = 0.4 * sin(0.45 * t + 0.3);
+    acc[0] = -9.80665 * sin(pitch) + 0.3 * sin(13.0 * t);
+    acc[1] = 9.80665 * sin(roll) * cos(pitch);
+    acc[2] = 9.80665 * cos(roll) * cos(pitch);
+    gyro[0] = 0.42 * cos(0.7 * t) + 0.01;
+    gyro[1] = 0.18 * cos(0.45 * t + 0.3) - 0.006;
+    gyro[2] = 0.2 * sin(0.1 * t);
+    *dt = 0.01;
+    if (i > 1000 && i < 1200) {  /* at rest */
+        acc[0] = acc[1] = 0.0;
+        acc[2] = 9.80665;
+        gyro[0] = gyro[1] = gyro[2] = 0.003;
+    }
+    if (i > 1500 && i < 1550) {  /* free fall */
+        acc[0] = acc[1] = acc[2] = 0.0;
+    }
+    switch (i % 97) {
+    case 1: acc[0] = NAN; break;
+    case 2: gyro[1] = INFINITY; break;
+    case 3: *dt = -1.0; break;
+    case 4: *dt = 0.0; break;
+    case 5: acc[2] = 1e300; break;
+    case 6: gyro[2] = 5000.0; break;
+    case 7: *dt = 2.0; break;
+    default: break;
+    }
+}
+
+static double acc_all[N][3], gyro_all[N][3], dt_all[N];
+static fc_estimate out[N];
+static unsigned char rejected[N];
+
+static int finite_estimate(const fc_estimate *e)
+{
+    return isfinite(e->roll) && isfinite(e->pitch) && isfinite(e->bias[0])
+        && isfinite(e->bias[1]) && isfinite(e->bias[2]);
+}
+
+int main(void)
+{
+    int bad = 0;
+    for (int i = 0; i < N; i++) {
+        sample(i, acc_all[i], gyro_all[i], &dt_all[i]);
+    }
+    for (int variant = 0; variant < 2; variant++) {
+        fc_cf cf;
+        fc_kf kf;
+        fc_cf_params cp;
+        fc_kf_params kp;
+        fc_cf_params_default(&cp);
+        fc_kf_params_default(&kp);
+        if (variant) {
+            cp.propagation = FC_CF_PROPAGATION_EULER;
+            kp.propagation = FC_KF_PROPAGATION_EULER;
+            kp.tilt_axes = FC_KF_TILT_AXES_BODY;
+        }
+        fc_cf_init(&cf, &cp);
+        fc_kf_init(&kf, &kp);
+        for (int i = 0; i < N; i++) {
+            fc_estimate e;
+            fc_cf_step(&cf, acc_all[i], gyro_all[i], dt_all[i], &e);
+            bad += !finite_estimate(&e);
+            fc_kf_step(&kf, acc_all[i], gyro_all[i], dt_all[i], &e);
+            bad += !finite_estimate(&e);
+        }
+        fc_cf_reset(&cf);
+        fc_kf_reset(&kf);
+        fc_cf_run(&cf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
+        for (int i = 0; i < N; i++) {
+            bad += !finite_estimate(&out[i]);
+        }
+        fc_kf_run(&kf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
+        for (int i = 0; i < N; i++) {
+            bad += !finite_estimate(&out[i]);
+        }
+    }
+    printf("non-finite estimates: %d\n", bad);
+    return bad != 0;
+}
