@@ -208,3 +208,13 @@ def test_valgrind_finds_no_memory_error_in_a_native_run(tmp_path: Path) -> None:
                            str(exe)], capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "non-finite estimates: 0" in proc.stdout
+
+
+@needs_twin
+@pytest.mark.parametrize("schedule", ["simulation", "experimental", "fixed"])
+def test_every_mgcf_schedule_is_equal(schedule: str) -> None:
+    rec = mixed_recording()
+    py, c = make("mgcf", schedule=schedule), make("mgcf", schedule=schedule)
+    assert_same(py.run(rec["acc"], rec["gyro"], rec["dt"], backend="python"),
+                c.run(rec["acc"], rec["gyro"], rec["dt"], backend="native"))
+    assert_same_state(py, c)

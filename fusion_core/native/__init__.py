@@ -33,14 +33,18 @@ from typing import Any
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-SOURCES = ("fc_core.c", "fc_cf.c", "fc_kf.c")
+SOURCES = ("fc_core.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c")
 """The C sources, in link order."""
-HEADERS = ("fc_core.h", "fc_params.h", "fc_cf.h", "fc_kf.h")
+HEADERS = ("fc_core.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h")
 """The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
 Python's does, which is what makes the twins equal."""
-TWINS = {"ComplementaryFilter": "fc_cf", "AngleBiasKalmanFilter": "fc_kf"}
+TWINS = {
+    "ComplementaryFilter": "fc_cf",
+    "GainScheduledComplementaryFilter": "fc_mgcf",
+    "AngleBiasKalmanFilter": "fc_kf",
+}
 """The estimators that have a C twin, by class name, and the twin's C prefix."""
 ESTIMATE_FIELDS = 11
 """Doubles per fc_estimate: roll, pitch, bias[3], pos[3], vel[3]."""

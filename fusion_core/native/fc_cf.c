@@ -110,46 +110,31 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
 }
 
+static void first_sample_op(void *self, const double acc[3], const double gyro[3])
+{
+    first_sample((fc_cf *)self, acc, gyro);
+}
+
+static void advance_op(void *self, const double acc[3], const double gyro[3], double dt)
+{
+    advance((fc_cf *)self, acc, gyro, dt);
+}
+
+static fc_estimate estimate_op(const void *self)
+{
+    return fc_cf_estimate((const fc_cf *)self);
+}
+
+static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};
+
 fc_status fc_cf_step(fc_cf *f, const double acc[3], const double gyro[3], double dt,
                      fc_estimate *out)
 {
-    double a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
-    fc_status status = fc_base_prepare(&f->base, a, g, dt);
-    if (status != FC_OK) {
-        return status;
-    }
-    if (f->base.initialized) {
-        advance(f, a, g, dt);
-    } else if (fc_base_can_init(a)) {
-        first_sample(f, a, g);
-        f->base.initialized = 1;
-    } else {
-        if (out) {
-            *out = f->last;
-        }
-        return FC_SKIPPED;
-    }
-    f->last = fc_cf_estimate(f);
-    memcpy(f->base.gyro_prev, g, sizeof g);
-    f->base.n_samples += 1;
-    if (out) {
-        *out = f->last;
-    }
-    return FC_OK;
+    return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);
 }
 
 long fc_cf_run(fc_cf *f, long n, const double *acc, const double *gyro, const double *dt,
                fc_estimate *out, unsigned char *rejected)
 {
-    long bad = 0;
-    for (long i = 0; i < n; i++) {
-        fc_status s = fc_cf_step(f, acc + 3 * i, gyro + 3 * i, dt[i], out + i);
-        rejected[i] = s > FC_SKIPPED;
-        if (rejected[i]) {
-            f->base.n_rejected += 1;
-            out[i] = f->last;
-            bad++;
-        }
-    }
-    return bad;
+    return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);
 }

@@ -3,6 +3,7 @@
 #include "fc_core.h"
 
 #include <math.h>
+#include <string.h>
 
 #define MIN_COS_PITCH 1e-9   /* kinematics._MIN_COS_PITCH */
 #define SMALL_ANGLE 1e-8     /* kinematics._SMALL_ANGLE */
@@ -79,6 +80,14 @@ void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch)
         s = -1.0 > s ? -1.0 : s;
     }
     *pitch = asin(s);
+}
+
+void fc_quat_gravity_body(const double q[4], double g[3])
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    g[0] = 2.0 * (x * z - w * y);
+    g[1] = 2.0 * (y * z + w * x);
+    g[2] = w * w - x * x - y * y + z * z;
 }
 
 void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
@@ -357,4 +366,49 @@ int fc_base_can_init(const double acc[3])
 {
     double norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
     return norm2 >= MIN_INIT_NORM * MIN_INIT_NORM;
+}
+
+fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                  const double acc[3], const double gyro[3], double dt, fc_estimate *out)
+{
+    double a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
+    fc_status status = fc_base_prepare(base, a, g, dt);
+    if (status != FC_OK) {
+        return status;
+    }
+    if (base->initialized) {
+        ops->advance(self, a, g, dt);
+    } else if (fc_base_can_init(a)) {
+        ops->first_sample(self, a, g);
+        base->initialized = 1;
+    } else {  /* no gravity direction to start from yet: skipped, nothing changes */
+        if (out) {
+            *out = *last;
+        }
+        return FC_SKIPPED;
+    }
+    *last = ops->estimate(self);
+    memcpy(base->gyro_prev, g, sizeof g);
+    base->n_samples += 1;
+    if (out) {
+        *out = *last;
+    }
+    return FC_OK;
+}
+
+long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
+            const double *acc, const double *gyro, const double *dt, fc_estimate *out,
+            unsigned char *rejected)
+{
+    long bad = 0;
+    for (long i = 0; i < n; i++) {
+        fc_status s = fc_step(ops, self, base, last, acc + 3 * i, gyro + 3 * i, dt[i], out + i);
+        rejected[i] = s > FC_SKIPPED;
+        if (rejected[i]) {
+            base->n_rejected += 1;
+            out[i] = *last;
+            bad++;
+        }
+    }
+    return bad;
 }

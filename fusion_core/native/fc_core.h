@@ -59,6 +59,7 @@ void fc_heun_euler_step(double phi, double theta, double p0, double q0, double r
                         double q1, double r1, double dt, double *phi_out, double *theta_out);
 void fc_quat_from_roll_pitch_yaw(double phi, double theta, double psi, double q[4]);
 void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch);
+void fc_quat_gravity_body(const double q[4], double g[3]);
 void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz);
 void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
                            double dt, double phi[3]);
@@ -95,5 +96,25 @@ void fc_base_reset(fc_base *b);
 fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], double dt);
 /* Whether a prepared sample may initialise the filter (its accelerometer norm >= 0.1 g). */
 int fc_base_can_init(const double acc[3]);
+
+/* What an estimator adds to the shared step (Estimator._init, _advance, _estimate), on a
+ * prepared sample (in the filter frame); self is the estimator's struct. */
+typedef struct fc_ops {
+    void (*first_sample)(void *self, const double acc[3], const double gyro[3]);
+    void (*advance)(void *self, const double acc[3], const double gyro[3], double dt);
+    fc_estimate (*estimate)(const void *self);
+} fc_ops;
+
+/* Estimator.step for any estimator: the sample rules, then first_sample or advance; *last is the
+ * estimator's last estimate. FC_OK or FC_SKIPPED with *out the estimate (out may be NULL); a
+ * rejection leaves everything as it was. */
+fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                  const double acc[3], const double gyro[3], double dt, fc_estimate *out);
+/* Estimator.run for any estimator: n samples (acc, gyro [n][3] row-major, dt [n]), out[i] the
+ * estimate after sample i, the last one for a rejected sample (rejected[i] = 1, counted in
+ * n_rejected). Returns the number of rejected samples. */
+long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
+            const double *acc, const double *gyro, const double *dt, fc_estimate *out,
+            unsigned char *rejected);
 
 #endif /* FC_CORE_H */

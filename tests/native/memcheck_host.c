@@ -7,6 +7,7 @@
 
 #include "fc_cf.h"
 #include "fc_kf.h"
+#include "fc_mgcf.h"
 
 #define N 4000
 
@@ -60,6 +61,14 @@ int main(void)
     for (int variant = 0; variant < 2; variant++) {
         fc_cf cf;
         fc_kf kf;
+        fc_mgcf mgcf;
+        fc_mgcf_params mp;
+        fc_mgcf_params_default(&mp);
+        if (variant) {
+            mp.schedule = FC_MGCF_SCHEDULE_SIMULATION;
+            mp.gyro_sampling = FC_MGCF_GYRO_SAMPLING_MEAN;
+        }
+        fc_mgcf_init(&mgcf, &mp);
         fc_cf_params cp;
         fc_kf_params kp;
         fc_cf_params_default(&cp);
@@ -77,6 +86,8 @@ int main(void)
             bad += !finite_estimate(&e);
             fc_kf_step(&kf, acc_all[i], gyro_all[i], dt_all[i], &e);
             bad += !finite_estimate(&e);
+            fc_mgcf_step(&mgcf, acc_all[i], gyro_all[i], dt_all[i], &e);
+            bad += !finite_estimate(&e);
         }
         fc_cf_reset(&cf);
         fc_kf_reset(&kf);
@@ -85,6 +96,11 @@ int main(void)
             bad += !finite_estimate(&out[i]);
         }
         fc_kf_run(&kf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
+        for (int i = 0; i < N; i++) {
+            bad += !finite_estimate(&out[i]);
+        }
+        fc_mgcf_reset(&mgcf);
+        fc_mgcf_run(&mgcf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
         for (int i = 0; i < N; i++) {
             bad += !finite_estimate(&out[i]);
         }

@@ -1,0 +1,193 @@
+/* fc_mgcf.c: see fc_mgcf.h; the twin of fusion_core/mgcf.py line by line. */
+#include "fc_mgcf.h"
+
+#include <math.h>
+#include <string.h>
+
+/* mgcf.SCHEDULES: (rho upper bound, w0 [rad/s]); rho at or above the last bound: w0 = 0 */
+static const double SIMULATION[3][2] = {{0.01, 0.1}, {0.25, 0.07}, {0.35, 0.035}};
+static const double EXPERIMENTAL[3][2] = {{0.025, 0.1}, {0.035, 0.07}, {0.05, 0.05}};
+
+static double scheduled_w0(double rho, const double (*table)[2], int rows)
+{
+    for (int i = 0; i < rows; i++) {
+        if (rho < table[i][0]) {
+            return table[i][1];
+        }
+    }
+    return 0.0;
+}
+
+/* _quat_first_order: q + dt/2 q (x) (0, w), renormalised (Mahony's reference code) */
+static void quat_first_order(double q[4], double w0, double w1, double w2, double dt)
+{
+    double qw = q[0], qx = q[1], qy = q[2], qz = q[3];
+    double wx = 0.5 * dt * w0, wy = 0.5 * dt * w1, wz = 0.5 * dt * w2;
+    double rw = qw - qx * wx - qy * wy - qz * wz;
+    double rx = qx + qw * wx + qy * wz - qz * wy;
+    double ry = qy + qw * wy - qx * wz + qz * wx;
+    double rz = qz + qw * wz + qx * wy - qy * wx;
+    double n = 1.0 / sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
+    q[0] = rw * n;
+    q[1] = rx * n;
+    q[2] = ry * n;
+    q[3] = rz * n;
+}
+
+void fc_mgcf_configure(fc_mgcf *f)
+{
+    const fc_mgcf_params *p = &f->params;
+    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
+                      p->mount_yaw);
+    f->table = p->schedule == FC_MGCF_SCHEDULE_SIMULATION ? SIMULATION
+        : p->schedule == FC_MGCF_SCHEDULE_EXPERIMENTAL ? EXPERIMENTAL : NULL;
+    f->table_rows = f->table ? 3 : 0;
+    f->w0_fixed = p->w0;
+    f->two_zeta = 2.0 * p->zeta;
+    f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;
+    f->acc_tau = p->acc_lowpass;
+    f->rest_time = p->rest_time;
+    f->rest_gyro = p->rest_gyro;
+    f->rest_acc = p->rest_acc;
+    f->options = f->rest_time > 0.0 || f->acc_tau > 0.0;
+}
+
+fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
+{
+    fc_estimate e;
+    memset(&e, 0, sizeof e);
+    fc_quat_roll_pitch(f->q, &e.roll, &e.pitch);
+    memcpy(e.bias, f->bias, sizeof e.bias);
+    return e;
+}
+
+void fc_mgcf_reset(fc_mgcf *f)
+{
+    fc_base_reset(&f->base);
+    f->q[0] = 1.0;
+    f->q[1] = f->q[2] = f->q[3] = 0.0;
+    memset(f->bias, 0, sizeof f->bias);
+    f->w0_now = 0.0;
+    memset(f->acc_f, 0, sizeof f->acc_f);
+    memset(f->rest, 0, sizeof f->rest);
+    f->last = fc_mgcf_estimate(f);
+}
+
+void fc_mgcf_init(fc_mgcf *f, const fc_mgcf_params *params)
+{
+    if (params) {
+        f->params = *params;
+    } else {
+        fc_mgcf_params_default(&f->params);
+    }
+    fc_mgcf_configure(f);
+    fc_mgcf_reset(f);
+}
+
+static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _init */
+{
+    double roll, pitch;
+    fc_accel_roll_pitch(a[0], a[1], a[2], &roll, &pitch);
+    fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, f->q);
+    memcpy(f->acc_f, a, sizeof f->acc_f);
+    f->rest[0] = g[0];
+    f->rest[1] = g[1];
+    f->rest[2] = g[2];
+    f->rest[3] = a[0];
+    f->rest[4] = a[1];
+    f->rest[5] = a[2];
+    f->rest[6] = 0.0;
+}
+
+static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double dt)
+{
+    double ax = a_in[0], ay = a_in[1], az = a_in[2];
+    double gx = g[0], gy = g[1], gz = g[2];
+    if (f->options) {  /* _real_sensor_options */
+        if (f->rest_time > 0.0) {
+            fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, dt, f->rest_gyro, f->rest_acc);
+            if (f->rest[6] >= f->rest_time) {
+                fc_bias_at_rest(f->bias, gx, gy, gz, dt, f->rest_time);
+            }
+        }
+        if (f->acc_tau > 0.0) {
+            double phi[3];
+            fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+            fc_lowpass_specific_force(f->acc_f, phi, a_in, dt, f->acc_tau);
+            ax = f->acc_f[0];
+            ay = f->acc_f[1];
+            az = f->acc_f[2];
+        }
+    }
+    double norm = sqrt(ax * ax + ay * ay + az * az);
+    double w0 = f->table ? scheduled_w0(fabs(norm / FC_G - 1.0), f->table, f->table_rows)
+        : f->w0_fixed;
+    if (!(norm > 0.0)) {  /* no gravity direction in this sample: gyro only */
+        w0 = 0.0;
+    }
+    f->w0_now = w0;
+    double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
+    double q[4];
+    memcpy(q, f->q, sizeof q);
+    if (f->trapezoid) {
+        const double *w = f->base.gyro_prev;
+        double phi[3];
+        fc_rotation_increment(w[0] - bx, w[1] - by, w[2] - bz, gx - bx, gy - by, gz - bz, dt,
+                              phi);
+        fc_quat_mul_rotvec(q, phi[0], phi[1], phi[2]);
+    }
+    double ex = 0.0, ey = 0.0, ez = 0.0;
+    if (w0 > 0.0) {
+        double v[3];
+        fc_quat_gravity_body(q, v);
+        double inv = 1.0 / norm;
+        double nx = ax * inv, ny = ay * inv, nz = az * inv;
+        ex = ny * v[2] - nz * v[1];
+        ey = nz * v[0] - nx * v[2];
+        ez = nx * v[1] - ny * v[0];
+        double ki_dt = w0 * w0 * dt;
+        bx = bx - ki_dt * ex;
+        by = by - ki_dt * ey;
+        bz = bz - ki_dt * ez;
+        f->bias[0] = bx;
+        f->bias[1] = by;
+        f->bias[2] = bz;
+    }
+    if (!f->trapezoid) {
+        double kp = f->two_zeta * w0;
+        quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz, dt);
+    } else if (w0 > 0.0) {
+        double kp_dt = f->two_zeta * w0 * dt;
+        fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
+    }
+    memcpy(f->q, q, sizeof q);
+}
+
+static void first_sample_op(void *self, const double acc[3], const double gyro[3])
+{
+    first_sample((fc_mgcf *)self, acc, gyro);
+}
+
+static void advance_op(void *self, const double acc[3], const double gyro[3], double dt)
+{
+    advance((fc_mgcf *)self, acc, gyro, dt);
+}
+
+static fc_estimate estimate_op(const void *self)
+{
+    return fc_mgcf_estimate((const fc_mgcf *)self);
+}
+
+static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};
+
+fc_status fc_mgcf_step(fc_mgcf *f, const double acc[3], const double gyro[3], double dt,
+                       fc_estimate *out)
+{
+    return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);
+}
+
+long fc_mgcf_run(fc_mgcf *f, long n, const double *acc, const double *gyro, const double *dt,
+                 fc_estimate *out, unsigned char *rejected)
+{
+    return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);
+}

@@ -1,0 +1,36 @@
+/* fc_mgcf.h: the gain-scheduled (modified-gain) complementary filter, a Mahony-style quaternion
+ * PI filter (fusion_core/mgcf.py, GainScheduledComplementaryFilter), the C twin. Duong Quoc et
+ * al. eq. 7-13 with their w0 schedules; Mahony, Hamel, Pflimlin (2008) for the PI law. */
+#ifndef FC_MGCF_H
+#define FC_MGCF_H
+
+#include "fc_core.h"
+#include "fc_params.h"
+
+typedef struct fc_mgcf {
+    fc_mgcf_params params;
+    fc_base base;
+    /* GainScheduledComplementaryFilter.STATE */
+    double q[4];
+    double bias[3];
+    double w0_now;
+    double acc_f[3];
+    double rest[7];
+    fc_estimate last;
+    /* derived from params (GainScheduledComplementaryFilter._configure) */
+    const double (*table)[2];  /* the schedule's (rho bound, w0) rows; NULL: fixed w0 */
+    int table_rows;
+    double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc;
+    int trapezoid, options;
+} fc_mgcf;
+
+void fc_mgcf_init(fc_mgcf *f, const fc_mgcf_params *params);
+void fc_mgcf_configure(fc_mgcf *f);
+void fc_mgcf_reset(fc_mgcf *f);
+fc_status fc_mgcf_step(fc_mgcf *f, const double acc[3], const double gyro[3], double dt,
+                       fc_estimate *out);
+long fc_mgcf_run(fc_mgcf *f, long n, const double *acc, const double *gyro, const double *dt,
+                 fc_estimate *out, unsigned char *rejected);
+fc_estimate fc_mgcf_estimate(const fc_mgcf *f);
+
+#endif /* FC_MGCF_H */
