@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup run demo test test-slow lint fmus clean
+.PHONY: setup run demo test test-slow lint fmus native clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -27,6 +27,10 @@ demo: setup
 
 fmus: setup
 	$(BIN)/python build_fmu.py --out dist
+
+# The C twin of fusion_core as a shared library (built on first use anyway; this says where).
+native: setup
+	$(BIN)/python -c "from fusion_core import native; print(native.build())"
 
 test: setup
 	$(BIN)/python -m pytest -q

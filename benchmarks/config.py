@@ -31,7 +31,7 @@ class BenchConfig:
     scaling_sizes: tuple[int, ...] = (1_000, 10_000, 100_000, 1_000_000)
     scaling_estimators: tuple[str, ...] = ESTIMATOR_KEYS
     peers: bool = True
-    sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "scaling")
+    sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "native", "scaling")
     quick: bool = False
     core: str = "auto"
 

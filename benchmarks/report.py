@@ -75,6 +75,25 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
                    "per step" if floor.get("api") is not None
                    and floor.get("lowlevel") is not None else ""),
             ))
+    nat = r.get("native")
+    if nat and nat.get("available"):
+        from .native import FASTER_THAN_VQF, NATIVE_TARGETS_US
+
+        vqf = nat.get("vqf_batch_us_per_sample")
+        for key, limit in NATIVE_TARGETS_US.items():
+            v = nat["run_us_per_sample"].get(key)
+            out.append(_target(
+                f"native.run_us_per_sample.{key}", v, f"<= {limit:g} us",
+                v is not None and v <= limit,
+                "no C twin yet" if v is None else
+                "libm's transcendental functions (atan2, asin, sin, cos: about a dozen per "
+                "sample, the same calls as the Python reference, which the twins must match)",
+            ))
+            if key in FASTER_THAN_VQF and v is not None and vqf is not None:
+                out.append(_target(
+                    f"native.{key} vs vqf_batch", vqf / v, "> 1x (faster than VQF's batch)",
+                    v < vqf, "as above",
+                ))
     tb = r.get("testbench")
     if tb:
         for key, rates in tb.items():
@@ -113,6 +132,26 @@ def _verdict(t: dict[str, Any] | None) -> str:
     if t is None or t["met"] is None:
         return ""
     return "met" if t["met"] else "NOT MET"
+
+
+def _native_lines(r: dict[str, Any], targets: dict[str, Any]) -> list[str]:
+    nat = r["native"]
+    if not nat.get("available"):
+        return ["", f"Native twin: unavailable ({nat.get('reason')})"]
+    lines = ["", f"Native twin: batch run over {nat['samples']} samples [us per sample]",
+             f"  {'filter':<15}{'native':>10}{'python':>10}{'speed-up':>10}   "
+             f"{'target':<22}verdict"]
+    for key, v in nat["run_us_per_sample"].items():
+        t = targets.get(f"native.run_us_per_sample.{key}")
+        lines.append(f"  {key:<15}{_fmt(v):>10}{_fmt(nat['python_run_us_per_sample'][key]):>10}"
+                     f"{_fmt(nat['speedup_vs_python'][key], 1):>9}x   "
+                     f"{(t['target'] if t else ''):<22}{_verdict(t)}")
+    for key in nat.get("no_twin_yet", []):
+        lines.append(f"  {key:<15}{'-':>10}   no C twin yet")
+    vqf = nat.get("vqf_batch_us_per_sample")
+    lines.append("  vqf (C++ updateBatch): " + (f"{_fmt(vqf)} us" if vqf is not None
+                                                 else f"unavailable: {nat.get('vqf_unavailable')}"))
+    return lines
 
 
 def format_table(r: dict[str, Any]) -> str:
@@ -191,6 +230,8 @@ def format_table(r: dict[str, Any]) -> str:
                     f"{_fmt(x['estimator_fmu_us_per_step'], 0):>9}   "
                     f"{(t['target'] if t else ''):<10}{_verdict(t)}"
                 )
+    if "native" in r:
+        lines += _native_lines(r, targets)
     if "scaling" in r:
         lines += ["", "Scaling of run(): time per sample and peak memory growth",
                   f"  {'estimator':<11}{'N':>9}{'us/sample':>11}{'peak MB':>9}"

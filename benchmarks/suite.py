@@ -25,6 +25,7 @@ from .common import (
 from .config import ESTIMATOR_KEYS, BenchConfig
 from .estimators import step_factories
 from .fmu import build_fmus, fmu_steps
+from .native import native_section
 from .peers import PEERS, available_peers
 from .report import evaluate_targets
 from .scaling import scaling
@@ -139,6 +140,9 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
                 results["testbench"] = testbench_throughput(
                     config.testbench_estimators, config.testbench_s, fmu_dir,
                     config.testbench_repeats)
+    if "native" in config.sections:
+        log("native batch runs (the C twin), the Python core and VQF's C++ batch")
+        results["native"] = native_section(rec, config.repeats)
     if "scaling" in config.sections:
         log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
         results["scaling"] = scaling(config.scaling_estimators, config.scaling_sizes, rec)

@@ -218,3 +218,18 @@ def test_every_mgcf_schedule_is_equal(schedule: str) -> None:
     assert_same(py.run(rec["acc"], rec["gyro"], rec["dt"], backend="python"),
                 c.run(rec["acc"], rec["gyro"], rec["dt"], backend="native"))
     assert_same_state(py, c)
+
+
+@needs_twin
+def test_the_embedded_example_builds_and_converges(tmp_path: Path) -> None:
+    """examples/embedded_kf.c, built as its comment says: 10 deg of roll within 0.1 deg."""
+    cc = native.compiler()
+    assert cc is not None
+    exe = tmp_path / "embedded_kf"
+    subprocess.run([cc, "-std=c99", "-O2", "-ffp-contract=off", f"-I{NATIVE}",
+                    str(REPO / "examples" / "embedded_kf.c"), str(NATIVE / "fc_core.c"),
+                    str(NATIVE / "fc_kf.c"), "-lm", "-o", str(exe)], check=True)
+    last = subprocess.run([str(exe)], capture_output=True, text=True, check=True
+                          ).stdout.splitlines()[-1]
+    roll = float(last.split("roll=")[1].split()[0])
+    assert abs(roll - 10.0) < 0.1, last
