@@ -44,8 +44,6 @@ from __future__ import annotations
 import math
 from typing import Final
 
-import numpy as np
-
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
@@ -59,7 +57,7 @@ from .building_blocks import (
     rest_step,
     zero_rate_psd_param,
 )
-from .kinematics import atan2, hypot, rotate_back
+from .kinematics import accel_roll_pitch, rotate_back
 from .types import DEG, Estimate, G, Param
 
 N_STATE: Final = 6  # X (3), gyro bias b (3)
@@ -224,16 +222,34 @@ class UnscentedKalmanFilter(Estimator):
 
     def _zero_rate_update(self, z: tuple[float, float, float], r: float) -> None:
         """At rest the gyro reads its bias: a linear Kalman update with z = gyro, h(x) = b
-        (variance r per axis), then X renormalised. Runs only at rest, so numpy is fine here."""
-        x = np.asarray(self.x)
-        P = np.asarray(self.P)
-        S = P[3:, 3:] + r * np.eye(3)
-        K = np.linalg.solve(S, P[3:, :]).T
-        x = x + K @ (np.asarray(z) - x[3:])
-        P = P - K @ P[3:, :]
-        x[:3] /= np.linalg.norm(x[:3])
-        self.x = x.tolist()
-        self.P = (0.5 * (P + P.T)).tolist()
+        (variance r per axis), then X renormalised. With S = P_bb + r I = L L^T and
+        Y = L^-1 P_b. (the bias rows of P): K (z - b) = Y^T L^-1 (z - b), K P_b. = Y^T Y, which
+        is symmetric as computed. A P_bb that rounding made indefinite skips the update."""
+        P = self._P
+        r3 = (P[15], P[16], P[17], P[18], P[19], P[20])  # row 5 of the packed lower triangle
+        L = _cholesky3(P[9] + r, P[13], P[14] + r, P[18], P[19], P[20] + r)
+        if L is None:
+            return
+        l00, l10, l11, l20, l21, l22 = L
+        x = self.x
+        cols = []  # L^-1 applied to each column of P_b. (j = 0..5) and to the innovation
+        for j in range(N_STATE + 1):
+            if j < N_STATE:
+                c0, c1, c2 = P[_packed_index(3, j)], P[_packed_index(4, j)], r3[j]
+            else:
+                c0, c1, c2 = z[0] - x[3], z[1] - x[4], z[2] - x[5]
+            y0 = c0 / l00
+            y1 = (c1 - l10 * y0) / l11
+            cols.append((y0, y1, (c2 - l20 * y0 - l21 * y1) / l22))
+        v0, v1, v2 = cols[N_STATE]
+        x = [x[i] + (cols[i][0] * v0 + cols[i][1] * v1 + cols[i][2] * v2) for i in range(N_STATE)]
+        self._P = tuple(
+            P[_packed_index(i, j)]
+            - (cols[i][0] * cols[j][0] + cols[i][1] * cols[j][1] + cols[i][2] * cols[j][2])
+            for i in range(N_STATE) for j in range(i + 1)
+        )
+        n = math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2])
+        self.x = [x[0] / n, x[1] / n, x[2] / n, x[3], x[4], x[5]]
 
     def _filter_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float,
@@ -367,9 +383,8 @@ class UnscentedKalmanFilter(Estimator):
 
     def _estimate(self) -> Estimate:
         X1, X2, X3, bx, by, bz = self.x
-        return tuple_new(
-            ESTIMATE, (atan2(X2, X3), atan2(-X1, hypot(X2, X3)), (bx, by, bz), None, None)
-        )
+        roll, pitch = accel_roll_pitch(X1, X2, X3)  # X is a resting accelerometer's direction
+        return tuple_new(ESTIMATE, (roll, pitch, (bx, by, bz), None, None))
 
 
 def _packed_index(i: int, j: int) -> int:
@@ -443,11 +458,49 @@ def _sigma_offsets(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]
 
 
 def _psd_sqrt_columns(P: tuple[float, ...], gamma: float) -> list[tuple[float, ...]]:
-    """For a P that rounding made indefinite: the columns of gamma times the symmetric square
-    root with negative eigenvalues clipped to zero (never raises for a finite P)."""
-    full = np.array([[P[_packed_index(i, j)] for j in range(N_STATE)] for i in range(N_STATE)])
-    w, V = np.linalg.eigh(full)
-    return [tuple(c) for c in (gamma * (V * np.sqrt(np.clip(w, 0.0, None)))).T.tolist()]
+    """For a P that rounding made indefinite: the columns of gamma V sqrt(max(w, 0)), P = V
+    diag(w) V^T by cyclic Jacobi rotations (Golub & Van Loan, Matrix Computations, 8.5) in
+    plain floats, so that the C twin does the same operations (never raises for a finite P)."""
+    n = N_STATE
+    A = [[P[_packed_index(i, j)] for j in range(n)] for i in range(n)]
+    V = [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)]
+    for _ in range(JACOBI_SWEEPS):
+        off = 0.0
+        for i in range(n):
+            for j in range(i + 1, n):
+                off += A[i][j] * A[i][j]
+        if off == 0.0:
+            break
+        for p in range(n):
+            for q in range(p + 1, n):
+                apq = A[p][q]
+                if apq == 0.0:
+                    continue
+                theta = (A[q][q] - A[p][p]) / (2.0 * apq)
+                t = (1.0 if theta >= 0.0 else -1.0) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                s = t * c
+                for k in range(n):  # A <- A J (columns p and q)
+                    akp, akq = A[k][p], A[k][q]
+                    A[k][p] = c * akp - s * akq
+                    A[k][q] = s * akp + c * akq
+                for k in range(n):  # A <- J^T A (rows p and q)
+                    apk, aqk = A[p][k], A[q][k]
+                    A[p][k] = c * apk - s * aqk
+                    A[q][k] = s * apk + c * aqk
+                for k in range(n):  # V <- V J
+                    vkp, vkq = V[k][p], V[k][q]
+                    V[k][p] = c * vkp - s * vkq
+                    V[k][q] = s * vkp + c * vkq
+    out = []
+    for j in range(n):
+        root = gamma * math.sqrt(A[j][j]) if A[j][j] > 0.0 else 0.0
+        out.append(tuple(V[k][j] * root for k in range(n)))
+    return out
+
+
+JACOBI_SWEEPS: Final = 30
+"""Most sweeps of the Jacobi eigenvalue iteration (a 6x6 matrix converges in well under 10)."""
 
 
 def _kalman_update(
@@ -523,6 +576,27 @@ def _consider_bias(result: UpdateResult, x: tuple[float, ...], P: tuple[float, .
             tuple(P[i] if i in bb else v for i, v in enumerate(Pn)))
 
 
+def _cholesky3(
+    s00: float, s10: float, s11: float, s20: float, s21: float, s22: float,
+) -> tuple[float, float, float, float, float, float] | None:
+    """The packed lower Cholesky factor of a packed 3x3 S, or None when S is not positive
+    definite."""
+    if not s00 > 0.0:
+        return None
+    l00 = math.sqrt(s00)
+    l10 = s10 / l00
+    d = s11 - l10 * l10
+    if not d > 0.0:
+        return None
+    l11 = math.sqrt(d)
+    l20 = s20 / l00
+    l21 = (s21 - l20 * l10) / l11
+    d = s22 - l20 * l20 - l21 * l21
+    if not d > 0.0:
+        return None
+    return l00, l10, l11, l20, l21, math.sqrt(d)
+
+
 def _cholesky4(
     s00: float, s10: float, s11: float, s20: float, s21: float, s22: float,
     s30: float, s31: float, s32: float, s33: float,
@@ -560,15 +634,38 @@ def _general_update(
     y: tuple[float, float, float, float],
 ) -> UpdateResult:
     """_kalman_update for an S that is not positive definite (possible only with beta < alpha^2,
-    which gives the central point a negative covariance weight): a general solve."""
-    S_full = np.array([[S[_packed_index(i, j)] for j in range(4)] for i in range(4)])
-    Pxz = np.array(rows)
-    K = np.linalg.solve(S_full, Pxz.T).T
-    x0, x1, x2, x3, x4, x5 = (np.asarray(x) + K @ np.asarray(y)).tolist()
-    KSK = K @ S_full @ K.T
-    KSK = 0.5 * (KSK + KSK.T)
-    n = N_STATE
+    which gives the central point a negative covariance weight): K^T = S^-1 P_xz^T by Gauss-Jordan
+    elimination with partial pivoting in plain floats (the C twin does the same operations); x +
+    K y and P - K S K^T, symmetrised. A singular S leaves x and P as they were."""
+    m = 4
+    Sf = [[S[_packed_index(i, j)] for j in range(m)] for i in range(m)]
+    # the augmented system [S | P_xz^T | y]: 6 right-hand sides for K^T, one for S^-1 y
+    aug = [Sf[i] + [rows[k][i] for k in range(N_STATE)] + [y[i]] for i in range(m)]
+    width = m + N_STATE + 1
+    for col in range(m):
+        pivot = col
+        for i in range(col + 1, m):
+            if abs(aug[i][col]) > abs(aug[pivot][col]):
+                pivot = i
+        if aug[pivot][col] == 0.0:
+            return x[0], x[1], x[2], x[3], x[4], x[5], P
+        aug[col], aug[pivot] = aug[pivot], aug[col]
+        inv = 1.0 / aug[col][col]
+        aug[col] = [v * inv for v in aug[col]]
+        for i in range(m):
+            if i != col and aug[i][col] != 0.0:
+                f = aug[i][col]
+                aug[i] = [aug[i][k] - f * aug[col][k] for k in range(width)]
+    # K[i][k] = (S^-1 P_xz^T)[k][i]; S^-1 y in the last column
+    K = [[aug[k][m + i] for k in range(m)] for i in range(N_STATE)]
+    Siy = [aug[k][width - 1] for k in range(m)]
+    x0, x1, x2, x3, x4, x5 = (x[i] + sum(rows[i][k] * Siy[k] for k in range(m))
+                              for i in range(N_STATE))
+    # K S K^T = K P_xz^T (K S = P_xz); symmetrised
+    KSK = [[sum(K[i][k] * rows[j][k] for k in range(m)) for j in range(N_STATE)]
+           for i in range(N_STATE)]
     return (
         x0, x1, x2, x3, x4, x5,
-        tuple(float(P[_packed_index(i, j)] - KSK[i, j]) for i in range(n) for j in range(i + 1)),
+        tuple(P[_packed_index(i, j)] - 0.5 * (KSK[i][j] + KSK[j][i])
+              for i in range(N_STATE) for j in range(i + 1)),
     )

@@ -84,10 +84,10 @@ def test_the_generated_parameter_header_is_up_to_date() -> None:
 
 def test_backend_names_are_checked_and_auto_falls_back_to_python() -> None:
     rec = mixed_recording()
-    est = make("ukf")
+    est = make("poskf")
     with pytest.raises(ValueError, match="backend='cuda' is not allowed"):
         est.run(rec["acc"][:5], rec["gyro"][:5], rec["dt"][:5], backend="cuda")
-    with pytest.raises(ValueError, match="UnscentedKalmanFilter has no C twin"):
+    with pytest.raises(ValueError, match="PositionKalmanFilter has no C twin"):
         est.run(rec["acc"][:5], rec["gyro"][:5], rec["dt"][:5], backend="native")
     auto = est.run(rec["acc"][:50], rec["gyro"][:50], rec["dt"][:50])
     assert np.isfinite(auto["roll"]).all()
@@ -233,3 +233,38 @@ def test_the_embedded_example_builds_and_converges(tmp_path: Path) -> None:
                           ).stdout.splitlines()[-1]
     roll = float(last.split("roll=")[1].split()[0])
     assert abs(roll - 10.0) < 0.1, last
+
+
+@needs_twin
+@pytest.mark.parametrize("params", [{"alpha": 0.3, "beta": 0.0, "kappa": -2.0},
+                                    {"alpha": 1.0, "beta": 0.5, "kappa": 1.0}])
+def test_ukf_sigma_point_settings_are_equal(params: dict) -> None:
+    """Other sigma-point spreads, beta < alpha^2 among them (a negative central weight, where
+    S may not be positive definite and the general solve takes over)."""
+    rec = mixed_recording()
+    py, c = make("ukf", **params), make("ukf", **params)
+    assert_same(py.run(rec["acc"], rec["gyro"], rec["dt"], backend="python"),
+                c.run(rec["acc"], rec["gyro"], rec["dt"], backend="native"))
+    assert_same_state(py, c)
+
+
+@needs_twin
+def test_ukf_with_a_covariance_made_indefinite_takes_the_same_square_root() -> None:
+    """P pushed just below positive definite: both twins fall back to the Jacobi square root."""
+    rec = mixed_recording()
+    acc, gyro, dt = rec["acc"], rec["gyro"], rec["dt"]
+    base = make("ukf")
+    base.run(acc[:300], gyro[:300], dt[:300], backend="python")
+    P = np.array(base.P)
+    w, V = np.linalg.eigh(P)
+    P = P - (w[0] + 1e-12 * w[-1]) * np.outer(V[:, 0], V[:, 0])
+    P = 0.5 * (P + P.T)
+    assert np.min(np.linalg.eigvalsh(P)) < 0.0
+    snapshot = base.get_state()
+    snapshot["state"]["P"] = P.tolist()
+    py, c = make("ukf"), make("ukf")
+    py.set_state(snapshot)
+    c.set_state(snapshot)
+    assert_same(py.run(acc[300:400], gyro[300:400], dt[300:400], backend="python"),
+                c.run(acc[300:400], gyro[300:400], dt[300:400], backend="native"))
+    assert_same_state(py, c)

@@ -33,9 +33,9 @@ from typing import Any
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-SOURCES = ("fc_core.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c")
+SOURCES = ("fc_core.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c")
 """The C sources, in link order."""
-HEADERS = ("fc_core.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h")
+HEADERS = ("fc_core.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h")
 """The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
@@ -44,11 +44,15 @@ TWINS = {
     "ComplementaryFilter": "fc_cf",
     "GainScheduledComplementaryFilter": "fc_mgcf",
     "AngleBiasKalmanFilter": "fc_kf",
+    "UnscentedKalmanFilter": "fc_ukf",
 }
 """The estimators that have a C twin, by class name, and the twin's C prefix."""
 ESTIMATE_FIELDS = 11
 """Doubles per fc_estimate: roll, pitch, bias[3], pos[3], vel[3]."""
 BASE_STATE = ("initialized", "n_samples", "n_rejected", "gyro_prev")
+STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}}
+"""Where a twin's state field is kept under another Python attribute: the UKF's P is its packed
+lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
 RUN_CHUNK = 1024
 """Samples per call of the C batch run (base.RUN_CHUNK)."""
 """Estimator._BASE_STATE: these live in the twin's `base` member."""
@@ -177,6 +181,8 @@ def _field_value(cdata: Any, name: str, template: Any) -> Any:
     value = getattr(cdata, name)
     if isinstance(template, tuple):
         return tuple(float(value[i]) for i in range(len(template)))
+    if isinstance(template, list):
+        return [float(value[i]) for i in range(len(template))]
     if isinstance(template, bool):
         return bool(value)
     if isinstance(template, int):
@@ -185,7 +191,7 @@ def _field_value(cdata: Any, name: str, template: Any) -> Any:
 
 
 def _set_field(cdata: Any, name: str, value: Any) -> None:
-    if isinstance(value, tuple):
+    if isinstance(value, (tuple, list)):
         arr = getattr(cdata, name)
         for i, v in enumerate(value):
             arr[i] = v
@@ -206,8 +212,9 @@ def new_twin(estimator: Any) -> Any:
     getattr(lib, f"{prefix}_init")(twin, params)
     for name in BASE_STATE:
         _set_field(twin.base, name, getattr(estimator, name))
+    attrs = STATE_ATTRIBUTES.get(type(estimator).__name__, {})
     for name in estimator.STATE:
-        _set_field(twin, name, getattr(estimator, name))
+        _set_field(twin, name, getattr(estimator, attrs.get(name, name)))
     twin.last = getattr(lib, f"{prefix}_estimate")(twin)
     return twin
 
@@ -216,8 +223,10 @@ def take_state(estimator: Any, twin: Any) -> None:
     """Copy the twin's state into the Python estimator (which continues from it exactly)."""
     for name in BASE_STATE:
         setattr(estimator, name, _field_value(twin.base, name, getattr(estimator, name)))
+    attrs = STATE_ATTRIBUTES.get(type(estimator).__name__, {})
     for name in estimator.STATE:
-        setattr(estimator, name, _field_value(twin, name, getattr(estimator, name)))
+        attr = attrs.get(name, name)
+        setattr(estimator, attr, _field_value(twin, name, getattr(estimator, attr)))
     estimator.last = estimator._estimate()
 
 

@@ -8,6 +8,7 @@
 #include "fc_cf.h"
 #include "fc_kf.h"
 #include "fc_mgcf.h"
+#include "fc_ukf.h"
 
 #define N 4000
 
@@ -69,6 +70,14 @@ int main(void)
             mp.gyro_sampling = FC_MGCF_GYRO_SAMPLING_MEAN;
         }
         fc_mgcf_init(&mgcf, &mp);
+        fc_ukf ukf;
+        fc_ukf_params up;
+        fc_ukf_params_default(&up);
+        if (variant) {
+            up.alpha = 0.3;
+            up.beta = 0.0;  /* a negative central weight: the general solve */
+        }
+        fc_ukf_init(&ukf, &up);
         fc_cf_params cp;
         fc_kf_params kp;
         fc_cf_params_default(&cp);
@@ -88,6 +97,8 @@ int main(void)
             bad += !finite_estimate(&e);
             fc_mgcf_step(&mgcf, acc_all[i], gyro_all[i], dt_all[i], &e);
             bad += !finite_estimate(&e);
+            fc_ukf_step(&ukf, acc_all[i], gyro_all[i], dt_all[i], &e);
+            bad += !finite_estimate(&e);
         }
         fc_cf_reset(&cf);
         fc_kf_reset(&kf);
@@ -101,6 +112,11 @@ int main(void)
         }
         fc_mgcf_reset(&mgcf);
         fc_mgcf_run(&mgcf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
+        for (int i = 0; i < N; i++) {
+            bad += !finite_estimate(&out[i]);
+        }
+        fc_ukf_reset(&ukf);
+        fc_ukf_run(&ukf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
         for (int i = 0; i < N; i++) {
             bad += !finite_estimate(&out[i]);
         }

@@ -1,0 +1,35 @@
+/* fc_ukf.h: the unscented Kalman filter on the gravity direction with three gyro-bias states
+ * (fusion_core/ukf.py, UnscentedKalmanFilter), the C twin. Duong Quoc et al. eq. 14-17; scaled
+ * sigma points after Wan & van der Merwe (2000); the identities that spare the matrices are
+ * derived in the Python module's docstring. */
+#ifndef FC_UKF_H
+#define FC_UKF_H
+
+#include "fc_core.h"
+#include "fc_params.h"
+
+typedef struct fc_ukf {
+    fc_ukf_params params;
+    fc_base base;
+    /* UnscentedKalmanFilter.STATE */
+    double x[6];      /* X (the gravity direction, 3), b (the gyro bias, 3) */
+    double P[21];     /* the covariance's lower triangle, row by row */
+    double acc_f[3];
+    double rest[7];
+    fc_estimate last;
+    /* derived from params (UnscentedKalmanFilter._configure) */
+    double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
+    double bias_lo2, bias_hi2;
+    int trapezoid, options;
+} fc_ukf;
+
+void fc_ukf_init(fc_ukf *f, const fc_ukf_params *params);
+void fc_ukf_configure(fc_ukf *f);
+void fc_ukf_reset(fc_ukf *f);
+fc_status fc_ukf_step(fc_ukf *f, const double acc[3], const double gyro[3], double dt,
+                      fc_estimate *out);
+long fc_ukf_run(fc_ukf *f, long n, const double *acc, const double *gyro, const double *dt,
+                fc_estimate *out, unsigned char *rejected);
+fc_estimate fc_ukf_estimate(const fc_ukf *f);
+
+#endif /* FC_UKF_H */
