@@ -32,6 +32,12 @@ REAL_ACC_DENSITY = 0.005
 """Accelerometer white-noise density [m/s^2/sqrt(Hz)] measured on a real MEMS IMU at rest
 (BROAD's myon aktos-t: 0.004-0.006), the recommended acc_psd's root."""
 
+PENDING_MAX = 2048
+"""Most accelerometer samples the stationary queue holds (tilt_update="stationary"); when full
+the oldest is dropped unapplied. The queue holds zupt_window seconds of samples: 250 at 1 kHz
+with the default window, so the bound is met up to 8 kHz. A fixed bound lets the C twin keep
+the queue in its state without allocating."""
+
 TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "gyro_sampling")
 """Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
 TILT_DEFAULTS = {k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "gate_low",
@@ -449,6 +455,8 @@ class PositionKalmanFilter(Estimator):
             if stationary and tilt.accel_trusted(ax * ax + ay * ay + az * az):
                 # Only samples that are themselves inside a stationary period (quiet for
                 # zupt_window before), so the tail of a deceleration is never taken for tilt.
+                if len(pending) >= PENDING_MAX:
+                    pending.pop(0)
                 pending.append((quiet_time, *accel_roll_pitch(ax, ay, az),
                                 turned_roll, turned_pitch))
             while pending and quiet_time - pending[0][0] >= window:

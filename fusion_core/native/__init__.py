@@ -33,9 +33,11 @@ from typing import Any
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-SOURCES = ("fc_core.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c")
+SOURCES = ("fc_core.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c")
 """The C sources, in link order."""
-HEADERS = ("fc_core.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h")
+HEADERS = (
+    "fc_core.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h", "fc_poskf.h",
+)
 """The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
@@ -45,6 +47,7 @@ TWINS = {
     "GainScheduledComplementaryFilter": "fc_mgcf",
     "AngleBiasKalmanFilter": "fc_kf",
     "UnscentedKalmanFilter": "fc_ukf",
+    "PositionKalmanFilter": "fc_poskf",
 }
 """The estimators that have a C twin, by class name, and the twin's C prefix."""
 ESTIMATE_FIELDS = 11
@@ -53,6 +56,8 @@ BASE_STATE = ("initialized", "n_samples", "n_rejected", "gyro_prev")
 STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}}
 """Where a twin's state field is kept under another Python attribute: the UKF's P is its packed
 lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
+POSKF_PENDING_MAX = 2048
+"""fc_poskf.h's FC_POSKF_PENDING_MAX (position.PENDING_MAX)."""
 RUN_CHUNK = 1024
 """Samples per call of the C batch run (base.RUN_CHUNK)."""
 """Estimator._BASE_STATE: these live in the twin's `base` member."""
@@ -118,14 +123,23 @@ def build(force: bool = False) -> Path:
 
 def cdef() -> str:
     """The headers as cffi declarations: comments, include guards, #includes and the static
-    inline default functions left out; integer #defines kept."""
-    out = []
+    inline default functions left out; integer #defines kept, and written into the declarations
+    that use them (array sizes)."""
+    out: list[str] = []
+    defines: dict[str, str] = {}
     for name in HEADERS:
         text = re.sub(r"/\*.*?\*/", "", (HERE / name).read_text(), flags=re.S)
         text = re.sub(r"static inline[^{]*\{.*?\n\}\n", "", text, flags=re.S)
         for line in text.splitlines():
-            if line.startswith("#") and not re.match(r"#define \w+ -?\d+$", line):
+            line = line.rstrip()
+            define = re.match(r"#define (\w+) (-?\d+)$", line)
+            if define:
+                defines[define.group(1)] = define.group(2)
+            elif line.startswith("#"):
                 continue
+            elif defines:
+                line = re.sub(r"\b(" + "|".join(defines) + r")\b",
+                              lambda m: defines[m.group(1)], line)
             out.append(line)
     return "\n".join(out)
 
@@ -199,6 +213,74 @@ def _set_field(cdata: Any, name: str, value: Any) -> None:
         setattr(cdata, name, value)
 
 
+def _fill(lib: Any, twin: Any, estimator: Any) -> None:
+    """Copy the Python estimator's whole state into its twin (a pointer to the C struct)."""
+    name = type(estimator).__name__
+    for field in BASE_STATE:
+        _set_field(twin.base, field, getattr(estimator, field))
+    if name == "PositionKalmanFilter":
+        _fill_position(lib, twin, estimator)
+    else:
+        attrs = STATE_ATTRIBUTES.get(name, {})
+        for field in estimator.STATE:
+            _set_field(twin, field, getattr(estimator, attrs.get(field, field)))
+    twin.last = getattr(lib, f"{TWINS[name]}_estimate")(twin)
+
+
+def _take(twin: Any, estimator: Any) -> None:
+    """Copy the twin's whole state into the Python estimator."""
+    name = type(estimator).__name__
+    for field in BASE_STATE:
+        setattr(estimator, field, _field_value(twin.base, field, getattr(estimator, field)))
+    if name == "PositionKalmanFilter":
+        _take_position(twin, estimator)
+    else:
+        attrs = STATE_ATTRIBUTES.get(name, {})
+        for field in estimator.STATE:
+            attr = attrs.get(field, field)
+            setattr(estimator, attr, _field_value(twin, field, getattr(estimator, attr)))
+    estimator.last = estimator._estimate()
+
+
+def _fill_position(lib: Any, twin: Any, est: Any) -> None:
+    """The position filter's state: its own fields, its queue and its two nested Kalman filters
+    (whose parameters fc_poskf_configure already set from the position filter's)."""
+    _, ffi = lib_and_ffi()
+    _fill(lib, ffi.addressof(twin[0], "tilt"), est.tilt)
+    _fill(lib, ffi.addressof(twin[0], "att"), est.att)
+    twin.yaw = est.yaw
+    _set_field(twin, "x", est._x)
+    _set_field(twin, "P", est._P)
+    twin.quiet_time = est.quiet_time
+    twin.stationary = est.stationary
+    if len(est.pending) > POSKF_PENDING_MAX:
+        raise ValueError(f"the stationary queue holds {len(est.pending)} samples, more than "
+                         f"the C twin's {POSKF_PENDING_MAX}")
+    twin.pending_head = 0
+    twin.pending_count = len(est.pending)
+    for i, entry in enumerate(est.pending):
+        for j, v in enumerate(entry):
+            twin.pending[i][j] = v
+    _set_field(twin, "turned", est.turned)
+    _set_field(twin, "f_mean", est.f_mean)
+
+
+def _take_position(twin: Any, est: Any) -> None:
+    _, ffi = lib_and_ffi()
+    _take(ffi.addressof(twin[0], "tilt"), est.tilt)
+    _take(ffi.addressof(twin[0], "att"), est.att)
+    est.yaw = float(twin.yaw)
+    est._x = tuple(float(v) for v in twin.x)
+    est._P = tuple(float(v) for v in twin.P)
+    est.quiet_time = float(twin.quiet_time)
+    est.stationary = bool(twin.stationary)
+    head, count = twin.pending_head, twin.pending_count
+    est.pending = [tuple(float(v) for v in twin.pending[(head + i) % POSKF_PENDING_MAX])
+                   for i in range(count)]
+    est.turned = tuple(float(v) for v in twin.turned)
+    est.f_mean = tuple(float(v) for v in twin.f_mean)
+
+
 def new_twin(estimator: Any) -> Any:
     """A C twin holding the estimator's parameters and its whole state."""
     lib, ffi = lib_and_ffi()
@@ -210,24 +292,13 @@ def new_twin(estimator: Any) -> Any:
         choices = specs[name].choices
         setattr(params, name, choices.index(value) if choices is not None else value)
     getattr(lib, f"{prefix}_init")(twin, params)
-    for name in BASE_STATE:
-        _set_field(twin.base, name, getattr(estimator, name))
-    attrs = STATE_ATTRIBUTES.get(type(estimator).__name__, {})
-    for name in estimator.STATE:
-        _set_field(twin, name, getattr(estimator, attrs.get(name, name)))
-    twin.last = getattr(lib, f"{prefix}_estimate")(twin)
+    _fill(lib, twin, estimator)
     return twin
 
 
 def take_state(estimator: Any, twin: Any) -> None:
     """Copy the twin's state into the Python estimator (which continues from it exactly)."""
-    for name in BASE_STATE:
-        setattr(estimator, name, _field_value(twin.base, name, getattr(estimator, name)))
-    attrs = STATE_ATTRIBUTES.get(type(estimator).__name__, {})
-    for name in estimator.STATE:
-        attr = attrs.get(name, name)
-        setattr(estimator, attr, _field_value(twin, name, getattr(estimator, attr)))
-    estimator.last = estimator._estimate()
+    _take(twin, estimator)
 
 
 def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray

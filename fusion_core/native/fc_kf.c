@@ -157,7 +157,7 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
 }
 
 /* propagate: the angles by the Euler rates or the quaternion, P by the papers' F and Q */
-static void propagate(fc_kf *f, const double g[3], double dt, const double *phi_in)
+void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_in)
 {
     double bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
     if (f->quaternion) {
@@ -192,7 +192,7 @@ static void propagate(fc_kf *f, const double g[3], double dt, const double *phi_
 }
 
 /* correct_innovation */
-static void correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
+void fc_kf_correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
 {
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
@@ -215,13 +215,25 @@ static void correct_innovation(fc_kf *f, double y_roll, double y_pitch, int lear
 }
 
 /* correct: the accelerometer's roll and pitch */
-static void correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
+void fc_kf_correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
 {
     double acc_roll, acc_pitch;
     fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
     double y_roll = acc_roll - f->roll;
-    correct_innovation(f, -FC_PI <= y_roll && y_roll <= FC_PI ? y_roll : fc_wrap_angle(y_roll),
+    fc_kf_correct_innovation(f, -FC_PI <= y_roll && y_roll <= FC_PI ? y_roll : fc_wrap_angle(y_roll),
                        acc_pitch - f->pitch, learn_bias);
+}
+
+/* correct_bias: direct measurements of the x and y gyro bias (variance r each) */
+void fc_kf_correct_bias(fc_kf *f, double z_x, double z_y, double r)
+{
+    bias_update(&f->roll, &f->bias_x, f->P_roll, z_x - f->bias_x, r);
+    bias_update(&f->pitch, &f->bias_y, f->P_pitch, z_y - f->bias_y, r);
+}
+
+int fc_kf_accel_trusted(const fc_kf *f, double norm2)
+{
+    return f->gate_low2 <= norm2 && norm2 <= f->gate_high2;
 }
 
 /* _zero_rate_update: at rest the gyro measures the bias */
@@ -231,8 +243,7 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
         double r = f->gyro_var / dt;
-        bias_update(&f->roll, &f->bias_x, f->P_roll, g[0] - f->bias_x, r);
-        bias_update(&f->pitch, &f->bias_y, f->P_pitch, g[1] - f->bias_y, r);
+        fc_kf_correct_bias(f, g[0], g[1], r);
         double k = f->P_z / (f->P_z + r);
         f->bias_z += k * (g[2] - f->bias_z);
         f->P_z -= k * f->P_z;
@@ -250,7 +261,7 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
         fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
         have_phi = 1;
     }
-    propagate(f, g, dt, have_phi ? phi : NULL);
+    fc_kf_propagate(f, g, dt, have_phi ? phi : NULL);
     double pred_roll = f->roll, pred_pitch = f->pitch;
     double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2;
@@ -263,7 +274,7 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
     }
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        correct(f, a[0], a[1], a[2], learn_bias);
+        fc_kf_correct(f, a[0], a[1], a[2], learn_bias);
     }
     if (f->quaternion && (f->roll != pred_roll || f->pitch != pred_pitch)) {
         fc_quat_with_roll_pitch(f->q_att, f->roll, f->pitch);
@@ -344,10 +355,10 @@ static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double
             switch_face(f);
         }
     } else {
-        propagate(f, g_in, dt, NULL);
+        fc_kf_propagate(f, g_in, dt, NULL);
         double n2 = a_in[0] * a_in[0] + a_in[1] * a_in[1] + a_in[2] * a_in[2];
         if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-            correct(f, a_in[0], a_in[1], a_in[2], f->bias_lo2 < n2 && n2 < f->bias_hi2);
+            fc_kf_correct(f, a_in[0], a_in[1], a_in[2], f->bias_lo2 < n2 && n2 < f->bias_hi2);
         }
     }
 }

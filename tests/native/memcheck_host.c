@@ -8,6 +8,7 @@
 #include "fc_cf.h"
 #include "fc_kf.h"
 #include "fc_mgcf.h"
+#include "fc_poskf.h"
 #include "fc_ukf.h"
 
 #define N 4000
@@ -78,6 +79,14 @@ int main(void)
             up.beta = 0.0;  /* a negative central weight: the general solve */
         }
         fc_ukf_init(&ukf, &up);
+        static fc_poskf poskf;  /* 160 kB with its queue: not on the stack */
+        fc_poskf_params pp;
+        fc_poskf_params_default(&pp);
+        if (variant) {
+            pp.tilt_update = FC_POSKF_TILT_UPDATE_ALWAYS;
+            pp.attitude = FC_POSKF_ATTITUDE_TILT_STAGE;
+        }
+        fc_poskf_init(&poskf, &pp);
         fc_cf_params cp;
         fc_kf_params kp;
         fc_cf_params_default(&cp);
@@ -99,6 +108,8 @@ int main(void)
             bad += !finite_estimate(&e);
             fc_ukf_step(&ukf, acc_all[i], gyro_all[i], dt_all[i], &e);
             bad += !finite_estimate(&e);
+            fc_poskf_step(&poskf, acc_all[i], gyro_all[i], dt_all[i], &e);
+            bad += !finite_estimate(&e);
         }
         fc_cf_reset(&cf);
         fc_kf_reset(&kf);
@@ -117,6 +128,11 @@ int main(void)
         }
         fc_ukf_reset(&ukf);
         fc_ukf_run(&ukf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
+        for (int i = 0; i < N; i++) {
+            bad += !finite_estimate(&out[i]);
+        }
+        fc_poskf_reset(&poskf);
+        fc_poskf_run(&poskf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
         for (int i = 0; i < N; i++) {
             bad += !finite_estimate(&out[i]);
         }

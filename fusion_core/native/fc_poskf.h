@@ -1,0 +1,45 @@
+/* fc_poskf.h: the position Kalman filter with a zero-velocity update (fusion_core/position.py,
+ * PositionKalmanFilter), the C twin. Safitri, Cahyadi, Firmansyah eq. 20-29, with the tilt from
+ * the [angle, bias] Kalman filter (fc_kf) run on the same samples. */
+#ifndef FC_POSKF_H
+#define FC_POSKF_H
+
+#include "fc_core.h"
+#include "fc_kf.h"
+#include "fc_params.h"
+
+#define FC_POSKF_PENDING_MAX 2048  /* position.PENDING_MAX */
+
+typedef struct fc_poskf {
+    fc_poskf_params params;
+    fc_base base;
+    /* PositionKalmanFilter.STATE */
+    double yaw;
+    double x[9];      /* [p, v, a] of x, y, z */
+    double P[6];      /* the covariance the axes share: m00, m01, m02, m11, m12, m22 */
+    double quiet_time;
+    int stationary;
+    /* the stationary queue: (quiet time, acc roll, acc pitch, turned roll, turned pitch) */
+    double pending[FC_POSKF_PENDING_MAX][5];
+    int pending_head, pending_count;
+    double turned[2];
+    double f_mean[3];
+    fc_kf tilt;       /* the tilt stage */
+    fc_kf att;        /* the attitude output (attitude="kf") */
+    fc_estimate last;
+    /* derived from params (PositionKalmanFilter._configure) */
+    double acc_var_density, zupt_var, gyro_var_density;
+    double Q[6], R, Q_dt;
+    int own_attitude, always;
+} fc_poskf;
+
+void fc_poskf_init(fc_poskf *f, const fc_poskf_params *params);
+void fc_poskf_configure(fc_poskf *f);
+void fc_poskf_reset(fc_poskf *f);
+fc_status fc_poskf_step(fc_poskf *f, const double acc[3], const double gyro[3], double dt,
+                        fc_estimate *out);
+long fc_poskf_run(fc_poskf *f, long n, const double *acc, const double *gyro, const double *dt,
+                  fc_estimate *out, unsigned char *rejected);
+fc_estimate fc_poskf_estimate(const fc_poskf *f);
+
+#endif /* FC_POSKF_H */
