@@ -260,6 +260,24 @@ BIAS_GATE_PARAM = Param(
 )
 
 
+BIAS_INNOVATION: Final = 10.0 * DEG
+"""Recommended bias_innovation. A gyro bias shows in the accelerometer update as a slow drift of
+the tilt that each correction takes back: innovations of tenths of a degree (after the
+pre-filter, BROAD's largest are a few degrees in the fast trials). An innovation of tens of
+degrees means the attitude itself is grossly off (after a stretch of absurd samples, a knock,
+a restart in motion); the filters' linear model of the angle-bias coupling does not hold there,
+and learning from it winds the bias up to tens or hundreds of deg/s, which then takes minutes to
+unwind (measured after 1 s of absurd but accepted samples: kf not back under 1 deg within 120 s;
+with the gate, 14 s). The angle is corrected as always; only the bias waits."""
+BIAS_INNOVATION_PARAM = Param(
+    "bias_innovation", BIAS_INNOVATION,
+    "Largest tilt innovation the gyro bias learns from: beyond it the attitude is grossly off "
+    "(not a bias drift) and the accelerometer update corrects the angle only; pi = no limit "
+    "(the papers)",
+    unit="rad", low=0.0, low_open=True, high=math.pi, display_unit="deg",
+)
+
+
 def bias_band2(gate: float) -> tuple[float, float]:
     """BIAS_GATE_PARAM as bounds on the raw sample's squared norm: the bias learns while
     lo < |a|^2 < hi (any sample when the gate is 0, off)."""

@@ -25,6 +25,7 @@ from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
     BIAS_GATE_PARAM,
+    BIAS_INNOVATION_PARAM,
     FACE_SWITCH_COS,
     FACES,
     GYRO_SAMPLING_PARAM,
@@ -176,7 +177,8 @@ class AngleBiasKalmanFilter(Estimator):
     pre-filter, rest detection and quaternion propagation as building_blocks recommends, on the
     nearest face; the bias learns from the accelerometer only while the raw sample's norm is
     within 5 % of g (bias_gate, building_blocks.BIAS_GATE_PARAM: Duong Quoc et al.'s real-sensor
-    cutoff).
+    cutoff) and while both innovations are within 10 deg (bias_innovation,
+    building_blocks.BIAS_INNOVATION: a larger one is a gross attitude error, not a bias drift).
     Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 1.16 / 0.95 / 0.94 deg):
     the accelerometer's error after the pre-filter is coloured (residual linear acceleration),
     so a bias random walk sized from the gyro's real drift (3e-6 deg^2/s^3) lets it steer the
@@ -186,7 +188,8 @@ class AngleBiasKalmanFilter(Estimator):
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2]; gate_low, gate_high;
     acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_psd
-    [rad^2/s]; init_bias_std [rad/s]; bias_gate; propagation; tilt_axes; gyro_sampling;
+    [rad^2/s]; init_bias_std [rad/s]; bias_gate; bias_innovation [rad]; propagation; tilt_axes;
+    gyro_sampling;
     max_dt [s], max_rate [rad/s].
     """
 
@@ -218,6 +221,7 @@ class AngleBiasKalmanFilter(Estimator):
             unit="rad/s", low=0.0, tunable=False, display_unit="deg/s",
         ),
         BIAS_GATE_PARAM,
+        BIAS_INNOVATION_PARAM,
         PROPAGATION_PARAM,
         Param(
             "tilt_axes", "nearest_face",
@@ -261,6 +265,7 @@ class AngleBiasKalmanFilter(Estimator):
         self._quaternion: bool = p["propagation"] == "quaternion"
         self._faces: bool = p["tilt_axes"] == "nearest_face"
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
+        self._bias_innovation = float(p["bias_innovation"])
         # any real-sensor option on (else the papers' filter: the short path of _advance)
         self._options = self._quaternion or self._acc_tau > 0.0 or float(p["rest_time"]) > 0.0
 
@@ -407,13 +412,17 @@ class AngleBiasKalmanFilter(Estimator):
 
     def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch (the biases
-        left alone unless learn_bias: bias_gate)."""
+        left alone unless learn_bias, bias_gate, and while an innovation exceeds
+        bias_innovation)."""
         acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
         y_roll = acc_roll - self.roll
-        self.correct_innovation(
-            y_roll if -PI <= y_roll <= PI else wrap_angle(y_roll), acc_pitch - self.pitch,
-            learn_bias,
-        )
+        if not -PI <= y_roll <= PI:
+            y_roll = wrap_angle(y_roll)
+        y_pitch = acc_pitch - self.pitch
+        gate = self._bias_innovation
+        if not (-gate <= y_roll <= gate and -gate <= y_pitch <= gate):
+            learn_bias = False  # grossly off: the angle only (bias_innovation)
+        self.correct_innovation(y_roll, y_pitch, learn_bias)
 
     def correct_innovation(self, y_roll: float, y_pitch: float, learn_bias: bool = True) -> None:
         """Measurement update with given innovations (accelerometer angle - predicted angle);

@@ -18,6 +18,7 @@ covariance P (and one gain per update), kept as its upper triangle
 from __future__ import annotations
 
 import dataclasses
+import math
 from math import cos, sin, sqrt
 from typing import Any
 
@@ -48,7 +49,7 @@ rest, where the specific force is gravity alone, so it may trust each sample as 
 values are for a filter that must trust the accelerometer in motion too."""
 TILT_FIXED = {
     "propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0,
-    "tilt_axes": "body",
+    "tilt_axes": "body", "bias_innovation": math.pi,
 }
 """The tilt stage's other kf options: off. This filter drives the stage step by step (propagate,
 correct_innovation, correct_bias) and does its own rest detection and bias updates."""

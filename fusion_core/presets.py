@@ -19,6 +19,7 @@ such files.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -47,8 +48,8 @@ w0 = 0.05."""
 PAPER_KF: dict[str, Any] = {
     "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
     "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "init_bias_std": 0.0, "bias_gate": 0.0, "propagation": "euler", "tilt_axes": "body",
-    "gyro_sampling": "mean",
+    "init_bias_std": 0.0, "bias_gate": 0.0, "bias_innovation": math.pi, "propagation": "euler",
+    "tilt_axes": "body", "gyro_sampling": "mean",
 }
 """Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
 (times (pi/180)^2 here), P = 0 at the start, the Euler rates, the rectangle rule."""
@@ -56,7 +57,8 @@ PAPER_KF: dict[str, Any] = {
 PAPER_UKF: dict[str, Any] = {
     "gyro_psd": (0.05 * DEG) ** 2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
-    "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0, "gyro_sampling": "mean",
+    "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
+    "bias_innovation": math.pi, "gyro_sampling": "mean",
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
 simulated MPU-6050 at 100 Hz (gyro 10x the datasheet density, acc_noise 0.06 with an allowance

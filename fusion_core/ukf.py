@@ -48,6 +48,7 @@ from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
     BIAS_GATE_PARAM,
+    BIAS_INNOVATION_PARAM,
     GYRO_SAMPLING_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
@@ -81,7 +82,9 @@ class UnscentedKalmanFilter(Estimator):
     (0.008 deg/s/sqrt(Hz))^2, and acc_noise 0.005 = the accelerometer's measured density over g:
     the measurement is the pre-filtered vector, so no allowance for linear acceleration is added,
     and no gate is needed (acc_gate 1.0: off); bias_psd (1e-4 deg/s/sqrt(s))^2, the gyro's drift
-    over a 150 s recording, the rest updates doing the rest. The paper gives no values; the ones
+    over a 150 s recording, the rest updates doing the rest; the bias learns only while the
+    measured and the predicted gravity direction are within 10 deg (bias_innovation,
+    building_blocks.BIAS_INNOVATION). The paper gives no values; the ones
     we used to reproduce its Table 1 (10x the MPU-6050 gyro density, acc_noise 0.06 with an
     allowance for linear acceleration, gate at rho 0.1) are presets.PAPER_UKF.
     Output: roll = atan2(X2, X3), pitch = atan2(-X1, sqrt(X2^2 + X3^2)); bias = b.
@@ -136,6 +139,7 @@ class UnscentedKalmanFilter(Estimator):
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
         BIAS_GATE_PARAM,
+        BIAS_INNOVATION_PARAM,
     )
     STATE = ("x", "P", "acc_f", "rest")
 
@@ -159,6 +163,9 @@ class UnscentedKalmanFilter(Estimator):
         # any real-sensor option on (else the paper's filter alone: the short path of _advance)
         self._options = float(p["acc_lowpass"]) > 0.0 or float(p["rest_time"]) > 0.0
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
+        gate = float(p["bias_innovation"])
+        # cos of the largest innovation angle the bias learns from (-2: every one)
+        self._cos_innovation = math.cos(gate) if gate < math.pi else -2.0
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -358,6 +365,8 @@ class UnscentedKalmanFilter(Estimator):
             x02, x12, x22, P[18], P[19], P[20] + qb,
         )
         if update:
+            if ax * X0 + ay * X1 + az * X2 < self._cos_innovation * norm * n:
+                learn_bias = False  # grossly off: X only (bias_innovation)
             # ---- update (eq. 16-17): z = [acc/g; 1], h = [X; |X|^2], R diagonal.
             # S = [[A + r I, s_v], [s_v^T, s_vv + r_norm]], P_xz = [[A, s_v], [C, c_v]].
             mu_v = w * v_sum

@@ -220,8 +220,15 @@ void fc_kf_correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
     double acc_roll, acc_pitch;
     fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
     double y_roll = acc_roll - f->roll;
-    fc_kf_correct_innovation(f, -FC_PI <= y_roll && y_roll <= FC_PI ? y_roll : fc_wrap_angle(y_roll),
-                       acc_pitch - f->pitch, learn_bias);
+    if (!(-FC_PI <= y_roll && y_roll <= FC_PI)) {
+        y_roll = fc_wrap_angle(y_roll);
+    }
+    double y_pitch = acc_pitch - f->pitch;
+    double gate = f->params.bias_innovation;
+    if (!(-gate <= y_roll && y_roll <= gate && -gate <= y_pitch && y_pitch <= gate)) {
+        learn_bias = 0;  /* grossly off: the angle only (bias_innovation) */
+    }
+    fc_kf_correct_innovation(f, y_roll, y_pitch, learn_bias);
 }
 
 /* correct_bias: direct measurements of the x and y gyro bias (variance r each) */

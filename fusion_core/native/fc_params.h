@@ -105,26 +105,27 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 #define FC_KF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_kf_params {
-    double Q_angle;        /* [0.0, inf) [rad2/s] */
-    double Q_bias;         /* [0.0, inf) [rad2/s3] */
-    double R_measure;      /* (0.0, inf) [rad2] */
-    double gate_low;       /* (0.0, 1.0] */
-    double gate_high;      /* [1.0, inf) */
-    double acc_lowpass;    /* [0.0, inf) [s] */
-    double rest_time;      /* [0.0, inf) [s] */
-    double rest_gyro;      /* (0.0, inf) [rad/s] */
-    double rest_acc;       /* (0.0, inf) [m/s2] */
-    double gyro_psd;       /* (0.0, inf) [rad2/s] */
-    double init_bias_std;  /* [0.0, inf) [rad/s] */
-    double bias_gate;      /* [0.0, inf) */
-    int propagation;       /* one of 'euler', 'quaternion' */
-    int tilt_axes;         /* one of 'body', 'nearest_face' */
-    int gyro_sampling;     /* one of 'point', 'mean' */
-    double max_dt;         /* (0.0, inf) [s] */
-    double max_rate;       /* (0.0, inf) [rad/s] */
-    double mount_roll;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double Q_angle;          /* [0.0, inf) [rad2/s] */
+    double Q_bias;           /* [0.0, inf) [rad2/s3] */
+    double R_measure;        /* (0.0, inf) [rad2] */
+    double gate_low;         /* (0.0, 1.0] */
+    double gate_high;        /* [1.0, inf) */
+    double acc_lowpass;      /* [0.0, inf) [s] */
+    double rest_time;        /* [0.0, inf) [s] */
+    double rest_gyro;        /* (0.0, inf) [rad/s] */
+    double rest_acc;         /* (0.0, inf) [m/s2] */
+    double gyro_psd;         /* (0.0, inf) [rad2/s] */
+    double init_bias_std;    /* [0.0, inf) [rad/s] */
+    double bias_gate;        /* [0.0, inf) */
+    double bias_innovation;  /* (0.0, 3.141592653589793] [rad] */
+    int propagation;         /* one of 'euler', 'quaternion' */
+    int tilt_axes;           /* one of 'body', 'nearest_face' */
+    int gyro_sampling;       /* one of 'point', 'mean' */
+    double max_dt;           /* (0.0, inf) [s] */
+    double max_rate;         /* (0.0, inf) [rad/s] */
+    double mount_roll;       /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_kf_params;
 
 /* The defaults: AngleBiasKalmanFilter.PARAMS, the recommended preset. */
@@ -142,6 +143,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->gyro_psd = 1.949551486634935e-08;
     p->init_bias_std = 0.017453292519943295;
     p->bias_gate = 0.05;
+    p->bias_innovation = 0.17453292519943295;
     p->propagation = FC_KF_PROPAGATION_QUATERNION;
     p->tilt_axes = FC_KF_TILT_AXES_NEAREST_FACE;
     p->gyro_sampling = FC_KF_GYRO_SAMPLING_POINT;
@@ -158,27 +160,28 @@ static inline void fc_kf_params_default(fc_kf_params *p)
 #define FC_UKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_ukf_params {
-    double gyro_psd;       /* (0.0, inf) [rad2/s] */
-    double bias_psd;       /* [0.0, inf) [rad2/s3] */
-    double acc_noise;      /* (0.0, inf) */
-    double norm_noise;     /* (0.0, inf) */
-    double acc_gate;       /* (0.0, inf) */
-    double init_bias_std;  /* (0.0, inf) [rad/s] */
-    double alpha;          /* (0.0, 1.0] */
-    double beta;           /* [0.0, inf) */
-    double kappa;          /* (-5.0, inf) */
-    int gyro_sampling;     /* one of 'point', 'mean' */
-    double acc_lowpass;    /* [0.0, inf) [s] */
-    double rest_time;      /* [0.0, inf) [s] */
-    double rest_gyro;      /* (0.0, inf) [rad/s] */
-    double rest_acc;       /* (0.0, inf) [m/s2] */
-    double zaru_psd;       /* (0.0, inf) [rad2/s] */
-    double bias_gate;      /* [0.0, inf) */
-    double max_dt;         /* (0.0, inf) [s] */
-    double max_rate;       /* (0.0, inf) [rad/s] */
-    double mount_roll;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double gyro_psd;         /* (0.0, inf) [rad2/s] */
+    double bias_psd;         /* [0.0, inf) [rad2/s3] */
+    double acc_noise;        /* (0.0, inf) */
+    double norm_noise;       /* (0.0, inf) */
+    double acc_gate;         /* (0.0, inf) */
+    double init_bias_std;    /* (0.0, inf) [rad/s] */
+    double alpha;            /* (0.0, 1.0] */
+    double beta;             /* [0.0, inf) */
+    double kappa;            /* (-5.0, inf) */
+    int gyro_sampling;       /* one of 'point', 'mean' */
+    double acc_lowpass;      /* [0.0, inf) [s] */
+    double rest_time;        /* [0.0, inf) [s] */
+    double rest_gyro;        /* (0.0, inf) [rad/s] */
+    double rest_acc;         /* (0.0, inf) [m/s2] */
+    double zaru_psd;         /* (0.0, inf) [rad2/s] */
+    double bias_gate;        /* [0.0, inf) */
+    double bias_innovation;  /* (0.0, 3.141592653589793] [rad] */
+    double max_dt;           /* (0.0, inf) [s] */
+    double max_rate;         /* (0.0, inf) [rad/s] */
+    double mount_roll;       /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_ukf_params;
 
 /* The defaults: UnscentedKalmanFilter.PARAMS, the recommended preset. */
@@ -200,6 +203,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->rest_acc = 0.5;
     p->zaru_psd = 1.949551486634935e-08;
     p->bias_gate = 0.05;
+    p->bias_innovation = 0.17453292519943295;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;

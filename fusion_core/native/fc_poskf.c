@@ -144,6 +144,7 @@ void fc_poskf_configure(fc_poskf *f)
     tp.rest_time = 0.0;
     tp.init_bias_std = 0.0;
     tp.tilt_axes = FC_KF_TILT_AXES_BODY;
+    tp.bias_innovation = FC_PI;
     tp.Q_angle = p->Q_angle;
     tp.Q_bias = p->Q_bias;
     tp.R_measure = p->R_measure;

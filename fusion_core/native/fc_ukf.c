@@ -334,6 +334,7 @@ void fc_ukf_configure(fc_ukf *f)
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
     f->options = p->acc_lowpass > 0.0 || p->rest_time > 0.0;
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
+    f->cos_innovation = p->bias_innovation < FC_PI ? cos(p->bias_innovation) : -2.0;
 }
 
 fc_estimate fc_ukf_estimate(const fc_ukf *f)
@@ -558,6 +559,9 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
         x02, x12, x22, P[18], P[19], P[20] + qb,
     };
     if (update) {
+        if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
+            learn_bias = 0;  /* grossly off: X only (bias_innovation) */
+        }
         double mu_v = w * v_sum;
         double sv0 = w * ev0 + w_mu * mu0 * mu_v;
         double sv1 = w * ev1 + w_mu * mu1 * mu_v;

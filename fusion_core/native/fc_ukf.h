@@ -19,7 +19,7 @@ typedef struct fc_ukf {
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
     double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
-    double bias_lo2, bias_hi2;
+    double bias_lo2, bias_hi2, cos_innovation;
     int trapezoid, options;
 } fc_ukf;
 
