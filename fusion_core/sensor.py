@@ -44,8 +44,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
-
+from .noise import NormalBlocks, normals
 from .types import (
     DEG,
     MPU6050_ACC_DENSITY,
@@ -154,6 +153,11 @@ and 'ideal' (white noise, range and quantisation only: the sensor of the papers'
 N_NORMALS = 19
 """Standard normals drawn per sample: white noise (6), bias random walk (6), Gauss-Markov bias
 instability (6), timestamp jitter (1)."""
+N_RUN_NORMALS = 30
+"""Standard normals of the per-run errors: turn-on biases (6), the gyro's and the
+accelerometer's scale and cross-axis errors (9 each), the bias instability's start (6)."""
+NOISE_STREAM, RUN_STREAM = 0, 1
+"""The streams of fusion_core.noise the sensor draws from: per sample, and once per run."""
 
 
 def sensor_preset(name: str) -> dict[str, Any]:
@@ -222,19 +226,22 @@ class ImuSensorModel:
 
     def reset(self) -> None:
         p = self.params
-        self.rng = np.random.Generator(np.random.PCG64(p["seed"]))
+        # Counter-based noise (fusion_core.noise): sample k's normals depend on (seed, k) only,
+        # the same in the C twin and whatever the partition of the run into steps.
+        self.k = 0  # samples drawn so far
+        self._noise = NormalBlocks(p["seed"], NOISE_STREAM, N_NORMALS)
         # The per-run errors from a stream of their own, so that they do not shift the noise.
-        run = np.random.Generator(np.random.PCG64([p["seed"], 1]))
+        r = normals(p["seed"], RUN_STREAM, 0, 1, N_RUN_NORMALS)[0].tolist()
         gyro_std, acc_std, acc_scale, acc_cross = CALIBRATION[p["calibration"]]
-        self.gyro_turn_on = (run.standard_normal(3) * gyro_std).tolist()
-        self.acc_turn_on = (run.standard_normal(3) * acc_std).tolist()
-        self.gyro_matrix = _error_matrix(run, p["gyro_scale_std"], p["gyro_cross_axis_std"])
-        self.acc_matrix = _error_matrix(run, acc_scale, acc_cross)
+        self.gyro_turn_on = [r[i] * gyro_std[i] for i in range(3)]
+        self.acc_turn_on = [r[3 + i] * acc_std[i] for i in range(3)]
+        self.gyro_matrix = _error_matrix(r[6:15], p["gyro_scale_std"], p["gyro_cross_axis_std"])
+        self.acc_matrix = _error_matrix(r[15:24], acc_scale, acc_cross)
         self.gyro_walk = [0.0, 0.0, 0.0]  # random walk (gyro_bias_psd)
         self.acc_walk = [0.0, 0.0, 0.0]
         # Gauss-Markov bias instability, started from its stationary distribution
-        self.gyro_gm = (run.standard_normal(3) * p["gyro_bias_instability"]).tolist()
-        self.acc_gm = (run.standard_normal(3) * p["acc_bias_instability"]).tolist()
+        self.gyro_gm = [v * p["gyro_bias_instability"] for v in r[24:27]]
+        self.acc_gm = [v * p["acc_bias_instability"] for v in r[27:30]]
         self.omega_prev: list[float] | None = None
         self.time_error = 0.0
         cfg = int(p["dlpf_cfg"])
@@ -267,7 +274,8 @@ class ImuSensorModel:
         p = self.params
         if not h > 0.0:
             raise ValueError(f"interval h={h!r} s must be > 0")
-        z = self.rng.standard_normal(N_NORMALS).tolist()
+        z = self._noise.at(self.k)
+        self.k += 1
         rate = list(omega)
         if p["gyro_sampling"] == "mean":
             # the rate's mean over the interval, the rate taken linear between its ends
@@ -306,7 +314,7 @@ class ImuSensorModel:
             raise ValueError(f"sensor parameter {name!r} is fixed after the start")
         self.params[name] = spec.validate(value)
 
-    _STATE = ("gyro_turn_on", "acc_turn_on", "gyro_matrix", "acc_matrix", "gyro_walk",
+    _STATE = ("k", "gyro_turn_on", "acc_turn_on", "gyro_matrix", "acc_matrix", "gyro_walk",
               "acc_walk", "gyro_gm", "acc_gm", "omega_prev", "time_error")
 
     def get_state(self) -> dict[str, Any]:
@@ -314,12 +322,11 @@ class ImuSensorModel:
         for name in ("gyro_filter", "acc_filter"):
             filt = getattr(self, name)
             state[name] = None if filt is None or filt.state is None else _copy(filt.state)
-        return {"params": dict(self.params), "rng": self.rng.bit_generator.state, **state}
+        return {"params": dict(self.params), **state}
 
     def set_state(self, state: dict[str, Any]) -> None:
         self.params = dict(state["params"])
         self.reset()
-        self.rng.bit_generator.state = state["rng"]
         for name in self._STATE:
             setattr(self, name, _copy(state[name]))
         for name in ("gyro_filter", "acc_filter"):
@@ -335,13 +342,12 @@ def _copy(value: Any) -> Any:
     return value
 
 
-def _error_matrix(rng: np.random.Generator, scale_std: float, cross_std: float
-                  ) -> list[list[float]]:
-    """I + diag(scale errors) + cross-axis terms off the diagonal: measured = M true."""
-    scale = rng.standard_normal(3) * scale_std
-    cross = rng.standard_normal(6) * cross_std
-    it = iter(cross.tolist())
-    return [[1.0 + scale[i] if i == j else next(it) for j in range(3)] for i in range(3)]
+def _error_matrix(z: list[float], scale_std: float, cross_std: float) -> list[list[float]]:
+    """I + diag(scale errors) + cross-axis terms off the diagonal: measured = M true; z holds 9
+    standard normals, the 3 scale errors' and the 6 cross-axis terms' in row order."""
+    cross = iter(z[3:9])
+    return [[1.0 + z[i] * scale_std if i == j else next(cross) * cross_std for j in range(3)]
+            for i in range(3)]
 
 
 def _apply(m: list[list[float]], v: Any) -> list[float]:

@@ -311,3 +311,16 @@ def test_poskf_hands_over_a_filled_stationary_queue(tilt_update: str) -> None:
     for name in ("roll", "pitch", "bias", "pos", "vel"):
         joined = np.concatenate([head[name], tail[name]])
         assert np.max(np.abs(joined - whole[name])) <= TOL, name
+
+
+@needs_twin
+def test_the_counter_based_noise_is_the_same_in_c() -> None:
+    """fusion_core.noise and fc_noise.c: the same 64-bit hashes, so the same normals but for the
+    last bit of numpy's log and cos against libm's; any block of samples, any starting k."""
+    from fusion_core import noise
+
+    for seed, stream, k0 in ((0, 0, 0), (12345, 1, 0), (2**31 - 1, 0, 10**9)):
+        py = noise.normals(seed, stream, k0, 300, 19)
+        c = native.normals(seed, stream, k0, 300, 19)
+        assert np.max(np.abs(py - c)) <= 1e-14
+    assert np.array_equal(noise.normals(7, 0, 100, 5, 19), noise.normals(7, 0, 0, 105, 19)[100:])

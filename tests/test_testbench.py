@@ -257,14 +257,16 @@ def _cli(*args: str, fmu_dir: Path, out: Path) -> subprocess.CompletedProcess:
 
 
 def test_cli_exits_0_when_every_check_passes(fmu_dir: Path, tmp_path: Path) -> None:
-    proc = _cli("--estimator", "cf,mgcf", "--scenario", "static_level", "--duration", "3",
+    # kf and ukf: 0.055 deg on this 3 s run, well inside the 0.1 deg bound (the complementary
+    # filters' slow correction keeps the first sample's noise for longer: 0.10-0.12 deg)
+    proc = _cli("--estimator", "kf,ukf", "--scenario", "static_level", "--duration", "3",
                 "--sensor", "ideal", fmu_dir=fmu_dir, out=tmp_path)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "PASS" in proc.stdout
     import json
 
     report = json.loads((tmp_path / "report.json").read_text())
-    assert {r["estimator"] for r in report["runs"]} == {"cf", "mgcf"}
+    assert {r["estimator"] for r in report["runs"]} == {"kf", "ukf"}
     assert "rmse_roll_deg" in report["runs"][0]["metrics"]
     assert (tmp_path / "report.md").is_file()
 

@@ -33,10 +33,13 @@ from typing import Any
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-SOURCES = ("fc_core.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c")
+SOURCES = (
+    "fc_core.c", "fc_noise.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c",
+)
 """The C sources, in link order."""
 HEADERS = (
-    "fc_core.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h", "fc_poskf.h",
+    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h",
+    "fc_poskf.h",
 )
 """The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
@@ -142,6 +145,17 @@ def cdef() -> str:
                               lambda m: defines[m.group(1)], line)
             out.append(line)
     return "\n".join(out)
+
+
+def normals(seed: int, stream: int, k0: int, n: int, channels: int) -> np.ndarray:
+    """fusion_core.noise.normals computed by the C twin (fc_noise.c)."""
+    lib, ffi = lib_and_ffi()
+    out = np.empty((n, channels))
+    key = lib.fc_stream_key(seed, stream)
+    for i in range(n):
+        lib.fc_normals(key, k0 + i, channels,
+                       ffi.cast("double *", ffi.from_buffer(out[i], require_writable=True)))
+    return out
 
 
 def _load() -> None:
