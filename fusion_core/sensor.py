@@ -306,6 +306,42 @@ class ImuSensorModel:
         return (_convert(acc, p["acc_range"], p["bits"]),
                 _convert(gyro, p["gyro_range"], p["bits"]), dt)
 
+    def run(self, omega: Any, f: Any, h: Any, backend: str = "auto") -> dict[str, Any]:
+        """N samples at once: true rates omega and specific forces f [N, 3], intervals h [N] or
+        a scalar. Returns numpy arrays acc, gyro [N, 3], dt [N] and gyro_bias [N, 3] (the true
+        bias at each sample). backend as in Estimator.run: "native" (fusion_core.native's
+        twin, fc_sensor.c), "python" or "auto" (native where available); the same samples to
+        1e-12 either way, and the model's state afterwards is the same."""
+        import numpy as np
+
+        from .base import BACKENDS
+
+        if backend not in BACKENDS:
+            raise ValueError(f"backend={backend!r} is not allowed: expected one of "
+                             f"{', '.join(repr(b) for b in BACKENDS)}")
+        omega = np.asarray(omega, dtype=float)
+        f = np.asarray(f, dtype=float)
+        if omega.ndim != 2 or omega.shape[1] != 3 or f.shape != omega.shape:
+            raise ValueError(f"omega and f must both have shape [N, 3]: got {omega.shape} and "
+                             f"{f.shape}")
+        n = omega.shape[0]
+        hs = np.broadcast_to(np.asarray(h, dtype=float), (n,))
+        if backend != "python":
+            from . import native
+
+            if native.available():
+                return native.sensor_run(self, omega, f, hs)
+            if backend == "native":
+                raise ValueError(f"backend='native': the C twin is unavailable: "
+                                 f"{native.reason()}")
+        out = {"acc": np.empty((n, 3)), "gyro": np.empty((n, 3)), "dt": np.empty(n),
+               "gyro_bias": np.empty((n, 3))}
+        for i, (w, a, step) in enumerate(zip(omega.tolist(), f.tolist(), hs.tolist(),
+                                             strict=True)):
+            out["acc"][i], out["gyro"][i], out["dt"][i] = self.sample(tuple(w), tuple(a), step)
+            out["gyro_bias"][i] = self.gyro_bias
+        return out
+
     def set_param(self, name: str, value: Any) -> None:
         """Change a tunable parameter between samples (a constant bias takes its value now)."""
         check_param_names((name,), _SPECS, "the IMU sensor model")

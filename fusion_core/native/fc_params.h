@@ -34,7 +34,7 @@ typedef struct fc_cf_params {
     double mount_yaw;    /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_cf_params;
 
-/* The defaults: ComplementaryFilter.PARAMS, the recommended preset. */
+/* The defaults: ComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
 static inline void fc_cf_params_default(fc_cf_params *p)
 {
     p->tau = 1.0;
@@ -77,7 +77,7 @@ typedef struct fc_mgcf_params {
     double mount_yaw;    /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_mgcf_params;
 
-/* The defaults: GainScheduledComplementaryFilter.PARAMS, the recommended preset. */
+/* The defaults: GainScheduledComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
 static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 {
     p->schedule = FC_MGCF_SCHEDULE_FIXED;
@@ -128,7 +128,7 @@ typedef struct fc_kf_params {
     double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_kf_params;
 
-/* The defaults: AngleBiasKalmanFilter.PARAMS, the recommended preset. */
+/* The defaults: AngleBiasKalmanFilter.PARAMS (for an estimator, the recommended preset). */
 static inline void fc_kf_params_default(fc_kf_params *p)
 {
     p->Q_angle = 1.949551486634935e-08;
@@ -184,7 +184,7 @@ typedef struct fc_ukf_params {
     double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_ukf_params;
 
-/* The defaults: UnscentedKalmanFilter.PARAMS, the recommended preset. */
+/* The defaults: UnscentedKalmanFilter.PARAMS (for an estimator, the recommended preset). */
 static inline void fc_ukf_params_default(fc_ukf_params *p)
 {
     p->gyro_psd = 1.949551486634935e-08;
@@ -252,7 +252,7 @@ typedef struct fc_poskf_params {
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
 } fc_poskf_params;
 
-/* The defaults: PositionKalmanFilter.PARAMS, the recommended preset. */
+/* The defaults: PositionKalmanFilter.PARAMS (for an estimator, the recommended preset). */
 static inline void fc_poskf_params_default(fc_poskf_params *p)
 {
     p->qr_form = FC_POSKF_QR_FORM_WHITE_JERK;
@@ -281,6 +281,68 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+}
+
+/* ----- ImuSensorModel (sensor) ---------------------------------------------- */
+
+#define FC_SENSOR_GYRO_SAMPLING_POINT 0
+#define FC_SENSOR_GYRO_SAMPLING_MEAN 1
+#define FC_SENSOR_CALIBRATION_STARTUP 0
+#define FC_SENSOR_CALIBRATION_NONE 1
+#define FC_SENSOR_CALIBRATION_PERFECT 2
+
+typedef struct fc_sensor_params {
+    long seed;                     /* [0, 2147483647] */
+    int gyro_sampling;             /* one of 'point', 'mean' */
+    double gyro_psd;               /* [0.0, inf) [rad2/s] */
+    double acc_psd;                /* [0.0, inf) [m2/s3] */
+    int calibration;               /* one of 'startup', 'none', 'perfect' */
+    double gyro_bias_x;            /* (-inf, inf) [rad/s] */
+    double gyro_bias_y;            /* (-inf, inf) [rad/s] */
+    double gyro_bias_z;            /* (-inf, inf) [rad/s] */
+    double acc_bias_x;             /* (-inf, inf) [m/s2] */
+    double acc_bias_y;             /* (-inf, inf) [m/s2] */
+    double acc_bias_z;             /* (-inf, inf) [m/s2] */
+    double gyro_bias_instability;  /* [0.0, inf) [rad/s] */
+    double acc_bias_instability;   /* [0.0, inf) [m/s2] */
+    double bias_time_constant;     /* (0.0, inf) [s] */
+    double gyro_bias_psd;          /* [0.0, inf) [rad2/s3] */
+    double acc_bias_psd;           /* [0.0, inf) [m2/s5] */
+    double gyro_scale_std;         /* [0.0, 0.5] */
+    double gyro_cross_axis_std;    /* [0.0, 0.5] */
+    long dlpf_cfg;                 /* [-1, 6] */
+    double gyro_range;             /* (0.0, inf) [rad/s] */
+    double acc_range;              /* (0.0, inf) [m/s2] */
+    long bits;                     /* [0, 32] */
+    double jitter;                 /* [0.0, inf) [s] */
+} fc_sensor_params;
+
+/* The defaults: ImuSensorModel.PARAMS (for an estimator, the recommended preset). */
+static inline void fc_sensor_params_default(fc_sensor_params *p)
+{
+    p->seed = 0L;
+    p->gyro_sampling = FC_SENSOR_GYRO_SAMPLING_POINT;
+    p->gyro_psd = 7.615435494667716e-09;
+    p->acc_psd = 1.53872614756e-05;
+    p->calibration = FC_SENSOR_CALIBRATION_STARTUP;
+    p->gyro_bias_x = 0.0;
+    p->gyro_bias_y = 0.0;
+    p->gyro_bias_z = 0.0;
+    p->acc_bias_x = 0.0;
+    p->acc_bias_y = 0.0;
+    p->acc_bias_z = 0.0;
+    p->gyro_bias_instability = 5.235987755982989e-05;
+    p->acc_bias_instability = 0.0009806650000000001;
+    p->bias_time_constant = 100.0;
+    p->gyro_bias_psd = 0.0;
+    p->acc_bias_psd = 0.0;
+    p->gyro_scale_std = 0.01;
+    p->gyro_cross_axis_std = 0.006666666666666667;
+    p->dlpf_cfg = 0L;
+    p->gyro_range = 34.90658503988659;
+    p->acc_range = 156.9064;
+    p->bits = 16L;
+    p->jitter = 0.0;
 }
 
 #endif /* FC_PARAMS_H */

@@ -1,4 +1,5 @@
-"""Generate fc_params.h, the C twin's parameter structs, from the estimators' PARAMS tables.
+"""Generate fc_params.h, the C twin's parameter structs, from the PARAMS tables of the estimators
+and of the sensor model.
 
 One source of truth: every estimator's parameters (names, defaults, ranges, units, choices) are
 declared once, in its Python class; this script writes them as C so that the two languages
@@ -15,12 +16,14 @@ import sys
 from pathlib import Path
 
 from fusion_core import ESTIMATORS
+from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
 from fusion_core.types import Param
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "fc_params.h"
-PREFIX = {"cf": "fc_cf", "mgcf": "fc_mgcf", "kf": "fc_kf", "ukf": "fc_ukf", "poskf": "fc_poskf"}
-"""The C name of each estimator (fusion_core.ESTIMATORS key -> prefix)."""
+PREFIX = {"cf": "fc_cf", "mgcf": "fc_mgcf", "kf": "fc_kf", "ukf": "fc_ukf", "poskf": "fc_poskf",
+          "sensor": "fc_sensor"}
+"""The C name of each estimator (fusion_core.ESTIMATORS key -> prefix) and of the sensor model."""
 
 
 def c_double(x: float) -> str:
@@ -59,11 +62,12 @@ def comment(p: Param) -> str:
 
 
 def estimator_block(key: str) -> list[str]:
-    cls = ESTIMATORS[key]
+    if key == "sensor":
+        name, specs = ImuSensorModel.__name__, list(SENSOR_PARAMS)
+    else:
+        name, specs = ESTIMATORS[key].__name__, list(ESTIMATORS[key].param_specs().values())
     prefix = PREFIX[key]
-    specs = list(cls.param_specs().values())
-    out = [f"/* ----- {cls.__name__} ({key}) " + "-" * (80 - len(cls.__name__) - len(key) - 14)
-           + " */", ""]
+    out = [f"/* ----- {name} ({key}) " + "-" * (80 - len(name) - len(key) - 14) + " */", ""]
     for p in specs:
         if p.choices is not None:
             for i, choice in enumerate(p.choices):
@@ -77,7 +81,7 @@ def estimator_block(key: str) -> list[str]:
         out.append(f"{decl:<{width}}  /* {comment(p)} */")
     out.append(f"}} {prefix}_params;")
     out.append("")
-    out.append(f"/* The defaults: {cls.__name__}.PARAMS, the recommended preset. */")
+    out.append(f"/* The defaults: {name}.PARAMS (for an estimator, the recommended preset). */")
     out.append(f"static inline void {prefix}_params_default({prefix}_params *p)")
     out.append("{")
     for p in specs:

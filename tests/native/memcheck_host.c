@@ -9,6 +9,7 @@
 #include "fc_kf.h"
 #include "fc_mgcf.h"
 #include "fc_poskf.h"
+#include "fc_sensor.h"
 #include "fc_ukf.h"
 
 #define N 4000
@@ -135,6 +136,30 @@ int main(void)
         fc_poskf_run(&poskf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
         for (int i = 0; i < N; i++) {
             bad += !finite_estimate(&out[i]);
+        }
+    }
+    /* the sensor model: every parameter set's samples finite, saturated and quantised */
+    static double s_acc[N][3], s_gyro[N][3], s_dt[N], s_bias[N][3];
+    for (int variant = 0; variant < 2; variant++) {
+        fc_sensor sensor;
+        fc_sensor_params sp;
+        fc_sensor_params_default(&sp);
+        if (variant) {
+            sp.gyro_sampling = FC_SENSOR_GYRO_SAMPLING_MEAN;
+            sp.dlpf_cfg = 4;
+            sp.jitter = 0.001;
+            sp.calibration = FC_SENSOR_CALIBRATION_NONE;
+        }
+        fc_sensor_init(&sensor, &sp);
+        for (int i = 0; i < N; i++) {
+            dt_all[i] = 0.01;
+        }
+        fc_sensor_run(&sensor, N, &gyro_all[0][0], &acc_all[0][0], dt_all, &s_acc[0][0],
+                      &s_gyro[0][0], s_dt, &s_bias[0][0]);
+        for (int i = 0; i < N; i++) {
+            for (int j = 0; j < 3; j++) {
+                bad += !isfinite(s_acc[i][j]) || !isfinite(s_gyro[i][j]) || !isfinite(s_bias[i][j]);
+            }
         }
     }
     printf("non-finite estimates: %d\n", bad);
