@@ -18,7 +18,7 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 from __future__ import annotations
 
 from math import cos, sin
-from typing import Any, Final
+from typing import Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
@@ -229,7 +229,7 @@ class AngleBiasKalmanFilter(Estimator):
             "papers'; on a sensor resting on another face they lose the tilt near pitch +-90 deg "
             "and cannot learn the bias of the horizontal z axis) or 'nearest_face' (the sensor "
             "frame turned by the right-angle rotation that brings the axis nearest to up onto z, "
-            "chosen again past 60 deg: every resting face is the level case; needs "
+            "chosen again past 60 deg: every resting face is the level case; takes effect with "
             "propagation='quaternion')",
             choices=("body", "nearest_face"), tunable=False,
         ),
@@ -239,14 +239,6 @@ class AngleBiasKalmanFilter(Estimator):
         "roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch", "bias_z", "P_z", "acc_f", "rest",
         "q_att", "face",
     )
-
-    def _check_params(self, values: dict[str, Any]) -> None:
-        if values["tilt_axes"] == "nearest_face" and values["propagation"] != "quaternion":
-            raise ValueError(
-                "tilt_axes='nearest_face' needs propagation='quaternion' (the attitude is carried "
-                f"from face to face as a quaternion); got propagation={values['propagation']!r}: "
-                "set tilt_axes='body' for the Euler-rate propagation"
-            )
 
     def _configure(self) -> None:
         p = self._params
@@ -263,7 +255,9 @@ class AngleBiasKalmanFilter(Estimator):
             float(p["gyro_psd"]),
         )
         self._quaternion: bool = p["propagation"] == "quaternion"
-        self._faces: bool = p["tilt_axes"] == "nearest_face"
+        # the faces need the attitude quaternion to carry the state across (with the Euler rates
+        # the filters stay on the sensor's axes)
+        self._faces: bool = p["tilt_axes"] == "nearest_face" and self._quaternion
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
         self._bias_innovation = float(p["bias_innovation"])
         # any real-sensor option on (else the papers' filter: the short path of _advance)

@@ -271,6 +271,15 @@ def test_cli_exits_0_when_every_check_passes(fmu_dir: Path, tmp_path: Path) -> N
     assert (tmp_path / "report.md").is_file()
 
 
+def test_cli_runs_the_paper_preset_through_the_fmus(fmu_dir: Path, tmp_path: Path) -> None:
+    """The FMU host sets the preset's parameters one by one, in its own order: no combination
+    on the way (propagation='euler' before tilt_axes='body') may be refused."""
+    proc = _cli("--estimator", "kf,poskf", "--scenario", "static_level", "--duration", "1",
+                "--preset", "paper", fmu_dir=fmu_dir, out=tmp_path)
+    assert "error" not in proc.stderr.lower(), proc.stderr
+    assert "refused" not in proc.stdout + proc.stderr
+
+
 def test_cli_exits_1_on_a_failed_check(fmu_dir: Path, tmp_path: Path) -> None:
     proc = _cli("--estimator", "cf", "--scenario", "roll_sweep", "--duration", "5",
                 "--param", "gyro_sampling=mean", fmu_dir=fmu_dir, out=tmp_path)

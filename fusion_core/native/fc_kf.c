@@ -74,7 +74,7 @@ void fc_kf_configure(fc_kf *f)
     f->rest_acc = p->rest_acc;
     f->gyro_var = p->gyro_psd;
     f->quaternion = p->propagation == FC_KF_PROPAGATION_QUATERNION;
-    f->faces = p->tilt_axes == FC_KF_TILT_AXES_NEAREST_FACE;
+    f->faces = p->tilt_axes == FC_KF_TILT_AXES_NEAREST_FACE && f->quaternion;
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
     f->options = f->quaternion || f->acc_tau > 0.0 || p->rest_time > 0.0;
 }
