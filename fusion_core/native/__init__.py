@@ -126,13 +126,14 @@ def build(force: bool = False) -> Path:
 
 
 def cdef() -> str:
-    """The headers as cffi declarations: comments, include guards, #includes and the static
-    inline default functions left out; integer #defines kept, and written into the declarations
-    that use them (array sizes)."""
+    """The headers as cffi declarations: comments, include guards, #includes, macros and the
+    static inline default functions left out; integer #defines kept, and written into the
+    declarations that use them (array sizes)."""
     out: list[str] = []
     defines: dict[str, str] = {}
     for name in HEADERS:
         text = re.sub(r"/\*.*?\*/", "", (HERE / name).read_text(), flags=re.S)
+        text = text.replace("\\\n", " ")  # a macro's continued lines into one
         text = re.sub(r"static inline[^{]*\{.*?\n\}\n", "", text, flags=re.S)
         for line in text.splitlines():
             line = line.rstrip()

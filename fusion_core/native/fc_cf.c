@@ -110,31 +110,4 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
 }
 
-static void first_sample_op(void *self, const double acc[3], const double gyro[3])
-{
-    first_sample((fc_cf *)self, acc, gyro);
-}
-
-static void advance_op(void *self, const double acc[3], const double gyro[3], double dt)
-{
-    advance((fc_cf *)self, acc, gyro, dt);
-}
-
-static fc_estimate estimate_op(const void *self)
-{
-    return fc_cf_estimate((const fc_cf *)self);
-}
-
-static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};
-
-fc_status fc_cf_step(fc_cf *f, const double acc[3], const double gyro[3], double dt,
-                     fc_estimate *out)
-{
-    return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);
-}
-
-long fc_cf_run(fc_cf *f, long n, const double *acc, const double *gyro, const double *dt,
-               fc_estimate *out, unsigned char *rejected)
-{
-    return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);
-}
+FC_DEFINE_STEP_AND_RUN(fc_cf)

@@ -117,4 +117,32 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
             const double *acc, const double *gyro, const double *dt, fc_estimate *out,
             unsigned char *rejected);
 
+/* The fc_ops glue of an estimator T (fc_cf, ...), written once: defines T_step and T_run from the
+ * file's static first_sample(T *, acc, gyro) and advance(T *, acc, gyro, dt) and its public
+ * T_estimate. */
+#define FC_DEFINE_STEP_AND_RUN(T)                                                             \
+    static void first_sample_op(void *self, const double acc[3], const double gyro[3])       \
+    {                                                                                         \
+        first_sample((T *)self, acc, gyro);                                                   \
+    }                                                                                         \
+    static void advance_op(void *self, const double acc[3], const double gyro[3], double dt) \
+    {                                                                                         \
+        advance((T *)self, acc, gyro, dt);                                                    \
+    }                                                                                         \
+    static fc_estimate estimate_op(const void *self)                                          \
+    {                                                                                         \
+        return T##_estimate((const T *)self);                                                 \
+    }                                                                                         \
+    static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};                     \
+    fc_status T##_step(T *f, const double acc[3], const double gyro[3], double dt,            \
+                       fc_estimate *out)                                                      \
+    {                                                                                         \
+        return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);                      \
+    }                                                                                         \
+    long T##_run(T *f, long n, const double *acc, const double *gyro, const double *dt,       \
+                 fc_estimate *out, unsigned char *rejected)                                   \
+    {                                                                                         \
+        return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);          \
+    }
+
 #endif /* FC_CORE_H */

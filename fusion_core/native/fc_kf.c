@@ -370,31 +370,4 @@ static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double
     }
 }
 
-static void first_sample_op(void *self, const double acc[3], const double gyro[3])
-{
-    first_sample((fc_kf *)self, acc, gyro);
-}
-
-static void advance_op(void *self, const double acc[3], const double gyro[3], double dt)
-{
-    advance((fc_kf *)self, acc, gyro, dt);
-}
-
-static fc_estimate estimate_op(const void *self)
-{
-    return fc_kf_estimate((const fc_kf *)self);
-}
-
-static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};
-
-fc_status fc_kf_step(fc_kf *f, const double acc[3], const double gyro[3], double dt,
-                     fc_estimate *out)
-{
-    return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);
-}
-
-long fc_kf_run(fc_kf *f, long n, const double *acc, const double *gyro, const double *dt,
-               fc_estimate *out, unsigned char *rejected)
-{
-    return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);
-}
+FC_DEFINE_STEP_AND_RUN(fc_kf)

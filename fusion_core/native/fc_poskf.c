@@ -338,31 +338,4 @@ static void advance(fc_poskf *f, const double a[3], const double g[3], double dt
     axis_filters(f->x, f->P, f->Q, dt, acc, f->R, stationary && p->zupt, f->zupt_var);
 }
 
-static void first_sample_op(void *self, const double acc[3], const double gyro[3])
-{
-    first_sample((fc_poskf *)self, acc, gyro);
-}
-
-static void advance_op(void *self, const double acc[3], const double gyro[3], double dt)
-{
-    advance((fc_poskf *)self, acc, gyro, dt);
-}
-
-static fc_estimate estimate_op(const void *self)
-{
-    return fc_poskf_estimate((const fc_poskf *)self);
-}
-
-static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};
-
-fc_status fc_poskf_step(fc_poskf *f, const double acc[3], const double gyro[3], double dt,
-                        fc_estimate *out)
-{
-    return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);
-}
-
-long fc_poskf_run(fc_poskf *f, long n, const double *acc, const double *gyro, const double *dt,
-                  fc_estimate *out, unsigned char *rejected)
-{
-    return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);
-}
+FC_DEFINE_STEP_AND_RUN(fc_poskf)
