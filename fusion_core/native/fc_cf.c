@@ -38,29 +38,14 @@ void fc_cf_reset(fc_cf *f)
     f->last = fc_cf_estimate(f);
 }
 
-void fc_cf_init(fc_cf *f, const fc_cf_params *params)
-{
-    if (params) {
-        f->params = *params;
-    } else {
-        fc_cf_params_default(&f->params);
-    }
-    fc_cf_configure(f);
-    fc_cf_reset(f);
-}
+FC_DEFINE_INIT(fc_cf)
 
 static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _init */
 {
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
     memcpy(f->acc_f, a, sizeof f->acc_f);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
-    f->rest[0] = g[0];
-    f->rest[1] = g[1];
-    f->rest[2] = g[2];
-    f->rest[3] = a[0];
-    f->rest[4] = a[1];
-    f->rest[5] = a[2];
-    f->rest[6] = 0.0;
+    fc_rest_start(f->rest, g, a);
 }
 
 static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt)  /* _advance */

@@ -198,6 +198,17 @@ void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[
     f[2] = t[2] + k * (a[2] - t[2]);
 }
 
+void fc_rest_start(double rest[7], const double gyro[3], const double acc[3])
+{
+    rest[0] = gyro[0];
+    rest[1] = gyro[1];
+    rest[2] = gyro[2];
+    rest[3] = acc[0];
+    rest[4] = acc[1];
+    rest[5] = acc[2];
+    rest[6] = 0.0;
+}
+
 void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,
                   double az, double dt, double th_gyro, double th_acc)
 {

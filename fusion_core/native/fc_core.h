@@ -76,6 +76,8 @@ void fc_body_rotation(const double g0[3], const double g1[3], const double bias[
                       int trapezoid, double phi[3]);
 void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
                                double tau);
+/* The rest detector's state at the first sample: its means start at that sample, quiet 0. */
+void fc_rest_start(double rest[7], const double gyro[3], const double acc[3]);
 void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,
                   double az, double dt, double th_gyro, double th_acc);
 void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
@@ -116,6 +118,19 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
 long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
             const double *acc, const double *gyro, const double *dt, fc_estimate *out,
             unsigned char *rejected);
+
+/* T_init(f, params) for an estimator T: params (NULL: the defaults) in, T_configure, T_reset. */
+#define FC_DEFINE_INIT(T)                                                                     \
+    void T##_init(T *f, const T##_params *params)                                             \
+    {                                                                                         \
+        if (params) {                                                                         \
+            f->params = *params;                                                              \
+        } else {                                                                              \
+            T##_params_default(&f->params);                                                   \
+        }                                                                                     \
+        T##_configure(f);                                                                     \
+        T##_reset(f);                                                                         \
+    }
 
 /* The fc_ops glue of an estimator T (fc_cf, ...), written once: defines T_step and T_run from the
  * file's static first_sample(T *, acc, gyro) and advance(T *, acc, gyro, dt) and its public

@@ -115,16 +115,7 @@ void fc_kf_reset(fc_kf *f)
     f->last = fc_kf_estimate(f);
 }
 
-void fc_kf_init(fc_kf *f, const fc_kf_params *params)
-{
-    if (params) {
-        f->params = *params;
-    } else {
-        fc_kf_params_default(&f->params);
-    }
-    fc_kf_configure(f);
-    fc_kf_reset(f);
-}
+FC_DEFINE_INIT(fc_kf)
 
 static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  /* _init */
 {
@@ -138,13 +129,7 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
     }
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
     memcpy(f->acc_f, a, sizeof a);
-    f->rest[0] = g[0];
-    f->rest[1] = g[1];
-    f->rest[2] = g[2];
-    f->rest[3] = a[0];
-    f->rest[4] = a[1];
-    f->rest[5] = a[2];
-    f->rest[6] = 0.0;
+    fc_rest_start(f->rest, g, a);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
     double p_b = pow(f->params.init_bias_std, 2.0);
     if (p_b > 0.0) {

@@ -73,16 +73,7 @@ void fc_mgcf_reset(fc_mgcf *f)
     f->last = fc_mgcf_estimate(f);
 }
 
-void fc_mgcf_init(fc_mgcf *f, const fc_mgcf_params *params)
-{
-    if (params) {
-        f->params = *params;
-    } else {
-        fc_mgcf_params_default(&f->params);
-    }
-    fc_mgcf_configure(f);
-    fc_mgcf_reset(f);
-}
+FC_DEFINE_INIT(fc_mgcf)
 
 static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _init */
 {
@@ -90,13 +81,7 @@ static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _
     fc_accel_roll_pitch(a[0], a[1], a[2], &roll, &pitch);
     fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, f->q);
     memcpy(f->acc_f, a, sizeof f->acc_f);
-    f->rest[0] = g[0];
-    f->rest[1] = g[1];
-    f->rest[2] = g[2];
-    f->rest[3] = a[0];
-    f->rest[4] = a[1];
-    f->rest[5] = a[2];
-    f->rest[6] = 0.0;
+    fc_rest_start(f->rest, g, a);
 }
 
 static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double dt)

@@ -209,16 +209,7 @@ void fc_poskf_reset(fc_poskf *f)
     f->last = fc_poskf_estimate(f);
 }
 
-void fc_poskf_init(fc_poskf *f, const fc_poskf_params *params)
-{
-    if (params) {
-        f->params = *params;
-    } else {
-        fc_poskf_params_default(&f->params);
-    }
-    fc_poskf_configure(f);
-    fc_poskf_reset(f);
-}
+FC_DEFINE_INIT(fc_poskf)
 
 static void first_sample(fc_poskf *f, const double a[3], const double g[3])  /* _init */
 {

@@ -359,16 +359,7 @@ void fc_ukf_reset(fc_ukf *f)
     f->last = fc_ukf_estimate(f);
 }
 
-void fc_ukf_init(fc_ukf *f, const fc_ukf_params *params)
-{
-    if (params) {
-        f->params = *params;
-    } else {
-        fc_ukf_params_default(&f->params);
-    }
-    fc_ukf_configure(f);
-    fc_ukf_reset(f);
-}
+FC_DEFINE_INIT(fc_ukf)
 
 static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _init */
 {
@@ -382,13 +373,7 @@ static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _i
     f->P[0] = f->P[2] = f->P[5] = p_x;
     f->P[9] = f->P[14] = f->P[20] = p_b;
     memcpy(f->acc_f, a, sizeof f->acc_f);
-    f->rest[0] = g[0];
-    f->rest[1] = g[1];
-    f->rest[2] = g[2];
-    f->rest[3] = a[0];
-    f->rest[4] = a[1];
-    f->rest[5] = a[2];
-    f->rest[6] = 0.0;
+    fc_rest_start(f->rest, g, a);
 }
 
 /* _zero_rate_update: at rest the gyro reads its bias (z = gyro, h(x) = b, variance r) */
