@@ -25,7 +25,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from .synthetic import VECTOR, Ops, Signal, Trajectory, add, constant, min_jerk, sine
+from .synthetic import (
+    VECTOR,
+    Ops,
+    Signal,
+    Trajectory,
+    add,
+    constant,
+    min_jerk,
+    sine,
+    with_spec,
+)
 from .types import DEG, G
 
 
@@ -42,7 +52,7 @@ def swelling_sine(peak: float, freq: float, env_period: float, phase: float = 0.
         ds, dds = w * c, -w * w * s
         return peak * e * s, peak * (de * s + e * ds), peak * (dde * s + 2 * de * ds + e * dds)
 
-    return f
+    return with_spec(f, "swelling_sine", peak, w, we, phase)
 
 
 def _accel_sine(acc_amplitude: float, freq: float, phase: float = 0.0) -> Signal:

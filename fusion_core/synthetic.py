@@ -60,12 +60,24 @@ class Signal(Protocol):
     def __call__(self, t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]: ...
 
 
+def with_spec(f: Signal, *spec: Any) -> Signal:
+    """f with its formula as data, `f.spec` = (kind, parameters..., child specs): what the C twin
+    of the plant evaluates (fusion_core/native/generate.py writes it into fc_scenarios.h)."""
+    setattr(f, "spec", spec)  # noqa: B010 (a Protocol-typed function: no attribute to assign)
+    return f
+
+
+def spec_of(f: Signal) -> tuple[Any, ...]:
+    """The formula of a signal made by this module's constructors (with_spec)."""
+    return getattr(f, "spec")  # type: ignore[no-any-return]  # noqa: B009
+
+
 def constant(value: float = 0.0) -> Signal:
     def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
         z = ops.zeros_like(t)
         return z + value, z, z
 
-    return f
+    return with_spec(f, "constant", value)
 
 
 def sine(amplitude: float, freq: float, phase: float = 0.0, offset: float = 0.0) -> Signal:
@@ -77,7 +89,7 @@ def sine(amplitude: float, freq: float, phase: float = 0.0, offset: float = 0.0)
         s, c = ops.sin(arg), ops.cos(arg)
         return offset + amplitude * s, amplitude * w * c, -amplitude * w * w * s
 
-    return f
+    return with_spec(f, "sine", amplitude, w, phase, offset)
 
 
 def add(*signals: Signal) -> Signal:
@@ -90,7 +102,7 @@ def add(*signals: Signal) -> Signal:
             v, dv, ddv = v + a, dv + da, ddv + dda
         return v, dv, ddv
 
-    return f
+    return with_spec(f, "add", *(spec_of(s) for s in signals))
 
 
 def min_jerk(start: float, end: float, t0: float, duration: float) -> Signal:
@@ -107,7 +119,7 @@ def min_jerk(start: float, end: float, t0: float, duration: float) -> Signal:
         acc = ops.where(inside, d * (s * (60.0 + s * (-180.0 + 120.0 * s))) / duration**2, 0.0)
         return pos, vel, acc
 
-    return f
+    return with_spec(f, "min_jerk", start, d, t0, duration)
 
 
 TRUTH_NAMES = (
@@ -230,7 +242,7 @@ def product(u: Signal, v: Signal) -> Signal:
         b, db, ddb = v(t, ops)
         return a * b, da * b + a * db, dda * b + 2 * da * db + a * ddb
 
-    return f
+    return with_spec(f, "product", spec_of(u), spec_of(v))
 
 
 def two_axis_motion() -> Trajectory:

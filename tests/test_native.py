@@ -358,3 +358,17 @@ def test_the_sensor_model_twin_draws_the_same_samples(params: dict) -> None:
     for name in whole:
         joined = np.concatenate([head[name], tail[name]])
         assert np.max(np.abs(joined - whole[name])) <= TOL, name
+
+
+@needs_twin
+def test_the_plant_twin_gives_every_scenarios_truth() -> None:
+    """fc_plant.c with fc_scenarios.h (generated from the scenarios' signals) against
+    Trajectory.truth_at, the plant FMU's own call, over each scenario and past its end."""
+    from fusion_core.scenarios import SCENARIOS
+
+    for sc in SCENARIOS.values():
+        t = np.linspace(0.0, 1.2 * sc.duration, 1501)
+        python = np.array([sc.trajectory().truth_at(x) for x in t.tolist()])
+        assert np.max(np.abs(native.plant_truth(sc.id, t) - python)) <= TOL, sc.name
+    with pytest.raises(ValueError, match="unknown scenario id 99"):
+        native.plant_truth(99, np.zeros(1))

@@ -35,13 +35,15 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 SOURCES = (
     "fc_core.c", "fc_noise.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c",
-    "fc_sensor.c",
+    "fc_sensor.c", "fc_plant.c",
 )
 """The C sources, in link order."""
 HEADERS = (
     "fc_core.h", "fc_noise.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h",
-    "fc_poskf.h", "fc_sensor.h",
+    "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
 )
+DATA_HEADERS = ("fc_scenarios.h",)
+"""Headers of tables the binding does not declare (the scenarios' signal nodes), compiled in."""
 """The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
@@ -98,7 +100,7 @@ def compiler() -> str | None:
 
 def _key(cc: str) -> str:
     h = hashlib.sha256()
-    for name in (*SOURCES, *HEADERS):
+    for name in (*SOURCES, *HEADERS, *DATA_HEADERS):
         h.update(name.encode() + b"\0" + (HERE / name).read_bytes())
     h.update(" ".join((cc, *CFLAGS)).encode())
     return h.hexdigest()[:16]
@@ -355,6 +357,20 @@ def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
     return out
 
 
+# ----- the plant -------------------------------------------------------------------------------
+def plant_truth(scenario_id: int, t: np.ndarray) -> np.ndarray:
+    """The truth of a scenario at times t [N] by the C twin (fc_plant.c): [N, 15] in
+    synthetic.TRUTH_NAMES' order, as Trajectory.truth_at gives it sample by sample."""
+    lib, ffi = lib_and_ffi()
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    out = np.empty((t.shape[0], 15))
+    for i, ti in enumerate(t.tolist()):
+        row = ffi.cast("double *", ffi.from_buffer(out[i], require_writable=True))
+        if lib.fc_plant_truth(scenario_id, ti, row) != 0:
+            raise ValueError(f"unknown scenario id {scenario_id}")
+    return out
+
+
 # ----- the sensor model ------------------------------------------------------------------------
 SENSOR_LISTS = ("gyro_turn_on", "acc_turn_on", "gyro_walk", "acc_walk", "gyro_gm", "acc_gm")
 """The sensor's per-axis state vectors (fields of the same names in fc_sensor)."""
@@ -428,5 +444,5 @@ def sensor_run(model: Any, omega: np.ndarray, f: np.ndarray, h: np.ndarray
     return out
 
 
-__all__ = ["available", "build", "cache_dir", "compiler", "has_twin", "normals", "reason", "run",
-           "sensor_run"]
+__all__ = ["available", "build", "cache_dir", "compiler", "has_twin", "normals", "plant_truth",
+           "reason", "run", "sensor_run"]

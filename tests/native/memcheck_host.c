@@ -8,6 +8,7 @@
 #include "fc_cf.h"
 #include "fc_kf.h"
 #include "fc_mgcf.h"
+#include "fc_plant.h"
 #include "fc_poskf.h"
 #include "fc_sensor.h"
 #include "fc_ukf.h"
@@ -159,6 +160,16 @@ int main(void)
         for (int i = 0; i < N; i++) {
             for (int j = 0; j < 3; j++) {
                 bad += !isfinite(s_acc[i][j]) || !isfinite(s_gyro[i][j]) || !isfinite(s_bias[i][j]);
+            }
+        }
+    }
+    /* the plant: every scenario's truth, past its end too */
+    for (int id = 0; id < 9; id++) {
+        double truth[FC_TRUTH_SIZE];
+        for (int i = 0; i < 1000; i++) {
+            bad += fc_plant_truth(id, i * 0.1, truth) != 0;
+            for (int j = 0; j < FC_TRUTH_SIZE; j++) {
+                bad += !isfinite(truth[j]);
             }
         }
     }
