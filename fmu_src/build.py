@@ -27,7 +27,10 @@ from .estimator import PRESET_ENV
 
 HERE = Path(__file__).resolve().parent
 MODELS_DIR = HERE / "models"
-RUNTIME_FILES = ("__init__.py", "variables.py", "slave.py", "estimator.py", "model_description.py")
+RUNTIME_FILES = (
+    "__init__.py", "variables.py", "slave.py", "estimator.py", "model_description.py",
+    "testbench_models.py",
+)
 """The part of fmu_src an FMU needs at run time (not the build code, not the other models)."""
 REQUIREMENTS = "numpy>=1.24\nscipy>=1.10\n"
 """What the host's Python must provide (resources/requirements.txt); pythonfmu is bundled."""

@@ -55,20 +55,22 @@ class NormalBlocks:
     noise of sample k is the same whatever the block boundaries)."""
 
     BLOCK = 1024
+    """Samples per block. The block is one numpy array (not Python lists of floats, whose many
+    small objects a process freeing and creating sensor instances keeps as fragmented heap)."""
 
     def __init__(self, seed: int, stream: int, channels: int) -> None:
         self.seed, self.stream, self.channels = seed, stream, channels
         self._k0 = -1
-        self._block: list[list[float]] = []
+        self._block = np.empty((0, channels))
 
     def at(self, k: int) -> list[float]:
         """The channels' normals of sample k."""
         i = k - self._k0
         if self._k0 < 0 or not 0 <= i < len(self._block):
             self._k0 = k
-            self._block = normals(self.seed, self.stream, k, self.BLOCK, self.channels).tolist()
+            self._block = normals(self.seed, self.stream, k, self.BLOCK, self.channels)
             i = 0
-        return self._block[i]
+        return self._block[i].tolist()  # type: ignore[no-any-return]
 
 
 __all__ = ["NormalBlocks", "normals", "splitmix64", "stream_key"]

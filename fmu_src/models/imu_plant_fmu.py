@@ -6,13 +6,12 @@ parameter `scenario`: Z-Y-X Euler angles, body rates consistent with them (inver
 kinematics), the specific force R^T (a + g e_z) in the body frame, position and velocity.
 """
 
-from collections.abc import Mapping
 from typing import Any
 
-from fmu_src.slave import FmiLog, FmuSlave
+from fmu_src.slave import FmuSlave
+from fmu_src.testbench_models import PlantModel, plant_start
 from fmu_src.variables import Variable, real_output, variable_table
-from fusion_core.scenarios import SCENARIO_BY_ID, SCENARIOS, get_scenario
-from fusion_core.synthetic import TRUTH_NAMES, Trajectory
+from fusion_core.scenarios import SCENARIO_BY_ID, SCENARIOS
 
 _ENUM = ", ".join(f"{s.id} = {s.name} ({s.description})" for s in SCENARIOS.values())
 _AXIS = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
@@ -27,33 +26,6 @@ _OUTPUTS = (
 )
 
 
-def _truth(trajectory: Trajectory, t: float) -> dict[str, float]:
-    """The output values: the trajectory's truth at time t, by variable name (plain-float
-    evaluation: the same values as Trajectory.truth, without numpy's per-call cost)."""
-    return dict(zip(TRUTH_NAMES, trajectory.truth_at(t), strict=True))
-
-
-class PlantModel:
-    """A scenario's truth, sampled at the end of each communication step."""
-
-    def __init__(self, params: dict[str, Any]) -> None:
-        self.scenario = get_scenario(int(params["scenario"]))
-        self.trajectory = self.scenario.trajectory()
-
-    def step(self, t: float, h: float, values: Mapping[str, Any], log: FmiLog) -> dict[str, Any]:
-        return _truth(self.trajectory, t + h)
-
-    def set_parameter(self, name: str, value: Any) -> None:
-        raise ValueError(f"parameter {name!r} is fixed after initialisation")
-
-    def get_state(self) -> dict[str, Any]:
-        return {"scenario": self.scenario.id}  # the truth is a function of time only
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__init__({"scenario": state["scenario"]})
-
-
-_START = _truth(get_scenario(0).trajectory(), 0.0)
 
 
 class ImuPlant(FmuSlave):
@@ -68,8 +40,8 @@ class ImuPlant(FmuSlave):
     VARIABLES = variable_table("ImuPlant", lambda: (
         Variable("scenario", "parameter", "Integer", f"Motion: {_ENUM}", 0,
                  variability="fixed", low=min(SCENARIO_BY_ID), high=max(SCENARIO_BY_ID)),
-        *(real_output(name, unit, text + "; the value at the end of the last step", _START[name],
-                      display) for name, unit, display, text in _OUTPUTS),
+        *(real_output(name, unit, text + "; the value at the end of the last step",
+                      plant_start()[name], display) for name, unit, display, text in _OUTPUTS),
     ))
 
     def create_model(self, params: dict[str, Any]) -> PlantModel:

@@ -7,42 +7,15 @@ and dt [s] (h, or h with timestamp jitter), and the gyro's true bias at that sam
 default (fusion_core.sensor); seeded and reproducible.
 """
 
-from collections.abc import Mapping
 from typing import Any
 
-from fmu_src.slave import FmiLog, FmuSlave
+from fmu_src.slave import FmuSlave
+from fmu_src.testbench_models import SensorModel
 from fmu_src.variables import parameter_variable, real_input, real_output, variable_table
 from fusion_core import G
-from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
+from fusion_core.sensor import SENSOR_PARAMS
 
 _AXIS = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
-
-
-class SensorModel:
-    """ImuSensorModel behind the FmuSlave model protocol."""
-
-    def __init__(self, params: dict[str, Any]) -> None:
-        self.model = ImuSensorModel(**params)
-
-    def step(self, t: float, h: float, values: Mapping[str, Any], log: FmiLog) -> dict[str, Any]:
-        acc, gyro, dt = self.model.sample(
-            (values["omega_x"], values["omega_y"], values["omega_z"]),
-            (values["f_x"], values["f_y"], values["f_z"]),
-            h,
-        )
-        bias = self.model.gyro_bias
-        return {"acc_x": acc[0], "acc_y": acc[1], "acc_z": acc[2],
-                "gyro_x": gyro[0], "gyro_y": gyro[1], "gyro_z": gyro[2], "dt": dt,
-                "true_bias_x": bias[0], "true_bias_y": bias[1], "true_bias_z": bias[2]}
-
-    def set_parameter(self, name: str, value: Any) -> None:
-        self.model.set_param(name, value)
-
-    def get_state(self) -> dict[str, Any]:
-        return self.model.get_state()
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.model.set_state(state)
 
 
 class ImuSensor(FmuSlave):
