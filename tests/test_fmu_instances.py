@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gc
 import os
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -73,6 +74,19 @@ def resident_bytes() -> int:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
+def rss_growth(cycle: Callable[[int], None]) -> int:
+    """Resident memory [bytes] that MEMORY_CYCLES calls of cycle(i) add, after 10 warm-up calls
+    (imports, first-time allocations)."""
+    for i in range(10):
+        cycle(i)
+    gc.collect()
+    before = resident_bytes()
+    for i in range(MEMORY_CYCLES):
+        cycle(i)
+    gc.collect()
+    return resident_bytes() - before
+
+
 @pytest.mark.skipif(not os.path.exists("/proc/self/statm"), reason="needs Linux /proc")
 def test_instantiate_free_cycles_do_not_grow_memory(built_fmus, tmp_path):
     from fmpy import extract
@@ -89,19 +103,13 @@ def test_instantiate_free_cycles_do_not_grow_memory(built_fmus, tmp_path):
         with FmuInstance(built_fmus.path(name), f"cycle{i}", unzip_dir=unzip[name]) as fmu:
             fmu.run_samples(*args)
 
-    for i in range(10):  # warm-up: imports, first-time allocations
-        cycle(i)
-    gc.collect()
-    before = resident_bytes()
-    for i in range(MEMORY_CYCLES):
-        cycle(i)
-    gc.collect()
-    growth = resident_bytes() - before
+    growth = rss_growth(cycle)
     print(f"RSS growth over {MEMORY_CYCLES} instantiate/free cycles: {growth / 2**20:.2f} MiB")
     assert growth < MEMORY_LIMIT
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(not os.path.exists("/proc/self/statm"), reason="needs Linux /proc")
 @pytest.mark.parametrize("name", [*ESTIMATOR_FMUS, "ImuPlant", "ImuSensor"])
 def test_200_instantiate_free_cycles_of_each_fmu_grow_its_memory_by_less_than_5_mb(
     built_fmus, tmp_path, name: str
@@ -117,13 +125,6 @@ def test_200_instantiate_free_cycles_of_each_fmu_grow_its_memory_by_less_than_5_
             for k in range(10):
                 fmu.fmu.doStep(k * 0.01, 0.01)
 
-    for i in range(10):  # warm-up: imports, first-time allocations
-        cycle(i)
-    gc.collect()
-    before = resident_bytes()
-    for i in range(MEMORY_CYCLES):
-        cycle(i)
-    gc.collect()
-    growth = resident_bytes() - before
+    growth = rss_growth(cycle)
     print(f"{name}: RSS growth over {MEMORY_CYCLES} cycles: {growth / 2**20:.2f} MiB")
     assert growth < MEMORY_LIMIT
