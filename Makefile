@@ -10,6 +10,8 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	@# the C twin where a C compiler exists (else everything runs in Python; the reason is printed)
+	$(BIN)/python -c "from fusion_core import native; print('native twin:', native.reason() or native.build())"
 	touch $(STAMP)
 
 setup: $(STAMP)
