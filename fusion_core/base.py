@@ -104,6 +104,13 @@ def mounting_matrix(roll: float, pitch: float, yaw: float) -> Mat9:
     )
 
 
+def check_backend(backend: str) -> None:
+    """ValueError unless backend is one of BACKENDS (Estimator.run, ImuSensorModel.run)."""
+    if backend not in BACKENDS:
+        raise ValueError(f"backend={backend!r} is not allowed: expected one of "
+                         f"{', '.join(repr(b) for b in BACKENDS)}")
+
+
 def _plain(value: Any) -> Any:
     """A json-serialisable copy of a state value (tuples become lists)."""
     if isinstance(value, (tuple, list)):
@@ -311,9 +318,7 @@ class Estimator:
         there is one and it is available, else Python). Either way the outputs and the state
         the filter is left in are the same (to 1e-12), so a run may continue with step().
         """
-        if backend not in BACKENDS:
-            raise ValueError(f"backend={backend!r} is not allowed: expected one of "
-                             f"{', '.join(repr(b) for b in BACKENDS)}")
+        check_backend(backend)
         acc = np.asarray(acc, dtype=float)
         gyro = np.asarray(gyro, dtype=float)
         if acc.ndim != 2 or acc.shape[1] != 3 or gyro.shape != acc.shape:

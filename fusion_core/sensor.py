@@ -314,11 +314,9 @@ class ImuSensorModel:
         1e-12 either way, and the model's state afterwards is the same."""
         import numpy as np
 
-        from .base import BACKENDS
+        from .base import check_backend
 
-        if backend not in BACKENDS:
-            raise ValueError(f"backend={backend!r} is not allowed: expected one of "
-                             f"{', '.join(repr(b) for b in BACKENDS)}")
+        check_backend(backend)
         omega = np.asarray(omega, dtype=float)
         f = np.asarray(f, dtype=float)
         if omega.ndim != 2 or omega.shape[1] != 3 or f.shape != omega.shape:

@@ -611,21 +611,11 @@ def _cholesky4(
     s30: float, s31: float, s32: float, s33: float,
 ) -> tuple[float, ...] | None:
     """The packed lower Cholesky factor of a packed 4x4 S, or None when S is not positive
-    definite."""
-    if not s00 > 0.0:
+    definite: _cholesky3 of its leading 3x3 block, then the last row."""
+    L3 = _cholesky3(s00, s10, s11, s20, s21, s22)
+    if L3 is None:
         return None
-    l00 = math.sqrt(s00)
-    l10 = s10 / l00
-    d = s11 - l10 * l10
-    if not d > 0.0:
-        return None
-    l11 = math.sqrt(d)
-    l20 = s20 / l00
-    l21 = (s21 - l20 * l10) / l11
-    d = s22 - l20 * l20 - l21 * l21
-    if not d > 0.0:
-        return None
-    l22 = math.sqrt(d)
+    l00, l10, l11, l20, l21, l22 = L3
     l30 = s30 / l00
     l31 = (s31 - l30 * l10) / l11
     l32 = (s32 - l30 * l20 - l31 * l21) / l22

@@ -32,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from ..base import RUN_CHUNK
+
 HERE = Path(__file__).resolve().parent
 SOURCES = (
     "fc_core.c", "fc_noise.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c",
@@ -64,8 +66,6 @@ STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}}
 lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
 POSKF_PENDING_MAX = 2048
 """fc_poskf.h's FC_POSKF_PENDING_MAX (position.PENDING_MAX)."""
-RUN_CHUNK = 1024
-"""Samples per call of the C batch run (base.RUN_CHUNK)."""
 """Estimator._BASE_STATE: these live in the twin's `base` member."""
 
 _lib: Any = None
@@ -245,8 +245,9 @@ def _fill(lib: Any, twin: Any, estimator: Any) -> None:
     twin.last = getattr(lib, f"{TWINS[name]}_estimate")(twin)
 
 
-def _take(twin: Any, estimator: Any) -> None:
-    """Copy the twin's whole state into the Python estimator."""
+def take_state(estimator: Any, twin: Any) -> None:
+    """Copy the twin's whole state into the Python estimator (which continues from it
+    exactly)."""
     name = type(estimator).__name__
     for field in BASE_STATE:
         setattr(estimator, field, _field_value(twin.base, field, getattr(estimator, field)))
@@ -285,8 +286,8 @@ def _fill_position(lib: Any, twin: Any, est: Any) -> None:
 
 def _take_position(twin: Any, est: Any) -> None:
     _, ffi = lib_and_ffi()
-    _take(ffi.addressof(twin[0], "tilt"), est.tilt)
-    _take(ffi.addressof(twin[0], "att"), est.att)
+    take_state(est.tilt, ffi.addressof(twin[0], "tilt"))
+    take_state(est.att, ffi.addressof(twin[0], "att"))
     est.yaw = float(twin.yaw)
     est._x = tuple(float(v) for v in twin.x)
     est._P = tuple(float(v) for v in twin.P)
@@ -312,11 +313,6 @@ def new_twin(estimator: Any) -> Any:
     getattr(lib, f"{prefix}_init")(twin, params)
     _fill(lib, twin, estimator)
     return twin
-
-
-def take_state(estimator: Any, twin: Any) -> None:
-    """Copy the twin's state into the Python estimator (which continues from it exactly)."""
-    _take(twin, estimator)
 
 
 def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray

@@ -87,12 +87,6 @@ static const fc_scenario_def *find(int id)
     return 0;
 }
 
-double fc_plant_duration(int id)
-{
-    const fc_scenario_def *sc = find(id);
-    return sc ? sc->duration : -1.0;
-}
-
 int fc_plant_truth(int id, double t, double out[FC_TRUTH_SIZE])  /* Trajectory._evaluate */
 {
     const fc_scenario_def *sc = find(id);

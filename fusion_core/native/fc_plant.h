@@ -9,7 +9,5 @@
  * omega [rad/s] (3), specific force [m/s^2] (3), position [m] (3), velocity [m/s] (3).
  * Returns 0, or -1 for an unknown scenario. */
 int fc_plant_truth(int id, double t, double out[FC_TRUTH_SIZE]);
-/* The scenario's default duration [s], or -1 for an unknown one. */
-double fc_plant_duration(int id);
 
 #endif /* FC_PLANT_H */

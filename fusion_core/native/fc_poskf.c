@@ -73,14 +73,13 @@ static void axis_filters(double x[9], double P[6], const double Q[6], double dt,
     v2 += k1 * y;
     a2 += k2 * y;
     double c2 = m12 - k2 * m12;
-    double n00 = m00 - k0 * m02, n01 = m01 - k0 * m12, n02 = m02 - k0 * m22;
-    double n11 = m11 - k1 * m12, n12 = m12 - k1 * m22, n22 = m22 - k2 * m22;
-    m00 = n00;
-    m01 = n01;
-    m02 = n02;
-    m11 = n11;
-    m12 = n12;
-    m22 = n22;
+    /* P - K c^T, in an order where each entry still reads the old values it needs */
+    m00 -= k0 * m02;
+    m01 -= k0 * m12;
+    m02 -= k0 * m22;
+    m11 -= k1 * m12;
+    m12 -= k1 * m22;
+    m22 -= k2 * m22;
     if (with_zupt) {
         s = m11 + zupt_r;
         k0 = m01 / s;
@@ -99,18 +98,12 @@ static void axis_filters(double x[9], double P[6], const double Q[6], double dt,
         v2 += k1 * y;
         a2 += k2 * y;
         double c0 = m01, c1 = m11;
-        n00 = m00 - k0 * c0;
-        n01 = m01 - k0 * c1;
-        n02 = m02 - k0 * c2;
-        n11 = m11 - k1 * c1;
-        n12 = m12 - k1 * c2;
-        n22 = m22 - k2 * c2;
-        m00 = n00;
-        m01 = n01;
-        m02 = n02;
-        m11 = n11;
-        m12 = n12;
-        m22 = n22;
+        m00 -= k0 * c0;
+        m01 -= k0 * c1;
+        m02 -= k0 * c2;
+        m11 -= k1 * c1;
+        m12 -= k1 * c2;
+        m22 -= k2 * c2;
     }
     const double xn[9] = {p0, v0, a0, p1, v1, a1, p2, v2, a2};
     const double Pn[6] = {m00, m01, m02, m11, m12, m22};

@@ -168,30 +168,22 @@ static int cholesky3(double s00, double s10, double s11, double s20, double s21,
     return 1;
 }
 
-static int cholesky4(const double S[10], double L[10])
+static int cholesky4(const double S[10], double L[10])  /* cholesky3, then the last row */
 {
-    double s00 = S[0], s10 = S[1], s11 = S[2], s20 = S[3], s21 = S[4], s22 = S[5];
-    double s30 = S[6], s31 = S[7], s32 = S[8], s33 = S[9];
-    if (!(s00 > 0.0)) {
+    if (!cholesky3(S[0], S[1], S[2], S[3], S[4], S[5], L)) {
         return 0;
     }
-    double l00 = sqrt(s00), l10 = s10 / l00, d = s11 - l10 * l10;
+    double l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
+    double l30 = S[6] / l00, l31 = (S[7] - l30 * l10) / l11;
+    double l32 = (S[8] - l30 * l20 - l31 * l21) / l22;
+    double d = S[9] - l30 * l30 - l31 * l31 - l32 * l32;
     if (!(d > 0.0)) {
         return 0;
     }
-    double l11 = sqrt(d), l20 = s20 / l00, l21 = (s21 - l20 * l10) / l11;
-    d = s22 - l20 * l20 - l21 * l21;
-    if (!(d > 0.0)) {
-        return 0;
-    }
-    double l22 = sqrt(d), l30 = s30 / l00, l31 = (s31 - l30 * l10) / l11;
-    double l32 = (s32 - l30 * l20 - l31 * l21) / l22;
-    d = s33 - l30 * l30 - l31 * l31 - l32 * l32;
-    if (!(d > 0.0)) {
-        return 0;
-    }
-    const double out[10] = {l00, l10, l11, l20, l21, l22, l30, l31, l32, sqrt(d)};
-    memcpy(L, out, sizeof out);
+    L[6] = l30;
+    L[7] = l31;
+    L[8] = l32;
+    L[9] = sqrt(d);
     return 1;
 }
 
