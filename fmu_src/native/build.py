@@ -1,0 +1,475 @@
+"""Build the native FMUs: FMI 2.0 and FMI 3.0 co-simulation FMUs from fusion_core's C twin.
+
+For each model the FMU's variable table (the one its pythonfmu FMU is built from) becomes
+- `config.h`: MODEL_IDENTIFIER and MODEL_TOKEN, one VR_<name> per variable (the value references
+  of the pythonfmu FMU: table order), the variable table with start values and ranges, and
+  `params_from_values`, which fills the C twin's params struct from the values (enumerations
+  1..n -> the C choice 0..n-1);
+- `modelDescription.xml` for FMI 2.0 and for FMI 3.0, with the same names, units, ranges,
+  descriptions and start values as the pythonfmu FMU's;
+and the FMU is a zip of that description, the binary for this platform (and for Windows where
+mingw-w64 is installed), and its complete C sources (FMI 2.0 SourceFiles, FMI 3.0
+sources/buildDescription.xml), so that a tool can rebuild it (`fmpy compile`).
+
+FMI 3.0 variables stay scalars with the pythonfmu FMUs' names, not arrays: the testbench, fmpy's
+CSV input and output, Simulink's FMU block and the FMI 2.0 FMUs then read and write the same
+names, and a model's three kinds of FMU can be swapped without touching a connection.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import os
+import shutil
+import subprocess
+import tempfile
+import uuid
+import zipfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from xml.dom import minidom
+from xml.etree.ElementTree import Element, SubElement, tostring
+
+from ..model_description import project_version, type_definitions, unit_definitions
+from ..variables import Variable
+
+HERE = Path(__file__).resolve().parent
+TWIN_DIR = HERE.parents[1] / "fusion_core" / "native"
+VERSIONS = ("fmi2", "fmi3")
+PLATFORMS = {
+    "linux": {"fmi2": "linux64", "fmi3": "x86_64-linux", "suffix": ".so"},
+    "windows": {"fmi2": "win64", "fmi3": "x86_64-windows", "suffix": ".dll"},
+}
+"""Binary folders per platform and FMI version, and the binary's file suffix."""
+CFLAGS = ("-std=c99", "-O2", "-shared", "-ffp-contract=off", "-fno-fast-math",
+          "-fvisibility=hidden", "-Wall", "-Wextra")
+"""As the C twin's (no fused multiply-add, no fast-math: equal to the Python reference); only
+the FMI functions are exported."""
+MINGW = "x86_64-w64-mingw32-gcc"
+"""Debian's mingw-w64 cross compiler (package gcc-mingw-w64-x86-64), for the Windows binary."""
+TOKEN_NAMESPACE = uuid.UUID("5b0b7a52-6a3e-4c1e-9a8f-1b7d3a0c2f10")
+LOG_CATEGORIES = (
+    ("logStatusWarning", "Warnings: a rejected IMU sample (the filter state is kept)"),
+    ("logStatusError", "Errors: a refused call (wrong state, unknown value reference, value out "
+                       "of range, a state this FMU did not write)"),
+    ("logEvents", "Other messages"),
+)
+KIND_SOURCES = {
+    "estimator": ("fc_core.c",),
+    "plant": ("fc_plant.c",),
+    "sensor": ("fc_sensor.c", "fc_noise.c"),
+}
+"""The C twin's sources each kind of model needs besides its own file."""
+
+
+@dataclass(frozen=True)
+class NativeModel:
+    """What a native FMU is built from: its name, description, variable table, kind
+    (estimator, plant or sensor) and, for an estimator, the C twin's prefix (fc_kf)."""
+
+    name: str
+    description: str
+    variables: tuple[Variable, ...]
+    kind: str
+    prefix: str = ""
+    params: tuple = ()  # the fusion_core Params that fill the twin's params struct
+
+    @property
+    def token(self) -> str:
+        """The FMI 2.0 guid and FMI 3.0 instantiationToken: a hash of everything a host reads
+        from modelDescription.xml, so that an FMU of another table or version is told apart."""
+        text = repr((self.name, project_version(), self.variables))
+        return "{" + str(uuid.uuid5(TOKEN_NAMESPACE, text)) + "}"
+
+    def twin_sources(self) -> tuple[str, ...]:
+        own = (f"{self.prefix}.c",) if self.prefix else ()
+        extra = ("fc_kf.c",) if self.prefix == "fc_poskf" else ()
+        return (*KIND_SOURCES[self.kind], *own, *extra)
+
+
+def native_model(name: str) -> NativeModel:
+    """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the start
+    values of the preset being built (fmu_src.estimator.PRESET_ENV)."""
+    from fusion_core.native import TWINS
+    from fusion_core.sensor import SENSOR_PARAMS
+
+    from ..build import script_path
+    from ..estimator import estimator_variables
+
+    module = importlib.import_module(f"fmu_src.models.{script_path(name).stem}")
+    cls = getattr(module, name)
+    estimator = getattr(cls, "estimator", None)
+    if estimator is not None:
+        variables = estimator_variables(estimator, cls.zero_bias)
+        params = tuple(estimator.param_specs().values())
+        return NativeModel(name, cls.description, variables, "estimator",
+                           TWINS[estimator.__name__], params)
+    if name == "ImuSensor":
+        return NativeModel(name, cls.description, cls.VARIABLES, "sensor", "", SENSOR_PARAMS)
+    if name == "ImuPlant":
+        return NativeModel(name, cls.description, cls.VARIABLES, "plant")
+    raise ValueError(f"{name} has no native model")
+
+
+# ----- config.h ----------------------------------------------------------------------------------
+
+def _c_double(x: float) -> str:
+    if math.isinf(x):
+        return "HUGE_VAL" if x > 0 else "-HUGE_VAL"
+    text = repr(float(x))
+    return text if any(c in text for c in ".e") else text + ".0"
+
+
+def _c_string(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _variable_row(v: Variable) -> str:
+    kind = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER", "Boolean": "FMU_BOOLEAN",
+            "Enumeration": "FMU_ENUMERATION"}[v.type]
+    causality = {"parameter": "FMU_PARAMETER", "input": "FMU_INPUT", "output": "FMU_OUTPUT"}
+    if v.type == "Enumeration":
+        low, high, low_open, high_open = 1.0, float(len(v.items or ())), False, False
+    else:
+        low = -math.inf if v.low is None else float(v.low)
+        high = math.inf if v.high is None else float(v.high)
+        low_open, high_open = v.low_open, v.high_open
+    return (f"    {{{_c_string(v.name)}, {kind}, {causality[v.causality]}, {int(v.tunable)}, "
+            f"{_c_double(float(v.start))}, {_c_double(low)}, {_c_double(high)}, "
+            f"{int(low_open)}, {int(high_open)}}},")
+
+
+def _param_assignment(p) -> str:
+    if p.choices is not None:
+        return f"    p->{p.name} = (int)v[VR_{p.name}] - 1;"
+    if isinstance(p.default, bool):
+        return f"    p->{p.name} = v[VR_{p.name}] != 0.0;"
+    if isinstance(p.default, int):
+        return f"    p->{p.name} = (long)v[VR_{p.name}];"
+    return f"    p->{p.name} = v[VR_{p.name}];"
+
+
+def render_config(model: NativeModel) -> str:
+    """The model's config.h."""
+    from fusion_core.synthetic import TRUTH_NAMES
+
+    lines = [
+        f"/* config.h: the native FMU {model.name}.",
+        " *",
+        " * GENERATED by fmu_src/native/build.py from the FMU's variable table (the one its",
+        " * pythonfmu FMU is built from): do not edit by hand. */",
+        "#ifndef CONFIG_H",
+        "#define CONFIG_H",
+        "",
+        "#include <math.h>",
+        "",
+        '#include "fmu_model.h"',
+    ]
+    if model.prefix:
+        lines.append(f'#include "{model.prefix}.h"')
+    if model.kind == "sensor":
+        lines.append('#include "fc_sensor.h"')
+    lines += [
+        "",
+        f"#define MODEL_IDENTIFIER {_c_string(model.name)}",
+        f"#define MODEL_TOKEN {_c_string(model.token)}",
+        "",
+        "enum value_reference {",
+        *(f"    VR_{v.name} = {i}," for i, v in enumerate(model.variables)),
+        "};",
+        f"#define N_VARIABLES {len(model.variables)}",
+        "",
+        "/* name, type, causality, tunable, start, low, high, low open, high open */",
+        "static const fmu_variable VARIABLES[N_VARIABLES] = {",
+        *(_variable_row(v) for v in model.variables),
+        "};",
+        "",
+    ]
+    if model.kind == "estimator":
+        names = {v.name for v in model.variables}
+        lines += [
+            f"#define FC_T {model.prefix}",
+            f"#define FC_PARAMS {model.prefix}_params",
+            f"#define FC_INIT {model.prefix}_init",
+            f"#define FC_CONFIGURE {model.prefix}_configure",
+            f"#define FC_STEP {model.prefix}_step",
+            f"#define HAS_POSITION {int('pos_x' in names)}",
+            "",
+        ]
+    if model.params:
+        struct = f"{model.prefix or 'fc_sensor'}_params"
+        lines += [
+            f"/* The twin's {struct} from the parameter values. */",
+            f"static void params_from_values({struct} *p, const double *v)",
+            "{",
+            *(_param_assignment(p) for p in model.params),
+            "}",
+            "",
+        ]
+    if model.kind == "plant":
+        lines += [
+            "/* The output of each value of fc_plant_truth, in its order (synthetic.TRUTH_NAMES). */",
+            "static const int TRUTH_VR[] = {"
+            + ", ".join(f"VR_{n}" for n in TRUTH_NAMES) + "};",
+            "",
+        ]
+    lines += ["#endif /* CONFIG_H */", ""]
+    return "\n".join(lines)
+
+
+# ----- modelDescription.xml ------------------------------------------------------------------------
+
+def _number(x: float | int | bool, kind: str) -> str:
+    if kind == "Boolean":
+        return "true" if x else "false"
+    if kind in ("Integer", "Enumeration"):
+        return str(int(x))
+    return repr(float(x))
+
+
+def _range_attributes(v: Variable) -> dict[str, str]:
+    attrs: dict[str, str] = {}
+    if v.type in ("Real", "Integer"):
+        if v.low is not None and not v.low_open:
+            attrs["min"] = _number(v.low, v.type)
+        if v.high is not None and not v.high_open:
+            attrs["max"] = _number(v.high, v.type)
+    return attrs
+
+
+def _header(root: Element, model: NativeModel) -> None:
+    root.set("description", model.description)
+    root.set("author", "imu-fusion-fmu contributors")
+    root.set("license", "MIT")
+    root.set("version", project_version())
+    root.set("generationTool", f"imu-fusion-fmu {project_version()} (fmu_src/native)")
+    root.set("generationDateAndTime",
+             datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z"))
+    root.set("variableNamingConvention", "flat")
+
+
+def _log_categories(parent: Element) -> None:
+    cats = SubElement(parent, "LogCategories")
+    for name, text in LOG_CATEGORIES:
+        SubElement(cats, "Category", {"name": name, "description": text})
+
+
+def _pretty(root: Element) -> bytes:
+    return minidom.parseString(tostring(root, encoding="unicode")).toprettyxml(
+        indent="  ", encoding="UTF-8")
+
+
+def fmi2_model_description(model: NativeModel, sources: Sequence[str]) -> bytes:
+    """modelDescription.xml of the FMI 2.0 co-simulation FMU."""
+    root = Element("fmiModelDescription", {"fmiVersion": "2.0", "modelName": model.name,
+                                           "guid": model.token})
+    _header(root, model)
+    root.set("numberOfEventIndicators", "0")
+    cs = SubElement(root, "CoSimulation", {
+        "modelIdentifier": model.name,
+        "needsExecutionTool": "false",
+        "canHandleVariableCommunicationStepSize": "true",
+        "canInterpolateInputs": "false",
+        "maxOutputDerivativeOrder": "0",
+        "canRunAsynchronuously": "false",
+        "canBeInstantiatedOnlyOncePerProcess": "false",
+        "canNotUseMemoryManagementFunctions": "true",
+        "canGetAndSetFMUstate": "true",
+        "canSerializeFMUstate": "true",
+        "providesDirectionalDerivative": "false",
+    })
+    files = SubElement(cs, "SourceFiles")
+    for name in sources:
+        SubElement(files, "File", {"name": name})
+    root.append(unit_definitions(model.variables))
+    types = type_definitions(model.variables)
+    if types is not None:
+        root.append(types)
+    _log_categories(root)
+    SubElement(root, "DefaultExperiment",
+               {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.01"})
+    variables = SubElement(root, "ModelVariables")
+    outputs = []
+    for vr, v in enumerate(model.variables):
+        attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
+                 "causality": v.causality, "variability": v.variability or "continuous"}
+        if v.causality == "output":
+            attrs["initial"] = "exact"
+            outputs.append(vr + 1)
+        sv = SubElement(variables, "ScalarVariable", attrs)
+        typed = {"declaredType": v.type_name or ""} if v.type == "Enumeration" else {}
+        if v.type == "Real":
+            typed["unit"] = v.unit or "1"
+            if v.display_unit:
+                typed["displayUnit"] = v.display_unit
+        typed.update(_range_attributes(v))
+        typed["start"] = _number(v.start, v.type)
+        SubElement(sv, v.type, typed)
+    structure = SubElement(root, "ModelStructure")
+    outs = SubElement(structure, "Outputs")
+    for index in outputs:
+        SubElement(outs, "Unknown", {"index": str(index)})
+    return _pretty(root)
+
+
+FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean",
+              "Enumeration": "Enumeration"}
+"""The FMI 3.0 type of each FMI 2.0 type of the variable tables."""
+
+
+def fmi3_model_description(model: NativeModel) -> bytes:
+    """modelDescription.xml of the FMI 3.0 co-simulation FMU."""
+    root = Element("fmiModelDescription", {"fmiVersion": "3.0", "modelName": model.name,
+                                           "instantiationToken": model.token})
+    _header(root, model)
+    SubElement(root, "CoSimulation", {
+        "modelIdentifier": model.name,
+        "needsExecutionTool": "false",
+        "canBeInstantiatedOnlyOncePerProcess": "false",
+        "canGetAndSetFMUState": "true",
+        "canSerializeFMUState": "true",
+        "canHandleVariableCommunicationStepSize": "true",
+        "providesIntermediateUpdate": "false",
+        "canReturnEarlyAfterIntermediateUpdate": "false",
+        "hasEventMode": "false",
+    })
+    time_unit = Variable("time", "input", "Real", "the independent variable", 0.0, "s")
+    root.append(unit_definitions((*model.variables, time_unit)))
+    enums = [v for v in model.variables if v.type == "Enumeration"]
+    if enums:
+        types = SubElement(root, "TypeDefinitions")
+        for v in enums:
+            et = SubElement(types, "EnumerationType",
+                            {"name": v.type_name or "", "description": f"Choices of {v.name}"})
+            for value, item in enumerate(v.items or (), 1):
+                SubElement(et, "Item", {"name": item, "value": str(value)})
+    _log_categories(root)
+    SubElement(root, "DefaultExperiment",
+               {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.01"})
+    variables = SubElement(root, "ModelVariables")
+    SubElement(variables, "Float64", {
+        "name": "time", "valueReference": str(len(model.variables)), "causality": "independent",
+        "variability": "continuous", "unit": "s",
+        "description": "Simulation time (the independent variable; value reference after the "
+                       "model's variables, which keep the FMI 2.0 FMUs' references)"})
+    outputs = []
+    for vr, v in enumerate(model.variables):
+        attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
+                 "causality": v.causality, "variability": v.variability or "continuous"}
+        if v.type == "Enumeration":
+            attrs["declaredType"] = v.type_name or ""
+        if v.type == "Real":
+            attrs["unit"] = v.unit or "1"
+            if v.display_unit:
+                attrs["displayUnit"] = v.display_unit
+        attrs.update(_range_attributes(v))
+        if v.causality == "output":
+            attrs["initial"] = "exact"
+            outputs.append(vr)
+        attrs["start"] = _number(v.start, v.type)
+        SubElement(variables, FMI3_TYPES[v.type], attrs)
+    structure = SubElement(root, "ModelStructure")
+    for vr in outputs:
+        SubElement(structure, "Output", {"valueReference": str(vr)})
+    return _pretty(root)
+
+
+def fmi3_build_description(model: NativeModel, sources: Sequence[str]) -> bytes:
+    """sources/buildDescription.xml of the FMI 3.0 FMU."""
+    root = Element("fmiBuildDescription", {"fmiVersion": "3.0"})
+    config = SubElement(root, "BuildConfiguration", {"modelIdentifier": model.name})
+    files = SubElement(config, "SourceFileSet", {"language": "C99"})
+    for name in sources:
+        SubElement(files, "SourceFile", {"name": name})
+    return _pretty(root)
+
+
+# ----- compile and package ----------------------------------------------------------------------------
+
+def compiler() -> str | None:
+    """The C compiler for this platform's binary: $CC, else cc, gcc or clang."""
+    from fusion_core.native import compiler as twin_compiler
+
+    return twin_compiler()
+
+
+def cross_compiler() -> str | None:
+    """mingw-w64's gcc for the Windows binary, where it is installed."""
+    return shutil.which(MINGW)
+
+
+def stage_sources(model: NativeModel, version: str, folder: Path) -> list[str]:
+    """Write the FMU's C sources into folder; return the files to compile, in order."""
+    folder.mkdir(parents=True, exist_ok=True)
+    plumbing = f"{version}Functions.c"
+    own = f"{model.kind}.c"
+    compiled = [plumbing, "fmu_instance.c", own, *model.twin_sources()]
+    shutil.copy2(HERE / plumbing, folder / plumbing)
+    shutil.copy2(HERE / "fmu_instance.c", folder / "fmu_instance.c")
+    shutil.copy2(HERE / "fmu_model.h", folder / "fmu_model.h")
+    shutil.copy2(HERE / "models" / own, folder / own)
+    for header in (HERE / "include").glob(f"{version}*.h"):
+        shutil.copy2(header, folder / header.name)
+    for path in TWIN_DIR.glob("*.h"):
+        shutil.copy2(path, folder / path.name)
+    for name in model.twin_sources():
+        shutil.copy2(TWIN_DIR / name, folder / name)
+    (folder / "config.h").write_text(render_config(model))
+    return compiled
+
+
+def compile_binary(cc: str, sources: Path, files: Sequence[str], target: Path,
+                   windows: bool = False) -> None:
+    """Compile the FMU's sources into target (a shared library); RuntimeError with the
+    compiler's last lines when it fails."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    flags = [*CFLAGS, *([] if windows else ["-fPIC"]), *(["-static-libgcc"] if windows else [])]
+    cmd = [cc, *flags, "-I", str(sources), "-o", str(target),
+           *(str(sources / f) for f in files), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-15:])
+        raise RuntimeError(f"compiling {target.name} failed ({' '.join(cmd)}):\n{tail}")
+    warnings = (proc.stdout + proc.stderr).strip()
+    if warnings:
+        raise RuntimeError(f"compiling {target.name} gave warnings:\n{warnings}")
+
+
+def build_native(model: NativeModel, version: str, out_dir: Path,
+                 cc: str | None = None, windows: bool | None = None) -> Path:
+    """Build out_dir/<version>/<name>.fmu for one model and FMI version ("fmi2" or "fmi3");
+    with a Windows binary too where mingw-w64 is installed (windows=None) or as asked."""
+    cc = cc or compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler found (set CC, or install cc, gcc or clang)")
+    mingw = cross_compiler() if windows is None else (cross_compiler() if windows else None)
+    if windows and mingw is None:
+        raise RuntimeError(f"no Windows cross compiler: install {MINGW} (Debian: "
+                           "gcc-mingw-w64-x86-64)")
+    target = out_dir / version / f"{model.name}.fmu"
+    with tempfile.TemporaryDirectory(prefix="native_fmu_") as tmp:
+        root = Path(tmp)
+        sources = root / "sources"
+        files = stage_sources(model, version, sources)
+        if version == "fmi2":
+            (root / "modelDescription.xml").write_bytes(fmi2_model_description(model, files))
+        else:
+            (root / "modelDescription.xml").write_bytes(fmi3_model_description(model))
+            (sources / "buildDescription.xml").write_bytes(fmi3_build_description(model, files))
+        platforms = [("linux", cc)] + ([("windows", mingw)] if mingw else [])
+        for platform, compiler_path in platforms:
+            folder = PLATFORMS[platform]
+            binary = root / "binaries" / folder[version] / (model.name + folder["suffix"])
+            compile_binary(compiler_path, sources, files, binary, platform == "windows")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp_zip = tempfile.mkstemp(suffix=".fmu", dir=target.parent)
+        os.close(fd)
+        with zipfile.ZipFile(tmp_zip, "w", zipfile.ZIP_DEFLATED) as fmu:
+            for path in sorted(root.rglob("*")):
+                if path.is_file():
+                    fmu.write(path, path.relative_to(root).as_posix())
+        os.replace(tmp_zip, target)
+    return target

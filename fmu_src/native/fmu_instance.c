@@ -1,0 +1,357 @@
+/* fmu_instance.c: the part of the FMI plumbing that FMI 2.0 and FMI 3.0 share (fmu_model.h):
+ * the instance, the log, the state checks, the value table with its checks, the step and the
+ * FMU state. The standards' own layers (fmi2Functions.c, fmi3Functions.c) map their calls
+ * onto these. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmu_model.h"
+
+#define STATE_MAGIC "IMUFMUST"
+#define STATE_FORMAT 1u
+#define MODEL_NAME_SIZE 48
+
+/* The header every FMU state starts with. */
+typedef struct state_header {
+    char magic[8];
+    char model[MODEL_NAME_SIZE];
+    uint32_t format;
+    uint32_t n_variables;
+    uint64_t data_size;
+    uint64_t length;                /* of the whole state, header included */
+    uint64_t checksum;              /* FNV-1a of everything after the header */
+} state_header;
+
+typedef struct state_body {
+    int32_t state;
+    int32_t reserved;
+    double time;
+} state_body;
+
+static const char *type_name(fmu_type t)
+{
+    static const char *const names[] = {"Real", "Integer", "Boolean", "Enumeration"};
+    return names[t];
+}
+
+fmu_instance *fmu_instance_new(const char *name, fmu_emit emit, const void *callbacks,
+                               void (*log_message)(void), void *environment, int logging_on)
+{
+    fmu_instance *inst = calloc(1, sizeof *inst);
+    if (!inst) {
+        return NULL;
+    }
+    inst->name = malloc(strlen(name) + 1);
+    inst->values = calloc(FMU_MODEL.n_variables ? FMU_MODEL.n_variables : 1, sizeof(double));
+    inst->data = calloc(1, FMU_MODEL.data_size ? FMU_MODEL.data_size : 1);
+    if (!inst->name || !inst->values || !inst->data) {
+        fmu_instance_free(inst);
+        return NULL;
+    }
+    strcpy(inst->name, name);
+    inst->emit = emit;
+    inst->callbacks = callbacks;
+    inst->log_message = log_message;
+    inst->environment = environment;
+    inst->logging_on = logging_on;
+    inst->time_vr = -1;
+    fmu_instance_reset(inst);
+    return inst;
+}
+
+void fmu_instance_free(fmu_instance *inst)
+{
+    if (!inst) {
+        return;
+    }
+    free(inst->name);
+    free(inst->values);
+    free(inst->data);
+    free(inst);
+}
+
+void fmu_instance_reset(fmu_instance *inst)
+{
+    unsigned i;
+    for (i = 0; i < FMU_MODEL.n_variables; i++) {
+        inst->values[i] = FMU_MODEL.variables[i].start;
+    }
+    memset(inst->data, 0, FMU_MODEL.data_size);
+    FMU_MODEL.setup(inst->data, inst->values);
+    inst->time = 0.0;
+    inst->state = FMU_INSTANTIATED;
+}
+
+void fmu_log(const fmu_instance *inst, int status, const char *format, ...)
+{
+    char message[1024];
+    va_list args;
+    if (!inst || !inst->emit || (status < FMU_ERROR && !inst->logging_on)) {
+        return;
+    }
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    inst->emit(inst, status,
+               status >= FMU_ERROR ? "logStatusError"
+                                   : (status == FMU_WARNING ? "logStatusWarning" : "logEvents"),
+               message);
+}
+
+const char *fmu_state_name(int state)
+{
+    switch (state) {
+    case FMU_INSTANTIATED: return "instantiated";
+    case FMU_CONFIGURATION: return "configuration mode";
+    case FMU_INITIALIZATION: return "initialization mode";
+    case FMU_STEP: return "step mode";
+    case FMU_TERMINATED: return "terminated";
+    default: return "unknown";
+    }
+}
+
+int fmu_allow(const fmu_instance *inst, int allowed, const char *call)
+{
+    if (inst->state & allowed) {
+        return FMU_OK;
+    }
+    fmu_log(inst, FMU_ERROR, "%s is not allowed in state '%s': nothing was done", call,
+            fmu_state_name(inst->state));
+    return FMU_ERROR;
+}
+
+const fmu_variable *fmu_variable_of(const fmu_instance *inst, const char *call, uint32_t vr,
+                                    int types)
+{
+    const fmu_variable *v;
+    if (vr >= FMU_MODEL.n_variables) {
+        fmu_log(inst, FMU_ERROR, "%s: unknown value reference %lu (this FMU has 0..%u)", call,
+                (unsigned long)vr, FMU_MODEL.n_variables - 1);
+        return NULL;
+    }
+    v = &FMU_MODEL.variables[vr];
+    if (!(types & FMU_TYPE_BIT(v->type))) {
+        fmu_log(inst, FMU_ERROR, "%s: value reference %lu is %s, a %s variable", call,
+                (unsigned long)vr, v->name, type_name(v->type));
+        return NULL;
+    }
+    return v;
+}
+
+int fmu_get(const fmu_instance *inst, const char *call, const uint32_t vr[], size_t nvr,
+            int types, double out[])
+{
+    size_t i;
+    if (nvr > 0 && (!vr || !out)) {
+        fmu_log(inst, FMU_ERROR, "%s: NULL value references or values for %lu variables", call,
+                (unsigned long)nvr);
+        return FMU_ERROR;
+    }
+    for (i = 0; i < nvr; i++) {
+        if (inst->time_vr >= 0 && vr[i] == (uint32_t)inst->time_vr &&
+            (types & FMU_TYPE_BIT(FMU_REAL))) {
+            out[i] = inst->time;
+            continue;
+        }
+        if (!fmu_variable_of(inst, call, vr[i], types)) {
+            return FMU_ERROR;
+        }
+        out[i] = inst->values[vr[i]];
+    }
+    return FMU_OK;
+}
+
+/* Why the value cannot be taken (a log line), or FMU_OK. */
+static int check_value(const fmu_instance *inst, const char *call, const fmu_variable *v,
+                       double value)
+{
+    int ok;
+    if (v->causality == FMU_OUTPUT) {
+        fmu_log(inst, FMU_ERROR, "%s: %s is an output, computed by the FMU: it cannot be set "
+                "(value %.17g refused)", call, v->name, value);
+        return FMU_ERROR;
+    }
+    if (v->causality == FMU_PARAMETER && !v->tunable &&
+        !(inst->state & (FMU_INSTANTIATED | FMU_CONFIGURATION | FMU_INITIALIZATION))) {
+        fmu_log(inst, FMU_ERROR, "%s: parameter %s is fixed after initialisation: set it before "
+                "exitInitializationMode (value %.17g refused, it keeps %.17g)", call, v->name,
+                value, inst->values[v - FMU_MODEL.variables]);
+        return FMU_ERROR;
+    }
+    if (v->causality == FMU_INPUT || v->type == FMU_BOOLEAN) {
+        return FMU_OK;  /* an input sample is the model's to judge (a bad one is rejected) */
+    }
+    ok = !isnan(value);
+    if (v->low != -HUGE_VAL) {
+        ok = ok && (v->low_open ? value > v->low : value >= v->low);
+    }
+    if (v->high != HUGE_VAL) {
+        ok = ok && (v->high_open ? value < v->high : value <= v->high);
+    }
+    if (!ok) {
+        fmu_log(inst, FMU_ERROR, "%s: parameter %s = %.17g is out of range: allowed %s%.17g, "
+                "%.17g%s; it keeps %.17g", call, v->name, value, v->low_open ? "(" : "[",
+                v->low, v->high, v->high_open ? ")" : "]", inst->values[v - FMU_MODEL.variables]);
+        return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+int fmu_set(fmu_instance *inst, const char *call, const uint32_t vr[], size_t nvr, int types,
+            const double in[])
+{
+    size_t i;
+    int tuned = 0;
+    if (nvr > 0 && (!vr || !in)) {
+        fmu_log(inst, FMU_ERROR, "%s: NULL value references or values for %lu variables", call,
+                (unsigned long)nvr);
+        return FMU_ERROR;
+    }
+    for (i = 0; i < nvr; i++) {
+        const fmu_variable *v;
+        if (inst->time_vr >= 0 && vr[i] == (uint32_t)inst->time_vr) {
+            fmu_log(inst, FMU_ERROR, "%s: value reference %lu is time, the independent variable: "
+                    "it cannot be set", call, (unsigned long)vr[i]);
+            return FMU_ERROR;
+        }
+        v = fmu_variable_of(inst, call, vr[i], types);
+        if (!v || check_value(inst, call, v, in[i]) != FMU_OK) {
+            return FMU_ERROR;
+        }
+    }
+    for (i = 0; i < nvr; i++) {
+        const fmu_variable *v = &FMU_MODEL.variables[vr[i]];
+        double value = v->type == FMU_BOOLEAN ? (in[i] != 0.0) : in[i];
+        if (v->causality == FMU_PARAMETER && inst->state == FMU_STEP &&
+            inst->values[vr[i]] != value) {
+            tuned = 1;
+        }
+        inst->values[vr[i]] = value;
+    }
+    if (tuned) {
+        FMU_MODEL.tune(inst->data, inst->values);
+    }
+    return FMU_OK;
+}
+
+int fmu_exit_initialization(fmu_instance *inst)
+{
+    memset(inst->data, 0, FMU_MODEL.data_size);
+    FMU_MODEL.setup(inst->data, inst->values);
+    inst->state = FMU_STEP;
+    return FMU_OK;
+}
+
+int fmu_do_step(fmu_instance *inst, double t, double h)
+{
+    char message[512];
+    if (!(h > 0.0) || !isfinite(h) || !isfinite(t)) {
+        fmu_log(inst, FMU_ERROR, "doStep(t = %.17g, h = %.17g): the communication step size must "
+                "be finite and > 0, and the time finite: nothing was done", t, h);
+        return FMU_ERROR;
+    }
+    message[0] = '\0';
+    if (FMU_MODEL.step(inst->data, inst->values, t, h, message, sizeof message)) {
+        fmu_log(inst, FMU_WARNING, "%s", message);
+    }
+    inst->time = t + h;
+    return FMU_OK;
+}
+
+/* ----- FMU state ----------------------------------------------------------------------------- */
+
+static uint64_t fnv1a(const unsigned char *p, size_t n)
+{
+    uint64_t h = 14695981039346656037ull;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+static size_t body_size(void)
+{
+    return sizeof(state_body) + FMU_MODEL.n_variables * sizeof(double) + FMU_MODEL.data_size;
+}
+
+size_t fmu_state_size(void)
+{
+    return sizeof(state_header) + body_size();
+}
+
+void fmu_state_write(const fmu_instance *inst, unsigned char *out)
+{
+    state_header h;
+    state_body b;
+    unsigned char *body = out + sizeof h;
+    memset(&h, 0, sizeof h);
+    memset(&b, 0, sizeof b);
+    b.state = inst->state;
+    b.time = inst->time;
+    memcpy(body, &b, sizeof b);
+    memcpy(body + sizeof b, inst->values, FMU_MODEL.n_variables * sizeof(double));
+    memcpy(body + sizeof b + FMU_MODEL.n_variables * sizeof(double), inst->data,
+           FMU_MODEL.data_size);
+    memcpy(h.magic, STATE_MAGIC, sizeof h.magic);
+    strncpy(h.model, FMU_MODEL.name, MODEL_NAME_SIZE - 1);
+    h.format = STATE_FORMAT;
+    h.n_variables = FMU_MODEL.n_variables;
+    h.data_size = FMU_MODEL.data_size;
+    h.length = fmu_state_size();
+    h.checksum = fnv1a(body, body_size());
+    memcpy(out, &h, sizeof h);
+}
+
+int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size)
+{
+    state_header h;
+    state_body b;
+    const unsigned char *body = in + sizeof h;
+    char model[MODEL_NAME_SIZE];
+    if (!in || size < sizeof h) {
+        fmu_log(inst, FMU_ERROR, "%s: %lu bytes are not an FMU state of %s (a state is %lu "
+                "bytes): the FMU keeps its state", call, (unsigned long)size, FMU_MODEL.name,
+                (unsigned long)fmu_state_size());
+        return FMU_ERROR;
+    }
+    memcpy(&h, in, sizeof h);
+    memset(model, 0, sizeof model);
+    strncpy(model, FMU_MODEL.name, MODEL_NAME_SIZE - 1);
+    if (memcmp(h.magic, STATE_MAGIC, sizeof h.magic) != 0) {
+        fmu_log(inst, FMU_ERROR, "%s: not an FMU state of this project (wrong magic): the FMU "
+                "keeps its state", call);
+        return FMU_ERROR;
+    }
+    if (memcmp(h.model, model, MODEL_NAME_SIZE) != 0 || h.format != STATE_FORMAT ||
+        h.n_variables != FMU_MODEL.n_variables || h.data_size != FMU_MODEL.data_size) {
+        h.model[MODEL_NAME_SIZE - 1] = '\0';
+        fmu_log(inst, FMU_ERROR, "%s: a state of model '%s', format %lu, does not fit %s, format "
+                "%lu: the FMU keeps its state", call, h.model, (unsigned long)h.format,
+                FMU_MODEL.name, (unsigned long)STATE_FORMAT);
+        return FMU_ERROR;
+    }
+    if (h.length != fmu_state_size() || size < h.length ||
+        h.checksum != fnv1a(body, body_size())) {
+        fmu_log(inst, FMU_ERROR, "%s: the state is truncated or corrupted (length %lu of %lu "
+                "bytes, or its checksum differs): the FMU keeps its state", call,
+                (unsigned long)size, (unsigned long)fmu_state_size());
+        return FMU_ERROR;
+    }
+    memcpy(&b, body, sizeof b);
+    if (!(b.state & FMU_ANY_STATE)) {
+        fmu_log(inst, FMU_ERROR, "%s: the state holds no valid FMI state: the FMU keeps its "
+                "state", call);
+        return FMU_ERROR;
+    }
+    inst->state = b.state;
+    inst->time = b.time;
+    memcpy(inst->values, body + sizeof b, FMU_MODEL.n_variables * sizeof(double));
+    memcpy(inst->data, body + sizeof b + FMU_MODEL.n_variables * sizeof(double),
+           FMU_MODEL.data_size);
+    return FMU_OK;
+}

@@ -1,0 +1,41 @@
+/* plant.c: the testbench plant (fc_plant.h, the twin of fusion_core.scenarios) as an FMU model
+ * (fmu_model.h). After doStep(t, h) the outputs are the truth at t+h of the scenario the fixed
+ * parameter `scenario` chooses. config.h, generated from the FMU's variable table, gives the
+ * value references and TRUTH_VR, the output of each truth value in fc_plant_truth's order. */
+#include "config.h"
+#include "fc_plant.h"
+#include "fmu_model.h"
+
+typedef struct model_data {
+    int scenario;
+} model_data;
+
+static void setup(void *data, double *values)
+{
+    ((model_data *)data)->scenario = (int)values[VR_scenario];
+}
+
+static void tune(void *data, const double *values)
+{
+    (void)data;
+    (void)values;  /* the plant has no tunable parameter */
+}
+
+static int step(void *data, double *v, double t, double h, char *message, size_t size)
+{
+    double truth[FC_TRUTH_SIZE];
+    int i;
+    (void)message;
+    (void)size;
+    if (fc_plant_truth(((model_data *)data)->scenario, t + h, truth) != 0) {
+        return 0;  /* unreachable: `scenario` is checked against its range when it is set */
+    }
+    for (i = 0; i < FC_TRUTH_SIZE; i++) {
+        v[TRUTH_VR[i]] = truth[i];
+    }
+    return 0;
+}
+
+const fmu_model FMU_MODEL = {
+    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), setup, tune, step,
+};
