@@ -1,7 +1,10 @@
-"""Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--core C]
-[--preset P]`.
+"""Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--kind K]
+[--core C] [--preset P]`.
 
-Builds every FMU (or the named ones) into dist/ (or DIR), with fusion_core compiled by mypyc
+Builds every model (or the named ones) as each kind of FMU: pythonfmu (DIR/NAME.fmu) and native
+FMI 2.0 and FMI 3.0 from the C twin (DIR/native/fmi2/NAME.fmu, DIR/native/fmi3/NAME.fmu); --kind
+all (the default where a C compiler exists), pythonfmu or native. The pythonfmu FMUs ship
+fusion_core compiled by mypyc
 (--core auto, the default, falls back to the pure-Python sources where mypyc or a C compiler is
 missing; --core compiled insists; --core python ships only the sources), with the estimators'
 start values of --preset (recommended, the defaults; paper; or a JSON file), validates each with
@@ -16,7 +19,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from fmu_src.build import build_all, format_table, model_names
+from fmu_src.build import KINDS, build_all, default_kind, format_table, model_names
 from fmu_src.compiled_core import CORES, CompiledCoreError
 
 
@@ -27,6 +30,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--only", nargs="+", metavar="NAME", choices=model_names(),
         help=f"build only these FMUs (of {', '.join(model_names())})",
+    )
+    parser.add_argument(
+        "--kind", choices=KINDS, default=None,
+        help="which FMUs: all (pythonfmu, native FMI 2.0 and 3.0; the default where a C "
+        "compiler exists, else pythonfmu), pythonfmu, or native",
     )
     parser.add_argument(
         "--core", choices=CORES, default="auto",
@@ -40,7 +48,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     try:
-        results = build_all(args.only or model_names(), args.out, args.core, args.preset)
+        kind = args.kind or default_kind()
+        if kind == "pythonfmu" and args.kind is None:
+            print("no C compiler found: building the pythonfmu FMUs only", file=sys.stderr)
+        results = build_all(args.only or model_names(), args.out, args.core, args.preset, kind)
     except CompiledCoreError as err:
         print(f"error: --core compiled: {err}", file=sys.stderr)
         return 2

@@ -1,7 +1,10 @@
 """Build and check the project's FMUs (the library behind `python build_fmu.py`).
 
-Every module fmu_src/models/<snake_name>_fmu.py is one FMU; its model name (and file name) is
-the CamelCase of <snake_name>. An FMU carries in resources/ its slave module, fusion_core, the
+Every module fmu_src/models/<snake_name>_fmu.py is one model; its model name (and file name) is
+the CamelCase of <snake_name>. Each model is built as up to three kinds of FMU from its one
+variable table: the pythonfmu FMU (out_dir/<Name>.fmu) and the native FMI 2.0 and FMI 3.0 FMUs
+(out_dir/native/fmi2/<Name>.fmu, out_dir/native/fmi3/<Name>.fmu; fmu_src/native). A pythonfmu FMU
+carries in resources/ its slave module, fusion_core, the
 runtime part of fmu_src, pythonfmu (added by pythonfmu's builder) and a requirements.txt with
 what the host interpreter must provide (numpy, scipy). With the compiled core (core="compiled",
 or "auto" where it builds; fmu_src/compiled_core.py) resources/ also holds fusion_core's
@@ -123,12 +126,24 @@ def check(path: Path) -> list[str]:
     return problems
 
 
+KINDS = ("all", "pythonfmu", "native")
+"""What build_all builds: every kind of FMU, the pythonfmu ones only, or the native ones only."""
+
+
+def default_kind() -> str:
+    """"all" where a C compiler exists (the native FMUs need one), else "pythonfmu"."""
+    from .native.build import compiler
+
+    return "all" if compiler() else "pythonfmu"
+
+
 @dataclass
 class BuildResult:
     """One row of the build table."""
 
     name: str
-    core: str = "python"  # the fusion_core it ships: "compiled" or "python"
+    core: str = "python"  # the fusion_core it ships: "compiled", "python" or "native" (C twin)
+    kind: str = "pythonfmu"  # "pythonfmu", "fmi2" or "fmi3"
     path: Path | None = None
     size: int = 0
     variables: int = 0
@@ -136,22 +151,52 @@ class BuildResult:
 
 
 def build_all(
-    names: Iterable[str], out_dir: Path, core: str = "auto", preset: str = "recommended"
+    names: Iterable[str], out_dir: Path, core: str = "auto", preset: str = "recommended",
+    kind: str | None = None,
 ) -> list[BuildResult]:
     """Build and check each FMU; a failed build is a problem of its row, not an exception.
     core: "auto" (the compiled fusion_core where it can be built, else the pure-Python one),
-    "compiled" or "python" (compiled_core.CORES); preset: the estimators' start values, a name
-    or a JSON file (fusion_core.presets.load_preset; ValueError for a bad one)."""
+    "compiled" or "python" (compiled_core.CORES), for the pythonfmu FMUs; preset: the
+    estimators' start values, a name or a JSON file (fusion_core.presets.load_preset;
+    ValueError for a bad one); kind: one of KINDS (None: default_kind())."""
     from fusion_core.presets import load_preset
 
+    kind = kind or default_kind()
+    if kind not in KINDS:
+        raise ValueError(f"kind {kind!r}: allowed {', '.join(KINDS)}")
+    names = list(names)
     starts = load_preset(preset)
-    compiled = resolve_core(core)
+    compiled = resolve_core(core) if kind != "native" else None
     with contextlib.ExitStack() as stack:
         if any(starts.values()):  # the recommended values need no file: they are the defaults
             tmp = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="preset_")))
             (tmp / "preset.json").write_text(json.dumps(starts, indent=1))
             stack.enter_context(mock.patch.dict(os.environ, {PRESET_ENV: str(tmp / "preset.json")}))
-        return [_build_and_check(name, out_dir, compiled) for name in names]
+        results = []
+        if kind != "native":
+            results += [_build_and_check(name, out_dir, compiled) for name in names]
+        if kind != "pythonfmu":
+            results += [_build_native_and_check(name, version, out_dir)
+                        for version in ("fmi2", "fmi3") for name in names]
+        return results
+
+
+def _build_native_and_check(name: str, version: str, out_dir: Path) -> BuildResult:
+    """One row of the build table for a native FMU (out_dir/native/<version>/<name>.fmu)."""
+    from fmpy import read_model_description
+
+    from .native.build import build_native, native_model
+
+    result = BuildResult(name, core="native", kind=version)
+    try:
+        result.path = build_native(native_model(name), version, out_dir / "native")
+        result.size = result.path.stat().st_size
+        result.variables = len(read_model_description(str(result.path)).modelVariables)
+        result.problems = check(result.path)
+    except Exception as err:
+        last = traceback.format_exception_only(type(err), err)[-1].strip()
+        result.problems = [f"build failed: {last}"]
+    return result
 
 
 def _build_and_check(name: str, out_dir: Path, compiled: Path | None) -> BuildResult:
@@ -171,22 +216,22 @@ def _build_and_check(name: str, out_dir: Path, compiled: Path | None) -> BuildRe
 
 
 def format_table(results: Sequence[BuildResult]) -> str:
-    """The build table: FMU, fusion_core it ships, size, number of variables, validation
+    """The build table: FMU, kind, fusion_core it runs, size, number of variables, validation
     problems."""
-    rows = [("FMU", "core", "size", "variables", "validation problems")]
+    rows = [("FMU", "kind", "core", "size", "variables", "validation problems")]
     for r in results:
         first = r.problems[0] if r.problems else ""
         count = f"{len(r.problems)}" + (f": {first}" if first else "")
         size = f"{r.size / 1024:.0f} kB" if r.path else "-"
-        rows.append((r.name, r.core, size, str(r.variables) if r.path else "-", count))
-    widths = [max(len(row[i]) for row in rows) for i in range(4)]
+        rows.append((r.name, r.kind, r.core, size, str(r.variables) if r.path else "-", count))
+    widths = [max(len(row[i]) for row in rows) for i in range(5)]
     lines = []
     for i, row in enumerate(rows):
-        cells = [row[0].ljust(widths[0]), row[1].ljust(widths[1]), row[2].rjust(widths[2]),
-                 row[3].rjust(widths[3]), row[4]]
+        cells = [row[0].ljust(widths[0]), row[1].ljust(widths[1]), row[2].ljust(widths[2]),
+                 row[3].rjust(widths[3]), row[4].rjust(widths[4]), row[5]]
         lines.append("  ".join(cells).rstrip())
         if i == 0:
-            lines.append("  ".join("-" * w for w in (*widths, len(rows[0][4]))))
+            lines.append("  ".join("-" * w for w in (*widths, len(rows[0][5]))))
     for r in results:
-        lines += [f"{r.name}: {p}" for p in r.problems[1:]]
+        lines += [f"{r.name} ({r.kind}): {p}" for p in r.problems[1:]]
     return "\n".join(lines)

@@ -15,7 +15,7 @@ from pathlib import Path
 from fusion_core.scenarios import SCENARIOS
 
 from .broad.cli import add_broad_parser
-from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS
+from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .options import choose
 
 
@@ -60,7 +60,9 @@ def cmd_run(args: argparse.Namespace) -> int:
             bar.set_postfix_str(f"{job.estimator} {job.scenario}")  # type: ignore[attr-defined]
             bar.update()
 
-        result = run_campaign(estimators, scenarios, args.seeds, args.jitter, args.fmu_dir,
+        fmu_dir = kind_dir(args.fmu_dir, args.kind)
+        print(f"FMUs: {fmu_dir}", file=sys.stderr)
+        result = run_campaign(estimators, scenarios, args.seeds, args.jitter, fmu_dir,
                               progress, not args.no_contract, parse_params(args.param),
                               args.duration, not args.no_timing_check, args.jobs,
                               preset=preset, sensor=sensor)
@@ -95,6 +97,9 @@ def main(argv: list[str] | None = None) -> int:
                      help="seconds per run instead of each scenario's own duration")
     run.add_argument("--out", type=Path, default=Path("reports"), help="report folder (reports)")
     run.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
+    run.add_argument("--kind", choices=KINDS, default="auto",
+                     help="FMUs to run: native (FMI 2.0 from the C twin, FMU_DIR/native/fmi2), "
+                     "pythonfmu (FMU_DIR), or auto: native where built (default)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--jobs", type=int, default=2,
                      help="worker processes (2: the campaign on two cores; 1: all in this one)")
