@@ -55,13 +55,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     preset = load_preset(args.preset)
     sensor = load_sensor(args.sensor)
     jobs = plan(estimators, scenarios, args.seeds, args.jitter, not args.no_contract)
+    fmu_dir = kind_dir(args.fmu_dir, args.kind)
+    print(f"FMUs: {fmu_dir}", file=sys.stderr)
     with tqdm(total=len(jobs), unit="run", file=sys.stderr) as bar:
         def progress(job: object) -> None:
             bar.set_postfix_str(f"{job.estimator} {job.scenario}")  # type: ignore[attr-defined]
             bar.update()
 
-        fmu_dir = kind_dir(args.fmu_dir, args.kind)
-        print(f"FMUs: {fmu_dir}", file=sys.stderr)
         result = run_campaign(estimators, scenarios, args.seeds, args.jitter, fmu_dir,
                               progress, not args.no_contract, parse_params(args.param),
                               args.duration, not args.no_timing_check, args.jobs,

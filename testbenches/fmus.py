@@ -8,6 +8,7 @@ FMI call's status checked (fmpy raises FMICallException on fmi2Error, fmi2Discar
 from __future__ import annotations
 
 import atexit
+import contextlib
 import shutil
 import tempfile
 from collections.abc import Iterable, Mapping
@@ -98,6 +99,7 @@ class FmuHandle:
             instanceName=instance_name,
         )
         self.fmu.instantiate()
+        self.running = False
 
     def vrs(self, names: Iterable[str]) -> list[int]:
         """Value references of the named variables (ValueError naming an unknown one)."""
@@ -127,10 +129,9 @@ class FmuHandle:
                         raise ValueError(f"{self.name}.{name} = {value!r}: allowed {items}")
                     value = items.index(value) + 1
                 setter, getter, value = self.fmu.setInteger, self.fmu.getInteger, int(value)
-            try:  # a native FMU refuses with fmi2Error, a pythonfmu FMU logs and keeps its value
+            # a native FMU refuses with fmi2Error, a pythonfmu FMU logs and keeps its value
+            with contextlib.suppress(FMICallException):
                 setter(vr, [value])
-            except FMICallException:
-                pass
             back = getter(vr)[0]
             if back != value:  # the FMU logs why it refused; the master must not go on
                 raise ValueError(
@@ -144,9 +145,13 @@ class FmuHandle:
         self.fmu.enterInitializationMode()
         self.set_parameters(params)
         self.fmu.exitInitializationMode()
+        self.running = True
 
     def free(self) -> None:
+        """Terminate (an instance that got as far as running; the FMI state machine allows
+        terminate only then) and free the instance."""
         try:
-            self.fmu.terminate()
+            if self.running:
+                self.fmu.terminate()
         finally:
             self.fmu.freeInstance()

@@ -41,6 +41,20 @@ class BuiltFmus:
             pytest.fail(f"{name}.fmu was not built; build_fmu.py said:\n{self.output}")
         return path
 
+    def native(self, version: str, name: str) -> Path:
+        """The native FMU called name of FMI version "fmi2" or "fmi3": skipped with the reason
+        where there is no C compiler (build_fmu.py then builds the pythonfmu FMUs only), a
+        failure where there is one and the FMU was not built."""
+        from fmu_src.native.build import compiler
+
+        if compiler() is None:
+            pytest.skip("no C compiler (set CC, or install cc, gcc or clang): no native FMUs")
+        path = self.directory / "native" / version / f"{name}.fmu"
+        if not path.is_file():
+            pytest.fail(f"native {version} {name}.fmu was not built; build_fmu.py said:\n"
+                        f"{self.output}")
+        return path
+
 
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     if "fmu_name" in metafunc.fixturenames:

@@ -71,10 +71,11 @@ which brings mypyc, is a dependency; a machine with only Python and pip has no C
 def test_build_command_builds_every_fmu_without_problems(built_fmus):
     assert built_fmus.returncode == 0, built_fmus.output
     lines = built_fmus.output.splitlines()
-    assert lines[0].split() == ["FMU", "core", "size", "variables", "validation", "problems"]
+    assert lines[0].split() == ["FMU", "kind", "core", "size", "variables", "validation",
+                                "problems"]
     for name in PAPERS:
         row = next(line.split() for line in lines if line.startswith(name + " "))
-        assert row[1] == EXPECTED_CORE, row  # no silent fallback where a compiler exists
+        assert row[1:3] == ["pythonfmu", EXPECTED_CORE], row  # no silent fallback
         assert row[-1] == "0", row  # validation problems
         assert (built_fmus.directory / f"{name}.fmu").stat().st_size > 0
 

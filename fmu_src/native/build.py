@@ -211,7 +211,7 @@ def render_config(model: NativeModel) -> str:
         ]
     if model.kind == "plant":
         lines += [
-            "/* The output of each value of fc_plant_truth, in its order (synthetic.TRUTH_NAMES). */",
+            "/* The output of each fc_plant_truth value, in its order (synthetic.TRUTH_NAMES). */",
             "static const int TRUTH_VR[] = {"
             + ", ".join(f"VR_{n}" for n in TRUTH_NAMES) + "};",
             "",
@@ -220,7 +220,7 @@ def render_config(model: NativeModel) -> str:
     return "\n".join(lines)
 
 
-# ----- modelDescription.xml ------------------------------------------------------------------------
+# ----- modelDescription.xml ----------------------------------------------------------------------
 
 def _number(x: float | int | bool, kind: str) -> str:
     if kind == "Boolean":
@@ -387,7 +387,7 @@ def fmi3_build_description(model: NativeModel, sources: Sequence[str]) -> bytes:
     return _pretty(root)
 
 
-# ----- compile and package ----------------------------------------------------------------------------
+# ----- compile and package -----------------------------------------------------------------------
 
 def compiler() -> str | None:
     """The C compiler for this platform's binary: $CC, else cc, gcc or clang."""

@@ -184,7 +184,8 @@ static int check_value(const fmu_instance *inst, const char *call, const fmu_var
     if (v->causality == FMU_INPUT || v->type == FMU_BOOLEAN) {
         return FMU_OK;  /* an input sample is the model's to judge (a bad one is rejected) */
     }
-    ok = !isnan(value);
+    /* fusion_core's Param.validate: finite, or +inf where the range has no upper bound */
+    ok = isfinite(value) || (value == HUGE_VAL && v->high == HUGE_VAL);
     if (v->low != -HUGE_VAL) {
         ok = ok && (v->low_open ? value > v->low : value >= v->low);
     }
