@@ -294,3 +294,75 @@ def test_fmpy_compile_rebuilds_every_native_fmu_from_its_own_sources(built_fmus,
             b = simulate_fmu(rebuilt, stop_time=2.0, output_interval=0.01)
             assert all(np.array_equal(a[k], b[k]) for k in a.dtype.names), (version, name)
             assert original  # the build made its own binary, not a copy
+
+
+# ----- a C host, as a tool that is not ours -------------------------------------------------------
+
+HOST_KIND = {"ImuPlant": "plant", "ImuSensor": "sensor"}
+
+
+@pytest.fixture(scope="module")
+def native_host(tmp_path_factory) -> Path:
+    """tests/fmu_host/native_host.c, compiled with the system compiler."""
+    from fmu_src.native.build import compiler
+
+    cc = compiler()
+    if cc is None:
+        pytest.skip("no C compiler: the C host cannot be built")
+    exe = tmp_path_factory.mktemp("host") / "native_host"
+    subprocess.run([cc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-O1", "-I",
+                    str(REPO / "fmu_src" / "native" / "include"), "-o", str(exe),
+                    str(REPO / "tests" / "fmu_host" / "native_host.c"), "-ldl", "-lm"],
+                   check=True, capture_output=True, text=True)
+    return exe
+
+
+@pytest.mark.parametrize("name", model_names())
+def test_a_c_host_runs_misuses_saves_restores_and_frees_every_native_fmu(
+        built_fmus, native_host, tmp_path, name):
+    """The C host loads the binary with no preload and no Python variables, runs 600 samples
+    (bad ones among them), saves, serializes, deserializes and restores a state (the run after
+    it is repeated bit for bit), commits every misuse of "FMI calls" (each refused with an
+    error and a log line, the run going on), frees and exits 0; under valgrind (where it is
+    installed) with 0 errors and no definitely lost bytes. Both versions give the same
+    outputs."""
+    valgrind = shutil.which("valgrind")
+    outputs = {}
+    for version in VERSIONS:
+        path = built_fmus.native(version, name)
+        md = read_model_description(str(path))
+        unzipdir = extract(str(path), unzipdir=str(tmp_path / version))
+        token = md.instantiationToken if version == "fmi3" else md.guid
+        reals = [str(v.valueReference) for v in md.modelVariables
+                 if v.causality == "output" and v.type in ("Real", "Float64")]
+        n_vars = len([v for v in md.modelVariables if v.name != "time"])
+        cmd = [str(native_host), version[-1], f"{unzipdir}/{BINARY[version]}/{name}.so", name,
+               token, HOST_KIND.get(name, "estimator"), str(n_vars), *reals]
+        if valgrind:
+            cmd = [valgrind, "-q", "--error-exitcode=9", "--leak-check=full",
+                   "--errors-for-leak-kinds=definite", *cmd]
+        proc = subprocess.run(cmd, env=_clean_env(), capture_output=True, text=True,
+                              timeout=300, check=False)
+        assert proc.returncode == 0, proc.stderr
+        outputs[version] = [float(x) for x in proc.stdout.split()]
+        assert len(outputs[version]) == len(reals) and all(np.isfinite(outputs[version]))
+    assert outputs["fmi2"] == outputs["fmi3"]
+
+
+@pytest.mark.parametrize("estimator", ["ukf", "poskf"])
+def test_the_testbench_gives_the_same_trace_on_both_kinds_of_fmu(built_fmus, estimator):
+    """testbenches run --kind native and --kind pythonfmu: plant, sensor and estimator of either
+    kind give the same truth, samples and estimates, bit for bit, with jittered steps."""
+    from testbenches import run_testbench
+    from testbenches.fmus import kind_dir
+
+    built_fmus.native("fmi2", "ImuPlant")  # skips without a compiler
+    runs = [run_testbench(estimator, "moderate_dynamics", seed=3, duration=8.0, jitter=0.2,
+                          fmu_dir=kind_dir(built_fmus.directory, kind), evaluate=False)
+            for kind in ("native", "pythonfmu")]
+    native, python = runs
+    for part in ("truth", "sample", "estimate"):
+        a, b = getattr(native, part), getattr(python, part)
+        assert a.keys() == b.keys()
+        assert all(np.array_equal(a[k], b[k]) for k in a), part
+    assert native.invalid_samples == python.invalid_samples

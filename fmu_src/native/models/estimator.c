@@ -10,6 +10,7 @@
  * estimate for the sample.
  */
 #include <stdio.h>
+#include <string.h>
 
 #include "config.h"
 #include "fmu_model.h"
@@ -22,6 +23,7 @@ static void setup(void *data, double *values)
 {
     model_data *m = (model_data *)data;
     FC_PARAMS p;
+    memset(&p, 0, sizeof p);  /* no stack garbage in its padding: a state is compared bytewise */
     params_from_values(&p, values);
     FC_INIT(&m->filter, &p);
 }

@@ -3,6 +3,8 @@
  * doStep(t, h) the outputs are the IMU sample taken at t+h (acc_*, gyro_*, dt) and the gyro's
  * true bias then (true_bias_*). config.h, generated from the FMU's variable table, gives the
  * value references and how the parameter values fill fc_sensor_params. */
+#include <string.h>
+
 #include "config.h"
 #include "fc_sensor.h"
 #include "fmu_model.h"
@@ -14,6 +16,7 @@ typedef struct model_data {
 static void setup(void *data, double *values)
 {
     fc_sensor_params p;
+    memset(&p, 0, sizeof p);  /* no stack garbage in its padding: a state is compared bytewise */
     params_from_values(&p, values);
     fc_sensor_init(&((model_data *)data)->sensor, &p);
 }
