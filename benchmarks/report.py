@@ -13,6 +13,14 @@ UKF_VS_FILTERPY = 10.0
 FMU_OVERHEAD_TARGET_US = 10.0
 TESTBENCH_RTF_TARGET = 50.0
 TESTBENCH_TARGET_RATE = "1000Hz"
+NATIVE_FMU_SPEEDUP = 4.0
+"""A native FMU step (fmpy low-level calls) at least this many times faster than pythonfmu's."""
+C_HOST_VS_TWIN = 2.0
+"""A native FMU step in a C host within this factor of the C twin's batch run per sample."""
+TESTBENCH_NATIVE_RATIO = 3.0
+TESTBENCH_NATIVE_RTF = 100.0
+"""The native testbench at 1 kHz: this many times the pythonfmu one's real-time factor, and at
+least this real-time factor on a quiet fast machine."""
 
 
 def _target(name: str, measured: float | None, target: str, met: bool | None,
@@ -94,6 +102,35 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
                     f"native.{key} vs vqf_batch", vqf / v, "> 1x (faster than VQF's batch)",
                     v < vqf, "as above",
                 ))
+    if nat and nat.get("fmu_step_us"):
+        floors = nat.get("fmu_floor_us", {})
+        for key, v in nat.get("fmu_step_speedup_vs_pythonfmu", {}).items():
+            out.append(_target(
+                f"native.fmu_step_speedup_vs_pythonfmu.{key}", v,
+                f">= {NATIVE_FMU_SPEEDUP:g}x", v >= NATIVE_FMU_SPEEDUP,
+                "the host's side: fmpy's wrapped ctypes calls cost "
+                f"{floors.get('fmi2', float('nan')):.1f} us per step even on a native FMU "
+                "whose calls return at once (fmu_floor_us)",
+            ))
+        for key, v in nat.get("c_host_vs_twin", {}).items():
+            out.append(_target(
+                f"native.c_host_step_us.fmi2.{key} vs twin run", v,
+                f"<= {C_HOST_VS_TWIN:g}x the twin's run per sample", v <= C_HOST_VS_TWIN,
+                "three FMI calls per step with their state and value-reference checks",
+            ))
+        for key, t in nat.get("testbench_rtf_1khz", {}).items():
+            out.append(_target(
+                f"native.testbench_rtf_1khz.{key}", t["ratio"],
+                f">= {TESTBENCH_NATIVE_RATIO:g}x the pythonfmu testbench",
+                t["ratio"] >= TESTBENCH_NATIVE_RATIO,
+                "fmpy's per-call cost in the Python master (eight FMI calls per step)",
+            ))
+            out.append(_target(
+                f"native.testbench_rtf_1khz.{key}.native", t["native"],
+                f">= {TESTBENCH_NATIVE_RTF:g} (on a quiet fast machine)",
+                t["native"] >= TESTBENCH_NATIVE_RTF,
+                "the Python master: fmpy's ctypes calls, eight per step",
+            ))
     tb = r.get("testbench")
     if tb:
         for key, rates in tb.items():

@@ -26,6 +26,7 @@ from .config import ESTIMATOR_KEYS, BenchConfig
 from .estimators import step_factories
 from .fmu import build_fmus, fmu_steps
 from .native import native_section
+from .native_fmu import native_fmu_section
 from .peers import PEERS, available_peers
 from .report import evaluate_targets
 from .scaling import scaling
@@ -110,7 +111,8 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         results["per_sample_detail"] = detail
         results["peers_unavailable"] = unavailable
         results["step_floor_us"] = floor["median_us"]
-    if {"fmu", "testbench"} & set(config.sections):
+    native_fmus: dict[str, Any] = {}
+    if {"fmu", "testbench", "native"} & set(config.sections):
         with tempfile.TemporaryDirectory(prefix="bench_fmus_") as tmp:
             fmu_dir = config.fmu_dir
             if fmu_dir is None:
@@ -135,6 +137,12 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
                 results["fmu_floor_us"] = {
                     k: {"api": m.get("floor_api"), "lowlevel": m.get("floor_lowlevel")}
                     for k, m in med.items()}
+            if "native" in config.sections:
+                fmu_data = np.column_stack(
+                    [rec["acc_meas"], rec["gyro_meas"], rec["dt"]]).tolist()
+                native_fmus = native_fmu_section(
+                    ESTIMATOR_KEYS, Path(fmu_dir), fmu_data, config.repeats,
+                    config.testbench_s.get(1000.0, 1.0), config.testbench_repeats, log)
             if "testbench" in config.sections:
                 log("testbench throughput")
                 results["testbench"] = testbench_throughput(
@@ -143,6 +151,11 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
     if "native" in config.sections:
         log("native batch runs (the C twin), the Python core and VQF's C++ batch")
         results["native"] = native_section(rec, config.repeats)
+        results["native"].update(native_fmus)
+        host, twin = native_fmus.get("c_host_step_us", {}), results["native"].get(
+            "run_us_per_sample", {})
+        results["native"]["c_host_vs_twin"] = {
+            key: host["fmi2"][key] / twin[key] for key in twin if key in host.get("fmi2", {})}
     if "scaling" in config.sections:
         log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
         results["scaling"] = scaling(config.scaling_estimators, config.scaling_sizes, rec)

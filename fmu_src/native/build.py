@@ -76,6 +76,7 @@ class NativeModel:
     kind: str
     prefix: str = ""
     params: tuple = ()  # the fusion_core Params that fill the twin's params struct
+    source: Path | None = None  # the model's C file, if not models/<kind>.c
 
     @property
     def token(self) -> str:
@@ -87,7 +88,7 @@ class NativeModel:
     def twin_sources(self) -> tuple[str, ...]:
         own = (f"{self.prefix}.c",) if self.prefix else ()
         extra = ("fc_kf.c",) if self.prefix == "fc_poskf" else ()
-        return (*KIND_SOURCES[self.kind], *own, *extra)
+        return (*KIND_SOURCES.get(self.kind, ()), *own, *extra)
 
 
 def native_model(name: str) -> NativeModel:
@@ -405,12 +406,13 @@ def stage_sources(model: NativeModel, version: str, folder: Path) -> list[str]:
     """Write the FMU's C sources into folder; return the files to compile, in order."""
     folder.mkdir(parents=True, exist_ok=True)
     plumbing = f"{version}Functions.c"
-    own = f"{model.kind}.c"
+    source = model.source or HERE / "models" / f"{model.kind}.c"
+    own = source.name
     compiled = [plumbing, "fmu_instance.c", own, *model.twin_sources()]
     shutil.copy2(HERE / plumbing, folder / plumbing)
     shutil.copy2(HERE / "fmu_instance.c", folder / "fmu_instance.c")
     shutil.copy2(HERE / "fmu_model.h", folder / "fmu_model.h")
-    shutil.copy2(HERE / "models" / own, folder / own)
+    shutil.copy2(source, folder / own)
     for header in (HERE / "include").glob(f"{version}*.h"):
         shutil.copy2(header, folder / header.name)
     for path in TWIN_DIR.glob("*.h"):
