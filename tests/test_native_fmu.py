@@ -385,3 +385,59 @@ def test_the_testbench_gives_the_same_trace_on_both_kinds_of_fmu(built_fmus, est
         assert a.keys() == b.keys()
         assert all(np.array_equal(a[k], b[k]) for k in a), part
     assert native.invalid_samples == python.invalid_samples
+
+
+# ----- Windows binaries, run under wine ----------------------------------------------------------
+
+WINDOWS_BINARY = {"fmi2": "binaries/win64", "fmi3": "binaries/x86_64-windows"}
+
+
+@pytest.fixture(scope="module")
+def windows_host(tmp_path_factory) -> Path:
+    """tests/fmu_host/native_host.c cross-compiled for Windows: skipped with the reason where
+    mingw-w64 or wine is missing (Debian: apt-get install gcc-mingw-w64-x86-64 wine64)."""
+    from fmu_src.native.build import MINGW, cross_compiler
+
+    if cross_compiler() is None:
+        pytest.skip(f"no {MINGW} (Debian package gcc-mingw-w64-x86-64): the native FMUs carry "
+                    "no Windows binary")
+    if shutil.which("wine") is None:
+        pytest.skip("no wine (Debian package wine64): the Windows binaries cannot be run here")
+    exe = tmp_path_factory.mktemp("winhost") / "native_host.exe"
+    subprocess.run([MINGW, "-std=c99", "-Wall", "-Wextra", "-Werror", "-O1", "-I",
+                    str(REPO / "fmu_src" / "native" / "include"), "-o", str(exe),
+                    str(REPO / "tests" / "fmu_host" / "native_host.c")],
+                   check=True, capture_output=True, text=True)
+    return exe
+
+
+@pytest.mark.parametrize("name", model_names())
+def test_the_windows_binary_of_every_native_fmu_runs_under_wine(built_fmus, windows_host,
+                                                                native_host, tmp_path, name):
+    """The C host, cross-compiled with mingw-w64, runs each FMU's Windows binary under wine
+    (misuses, state round trip, free: exit 0) and gets the Linux binary's outputs within 1e-12
+    (the two C libraries' sin, cos and atan2 may differ in the last bit)."""
+    env = {**_clean_env(), "WINEDEBUG": "-all"}
+    for version in VERSIONS:
+        path = built_fmus.native(version, name)
+        md = read_model_description(str(path))
+        unzipdir = Path(extract(str(path), unzipdir=str(tmp_path / version)))
+        token = md.instantiationToken if version == "fmi3" else md.guid
+        reals = [str(v.valueReference) for v in md.modelVariables
+                 if v.causality == "output" and v.type in ("Real", "Float64")]
+        n_vars = str(len([v for v in md.modelVariables if v.name != "time"]))
+        kind = HOST_KIND.get(name, "estimator")
+        dll = unzipdir / WINDOWS_BINARY[version] / f"{name}.dll"
+        assert dll.is_file(), f"{path} has no Windows binary"
+        win = subprocess.run(["wine", str(windows_host), version[-1], "Z:" + str(dll), name,
+                              token, kind, n_vars, *reals], env=env, capture_output=True,
+                             text=True, timeout=300, check=False)
+        assert win.returncode == 0, win.stderr[-2000:]
+        linux = subprocess.run([str(native_host), version[-1],
+                                str(unzipdir / BINARY[version] / f"{name}.so"), name, token,
+                                kind, n_vars, *reals], env=env, capture_output=True, text=True,
+                               check=True)
+        a = np.array(win.stdout.split(), dtype=float)
+        b = np.array(linux.stdout.split(), dtype=float)
+        assert a.shape == b.shape == (len(reals),)
+        assert np.max(np.abs(a - b)) <= 1e-12

@@ -9,7 +9,6 @@
  * KIND says what the first value references are: estimator (acc x,y,z, gyro x,y,z, dt), sensor
  * (omega x,y,z, f x,y,z) or plant (no inputs). Prints the last outputs, one per line.
  */
-#include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -18,6 +17,16 @@
 
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
+
+#ifdef _WIN32  /* the same host cross-compiled for Windows (mingw-w64), run under wine */
+#include <windows.h>
+#define dlopen(path, flags) ((void *)LoadLibraryA(path))
+#define dlsym(lib, name) ((void *)GetProcAddress((HMODULE)(lib), (name)))
+#define dlclose(lib) FreeLibrary((HMODULE)(lib))
+#define dlerror() "LoadLibrary failed"
+#else
+#include <dlfcn.h>
+#endif
 
 #define STEPS 600
 #define MAX_OUT 32
