@@ -188,6 +188,27 @@ def _native_lines(r: dict[str, Any], targets: dict[str, Any]) -> list[str]:
     vqf = nat.get("vqf_batch_us_per_sample")
     lines.append("  vqf (C++ updateBatch): " + (f"{_fmt(vqf)} us" if vqf is not None
                                                  else f"unavailable: {nat.get('vqf_unavailable')}"))
+    steps = nat.get("fmu_step_us")
+    if not steps:
+        return lines
+    floors, host = nat.get("fmu_floor_us", {}), nat.get("c_host_step_us", {})
+    rtf = nat.get("testbench_rtf_1khz", {})
+    lines += ["", "Native FMUs: one set/doStep/get cycle through fmpy's low-level calls, and in a C "
+              "host's own loop [us]; testbench real-time factor at 1 kHz",
+              f"  {'filter':<8}{'pythonfmu':>10}{'fmi2':>7}{'fmi3':>7}{'speed-up':>9}"
+              f"{'C fmi2':>8}{'C fmi3':>8}{'C/twin':>7}{'RTF nat':>9}{'RTF py':>8}{'ratio':>7}"]
+    for key in steps.get("fmi2", {}):
+        r_ = rtf.get(key, {})
+        lines.append(
+            f"  {key:<8}{_fmt(steps['pythonfmu'][key]):>10}{_fmt(steps['fmi2'][key]):>7}"
+            f"{_fmt(steps['fmi3'][key]):>7}"
+            f"{_fmt(nat['fmu_step_speedup_vs_pythonfmu'][key], 1):>8}x"
+            f"{_fmt(host.get('fmi2', {}).get(key)):>8}{_fmt(host.get('fmi3', {}).get(key)):>8}"
+            f"{_fmt(nat.get('c_host_vs_twin', {}).get(key), 1):>6}x"
+            f"{_fmt(r_.get('native'), 0):>9}{_fmt(r_.get('pythonfmu'), 0):>8}"
+            f"{_fmt(r_.get('ratio'), 1):>6}x")
+    lines.append("  floor (an FMU whose calls return at once): " + ", ".join(
+        f"{k} {_fmt(v)} us" for k, v in floors.items()))
     return lines
 
 

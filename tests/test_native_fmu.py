@@ -297,7 +297,7 @@ def test_fmpy_compile_rebuilds_every_native_fmu_from_its_own_sources(built_fmus,
     if shutil.which("cmake") is None:
         pytest.skip("cmake is not installed: fmpy compile needs it")
     for version in VERSIONS:
-        for name in ("PositionKalmanFilter", "ImuSensor", "ImuPlant"):
+        for name in model_names():
             path = built_fmus.native(version, name)
             unzipdir = extract(str(path), unzipdir=str(tmp_path / f"{version}-{name}"))
             binary = Path(unzipdir) / BINARY[version] / f"{name}.so"
