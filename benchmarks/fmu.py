@@ -3,8 +3,9 @@
 Two hosts, both fmpy's FMU2Slave:
   api       setReal(list) / doStep / getReal(list), what testbenches.master does: fmpy builds
             ctypes arrays from the lists on every call;
-  lowlevel  fmpy's wrapped FMI functions (fmi2SetReal, fmi2DoStep, fmi2GetReal) with ctypes
-            arrays allocated once: what a host can save on its own side.
+  lowlevel  the FMI functions as the ctypes functions fmpy loaded (fmi2SetReal, fmi2DoStep,
+            fmi2GetReal; testbenches.fmus.direct_calls, the statuses checked in the loop) with
+            ctypes arrays allocated once: the testbench master's way.
 The overhead is the FMU step time less the same estimator's `step` in fusion_core, timed in
 turn with it.
 
@@ -26,6 +27,7 @@ from typing import Any
 from fmpy.fmi2 import fmi2Real, fmi2True, fmi2ValueReference
 
 from fmu_src.host import INPUTS, FmuInstance
+from testbenches.fmus import direct_calls
 
 from .common import time_interleaved
 from .estimators import step_pass
@@ -158,7 +160,7 @@ class FmuPasses:
 
             return run
         component = fmu.component
-        c_set, c_step, c_get = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
+        c_set, c_step, c_get = direct_calls(fmu, "fmi2SetReal", "fmi2DoStep", "fmi2GetReal")
         n_in, n_out = len(in_vr), len(out_vr)
         vr_in = (fmi2ValueReference * n_in)(*in_vr)
         vr_out = (fmi2ValueReference * n_out)(*out_vr)
@@ -167,11 +169,13 @@ class FmuPasses:
 
         def run_lowlevel() -> int:
             t = 0.0
-            for sample in data:
+            for sample in data:  # with the testbench master's calls and status checks
                 values[:] = sample
-                c_set(component, vr_in, n_in, values)
-                c_step(component, t, h, fmi2True)
-                c_get(component, vr_out, n_out, outputs)
+                a = c_set(component, vr_in, n_in, values)
+                b = c_step(component, t, h, fmi2True)
+                c = c_get(component, vr_out, n_out, outputs)
+                if a > 1 or b > 1 or c > 1:
+                    raise RuntimeError(f"{self.path.name}: an FMI call failed at t = {t}")
                 outputs[:]  # read back as Python floats, as a host would
                 t += h
             return len(data)

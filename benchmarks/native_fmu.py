@@ -2,8 +2,9 @@
 and the testbench, all measured in one run beside the pythonfmu FMUs.
 
 fmu_step_us       {kind: {estimator: us}}: one set-inputs / doStep / get-outputs cycle through
-                  fmpy's low-level calls with ctypes arrays made once (the way the testbench
-                  calls), for pythonfmu, native fmi2 and native fmi3;
+                  the ctypes functions fmpy loaded, with ctypes arrays made once and the
+                  statuses checked (the testbench master's way), for pythonfmu, native fmi2
+                  and native fmi3;
 fmu_floor_us      {kind: us}: the same cycle on a floor FMU of that kind whose calls return at
                   once (benchmarks/native_floor.c; fmu.FLOOR_MODULE for pythonfmu): the host's
                   side of every step, which no FMU can go below;
@@ -29,6 +30,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3True, fmi3ValueReference
 
 from fmu_src.host import INPUTS
+from testbenches.fmus import direct_calls
 
 from .common import time_interleaved
 from .fmu import FMU_NAMES, FmuPasses, _output_names, build_floor_fmu
@@ -85,16 +87,19 @@ class Fmi3Passes:
         last = fmi3Float64()
         refs = [byref(f) for f in flags] + [byref(last)]
         component, data = fmu.component, self.data
-        c_set, c_step, c_get = fmu.fmi3SetFloat64, fmu.fmi3DoStep, fmu.fmi3GetFloat64
+        c_set, c_step, c_get = direct_calls(fmu, "fmi3SetFloat64", "fmi3DoStep",
+                                            "fmi3GetFloat64")
         h = 0.01
 
         def run() -> int:
             t = 0.0
-            for sample in data:
+            for sample in data:  # as FmuPasses' low-level host: statuses checked in the loop
                 values[:] = sample
-                c_set(component, vr_in, n_in, values, n_in)
-                c_step(component, t, h, fmi3True, *refs)
-                c_get(component, vr_out, n_out, outputs, n_out)
+                a = c_set(component, vr_in, n_in, values, n_in)
+                b = c_step(component, t, h, fmi3True, *refs)
+                c = c_get(component, vr_out, n_out, outputs, n_out)
+                if a > 1 or b > 1 or c > 1:
+                    raise RuntimeError(f"{self.path.name}: an FMI call failed at t = {t}")
                 outputs[:]  # read back as Python floats, as a host would
                 t += h
             return len(data)

@@ -193,8 +193,9 @@ def _native_lines(r: dict[str, Any], targets: dict[str, Any]) -> list[str]:
         return lines
     floors, host = nat.get("fmu_floor_us", {}), nat.get("c_host_step_us", {})
     rtf = nat.get("testbench_rtf_1khz", {})
-    lines += ["", "Native FMUs: one set/doStep/get cycle through fmpy's low-level calls, and in a C "
-              "host's own loop [us]; testbench real-time factor at 1 kHz",
+    lines += ["", "Native FMUs: one set/doStep/get cycle as the testbench calls (the ctypes "
+              "functions fmpy loaded), and in a C host's own loop [us]; testbench real-time "
+              "factor at 1 kHz",
               f"  {'filter':<8}{'pythonfmu':>10}{'fmi2':>7}{'fmi3':>7}{'speed-up':>9}"
               f"{'C fmi2':>8}{'C fmi3':>8}{'C/twin':>7}{'RTF nat':>9}{'RTF py':>8}{'ratio':>7}"]
     for key in steps.get("fmi2", {}):

@@ -84,6 +84,22 @@ def unpack(path: Path) -> _Unpacked:
     return _CACHE[path]
 
 
+def direct_calls(fmu: Any, *names: str) -> tuple[Any, ...]:
+    """An FMU instance's FMI functions, by name, as the ctypes functions fmpy loaded (with their
+    argument and result types): the hot loops call them without fmpy's wrapper, which costs
+    three Python calls per FMI call to check the status. The caller checks the statuses."""
+    return tuple(getattr(fmu.dll, name) for name in names)
+
+
+def failed(handle: FmuHandle, calls: tuple[str, ...], statuses: tuple[int, ...], t: float,
+           h: float) -> None:
+    """Raise FMICallException for the first of an FMU's calls in the step [t, t+h] whose
+    status was a failure (fmi2Discard or worse; the FMU's log says why)."""
+    call, status = next((c, s) for c, s in zip(calls, statuses, strict=True) if s > 1)
+    raise FMICallException(function=f"{handle.name} {call} (step at t = {t!r} s, h = {h!r} s)",
+                           status=int(status))
+
+
 class FmuHandle:
     """One instance of an FMU, driven by name."""
 

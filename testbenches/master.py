@@ -5,19 +5,20 @@ Per communication step [t, t+h] (docs/interface.md, Timing):
   2. sensor inputs := plant outputs; sensor.doStep(t, h): the IMU sample taken at t+h, dt = h;
   3. estimator inputs := sensor outputs; estimator.doStep(t, h): the estimate at t+h.
 With jitter > 0 the communication steps are h_k = (1 + jitter u_k) / rate, u_k uniform in
-[-1, 1] from the run's seed, so dt follows. Every FMI call's status is checked (fmpy's wrapped
-FMI functions raise FMICallException on fmi2Discard, fmi2Error and fmi2Fatal); the CPU time (of
+[-1, 1] from the run's seed, so dt follows. Every FMI call's status is checked (a status of
+fmi2Discard or worse raises FMICallException naming the FMU and the step); the CPU time (of
 this thread) of set-inputs + doStep + get-outputs of the estimator is recorded per step for
 contract check T3.
 
-The step loop is the hot path of every campaign (at 1 kHz the FMUs are called 9000 times per
-simulated second), so it calls fmpy's low-level fmi2SetReal/fmi2DoStep/fmi2GetReal on ctypes
-arrays allocated once, instead of setReal/getReal, which build new arrays from Python lists on
-every call. The arrays are views of one row of doubles laid out like the recording (truth,
-sample, estimate): the plant writes the truth into it, the sensor reads its inputs from the
-truth part and writes the sample, the estimator reads the sample and writes the estimate, and
-each step ends with one copy of the row into the preallocated record. The values are the same
-doubles the list-based calls passed on.
+The step loop is the hot path of every campaign (at 1 kHz the FMUs are called 8000 times per
+simulated second), so it calls the FMUs' fmi2SetReal/fmi2DoStep/fmi2GetReal as the plain ctypes
+functions fmpy loaded (testbenches.fmus.direct_calls: without fmpy's Python wrapper around each
+call, the statuses checked in the loop) on ctypes arrays allocated once, instead of
+setReal/getReal, which build new arrays from Python lists on every call. The arrays are views of
+one row of doubles laid out like the recording (truth, sample, estimate): the plant writes the
+truth into it, the sensor reads its inputs from the truth part and writes the sample, the
+estimator reads the sample and writes the estimate, and each step ends with one copy of the row
+into the preallocated record. The values are the same doubles the list-based calls passed on.
 """
 
 from __future__ import annotations
@@ -34,7 +35,16 @@ from fmpy.fmi2 import fmi2Real, fmi2True, fmi2ValueReference
 from fusion_core.scenarios import get_scenario
 from fusion_core.synthetic import TRUTH_NAMES
 
-from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, FmuHandle, fmu_path
+from .fmus import (
+    DEFAULT_FMU_DIR,
+    ESTIMATOR_FMUS,
+    PLANT_FMU,
+    SENSOR_FMU,
+    FmuHandle,
+    direct_calls,
+    failed,
+    fmu_path,
+)
 
 TRUTH = TRUTH_NAMES
 """The plant's outputs, recorded in this order."""
@@ -156,9 +166,9 @@ def run_testbench(
 
         p_fmu, s_fmu, e_fmu = plant.fmu, sensor.fmu, est.fmu
         p_c, s_c, e_c = p_fmu.component, s_fmu.component, e_fmu.component
-        p_step, p_get = p_fmu.fmi2DoStep, p_fmu.fmi2GetReal
-        s_set, s_step, s_get = s_fmu.fmi2SetReal, s_fmu.fmi2DoStep, s_fmu.fmi2GetReal
-        e_set, e_step, e_get = e_fmu.fmi2SetReal, e_fmu.fmi2DoStep, e_fmu.fmi2GetReal
+        p_step, p_get = direct_calls(p_fmu, "fmi2DoStep", "fmi2GetReal")
+        s_set, s_step, s_get = direct_calls(s_fmu, "fmi2SetReal", "fmi2DoStep", "fmi2GetReal")
+        e_set, e_step, e_get = direct_calls(e_fmu, "fmi2SetReal", "fmi2DoStep", "fmi2GetReal")
         truth_refs, sample_refs = _refs(truth_vr), _refs(sample_vr)
         sensor_in_refs, est_in_refs = _refs(sensor_in_vr), _refs(est_in_vr)
         est_out_refs = _refs(est_out_vr)
@@ -168,16 +178,20 @@ def run_testbench(
         perf = time.thread_time_ns
         t = 0.0
         for k, h in enumerate(steps.tolist()):
-            p_step(p_c, t, h, fmi2True)
-            p_get(p_c, truth_refs, n_truth, truth_buf)
-            s_set(s_c, sensor_in_refs, n_in, sensor_in_buf)
-            s_step(s_c, t, h, fmi2True)
-            s_get(s_c, sample_refs, n_sample, sample_buf)
+            # Statuses are ints: fmi2OK 0, fmi2Warning 1 (a rejected sample), failures above.
+            status = p_step(p_c, t, h, fmi2True), p_get(p_c, truth_refs, n_truth, truth_buf)
+            if status[0] > 1 or status[1] > 1:
+                failed(plant, ("fmi2DoStep", "fmi2GetReal"), status, t, h)
+            status = (s_set(s_c, sensor_in_refs, n_in, sensor_in_buf),
+                      s_step(s_c, t, h, fmi2True), s_get(s_c, sample_refs, n_sample, sample_buf))
+            if status[0] > 1 or status[1] > 1 or status[2] > 1:
+                failed(sensor, ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), status, t, h)
             t0 = perf()
-            e_set(e_c, est_in_refs, n_sample, sample_buf)
-            e_step(e_c, t, h, fmi2True)
-            e_get(e_c, est_out_refs, n_out, out_buf)
+            status = (e_set(e_c, est_in_refs, n_sample, sample_buf), e_step(e_c, t, h, fmi2True),
+                      e_get(e_c, est_out_refs, n_out, out_buf))
             step_ns[k] = perf() - t0
+            if status[0] > 1 or status[1] > 1 or status[2] > 1:
+                failed(est, ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), status, t, h)
             record[k] = row_np
             t += h
             t_points[k] = t
