@@ -23,11 +23,10 @@ carries no gravity direction: every block below skips it, and so does every corr
 from __future__ import annotations
 
 import math
+from math import cos, sin
 from typing import Final
 
 from .kinematics import (
-    atan2,
-    quat_from_roll_pitch_yaw,
     rotate_back,
     rotation_increment,
 )
@@ -117,9 +116,10 @@ innovation of roll, which the accelerometer cannot observe near pitch +-90 deg, 
 back. With 'quaternion' the filter keeps an attitude quaternion q (yaw free, unobservable), turns
 it by the bias-corrected rotation vector of each interval (the same integration rule as the
 quaternion filters, kinematics.rotation_increment), takes roll and pitch from it, applies its
-paper's correction to roll and pitch, and rebuilds q from the corrected roll and pitch and q's own
-yaw. The correction law, its gains and its covariance are the paper's. Recommended: 'quaternion'
-(no orientation is singular for it); 'euler' is the papers'."""
+paper's correction to roll and pitch, and rebuilds q from the corrected roll and pitch with yaw 0
+(quat_from_roll_pitch: the free yaw does not change roll or pitch). The correction law, its
+gains and its covariance are the paper's. Recommended: 'quaternion' (no orientation is singular
+for it); 'euler' is the papers'."""
 
 RestState = tuple[float, float, float, float, float, float, float]
 """The rest detector's state: running means of the rate (3) and of the specific force (3), and
@@ -170,17 +170,16 @@ def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
     )
 
 
-def quat_yaw(w: float, x: float, y: float, z: float) -> float:
-    """Yaw of a unit quaternion (body to world, Z-Y-X Euler), the companion of
-    kinematics.quat_roll_pitch."""
-    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def quat_with_roll_pitch(
-    q: tuple[float, float, float, float], roll: float, pitch: float
-) -> tuple[float, float, float, float]:
-    """The attitude with the given roll and pitch and q's yaw (PROPAGATION_PARAM)."""
-    return quat_from_roll_pitch_yaw(roll, pitch, quat_yaw(*q))
+def quat_from_roll_pitch(roll: float, pitch: float) -> tuple[float, float, float, float]:
+    """The attitude quaternion (w, x, y, z) of roll and pitch with yaw 0 (PROPAGATION_PARAM):
+    kinematics.quat_from_roll_pitch_yaw(roll, pitch, 0.0), written without the yaw's terms (the
+    same doubles, two sine-cosine pairs instead of three). The yaw of the filters' quaternion is
+    free: a turn about world z changes only the first two rows of the rotation matrix, and roll
+    and pitch are read from the third, so rebuilding q with yaw 0 leaves every later roll and
+    pitch as it was."""
+    cr, sr = cos(0.5 * roll), sin(0.5 * roll)
+    cp, sp = cos(0.5 * pitch), sin(0.5 * pitch)
+    return cr * cp, sr * cp, cr * sp, -(sr * sp)
 
 
 def gate_bounds2(params: dict) -> tuple[float, float]:

@@ -21,7 +21,7 @@ from .building_blocks import (
     body_rotation,
     gate_bounds2,
     lowpass_specific_force,
-    quat_with_roll_pitch,
+    quat_from_roll_pitch,
     rest_step,
 )
 from .kinematics import (
@@ -149,7 +149,7 @@ class ComplementaryFilter(Estimator):
             roll += k * (y if -PI <= y <= PI else wrap_angle(y))
             pitch += k * (acc_pitch - pitch)
             if self._quaternion:
-                self.q_att = quat_with_roll_pitch(self.q_att, roll, pitch)
+                self.q_att = quat_from_roll_pitch(roll, pitch)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         return tuple_new(ESTIMATE, (roll, pitch, bias, None, None))

@@ -41,7 +41,7 @@ from .building_blocks import (
     mat_t_vec,
     mat_vec,
     nearest_face,
-    quat_with_roll_pitch,
+    quat_from_roll_pitch,
     rest_step,
     zero_rate_psd_param,
 )
@@ -310,8 +310,12 @@ class AngleBiasKalmanFilter(Estimator):
                 gx, gy, gz = mat_vec(C, (gx, gy, gz))
                 prev = mat_vec(C, prev)
             self._update_with_options(ax, ay, az, gx, gy, gz, dt, prev)
-            if self._faces and cos(self.roll) * cos(self.pitch) < FACE_SWITCH_COS:
-                self._switch_face()
+            # up's z in the face frame, cos(roll) cos(pitch), read off the attitude quaternion
+            # (the z of quat_gravity_body) without two cosines
+            if self._faces:
+                w, x, y, z = self.q_att
+                if w * w - x * x - y * y + z * z < FACE_SWITCH_COS:
+                    self._switch_face()
             if self.face:
                 return self._estimate()
         else:
@@ -349,7 +353,7 @@ class AngleBiasKalmanFilter(Estimator):
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             self.correct(ax, ay, az, learn_bias)
         if self._quaternion and (self.roll, self.pitch) != predicted:
-            self.q_att = quat_with_roll_pitch(self.q_att, self.roll, self.pitch)
+            self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
 
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float

@@ -88,7 +88,7 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
         roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
         pitch += k * (acc_pitch - pitch);
         if (f->quaternion) {
-            fc_quat_with_roll_pitch(f->q_att, roll, pitch);
+            fc_quat_from_roll_pitch(roll, pitch, f->q_att);
         }
     }
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);

@@ -156,15 +156,15 @@ const double FC_FACES[6][9] = {
     {0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0},
 };
 
-double fc_quat_yaw(const double q[4])
+/* quat_from_roll_pitch: roll and pitch with yaw 0 (the filters' free yaw) */
+void fc_quat_from_roll_pitch(double roll, double pitch, double q[4])
 {
-    double w = q[0], x = q[1], y = q[2], z = q[3];
-    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
-}
-
-void fc_quat_with_roll_pitch(double q[4], double roll, double pitch)
-{
-    fc_quat_from_roll_pitch_yaw(roll, pitch, fc_quat_yaw(q), q);
+    double cr = cos(0.5 * roll), sr = sin(0.5 * roll);
+    double cp = cos(0.5 * pitch), sp = sin(0.5 * pitch);
+    q[0] = cr * cp;
+    q[1] = sr * cp;
+    q[2] = cr * sp;
+    q[3] = -(sr * sp);
 }
 
 void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2)

@@ -69,8 +69,7 @@ void fc_rotate_back(const double v[3], const double phi[3], double out[3]);
 #define FC_REST_MEAN_TAU 0.5
 #define FC_FACE_SWITCH_COS 0.5
 extern const double FC_FACES[6][9];
-double fc_quat_yaw(const double q[4]);
-void fc_quat_with_roll_pitch(double q[4], double roll, double pitch);
+void fc_quat_from_roll_pitch(double roll, double pitch, double q[4]);
 void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2);
 void fc_body_rotation(const double g0[3], const double g1[3], const double bias[3], double dt,
                       int trapezoid, double phi[3]);

@@ -269,7 +269,7 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
         fc_kf_correct(f, a[0], a[1], a[2], learn_bias);
     }
     if (f->quaternion && (f->roll != pred_roll || f->pitch != pred_pitch)) {
-        fc_quat_with_roll_pitch(f->q_att, f->roll, f->pitch);
+        fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
     }
 }
 
@@ -343,8 +343,12 @@ static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double
             fc_mat_vec(C, prev, prev);
         }
         update_with_options(f, a, g, dt, prev);
-        if (f->faces && cos(f->roll) * cos(f->pitch) < FC_FACE_SWITCH_COS) {
-            switch_face(f);
+        /* up's z in the face frame, cos(roll) cos(pitch), read off the attitude quaternion */
+        if (f->faces) {
+            const double *q = f->q_att;
+            if (q[0] * q[0] - q[1] * q[1] - q[2] * q[2] + q[3] * q[3] < FC_FACE_SWITCH_COS) {
+                switch_face(f);
+            }
         }
     } else {
         fc_kf_propagate(f, g_in, dt, NULL);
