@@ -23,7 +23,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from .types import DEG, MPU6050_ACC_DENSITY
+from .types import DEG, MPU6050_ACC_DENSITY, G
 
 DEG2 = DEG * DEG
 KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
@@ -92,6 +92,40 @@ def _unknown(name: str) -> ValueError:
     hint = (f" ('{name}' is now '{RENAMED_PRESETS[name]}')" if name in RENAMED_PRESETS else "")
     return ValueError(f"unknown preset {name!r}{hint}: allowed {', '.join(PRESETS)} or a JSON "
                       "file of parameters per estimator")
+
+
+REFERENCE_ACC_SAMPLE_STD = 0.05
+"""Standard deviation of one accelerometer sample at rest [m/s^2] on the real MEMS IMU the
+recommended values are derived for (BROAD's myon aktos-t: 0.045-0.07 m/s^2 per axis)."""
+
+
+def noise_preset(gyro_density: float, acc_density: float,
+                 acc_sample_std: float) -> dict[str, dict[str, float]]:
+    """The recommended values that follow from a sensor's noise, per estimator: the derivations
+    of the classes' docstrings as one function, which `python -m testbenches noise` applies to
+    a user's own sensor. gyro_density [rad/s/sqrt(Hz)] and acc_density [m/s^2/sqrt(Hz)] are
+    the white-noise densities (the Allan deviation at tau = 1 s), acc_sample_std [m/s^2] the
+    standard deviation of one accelerometer sample at rest at the rate the filter will run.
+
+    kf: Q_angle = the gyro's PSD, R_measure = the variance of one sample's tilt,
+    (acc_sample_std / g)^2, gyro_psd (its zero-rate update) the gyro's PSD; ukf: gyro_psd and
+    zaru_psd the gyro's PSD, acc_noise = acc_sample_std / g; poskf: acc_psd the accelerometer's
+    PSD and gyro_psd the gyro's (its tilt stage keeps the papers' Q and R, which the position
+    contract was met with). cf and mgcf have no noise-derived value (their time constants come
+    from the bias a correction must hold off and from scans, see their docstrings): {}.
+
+    The recommended defaults are this function at the reference sensor, kalman.REAL_GYRO_DENSITY,
+    position.REAL_ACC_DENSITY and REFERENCE_ACC_SAMPLE_STD (tests/test_presets.py holds them to
+    it; ukf's acc_noise is rounded to 0.005)."""
+    gyro_psd = gyro_density * gyro_density
+    r = (acc_sample_std / G) ** 2
+    return {
+        "cf": {},
+        "mgcf": {},
+        "kf": {"Q_angle": gyro_psd, "R_measure": r, "gyro_psd": gyro_psd},
+        "ukf": {"gyro_psd": gyro_psd, "zaru_psd": gyro_psd, "acc_noise": acc_sample_std / G},
+        "poskf": {"acc_psd": acc_density * acc_density, "gyro_psd": gyro_psd},
+    }
 
 
 def preset_params(preset: str, key: str) -> dict[str, Any]:

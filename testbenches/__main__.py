@@ -4,6 +4,10 @@
               table, writes DIR/report.json, DIR/report.md and plots; exit status 1 on any FAIL.
   export-ssp  the plant, sensor and estimator FMUs and their connections as an SSP file.
   broad       accuracy on BROAD's real recordings beside VQF, Madgwick, Mahony (testbenches.broad).
+  noise       noise densities of a static recording (Allan deviation), a preset for every
+              estimator and the sensor FMU's parameters for that sensor (testbenches.fit).
+  tune        an estimator's tunable parameters fitted to recordings with a reference, validated
+              on others (testbenches.fit).
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from pathlib import Path
 from fusion_core.scenarios import SCENARIOS
 
 from .broad.cli import add_broad_parser
+from .fit.cli import add_fit_parsers
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .options import choose
 
@@ -118,6 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     ssp.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
     ssp.add_argument("out", type=Path, help="the SSP file to write")
     add_broad_parser(sub)
+    add_fit_parsers(sub)
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
@@ -135,6 +141,10 @@ def main(argv: list[str] | None = None) -> int:
             from .broad.cli import cmd_broad
 
             return cmd_broad(args)
+        if args.command in ("noise", "tune"):
+            from .fit.cli import cmd_noise, cmd_tune
+
+            return (cmd_noise if args.command == "noise" else cmd_tune)(args)
     except (ValueError, FileNotFoundError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

@@ -1,0 +1,108 @@
+"""The `noise` and `tune` commands' argument parsing (python -m testbenches noise|tune ...)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from fusion_core import ESTIMATORS
+
+
+def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
+    noise = sub.add_parser(
+        "noise", help="noise densities of a static recording (Allan deviation), a preset for "
+        "every estimator and the sensor FMU's parameters for that sensor")
+    noise.add_argument("file", type=Path, help="a static recording: CSV (acc_x..z [m/s2], "
+                       "gyro_x..z [rad/s], optional time or dt [s]) or a BROAD trial (its rest "
+                       "segment is used)")
+    noise.add_argument("--rate", type=float, default=None,
+                       help="sampling rate [Hz] of a CSV without time or dt columns")
+    noise.add_argument("--out", type=Path, default=Path("reports/noise"),
+                       help="folder for noise.json, preset.json, sensor.json, allan.png")
+    noise.add_argument("--no-plots", action="store_true", help="skip allan.png")
+
+    tune = sub.add_parser(
+        "tune", help="fit an estimator's tunable parameters to recordings with a reference, "
+        "validated on others")
+    tune.add_argument("--estimator", required=True, choices=list(ESTIMATORS))
+    tune.add_argument("files", type=Path, nargs="+",
+                      help="recordings to fit: BROAD trials, or CSV with reference columns "
+                      "(q_w, q_x, q_y, q_z or roll, pitch [rad])")
+    tune.add_argument("--validate", type=Path, nargs="*", default=[],
+                      help="recordings that check the fit (not fitted)")
+    tune.add_argument("--start", default="recommended",
+                      help="where the fit starts: recommended (default), paper, or a preset "
+                      "JSON file")
+    tune.add_argument("--params", default=None,
+                      help="comma list of the parameters to fit (default: all tunable ones)")
+    tune.add_argument("--max-evaluations", type=int, default=300,
+                      help="runs of the estimator over the fit set at most (300)")
+    tune.add_argument("--rate", type=float, default=None,
+                      help="sampling rate [Hz] of CSV files without time or dt columns")
+    tune.add_argument("--fmu", action="store_true",
+                      help="confirm the fitted preset through the estimator's FMU")
+    tune.add_argument("--fmu-dir", type=Path, default=Path("dist"), help="built FMUs (dist)")
+    tune.add_argument("--out", type=Path, default=Path("reports/tune"),
+                      help="folder for preset.json, tune.json, tune.png")
+    tune.add_argument("--no-plots", action="store_true", help="skip tune.png")
+
+
+def cmd_noise(args: argparse.Namespace) -> int:
+    from .noise import run_noise
+    from .recording import load, rest
+
+    rec = rest(load(args.file, args.rate))
+    noise = run_noise(rec, args.out, plots=not args.no_plots)
+    g, a = noise["gyro_density"]["mean"], noise["acc_density"]["mean"]
+    print(f"{rec.name}: {rec.duration:.0f} s at {rec.rate:g} Hz")
+    print(f"  gyro white noise {noise['gyro_density_deg_s_sqrt_hz']:.4g} deg/s/sqrt(Hz) "
+          f"(gyro_psd {g * g:.4g} rad2/s)")
+    print(f"  acc white noise {noise['acc_density_ug_sqrt_hz']:.4g} ug/sqrt(Hz) "
+          f"(acc_psd {a * a:.4g} m2/s3)")
+    if "note" in noise:
+        print(f"  note: {noise['note']}")
+    print(f"wrote {args.out}/noise.json, preset.json, sensor.json"
+          + ("" if args.no_plots else ", allan.png"))
+    return 0
+
+
+def cmd_tune(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from fusion_core.presets import load_preset
+
+    from .recording import load
+    from .tune import fmu_score, tune, write
+
+    fit_recs = [load(p, args.rate) for p in args.files]
+    val_recs = [load(p, args.rate) for p in args.validate]
+    start = load_preset(args.start)[args.estimator]
+    names = [n.strip() for n in args.params.split(",")] if args.params else None
+    with tqdm(total=args.max_evaluations, unit="run", file=sys.stderr) as bar:
+        def progress(best: float) -> None:
+            bar.set_postfix_str(f"best {best:.4f} deg")
+            bar.update()
+
+        result = tune(args.estimator, fit_recs, val_recs, start, names, args.max_evaluations,
+                      progress)
+    if args.fmu:
+        from ..fmus import kind_dir
+
+        result.fmu_fit_rmse_deg = fmu_score(args.estimator, result.fitted, fit_recs,
+                                            kind_dir(args.fmu_dir))
+    write(result, args.out, plots=not args.no_plots)
+    print(f"{args.estimator}: fit {result.start_fit_rmse_deg:.4f} -> {result.fit_rmse_deg:.4f} "
+          f"deg over {len(fit_recs)} recording(s), {result.evaluations} runs, "
+          f"{result.seconds:.0f} s")
+    if result.validation_rmse_deg is not None:
+        print(f"  validation {result.start_validation_rmse_deg:.4f} -> "
+              f"{result.validation_rmse_deg:.4f} deg over {len(val_recs)} recording(s)")
+    if result.fmu_fit_rmse_deg is not None:
+        print(f"  through the FMU: fit {result.fmu_fit_rmse_deg:.4f} deg")
+    specs = ESTIMATORS[args.estimator].param_specs()
+    for d in result.dimensions:
+        before = result.start.get(d.name, specs[d.name].default)
+        print(f"  {d.name}: {before:.6g} -> {result.fitted.get(d.name, before):.6g}")
+    print(f"wrote {args.out}/preset.json, tune.json" + ("" if args.no_plots else ", tune.png"))
+    return 0

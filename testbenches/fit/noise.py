@@ -1,0 +1,179 @@
+"""`python -m testbenches noise`: a static recording in; noise densities, a preset for every
+estimator and the sensor FMU's parameters for that sensor out.
+
+From the Allan deviation of each axis (allan.py): the white-noise densities (gyro_psd, acc_psd:
+their squares, the units of the sensor FMU's parameters), the rate random walk (gyro_bias_psd,
+acc_bias_psd) and the bias instability, per axis and their mean; beside them the static biases,
+the accelerometer's norm and one sample's standard deviation. The preset is
+fusion_core.presets.noise_preset of those numbers (the derivation the recommended defaults come
+from), so the command and the defaults cannot drift apart.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.presets import noise_preset
+from fusion_core.types import DEG, G
+
+from .allan import AllanFit, allan_deviation, fit
+from .recording import Recording, RecordingError
+
+MIN_DURATION_S = 20.0
+"""The white-noise fit needs taus up to a few seconds, each averaged over ten clusters at least."""
+LONG_DURATION_S = 2 * 3600.0
+"""Bias instability and rate random walk of a MEMS IMU show from minutes to an hour: record this
+long to resolve them (the usual 2 h static recording)."""
+MAX_GYRO_SWING = 1.0 * DEG
+"""Peak-to-peak of the gyro's 1 s means [rad/s] beyond which the recording is not static."""
+MAX_TILT_CHANGE = 1.0 * DEG
+"""Change of the accelerometer's direction (1 s means) beyond which the sensor moved."""
+AXES = ("x", "y", "z")
+
+
+def check_static(rec: Recording) -> None:
+    """RecordingError unless rec is long enough and static (see the constants)."""
+    if rec.duration < MIN_DURATION_S:
+        raise RecordingError(
+            f"{rec.name}: {rec.duration:.1f} s is too short: the white-noise fit needs at least "
+            f"{MIN_DURATION_S:.0f} s at rest ({LONG_DURATION_S / 3600:.0f} h to resolve the bias "
+            "instability and the random walk)")
+    block = max(1, round(rec.rate))
+    n = len(rec.dt) // block * block
+    g_means = rec.gyro[:n].reshape(-1, block, 3).mean(axis=1)
+    swing = float(np.max(np.ptp(g_means, axis=0)))
+    if swing > MAX_GYRO_SWING:
+        raise RecordingError(
+            f"{rec.name}: not static: rotation seen in the gyro (its 1 s means move by "
+            f"{np.degrees(swing):.2f} deg/s, allowed {np.degrees(MAX_GYRO_SWING):.1f}); record "
+            "with the sensor at rest")
+    a_means = rec.acc[:n].reshape(-1, block, 3).mean(axis=1)
+    u = a_means / np.linalg.norm(a_means, axis=1, keepdims=True)
+    tilt = float(np.max(np.arccos(np.clip(u @ u[0], -1.0, 1.0))))
+    if tilt > MAX_TILT_CHANGE:
+        raise RecordingError(
+            f"{rec.name}: not static: the accelerometer's direction changed by "
+            f"{np.degrees(tilt):.2f} deg (allowed {np.degrees(MAX_TILT_CHANGE):.1f}): the sensor "
+            "moved")
+
+
+def _axes(values: list[float | None]) -> dict[str, float | None]:
+    out: dict[str, float | None] = dict(zip(AXES, values, strict=True))
+    known = [v for v in values if v is not None]
+    out["mean"] = float(np.mean(known)) if len(known) == len(values) else None
+    return out
+
+
+def _squared(d: dict[str, float | None]) -> dict[str, float | None]:
+    return {k: (None if v is None else v * v) for k, v in d.items()}
+
+
+def analyse(rec: Recording) -> tuple[dict[str, Any], dict[str, list[AllanFit]]]:
+    """noise.json's content for a static recording, and the fits per signal (for the plot)."""
+    check_static(rec)
+    fits = {
+        "gyro": [fit(*allan_deviation(rec.gyro[:, i], rec.rate)) for i in range(3)],
+        "acc": [fit(*allan_deviation(rec.acc[:, i], rec.rate)) for i in range(3)],
+    }
+    out: dict[str, Any] = {
+        "recording": {"name": rec.name, "samples": len(rec.dt), "duration_s": rec.duration,
+                      "rate_hz": rec.rate},
+        "units": {"gyro_density": "rad/s/sqrt(Hz)", "gyro_psd": "rad2/s (= (rad/s)^2/Hz)",
+                  "acc_density": "m/s2/sqrt(Hz)", "acc_psd": "m2/s3 (= (m/s^2)^2/Hz)",
+                  "gyro_bias_psd": "rad2/s3", "acc_bias_psd": "m2/s5",
+                  "gyro_bias_instability": "rad/s", "acc_bias_instability": "m/s2"},
+    }
+    for sig in ("gyro", "acc"):
+        f = fits[sig]
+        density = _axes([x.white for x in f])
+        walk = _axes([x.random_walk for x in f])
+        out[f"{sig}_density"] = density
+        out[f"{sig}_psd"] = _squared(density)
+        out[f"{sig}_bias_psd"] = _squared(walk)
+        out[f"{sig}_bias_instability"] = _axes([x.instability for x in f])
+        out[f"{sig}_white_fit_taus_s"] = [list(x.white_taus) for x in f]
+    out["gyro_density_deg_s_sqrt_hz"] = float(np.degrees(out["gyro_density"]["mean"]))
+    out["acc_density_ug_sqrt_hz"] = float(out["acc_density"]["mean"] / G * 1e6)
+    out["gyro_static_bias"] = dict(zip(AXES, rec.gyro.mean(axis=0).tolist(), strict=True))
+    out["acc_mean"] = dict(zip(AXES, rec.acc.mean(axis=0).tolist(), strict=True))
+    norm = float(np.linalg.norm(rec.acc.mean(axis=0)))
+    out["acc_norm"] = norm
+    out["acc_norm_g"] = norm / G
+    out["acc_sample_std"] = float(np.mean(np.std(rec.acc, axis=0)))
+    if rec.duration < LONG_DURATION_S:
+        out["note"] = (f"{rec.duration:.0f} s of data: bias instability and random walk need "
+                       f"about {LONG_DURATION_S / 3600:.0f} h at rest to be resolved; None where "
+                       "this recording does not reach them")
+    return out, fits
+
+
+def preset_for(noise: dict[str, Any]) -> dict[str, dict[str, float]]:
+    """The recommended-style preset for every estimator (fusion_core.presets.noise_preset)."""
+    return noise_preset(noise["gyro_density"]["mean"], noise["acc_density"]["mean"],
+                        noise["acc_sample_std"])
+
+
+def sensor_params(noise: dict[str, Any]) -> dict[str, float]:
+    """The sensor FMU's (ImuSensor's) parameters for this sensor: its white noise, and its bias
+    instability and random walk where the recording resolved them (the per-run calibration
+    residual, scale and cross-axis errors keep the model's defaults)."""
+    out = {"gyro_psd": noise["gyro_psd"]["mean"], "acc_psd": noise["acc_psd"]["mean"]}
+    for sig in ("gyro", "acc"):
+        b = noise[f"{sig}_bias_instability"]["mean"]
+        if b is not None:
+            out[f"{sig}_bias_instability"] = b
+        k = noise[f"{sig}_bias_psd"]["mean"]
+        if k is not None:
+            out[f"{sig}_bias_psd"] = k
+    return out
+
+
+def plot(fits: dict[str, list[AllanFit]], path: Path, title: str) -> None:
+    """allan.png: the Allan deviation of each axis with the fitted lines, as datasheets show it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    scale = {"gyro": (np.degrees(1.0) * 3600.0, "Allan deviation [deg/h]"),
+             "acc": (1e6 / G, "Allan deviation [ug]")}
+    for ax, (sig, f) in zip(axes, fits.items(), strict=True):
+        k, label = scale[sig]
+        for axis, x in zip(AXES, f, strict=True):
+            line = ax.loglog(x.taus, x.adev * k, label=f"{sig} {axis}")[0]
+            t = x.taus
+            ax.loglog(t, x.white / np.sqrt(t) * k, "--", color=line.get_color(), lw=0.8)
+            if x.random_walk is not None:
+                ax.loglog(t, x.random_walk * np.sqrt(t / 3.0) * k, ":", color=line.get_color(),
+                          lw=0.8)
+            if x.instability is not None:
+                ax.plot(x.instability_tau, x.instability * 0.664 * k, "o",
+                        color=line.get_color())
+        ax.set_xlabel("tau [s]")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title(f"{sig}: -- white noise (-1/2), : random walk (+1/2), o floor")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def run_noise(rec: Recording, out_dir: Path, plots: bool = True) -> dict[str, Any]:
+    """Write noise.json, preset.json, sensor.json (and allan.png) into out_dir; return the
+    noise.json content."""
+    noise, fits = analyse(rec)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "noise.json").write_text(json.dumps(noise, indent=1))
+    (out_dir / "preset.json").write_text(json.dumps(preset_for(noise), indent=1))
+    (out_dir / "sensor.json").write_text(json.dumps(sensor_params(noise), indent=1))
+    if plots:
+        plot(fits, out_dir / "allan.png",
+             f"{rec.name}: {rec.duration:.0f} s at {rec.rate:g} Hz")
+    return noise
