@@ -29,9 +29,11 @@ from .kinematics import PI, accel_roll_pitch, wrap_angle
 from .presets import PAPER_KF
 from .types import DEG, Estimate, G, Param
 
-REAL_ACC_DENSITY = 0.005
-"""Accelerometer white-noise density [m/s^2/sqrt(Hz)] measured on a real MEMS IMU at rest
-(BROAD's myon aktos-t: 0.004-0.006), the recommended acc_psd's root."""
+REAL_ACC_DENSITY = 0.0033
+"""Accelerometer white-noise density [m/s^2/sqrt(Hz)] of a real MEMS IMU at rest, the
+recommended acc_psd's root: the Allan deviation at tau = 1 s on the rest segments of 13 BROAD
+trials (myon aktos-t; `python -m testbenches noise`: 0.0031-0.0039, median 0.0033), the
+convention of the sensor model (one sample's standard deviation = density sqrt(rate))."""
 
 PENDING_MAX = 2048
 """Most accelerometer samples the stationary queue holds (tilt_update="stationary"); when full
@@ -215,7 +217,7 @@ class PositionKalmanFilter(Estimator):
         Param(
             "acc_psd", REAL_ACC_DENSITY**2,
             "Accelerometer white-noise power spectral density, R = acc_psd/dt (measured on a real "
-            "MEMS IMU: (0.005 m/s2/sqrt(Hz))^2; MPU-6050 datasheet (400 ug/sqrt(Hz))^2)",
+            "MEMS IMU: (0.0033 m/s2/sqrt(Hz))^2; MPU-6050 datasheet (400 ug/sqrt(Hz))^2)",
             unit="m2/s3", low=0.0, low_open=True,
         ),
         Param("zupt", True, "Zero-velocity update while the platform is stationary"),

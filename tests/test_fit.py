@@ -114,7 +114,7 @@ def test_log_space_where_a_range_spans_decades_and_within_the_allowed_range():
     assert q.log and q.low == pytest.approx(specs["Q_angle"].default / 100)
     gate = dimension(specs["gate_low"], 0.5)
     assert not gate.log and gate.low > 0.0 and gate.high <= 1.0
-    names = [p.name for p in tunable("mgcf")]
+    names = [p.name for p in tunable("mgcf", ["all"])]
     assert "w0" in names and "max_dt" not in names and "schedule" not in names
     with pytest.raises(ValueError, match="cannot be fitted"):
         tunable("mgcf", ["schedule"])
@@ -155,3 +155,8 @@ def test_noise_on_a_broad_trial_takes_its_rest_segment(tmp_path):
     # BROAD's myon aktos-t, in the range the recommended preset's docstrings state
     assert 0.004 * DEG < noise["gyro_density"]["mean"] < 0.012 * DEG
     assert 0.002 < noise["acc_density"]["mean"] < 0.006
+
+
+def test_tune_fits_by_default_what_physics_leaves_open():
+    assert [p.name for p in tunable("mgcf")] == ["w0", "zeta"]
+    assert [p.name for p in tunable("kf")] == ["Q_bias"]

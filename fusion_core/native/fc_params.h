@@ -257,7 +257,7 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
 {
     p->qr_form = FC_POSKF_QR_FORM_WHITE_JERK;
     p->q = 1.0;
-    p->acc_psd = 2.5e-05;
+    p->acc_psd = 1.0889999999999999e-05;
     p->zupt = 1;
     p->zupt_acc = 0.2;
     p->zupt_level_acc = 0.5;

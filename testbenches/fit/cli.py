@@ -35,9 +35,14 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
                       help="where the fit starts: recommended (default), paper, or a preset "
                       "JSON file")
     tune.add_argument("--params", default=None,
-                      help="comma list of the parameters to fit (default: all tunable ones)")
+                      help="comma list of the parameters to fit, or all (every tunable one); "
+                      "default: those the recommended preset took from a scan (cf tau, mgcf "
+                      "w0 and zeta, kf Q_bias, ukf bias_psd, poskf q)")
     tune.add_argument("--max-evaluations", type=int, default=300,
                       help="runs of the estimator over the fit set at most (300)")
+    tune.add_argument("--max-worse", type=float, default=0.03,
+                      help="how much worse than at the start any one fit recording may end, a "
+                      "fraction (0.03)")
     tune.add_argument("--rate", type=float, default=None,
                       help="sampling rate [Hz] of CSV files without time or dt columns")
     tune.add_argument("--fmu", action="store_true",
@@ -85,7 +90,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
             bar.update()
 
         result = tune(args.estimator, fit_recs, val_recs, start, names, args.max_evaluations,
-                      progress)
+                      progress, args.max_worse)
     if args.fmu:
         from ..fmus import kind_dir
 
