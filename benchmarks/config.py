@@ -31,7 +31,9 @@ class BenchConfig:
     scaling_sizes: tuple[int, ...] = (1_000, 10_000, 100_000, 1_000_000)
     scaling_estimators: tuple[str, ...] = ESTIMATOR_KEYS
     peers: bool = True
-    sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "native", "scaling")
+    sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "native", "campaign",
+                                 "scaling")
+    campaign_seeds: int = 300
     quick: bool = False
     core: str = "auto"
 
@@ -46,5 +48,6 @@ class BenchConfig:
             testbench_s={100.0: 5.0, 1000.0: 1.0},
             testbench_repeats=1,
             scaling_sizes=(1_000, 10_000, 100_000),
+            campaign_seeds=60,
             quick=True,
         )

@@ -131,6 +131,21 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
                 t["native"] >= TESTBENCH_NATIVE_RTF,
                 "the Python master: fmpy's ctypes calls, eight per step",
             ))
+    camp = r.get("campaign")
+    if camp and camp.get("available"):
+        from .campaign import SAMPLES_PER_S_TARGET, SCALING_TARGET
+
+        out.append(_target(
+            "campaign.samples_per_s", camp["samples_per_s"], f">= {SAMPLES_PER_S_TARGET:.0e}",
+            camp["samples_per_s"] >= SAMPLES_PER_S_TARGET,
+            "per run: the estimator's batch run (0.2-0.6 us per sample), the sensor's samples "
+            "shared by the estimators of a seed, the contract metrics, the cluster's start",
+        ))
+        out.append(_target(
+            "campaign.scaling", camp["scaling"], f">= {SCALING_TARGET:g}",
+            camp["scaling"] >= SCALING_TARGET,
+            "the cluster's start and the client's Parquet writes do not scale with workers",
+        ))
     tb = r.get("testbench")
     if tb:
         for key, rates in tb.items():
@@ -213,6 +228,19 @@ def _native_lines(r: dict[str, Any], targets: dict[str, Any]) -> list[str]:
     return lines
 
 
+def _campaign_lines(r: dict[str, Any], targets: dict[str, Any]) -> list[str]:
+    c = r["campaign"]
+    if not c.get("available"):
+        return ["", f"Campaign: unavailable ({c.get('reason')})"]
+    t, s = targets.get("campaign.samples_per_s"), targets.get("campaign.scaling")
+    return ["", f"Campaign on a local Dask cluster: {c['runs']} runs",
+            f"  2 workers: {c['samples_per_s']:.3g} samples/s ({c['seconds']:.1f} s), target "
+            f"{t['target'] if t else ''}: {_verdict(t)}",
+            f"  1 worker:  {c['samples_per_s_1_worker']:.3g} samples/s "
+            f"({c['seconds_1_worker']:.1f} s); scaling {c['scaling']:.2f} (target "
+            f"{s['target'] if s else ''}): {_verdict(s)}"]
+
+
 def format_table(r: dict[str, Any]) -> str:
     """The results as a terminal table, every target beside its measurement."""
     targets = {t["name"]: t for t in r.get("targets", [])}
@@ -291,6 +319,8 @@ def format_table(r: dict[str, Any]) -> str:
                 )
     if "native" in r:
         lines += _native_lines(r, targets)
+    if "campaign" in r:
+        lines += _campaign_lines(r, targets)
     if "scaling" in r:
         lines += ["", "Scaling of run(): time per sample and peak memory growth",
                   f"  {'estimator':<11}{'N':>9}{'us/sample':>11}{'peak MB':>9}"

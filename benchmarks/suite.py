@@ -13,6 +13,7 @@ from fmu_src.compiled_core import is_compiled
 from fusion_core.base import Estimator
 from fusion_core.types import Estimate
 
+from .campaign import campaign_section
 from .common import (
     RATE_HZ,
     SCENARIO,
@@ -156,6 +157,9 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
             "run_us_per_sample", {})
         results["native"]["c_host_vs_twin"] = {
             key: host["fmi2"][key] / twin[key] for key in twin if key in host.get("fmi2", {})}
+    if "campaign" in config.sections:
+        log("campaign throughput on a local Dask cluster (2 workers, then 1)")
+        results["campaign"] = campaign_section(config.campaign_seeds)
     if "scaling" in config.sections:
         log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
         results["scaling"] = scaling(config.scaling_estimators, config.scaling_sizes, rec)

@@ -8,6 +8,8 @@
               estimator and the sensor FMU's parameters for that sensor (testbenches.fit).
   tune        an estimator's tunable parameters fitted to recordings with a reference, validated
               on others (testbenches.fit).
+  campaign    a Monte Carlo campaign of seeded runs on Dask, resumable, with percentiles and
+              confidence intervals (testbenches.montecarlo).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from fusion_core.scenarios import SCENARIOS
 from .broad.cli import add_broad_parser
 from .fit.cli import add_fit_parsers
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
+from .montecarlo.cli import add_campaign_parser
 from .options import choose
 
 
@@ -124,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
     ssp.add_argument("out", type=Path, help="the SSP file to write")
     add_broad_parser(sub)
     add_fit_parsers(sub)
+    add_campaign_parser(sub)
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
@@ -145,6 +149,10 @@ def main(argv: list[str] | None = None) -> int:
             from .fit.cli import cmd_noise, cmd_tune
 
             return (cmd_noise if args.command == "noise" else cmd_tune)(args)
+        if args.command == "campaign":
+            from .montecarlo.cli import cmd_campaign
+
+            return cmd_campaign(args)
     except (ValueError, FileNotFoundError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

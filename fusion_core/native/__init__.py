@@ -360,10 +360,9 @@ def plant_truth(scenario_id: int, t: np.ndarray) -> np.ndarray:
     lib, ffi = lib_and_ffi()
     t = np.ascontiguousarray(t, dtype=np.float64)
     out = np.empty((t.shape[0], 15))
-    for i, ti in enumerate(t.tolist()):
-        row = ffi.cast("double *", ffi.from_buffer(out[i], require_writable=True))
-        if lib.fc_plant_truth(scenario_id, ti, row) != 0:
-            raise ValueError(f"unknown scenario id {scenario_id}")
+    if lib.fc_plant_run(scenario_id, t.shape[0], ffi.cast("double *", ffi.from_buffer(t)),
+                        ffi.cast("double *", ffi.from_buffer(out, require_writable=True))) != 0:
+        raise ValueError(f"unknown scenario id {scenario_id}")
     return out
 
 

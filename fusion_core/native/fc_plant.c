@@ -127,3 +127,13 @@ int fc_plant_truth(int id, double t, double out[FC_TRUTH_SIZE])  /* Trajectory._
     }
     return 0;
 }
+
+int fc_plant_run(int id, long n, const double *t, double *out)
+{
+    for (long i = 0; i < n; i++) {
+        if (fc_plant_truth(id, t[i], out + FC_TRUTH_SIZE * i) != 0) {
+            return -1;
+        }
+    }
+    return 0;
+}

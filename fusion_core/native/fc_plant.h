@@ -9,5 +9,7 @@
  * omega [rad/s] (3), specific force [m/s^2] (3), position [m] (3), velocity [m/s] (3).
  * Returns 0, or -1 for an unknown scenario. */
 int fc_plant_truth(int id, double t, double out[FC_TRUTH_SIZE]);
+/* The truth at n times t[i], row i of out [n][FC_TRUTH_SIZE]; 0, or -1 for an unknown scenario. */
+int fc_plant_run(int id, long n, const double *t, double *out);
 
 #endif /* FC_PLANT_H */

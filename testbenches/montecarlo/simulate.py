@@ -1,0 +1,119 @@
+"""One campaign run: plant -> sensor -> estimator, scored by the contract's metrics.
+
+By default through fusion_core: the scenario's truth (fusion_core.native.plant_truth, the C
+twin of the plant FMU, or the Python trajectory where there is no twin), the sensor model's
+batch run and the estimator's batch run (the C twins where built). A worker keeps the last
+scenarios' truth and the last seeds' samples: they do not depend on the estimator, and the
+plan puts the estimators of one seed next to each other. The data flow is the
+testbench master's (docs/interface.md, Timing): the truth at t_k, the sensor's sample at t_k
+with dt = h, the estimate for that sample; so a run gives what the three FMUs give for the same
+seed, at the C twins' speed (tests/test_montecarlo.py compares them). With fmu=True the run is
+the FMU testbench itself (testbenches.master.run_testbench through fmpy).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core import ESTIMATORS, native
+from fusion_core.scenarios import get_scenario
+from fusion_core.sensor import ImuSensorModel
+from fusion_core.synthetic import TRUTH_NAMES
+
+from ..contract import compute_metrics
+from ..master import ESTIMATE, POSITION, SAMPLE, TestbenchResult, communication_steps
+from .plan import Run
+
+RATE = 100.0
+"""The campaign's sample rate [Hz], the contract's."""
+METRICS = ("rmse_roll_deg", "rmse_pitch_deg", "max_err_deg", "bias_err_dps", "invalid_samples",
+           "samples")
+"""The contract metrics each row keeps."""
+
+
+@functools.lru_cache(maxsize=16)
+def _truth(scenario_id: int, duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Steps, times and [N, 15] truth (TRUTH_NAMES' order) of a scenario: the plant's C twin,
+    or the Python trajectory. The truth depends on the scenario and the duration only, so a
+    worker computes it once for all its runs of that scenario (read-only arrays)."""
+    steps = communication_steps(duration, RATE, 0.0, 0)
+    t = np.cumsum(steps)
+    if native.available():
+        truth = native.plant_truth(scenario_id, t)
+    else:
+        x = get_scenario(scenario_id).trajectory().truth(t)
+        truth = np.column_stack([x["roll"], x["pitch"], x["yaw"], *x["omega"].T, *x["f"].T,
+                                 *x["pos"].T, *x["vel"].T])
+    for a in (steps, t, truth):
+        a.setflags(write=False)
+    return steps, t, truth
+
+
+@functools.lru_cache(maxsize=4)
+def _samples(scenario_id: int, duration: float, sensor_json: str) -> dict[str, np.ndarray]:
+    """The sensor's samples of a scenario for one parameter set (with its seed): the same for
+    every estimator of a seed, which the plan puts next to each other, so that a worker runs the
+    sensor once for them."""
+    steps, _, truth = _truth(scenario_id, duration)
+    out = ImuSensorModel(**json.loads(sensor_json)).run(truth[:, 3:6], truth[:, 6:9], steps)
+    for a in out.values():
+        a.setflags(write=False)
+    return out
+
+
+def simulate(run: Run) -> TestbenchResult:
+    """The run's traces, as the FMU testbench's result (metrics not yet computed)."""
+    sc = get_scenario(run.scenario)
+    duration = sc.duration if run.duration is None else float(run.duration)
+    _, t, truth = _truth(sc.id, duration)
+    sensor_params = {**run.sensor, "seed": run.seed}
+    sample = _samples(sc.id, duration, json.dumps(sensor_params, sort_keys=True))
+    params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **run.params}
+    est = ESTIMATORS[run.estimator](**params)
+    out = est.run(sample["acc"], sample["gyro"], sample["dt"])
+    estimate = {"roll": out["roll"], "pitch": out["pitch"],
+                **{f"bias_{a}": out["bias"][:, i] for i, a in enumerate("xyz")}}
+    if est.HAS_POSITION:
+        estimate.update({f"pos_{a}": out["pos"][:, i] for i, a in enumerate("xyz")})
+        estimate.update({f"vel_{a}": out["vel"][:, i] for i, a in enumerate("xyz")})
+    samples = np.column_stack([sample["acc"], sample["gyro"], sample["dt"]])
+    return TestbenchResult(
+        estimator=run.estimator, scenario=sc.name, seed=run.seed, rate=RATE, jitter=0.0,
+        params=params, sensor_params=sensor_params, t=t,
+        truth={n: truth[:, i] for i, n in enumerate(TRUTH_NAMES)},
+        sample={n: samples[:, i] for i, n in enumerate(SAMPLE)},
+        estimate=estimate, invalid_samples=int(np.sum(out["rejected"])),
+        step_us=np.zeros(len(t)), true_gyro_bias=tuple(sample["gyro_bias"][-1].tolist()),
+    )
+
+
+def run_row(run: Run, fmu_dir: Path | str | None = None) -> dict[str, Any]:
+    """One Parquet row: the run's identity, its varied parameters and its metrics."""
+    t0 = time.perf_counter()
+    if run.fmu:
+        from ..fmus import kind_dir
+        from ..master import run_testbench
+
+        result = run_testbench(run.estimator, run.scenario, seed=run.seed,
+                               duration=run.duration, rate=RATE, params=run.params,
+                               sensor_params=run.sensor, fmu_dir=kind_dir(fmu_dir or "dist"),
+                               evaluate=False)
+    else:
+        result = simulate(run)
+    m = compute_metrics(result)
+    row: dict[str, Any] = {"key": run.key, "estimator": run.estimator,
+                           "scenario": run.scenario, "seed": run.seed, "status": "ok",
+                           "error": "", "attempts": 1}
+    row.update({f"vary_{k}": float(v) for k, v in run.varied.items()})
+    row.update({k: float(m[k]) for k in METRICS})
+    row["seconds"] = time.perf_counter() - t0
+    return row
+
+
+assert ESTIMATE and POSITION  # the master's output names, which estimate above follows
