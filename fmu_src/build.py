@@ -20,7 +20,7 @@ import os
 import shutil
 import tempfile
 import traceback
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from unittest import mock
@@ -183,29 +183,25 @@ def build_all(
 
 def _build_native_and_check(name: str, version: str, out_dir: Path) -> BuildResult:
     """One row of the build table for a native FMU (out_dir/native/<version>/<name>.fmu)."""
-    from fmpy import read_model_description
-
     from .native.build import build_native, native_model
 
-    result = BuildResult(name, core="native", kind=version)
-    try:
-        result.path = build_native(native_model(name), version, out_dir / "native")
-        result.size = result.path.stat().st_size
-        result.variables = len(read_model_description(str(result.path)).modelVariables)
-        result.problems = check(result.path)
-    except Exception as err:
-        last = traceback.format_exception_only(type(err), err)[-1].strip()
-        result.problems = [f"build failed: {last}"]
-    return result
+    return _checked(BuildResult(name, core="native", kind=version),
+                    lambda: build_native(native_model(name), version, out_dir / "native"))
 
 
 def _build_and_check(name: str, out_dir: Path, compiled: Path | None) -> BuildResult:
-    """One row of the build table: build the FMU, then check it."""
+    """One row of the build table for a pythonfmu FMU."""
+    return _checked(BuildResult(name, core="python" if compiled is None else "compiled"),
+                    lambda: build(name, out_dir, compiled))
+
+
+def _checked(result: BuildResult, make: Callable[[], Path]) -> BuildResult:
+    """result filled in: the FMU make() builds, its size, variables and problems (a failed
+    build is a problem of its row, not an exception)."""
     from fmpy import read_model_description
 
-    result = BuildResult(name, core="python" if compiled is None else "compiled")
     try:
-        result.path = build(name, out_dir, compiled)
+        result.path = make()
         result.size = result.path.stat().st_size
         result.variables = len(read_model_description(str(result.path)).modelVariables)
         result.problems = check(result.path)

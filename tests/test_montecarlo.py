@@ -117,3 +117,13 @@ def test_a_campaign_run_is_the_fmu_testbench_run(built_fmus):
     assert run_row(run)["rmse_roll_deg"] == pytest.approx(
         __import__("testbenches.contract", fromlist=["x"]).compute_metrics(ref)["rmse_roll_deg"],
         abs=0.0)
+
+
+def test_an_fmu_in_the_loop_run_scores_as_the_native_core_run(built_fmus):
+    """--fmu: the run through the FMUs (fmpy) gives the native core's row."""
+    built_fmus.native("fmi2", "ImuPlant")
+    run = plan(["ukf"], ["vibration"], 1, duration=6.0, sensor=load_sensor("realistic"))[0]
+    fmu_run = dataclasses.replace(run, fmu=True)
+    a, b = run_row(run), run_row(fmu_run, str(built_fmus.directory))
+    for metric in ("rmse_roll_deg", "rmse_pitch_deg", "max_err_deg", "bias_err_dps"):
+        assert a[metric] == b[metric]

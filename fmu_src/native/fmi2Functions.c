@@ -320,32 +320,16 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],
                                    size_t size, fmi2FMUstate *FMUstate)
 {
-    fmu_instance probe;
     unsigned char *state;
     INSTANCE(c, "fmi2DeSerializeFMUstate", MASK_ANY)
     if (!FMUstate) {
         fmu_log(inst, FMU_ERROR, "fmi2DeSerializeFMUstate: FMUstate is NULL");
         return fmi2Error;
     }
-    /* Checked by reading it into a scratch instance: nothing of inst changes on refusal. */
-    memset(&probe, 0, sizeof probe);
-    probe = *inst;
-    probe.values = malloc(FMU_MODEL.n_variables * sizeof(double) + 1);
-    probe.data = malloc(FMU_MODEL.data_size + 1);
-    if (!probe.values || !probe.data) {
-        free(probe.values);
-        free(probe.data);
-        fmu_log(inst, FMU_ERROR, "fmi2DeSerializeFMUstate: out of memory");
+    if (fmu_state_check(inst, "fmi2DeSerializeFMUstate", (const unsigned char *)serializedState,
+                        size) != FMU_OK) {
         return fmi2Error;
     }
-    if (fmu_state_read(&probe, "fmi2DeSerializeFMUstate", (const unsigned char *)serializedState,
-                       size) != FMU_OK) {
-        free(probe.values);
-        free(probe.data);
-        return fmi2Error;
-    }
-    free(probe.values);
-    free(probe.data);
     state = *FMUstate ? (unsigned char *)*FMUstate : malloc(fmu_state_size());
     if (!state) {
         fmu_log(inst, FMU_ERROR, "fmi2DeSerializeFMUstate: out of memory");

@@ -375,24 +375,13 @@ fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],
                                    size_t size, fmi3FMUState *FMUState)
 {
-    fmu_instance probe;
     unsigned char *state;
-    int status;
     INSTANCE(instance, "fmi3DeserializeFMUState", MASK_ANY)
     if (!FMUState) {
         fmu_log(inst, FMU_ERROR, "fmi3DeserializeFMUState: FMUState is NULL");
         return fmi3Error;
     }
-    /* Checked by reading it into a scratch instance: nothing of inst changes on refusal. */
-    probe = *inst;
-    probe.values = malloc(FMU_MODEL.n_variables * sizeof(double) + 1);
-    probe.data = malloc(FMU_MODEL.data_size + 1);
-    status = probe.values && probe.data
-                 ? fmu_state_read(&probe, "fmi3DeserializeFMUState", serializedState, size)
-                 : FMU_ERROR;
-    free(probe.values);
-    free(probe.data);
-    if (status != FMU_OK) {
+    if (fmu_state_check(inst, "fmi3DeserializeFMUState", serializedState, size) != FMU_OK) {
         return fmi3Error;
     }
     state = *FMUState ? (unsigned char *)*FMUState : malloc(fmu_state_size());

@@ -308,7 +308,8 @@ void fmu_state_write(const fmu_instance *inst, unsigned char *out)
     memcpy(out, &h, sizeof h);
 }
 
-int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size)
+int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned char *in,
+                    size_t size)
 {
     state_header h;
     state_body b;
@@ -349,6 +350,17 @@ int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in
                 "state", call);
         return FMU_ERROR;
     }
+    return FMU_OK;
+}
+
+int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size)
+{
+    state_body b;
+    const unsigned char *body = in + sizeof(state_header);
+    if (fmu_state_check(inst, call, in, size) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    memcpy(&b, body, sizeof b);
     inst->state = b.state;
     inst->time = b.time;
     memcpy(inst->values, body + sizeof b, FMU_MODEL.n_variables * sizeof(double));

@@ -117,6 +117,9 @@ int fmu_do_step(fmu_instance *inst, double t, double h);
  * values and model data. A state that this FMU and format did not write is refused. */
 size_t fmu_state_size(void);
 void fmu_state_write(const fmu_instance *inst, unsigned char *out);
+/* FMU_OK if `in` is a whole state this FMU wrote, else FMU_ERROR with a log line. */
+int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned char *in,
+                    size_t size);
 int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size);
 
 #endif /* FMU_MODEL_H */
