@@ -52,7 +52,7 @@ test-slow: setup
 
 lint: setup
 	$(BIN)/ruff check .
-	$(BIN)/mypy fusion_core  # mypy-clean: what mypyc compiles (fmu_src/compiled_core.py)
+	$(BIN)/mypy fusion_core  # the reference is typed: mypy-clean
 
 .PHONY: bench
 bench: setup

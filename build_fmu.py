@@ -1,16 +1,15 @@
 """Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--kind K]
-[--core C] [--preset P]`.
+[--preset P]`.
 
 Builds every model (or the named ones) as each kind of FMU: pythonfmu (DIR/NAME.fmu) and native
 FMI 2.0 and FMI 3.0 from the C twin (DIR/native/fmi2/NAME.fmu, DIR/native/fmi3/NAME.fmu); --kind
-all (the default where a C compiler exists), pythonfmu or native. The pythonfmu FMUs ship
-fusion_core compiled by mypyc
-(--core auto, the default, falls back to the pure-Python sources where mypyc or a C compiler is
-missing; --core compiled insists; --core python ships only the sources), with the estimators'
-start values of --preset (recommended, the defaults; paper; or a JSON file), validates each with
-fmpy.validation.validate_fmu plus the project's checks (every variable described, every Real
-with a unit), prints a table (FMU, core, size, variables, validation problems) and exits with
-status 1 if any FMU failed to build or has a problem. A thin layer over fmu_src.build.
+all (the default where a C compiler exists), pythonfmu or native. The pythonfmu FMUs carry the C
+twin's library beside fusion_core's sources where a compiler built it (fmu_src.build). Start
+values: the estimators' --preset (recommended, the defaults; paper; or a JSON file). Validates
+each FMU with fmpy.validation.validate_fmu plus the project's checks (every variable described,
+every Real with a unit), prints a table (FMU, kind, core, size, variables, validation problems)
+and exits with status 1 if any FMU failed to build or has a problem. A thin layer over
+fmu_src.build.
 """
 
 from __future__ import annotations
@@ -20,7 +19,6 @@ import sys
 from pathlib import Path
 
 from fmu_src.build import KINDS, build_all, default_kind, format_table, model_names
-from fmu_src.compiled_core import CORES, CompiledCoreError
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -37,11 +35,6 @@ def main(argv: list[str] | None = None) -> int:
         "compiler exists, else pythonfmu), pythonfmu, or native",
     )
     parser.add_argument(
-        "--core", choices=CORES, default="auto",
-        help="fusion_core to ship: compiled by mypyc (built once, cached in build/), the "
-        "pure-Python sources, or auto = compiled where it can be built (default)",
-    )
-    parser.add_argument(
         "--preset", default="recommended",
         help="the estimators' start values: recommended (the defaults), paper, or a JSON file "
         "of parameters per estimator",
@@ -51,10 +44,7 @@ def main(argv: list[str] | None = None) -> int:
         kind = args.kind or default_kind()
         if kind == "pythonfmu" and args.kind is None:
             print("no C compiler found: building the pythonfmu FMUs only", file=sys.stderr)
-        results = build_all(args.only or model_names(), args.out, args.core, args.preset, kind)
-    except CompiledCoreError as err:
-        print(f"error: --core compiled: {err}", file=sys.stderr)
-        return 2
+        results = build_all(args.only or model_names(), args.out, args.preset, kind)
     except ValueError as err:
         print(f"error: --preset: {err}", file=sys.stderr)
         return 2

@@ -26,8 +26,7 @@ __all__ = ["BenchConfig", "run_benchmarks"]
 
 
 def __getattr__(name: str) -> Any:
-    # run_benchmarks on first use: importing the package must not import fusion_core, whose
-    # compiled or pure-Python build `python -m benchmarks --core` chooses first
+    # run_benchmarks on first use: importing the package does not import fusion_core
     if name == "run_benchmarks":
         from .suite import run_benchmarks
 

@@ -17,9 +17,7 @@ class BenchConfig:
     repeats: timed passes over it (the medians are reported); fmu_dir: prebuilt FMUs (None:
     build them into a temporary folder with build_fmu.py); testbench_s: simulated seconds per
     testbench rate, for each of testbench_estimators; scaling_sizes: sample counts of the `run`
-    scaling test; peers: time the peer filters too; sections: which parts to run (all); core:
-    the fusion_core the FMUs ship (fmu_src.compiled_core.CORES; the process's own fusion_core is
-    whichever was imported, see benchmarks/__main__.py).
+    scaling test; peers: time the peer filters too; sections: which parts to run (all).
     """
 
     duration_s: float = 60.0
@@ -35,7 +33,6 @@ class BenchConfig:
                                  "scaling")
     campaign_seeds: int = 300
     quick: bool = False
-    core: str = "auto"
 
     @classmethod
     def quick_config(cls, fmu_dir: Path | None = None) -> BenchConfig:

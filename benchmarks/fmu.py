@@ -86,11 +86,10 @@ class {FLOOR_NAME}(FmuSlave):
 """Source of the floor FMU's slave module (built by build_floor_fmu)."""
 
 
-def build_fmus(out: Path, core: str = "auto") -> Path:
-    """Build every FMU with the project's command line (python build_fmu.py --out out --core
-    core)."""
+def build_fmus(out: Path) -> Path:
+    """Build every FMU with the project's command line (python build_fmu.py --out out)."""
     proc = subprocess.run(
-        [sys.executable, "build_fmu.py", "--out", str(out), "--core", core],
+        [sys.executable, "build_fmu.py", "--out", str(out)],
         cwd=REPO, capture_output=True, text=True, timeout=600,
     )
     if proc.returncode != 0:

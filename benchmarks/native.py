@@ -3,7 +3,7 @@
 run_us_per_sample: Estimator.run(backend="native") over the recording repeated to at least
 MIN_SAMPLES samples (the C batch run, chunked by the binding), per sample, median of the passes;
 python_run_us_per_sample: run(backend="python") over a slice of PYTHON_SAMPLES, the core this
-process imported (compiled or pure Python, as the report's `core` says); speedup_vs_python their
+process imported (the Python reference); speedup_vs_python their
 ratio; vqf_batch_us_per_sample: VQF's C++ updateBatch on the same samples (the fastest public
 6D filter's own batch loop), when the vqf package is installed.
 """

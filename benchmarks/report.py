@@ -39,16 +39,12 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
             f"the step API alone (input conversion, checks, Estimate) costs {floor:.2f} us "
             "per call in this interpreter" if floor is not None else ""
         )
-        compiled = r.get("core", {}).get("kind") == "compiled"
         vqf = ps.get("vqf")
         limit_text = (
-            "the compiled step's calls into CPython: six list items read through the sequence "
-            "protocol, math.atan2 called through Python (mypyc has no primitive for it), the "
-            "Estimate NamedTuple built by tuple.__new__"
+            "CPython float arithmetic: step() is the Python reference, interpreted (the one "
+            "compiled path is the C twin, behind run() and every FMU; see README, Speed)"
+            + (f"; {floor_text}" if floor_text else "")
             + (f"; VQF (C++) costs {vqf:.2f} us in the same run" if vqf is not None else "")
-            if compiled else
-            f"CPython float arithmetic in the filter's own work (this run timed the pure-Python "
-            f"core: the FMUs ship the compiled one); {floor_text}"
         )
         for key, limit in PER_SAMPLE_TARGETS_US.items():
             v = ps.get(key)
@@ -61,8 +57,7 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
             out.append(_target(
                 "per_sample_us.ukf vs filterpy_ukf", peer / ukf,
                 f">= {UKF_VS_FILTERPY:g}x faster", peer / ukf >= UKF_VS_FILTERPY,
-                "13 sigma points through the exact rotation, 6x6 covariance in Python floats"
-                + ("" if compiled else " (the pure-Python core)"),
+                "13 sigma points through the exact rotation, 6x6 covariance in Python floats",
             ))
     overhead = r.get("fmu_overhead_us")
     if overhead:
@@ -257,12 +252,9 @@ def format_table(r: dict[str, Any]) -> str:
         f"medians of {r['repeats']} passes{' (--quick)' if r['quick'] else ''}"
     )
     if "core" in r:
-        kind = r["core"]["kind"]
-        lines.append(
-            "fusion_core: " + ("compiled by mypyc (the core the FMUs ship; --core python times "
-                               "the sources)" if kind == "compiled" else
-                               "pure Python (--core python, or mypyc unavailable)")
-        )
+        lines.append("fusion_core: the Python reference's step; run() and the pythonfmu FMUs' "
+                     "steps " + ("through the C twin" if r["core"].get("native") else
+                                 f"in Python too ({r['core'].get('native_reason')})"))
     if "per_sample_us" in r:
         lines += ["", "Per sample: one step/update call in a Python loop [us]",
                   f"  {'filter':<15}{'median':>10}{'min':>10}   {'target':<22}verdict"]

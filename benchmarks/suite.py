@@ -9,7 +9,6 @@ from typing import Any
 
 import numpy as np
 
-from fmu_src.compiled_core import is_compiled
 from fusion_core.base import Estimator
 from fusion_core.types import Estimate
 
@@ -72,11 +71,11 @@ def _noop_pass(data: list[tuple[list[float], list[float], float]]) -> Any:
 
 
 def core_info() -> dict[str, Any]:
-    """Which fusion_core this process runs: "compiled" (mypyc extension modules) or "python"."""
-    import fusion_core.base
+    """What this process runs: fusion_core's Python step, and whether the C twin is loaded
+    (run() and the pythonfmu FMUs' steps go through it then)."""
+    from fusion_core import native
 
-    compiled = is_compiled(fusion_core.base)
-    return {"kind": "compiled" if compiled else "python", "base_module": fusion_core.base.__file__}
+    return {"kind": "python", "native": native.available(), "native_reason": native.reason()}
 
 
 def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
@@ -118,7 +117,7 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
             fmu_dir = config.fmu_dir
             if fmu_dir is None:
                 log("building the FMUs (build_fmu.py)")
-                fmu_dir = build_fmus(Path(tmp), config.core)
+                fmu_dir = build_fmus(Path(tmp))
             results["fmu_dir"] = str(config.fmu_dir) if config.fmu_dir else "(built, temporary)"
             if "fmu" in config.sections:
                 log("FMU step timing (fusion_core, fmpy API and low-level host in turn)")

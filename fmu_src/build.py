@@ -3,13 +3,13 @@
 Every module fmu_src/models/<snake_name>_fmu.py is one model; its model name (and file name) is
 the CamelCase of <snake_name>. Each model is built as up to three kinds of FMU from its one
 variable table: the pythonfmu FMU (out_dir/<Name>.fmu) and the native FMI 2.0 and FMI 3.0 FMUs
-(out_dir/native/fmi2/<Name>.fmu, out_dir/native/fmi3/<Name>.fmu; fmu_src/native). A pythonfmu FMU
-carries in resources/ its slave module, fusion_core, the
-runtime part of fmu_src, pythonfmu (added by pythonfmu's builder) and a requirements.txt with
-what the host interpreter must provide (numpy, scipy). With the compiled core (core="compiled",
-or "auto" where it builds; fmu_src/compiled_core.py) resources/ also holds fusion_core's
-extension modules for the builder's CPython and mypyc's shared runtime module; other hosts run
-the .py sources beside them.
+(out_dir/native/fmi2/<Name>.fmu, out_dir/native/fmi3/<Name>.fmu; fmu_src/native).
+
+A pythonfmu FMU carries in resources/ its slave module, fusion_core (the Python sources and,
+where a C compiler built it, the C twin's library beside them: its estimators then step through
+the twin, fusion_core.native.Stepper), the runtime part of fmu_src, pythonfmu (added by
+pythonfmu's builder) and a requirements.txt with what the host interpreter must provide (numpy,
+scipy, cffi). A host of another platform, or without cffi, runs the Python sources.
 """
 
 from __future__ import annotations
@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from unittest import mock
 
-from .compiled_core import fusion_core_dir, resolve_core, shipped_files
 from .estimator import PRESET_ENV
 
 HERE = Path(__file__).resolve().parent
@@ -35,7 +34,7 @@ RUNTIME_FILES = (
     "testbench_models.py",
 )
 """The part of fmu_src an FMU needs at run time (not the build code, not the other models)."""
-REQUIREMENTS = "numpy>=1.24\nscipy>=1.10\n"
+REQUIREMENTS = "numpy>=1.24\nscipy>=1.10\ncffi>=1.15\n"
 """What the host's Python must provide (resources/requirements.txt); pythonfmu is bundled."""
 
 
@@ -60,19 +59,19 @@ def script_path(name: str) -> Path:
     return path
 
 
-def _stage(root: Path, compiled: Path | None = None) -> list[Path]:
-    """Copy what goes into resources/ besides the slave module; return the paths. compiled: a
-    compiled-core folder (compiled_core.build_compiled_core) to ship instead of the sources."""
-    staged = []
-    if compiled is None:
-        core = fusion_core_dir()
-        shutil.copytree(core, root / "fusion_core", ignore=shutil.ignore_patterns("__pycache__"))
-        staged.append(root / "fusion_core")
-    else:
-        for entry in shipped_files(compiled):
-            copy = shutil.copytree if entry.is_dir() else shutil.copy2
-            copy(entry, root / entry.name)
-            staged.append(root / entry.name)
+def fusion_core_dir() -> Path:
+    """The fusion_core package the FMUs ship (the one this project imports)."""
+    import fusion_core
+
+    return Path(fusion_core.__file__).resolve().parent
+
+
+def _stage(root: Path) -> list[Path]:
+    """Copy what goes into resources/ besides the slave module; return the paths."""
+    shutil.copytree(fusion_core_dir(), root / "fusion_core",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.so"))
+    _ship_native_library(root / "fusion_core")
+    staged = [root / "fusion_core"]
     (root / "fmu_src").mkdir()
     for name in RUNTIME_FILES:
         shutil.copy2(HERE / name, root / "fmu_src" / name)
@@ -85,23 +84,34 @@ def _stage(root: Path, compiled: Path | None = None) -> list[Path]:
     return staged
 
 
-def build(name: str, out_dir: Path, compiled: Path | None = None) -> Path:
-    """Build the FMU called name into out_dir/<name>.fmu and return its path (with the
-    compiled core of the folder `compiled`, or the pure-Python one)."""
-    path = build_script(script_path(name), out_dir, compiled)
+def _ship_native_library(core: Path) -> None:
+    """Put the C twin's library, built for this platform, beside the FMU's fusion_core sources
+    (fusion_core.native.PREBUILT), where it can be built: the FMU's estimators then step
+    through it (fusion_core.native.Stepper); a host of another platform, or without cffi, runs
+    the Python core."""
+    from fusion_core import native
+
+    if native.reason() is not None:
+        return
+    shutil.copy2(native.build(), core / "native" / native.PREBUILT.name)
+
+
+def build(name: str, out_dir: Path) -> Path:
+    """Build the pythonfmu FMU called name into out_dir/<name>.fmu and return its path."""
+    path = build_script(script_path(name), out_dir)
     if path.name != f"{name}.fmu":
         raise RuntimeError(f"{script_path(name).name} built {path.name}: its class must be {name}")
     return path
 
 
-def build_script(script: Path, out_dir: Path, compiled: Path | None = None) -> Path:
+def build_script(script: Path, out_dir: Path) -> Path:
     """Build the FMU of one slave module (any FmuSlave subclass) into out_dir; the FMU is
     named after the class. The module name must be unique among the FMUs of a process."""
     from pythonfmu import FmuBuilder
 
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fmu_stage_") as tmp:
-        files = _stage(Path(tmp), compiled)
+        files = _stage(Path(tmp))
         path = FmuBuilder.build_FMU(script, dest=out_dir, project_files=files)
     return Path(path)
 
@@ -142,7 +152,7 @@ class BuildResult:
     """One row of the build table."""
 
     name: str
-    core: str = "python"  # the fusion_core it ships: "compiled", "python" or "native" (C twin)
+    core: str = "python"  # what its estimators step with: "native" (the C twin) or "python"
     kind: str = "pythonfmu"  # "pythonfmu", "fmi2" or "fmi3"
     path: Path | None = None
     size: int = 0
@@ -151,13 +161,10 @@ class BuildResult:
 
 
 def build_all(
-    names: Iterable[str], out_dir: Path, core: str = "auto", preset: str = "recommended",
-    kind: str | None = None,
+    names: Iterable[str], out_dir: Path, preset: str = "recommended", kind: str | None = None,
 ) -> list[BuildResult]:
     """Build and check each FMU; a failed build is a problem of its row, not an exception.
-    core: "auto" (the compiled fusion_core where it can be built, else the pure-Python one),
-    "compiled" or "python" (compiled_core.CORES), for the pythonfmu FMUs; preset: the
-    estimators' start values, a name or a JSON file (fusion_core.presets.load_preset;
+    preset: the estimators' start values, a name or a JSON file (fusion_core.presets.load_preset;
     ValueError for a bad one); kind: one of KINDS (None: default_kind())."""
     from fusion_core.presets import load_preset
 
@@ -166,7 +173,6 @@ def build_all(
         raise ValueError(f"kind {kind!r}: allowed {', '.join(KINDS)}")
     names = list(names)
     starts = load_preset(preset)
-    compiled = resolve_core(core) if kind != "native" else None
     with contextlib.ExitStack() as stack:
         if any(starts.values()):  # the recommended values need no file: they are the defaults
             tmp = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="preset_")))
@@ -174,7 +180,7 @@ def build_all(
             stack.enter_context(mock.patch.dict(os.environ, {PRESET_ENV: str(tmp / "preset.json")}))
         results = []
         if kind != "native":
-            results += [_build_and_check(name, out_dir, compiled) for name in names]
+            results += [_build_and_check(name, out_dir) for name in names]
         if kind != "pythonfmu":
             results += [_build_native_and_check(name, version, out_dir)
                         for version in ("fmi2", "fmi3") for name in names]
@@ -189,10 +195,12 @@ def _build_native_and_check(name: str, version: str, out_dir: Path) -> BuildResu
                     lambda: build_native(native_model(name), version, out_dir / "native"))
 
 
-def _build_and_check(name: str, out_dir: Path, compiled: Path | None) -> BuildResult:
+def _build_and_check(name: str, out_dir: Path) -> BuildResult:
     """One row of the build table for a pythonfmu FMU."""
-    return _checked(BuildResult(name, core="python" if compiled is None else "compiled"),
-                    lambda: build(name, out_dir, compiled))
+    from fusion_core import native
+
+    return _checked(BuildResult(name, core="python" if native.reason() else "native"),
+                    lambda: build(name, out_dir))
 
 
 def _checked(result: BuildResult, make: Callable[[], Path]) -> BuildResult:

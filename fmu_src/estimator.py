@@ -179,6 +179,8 @@ class EstimatorModel:
     """
 
     def __init__(self, cls: type[Estimator], params: dict[str, Any]) -> None:
+        from fusion_core.native import stepper
+
         self.estimator = cls(**params)
         self.invalid_samples = 0
         self._position = cls.HAS_POSITION
@@ -186,23 +188,49 @@ class EstimatorModel:
         self._gyro = itemgetter(*GYRO_INPUTS)
         self._out: dict[str, Any] = {}
         self.outputs(self.estimator.last)  # every output key, in a fixed order
+        # The samples go through the C twin where it loads (fusion_core.native.Stepper: the
+        # same outputs, to the bit, at the twin's speed), else through the Python estimator.
+        self._stepper = stepper(self.estimator)
+        self._names = ("roll", "pitch", "bias_x", "bias_y", "bias_z") + (
+            tuple(f"{q}_{a}" for q in ("pos", "vel") for a in AXES) if self._position else ())
 
     def step(
         self, t: float, h: float, values: Mapping[str, Any], log: FmiLog
     ) -> dict[str, Any]:
         est = self.estimator
+        acc, gyro, dt = self._acc(values), self._gyro(values), values["dt"]
+        st = self._stepper
+        if st is not None:
+            taken = st.step(acc, gyro, dt)
+            if not taken:
+                self._rejected(t + h, est, acc, gyro, dt, log)
+            out = self._out
+            out.update(zip(self._names, st.last(), strict=True))
+            out["invalid_samples"] = self.invalid_samples
+            return out
         try:
             # Every sample goes to the estimator, which checks it (fusion_core's step): a bad
             # one raises InvalidSample and leaves the filter state as it was.
-            estimate = est.step(self._acc(values), self._gyro(values), values["dt"])
+            estimate = est.step(acc, gyro, dt)
         except InvalidSample as err:
-            self.invalid_samples += 1
-            log.warning(
-                f"sample at t = {t + h:.9g} s rejected, the filter state is kept: {err} "
-                f"({self.invalid_samples} rejected so far)"
-            )
+            self._count(t + h, str(err), log)
             estimate = est.last
         return self.outputs(estimate)
+
+    def _rejected(self, t: float, est: Estimator, acc: Any, gyro: Any, dt: float,
+                  log: FmiLog) -> None:
+        """A sample the twin rejected: counted and logged with the sample rules' reason."""
+        try:
+            est.check_sample(acc, gyro, dt)
+            reason = "rejected by the sample rules"
+        except InvalidSample as err:
+            reason = str(err)
+        self._count(t, reason, log)
+
+    def _count(self, t: float, reason: str, log: FmiLog) -> None:
+        self.invalid_samples += 1
+        log.warning(f"sample at t = {t:.9g} s rejected, the filter state is kept: {reason} "
+                    f"({self.invalid_samples} rejected so far)")
 
     def outputs(self, e: Estimate) -> dict[str, Any]:
         """The output values for an estimate, in the model's output dict (refilled on every
@@ -218,14 +246,22 @@ class EstimatorModel:
         return out
 
     def set_parameter(self, name: str, value: Any) -> None:
+        if self._stepper is not None:
+            self._stepper.sync()
         self.estimator.set_param(name, value)
+        if self._stepper is not None:
+            self._stepper.load()
 
     def get_state(self) -> dict[str, Any]:
+        if self._stepper is not None:
+            self._stepper.sync()
         return {"estimator": self.estimator.get_state(), "invalid_samples": self.invalid_samples}
 
     def set_state(self, state: dict[str, Any]) -> None:
         self.estimator.set_state(state["estimator"])
         self.invalid_samples = int(state["invalid_samples"])
+        if self._stepper is not None:
+            self._stepper.load()
 
 
 class EstimatorSlave(FmuSlave):

@@ -11,20 +11,12 @@ once here.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any, ClassVar, Final
 
 import numpy as np
 
 from .types import Estimate, G, InvalidSample, Param, check_param_names
-
-try:  # class options for the mypyc-compiled core (fmu_src/compiled_core.py); else a no-op
-    from mypy_extensions import mypyc_attr
-except ImportError:  # a host without mypy_extensions runs the pure-Python modules
-
-    def mypyc_attr(*attrs: str, **kwattrs: object) -> Callable[[type], type]:  # type: ignore[misc]
-        return lambda cls: cls
-
 
 MAX_RATE_DEFAULT: Final = 1000.0
 """Default max_rate [rad/s] (57,300 deg/s): about three times the widest full-scale range of any
@@ -74,8 +66,7 @@ _MAX_ACC_NORM2: Final = MAX_ACC_NORM * MAX_ACC_NORM
 tuple_new: Final = tuple.__new__
 ESTIMATE: Final = Estimate
 """`tuple_new(ESTIMATE, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
-without the NamedTuple's Python-level __new__: the hot paths build their estimate this way. The
-Final names spare the compiled core (fmu_src/compiled_core.py) two module-dict look-ups."""
+without the NamedTuple's Python-level __new__: the hot paths build their estimate this way."""
 
 
 Mat9 = tuple[float, float, float, float, float, float, float, float, float]
@@ -132,7 +123,6 @@ def _restore(template: Any, value: Any) -> Any:
     return value
 
 
-@mypyc_attr(allow_interpreted_subclasses=True)  # reference filters and benchmarks subclass it
 class Estimator:
     """Base class of the five estimators. See the module docstring."""
 

@@ -394,8 +394,7 @@ class AngleBiasKalmanFilter(Estimator):
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         # The roll and the pitch filter have the same F, Q and R and every update treats both,
         # so P_roll == P_pitch: one covariance, computed once (the same numbers as twice). A
-        # state snapshot with two different ones is still followed axis by axis. (== and not
-        # `is`: the compiled core keeps these tuples unboxed, where == compares four doubles.)
+        # state snapshot with two different ones is still followed axis by axis.
         P, P_pitch = self.P_roll, self.P_pitch
         self.P_roll = predict_covariance(P, dt, self._q_angle, self._q_bias)
         if P_pitch == P:

@@ -15,8 +15,6 @@ import math
 from math import copysign, cos, sin, sqrt
 from typing import Final
 
-# mypyc compiles math's sin, cos, tan, sqrt and copysign to C calls, not these; as Final names
-# the compiled core (fmu_src/compiled_core.py) calls them without a module-dict look-up.
 atan2: Final = math.atan2
 asin: Final = math.asin
 hypot: Final = math.hypot

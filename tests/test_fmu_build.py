@@ -14,7 +14,7 @@ from fmpy.validation import validate_fmu
 
 import fusion_core
 from fmu_src.build import check
-from fmu_src.compiled_core import COMPILED_MODULES, EXT_SUFFIX, toolchain_missing
+from fusion_core import native
 
 REPO = Path(__file__).resolve().parents[1]
 DEG = 180.0 / math.pi
@@ -63,9 +63,9 @@ PAPERS = {
 }
 
 
-EXPECTED_CORE = "python" if toolchain_missing() else "compiled"
-"""What build_fmu.py --core auto ships here: the compiled core wherever it can be built (mypy,
-which brings mypyc, is a dependency; a machine with only Python and pip has no C compiler)."""
+EXPECTED_CORE = "python" if native.reason() else "native"
+"""What a pythonfmu FMU's estimators step with: the C twin's library it carries wherever a C
+compiler built it (a machine with only Python and pip has none: the Python sources)."""
 
 
 def test_build_command_builds_every_fmu_without_problems(built_fmus):
@@ -80,18 +80,19 @@ def test_build_command_builds_every_fmu_without_problems(built_fmus):
         assert (built_fmus.directory / f"{name}.fmu").stat().st_size > 0
 
 
-@pytest.mark.skipif(
-    EXPECTED_CORE == "python", reason=f"{toolchain_missing()}: the FMUs ship the sources"
-)
-def test_each_fmu_ships_the_compiled_core_beside_its_sources(fmu_path):
-    """resources/ holds every fusion_core source and, for the compiled modules, the extension
-    module of the builder's CPython, plus mypyc's shared runtime module."""
+@pytest.mark.skipif(EXPECTED_CORE == "python",
+                    reason=f"{native.reason()}: the FMUs carry the Python sources only")
+def test_each_fmu_carries_the_c_twins_library_beside_the_sources(fmu_path):
+    """resources/ holds every fusion_core source, the C twin's sources and the library built
+    from them (fusion_core.native.PREBUILT), and asks the host for cffi to load it."""
     with zipfile.ZipFile(fmu_path) as z:
         names = set(z.namelist())
-    for module in COMPILED_MODULES:
+        requirements = z.read("resources/requirements.txt").decode()
+    for module in ("base", "kalman", "ukf", "native/__init__"):
         assert f"resources/fusion_core/{module}.py" in names
-        assert f"resources/fusion_core/{module}{EXT_SUFFIX}" in names
-    assert any(n.startswith("resources/") and n.endswith(f"__mypyc{EXT_SUFFIX}") for n in names)
+    assert "resources/fusion_core/native/fc_kf.c" in names
+    assert f"resources/fusion_core/native/{native.PREBUILT.name}" in names
+    assert "cffi" in requirements
 
 
 def test_fmu_passes_fmpy_validation(fmu_path):
@@ -194,7 +195,7 @@ def test_fmu_carries_fusion_core_and_requirements(fmu_path):
     assert "resources/fmu_src/slave.py" in names
     assert f"resources/{module}.py" in names
     assert "binaries/linux64/" + fmu_path.stem + ".so" in names
-    assert sorted(r.split(">=")[0] for r in requirements) == ["numpy", "scipy"]
+    assert sorted(r.split(">=")[0] for r in requirements) == ["cffi", "numpy", "scipy"]
 
 
 def test_slave_modules_have_unique_names(built_fmus):
@@ -225,7 +226,7 @@ def test_build_command_exits_non_zero_on_a_validation_problem(
     cli = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cli)
 
-    def build_copy(name: str, out_dir: Path, compiled: Path | None) -> Path:  # no rebuild
+    def build_copy(name: str, out_dir: Path) -> Path:  # no rebuild
         out_dir.mkdir(parents=True, exist_ok=True)
         return Path(shutil.copy(built_fmus.path(name), out_dir))
 
@@ -233,9 +234,10 @@ def test_build_command_exits_non_zero_on_a_validation_problem(
         return ["The unit \"x\" of variable \"dt\" is not defined."]
 
     monkeypatch.setattr("fmu_src.build.build", build_copy)
-    assert cli.main(["--out", str(tmp_path), "--only", "ComplementaryFilter"]) == 0
+    args = ["--out", str(tmp_path), "--only", "ComplementaryFilter", "--kind", "pythonfmu"]
+    assert cli.main(args) == 0
     monkeypatch.setattr("fmu_src.build.check", one_problem)
-    assert cli.main(["--out", str(tmp_path), "--only", "ComplementaryFilter"]) == 1
+    assert cli.main(args) == 1
     assert "1: The unit" in capsys.readouterr().out
 
 

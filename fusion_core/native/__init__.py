@@ -58,6 +58,8 @@ TWINS = {
     "PositionKalmanFilter": "fc_poskf",
 }
 """The estimators that have a C twin, by class name, and the twin's C prefix."""
+FC_SKIPPED = 1
+"""fc_status: FC_OK 0 and FC_SKIPPED 1 took the sample, the larger values rejected it."""
 ESTIMATE_FIELDS = 11
 """Doubles per fc_estimate: roll, pitch, bias[3], pos[3], vel[3]."""
 BASE_STATE = ("initialized", "n_samples", "n_rejected", "gyro_prev")
@@ -67,6 +69,10 @@ lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
 POSKF_PENDING_MAX = 2048
 """fc_poskf.h's FC_POSKF_PENDING_MAX (position.PENDING_MAX)."""
 """Estimator._BASE_STATE: these live in the twin's `base` member."""
+
+PREBUILT = HERE / "libfusion_core.so"
+"""A library built beside the sources, as the pythonfmu FMUs ship it (fmu_src.build): loaded
+first where it loads (same platform); elsewhere the library is built or Python runs."""
 
 _lib: Any = None
 _ffi: Any = None
@@ -170,14 +176,23 @@ def _load() -> None:
     except ImportError as err:
         _reason = f"cffi is not installed ({err})"
         return
+    ffi = cffi.FFI()
     try:
-        path = build()
-        ffi = cffi.FFI()
         ffi.cdef(cdef())
-        _lib = ffi.dlopen(str(path))
+    except (cffi.CDefError, cffi.FFIError) as err:
+        _reason = str(err)
+        return
+    if PREBUILT.is_file():  # an FMU's copy: the library built with it, if it loads here
+        try:
+            _lib, _ffi, _reason = ffi.dlopen(str(PREBUILT)), ffi, None
+            return
+        except OSError:
+            pass
+    try:
+        _lib = ffi.dlopen(str(build()))
         _ffi = ffi
         _reason = None
-    except (RuntimeError, OSError, cffi.CDefError, cffi.FFIError) as err:
+    except (RuntimeError, OSError) as err:
         _reason = str(err)
 
 
@@ -351,6 +366,53 @@ def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
             out["vel"][lo:hi] = est[:k, 8:11]
     take_state(estimator, twin)
     return out
+
+
+class Stepper:
+    """An estimator stepped sample by sample through its C twin: Estimator.step's outputs (to
+    the bit) at the twin's speed, for the pythonfmu FMUs' doStep.
+
+    While it steps, the twin holds the state: `sync()` copies it into the Python estimator
+    (before anything reads that object: get_state, set_param), `load()` takes the estimator's
+    parameters and state into a new twin (after set_state or set_param)."""
+
+    def __init__(self, estimator: Any) -> None:
+        lib, ffi = lib_and_ffi()
+        self.estimator = estimator
+        self.position = bool(estimator.HAS_POSITION)
+        self._step = getattr(lib, f"{TWINS[type(estimator).__name__]}_step")
+        self._acc = ffi.new("double[3]")
+        self._gyro = ffi.new("double[3]")
+        self._out = ffi.new("fc_estimate *")
+        self.twin = new_twin(estimator)
+
+    def load(self) -> None:
+        self.twin = new_twin(self.estimator)
+
+    def sync(self) -> None:
+        take_state(self.estimator, self.twin)
+
+    def step(self, acc: Any, gyro: Any, dt: float) -> bool:
+        """One sample; False when the twin rejected it (its state unchanged: the estimator's
+        check_sample says why)."""
+        a, g = self._acc, self._gyro
+        a[0], a[1], a[2] = acc
+        g[0], g[1], g[2] = gyro
+        return self._step(self.twin, a, g, dt, self._out) <= FC_SKIPPED
+
+    def last(self) -> tuple[float, ...]:
+        """The last estimate: roll, pitch, bias (3) and, for the position filter, pos, vel."""
+        e = self.twin.last
+        b = e.bias
+        if self.position:
+            p, v = e.pos, e.vel
+            return (e.roll, e.pitch, b[0], b[1], b[2], p[0], p[1], p[2], v[0], v[1], v[2])
+        return (e.roll, e.pitch, b[0], b[1], b[2])
+
+
+def stepper(estimator: Any) -> Stepper | None:
+    """A Stepper for the estimator where its twin is available, else None (Python steps)."""
+    return Stepper(estimator) if has_twin(estimator) and available() else None
 
 
 # ----- the plant -------------------------------------------------------------------------------
