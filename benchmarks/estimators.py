@@ -19,6 +19,26 @@ def step_pass(key: str, data: list[tuple[list[float], list[float], float]]) -> C
     return run
 
 
+def fmu_core_pass(key: str, data: list[tuple[list[float], list[float], float]]
+                  ) -> Callable[[], int]:
+    """What a pythonfmu FMU's doStep runs per sample: the twin's step through
+    fusion_core.native.Stepper where the twin loads, else the Python step."""
+    from fusion_core import native
+
+    st = native.stepper(fusion_core.ESTIMATORS[key]())
+    if st is None:
+        return step_pass(key, data)
+    step, last = st.step, st.last
+
+    def run() -> int:
+        for acc, gyro, dt in data:
+            step(acc, gyro, dt)
+            last()
+        return len(data)
+
+    return run
+
+
 def step_factories(
     keys: tuple[str, ...], data: list[tuple[list[float], list[float], float]]
 ) -> dict[str, Callable[[], Callable[[], int]]]:

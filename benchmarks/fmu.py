@@ -6,7 +6,8 @@ Two hosts, both fmpy's FMU2Slave:
   lowlevel  the FMI functions as the ctypes functions fmpy loaded (fmi2SetReal, fmi2DoStep,
             fmi2GetReal; testbenches.fmus.direct_calls, the statuses checked in the loop) with
             ctypes arrays allocated once: the testbench master's way.
-The overhead is the FMU step time less the same estimator's `step` in fusion_core, timed in
+The overhead is the FMU step time less what its doStep runs per sample (the C twin's step
+through fusion_core.native.Stepper where it loads, else fusion_core's Python step), timed in
 turn with it.
 
 The floor: the same two hosts on `FmuFloor`, an FMU with the estimator FMUs' inputs and outputs
@@ -30,7 +31,7 @@ from fmu_src.host import INPUTS, FmuInstance
 from testbenches.fmus import direct_calls
 
 from .common import time_interleaved
-from .estimators import step_pass
+from .estimators import fmu_core_pass
 
 REPO = Path(__file__).resolve().parents[1]
 FMU_NAMES = {
@@ -204,7 +205,7 @@ def fmu_steps(
                               for host in ("api", "lowlevel")})
             try:
                 out[key] = time_interleaved(
-                    {"core": lambda key=key: step_pass(key, core_data), **hosts}, repeats)
+                    {"core": lambda key=key: fmu_core_pass(key, core_data), **hosts}, repeats)
             finally:
                 for passes in hosts.values():
                     passes.close()

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import struct
 import re
 import shutil
 import subprocess
@@ -62,6 +63,8 @@ FC_SKIPPED = 1
 """fc_status: FC_OK 0 and FC_SKIPPED 1 took the sample, the larger values rejected it."""
 ESTIMATE_FIELDS = 11
 """Doubles per fc_estimate: roll, pitch, bias[3], pos[3], vel[3]."""
+_ESTIMATE_DOUBLES = struct.Struct("=11d")
+"""An fc_estimate's memory, read as Python floats."""
 BASE_STATE = ("initialized", "n_samples", "n_rejected", "gyro_prev")
 STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}}
 """Where a twin's state field is kept under another Python attribute: the UKF's P is its packed
@@ -384,10 +387,14 @@ class Stepper:
         self._acc = ffi.new("double[3]")
         self._gyro = ffi.new("double[3]")
         self._out = ffi.new("fc_estimate *")
-        self.twin = new_twin(estimator)
+        self._n = 11 if self.position else 5
+        self.load()
 
     def load(self) -> None:
+        _, ffi = lib_and_ffi()
         self.twin = new_twin(self.estimator)
+        # the twin's last estimate as doubles, read without a cffi attribute access per field
+        self._last = ffi.buffer(ffi.addressof(self.twin[0], "last"))
 
     def sync(self) -> None:
         take_state(self.estimator, self.twin)
@@ -402,12 +409,7 @@ class Stepper:
 
     def last(self) -> tuple[float, ...]:
         """The last estimate: roll, pitch, bias (3) and, for the position filter, pos, vel."""
-        e = self.twin.last
-        b = e.bias
-        if self.position:
-            p, v = e.pos, e.vel
-            return (e.roll, e.pitch, b[0], b[1], b[2], p[0], p[1], p[2], v[0], v[1], v[2])
-        return (e.roll, e.pitch, b[0], b[1], b[2])
+        return _ESTIMATE_DOUBLES.unpack_from(self._last)[:self._n]
 
 
 def stepper(estimator: Any) -> Stepper | None:
