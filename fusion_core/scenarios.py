@@ -112,6 +112,24 @@ class Scenario:
     def trajectory(self) -> Trajectory:
         return self.build()
 
+    def truth(self, t: Any, backend: str = "auto") -> Any:
+        """The truth at times t [N] as an [N, 15] array in synthetic.TRUTH_NAMES' order (the
+        plant FMU's outputs): through the plant's C twin (fusion_core.native.plant_truth) or
+        the Python trajectory, backend as in Estimator.run ("auto": the twin where it loads);
+        the same numbers either way (tests/test_native.py)."""
+        import numpy as np
+
+        from . import native
+        from .base import check_backend
+
+        check_backend(backend)
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        if backend == "native" or (backend == "auto" and native.available()):
+            return native.plant_truth(self.id, t)
+        x = self.trajectory().truth(t)
+        return np.column_stack([x["roll"], x["pitch"], x["yaw"], *x["omega"].T, *x["f"].T,
+                                *x["pos"].T, *x["vel"].T])
+
 
 SCENARIOS: dict[str, Scenario] = {
     s.name: s

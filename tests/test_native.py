@@ -372,3 +372,16 @@ def test_the_plant_twin_gives_every_scenarios_truth() -> None:
         assert np.max(np.abs(native.plant_truth(sc.id, t) - python)) <= TOL, sc.name
     with pytest.raises(ValueError, match="unknown scenario id 99"):
         native.plant_truth(99, np.zeros(1))
+
+
+def test_a_scenarios_truth_is_the_same_from_either_backend():
+    """Scenario.truth(t, backend): the plant's C twin and the Python trajectory agree."""
+    from fusion_core.scenarios import SCENARIOS
+
+    if not native.available():
+        pytest.skip(f"the native twin is not available: {native.reason()}")
+    t = np.linspace(0.0, 20.0, 2001)
+    for sc in SCENARIOS.values():
+        a, b = sc.truth(t, backend="native"), sc.truth(t, backend="python")
+        assert a.shape == b.shape == (2001, 15)
+        assert np.max(np.abs(a - b)) <= 1e-12, sc.name

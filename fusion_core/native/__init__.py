@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import hashlib
 import os
-import struct
 import re
 import shutil
+import struct
 import subprocess
 import tempfile
 from pathlib import Path

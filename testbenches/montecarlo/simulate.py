@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from fusion_core import ESTIMATORS, native
+from fusion_core import ESTIMATORS
 from fusion_core.scenarios import get_scenario
 from fusion_core.sensor import ImuSensorModel
 from fusion_core.synthetic import TRUTH_NAMES
@@ -44,12 +44,7 @@ def _truth(scenario_id: int, duration: float) -> tuple[np.ndarray, np.ndarray, n
     worker computes it once for all its runs of that scenario (read-only arrays)."""
     steps = communication_steps(duration, RATE, 0.0, 0)
     t = np.cumsum(steps)
-    if native.available():
-        truth = native.plant_truth(scenario_id, t)
-    else:
-        x = get_scenario(scenario_id).trajectory().truth(t)
-        truth = np.column_stack([x["roll"], x["pitch"], x["yaw"], *x["omega"].T, *x["f"].T,
-                                 *x["pos"].T, *x["vel"].T])
+    truth = get_scenario(scenario_id).truth(t)
     for a in (steps, t, truth):
         a.setflags(write=False)
     return steps, t, truth
