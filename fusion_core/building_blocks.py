@@ -199,10 +199,12 @@ def body_rotation(g0: Vec3, g1: Vec3, bias: Vec3, dt: float, trapezoid: bool) ->
     return (g1[0] - b0) * dt, (g1[1] - b1) * dt, (g1[2] - b2) * dt
 
 
-def lowpass_specific_force(f: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float) -> Vec3:
+def lowpass_specific_force(f: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
+                           terms: tuple[float, float, float, float] | None = None) -> Vec3:
     """One step of the accelerometer pre-filter (ACC_LOWPASS_PARAM): the filtered specific force
-    f turned with the body by phi, then blended with the new sample a, k = dt / (tau + dt)."""
-    f0, f1, f2 = rotate_back(f, phi)
+    f turned with the body by phi, then blended with the new sample a, k = dt / (tau + dt);
+    terms: kinematics.rotvec_terms(*phi) when the caller has them."""
+    f0, f1, f2 = rotate_back(f, phi, terms)
     k = dt / (tau + dt)
     return f0 + k * (a[0] - f0), f1 + k * (a[1] - f1), f2 + k * (a[2] - f2)
 

@@ -34,6 +34,7 @@ from .kinematics import (
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
     quat_roll_pitch,
+    rotvec_terms,
     wrap_angle,
 )
 from .types import Estimate, Param
@@ -129,12 +130,13 @@ class ComplementaryFilter(Estimator):
         bx, by, bz = bias
         if self._rotating:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
+            terms = rotvec_terms(*phi)  # once, for the pre-filter and the propagation
             if self._acc_tau > 0.0:  # the filter and its gate use the pre-filtered vector
                 self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
-                                                    self._acc_tau)
+                                                    self._acc_tau, terms)
                 ax, ay, az = self.acc_f
         if self._quaternion:  # (then self._rotating: phi is this interval's rotation)
-            self.q_att = quat_mul_rotvec(self.q_att, *phi)
+            self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
             roll, pitch = quat_roll_pitch(*self.q_att)
         elif self._trapezoid:
             p0, q0, r0 = self.gyro_prev

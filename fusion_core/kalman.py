@@ -55,6 +55,7 @@ from .kinematics import (
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
     quat_roll_pitch,
+    rotvec_terms,
     wrap_angle,
 )
 from .types import DEG, Estimate, G, Param
@@ -335,11 +336,12 @@ class AngleBiasKalmanFilter(Estimator):
     ) -> None:
         """One sample with the real-sensor options (see the class docstring), in the filters'
         frame; prev is the previous gyro sample in that frame."""
-        phi = None
+        phi = terms = None
         if self._quaternion or self._acc_tau > 0.0:
             bias = (self.bias_x, self.bias_y, self.bias_z)
             phi = body_rotation(prev, (gx, gy, gz), bias, dt, self._trapezoid)
-        self.propagate(gx, gy, gz, dt, phi)
+            terms = rotvec_terms(*phi)  # once, for the propagation and the pre-filter
+        self.propagate(gx, gy, gz, dt, phi, terms)
         predicted = (self.roll, self.pitch)
         raw2 = ax * ax + ay * ay + az * az
         lo, hi = self._bias_band2
@@ -348,7 +350,8 @@ class AngleBiasKalmanFilter(Estimator):
             self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
         if self._acc_tau > 0.0:
             assert phi is not None  # computed above whenever acc_tau > 0
-            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau)
+            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau,
+                                                terms)
             ax, ay, az = self.acc_f
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             self.correct(ax, ay, az, learn_bias)
@@ -371,17 +374,19 @@ class AngleBiasKalmanFilter(Estimator):
             self.P_z -= k * self.P_z
 
     def propagate(
-        self, gx: float, gy: float, gz: float, dt: float, phi: Vec3 | None = None
+        self, gx: float, gy: float, gz: float, dt: float, phi: Vec3 | None = None,
+        terms: tuple[float, float, float, float] | None = None,
     ) -> None:
         """Time update: angles by the Euler-rate kinematics (or, with propagation="quaternion",
         by the attitude quaternion turned by the rotation vector phi of the interval, computed
-        here when not given), P by the papers' F and Q (predict_covariance)."""
+        here when not given, with its rotvec_terms), P by the papers' F and Q
+        (predict_covariance)."""
         bx, by, bz = self.bias_x, self.bias_y, self.bias_z
         if self._quaternion:
             if phi is None:
                 phi = body_rotation(self.gyro_prev, (gx, gy, gz), (bx, by, bz), dt,
                                     self._trapezoid)
-            self.q_att = quat_mul_rotvec(self.q_att, *phi)
+            self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
             roll, pitch = quat_roll_pitch(*self.q_att)
         elif self._trapezoid:
             p0, q0, r0 = self.gyro_prev

@@ -128,18 +128,29 @@ def quat_gravity_body(w: float, x: float, y: float, z: float) -> tuple[float, fl
     )
 
 
+def rotvec_terms(vx: float, vy: float, vz: float) -> tuple[float, float, float, float]:
+    """The trigonometry of a rotation vector v of angle a, from one sine-cosine pair of a/2:
+    (cos(a/2), sin(a/2)/a) for quat_mul_rotvec and (sin(a)/a, (1 - cos a)/a^2) for rotate_back,
+    by sin a = 2 sin(a/2) cos(a/2) and 1 - cos a = 2 sin^2(a/2) (the second without the
+    cancellation of 1 - cos a). Below 1e-8 rad their series, exact to double precision there.
+    A filter that turns its attitude and its pre-filter by the same interval computes them once."""
+    a2 = vx * vx + vy * vy + vz * vz
+    angle = sqrt(a2)
+    if angle < _SMALL_ANGLE:
+        return (1.0 - angle * angle / 8.0, 0.5 - angle * angle / 48.0, 1.0 - a2 / 6.0,
+                0.5 - a2 / 24.0)
+    ch, sh = cos(0.5 * angle), sin(0.5 * angle)
+    return ch, sh / angle, 2.0 * sh * ch / angle, 2.0 * sh * sh / a2
+
+
 def quat_mul_rotvec(
-    q: tuple[float, float, float, float], vx: float, vy: float, vz: float
+    q: tuple[float, float, float, float], vx: float, vy: float, vz: float,
+    terms: tuple[float, float, float, float] | None = None,
 ) -> tuple[float, float, float, float]:
-    """q (x) exp(v/2): rotate the body frame by the rotation vector v (body axes), renormalised."""
+    """q (x) exp(v/2): rotate the body frame by the rotation vector v (body axes), renormalised;
+    terms: rotvec_terms(vx, vy, vz) when the caller has them."""
     w, x, y, z = q
-    angle = sqrt(vx * vx + vy * vy + vz * vz)
-    if angle < 1e-8:  # series of sin(a/2)/a and cos(a/2), exact to double precision here
-        c = 1.0 - angle * angle / 8.0
-        s = 0.5 - angle * angle / 48.0
-    else:
-        c = cos(0.5 * angle)
-        s = sin(0.5 * angle) / angle
+    c, s, _, _ = rotvec_terms(vx, vy, vz) if terms is None else terms
     bx, by, bz = s * vx, s * vy, s * vz
     rw = w * c - x * bx - y * by - z * bz
     rx = w * bx + x * c + y * bz - z * by
@@ -169,17 +180,14 @@ def rotation_increment(
     )
 
 
-def rotate_back(v: tuple[float, float, float], phi: tuple[float, float, float]
+def rotate_back(v: tuple[float, float, float], phi: tuple[float, float, float],
+                terms: tuple[float, float, float, float] | None = None
                 ) -> tuple[float, float, float]:
     """v as seen from a body that turned by the rotation vector phi: exp(-[phi]x) v (Rodrigues),
-    v - sin(a)/a (phi x v) + (1 - cos a)/a^2 phi x (phi x v), a = |phi|."""
+    v - sin(a)/a (phi x v) + (1 - cos a)/a^2 phi x (phi x v), a = |phi|; terms:
+    rotvec_terms(*phi) when the caller has them."""
     p0, p1, p2 = phi
-    a2 = p0 * p0 + p1 * p1 + p2 * p2
-    a = sqrt(a2)
-    if a < _SMALL_ANGLE:  # series of sin(a)/a and (1 - cos a)/a^2
-        s, c = 1.0 - a2 / 6.0, 0.5 - a2 / 24.0
-    else:
-        s, c = sin(a) / a, (1.0 - cos(a)) / a2
+    _, _, s, c = rotvec_terms(p0, p1, p2) if terms is None else terms
     v0, v1, v2 = v
     u0, u1, u2 = p1 * v2 - p2 * v1, p2 * v0 - p0 * v2, p0 * v1 - p1 * v0  # phi x v
     return (

@@ -53,7 +53,7 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     const fc_cf_params *p = &f->params;
     double a[3] = {a_in[0], a_in[1], a_in[2]};
     double rest_time = p->rest_time;
-    double roll, pitch, phi[3];
+    double roll, pitch, phi[3], terms[4];
     if (rest_time > 0.0) {
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, p->rest_gyro,
                      p->rest_acc);
@@ -64,13 +64,14 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
     if (f->rotating) {
         fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
         if (f->acc_tau > 0.0) {
-            fc_lowpass_specific_force(f->acc_f, phi, a, dt, f->acc_tau);
+            fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, f->acc_tau);
             memcpy(a, f->acc_f, sizeof a);
         }
     }
     if (f->quaternion) {
-        fc_quat_mul_rotvec(f->q_att, phi[0], phi[1], phi[2]);
+        fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
         fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     } else if (f->trapezoid) {
         const double *w0 = f->base.gyro_prev;

@@ -90,18 +90,29 @@ void fc_quat_gravity_body(const double q[4], double g[3])
     g[2] = w * w - x * x - y * y + z * z;
 }
 
-void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
+/* rotvec_terms: cos(a/2), sin(a/2)/a, sin(a)/a, (1 - cos a)/a^2 from one sine-cosine pair */
+void fc_rotvec_terms(double vx, double vy, double vz, double t[4])
+{
+    double a2 = vx * vx + vy * vy + vz * vz;
+    double angle = sqrt(a2);
+    if (angle < SMALL_ANGLE) {
+        t[0] = 1.0 - angle * angle / 8.0;
+        t[1] = 0.5 - angle * angle / 48.0;
+        t[2] = 1.0 - a2 / 6.0;
+        t[3] = 0.5 - a2 / 24.0;
+        return;
+    }
+    double ch = cos(0.5 * angle), sh = sin(0.5 * angle);
+    t[0] = ch;
+    t[1] = sh / angle;
+    t[2] = 2.0 * sh * ch / angle;
+    t[3] = 2.0 * sh * sh / a2;
+}
+
+void fc_quat_mul_rotvec_terms(double q[4], double vx, double vy, double vz, const double t[4])
 {
     double w = q[0], x = q[1], y = q[2], z = q[3];
-    double angle = sqrt(vx * vx + vy * vy + vz * vz);
-    double c, s;
-    if (angle < 1e-8) {
-        c = 1.0 - angle * angle / 8.0;
-        s = 0.5 - angle * angle / 48.0;
-    } else {
-        c = cos(0.5 * angle);
-        s = sin(0.5 * angle) / angle;
-    }
+    double c = t[0], s = t[1];
     double bx = s * vx, by = s * vy, bz = s * vz;
     double rw = w * c - x * bx - y * by - z * bz;
     double rx = w * bx + x * c + y * bz - z * by;
@@ -112,6 +123,13 @@ void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
     q[1] = rx * n;
     q[2] = ry * n;
     q[3] = rz * n;
+}
+
+void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
+{
+    double t[4];
+    fc_rotvec_terms(vx, vy, vz, t);
+    fc_quat_mul_rotvec_terms(q, vx, vy, vz, t);
 }
 
 void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
@@ -125,24 +143,23 @@ void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1
     phi[2] = 0.5 * (a2 + b2) + k * (a0 * b1 - a1 * b0);
 }
 
-void fc_rotate_back(const double v[3], const double phi[3], double out[3])
+void fc_rotate_back_terms(const double v[3], const double phi[3], const double t[4],
+                          double out[3])
 {
     double p0 = phi[0], p1 = phi[1], p2 = phi[2];
-    double a2 = p0 * p0 + p1 * p1 + p2 * p2;
-    double a = sqrt(a2);
-    double s, c;
-    if (a < SMALL_ANGLE) {
-        s = 1.0 - a2 / 6.0;
-        c = 0.5 - a2 / 24.0;
-    } else {
-        s = sin(a) / a;
-        c = (1.0 - cos(a)) / a2;
-    }
+    double s = t[2], c = t[3];
     double v0 = v[0], v1 = v[1], v2 = v[2];
     double u0 = p1 * v2 - p2 * v1, u1 = p2 * v0 - p0 * v2, u2 = p0 * v1 - p1 * v0;
     out[0] = v0 - s * u0 + c * (p1 * u2 - p2 * u1);
     out[1] = v1 - s * u1 + c * (p2 * u0 - p0 * u2);
     out[2] = v2 - s * u2 + c * (p0 * u1 - p1 * u0);
+}
+
+void fc_rotate_back(const double v[3], const double phi[3], double out[3])
+{
+    double t[4];
+    fc_rotvec_terms(phi[0], phi[1], phi[2], t);
+    fc_rotate_back_terms(v, phi, t, out);
 }
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
@@ -187,15 +204,23 @@ void fc_body_rotation(const double g0[3], const double g1[3], const double bias[
     phi[2] = (g1[2] - b2) * dt;
 }
 
-void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
-                               double tau)
+void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
+                                     const double a[3], double dt, double tau)
 {
     double t[3];
-    fc_rotate_back(f, phi, t);
+    fc_rotate_back_terms(f, phi, terms, t);
     double k = dt / (tau + dt);
     f[0] = t[0] + k * (a[0] - t[0]);
     f[1] = t[1] + k * (a[1] - t[1]);
     f[2] = t[2] + k * (a[2] - t[2]);
+}
+
+void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
+                               double tau)
+{
+    double t[4];
+    fc_rotvec_terms(phi[0], phi[1], phi[2], t);
+    fc_lowpass_specific_force_terms(f, phi, t, a, dt, tau);
 }
 
 void fc_rest_start(double rest[7], const double gyro[3], const double acc[3])

@@ -60,10 +60,14 @@ void fc_heun_euler_step(double phi, double theta, double p0, double q0, double r
 void fc_quat_from_roll_pitch_yaw(double phi, double theta, double psi, double q[4]);
 void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch);
 void fc_quat_gravity_body(const double q[4], double g[3]);
+void fc_rotvec_terms(double vx, double vy, double vz, double t[4]);
 void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz);
+void fc_quat_mul_rotvec_terms(double q[4], double vx, double vy, double vz, const double t[4]);
 void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
                            double dt, double phi[3]);
 void fc_rotate_back(const double v[3], const double phi[3], double out[3]);
+void fc_rotate_back_terms(const double v[3], const double phi[3], const double t[4],
+                          double out[3]);
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 #define FC_REST_MEAN_TAU 0.5
@@ -75,6 +79,8 @@ void fc_body_rotation(const double g0[3], const double g1[3], const double bias[
                       int trapezoid, double phi[3]);
 void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
                                double tau);
+void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
+                                     const double a[3], double dt, double tau);
 /* The rest detector's state at the first sample: its means start at that sample, quiet 0. */
 void fc_rest_start(double rest[7], const double gyro[3], const double acc[3]);
 void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,

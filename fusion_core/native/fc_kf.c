@@ -142,7 +142,8 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
 }
 
 /* propagate: the angles by the Euler rates or the quaternion, P by the papers' F and Q */
-void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_in)
+void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_in,
+                     const double *terms)
 {
     double bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
     if (f->quaternion) {
@@ -153,7 +154,11 @@ void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_i
             double b[3] = {bx, by, bz};
             fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
         }
-        fc_quat_mul_rotvec(f->q_att, phi[0], phi[1], phi[2]);
+        if (terms) {
+            fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
+        } else {
+            fc_quat_mul_rotvec(f->q_att, phi[0], phi[1], phi[2]);
+        }
         fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     } else if (f->trapezoid) {
         const double *w0 = f->base.gyro_prev;
@@ -246,14 +251,15 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
 static void update_with_options(fc_kf *f, const double a_in[3], const double g[3], double dt,
                                 const double prev[3])
 {
-    double a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3];
+    double a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4];
     int have_phi = 0;
     if (f->quaternion || f->acc_tau > 0.0) {
         double b[3] = {f->bias_x, f->bias_y, f->bias_z};
         fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
+        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
         have_phi = 1;
     }
-    fc_kf_propagate(f, g, dt, have_phi ? phi : NULL);
+    fc_kf_propagate(f, g, dt, have_phi ? phi : NULL, have_phi ? terms : NULL);
     double pred_roll = f->roll, pred_pitch = f->pitch;
     double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2;
@@ -261,7 +267,7 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
         zero_rate_update(f, a, g, dt);
     }
     if (f->acc_tau > 0.0) {
-        fc_lowpass_specific_force(f->acc_f, phi, a, dt, f->acc_tau);
+        fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, f->acc_tau);
         memcpy(a, f->acc_f, sizeof a);
     }
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
@@ -351,7 +357,7 @@ static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double
             }
         }
     } else {
-        fc_kf_propagate(f, g_in, dt, NULL);
+        fc_kf_propagate(f, g_in, dt, NULL, NULL);
         double n2 = a_in[0] * a_in[0] + a_in[1] * a_in[1] + a_in[2] * a_in[2];
         if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
             fc_kf_correct(f, a_in[0], a_in[1], a_in[2], f->bias_lo2 < n2 && n2 < f->bias_hi2);

@@ -38,9 +38,10 @@ fc_estimate fc_kf_estimate(const fc_kf *f);
 
 /* The parts the position filter drives one by one (AngleBiasKalmanFilter's methods of the same
  * names): the time update (phi: the interval's rotation vector, or NULL to compute it from
- * base.gyro_prev), the accelerometer update, an update with given innovations, a direct bias
+ * base.gyro_prev; terms: its fc_rotvec_terms, or NULL), the accelerometer update, an update with given innovations, a direct bias
  * measurement, and the accelerometer gate. */
-void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi);
+void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi,
+                     const double *terms);
 void fc_kf_correct(fc_kf *f, double ax, double ay, double az, int learn_bias);
 void fc_kf_correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias);
 void fc_kf_correct_bias(fc_kf *f, double z_x, double z_y, double r);

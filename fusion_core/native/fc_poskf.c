@@ -257,7 +257,7 @@ static void advance(fc_poskf *f, const double a[3], const double g[3], double dt
         && (quiet_time >= p->zupt_force_after || slow_enough(f));
     /* 2. tilt stage */
     memcpy(tilt->base.gyro_prev, f->base.gyro_prev, sizeof f->base.gyro_prev);
-    fc_kf_propagate(tilt, g, dt, NULL);
+    fc_kf_propagate(tilt, g, dt, NULL, NULL);
     double d_roll = tilt->roll - roll;
     double turned_roll = f->turned[0], turned_pitch = f->turned[1];
     turned_roll += -FC_PI <= d_roll && d_roll <= FC_PI ? d_roll : fc_wrap_angle(d_roll);
