@@ -22,6 +22,8 @@ static void quiet2(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2S
     (void)e; (void)n; (void)s; (void)c; (void)m;
 }
 
+#define SYM(T, name) ((T *)dlsym(lib, name))
+
 static double now(void)
 {
     struct timespec ts;
@@ -69,13 +71,16 @@ int main(int argc, char **argv)
     for (p = 0; p < passes; p++) {
         double t0, t1;
         if (v3) {
-            fmi3InstantiateCoSimulationTYPE *inst = (fmi3InstantiateCoSimulationTYPE *)dlsym(lib, "fmi3InstantiateCoSimulation");
-            fmi3EnterInitializationModeTYPE *enter = (fmi3EnterInitializationModeTYPE *)dlsym(lib, "fmi3EnterInitializationMode");
-            fmi3ExitInitializationModeTYPE *exit_init = (fmi3ExitInitializationModeTYPE *)dlsym(lib, "fmi3ExitInitializationMode");
-            fmi3SetFloat64TYPE *set = (fmi3SetFloat64TYPE *)dlsym(lib, "fmi3SetFloat64");
-            fmi3GetFloat64TYPE *get = (fmi3GetFloat64TYPE *)dlsym(lib, "fmi3GetFloat64");
-            fmi3DoStepTYPE *step = (fmi3DoStepTYPE *)dlsym(lib, "fmi3DoStep");
-            fmi3FreeInstanceTYPE *free_instance = (fmi3FreeInstanceTYPE *)dlsym(lib, "fmi3FreeInstance");
+            fmi3InstantiateCoSimulationTYPE *inst =
+                SYM(fmi3InstantiateCoSimulationTYPE, "fmi3InstantiateCoSimulation");
+            fmi3EnterInitializationModeTYPE *enter =
+                SYM(fmi3EnterInitializationModeTYPE, "fmi3EnterInitializationMode");
+            fmi3ExitInitializationModeTYPE *exit_init =
+                SYM(fmi3ExitInitializationModeTYPE, "fmi3ExitInitializationMode");
+            fmi3SetFloat64TYPE *set = SYM(fmi3SetFloat64TYPE, "fmi3SetFloat64");
+            fmi3GetFloat64TYPE *get = SYM(fmi3GetFloat64TYPE, "fmi3GetFloat64");
+            fmi3DoStepTYPE *step = SYM(fmi3DoStepTYPE, "fmi3DoStep");
+            fmi3FreeInstanceTYPE *free_instance = SYM(fmi3FreeInstanceTYPE, "fmi3FreeInstance");
             fmi3Boolean ev, term, early;
             fmi3Float64 last;
             fmi3Instance c = inst("bench", argv[3], "", fmi3False, fmi3False, fmi3False, fmi3False,
@@ -93,14 +98,16 @@ int main(int argc, char **argv)
             t1 = now();
             free_instance(c);
         } else {
-            fmi2InstantiateTYPE *inst = (fmi2InstantiateTYPE *)dlsym(lib, "fmi2Instantiate");
-            fmi2SetupExperimentTYPE *setup = (fmi2SetupExperimentTYPE *)dlsym(lib, "fmi2SetupExperiment");
-            fmi2EnterInitializationModeTYPE *enter = (fmi2EnterInitializationModeTYPE *)dlsym(lib, "fmi2EnterInitializationMode");
-            fmi2ExitInitializationModeTYPE *exit_init = (fmi2ExitInitializationModeTYPE *)dlsym(lib, "fmi2ExitInitializationMode");
-            fmi2SetRealTYPE *set = (fmi2SetRealTYPE *)dlsym(lib, "fmi2SetReal");
-            fmi2GetRealTYPE *get = (fmi2GetRealTYPE *)dlsym(lib, "fmi2GetReal");
-            fmi2DoStepTYPE *step = (fmi2DoStepTYPE *)dlsym(lib, "fmi2DoStep");
-            fmi2FreeInstanceTYPE *free_instance = (fmi2FreeInstanceTYPE *)dlsym(lib, "fmi2FreeInstance");
+            fmi2InstantiateTYPE *inst = SYM(fmi2InstantiateTYPE, "fmi2Instantiate");
+            fmi2SetupExperimentTYPE *setup = SYM(fmi2SetupExperimentTYPE, "fmi2SetupExperiment");
+            fmi2EnterInitializationModeTYPE *enter =
+                SYM(fmi2EnterInitializationModeTYPE, "fmi2EnterInitializationMode");
+            fmi2ExitInitializationModeTYPE *exit_init =
+                SYM(fmi2ExitInitializationModeTYPE, "fmi2ExitInitializationMode");
+            fmi2SetRealTYPE *set = SYM(fmi2SetRealTYPE, "fmi2SetReal");
+            fmi2GetRealTYPE *get = SYM(fmi2GetRealTYPE, "fmi2GetReal");
+            fmi2DoStepTYPE *step = SYM(fmi2DoStepTYPE, "fmi2DoStep");
+            fmi2FreeInstanceTYPE *free_instance = SYM(fmi2FreeInstanceTYPE, "fmi2FreeInstance");
             fmi2CallbackFunctions cb = {quiet2, calloc, free, NULL, NULL};
             fmi2Component c = inst("bench", fmi2CoSimulation, argv[3], "", &cb, fmi2False,
                                    fmi2False);

@@ -256,24 +256,12 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     return fmi2Error;
 }
 
-/* ----- FMU state ---------------------------------------------------------------------------- */
+/* ----- FMU state (fmu_instance.c) ---------------------------------------------------------- */
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
-    unsigned char *state;
     INSTANCE(c, "fmi2GetFMUstate", MASK_ANY)
-    if (!FMUstate) {
-        fmu_log(inst, FMU_ERROR, "fmi2GetFMUstate: FMUstate is NULL");
-        return fmi2Error;
-    }
-    state = *FMUstate ? (unsigned char *)*FMUstate : malloc(fmu_state_size());
-    if (!state) {
-        fmu_log(inst, FMU_ERROR, "fmi2GetFMUstate: out of memory");
-        return fmi2Error;
-    }
-    fmu_state_write(inst, state);
-    *FMUstate = state;
-    return fmi2OK;
+    return (fmi2Status)fmu_state_get(inst, "fmi2GetFMUstate", (void **)FMUstate);
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
@@ -285,10 +273,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     INSTANCE(c, "fmi2FreeFMUstate", MASK_ANY)
-    if (FMUstate) {
-        free(*FMUstate);
-        *FMUstate = NULL;
-    }
+    fmu_state_free((void **)FMUstate);
     return fmi2OK;
 }
 
@@ -296,48 +281,23 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, si
 {
     INSTANCE(c, "fmi2SerializedFMUstateSize", MASK_ANY)
     (void)FMUstate;
-    if (!size) {
-        fmu_log(inst, FMU_ERROR, "fmi2SerializedFMUstateSize: size is NULL");
-        return fmi2Error;
-    }
-    *size = fmu_state_size();
-    return fmi2OK;
+    return (fmi2Status)fmu_state_size_of(inst, "fmi2SerializedFMUstateSize", size);
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                  size_t size)
 {
     INSTANCE(c, "fmi2SerializeFMUstate", MASK_ANY)
-    if (!FMUstate || !serializedState || size < fmu_state_size()) {
-        fmu_log(inst, FMU_ERROR, "fmi2SerializeFMUstate: needs a state and %lu bytes (got %lu)",
-                (unsigned long)fmu_state_size(), (unsigned long)size);
-        return fmi2Error;
-    }
-    memcpy(serializedState, FMUstate, fmu_state_size());
-    return fmi2OK;
+    return (fmi2Status)fmu_state_serialize(inst, "fmi2SerializeFMUstate", FMUstate,
+                                           serializedState, size);
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],
-                                   size_t size, fmi2FMUstate *FMUstate)
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate)
 {
-    unsigned char *state;
     INSTANCE(c, "fmi2DeSerializeFMUstate", MASK_ANY)
-    if (!FMUstate) {
-        fmu_log(inst, FMU_ERROR, "fmi2DeSerializeFMUstate: FMUstate is NULL");
-        return fmi2Error;
-    }
-    if (fmu_state_check(inst, "fmi2DeSerializeFMUstate", (const unsigned char *)serializedState,
-                        size) != FMU_OK) {
-        return fmi2Error;
-    }
-    state = *FMUstate ? (unsigned char *)*FMUstate : malloc(fmu_state_size());
-    if (!state) {
-        fmu_log(inst, FMU_ERROR, "fmi2DeSerializeFMUstate: out of memory");
-        return fmi2Error;
-    }
-    memcpy(state, serializedState, fmu_state_size());
-    *FMUstate = state;
-    return fmi2OK;
+    return (fmi2Status)fmu_state_deserialize(inst, "fmi2DeSerializeFMUstate", serializedState,
+                                             size, (void **)FMUstate);
 }
 
 /* ----- co-simulation ------------------------------------------------------------------------ */

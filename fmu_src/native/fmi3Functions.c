@@ -311,24 +311,12 @@ fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
                ? fmi3OK : fmi3Error;
 }
 
-/* ----- FMU state ---------------------------------------------------------------------------- */
+/* ----- FMU state (fmu_instance.c) ---------------------------------------------------------- */
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
-    unsigned char *state;
     INSTANCE(instance, "fmi3GetFMUState", MASK_ANY)
-    if (!FMUState) {
-        fmu_log(inst, FMU_ERROR, "fmi3GetFMUState: FMUState is NULL");
-        return fmi3Error;
-    }
-    state = *FMUState ? (unsigned char *)*FMUState : malloc(fmu_state_size());
-    if (!state) {
-        fmu_log(inst, FMU_ERROR, "fmi3GetFMUState: out of memory");
-        return fmi3Error;
-    }
-    fmu_state_write(inst, state);
-    *FMUState = state;
-    return fmi3OK;
+    return (fmi3Status)fmu_state_get(inst, "fmi3GetFMUState", (void **)FMUState);
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
@@ -340,10 +328,7 @@ fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     INSTANCE(instance, "fmi3FreeFMUState", MASK_ANY)
-    if (FMUState) {
-        free(*FMUState);
-        *FMUState = NULL;
-    }
+    fmu_state_free((void **)FMUState);
     return fmi3OK;
 }
 
@@ -351,47 +336,24 @@ fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUSta
 {
     INSTANCE(instance, "fmi3SerializedFMUStateSize", MASK_ANY)
     (void)FMUState;
-    if (!size) {
-        fmu_log(inst, FMU_ERROR, "fmi3SerializedFMUStateSize: size is NULL");
-        return fmi3Error;
-    }
-    *size = fmu_state_size();
-    return fmi3OK;
+    return (fmi3Status)fmu_state_size_of(inst, "fmi3SerializedFMUStateSize", size);
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
                                  fmi3Byte serializedState[], size_t size)
 {
     INSTANCE(instance, "fmi3SerializeFMUState", MASK_ANY)
-    if (!FMUState || !serializedState || size < fmu_state_size()) {
-        fmu_log(inst, FMU_ERROR, "fmi3SerializeFMUState: needs a state and %lu bytes (got %lu)",
-                (unsigned long)fmu_state_size(), (unsigned long)size);
-        return fmi3Error;
-    }
-    memcpy(serializedState, FMUState, fmu_state_size());
-    return fmi3OK;
+    return (fmi3Status)fmu_state_serialize(inst, "fmi3SerializeFMUState", FMUState,
+                                           serializedState, size);
 }
 
-fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],
-                                   size_t size, fmi3FMUState *FMUState)
+fmi3Status fmi3DeserializeFMUState(fmi3Instance instance,
+                                   const fmi3Byte serializedState[], size_t size,
+                                   fmi3FMUState *FMUState)
 {
-    unsigned char *state;
     INSTANCE(instance, "fmi3DeserializeFMUState", MASK_ANY)
-    if (!FMUState) {
-        fmu_log(inst, FMU_ERROR, "fmi3DeserializeFMUState: FMUState is NULL");
-        return fmi3Error;
-    }
-    if (fmu_state_check(inst, "fmi3DeserializeFMUState", serializedState, size) != FMU_OK) {
-        return fmi3Error;
-    }
-    state = *FMUState ? (unsigned char *)*FMUState : malloc(fmu_state_size());
-    if (!state) {
-        fmu_log(inst, FMU_ERROR, "fmi3DeserializeFMUState: out of memory");
-        return fmi3Error;
-    }
-    memcpy(state, serializedState, fmu_state_size());
-    *FMUState = state;
-    return fmi3OK;
+    return (fmi3Status)fmu_state_deserialize(inst, "fmi3DeserializeFMUState", serializedState,
+                                             size, (void **)FMUState);
 }
 
 /* ----- co-simulation ------------------------------------------------------------------------ */

@@ -368,3 +368,73 @@ int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in
            FMU_MODEL.data_size);
     return FMU_OK;
 }
+
+/* ----- the FMU-state calls both standards share: a state is a malloc'ed copy of
+ * fmu_state_size() bytes (fmu_state_write) --------------------------------------------------- */
+
+/* *state (allocated when NULL) holds the bytes, or FMU_ERROR with a log line. */
+static int fill_state(const fmu_instance *inst, const char *call, void **state,
+                      const unsigned char *bytes)
+{
+    unsigned char *out;
+    if (!state) {
+        fmu_log(inst, FMU_ERROR, "%s: the FMU state pointer is NULL", call);
+        return FMU_ERROR;
+    }
+    out = *state ? (unsigned char *)*state : malloc(fmu_state_size());
+    if (!out) {
+        fmu_log(inst, FMU_ERROR, "%s: out of memory", call);
+        return FMU_ERROR;
+    }
+    if (bytes) {
+        memcpy(out, bytes, fmu_state_size());
+    } else {
+        fmu_state_write(inst, out);
+    }
+    *state = out;
+    return FMU_OK;
+}
+
+int fmu_state_get(const fmu_instance *inst, const char *call, void **state)
+{
+    return fill_state(inst, call, state, NULL);
+}
+
+int fmu_state_size_of(const fmu_instance *inst, const char *call, size_t *size)
+{
+    if (!size) {
+        fmu_log(inst, FMU_ERROR, "%s: size is NULL", call);
+        return FMU_ERROR;
+    }
+    *size = fmu_state_size();
+    return FMU_OK;
+}
+
+int fmu_state_serialize(const fmu_instance *inst, const char *call, const void *state,
+                        void *out, size_t size)
+{
+    if (!state || !out || size < fmu_state_size()) {
+        fmu_log(inst, FMU_ERROR, "%s: needs a state and %lu bytes (got %lu)", call,
+                (unsigned long)fmu_state_size(), (unsigned long)size);
+        return FMU_ERROR;
+    }
+    memcpy(out, state, fmu_state_size());
+    return FMU_OK;
+}
+
+int fmu_state_deserialize(const fmu_instance *inst, const char *call, const void *in,
+                          size_t size, void **state)
+{
+    if (fmu_state_check(inst, call, in, size) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    return fill_state(inst, call, state, in);
+}
+
+void fmu_state_free(void **state)
+{
+    if (state) {
+        free(*state);
+        *state = NULL;
+    }
+}

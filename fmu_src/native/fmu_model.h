@@ -121,5 +121,14 @@ void fmu_state_write(const fmu_instance *inst, unsigned char *out);
 int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned char *in,
                     size_t size);
 int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size);
+/* The FMU-state functions of both standards: get (allocating *state when NULL), size, serialize,
+ * deserialize (checked), free. */
+int fmu_state_get(const fmu_instance *inst, const char *call, void **state);
+int fmu_state_size_of(const fmu_instance *inst, const char *call, size_t *size);
+int fmu_state_serialize(const fmu_instance *inst, const char *call, const void *state,
+                        void *out, size_t size);
+int fmu_state_deserialize(const fmu_instance *inst, const char *call, const void *in,
+                          size_t size, void **state);
+void fmu_state_free(void **state);
 
 #endif /* FMU_MODEL_H */
