@@ -10,6 +10,7 @@ doStep, FMU state, terminate, freeInstance) and collects the FMU's log messages.
 
 from __future__ import annotations
 
+import math
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from ctypes import byref
@@ -66,6 +67,7 @@ class FmuInstance:
         self.unzip_dir = Path(extract(str(fmu)) if unzip_dir is None else unzip_dir)
         self.messages: list[LogMessage] = []
         self.time = start_time
+        self._last_step = 0.01  # the communication step sample() falls back to
         self._callbacks = _callbacks(self._on_log)
         self.fmu = FMU2Slave(
             guid=md.guid,
@@ -113,8 +115,11 @@ class FmuInstance:
     # ----- stepping -----------------------------------------------------------------------------
     def sample(self, acc: Sequence[float], gyro: Sequence[float], dt: float,
                h: float | None = None) -> None:
-        """Set one IMU sample and doStep over h (default dt) from the current time."""
-        h = dt if h is None else h
+        """Set one IMU sample and doStep over h (default: dt, or the last step where dt is not
+        finite and > 0: a bad sample's dt is the sample's, not the communication step's)."""
+        if h is None:
+            h = dt if math.isfinite(dt) and dt > 0.0 else self._last_step
+        self._last_step = h
         self.fmu.setReal(self.vr(INPUTS), [*map(float, acc), *map(float, gyro), float(dt)])
         self.fmu.doStep(currentCommunicationPoint=self.time, communicationStepSize=h)
         self.time += h
@@ -140,8 +145,13 @@ class FmuInstance:
         counts = np.empty(n, dtype=int)
         set_real, do_step = self.fmu.setReal, self.fmu.doStep
         get_real, get_integer = self.fmu.getReal, self.fmu.getInteger
+        # A bad sample's dt (0, negative, NaN) is the sample's to carry, not the communication
+        # step's: a step size that is not > 0 is a host error the FMUs refuse (docs/interface.md)
+        good = dts[np.isfinite(dts) & (dts > 0.0)]
+        nominal = float(np.median(good)) if good.size else 0.01
         for i in range(n):
-            step = float(dts[i]) if h is None else h
+            d = float(dts[i])
+            step = (d if math.isfinite(d) and d > 0.0 else nominal) if h is None else h
             set_real(in_vr, [*acc[i].tolist(), *gyro[i].tolist(), float(dts[i])])
             do_step(currentCommunicationPoint=self.time, communicationStepSize=step)
             self.time += step

@@ -228,8 +228,23 @@ class FmuSlave(Fmi2Slave):
     # ----- life cycle ---------------------------------------------------------------------------
     def exit_initialization_mode(self) -> None:
         self._running = True
+        self._terminated = False
+
+    def terminate(self) -> None:
+        self._terminated = True
 
     def do_step(self, current_time: float, step_size: float) -> bool:
+        # The call sequence as far as pythonfmu lets a slave see it: a doStep out of sequence
+        # or with a step size that is not > 0 is logged and answered with fmi2Discard (pythonfmu
+        # has no fmi2Error for a slave to return), and nothing is stepped.
+        why = ("before exitInitializationMode" if not self._running else
+               "after terminate" if getattr(self, "_terminated", False) else
+               f"with a step size h = {step_size!r} that is not > 0"
+               if not step_size > 0.0 else "")
+        if why:
+            self._fmi_log.error(f"doStep(t={current_time!r}, h={step_size!r}) {why}: nothing "
+                                "was stepped")
+            return False
         try:
             outputs = self._model.step(current_time, step_size, self._view, self._fmi_log)
             self._values.update(outputs)

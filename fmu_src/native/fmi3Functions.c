@@ -298,17 +298,31 @@ NO_VARIABLES(Set, String, fmi3String, const)
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                          size_t valueSizes[], fmi3Binary values[], size_t nValues)
 {
+    INSTANCE(instance, "fmi3GetBinary", MASK_GET)
     (void)valueSizes;
-    return fmi3GetUInt8(instance, vr, nvr, (fmi3UInt8 *)values, nValues) == fmi3OK
-               ? fmi3OK : fmi3Error;
+    (void)values;
+    (void)nValues;
+    if (nvr == 0) {
+        return fmi3OK;
+    }
+    fmu_log(inst, FMU_ERROR, "fmi3GetBinary: this FMU has no Binary variables (value reference "
+            "%lu)", vr ? (unsigned long)vr[0] : 0ul);
+    return fmi3Error;
 }
 
 fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                          const size_t valueSizes[], const fmi3Binary values[], size_t nValues)
 {
+    INSTANCE(instance, "fmi3SetBinary", MASK_SET)
     (void)valueSizes;
-    return fmi3SetUInt8(instance, vr, nvr, (const fmi3UInt8 *)values, nValues) == fmi3OK
-               ? fmi3OK : fmi3Error;
+    (void)values;
+    (void)nValues;
+    if (nvr == 0) {
+        return fmi3OK;
+    }
+    fmu_log(inst, FMU_ERROR, "fmi3SetBinary: this FMU has no Binary variables (value reference "
+            "%lu)", vr ? (unsigned long)vr[0] : 0ul);
+    return fmi3Error;
 }
 
 /* ----- FMU state (fmu_instance.c) ---------------------------------------------------------- */
