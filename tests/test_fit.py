@@ -160,3 +160,29 @@ def test_noise_on_a_broad_trial_takes_its_rest_segment(tmp_path):
 def test_tune_fits_by_default_what_physics_leaves_open():
     assert [p.name for p in tunable("mgcf")] == ["w0", "zeta"]
     assert [p.name for p in tunable("kf")] == ["Q_bias"]
+
+
+def test_the_tune_command_on_csv_recordings_with_roll_and_pitch(tmp_path):
+    """tune reads CSV recordings whose reference is roll and pitch columns and writes
+    preset.json (loadable as --preset), tune.json and tune.png."""
+    from fusion_core import synthetic
+
+    for i, seed in enumerate((1, 2)):
+        rec = _tilt_recording(seed)
+        raw = synthetic.record(synthetic.two_axis_motion(), 20.0, 100.0,
+                               noise=synthetic.ImuNoise(gyro_bias=(0.01, -0.006, 0.004)),
+                               seed=seed)
+        header = "dt,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z,roll,pitch"
+        np.savetxt(tmp_path / f"rec{i}.csv", np.column_stack(
+            [rec.dt, rec.acc, rec.gyro, raw["roll"], raw["pitch"]]), delimiter=",",
+            header=header, comments="")
+    proc = subprocess.run([sys.executable, "-m", "testbenches", "tune", "--estimator", "cf",
+                           str(tmp_path / "rec0.csv"), "--validate", str(tmp_path / "rec1.csv"),
+                           "--max-evaluations", "20", "--out", str(tmp_path / "out")],
+                          cwd=REPO, capture_output=True, text=True, timeout=300, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    result = json.loads((tmp_path / "out" / "tune.json").read_text())
+    assert result["fit_rmse_deg"] <= result["start_fit_rmse_deg"]
+    assert result["validation_rmse_deg"] is not None and result["evaluations"] <= 25
+    assert (tmp_path / "out" / "tune.png").is_file()
+    assert "tau" in load_preset(tmp_path / "out" / "preset.json")["cf"]

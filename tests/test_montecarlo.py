@@ -127,3 +127,26 @@ def test_an_fmu_in_the_loop_run_scores_as_the_native_core_run(built_fmus):
     a, b = run_row(run), run_row(fmu_run, str(built_fmus.directory))
     for metric in ("rmse_roll_deg", "rmse_pitch_deg", "max_err_deg", "bias_err_dps"):
         assert a[metric] == b[metric]
+
+
+def test_the_campaign_command_writes_its_summary_and_plots(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from conftest import REPO
+
+    cmd = [sys.executable, "-m", "testbenches", "campaign", "--estimator", "cf,kf", "--scenario",
+           "static_tilted", "--seeds", "6", "--duration", "6", "--vary",
+           "gyro_scale_std=0:0.02", "--workers", "2", "--out", str(tmp_path)]
+    proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=300,
+                          check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "| cf | static_tilted | 6 | 0 |" in proc.stdout
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["runs"] == 12 and len(summary["groups"]) == 2
+    for name in ("summary.md", "errors.png", "vary_gyro_scale_std.png", "campaign.json"):
+        assert (tmp_path / name).is_file(), name
+    again = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=300,
+                           check=False)
+    assert "0 run(s) now" in again.stdout and "12 already in" in again.stdout
