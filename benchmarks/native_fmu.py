@@ -33,11 +33,10 @@ from fmu_src.host import INPUTS
 from testbenches.fmus import direct_calls
 
 from .common import time_interleaved
-from .fmu import FMU_NAMES, FmuPasses, _output_names, build_floor_fmu
+from .fmu import FMU_NAMES, REPO, FmuPasses, _output_names, build_floor_fmu
 from .testbench import testbench_rate
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parent
 FLOOR = "FmuFloor"
 
 
@@ -108,7 +107,7 @@ class Fmi3Passes:
 
 
 def _c_host(tmp: Path) -> Path | None:
-    from fmu_src.native.build import compiler
+    from fusion_core.native import compiler
 
     cc = compiler()
     if cc is None:

@@ -142,7 +142,7 @@ KINDS = ("all", "pythonfmu", "native")
 
 def default_kind() -> str:
     """"all" where a C compiler exists (the native FMUs need one), else "pythonfmu"."""
-    from .native.build import compiler
+    from fusion_core.native import compiler
 
     return "all" if compiler() else "pythonfmu"
 

@@ -113,13 +113,19 @@ class FmuInstance:
         return self.fmu.getInteger(vr)[0]
 
     # ----- stepping -----------------------------------------------------------------------------
+    def _step_for(self, dt: float) -> float:
+        """The communication step for a sample: its dt, or the last step where dt is not finite
+        and > 0 (a bad sample's dt is the sample's to carry; a step size that is not > 0 is a
+        host error the FMUs refuse, docs/interface.md)."""
+        if math.isfinite(dt) and dt > 0.0:
+            self._last_step = dt
+        return self._last_step
+
     def sample(self, acc: Sequence[float], gyro: Sequence[float], dt: float,
                h: float | None = None) -> None:
-        """Set one IMU sample and doStep over h (default: dt, or the last step where dt is not
-        finite and > 0: a bad sample's dt is the sample's, not the communication step's)."""
-        if h is None:
-            h = dt if math.isfinite(dt) and dt > 0.0 else self._last_step
-        self._last_step = h
+        """Set one IMU sample and doStep over h (default: _step_for(dt)) from the current
+        time."""
+        h = self._step_for(dt) if h is None else h
         self.fmu.setReal(self.vr(INPUTS), [*map(float, acc), *map(float, gyro), float(dt)])
         self.fmu.doStep(currentCommunicationPoint=self.time, communicationStepSize=h)
         self.time += h
@@ -145,13 +151,8 @@ class FmuInstance:
         counts = np.empty(n, dtype=int)
         set_real, do_step = self.fmu.setReal, self.fmu.doStep
         get_real, get_integer = self.fmu.getReal, self.fmu.getInteger
-        # A bad sample's dt (0, negative, NaN) is the sample's to carry, not the communication
-        # step's: a step size that is not > 0 is a host error the FMUs refuse (docs/interface.md)
-        good = dts[np.isfinite(dts) & (dts > 0.0)]
-        nominal = float(np.median(good)) if good.size else 0.01
         for i in range(n):
-            d = float(dts[i])
-            step = (d if math.isfinite(d) and d > 0.0 else nominal) if h is None else h
+            step = self._step_for(float(dts[i])) if h is None else h
             set_real(in_vr, [*acc[i].tolist(), *gyro[i].tolist(), float(dts[i])])
             do_step(currentCommunicationPoint=self.time, communicationStepSize=step)
             self.time += step

@@ -129,6 +129,7 @@ class FmuSlave(Fmi2Slave):
         self._values.update(self.start_values())
         self._view = MappingProxyType(self._values)
         self._running = False
+        self._terminated = False
         for var in self.VARIABLES:
             self.register_variable(self._scalar_variable(var), nested=False)
         self._fast_inputs, self._fast_reals, self._fast_integers = self._fast_tables()
@@ -238,7 +239,7 @@ class FmuSlave(Fmi2Slave):
         # or with a step size that is not > 0 is logged and answered with fmi2Discard (pythonfmu
         # has no fmi2Error for a slave to return), and nothing is stepped.
         why = ("before exitInitializationMode" if not self._running else
-               "after terminate" if getattr(self, "_terminated", False) else
+               "after terminate" if self._terminated else
                f"with a step size h = {step_size!r} that is not > 0"
                if not step_size > 0.0 else "")
         if why:

@@ -52,6 +52,8 @@ SENSOR_IN = ("omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z")
 SAMPLE = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt")
 ESTIMATE = ("roll", "pitch", "bias_x", "bias_y", "bias_z")
 POSITION = ("pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z")
+SET_STEP_GET = ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal")
+"""The calls of a step whose statuses `failed` names."""
 _SENSOR_IN_AT = TRUTH.index(SENSOR_IN[0])
 """Where the sensor's inputs start among the plant outputs (they are consecutive there)."""
 assert TRUTH[_SENSOR_IN_AT:_SENSOR_IN_AT + len(SENSOR_IN)] == SENSOR_IN
@@ -179,19 +181,22 @@ def run_testbench(
         t = 0.0
         for k, h in enumerate(steps.tolist()):
             # Statuses are ints: fmi2OK 0, fmi2Warning 1 (a rejected sample), failures above.
-            status = p_step(p_c, t, h, fmi2True), p_get(p_c, truth_refs, n_truth, truth_buf)
-            if status[0] > 1 or status[1] > 1:
-                failed(plant, ("fmi2DoStep", "fmi2GetReal"), status, t, h)
-            status = (s_set(s_c, sensor_in_refs, n_in, sensor_in_buf),
-                      s_step(s_c, t, h, fmi2True), s_get(s_c, sample_refs, n_sample, sample_buf))
-            if status[0] > 1 or status[1] > 1 or status[2] > 1:
-                failed(sensor, ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), status, t, h)
+            a = p_step(p_c, t, h, fmi2True)
+            b = p_get(p_c, truth_refs, n_truth, truth_buf)
+            if a > 1 or b > 1:
+                failed(plant, ("fmi2DoStep", "fmi2GetReal"), (a, b), t, h)
+            a = s_set(s_c, sensor_in_refs, n_in, sensor_in_buf)
+            b = s_step(s_c, t, h, fmi2True)
+            c = s_get(s_c, sample_refs, n_sample, sample_buf)
+            if a > 1 or b > 1 or c > 1:
+                failed(sensor, SET_STEP_GET, (a, b, c), t, h)
             t0 = perf()
-            status = (e_set(e_c, est_in_refs, n_sample, sample_buf), e_step(e_c, t, h, fmi2True),
-                      e_get(e_c, est_out_refs, n_out, out_buf))
+            a = e_set(e_c, est_in_refs, n_sample, sample_buf)
+            b = e_step(e_c, t, h, fmi2True)
+            c = e_get(e_c, est_out_refs, n_out, out_buf)
             step_ns[k] = perf() - t0
-            if status[0] > 1 or status[1] > 1 or status[2] > 1:
-                failed(est, ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), status, t, h)
+            if a > 1 or b > 1 or c > 1:
+                failed(est, SET_STEP_GET, (a, b, c), t, h)
             record[k] = row_np
             t += h
             t_points[k] = t

@@ -45,7 +45,7 @@ class BuiltFmus:
         """The native FMU called name of FMI version "fmi2" or "fmi3": skipped with the reason
         where there is no C compiler (build_fmu.py then builds the pythonfmu FMUs only), a
         failure where there is one and the FMU was not built."""
-        from fmu_src.native.build import compiler
+        from fusion_core.native import compiler
 
         if compiler() is None:
             pytest.skip("no C compiler (set CC, or install cc, gcc or clang): no native FMUs")

@@ -323,7 +323,7 @@ HOST_KIND = {"ImuPlant": "plant", "ImuSensor": "sensor"}
 @pytest.fixture(scope="module")
 def native_host(tmp_path_factory) -> Path:
     """tests/fmu_host/native_host.c, compiled with the system compiler."""
-    from fmu_src.native.build import compiler
+    from fusion_core.native import compiler
 
     cc = compiler()
     if cc is None:

@@ -33,6 +33,9 @@ from pathlib import Path
 from xml.dom import minidom
 from xml.etree.ElementTree import Element, SubElement, tostring
 
+from fusion_core.native import compiler as twin_compiler
+from fusion_core.native.generate import c_double
+
 from ..model_description import project_version, type_definitions, unit_definitions
 from ..variables import Variable
 
@@ -117,13 +120,6 @@ def native_model(name: str) -> NativeModel:
 
 # ----- config.h ----------------------------------------------------------------------------------
 
-def _c_double(x: float) -> str:
-    if math.isinf(x):
-        return "HUGE_VAL" if x > 0 else "-HUGE_VAL"
-    text = repr(float(x))
-    return text if any(c in text for c in ".e") else text + ".0"
-
-
 def _c_string(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
@@ -139,7 +135,7 @@ def _variable_row(v: Variable) -> str:
         high = math.inf if v.high is None else float(v.high)
         low_open, high_open = v.low_open, v.high_open
     return (f"    {{{_c_string(v.name)}, {kind}, {causality[v.causality]}, {int(v.tunable)}, "
-            f"{_c_double(float(v.start))}, {_c_double(low)}, {_c_double(high)}, "
+            f"{c_double(float(v.start))}, {c_double(low)}, {c_double(high)}, "
             f"{int(low_open)}, {int(high_open)}}},")
 
 
@@ -390,13 +386,6 @@ def fmi3_build_description(model: NativeModel, sources: Sequence[str]) -> bytes:
 
 # ----- compile and package -----------------------------------------------------------------------
 
-def compiler() -> str | None:
-    """The C compiler for this platform's binary: $CC, else cc, gcc or clang."""
-    from fusion_core.native import compiler as twin_compiler
-
-    return twin_compiler()
-
-
 def cross_compiler() -> str | None:
     """mingw-w64's gcc for the Windows binary, where it is installed."""
     return shutil.which(MINGW)
@@ -444,7 +433,7 @@ def build_native(model: NativeModel, version: str, out_dir: Path,
                  cc: str | None = None, windows: bool | None = None) -> Path:
     """Build out_dir/<version>/<name>.fmu for one model and FMI version ("fmi2" or "fmi3");
     with a Windows binary too where mingw-w64 is installed (windows=None) or as asked."""
-    cc = cc or compiler()
+    cc = cc or twin_compiler()
     if cc is None:
         raise RuntimeError("no C compiler found (set CC, or install cc, gcc or clang)")
     mingw = cross_compiler() if windows is None else (cross_compiler() if windows else None)

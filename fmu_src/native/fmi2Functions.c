@@ -235,12 +235,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 {
     INSTANCE(c, "fmi2GetString", MASK_GET)
     (void)value;
-    if (nvr == 0) {
-        return fmi2OK;
-    }
-    fmu_log(inst, FMU_ERROR, "fmi2GetString: this FMU has no String variables (value reference "
-            "%lu)", vr ? (unsigned long)vr[0] : 0ul);
-    return fmi2Error;
+    return (fmi2Status)fmu_no_variables(inst, "fmi2GetString", "String", vr, nvr);
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -248,12 +243,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 {
     INSTANCE(c, "fmi2SetString", MASK_SET)
     (void)value;
-    if (nvr == 0) {
-        return fmi2OK;
-    }
-    fmu_log(inst, FMU_ERROR, "fmi2SetString: this FMU has no String variables (value reference "
-            "%lu)", vr ? (unsigned long)vr[0] : 0ul);
-    return fmi2Error;
+    return (fmi2Status)fmu_no_variables(inst, "fmi2SetString", "String", vr, nvr);
 }
 
 /* ----- FMU state (fmu_instance.c) ---------------------------------------------------------- */
@@ -434,8 +424,10 @@ fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c)
     return not_provided(c, "fmi2EnterContinuousTimeMode");
 }
 
-fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
-                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation)
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c,
+                                       fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode,
+                                       fmi2Boolean *terminateSimulation)
 {
     (void)noSetFMUStatePriorToCurrentPoint;
     (void)enterEventMode;

@@ -259,12 +259,7 @@ static int counts_match(fmu_instance *inst, const char *call, size_t nvr, size_t
         INSTANCE(instance, "fmi3" #Kind #Name, Kind##_MASK)                                   \
         (void)values;                                                                         \
         (void)nValues;                                                                        \
-        if (nvr == 0) {                                                                       \
-            return fmi3OK;                                                                    \
-        }                                                                                     \
-        fmu_log(inst, FMU_ERROR, "fmi3" #Kind #Name ": this FMU has no " #Name " variables "  \
-                "(value reference %lu)", vr ? (unsigned long)vr[0] : 0ul);                    \
-        return fmi3Error;                                                                     \
+        return (fmi3Status)fmu_no_variables(inst, "fmi3" #Kind #Name, #Name, vr, nvr);       \
     }
 #define Get_MASK MASK_GET
 #define Set_MASK MASK_SET
@@ -302,12 +297,7 @@ fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
     (void)valueSizes;
     (void)values;
     (void)nValues;
-    if (nvr == 0) {
-        return fmi3OK;
-    }
-    fmu_log(inst, FMU_ERROR, "fmi3GetBinary: this FMU has no Binary variables (value reference "
-            "%lu)", vr ? (unsigned long)vr[0] : 0ul);
-    return fmi3Error;
+    return (fmi3Status)fmu_no_variables(inst, "fmi3GetBinary", "Binary", vr, nvr);
 }
 
 fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
@@ -317,12 +307,7 @@ fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
     (void)valueSizes;
     (void)values;
     (void)nValues;
-    if (nvr == 0) {
-        return fmi3OK;
-    }
-    fmu_log(inst, FMU_ERROR, "fmi3SetBinary: this FMU has no Binary variables (value reference "
-            "%lu)", vr ? (unsigned long)vr[0] : 0ul);
-    return fmi3Error;
+    return (fmi3Status)fmu_no_variables(inst, "fmi3SetBinary", "Binary", vr, nvr);
 }
 
 /* ----- FMU state (fmu_instance.c) ---------------------------------------------------------- */

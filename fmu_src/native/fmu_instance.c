@@ -238,6 +238,17 @@ int fmu_set(fmu_instance *inst, const char *call, const uint32_t vr[], size_t nv
     return FMU_OK;
 }
 
+int fmu_no_variables(const fmu_instance *inst, const char *call, const char *type,
+                     const uint32_t vr[], size_t nvr)
+{
+    if (nvr == 0) {
+        return FMU_OK;
+    }
+    fmu_log(inst, FMU_ERROR, "%s: this FMU has no %s variables (value reference %lu)", call, type,
+            vr ? (unsigned long)vr[0] : 0ul);
+    return FMU_ERROR;
+}
+
 int fmu_exit_initialization(fmu_instance *inst)
 {
     memset(inst->data, 0, FMU_MODEL.data_size);

@@ -110,6 +110,11 @@ int fmu_get(const fmu_instance *inst, const char *call, const uint32_t vr[], siz
 int fmu_set(fmu_instance *inst, const char *call, const uint32_t vr[], size_t nvr, int types,
             const double in[]);
 
+/* A get or set of a type this FMU has no variables of: FMU_OK for none asked, else FMU_ERROR
+ * with a log line naming the first value reference. */
+int fmu_no_variables(const fmu_instance *inst, const char *call, const char *type,
+                     const uint32_t vr[], size_t nvr);
+
 int fmu_exit_initialization(fmu_instance *inst);
 int fmu_do_step(fmu_instance *inst, double t, double h);
 

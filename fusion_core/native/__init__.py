@@ -382,12 +382,11 @@ class Stepper:
     def __init__(self, estimator: Any) -> None:
         lib, ffi = lib_and_ffi()
         self.estimator = estimator
-        self.position = bool(estimator.HAS_POSITION)
         self._step = getattr(lib, f"{TWINS[type(estimator).__name__]}_step")
         self._acc = ffi.new("double[3]")
         self._gyro = ffi.new("double[3]")
-        self._out = ffi.new("fc_estimate *")
-        self._n = 11 if self.position else 5
+        self._null = ffi.NULL  # no estimate copied out: last() reads the twin's own
+        self._n = ESTIMATE_FIELDS if estimator.HAS_POSITION else 5
         self.load()
 
     def load(self) -> None:
@@ -405,7 +404,7 @@ class Stepper:
         a, g = self._acc, self._gyro
         a[0], a[1], a[2] = acc
         g[0], g[1], g[2] = gyro
-        return self._step(self.twin, a, g, dt, self._out) <= FC_SKIPPED
+        return self._step(self.twin, a, g, dt, self._null) <= FC_SKIPPED
 
     def last(self) -> tuple[float, ...]:
         """The last estimate: roll, pitch, bias (3) and, for the position filter, pos, vel."""

@@ -34,6 +34,8 @@ def c_double(x: float) -> str:
     """x as a C double literal that parses back to exactly x (repr is the shortest such)."""
     if x == float("inf"):
         return "HUGE_VAL"
+    if x == float("-inf"):
+        return "-HUGE_VAL"
     text = repr(float(x))
     return text if any(c in text for c in ".e") else text + ".0"
 

@@ -42,6 +42,11 @@ class Recording:
     counts: np.ndarray | None = None
 
     @property
+    def counted(self) -> np.ndarray:
+        """The samples a score counts (all of them where the recording does not say)."""
+        return self.counts if self.counts is not None else np.ones(len(self.dt), dtype=bool)
+
+    @property
     def duration(self) -> float:
         return float(np.sum(self.dt))
 

@@ -132,8 +132,7 @@ def score(key: str, params: dict[str, Any], rec: Recording) -> float:
     est = ESTIMATORS[key](**{"gyro_sampling": rec.gyro_sampling, **params})
     out = est.run(rec.acc, rec.gyro, rec.dt)
     g = gravity_from_roll_pitch(out["roll"], out["pitch"])
-    counts = rec.counts if rec.counts is not None else np.ones(len(rec.dt), dtype=bool)
-    return inclination_rmse_deg(g, rec.up_ref, counts)
+    return inclination_rmse_deg(g, rec.up_ref, rec.counted)
 
 
 @dataclass
@@ -249,9 +248,8 @@ def fmu_score(key: str, params: dict[str, Any], recs: Sequence[Recording],
                 t += sample[6]
         finally:
             fmu.free()
-        counts = rec.counts if rec.counts is not None else np.ones(len(rec.dt), dtype=bool)
         scores.append(inclination_rmse_deg(gravity_from_roll_pitch(out[:, 0], out[:, 1]),
-                                           rec.up_ref, counts))
+                                           rec.up_ref, rec.counted))
     return float(np.mean(scores))
 
 

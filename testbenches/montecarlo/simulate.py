@@ -72,11 +72,12 @@ def simulate(run: Run) -> TestbenchResult:
     params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **run.params}
     est = ESTIMATORS[run.estimator](**params)
     out = est.run(sample["acc"], sample["gyro"], sample["dt"])
-    estimate = {"roll": out["roll"], "pitch": out["pitch"],
-                **{f"bias_{a}": out["bias"][:, i] for i, a in enumerate("xyz")}}
+    parts = [out["roll"], out["pitch"], out["bias"]]
+    names = ESTIMATE + (POSITION if est.HAS_POSITION else ())
     if est.HAS_POSITION:
-        estimate.update({f"pos_{a}": out["pos"][:, i] for i, a in enumerate("xyz")})
-        estimate.update({f"vel_{a}": out["vel"][:, i] for i, a in enumerate("xyz")})
+        parts += [out["pos"], out["vel"]]
+    columns = np.column_stack(parts)  # the master's estimate names, in its order
+    estimate = {n: columns[:, i] for i, n in enumerate(names)}
     samples = np.column_stack([sample["acc"], sample["gyro"], sample["dt"]])
     return TestbenchResult(
         estimator=run.estimator, scenario=sc.name, seed=run.seed, rate=RATE, jitter=0.0,
@@ -110,5 +111,3 @@ def run_row(run: Run, fmu_dir: Path | str | None = None) -> dict[str, Any]:
     row["seconds"] = time.perf_counter() - t0
     return row
 
-
-assert ESTIMATE and POSITION  # the master's output names, which estimate above follows
