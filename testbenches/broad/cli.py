@@ -47,6 +47,10 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--out", type=Path, default=Path("reports/broad"),
                    help="report folder (reports/broad)")
     p.add_argument("--no-plot", action="store_true", help="skip the bar chart")
+    p.add_argument("--gyro-fit", action="store_true",
+                   help="also fit each trial's gyro against the reference (scale-factor, "
+                   "cross-axis and bias errors, testbenches.broad.gyro): a table and "
+                   "DIR/gyro_fit.json")
     return p
 
 
@@ -88,7 +92,37 @@ def cmd_broad(args: argparse.Namespace) -> int:
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
+    if args.gyro_fit:
+        print(f"\n{gyro_fit_table(trials, args.out)}")
     return 0
+
+
+def gyro_fit_table(trials: list, out: Path) -> str:  # type: ignore[type-arg]
+    """The gyro fit of every trial (testbenches.broad.gyro) as a table, also written to
+    out/gyro_fit.json."""
+    import json
+
+    from .gyro import fit_gyro
+
+    rows, fits = [], {}
+    head = (f"{'trial':44s} {'scale error x/y/z %':>22s} {'max cross %':>11s} "
+            f"{'bias x/y/z deg/s':>22s} {'windows':>7s} {'resid deg':>9s}")
+    for trial in trials:
+        try:
+            fit = fit_gyro(trial)
+        except ValueError as err:
+            rows.append(f"{trial.name[:44]:44s} {err}")
+            continue
+        d = fit.as_dict()
+        fits[trial.name] = d
+        scale = "/".join(f"{v:+.2f}" for v in d["scale_error_pct"])
+        bias = "/".join(f"{v:+.3f}" for v in d["bias_dps"])
+        rows.append(f"{trial.name[:44]:44s} {scale:>22s} {d['max_abs_cross_axis_pct']:11.2f} "
+                    f"{bias:>22s} {d['windows']:7d} {d['residual_deg']:9.3f}")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "gyro_fit.json").write_text(json.dumps(fits, indent=1))
+    return "\n".join(["gyro against the reference (integral(gyro) = M dphi + b T):", head,
+                      "-" * len(head), *rows])
 
 
 __all__ = ["add_broad_parser", "cmd_broad"]
