@@ -245,3 +245,19 @@ def test_fmu_gives_the_fusion_core_numbers_with_the_recommended_preset(built_fmu
     np.testing.assert_array_equal(fmu["roll"], core["roll"])
     np.testing.assert_array_equal(fmu["pitch"], core["pitch"])
     assert Column(key, "fmu", key).kind == "fmu"
+
+
+def test_cli_gyro_fit_writes_each_trials_gyro_errors_and_the_oracle_rmse(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 90.0, MAT_TRIAL)
+    out = tmp_path / "report"
+    assert main(["broad", str(path), "--estimator", "kf", "--gyro-fit", "--no-plot",
+                 "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "gyro against the reference" in text and "kf " in text
+    (fit,) = json.loads((out / "gyro_fit.json").read_text()).values()
+    assert len(fit["scale_error_pct"]) == 3 and len(fit["cross_axis_pct"]) == 6
+    assert all(abs(v) < 2.0 for v in fit["scale_error_pct"])  # a calibrated gyro: percents
+    assert fit["windows"] >= 100
+    assert 0.0 < fit["rmse_deg"]["kf"] < 5.0 and 0.0 < fit["rmse_scale_removed_deg"]["kf"] < 5.0

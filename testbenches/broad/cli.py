@@ -93,16 +93,25 @@ def cmd_broad(args: argparse.Namespace) -> int:
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
     if args.gyro_fit:
-        print(f"\n{gyro_fit_table(trials, args.out)}")
+        keys = [c.key for c in columns if c.kind == "fusion_core" and c.preset == "recommended"]
+        print(f"\n{gyro_fit_table(trials, args.out, keys)}")
     return 0
 
 
-def gyro_fit_table(trials: list, out: Path) -> str:  # type: ignore[type-arg]
+def gyro_fit_table(trials: list, out: Path, keys: list[str]) -> str:  # type: ignore[type-arg]
     """The gyro fit of every trial (testbenches.broad.gyro) as a table, also written to
-    out/gyro_fit.json."""
+    out/gyro_fit.json; and for the estimators `keys` (recommended values) the mean inclination
+    RMSE with and without each trial's fitted scale-factor errors divided out of its gyro. That
+    second figure is an oracle (the trial's own reference calibrates its gyro): the most that an
+    in-run estimate of the scale factors could give."""
     import json
+    from dataclasses import replace
+
+    import numpy as np
 
     from .gyro import fit_gyro
+    from .metric import gravity_from_quat, gravity_from_roll_pitch, inclination_rmse_deg
+    from .run import run_fusion_core
 
     rows, fits = [], {}
     head = (f"{'trial':44s} {'scale error x/y/z %':>22s} {'max cross %':>11s} "
@@ -114,6 +123,14 @@ def gyro_fit_table(trials: list, out: Path) -> str:  # type: ignore[type-arg]
             rows.append(f"{trial.name[:44]:44s} {err}")
             continue
         d = fit.as_dict()
+        g_ref = gravity_from_quat(trial.opt_quat)
+        for key in keys:
+            for name, t in (("rmse_deg", trial),
+                            ("rmse_scale_removed_deg",
+                             replace(trial, gyro=trial.gyro / np.diag(fit.matrix)))):
+                out_k = run_fusion_core(key, {}, t)
+                d.setdefault(name, {})[key] = inclination_rmse_deg(
+                    gravity_from_roll_pitch(out_k["roll"], out_k["pitch"]), g_ref, trial.movement)
         fits[trial.name] = d
         scale = "/".join(f"{v:+.2f}" for v in d["scale_error_pct"])
         bias = "/".join(f"{v:+.3f}" for v in d["bias_dps"])
@@ -121,8 +138,16 @@ def gyro_fit_table(trials: list, out: Path) -> str:  # type: ignore[type-arg]
                     f"{bias:>22s} {d['windows']:7d} {d['residual_deg']:9.3f}")
     out.mkdir(parents=True, exist_ok=True)
     (out / "gyro_fit.json").write_text(json.dumps(fits, indent=1))
-    return "\n".join(["gyro against the reference (integral(gyro) = M dphi + b T):", head,
-                      "-" * len(head), *rows])
+    lines = ["gyro against the reference (integral(gyro) = M dphi + b T):", head,
+             "-" * len(head), *rows]
+    if keys and fits:
+        lines.append(f"\nmean inclination RMSE over the {len(fits)} fitted trials, as recorded "
+                     "-> with each trial's fitted scale errors divided out of its gyro (oracle):")
+        for key in keys:
+            a = np.mean([d["rmse_deg"][key] for d in fits.values()])
+            b = np.mean([d["rmse_scale_removed_deg"][key] for d in fits.values()])
+            lines.append(f"  {key:6s} {a:.3f} -> {b:.3f} deg")
+    return "\n".join(lines)
 
 
 __all__ = ["add_broad_parser", "cmd_broad"]
