@@ -10,9 +10,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..fmus import DEFAULT_FMU_DIR
 from ..options import choose
+
+if TYPE_CHECKING:
+    from .data import BroadTrial
+    from .run import BroadResult
 
 HELP = """\
 Evaluate the estimators on BROAD trials (Laidig et al., Data 2021): inclination RMSE over each
@@ -80,57 +85,48 @@ def cmd_broad(args: argparse.Namespace) -> int:
     if not files:
         raise ValueError(f"no trial files in {', '.join(map(str, args.paths))}")
     trials = [load_trial(f) for f in files]  # refuses a non-trial before any long run
+    if args.head is not None:
+        trials = [t.head(args.head) for t in trials]
     with tqdm(total=len(files) * len(columns), unit="run", file=sys.stderr) as bar:
         def progress(trial: str, column: str) -> None:
             bar.set_postfix_str(f"{trial[:28]} {column}")
             bar.update()
 
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
-                          progress=progress, head_seconds=args.head)
+                          progress=progress)
     print(table(result))
     paths = write_reports(result, args.out, plot=not args.no_plot)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
     if args.gyro_fit:
-        keys = [c.key for c in columns if c.kind == "fusion_core" and c.preset == "recommended"]
-        print(f"\n{gyro_fit_table(trials, args.out, keys)}")
+        print(f"\n{gyro_fit_table(trials, result, args.out)}")
     return 0
 
 
-def gyro_fit_table(trials: list, out: Path, keys: list[str]) -> str:  # type: ignore[type-arg]
-    """The gyro fit of every trial (testbenches.broad.gyro) as a table, also written to
-    out/gyro_fit.json; and for the estimators `keys` (recommended values) the mean inclination
-    RMSE with and without each trial's fitted scale-factor errors divided out of its gyro. That
-    second figure is an oracle (the trial's own reference calibrates its gyro): the most that an
-    in-run estimate of the scale factors could give."""
+def gyro_fit_table(trials: list[BroadTrial], result: BroadResult, out: Path) -> str:
+    """Each trial's gyro fitted against its reference (testbenches.broad.gyro) as a table, also
+    written to out/gyro_fit.json, and every column's mean inclination RMSE as evaluated beside
+    its scale oracle (gyro.scale_oracle). trials: the evaluated trials, in result's order."""
     import json
-    from dataclasses import replace
 
     import numpy as np
 
-    from .gyro import fit_gyro
-    from .metric import gravity_from_quat, gravity_from_roll_pitch, inclination_rmse_deg
-    from .run import run_fusion_core
+    from .gyro import fit_gyro, scale_oracle
 
     rows, fits = [], {}
     head = (f"{'trial':44s} {'scale error x/y/z %':>22s} {'max cross %':>11s} "
             f"{'bias x/y/z deg/s':>22s} {'windows':>7s} {'resid deg':>9s}")
-    for trial in trials:
+    for trial, evaluated in zip(trials, result.trials, strict=True):
         try:
             fit = fit_gyro(trial)
         except ValueError as err:
             rows.append(f"{trial.name[:44]:44s} {err}")
             continue
         d = fit.as_dict()
-        g_ref = gravity_from_quat(trial.opt_quat)
-        for key in keys:
-            for name, t in (("rmse_deg", trial),
-                            ("rmse_scale_removed_deg",
-                             replace(trial, gyro=trial.gyro / np.diag(fit.matrix)))):
-                out_k = run_fusion_core(key, {}, t)
-                d.setdefault(name, {})[key] = inclination_rmse_deg(
-                    gravity_from_roll_pitch(out_k["roll"], out_k["pitch"]), g_ref, trial.movement)
+        d["rmse_deg"] = evaluated.rmse_deg
+        d["rmse_scale_removed_deg"] = scale_oracle(trial, fit, result.columns,
+                                                   evaluated.groups).rmse_deg
         fits[trial.name] = d
         scale = "/".join(f"{v:+.2f}" for v in d["scale_error_pct"])
         bias = "/".join(f"{v:+.3f}" for v in d["bias_dps"])
@@ -140,13 +136,13 @@ def gyro_fit_table(trials: list, out: Path, keys: list[str]) -> str:  # type: ig
     (out / "gyro_fit.json").write_text(json.dumps(fits, indent=1))
     lines = ["gyro against the reference (integral(gyro) = M dphi + b T):", head,
              "-" * len(head), *rows]
-    if keys and fits:
-        lines.append(f"\nmean inclination RMSE over the {len(fits)} fitted trials, as recorded "
+    if fits:
+        lines.append(f"\nmean inclination RMSE over the {len(fits)} fitted trials, as evaluated "
                      "-> with each trial's fitted scale errors divided out of its gyro (oracle):")
-        for key in keys:
-            a = np.mean([d["rmse_deg"][key] for d in fits.values()])
-            b = np.mean([d["rmse_scale_removed_deg"][key] for d in fits.values()])
-            lines.append(f"  {key:6s} {a:.3f} -> {b:.3f} deg")
+        for name in result.names:
+            a = np.mean([d["rmse_deg"][name] for d in fits.values()])
+            b = np.mean([d["rmse_scale_removed_deg"][name] for d in fits.values()])
+            lines.append(f"  {name:12s} {a:.3f} -> {b:.3f} deg")
     return "\n".join(lines)
 
 

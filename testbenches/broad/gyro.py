@@ -20,11 +20,13 @@ dominates).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
 from .data import BroadTrial
+from .run import Column, TrialResult, evaluate_trial
 
 WINDOW_S = 0.035
 """Window length [s]: 10 samples at BROAD's 285.7 Hz; short enough that the coning term is
@@ -56,7 +58,7 @@ class GyroFit:
         """The six off-diagonal entries of M, row by row."""
         return self.matrix[~np.eye(3, dtype=bool)]
 
-    def as_dict(self) -> dict[str, object]:
+    def as_dict(self) -> dict[str, Any]:
         return {
             "scale_error_pct": (100.0 * self.scale_error).tolist(),
             "cross_axis_pct": (100.0 * self.cross_axis).tolist(),
@@ -87,8 +89,8 @@ def fit_gyro(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = MI
     q = trial.opt_quat
     ok = np.all(np.isfinite(q), axis=1)
     a = np.arange(trial.n - w)
+    a = a[ok[a] & ok[a + w]]
     b = a + w
-    a, b = a[ok[a] & ok[b]], b[ok[a] & ok[b]]
     dphi = _rotvec_between(q[a], q[b])
     # the gyro's integral over (t_a, t_b]: mean samples a+1..b, or the trapezoid of point samples
     c = np.vstack([np.zeros(3), np.cumsum(trial.gyro, axis=0)]) * trial.dt
@@ -106,3 +108,11 @@ def fit_gyro(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = MI
     residual = g_int[turning] - x @ sol
     return GyroFit(matrix=sol[:3].T.copy(), bias=sol[3].copy(), windows=int(turning.sum()),
                    residual=float(np.sqrt(np.mean(residual**2))))
+
+
+def scale_oracle(trial: BroadTrial, fit: GyroFit, columns: list[Column], groups: list[str]
+                 ) -> TrialResult:
+    """The columns on the trial with its fitted scale-factor errors divided out of the gyro. An
+    oracle (the trial's own reference calibrates its gyro): the most an in-run estimate of the
+    scale factors could give."""
+    return evaluate_trial(replace(trial, gyro=trial.gyro / np.diag(fit.matrix)), columns, groups)
