@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from fusion_core.scenarios import SCENARIOS
 
@@ -62,6 +63,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     preset = load_preset(args.preset)
     sensor = load_sensor(args.sensor)
+    peers = _peers(args)  # checked before the runs: a missing package fails at once
     jobs = plan(estimators, scenarios, args.seeds, args.jitter, not args.no_contract)
     fmu_dir = kind_dir(args.fmu_dir, args.kind)
     print(f"FMUs: {fmu_dir}", file=sys.stderr)
@@ -75,9 +77,32 @@ def cmd_run(args: argparse.Namespace) -> int:
                               args.duration, not args.no_timing_check, args.jobs,
                               preset=preset, sensor=sensor)
     print(contract_table(result))
-    write_reports(result, args.out, plots=not args.no_plots)
+    peer_rows = None
+    if peers:
+        from .peer_runs import peer_table, run_peers
+
+        peer_rows = run_peers(peers, scenarios, args.seeds, sensor, args.duration)
+        print("\n" + peer_table(peer_rows))
+    write_reports(result, args.out, plots=not args.no_plots, peers=peer_rows)
     print(f"\nreports: {args.out / 'report.md'}, {args.out / 'report.json'}")
     return 0 if result.passed else 1
+
+
+def _peers(args: argparse.Namespace) -> dict[str, Any]:
+    """The public filters of --peers by name (testbenches.peers), their packages checked."""
+    if not args.peers:
+        return {}
+    from .peers import PEERS, PeerUnavailable, check_peers
+
+    if args.jitter:
+        raise ValueError(f"--peers needs one sample rate, so --jitter 0: got --jitter "
+                         f"{args.jitter:g}")
+    names = choose(args.peers, list(PEERS), "peer")
+    try:
+        check_peers(names)
+    except PeerUnavailable as err:  # the pip command is in the message
+        raise ValueError(str(err)) from None
+    return {n: PEERS[n] for n in names}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -116,6 +141,10 @@ def main(argv: list[str] | None = None) -> int:
                      "verdict, e.g. under a profiler or valgrind")
     run.add_argument("--no-contract", action="store_true",
                      help="only the runs, without the T1, T2, T4 and position extras")
+    run.add_argument("--peers", default="", metavar="LIST",
+                     help="also run public filters on the same samples and score them against "
+                     "the same bounds, for reference (not in the verdict): all or a comma list "
+                     "of vqf, madgwick, mahony (the bench extra: pip install -e '.[bench]')")
     ssp = sub.add_parser("export-ssp", help="write a testbench as an SSP file")
     ssp.add_argument("--estimator", required=True, choices=list(ESTIMATOR_FMUS))
     ssp.add_argument("--scenario", required=True, choices=list(SCENARIOS))

@@ -139,14 +139,27 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return np.remainder(x + math.pi, 2 * math.pi) - math.pi
 
 
+def attitude_errors(
+    scenario: str, t: np.ndarray, truth: dict[str, np.ndarray], roll: np.ndarray,
+    pitch: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Roll and pitch errors [deg] of an estimate against the truth (roll wrapped to +-180 deg)
+    and the mask of the samples the contract scores: from SETTLE_S (or the scenario's own
+    settling time) on."""
+    err_roll = _wrap(roll - truth["roll"]) / DEG
+    err_pitch = (pitch - truth["pitch"]) / DEG
+    keep = t >= SETTLE_BY_SCENARIO.get(scenario, SETTLE_S)
+    if not keep.any():
+        keep = np.ones_like(t, dtype=bool)
+    return err_roll, err_pitch, keep
+
+
 def compute_metrics(result: Any) -> dict[str, float]:
     """RMSE and max error after SETTLE_S, bias error, convergence time, position error, timing."""
     t = result.t
-    err_roll = _wrap(result.estimate["roll"] - result.truth["roll"]) / DEG
-    err_pitch = (result.estimate["pitch"] - result.truth["pitch"]) / DEG
-    keep = t >= SETTLE_BY_SCENARIO.get(result.scenario, SETTLE_S)
-    if not keep.any():
-        keep = np.ones_like(t, dtype=bool)
+    err_roll, err_pitch, keep = attitude_errors(
+        result.scenario, t, result.truth, result.estimate["roll"], result.estimate["pitch"]
+    )
     err = np.maximum(np.abs(err_roll), np.abs(err_pitch))
     above = np.nonzero(err > CONVERGED_DEG)[0]
     conv = 0.0 if len(above) == 0 else (

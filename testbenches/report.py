@@ -14,6 +14,7 @@ from fusion_core.types import DEG
 from . import contract
 from .campaign import CampaignResult
 from .master import TestbenchResult
+from .peer_runs import PeerRun, peer_table
 
 
 def _finite(x: float) -> float | None:
@@ -96,8 +97,10 @@ def plot_run(r: TestbenchResult, path: Path) -> None:
     plt.close(fig)
 
 
-def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True) -> None:
-    """report.json, report.md and, with plots, a PNG per run under out_dir/plots."""
+def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True,
+                  peers: list[PeerRun] | None = None) -> None:
+    """report.json, report.md and, with plots, a PNG per run under out_dir/plots; with peers,
+    the public filters' rows on the same samples (peer_runs) in both."""
     out_dir.mkdir(parents=True, exist_ok=True)
     records = []
     for r in result.runs:
@@ -113,9 +116,13 @@ def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True) -> 
         "runs": records,
         "checks": [c.as_dict() for c in result.checks],
     }
+    if peers is not None:
+        report["peers"] = [r.as_dict() for r in peers]
     (out_dir / "report.json").write_text(json.dumps(report, indent=1))
     md = ["# Testbench report", "", f"Contract v{contract.CONTRACT_VERSION}: "
           f"{'PASS' if result.passed else 'FAIL'}", "", "```", contract_table(result), "```", ""]
+    if peers is not None:
+        md += ["```", peer_table(peers), "```", ""]
     for rec in records:
         if rec["plot"]:
             md += [f"## {rec['estimator']} on {rec['scenario']} (seed {rec['seed']})", "",

@@ -335,3 +335,45 @@ def test_cli_exits_2_with_a_message_for_an_unknown_estimator(fmu_dir: Path, tmp_
                 out=tmp_path)
     assert proc.returncode == 2
     assert "unknown estimator 'nope': allowed all, cf" in proc.stderr
+
+
+def test_cli_peers_refuses_an_unknown_name_and_a_jittered_run(tmp_path: Path) -> None:
+    from testbenches.__main__ import main
+
+    assert main(["run", "--peers", "vqf,nope", "--out", str(tmp_path)]) == 2
+    assert main(["run", "--peers", "vqf", "--jitter", "0.2", "--out", str(tmp_path)]) == 2
+
+
+def test_cli_peers_says_how_to_install_a_missing_peer(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from testbenches.__main__ import main
+
+    monkeypatch.setitem(sys.modules, "vqf", None)  # import vqf now raises ImportError
+    assert main(["run", "--peers", "vqf", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "needs the Python package 'vqf'" in err and "pip install" in err
+
+
+def test_cli_peers_scores_vqf_on_the_same_samples_beside_the_contract(
+    fmu_dir: Path, tmp_path: Path
+) -> None:
+    pytest.importorskip("vqf", reason="the VQF peer needs the bench extra (pip install -e "
+                        "'.[bench]')")
+    import json
+
+    from fusion_core.sensor import sensor_preset
+    from testbenches.peer_runs import run_peers
+    from testbenches.peers import PEERS
+
+    proc = _cli("--estimator", "kf", "--scenario", "roll_sweep", "--duration", "8",
+                "--peers", "vqf", fmu_dir=fmu_dir, out=tmp_path)
+    assert proc.returncode in (0, 1), proc.stderr
+    assert "Public filters on the same samples" in proc.stdout
+    report = json.loads((tmp_path / "report.json").read_text())
+    (row,) = report["peers"]
+    (direct,) = run_peers({"vqf": PEERS["vqf"]}, ["roll_sweep"], 1, sensor_preset("realistic"),
+                          duration=8.0)
+    assert (row["peer"], row["scenario"], row["seed"]) == ("vqf", "roll_sweep", 0)
+    assert row["rmse_roll_deg"] == direct.rmse_roll_deg
+    assert "vqf       roll_sweep" in (tmp_path / "report.md").read_text()

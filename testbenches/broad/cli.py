@@ -67,8 +67,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from fusion_core import ESTIMATORS
     from fusion_core.presets import PRESETS
 
+    from ..peers import PEERS, PeerUnavailable, check_peers
     from .data import load_trial
-    from .peers import PEERS, PeerUnavailable, check_peers
     from .report import table, write_reports
     from .run import collect_paths, evaluate, plan_columns
 

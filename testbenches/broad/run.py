@@ -31,6 +31,7 @@ from fusion_core import ESTIMATORS
 from fusion_core.presets import load_preset
 
 from ..fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, FmuHandle, fmu_path
+from ..peers import PEERS
 from .data import (
     GROUP_ORDER,
     BroadTrial,
@@ -40,7 +41,6 @@ from .data import (
     trial_groups,
 )
 from .metric import gravity_from_quat, gravity_from_roll_pitch, inclination_rmse_deg
-from .peers import PEERS
 
 TRIAL_SUFFIXES = (".hdf5", ".h5", ".mat")
 """File endings collected from a directory given as PATH."""

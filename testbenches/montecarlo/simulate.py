@@ -62,13 +62,25 @@ def _samples(scenario_id: int, duration: float, sensor_json: str) -> dict[str, n
     return out
 
 
+def scenario_samples(
+    scenario: str, seed: int, sensor: dict[str, Any], duration: float | None = None
+) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    """Times [N], truth [N, 15] (TRUTH_NAMES' order) and the sensor's samples (acc, gyro [N, 3],
+    dt [N], gyro_bias [N, 3]) of a scenario for one sensor parameter set and seed: what the
+    estimator FMUs get in the testbench for that seed (read-only arrays, shared by a worker's
+    runs)."""
+    sc = get_scenario(scenario)
+    duration = sc.duration if duration is None else float(duration)
+    _, t, truth = _truth(sc.id, duration)
+    sample = _samples(sc.id, duration, json.dumps({**sensor, "seed": seed}, sort_keys=True))
+    return t, truth, sample
+
+
 def simulate(run: Run) -> TestbenchResult:
     """The run's traces, as the FMU testbench's result (metrics not yet computed)."""
     sc = get_scenario(run.scenario)
-    duration = sc.duration if run.duration is None else float(run.duration)
-    _, t, truth = _truth(sc.id, duration)
+    t, truth, sample = scenario_samples(sc.name, run.seed, run.sensor, run.duration)
     sensor_params = {**run.sensor, "seed": run.seed}
-    sample = _samples(sc.id, duration, json.dumps(sensor_params, sort_keys=True))
     params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **run.params}
     est = ESTIMATORS[run.estimator](**params)
     out = est.run(sample["acc"], sample["gyro"], sample["dt"])

@@ -1,5 +1,6 @@
-"""Public 6D orientation filters run beside ours on BROAD (the `bench` extra): VQF, Madgwick,
-Mahony. Each returns the estimated up direction in the sensor frame, [N, 3], for the metric.
+"""Public 6D orientation filters run beside ours (the `bench` extra): VQF, Madgwick, Mahony, on
+BROAD (`testbenches broad --peers`) and on the contract's own samples (`testbenches run --peers`,
+peer_runs). Each returns the estimated up direction in the sensor frame, [N, 3].
 
 - VQF: D. Laidig, T. Seel. "VQF: Highly Accurate IMU Orientation Estimation with Bias Estimation
   and Magnetic Disturbance Rejection". Information Fusion 91:187-204, 2023. The `vqf` package's
@@ -31,7 +32,7 @@ from types import ModuleType
 
 import numpy as np
 
-from .metric import gravity_from_quat
+from .broad.metric import gravity_from_quat
 
 PEER_INSTALL = "pip install 'vqf>=2.0' 'ahrs>=0.3.1'  (or: pip install -e '.[bench]')"
 
