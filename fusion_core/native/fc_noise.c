@@ -23,12 +23,25 @@ static double uniform(uint64_t u)  /* in (0, 1), never 0 */
     return ((double)(u >> 11) + 0.5) * (1.0 / 9007199254740992.0);
 }
 
+static double normal(uint64_t per_sample, int c)  /* channel c of one sample */
+{
+    double u1 = uniform(fc_splitmix64(per_sample ^ (uint64_t)(2 * c)));
+    double u2 = uniform(fc_splitmix64(per_sample ^ (uint64_t)(2 * c + 1)));
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * FC_PI_NOISE * u2);
+}
+
 void fc_normals(uint64_t key, uint64_t k, int n, double *out)
 {
     uint64_t per_sample = fc_splitmix64(key ^ k);
     for (int c = 0; c < n; c++) {
-        double u1 = uniform(fc_splitmix64(per_sample ^ (uint64_t)(2 * c)));
-        double u2 = uniform(fc_splitmix64(per_sample ^ (uint64_t)(2 * c + 1)));
-        out[c] = sqrt(-2.0 * log(u1)) * cos(2.0 * FC_PI_NOISE * u2);
+        out[c] = normal(per_sample, c);
+    }
+}
+
+void fc_normals_used(uint64_t key, uint64_t k, int n, const unsigned char *used, double *out)
+{
+    uint64_t per_sample = fc_splitmix64(key ^ k);
+    for (int c = 0; c < n; c++) {
+        out[c] = used[c] ? normal(per_sample, c) : 0.0;
     }
 }

@@ -178,15 +178,44 @@ static void acc_bias(const fc_sensor *s, double out[3])
     }
 }
 
-int fc_sensor_sample(fc_sensor *s, const double omega[3], const double f[3], double h,
-                     double acc_out[3], double gyro_out[3], double *dt)
+/* What a sample computes from its interval h and the parameters only: the noise and drive
+ * scales, the quantisation steps, and which normals the sample uses (a term switched off, whose
+ * scale is 0, adds 0 whatever its deviate). fc_sensor_run computes them once per distinct h. */
+typedef struct interval {
+    double h, gw, aw, decay, g_gm, a_gm, gn, an, lsb_a, lsb_g;
+    unsigned char used[FC_SENSOR_NORMALS];
+} interval;
+
+static void interval_constants(const fc_sensor_params *p, double h, interval *c)
+{
+    c->h = h;
+    c->gw = sqrt(p->gyro_bias_psd * h);
+    c->aw = sqrt(p->acc_bias_psd * h);
+    c->decay = exp(-h / p->bias_time_constant);
+    double drive = sqrt(1.0 - c->decay * c->decay);
+    c->g_gm = drive * p->gyro_bias_instability;
+    c->a_gm = drive * p->acc_bias_instability;
+    c->gn = sqrt(p->gyro_psd / h);
+    c->an = sqrt(p->acc_psd / h);
+    c->lsb_a = p->bits ? 2.0 * p->acc_range / pow(2.0, (double)p->bits) : 0.0;
+    c->lsb_g = p->bits ? 2.0 * p->gyro_range / pow(2.0, (double)p->bits) : 0.0;
+    /* channels: white noise 0-5, random walk 6-11, Gauss-Markov 12-17, jitter 18 */
+    const double scale[6] = {c->gn, c->an, c->gw, c->aw, c->g_gm, c->a_gm};
+    for (int b = 0; b < 6; b++) {
+        for (int i = 0; i < 3; i++) {
+            c->used[3 * b + i] = scale[b] != 0.0;
+        }
+    }
+    c->used[18] = p->jitter > 0.0;
+}
+
+static void sample_in(fc_sensor *s, const interval *c, const double omega[3],
+                      const double f[3], double acc_out[3], double gyro_out[3], double *dt)
 {
     const fc_sensor_params *p = &s->params;
-    if (!(h > 0.0)) {
-        return -1;
-    }
+    double h = c->h;
     double z[FC_SENSOR_NORMALS];
-    fc_normals(s->noise_key, (uint64_t)s->k, FC_SENSOR_NORMALS, z);
+    fc_normals_used(s->noise_key, (uint64_t)s->k, FC_SENSOR_NORMALS, c->used, z);
     s->k += 1;
     double rate[3] = {omega[0], omega[1], omega[2]};
     if (p->gyro_sampling == FC_SENSOR_GYRO_SAMPLING_MEAN) {
@@ -198,17 +227,14 @@ int fc_sensor_sample(fc_sensor *s, const double omega[3], const double f[3], dou
             rate[i] = 0.5 * (prev[i] + omega[i]);
         }
     }
-    double gw = sqrt(p->gyro_bias_psd * h), aw = sqrt(p->acc_bias_psd * h);
-    double decay = exp(-h / p->bias_time_constant);
-    double drive = sqrt(1.0 - decay * decay);
-    double g_gm = drive * p->gyro_bias_instability, a_gm = drive * p->acc_bias_instability;
+    double decay = c->decay;
     for (int i = 0; i < 3; i++) {
-        s->gyro_walk[i] += gw * z[6 + i];
-        s->acc_walk[i] += aw * z[9 + i];
-        s->gyro_gm[i] = decay * s->gyro_gm[i] + g_gm * z[12 + i];
-        s->acc_gm[i] = decay * s->acc_gm[i] + a_gm * z[15 + i];
+        s->gyro_walk[i] += c->gw * z[6 + i];
+        s->acc_walk[i] += c->aw * z[9 + i];
+        s->gyro_gm[i] = decay * s->gyro_gm[i] + c->g_gm * z[12 + i];
+        s->acc_gm[i] = decay * s->acc_gm[i] + c->a_gm * z[15 + i];
     }
-    double gn = sqrt(p->gyro_psd / h), an = sqrt(p->acc_psd / h);
+    double gn = c->gn, an = c->an;
     double gb[3], ab[3], g[3], a[3];
     fc_sensor_gyro_bias(s, gb);
     acc_bias(s, ab);
@@ -229,23 +255,37 @@ int fc_sensor_sample(fc_sensor *s, const double omega[3], const double f[3], dou
         *dt = floor > d ? floor : d;  /* max(d, 1e-6 h) */
         s->time_error = new_error;
     }
-    double lsb_a = p->bits ? 2.0 * p->acc_range / pow(2.0, (double)p->bits) : 0.0;
-    double lsb_g = p->bits ? 2.0 * p->gyro_range / pow(2.0, (double)p->bits) : 0.0;
     for (int i = 0; i < 3; i++) {
-        acc_out[i] = convert(a[i], p->acc_range, p->bits, lsb_a);
-        gyro_out[i] = convert(g[i], p->gyro_range, p->bits, lsb_g);
+        acc_out[i] = convert(a[i], p->acc_range, p->bits, c->lsb_a);
+        gyro_out[i] = convert(g[i], p->gyro_range, p->bits, c->lsb_g);
     }
+}
+
+int fc_sensor_sample(fc_sensor *s, const double omega[3], const double f[3], double h,
+                     double acc_out[3], double gyro_out[3], double *dt)
+{
+    if (!(h > 0.0)) {
+        return -1;
+    }
+    interval c;
+    interval_constants(&s->params, h, &c);
+    sample_in(s, &c, omega, f, acc_out, gyro_out, dt);
     return 0;
 }
 
 int fc_sensor_run(fc_sensor *s, long n, const double *omega, const double *f, const double *h,
                   double *acc, double *gyro, double *dt, double *gyro_bias)
 {
+    interval c;
+    c.h = 0.0;  /* no interval yet: the first sample computes its constants */
     for (long i = 0; i < n; i++) {
-        if (fc_sensor_sample(s, omega + 3 * i, f + 3 * i, h[i], acc + 3 * i, gyro + 3 * i,
-                             dt + i) != 0) {
+        if (!(h[i] > 0.0)) {
             return -1;
         }
+        if (h[i] != c.h) {
+            interval_constants(&s->params, h[i], &c);
+        }
+        sample_in(s, &c, omega + 3 * i, f + 3 * i, acc + 3 * i, gyro + 3 * i, dt + i);
         fc_sensor_gyro_bias(s, gyro_bias + 3 * i);
     }
     return 0;

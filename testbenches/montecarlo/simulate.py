@@ -84,18 +84,16 @@ def simulate(run: Run) -> TestbenchResult:
     params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **run.params}
     est = ESTIMATORS[run.estimator](**params)
     out = est.run(sample["acc"], sample["gyro"], sample["dt"])
-    parts = [out["roll"], out["pitch"], out["bias"]]
-    names = ESTIMATE + (POSITION if est.HAS_POSITION else ())
+    # the master's names, as views of the runs' own arrays (nothing is copied)
+    estimate = dict(zip(ESTIMATE, (out["roll"], out["pitch"], *out["bias"].T), strict=True))
     if est.HAS_POSITION:
-        parts += [out["pos"], out["vel"]]
-    columns = np.column_stack(parts)  # the master's estimate names, in its order
-    estimate = {n: columns[:, i] for i, n in enumerate(names)}
-    samples = np.column_stack([sample["acc"], sample["gyro"], sample["dt"]])
+        estimate.update(zip(POSITION, (*out["pos"].T, *out["vel"].T), strict=True))
+    samples = (*sample["acc"].T, *sample["gyro"].T, sample["dt"])
     return TestbenchResult(
         estimator=run.estimator, scenario=sc.name, seed=run.seed, rate=RATE, jitter=0.0,
         params=params, sensor_params=sensor_params, t=t,
         truth={n: truth[:, i] for i, n in enumerate(TRUTH_NAMES)},
-        sample={n: samples[:, i] for i, n in enumerate(SAMPLE)},
+        sample=dict(zip(SAMPLE, samples, strict=True)),
         estimate=estimate, invalid_samples=int(np.sum(out["rejected"])),
         step_us=np.zeros(len(t)), true_gyro_bias=tuple(sample["gyro_bias"][-1].tolist()),
     )
