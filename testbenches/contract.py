@@ -160,6 +160,11 @@ def attitude_errors(
     return err_roll, err_pitch, keep
 
 
+def scored_rmse(err: np.ndarray, keep: np.ndarray) -> float:
+    """RMSE of an error trace over the samples the contract scores (attitude_errors' mask)."""
+    return float(np.sqrt(np.mean(err[keep] ** 2)))
+
+
 def compute_metrics(result: Any) -> dict[str, float]:
     """RMSE and max error after SETTLE_S, bias error, convergence time, position error, timing."""
     t = result.t
@@ -176,8 +181,8 @@ def compute_metrics(result: Any) -> dict[str, float]:
     observable = {"cf": [], "kf": [0, 1], "poskf": [0, 1], "mgcf": [0, 1, 2], "ukf": [0, 1, 2]}
     axes = observable.get(result.estimator, [])
     metrics = {
-        "rmse_roll_deg": float(np.sqrt(np.mean(err_roll[keep] ** 2))),
-        "rmse_pitch_deg": float(np.sqrt(np.mean(err_pitch[keep] ** 2))),
+        "rmse_roll_deg": scored_rmse(err_roll, keep),
+        "rmse_pitch_deg": scored_rmse(err_pitch, keep),
         "max_err_deg": float(err[keep].max()),
         "convergence_s": conv,
         "bias_err_dps": float(np.abs(bias_est - bias_true)[axes].max() / DEG) if axes else 0.0,

@@ -75,8 +75,7 @@ def run_peers(
                 roll, pitch = roll_pitch_from_up(peer(sample["acc"], sample["gyro"], RATE))
                 err_roll, err_pitch, keep = contract.attitude_errors(scenario, t, truth, roll,
                                                                      pitch)
-                rmse = (float(np.sqrt(np.mean(err_roll[keep] ** 2))),
-                        float(np.sqrt(np.mean(err_pitch[keep] ** 2))))
+                rmse = (contract.scored_rmse(err_roll, keep), contract.scored_rmse(err_pitch, keep))
                 allowed = peer_limits(scenario)
                 passed = None if allowed is None else bool(
                     rmse[0] <= allowed[0] and rmse[1] <= allowed[1]
