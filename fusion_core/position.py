@@ -41,7 +41,8 @@ the oldest is dropped unapplied. The queue holds zupt_window seconds of samples:
 with the default window, so the bound is met up to 8 kHz. A fixed bound lets the C twin keep
 the queue in its state without allocating."""
 
-TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high", "gyro_sampling")
+TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "R_loop_time", "gate_low", "gate_high",
+               "gyro_sampling")
 """Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
 TILT_DEFAULTS = {k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "gate_low",
                                           "gate_high")}

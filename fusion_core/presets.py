@@ -47,12 +47,14 @@ w0 = 0.05."""
 
 PAPER_KF: dict[str, Any] = {
     "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
-    "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
+    "R_loop_time": 0.033, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
     "init_bias_std": 0.0, "bias_gate": 0.0, "bias_innovation": math.pi, "propagation": "euler",
     "tilt_axes": "body", "gyro_sampling": "mean",
 }
 """Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
-(times (pi/180)^2 here), P = 0 at the start, the Euler rates, the rectangle rule."""
+(times (pi/180)^2 here), tuned at Gui et al.'s loop time of 0.033 s (R_loop_time: the same
+correction time constant at any rate, kalman.AngleBiasKalmanFilter), P = 0 at the start, the
+Euler rates, the rectangle rule."""
 
 PAPER_UKF: dict[str, Any] = {
     "gyro_psd": (0.05 * DEG) ** 2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
@@ -67,8 +69,8 @@ for linear acceleration, gate at rho 0.1), the rectangle rule of its eq. 14."""
 PAPER_POSKF: dict[str, Any] = {
     "qr_form": "white_jerk", "q": 1.0, "acc_psd": MPU6050_ACC_DENSITY**2, "zupt": False,
     "zaru": False, "tilt_update": "always", "attitude": "tilt_stage",
-    **{k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "gate_low", "gate_high",
-                                "gyro_sampling")},
+    **{k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "R_loop_time", "gate_low",
+                                "gate_high", "gyro_sampling")},
 }
 """Safitri et al. eq. 20-29 (their white-jerk Q, eq. 29) without the zero-velocity and
 zero-angular-rate updates, which the paper does not have; the tilt from the papers' Kalman filter

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import scipy.linalg
 from helpers import paper
 
@@ -25,11 +26,15 @@ def papers_kalman_deg(
     Q_angle: float = 0.001,
     Q_bias: float = 0.003,
     R_measure: float = 0.03,
+    loop_time: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Das & Mary eq. 18-27 as the papers write them, in degrees and deg/s.
 
     The first sample sets the angle (bias 0, P = 0); every later sample predicts with its dt and
-    updates with the accelerometer angle. Returns angle [deg] and bias [deg/s] per sample.
+    updates with the accelerometer angle. With loop_time > 0, R_measure is the variance at that
+    loop time and a sample of interval h gets R_measure loop_time / h (the rule that keeps the
+    papers' correction time constant at another rate). Returns angle [deg] and bias [deg/s] per
+    sample.
     """
     angle = float(new_angle[0])
     bias = 0.0
@@ -45,7 +50,7 @@ def papers_kalman_deg(
         P10 -= h * P11
         P11 += Q_bias * h
         # update (eq. 23-27), with the temporaries of the old P
-        S = P00 + R_measure
+        S = P00 + (R_measure * loop_time / h if loop_time else R_measure)
         K0 = P00 / S
         K1 = P10 / S
         y = newAngle - angle
@@ -85,7 +90,8 @@ def test_rectangle_rule_roll_equals_papers_scalar_filter_to_1e_9_deg() -> None:
     out = AngleBiasKalmanFilter(**PAPER_KF).run(seq["acc"], seq["gyro"], seq["dt"])
 
     new_angle = np.degrees(np.arctan2(seq["acc"][:, 1], seq["acc"][:, 2]))
-    ref_angle, ref_bias = papers_kalman_deg(new_angle, np.degrees(seq["gyro"][:, 0]), seq["dt"])
+    ref_angle, ref_bias = papers_kalman_deg(new_angle, np.degrees(seq["gyro"][:, 0]), seq["dt"],
+                                            loop_time=PAPER_KF["R_loop_time"])
 
     angle_diff = np.abs(out["roll"] / DEG - ref_angle)[SKIP:].max()
     bias_diff = np.abs(out["bias"][:, 0] / DEG - ref_bias)[SKIP:].max()
@@ -99,6 +105,23 @@ def test_rectangle_rule_roll_equals_papers_scalar_filter_to_1e_9_deg() -> None:
     assert abs(ref_bias[SKIP:].mean() - 1.5) < 0.1
     assert angle_diff < EXACT_TOL_DEG
     assert bias_diff < EXACT_TOL_DEG
+
+
+def test_at_the_papers_loop_time_r_loop_time_is_the_papers_r_per_sample() -> None:
+    """At Gui et al.'s 0.033 s the papers' R (0.03 deg^2) is each sample's variance as written;
+    at 0.01 s the same correction time constant needs 3.3 times that variance."""
+    seq = roll_only_sequence()
+    acc, gyro = seq["acc"][:2000], seq["gyro"][:2000]
+    loop = PAPER_KF["R_loop_time"]
+    for dt, r_per_sample in ((loop, PAPER_KF["R_measure"]), (0.01, PAPER_KF["R_measure"] * 3.3)):
+        h = np.full(len(acc), dt)
+        ruled = AngleBiasKalmanFilter(**PAPER_KF).run(acc, gyro, h)["roll"]
+        as_written = AngleBiasKalmanFilter(**{**PAPER_KF, "R_loop_time": 0.0,
+                                              "R_measure": r_per_sample}).run(acc, gyro, h)["roll"]
+        assert np.abs(ruled - as_written).max() / DEG < 1e-9
+    assert AngleBiasKalmanFilter(**PAPER_KF).run(acc, gyro, h)["roll"][-1] != pytest.approx(
+        AngleBiasKalmanFilter(**{**PAPER_KF, "R_loop_time": 0.0}).run(acc, gyro, h)["roll"][-1],
+        abs=1e-6)
 
 
 def steady_state_solution(dt: float, q_angle: float, q_bias: float, r: float) -> dict:
@@ -120,7 +143,8 @@ def test_converged_covariance_and_gain_equal_the_dare_solution_to_1e_6() -> None
     dt = 0.01
     kf = AngleBiasKalmanFilter(**paper("kf"))
     p = kf.params
-    ss = steady_state_solution(dt, p["Q_angle"], p["Q_bias"], p["R_measure"])
+    ss = steady_state_solution(dt, p["Q_angle"], p["Q_bias"],
+                               p["R_measure"] * p["R_loop_time"] / dt)
     phi, theta = 0.3, 0.2
     tilted = (
         -G * math.sin(theta),

@@ -66,6 +66,8 @@ void fc_kf_configure(fc_kf *f)
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;
+    f->r_loop = f->r * p->R_loop_time;
+    f->r_step = f->r;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
@@ -112,6 +114,7 @@ void fc_kf_reset(fc_kf *f)
     f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
     f->gain_roll[0] = f->gain_roll[1] = f->gain_pitch[0] = f->gain_pitch[1] = 0.0;
     f->face = 0;
+    f->r_step = f->r;
     f->last = fc_kf_estimate(f);
 }
 
@@ -169,6 +172,8 @@ void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_i
     }
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+    if (f->r_loop > 0.0)
+        f->r_step = f->r_loop / dt;
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
     predict_covariance(P, dt, f->q_angle, f->q_bias, f->P_roll);
@@ -187,14 +192,14 @@ void fc_kf_correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
     int shared = same4(f->P_pitch, P);
-    gain(P, f->r, learn_bias, f->gain_roll, f->P_roll);
+    gain(P, f->r_step, learn_bias, f->gain_roll, f->P_roll);
     if (shared) {
         memcpy(f->gain_pitch, f->gain_roll, sizeof f->gain_roll);
         memcpy(f->P_pitch, f->P_roll, sizeof P);
     } else {
         double Pp[4];
         memcpy(Pp, f->P_pitch, sizeof Pp);
-        gain(Pp, f->r, learn_bias, f->gain_pitch, f->P_pitch);
+        gain(Pp, f->r_step, learn_bias, f->gain_pitch, f->P_pitch);
     }
     double roll = f->roll + f->gain_roll[0] * y_roll;
     f->bias_x += f->gain_roll[1] * y_roll;

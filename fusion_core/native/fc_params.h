@@ -108,6 +108,7 @@ typedef struct fc_kf_params {
     double Q_angle;          /* [0.0, inf) [rad2/s] */
     double Q_bias;           /* [0.0, inf) [rad2/s3] */
     double R_measure;        /* (0.0, inf) [rad2] */
+    double R_loop_time;      /* [0.0, inf) [s] */
     double gate_low;         /* (0.0, 1.0] */
     double gate_high;        /* [1.0, inf) */
     double acc_lowpass;      /* [0.0, inf) [s] */
@@ -134,6 +135,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->Q_angle = 1.949551486634935e-08;
     p->Q_bias = 3.046174197867086e-12;
     p->R_measure = 2.5995528875251195e-05;
+    p->R_loop_time = 0.0;
     p->gate_low = 0.5;
     p->gate_high = 2.0;
     p->acc_lowpass = 1.0;
@@ -242,6 +244,7 @@ typedef struct fc_poskf_params {
     double Q_angle;           /* [0.0, inf) [rad2/s] */
     double Q_bias;            /* [0.0, inf) [rad2/s3] */
     double R_measure;         /* (0.0, inf) [rad2] */
+    double R_loop_time;       /* [0.0, inf) [s] */
     double gate_low;          /* (0.0, 1.0] */
     double gate_high;         /* [1.0, inf) */
     int gyro_sampling;        /* one of 'point', 'mean' */
@@ -273,6 +276,7 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->Q_angle = 3.046174197867086e-07;
     p->Q_bias = 9.138522593601257e-07;
     p->R_measure = 9.138522593601256e-06;
+    p->R_loop_time = 0.0;
     p->gate_low = 0.9;
     p->gate_high = 1.1;
     p->gyro_sampling = FC_POSKF_GYRO_SAMPLING_POINT;

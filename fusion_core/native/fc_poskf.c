@@ -141,6 +141,7 @@ void fc_poskf_configure(fc_poskf *f)
     tp.Q_angle = p->Q_angle;
     tp.Q_bias = p->Q_bias;
     tp.R_measure = p->R_measure;
+    tp.R_loop_time = p->R_loop_time;
     tp.gate_low = p->gate_low;
     tp.gate_high = p->gate_high;
     tp.gyro_sampling = p->gyro_sampling;
