@@ -23,7 +23,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from .types import DEG, MPU6050_ACC_DENSITY, G
+from .types import DEG, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
 
 DEG2 = DEG * DEG
 KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
@@ -57,14 +57,15 @@ correction time constant at any rate, kalman.AngleBiasKalmanFilter), P = 0 at th
 Euler rates, the rectangle rule."""
 
 PAPER_UKF: dict[str, Any] = {
-    "gyro_psd": (0.05 * DEG) ** 2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
+    "gyro_psd": MPU6050_GYRO_DENSITY**2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
     "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
     "bias_innovation": math.pi, "gyro_sampling": "mean",
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
-simulated MPU-6050 at 100 Hz (gyro 10x the datasheet density, acc_noise 0.06 with an allowance
-for linear acceleration, gate at rho 0.1), the rectangle rule of its eq. 14."""
+simulated MPU-6050 at 100 Hz: the gyro's process noise that sensor's datasheet density (as the
+recommended values take the measured density of theirs), acc_noise 0.06 with an allowance for
+linear acceleration, gate at rho 0.1, the rectangle rule of its eq. 14."""
 
 PAPER_POSKF: dict[str, Any] = {
     "qr_form": "white_jerk", "q": 1.0, "acc_psd": MPU6050_ACC_DENSITY**2, "zupt": False,

@@ -85,8 +85,8 @@ class UnscentedKalmanFilter(Estimator):
     over a 150 s recording, the rest updates doing the rest; the bias learns only while the
     measured and the predicted gravity direction are within 10 deg (bias_innovation,
     building_blocks.BIAS_INNOVATION). The paper gives no values; the ones
-    we used to reproduce its Table 1 (10x the MPU-6050 gyro density, acc_noise 0.06 with an
-    allowance for linear acceleration, gate at rho 0.1) are presets.PAPER_UKF.
+    we used to reproduce its Table 1 (the MPU-6050's datasheet gyro density, acc_noise 0.06
+    with an allowance for linear acceleration, gate at rho 0.1) are presets.PAPER_UKF.
     Output: roll = atan2(X2, X3), pitch = atan2(-X1, sqrt(X2^2 + X3^2)); bias = b.
 
     Parameters: gyro_psd [rad^2/s] (the gyro's noise density squared), bias_psd [rad^2/s^3]

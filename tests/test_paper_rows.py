@@ -1,0 +1,47 @@
+"""moderate_dynamics against Duong Quoc et al.'s Table 1 (contract.PAPER_MODERATE): the papers'
+values on the papers' sensor within each row, the defaults on the realistic sensor at most half
+of it. The runs are the campaign's (the C twins where built, else fusion_core): the samples the
+FMU testbench gets for seed 0 (tests/test_montecarlo.py holds the two paths to each other)."""
+
+from __future__ import annotations
+
+import pytest
+
+from fusion_core.presets import KEYS, preset_params
+from fusion_core.sensor import sensor_preset
+from testbenches.contract import PAPER_MODERATE, compute_metrics
+from testbenches.montecarlo.plan import Run
+from testbenches.montecarlo.simulate import simulate
+
+
+def moderate_rmse(key: str, preset: str, sensor: str) -> tuple[float, float]:
+    """Roll and pitch RMSE [deg] of estimator key on moderate_dynamics, seed 0."""
+    run = Run("k", key, "moderate_dynamics", 0, None, sensor_preset(sensor),
+              preset_params(preset, key), {})
+    m = compute_metrics(simulate(run))
+    return m["rmse_roll_deg"], m["rmse_pitch_deg"]
+
+
+@pytest.mark.parametrize("key", KEYS)
+def test_the_papers_values_on_the_ideal_sensor_are_within_the_papers_row(key: str) -> None:
+    roll, pitch = moderate_rmse(key, "paper", "ideal")
+    row = PAPER_MODERATE[key]
+    print(f"\n{key} paper/ideal {roll:.3f}/{pitch:.3f} against {row[0]}/{row[1]}")
+    assert roll <= row[0] and pitch <= row[1]
+
+
+HALF_ROW_NOT_MET = {
+    "ukf": "not met yet: 0.27/0.31 against 0.175/0.205; the realistic gyro's 1 % scale and "
+           "0.67 % cross-axis errors, which the UKF's bias states chase (0.18/0.26 on the ideal "
+           "sensor)",
+}
+
+
+@pytest.mark.parametrize("key", [
+    pytest.param(k, marks=pytest.mark.xfail(strict=True, reason=HALF_ROW_NOT_MET[k]))
+    if k in HALF_ROW_NOT_MET else k for k in KEYS])
+def test_the_defaults_on_the_realistic_sensor_are_at_most_half_the_papers_row(key: str) -> None:
+    roll, pitch = moderate_rmse(key, "recommended", "realistic")
+    row = PAPER_MODERATE[key]
+    print(f"\n{key} recommended/realistic {roll:.3f}/{pitch:.3f} against half of {row}")
+    assert roll <= row[0] / 2 and pitch <= row[1] / 2
