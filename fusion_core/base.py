@@ -16,6 +16,7 @@ from typing import Any, ClassVar, Final
 
 import numpy as np
 
+from .kinematics import roll_pitch_ahead
 from .types import Estimate, G, InvalidSample, Param, check_param_names
 
 MAX_RATE_DEFAULT: Final = 1000.0
@@ -47,6 +48,14 @@ COMMON_PARAMS: tuple[Param, ...] = (
         unit="rad/s", low=0.0, low_open=True, display_unit="deg/s",
     ),
     *MOUNTING_PARAMS,
+    Param(
+        "sensor_delay", 0.0,
+        "How long the sensor's samples lag the instants they are read at (its internal "
+        "filters' group delay, e.g. the MPU-6050 DLPF's 0.98-19 ms): the roll and pitch outputs "
+        "are turned ahead over it with the last bias-corrected rate, so they are the attitude at "
+        "the sample's time stamp; the filter's state is not changed (0: outputs as estimated)",
+        unit="s", low=0.0, high=0.1,
+    ),
 )
 MIN_INIT_NORM: Final = 0.1 * G
 """Accelerometer norm [m/s^2] a sample needs to initialise roll and pitch: below it (free fall,
@@ -169,6 +178,7 @@ class Estimator:
         self._mounting = mounting_matrix(float(values["mount_roll"]), float(values["mount_pitch"]),
                                          float(values["mount_yaw"]))
         self._mounted: bool = self._mounting != IDENTITY
+        self._delay = float(values["sensor_delay"])
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:
@@ -185,7 +195,7 @@ class Estimator:
         self.n_rejected = 0
         self.gyro_prev = (0.0, 0.0, 0.0)
         self._reset()
-        self.last = self._estimate()
+        self.last = self.output()
 
     def _reset(self) -> None:
         raise NotImplementedError
@@ -270,10 +280,26 @@ class Estimator:
             last = self._estimate()
         else:  # no gravity direction to start from yet (MIN_INIT_NORM)
             return self.last
-        self.last = last
         self.gyro_prev = (gx, gy, gz)
+        if self._delay > 0.0:
+            last = self._ahead(last)
+        self.last = last
         self.n_samples += 1
         return last
+
+    def output(self) -> Estimate:
+        """The estimate of the current state as the outputs give it (sensor_delay)."""
+        est = self._estimate()
+        return self._ahead(est) if self._delay > 0.0 and self.initialized else est
+
+    def _ahead(self, est: Estimate) -> Estimate:
+        """est with roll and pitch turned ahead over sensor_delay by the last sample's rate minus
+        est's bias (kinematics.roll_pitch_ahead)."""
+        gx, gy, gz = self.gyro_prev
+        bx, by, bz = est.bias
+        roll, pitch = roll_pitch_ahead(est.roll, est.pitch, gx - bx, gy - by, gz - bz,
+                                       self._delay)
+        return est._replace(roll=roll, pitch=pitch)
 
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -387,7 +413,7 @@ class Estimator:
         for name in names:
             setattr(self, name, _restore(getattr(self, name), state[name]))
         self._restored()
-        self.last = self._estimate()
+        self.last = self.output()
 
     def _restored(self) -> None:
         """Hook for subclasses whose state holds nested estimators."""

@@ -160,6 +160,17 @@ def quat_mul_rotvec(
     return rw * n, rx * n, ry * n, rz * n
 
 
+def roll_pitch_ahead(
+    roll: float, pitch: float, wx: float, wy: float, wz: float, delay: float
+) -> tuple[float, float]:
+    """Roll and pitch turned ahead by the body rate (wx, wy, wz) [rad/s] held for delay [s]: the
+    attitude quaternion of roll and pitch (yaw 0, which the tilt does not depend on) times
+    exp(w delay / 2), read back as roll and pitch."""
+    q = quat_mul_rotvec(quat_from_roll_pitch_yaw(roll, pitch, 0.0), wx * delay, wy * delay,
+                        wz * delay)
+    return quat_roll_pitch(*q)
+
+
 def rotation_increment(
     p0: float, q0: float, r0: float, p1: float, q1: float, r1: float, dt: float
 ) -> tuple[float, float, float]:

@@ -10,6 +10,8 @@ Two sets, as the interface contract names them:
 - "paper": the seed papers' own values and rules (PAPER below), to reproduce their results.
   The papers tune for one calibrated sensor at one loop rate and integrate the gyro with the
   rectangle rule; on a real IMU at another rate their gains are far off (README, "Presets").
+  None of them turns its output ahead over the sensor's delay: sensor_delay 0 in each, also
+  where a recording states the delay of its sensor.
 
 A preset may also be a JSON file with the same shape, {"kf": {"R_measure": 1e-4, ...}, ...},
 for any subset of the estimators (load_preset); `python -m testbenches tune` and `noise` write
@@ -30,7 +32,7 @@ KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
 
 PAPER_CF: dict[str, Any] = {
     "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "propagation": "euler", "gyro_sampling": "mean",
+    "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Gui et al. eq. 1-2: tau = 0.75 s (a = 0.96 at their 30 ms loop), the Euler rates, the
 rectangle rule (gyro_sampling="mean"). Their gate has no bounds in the text: 0.9-1.1 g is our
@@ -38,7 +40,7 @@ reading (complementary.ComplementaryFilter)."""
 
 PAPER_MGCF: dict[str, Any] = {
     "schedule": "simulation", "w0": 0.1, "zeta": 2.0, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "gyro_sampling": "mean",
+    "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Duong Quoc et al. eq. 7-13 with their simulation table (section 4.1) and zeta = 2; Mahony's
 reference order (error from the previous attitude, first-order step: gyro_sampling="mean").
@@ -49,7 +51,7 @@ PAPER_KF: dict[str, Any] = {
     "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
     "R_loop_time": 0.033, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
     "init_bias_std": 0.0, "bias_gate": 0.0, "bias_innovation": math.pi, "propagation": "euler",
-    "tilt_axes": "body", "gyro_sampling": "mean",
+    "tilt_axes": "body", "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
 (times (pi/180)^2 here), tuned at Gui et al.'s loop time of 0.033 s (R_loop_time: the same
@@ -60,7 +62,7 @@ PAPER_UKF: dict[str, Any] = {
     "gyro_psd": MPU6050_GYRO_DENSITY**2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
     "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
-    "bias_innovation": math.pi, "gyro_sampling": "mean",
+    "bias_innovation": math.pi, "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
 simulated MPU-6050 at 100 Hz: the gyro's process noise that sensor's datasheet density (as the
@@ -71,7 +73,7 @@ PAPER_POSKF: dict[str, Any] = {
     "qr_form": "white_jerk", "q": 1.0, "acc_psd": MPU6050_ACC_DENSITY**2, "zupt": False,
     "zaru": False, "tilt_update": "always", "attitude": "tilt_stage",
     **{k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "R_loop_time", "gate_low",
-                                "gate_high", "gyro_sampling")},
+                                "gate_high", "gyro_sampling", "sensor_delay")},
 }
 """Safitri et al. eq. 20-29 (their white-jerk Q, eq. 29) without the zero-velocity and
 zero-angular-rate updates, which the paper does not have; the tilt from the papers' Kalman filter

@@ -21,6 +21,10 @@ same formula as for BROAD's reference (ahrs's NED option concerns only its magne
 The filters' heading is arbitrary, which the inclination metric ignores. Madgwick and Mahony
 start from the first accelerometer sample (ahrs's `acc2q`), VQF from its own first sample.
 
+On recordings whose sensor lags the reference (BROAD: sensor_delay 2.4 ms) `vqf-ahead` is VQF
+with its output turned ahead over that delay by its own bias-corrected rate, the prediction our
+estimators' sensor_delay makes: the comparison with the same help, beside VQF as published.
+
 The packages are imported only when a peer runs; a missing one raises PeerUnavailable with the
 pip command.
 """
@@ -62,6 +66,24 @@ def run_vqf(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
     return gravity_from_quat(out["quat6D"])
 
 
+def up_ahead(up: np.ndarray, rate: np.ndarray, delay: float) -> np.ndarray:
+    """The up direction [N, 3] in the sensor frame delay [s] later, the sensor turning at rate
+    [N, 3] rad/s (its frame): a direction fixed in the world turns by -rate * delay in it."""
+    from scipy.spatial.transform import Rotation
+
+    return np.asarray(Rotation.from_rotvec(-np.asarray(rate) * delay).apply(up))
+
+
+def run_vqf_ahead(acc: np.ndarray, gyro: np.ndarray, rate: float, delay: float) -> np.ndarray:
+    """VQF 6D as run_vqf, its up direction turned ahead over the sensor's delay [s] by the gyro
+    minus VQF's bias estimate (up_ahead): up direction [N, 3]."""
+    vqf = _import("vqf", "the vqf-ahead peer")
+    f = vqf.VQF(1.0 / rate)
+    out = f.updateBatch(np.ascontiguousarray(gyro, dtype=float),
+                        np.ascontiguousarray(acc, dtype=float))
+    return up_ahead(gravity_from_quat(out["quat6D"]), gyro - out["bias"], delay)
+
+
 def run_madgwick(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
     """ahrs Madgwick (IMU) with its default gain: up direction [N, 3]."""
     filters = _import("ahrs.filters", "the Madgwick peer")
@@ -83,12 +105,18 @@ PEERS: dict[str, Callable[[np.ndarray, np.ndarray, float], np.ndarray]] = {
 }
 """Peer name -> run(acc [N, 3], gyro [N, 3], rate [Hz]) -> up direction [N, 3]."""
 
+AHEAD_PEERS: dict[str, Callable[[np.ndarray, np.ndarray, float, float], np.ndarray]] = {
+    "vqf-ahead": run_vqf_ahead,
+}
+"""Peers for recordings that state their sensor's delay: run(acc, gyro, rate, delay [s])."""
+
 
 def check_peers(names: list[str]) -> None:
     """Raise PeerUnavailable (with the pip command) unless every named peer can be imported."""
-    modules = {"vqf": "vqf", "madgwick": "ahrs.filters", "mahony": "ahrs.filters"}
+    modules = {"vqf": "vqf", "vqf-ahead": "vqf", "madgwick": "ahrs.filters",
+               "mahony": "ahrs.filters"}
     for name in names:
         _import(modules[name], f"the {name} peer")
 
 
-__all__ = ["PEERS", "PEER_INSTALL", "PeerUnavailable", "check_peers"]
+__all__ = ["AHEAD_PEERS", "PEERS", "PEER_INSTALL", "PeerUnavailable", "check_peers"]

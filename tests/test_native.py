@@ -128,7 +128,8 @@ def test_the_c_defaults_are_the_python_defaults(key: str) -> None:
 @pytest.mark.parametrize("preset", PRESETS)
 @pytest.mark.parametrize("key", TWIN_KEYS)
 @pytest.mark.parametrize("extra", [{}, {"gyro_sampling": "mean"},
-                                   {"mount_pitch": -np.pi / 2, "mount_yaw": 0.3}])
+                                   {"mount_pitch": -np.pi / 2, "mount_yaw": 0.3},
+                                   {"sensor_delay": 2.4e-3, "mount_roll": 0.4}])
 def test_python_and_native_runs_are_equal(key: str, preset: str, extra: dict) -> None:
     rec = mixed_recording()
     params = {**preset_params(preset, key), **extra}
@@ -158,24 +159,26 @@ def test_a_sensor_on_its_side_switches_faces_the_same_way(key: str) -> None:
 @needs_twin
 @pytest.mark.parametrize("key", TWIN_KEYS)
 @pytest.mark.parametrize("first", ["python", "native"])
-def test_a_run_hands_its_state_over_to_the_other_backend(key: str, first: str) -> None:
+@pytest.mark.parametrize("delay", [0.0, 2.4e-3])
+def test_a_run_hands_its_state_over_to_the_other_backend(key: str, first: str, delay: float
+                                                         ) -> None:
     rec = mixed_recording()
     acc, gyro, dt = rec["acc"], rec["gyro"], rec["dt"]
-    whole = make(key).run(acc, gyro, dt, backend="python")
-    est = make(key)
+    whole = make(key, sensor_delay=delay).run(acc, gyro, dt, backend="python")
+    est = make(key, sensor_delay=delay)
     second = "native" if first == "python" else "python"
     head = est.run(acc[:900], gyro[:900], dt[:900], backend=first)
     snapshot = est.get_state()
-    other = make(key)
+    other = make(key, sensor_delay=delay)
     other.set_state(snapshot)
     tail = other.run(acc[900:], gyro[900:], dt[900:], backend=second)
     for name in ("roll", "pitch", "bias"):
         joined = np.concatenate([head[name], tail[name]])
         assert np.max(np.abs(joined - whole[name])) <= TOL, name
     # and step() continues from a native run exactly as from a Python one
-    est_py = make(key)
+    est_py = make(key, sensor_delay=delay)
     est_py.run(acc[:900], gyro[:900], dt[:900], backend="python")
-    est_c = make(key)
+    est_c = make(key, sensor_delay=delay)
     est_c.run(acc[:900], gyro[:900], dt[:900], backend="native")
     for i in range(900, 960):
         a, b = est_py.step(acc[i], gyro[i], 0.01), est_c.step(acc[i], gyro[i], 0.01)
@@ -195,13 +198,13 @@ sample = st.tuples(
 @needs_twin
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(samples=st.lists(sample, min_size=1, max_size=60), key=st.sampled_from(TWIN_KEYS),
-       preset=st.sampled_from(sorted(PRESETS)))
-def test_random_short_recordings_give_equal_outputs(samples: list, key: str, preset: str
-                                                    ) -> None:
+       preset=st.sampled_from(sorted(PRESETS)), delay=st.sampled_from([0.0, 0.004]))
+def test_random_short_recordings_give_equal_outputs(samples: list, key: str, preset: str,
+                                                    delay: float) -> None:
     acc = np.array([s[0] for s in samples], dtype=float)
     gyro = np.array([s[1] for s in samples], dtype=float)
     dt = np.array([s[2] for s in samples], dtype=float)
-    params = preset_params(preset, key)
+    params = {**preset_params(preset, key), "sensor_delay": delay}
     with np.errstate(all="ignore"):
         out_py = make(key, **params).run(acc, gyro, dt, backend="python")
         out_c = make(key, **params).run(acc, gyro, dt, backend="native")

@@ -260,7 +260,9 @@ def _fill(lib: Any, twin: Any, estimator: Any) -> None:
         attrs = STATE_ATTRIBUTES.get(name, {})
         for field in estimator.STATE:
             _set_field(twin, field, getattr(estimator, attrs.get(field, field)))
-    twin.last = getattr(lib, f"{TWINS[name]}_estimate")(twin)
+    _, ffi = lib_and_ffi()
+    twin.last = lib.fc_base_output(ffi.addressof(twin, "base"),
+                                   getattr(lib, f"{TWINS[name]}_estimate")(twin))
 
 
 def take_state(estimator: Any, twin: Any) -> None:
@@ -276,7 +278,7 @@ def take_state(estimator: Any, twin: Any) -> None:
         for field in estimator.STATE:
             attr = attrs.get(field, field)
             setattr(estimator, attr, _field_value(twin, field, getattr(estimator, attr)))
-    estimator.last = estimator._estimate()
+    estimator.last = estimator.output()
 
 
 def _fill_position(lib: Any, twin: Any, est: Any) -> None:

@@ -132,6 +132,15 @@ void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
     fc_quat_mul_rotvec_terms(q, vx, vy, vz, t);
 }
 
+void fc_roll_pitch_ahead(double roll, double pitch, double wx, double wy, double wz,
+                         double delay, double *roll_out, double *pitch_out)
+{
+    double q[4];
+    fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, q);
+    fc_quat_mul_rotvec(q, wx * delay, wy * delay, wz * delay);
+    fc_quat_roll_pitch(q, roll_out, pitch_out);
+}
+
 void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
                            double dt, double phi[3])
 {
@@ -344,8 +353,9 @@ void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9])
 }
 
 void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
-                       double mount_pitch, double mount_yaw)
+                       double mount_pitch, double mount_yaw, double sensor_delay)
 {
+    b->delay = sensor_delay;
     static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
     b->max_dt = max_dt;
     b->max_rate = max_rate;
@@ -404,6 +414,16 @@ int fc_base_can_init(const double acc[3])
     return norm2 >= MIN_INIT_NORM * MIN_INIT_NORM;
 }
 
+fc_estimate fc_base_output(const fc_base *b, fc_estimate e)
+{
+    if (b->delay > 0.0 && b->initialized) {
+        const double *g = b->gyro_prev;
+        fc_roll_pitch_ahead(e.roll, e.pitch, g[0] - e.bias[0], g[1] - e.bias[1], g[2] - e.bias[2],
+                            b->delay, &e.roll, &e.pitch);
+    }
+    return e;
+}
+
 fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
                   const double acc[3], const double gyro[3], double dt, fc_estimate *out)
 {
@@ -423,8 +443,8 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
         }
         return FC_SKIPPED;
     }
-    *last = ops->estimate(self);
     memcpy(base->gyro_prev, g, sizeof g);
+    *last = fc_base_output(base, ops->estimate(self));
     base->n_samples += 1;
     if (out) {
         *out = *last;

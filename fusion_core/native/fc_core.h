@@ -47,6 +47,7 @@ typedef struct fc_base {
     double max_dt, max_rate, max_rate2;
     double mounting[9];
     int mounted;
+    double delay;  /* sensor_delay [s] */
 } fc_base;
 
 /* ----- kinematics.py ----------------------------------------------------------------------- */
@@ -63,6 +64,8 @@ void fc_quat_gravity_body(const double q[4], double g[3]);
 void fc_rotvec_terms(double vx, double vy, double vz, double t[4]);
 void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz);
 void fc_quat_mul_rotvec_terms(double q[4], double vx, double vy, double vz, const double t[4]);
+void fc_roll_pitch_ahead(double roll, double pitch, double wx, double wy, double wz,
+                         double delay, double *roll_out, double *pitch_out);
 void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
                            double dt, double phi[3]);
 void fc_rotate_back(const double v[3], const double phi[3], double out[3]);
@@ -95,12 +98,15 @@ void fc_mat_t_vec(const double m[9], const double v[3], double out[3]);
 /* ----- base.py ----------------------------------------------------------------------------- */
 void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9]);
 void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
-                       double mount_pitch, double mount_yaw);
+                       double mount_pitch, double mount_yaw, double sensor_delay);
 void fc_base_reset(fc_base *b);
 /* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
  * was), turns it into the filter frame (mounting) and takes an absurd accelerometer reading as
  * none. Returns FC_OK with acc and gyro rewritten in place, or the rejection. */
 fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], double dt);
+/* Estimator.output: e as the outputs give it, its roll and pitch turned ahead over sensor_delay
+ * with the last sample's rate minus e's bias (fc_roll_pitch_ahead) once initialised. */
+fc_estimate fc_base_output(const fc_base *b, fc_estimate e);
 /* Whether a prepared sample may initialise the filter (its accelerometer norm >= 0.1 g). */
 int fc_base_can_init(const double acc[3]);
 

@@ -38,7 +38,7 @@ void fc_mgcf_configure(fc_mgcf *f)
 {
     const fc_mgcf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw);
+                      p->mount_yaw, p->sensor_delay);
     f->table = p->schedule == FC_MGCF_SCHEDULE_SIMULATION ? SIMULATION
         : p->schedule == FC_MGCF_SCHEDULE_EXPERIMENTAL ? EXPERIMENTAL : NULL;
     f->table_rows = f->table ? 3 : 0;

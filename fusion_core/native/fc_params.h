@@ -18,20 +18,21 @@
 #define FC_CF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_cf_params {
-    double tau;          /* (0.0, inf) [s] */
-    double gate_low;     /* (0.0, 1.0] */
-    double gate_high;    /* [1.0, inf) */
-    double acc_lowpass;  /* [0.0, inf) [s] */
-    double rest_time;    /* [0.0, inf) [s] */
-    double rest_gyro;    /* (0.0, inf) [rad/s] */
-    double rest_acc;     /* (0.0, inf) [m/s2] */
-    int propagation;     /* one of 'euler', 'quaternion' */
-    int gyro_sampling;   /* one of 'point', 'mean' */
-    double max_dt;       /* (0.0, inf) [s] */
-    double max_rate;     /* (0.0, inf) [rad/s] */
-    double mount_roll;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;  /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double tau;           /* (0.0, inf) [s] */
+    double gate_low;      /* (0.0, 1.0] */
+    double gate_high;     /* [1.0, inf) */
+    double acc_lowpass;   /* [0.0, inf) [s] */
+    double rest_time;     /* [0.0, inf) [s] */
+    double rest_gyro;     /* (0.0, inf) [rad/s] */
+    double rest_acc;      /* (0.0, inf) [m/s2] */
+    int propagation;      /* one of 'euler', 'quaternion' */
+    int gyro_sampling;    /* one of 'point', 'mean' */
+    double max_dt;        /* (0.0, inf) [s] */
+    double max_rate;      /* (0.0, inf) [rad/s] */
+    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_cf_params;
 
 /* The defaults: ComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
@@ -51,6 +52,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
 }
 
 /* ----- GainScheduledComplementaryFilter (mgcf) ------------------------------ */
@@ -62,19 +64,20 @@ static inline void fc_cf_params_default(fc_cf_params *p)
 #define FC_MGCF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_mgcf_params {
-    int schedule;        /* one of 'simulation', 'experimental', 'fixed' */
-    double w0;           /* [0.0, inf) [rad/s] */
-    double zeta;         /* [0.0, inf) */
-    double acc_lowpass;  /* [0.0, inf) [s] */
-    double rest_time;    /* [0.0, inf) [s] */
-    double rest_gyro;    /* (0.0, inf) [rad/s] */
-    double rest_acc;     /* (0.0, inf) [m/s2] */
-    int gyro_sampling;   /* one of 'point', 'mean' */
-    double max_dt;       /* (0.0, inf) [s] */
-    double max_rate;     /* (0.0, inf) [rad/s] */
-    double mount_roll;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;  /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    int schedule;         /* one of 'simulation', 'experimental', 'fixed' */
+    double w0;            /* [0.0, inf) [rad/s] */
+    double zeta;          /* [0.0, inf) */
+    double acc_lowpass;   /* [0.0, inf) [s] */
+    double rest_time;     /* [0.0, inf) [s] */
+    double rest_gyro;     /* (0.0, inf) [rad/s] */
+    double rest_acc;      /* (0.0, inf) [m/s2] */
+    int gyro_sampling;    /* one of 'point', 'mean' */
+    double max_dt;        /* (0.0, inf) [s] */
+    double max_rate;      /* (0.0, inf) [rad/s] */
+    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_mgcf_params;
 
 /* The defaults: GainScheduledComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
@@ -93,6 +96,7 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
 }
 
 /* ----- AngleBiasKalmanFilter (kf) ------------------------------------------- */
@@ -127,6 +131,7 @@ typedef struct fc_kf_params {
     double mount_roll;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;      /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;     /* [0.0, 0.1] [s] */
 } fc_kf_params;
 
 /* The defaults: AngleBiasKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -154,6 +159,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
 }
 
 /* ----- UnscentedKalmanFilter (ukf) ------------------------------------------ */
@@ -184,6 +190,7 @@ typedef struct fc_ukf_params {
     double mount_roll;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;      /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;     /* [0.0, 0.1] [s] */
 } fc_ukf_params;
 
 /* The defaults: UnscentedKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -211,6 +218,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
 }
 
 /* ----- PositionKalmanFilter (poskf) ----------------------------------------- */
@@ -253,6 +261,7 @@ typedef struct fc_poskf_params {
     double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_poskf_params;
 
 /* The defaults: PositionKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -285,6 +294,7 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
 }
 
 /* ----- ImuSensorModel (sensor) ---------------------------------------------- */

@@ -312,7 +312,7 @@ void fc_ukf_configure(fc_ukf *f)
 {
     const fc_ukf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw);
+                      p->mount_yaw, p->sensor_delay);
     double alpha2 = pow(p->alpha, 2.0);
     double lam = alpha2 * (N_STATE + p->kappa) - N_STATE;
     f->gamma = sqrt(N_STATE + lam);

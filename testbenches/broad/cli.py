@@ -39,7 +39,8 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "papers' values), a JSON file of parameters per estimator, all (both named "
                    "ones), or a comma list (recommended)")
     p.add_argument("--peers", action="store_true",
-                   help="also run VQF (6D), Madgwick and Mahony (ahrs) on the same trials")
+                   help="also run VQF (6D), Madgwick and Mahony (ahrs) on the same trials, and VQF "
+                   "with its output turned ahead over the sensor's delay as ours (vqf-ahead)")
     p.add_argument("--fmu", action="store_true",
                    help="run the estimators as the built FMUs through fmpy instead of fusion_core")
     p.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR,
@@ -54,7 +55,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--no-plot", action="store_true", help="skip the bar chart")
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
-                   "cross-axis and bias errors, testbenches.broad.gyro): a table and "
+                   "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
                    "DIR/gyro_fit.json")
     return p
 
@@ -67,14 +68,14 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from fusion_core import ESTIMATORS
     from fusion_core.presets import PRESETS
 
-    from ..peers import PEERS, PeerUnavailable, check_peers
+    from ..peers import AHEAD_PEERS, PEERS, PeerUnavailable, check_peers
     from .data import load_trial
     from .report import table, write_reports
     from .run import collect_paths, evaluate, plan_columns
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
     presets = list(PRESETS) if args.preset == "all" else [p for p in args.preset.split(",") if p]
-    peers = list(PEERS) if args.peers else []
+    peers = [*PEERS, *AHEAD_PEERS] if args.peers else []
     try:
         check_peers(peers)
     except PeerUnavailable as err:
@@ -112,18 +113,18 @@ def gyro_fit_table(trials: list[BroadTrial], result: BroadResult, out: Path) -> 
 
     import numpy as np
 
-    from .gyro import fit_gyro, scale_oracle
+    from .gyro import fit_delay, fit_gyro, scale_oracle
 
     rows, fits = [], {}
     head = (f"{'trial':44s} {'scale error x/y/z %':>22s} {'max cross %':>11s} "
-            f"{'bias x/y/z deg/s':>22s} {'windows':>7s} {'resid deg':>9s}")
+            f"{'bias x/y/z deg/s':>22s} {'windows':>7s} {'resid deg':>9s} {'lag ms':>6s}")
     for trial, evaluated in zip(trials, result.trials, strict=True):
         try:
             fit = fit_gyro(trial)
         except ValueError as err:
             rows.append(f"{trial.name[:44]:44s} {err}")
             continue
-        d = fit.as_dict()
+        d = {**fit.as_dict(), **fit_delay(trial).as_dict()}
         d["rmse_deg"] = evaluated.rmse_deg
         d["rmse_scale_removed_deg"] = scale_oracle(trial, fit, result.columns,
                                                    evaluated.groups).rmse_deg
@@ -131,10 +132,12 @@ def gyro_fit_table(trials: list[BroadTrial], result: BroadResult, out: Path) -> 
         scale = "/".join(f"{v:+.2f}" for v in d["scale_error_pct"])
         bias = "/".join(f"{v:+.3f}" for v in d["bias_dps"])
         rows.append(f"{trial.name[:44]:44s} {scale:>22s} {d['max_abs_cross_axis_pct']:11.2f} "
-                    f"{bias:>22s} {d['windows']:7d} {d['residual_deg']:9.3f}")
+                    f"{bias:>22s} {d['windows']:7d} {d['residual_deg']:9.3f} "
+                    f"{d['delay_ms']:6.2f}")
     out.mkdir(parents=True, exist_ok=True)
     (out / "gyro_fit.json").write_text(json.dumps(fits, indent=1))
-    lines = ["gyro against the reference (integral(gyro) = M dphi + b T):", head,
+    lines = ["gyro against the reference (integral(gyro) = M dphi + b T; lag: how late the "
+             "gyro shows the reference's rotation, gyro.fit_delay):", head,
              "-" * len(head), *rows]
     if fits:
         lines.append(f"\nmean inclination RMSE over the {len(fits)} fitted trials, as evaluated "

@@ -80,34 +80,116 @@ def _rotvec_between(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
     return np.asarray((rot(qa).inv() * rot(qb)).as_rotvec())
 
 
-def fit_gyro(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = MIN_TURN
-             ) -> GyroFit:
-    """Fit the trial's gyro against its reference orientation (see the module docstring).
+def _reference_windows(trial: BroadTrial, w: int, margin: int
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Start and end samples a, b = a + w of every window with a reference at both ends, at least
+    margin samples from either end of the trial, and the reference's rotation over each."""
+    q = trial.opt_quat
+    ok = np.all(np.isfinite(q), axis=1)
+    a = np.arange(margin, trial.n - w - margin)
+    a = a[ok[a] & ok[a + w]]
+    b = a + w
+    return a, b, _rotvec_between(q[a], q[b])
+
+
+def _gyro_cumulative(trial: BroadTrial) -> np.ndarray:
+    """The gyro's integral [N, 3] from the first sample's instant to each sample's [rad], by the
+    rule its sampling property gives: a mean sample k holds the interval (t_k-1, t_k] (the first
+    one's interval lies before the recording and is left out), point samples are joined by the
+    trapezoid rule."""
+    g = trial.gyro
+    steps = g[1:] if trial.gyro_sampling == "mean" else 0.5 * (g[1:] + g[:-1])
+    return np.vstack([np.zeros(3), np.cumsum(steps, axis=0)]) * trial.dt
+
+
+def _window_integrals(trial: BroadTrial, cum: np.ndarray, a: np.ndarray, b: np.ndarray,
+                      shift: float) -> np.ndarray:
+    """The gyro's integral [K, 3] over (t_a + shift h, t_b + shift h] from its cumulative
+    integral cum (_gyro_cumulative), linear between samples (exact for mean samples, whose rate
+    is constant over each interval)."""
+    if shift == 0.0:
+        return cum[b] - cum[a]
+    index = np.arange(trial.n, dtype=float)
+    return np.column_stack([np.interp(b + shift, index, cum[:, k]) -
+                            np.interp(a + shift, index, cum[:, k]) for k in range(3)])
+
+
+def fit_gyro(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = MIN_TURN,
+             delay: float | None = None) -> GyroFit:
+    """Fit the trial's gyro against its reference orientation (see the module docstring), the
+    gyro's windows taken delay [s] later than the reference's (default: the trial's
+    sensor_delay; fit_delay measures it), so that its lag is not read as scale errors.
     ValueError when fewer than 100 windows turn by min_turn (nothing to fit: a recording at rest
     measures the bias only)."""
     w = max(1, round(window_s * trial.rate))
-    q = trial.opt_quat
-    ok = np.all(np.isfinite(q), axis=1)
-    a = np.arange(trial.n - w)
-    a = a[ok[a] & ok[a + w]]
-    b = a + w
-    dphi = _rotvec_between(q[a], q[b])
-    # the gyro's integral over (t_a, t_b]: mean samples a+1..b, or the trapezoid of point samples
-    c = np.vstack([np.zeros(3), np.cumsum(trial.gyro, axis=0)]) * trial.dt
-    if trial.gyro_sampling == "mean":
-        g_int = c[b + 1] - c[a + 1]
-    else:
-        g_int = c[b + 1] - c[a + 1] - 0.5 * trial.dt * (trial.gyro[b] - trial.gyro[a])
+    shift = (trial.sensor_delay if delay is None else delay) / trial.dt
+    a, b, dphi = _reference_windows(trial, w, margin=int(np.ceil(abs(shift))) + 1)
     turning = np.linalg.norm(dphi, axis=1) >= min_turn
     if int(turning.sum()) < 100:
         raise ValueError(f"{trial.name}: {int(turning.sum())} windows of {w} samples turn by "
                          f"{np.degrees(min_turn):.1f} deg or more; at least 100 are needed to fit "
                          "the gyro's scale and cross-axis errors")
-    x = np.column_stack([dphi[turning], np.full(int(turning.sum()), w * trial.dt)])
-    sol, *_ = np.linalg.lstsq(x, g_int[turning], rcond=None)
-    residual = g_int[turning] - x @ sol
-    return GyroFit(matrix=sol[:3].T.copy(), bias=sol[3].copy(), windows=int(turning.sum()),
+    a, b = a[turning], b[turning]
+    g_int = _window_integrals(trial, _gyro_cumulative(trial), a, b, shift)
+    x = np.column_stack([dphi[turning], np.full(a.size, w * trial.dt)])
+    sol, *_ = np.linalg.lstsq(x, g_int, rcond=None)
+    residual = g_int - x @ sol
+    return GyroFit(matrix=sol[:3].T.copy(), bias=sol[3].copy(), windows=int(a.size),
                    residual=float(np.sqrt(np.mean(residual**2))))
+
+
+@dataclass(frozen=True)
+class GyroDelay:
+    """How far the gyro's samples lag the reference orientation in one recording."""
+
+    samples: float
+    """The lag in sample periods (positive: the gyro shows a rotation later than the reference)."""
+    seconds: float
+    """The same lag [s]."""
+    shifts: np.ndarray
+    """The shifts tried [samples]."""
+    residuals: np.ndarray
+    """The fit's RMS residual per window [rad] at each shift."""
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"delay_samples": float(self.samples), "delay_ms": float(1e3 * self.seconds),
+                "residual_deg_at_delay": float(np.degrees(np.min(self.residuals))),
+                "residual_deg_at_zero": float(np.degrees(np.interp(0.0, self.shifts,
+                                                                   self.residuals)))}
+
+
+def fit_delay(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = MIN_TURN,
+              max_shift: float = 2.0, step: float = 0.25) -> GyroDelay:
+    """The gyro's lag behind the reference: the shift s [samples] of the gyro's integration
+    window, (t_a + s h, t_b + s h] against the reference's (t_a, t_b], at which the fit of
+    fit_gyro leaves the least residual (_window_integrals); shifts from -max_shift to max_shift
+    in steps of step, the minimum refined by the parabola through it and its neighbours. The
+    lag is the sensor's: its internal low-pass filters' group delay and the time-stamping of its
+    samples against the reference, which an estimator's output shares (sensor_delay turns the
+    output ahead over it)."""
+    w = max(1, round(window_s * trial.rate))
+    margin = int(np.ceil(max_shift)) + 1
+    a, b, dphi = _reference_windows(trial, w, margin)
+    turning = np.linalg.norm(dphi, axis=1) >= min_turn
+    if int(turning.sum()) < 100:
+        raise ValueError(f"{trial.name}: {int(turning.sum())} windows of {w} samples turn by "
+                         f"{np.degrees(min_turn):.1f} deg or more; at least 100 are needed to fit "
+                         "the gyro's delay")
+    a, b = a[turning], b[turning]
+    x = np.column_stack([dphi[turning], np.full(a.size, w * trial.dt)])
+    cum = _gyro_cumulative(trial)
+    shifts = np.arange(-max_shift, max_shift + 0.5 * step, step)
+    residuals = np.empty(shifts.size)
+    for i, s in enumerate(shifts):
+        g_int = _window_integrals(trial, cum, a, b, float(s))
+        sol, *_ = np.linalg.lstsq(x, g_int, rcond=None)
+        residuals[i] = np.sqrt(np.mean((g_int - x @ sol) ** 2))
+    i = int(np.argmin(residuals))
+    best = float(shifts[i])
+    if 0 < i < shifts.size - 1:
+        y0, y1, y2 = residuals[i - 1:i + 2]
+        best += step * 0.5 * (y0 - y2) / (y0 - 2.0 * y1 + y2)
+    return GyroDelay(samples=best, seconds=best * trial.dt, shifts=shifts, residuals=residuals)
 
 
 def scale_oracle(trial: BroadTrial, fit: GyroFit, columns: list[Column], groups: list[str]

@@ -8,7 +8,10 @@
   dt = 1/sampling_rate, either in fusion_core (`Estimator.run`) or, with `fmu=True`, through the
   built FMUs in fmpy, one doStep per sample (the same numbers: the FMUs are bit-identical to
   fusion_core);
-- with peers, VQF, Madgwick and Mahony run on the same samples (`peers`);
+- the trial's sensor properties (gyro_sampling, sensor_delay) are the estimators' unless the
+  preset sets them;
+- with peers, VQF, Madgwick and Mahony run on the same samples (`peers`), and VQF turned ahead
+  over the trial's sensor delay as our outputs are (`vqf-ahead`);
 - every run is scored by BROAD's inclination RMSE over the `movement` samples
   (`metric`), and the per-trial numbers are averaged over the given trials and over
   BROAD's groups (trials.json beside the files, or the groups in the trial names).
@@ -31,7 +34,7 @@ from fusion_core import ESTIMATORS
 from fusion_core.presets import load_preset
 
 from ..fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, FmuHandle, fmu_path
-from ..peers import PEERS
+from ..peers import AHEAD_PEERS, PEERS
 from .data import (
     GROUP_ORDER,
     BroadTrial,
@@ -128,9 +131,10 @@ def plan_columns(
     if bad:
         raise ValueError(f"unknown estimator(s) {', '.join(bad)}: allowed {', '.join(ESTIMATORS)}")
     loaded = {p: load_preset(p) for p in presets}  # ValueError for an unknown one
-    bad = [p for p in peers if p not in PEERS]
+    allowed = [*PEERS, *AHEAD_PEERS]
+    bad = [p for p in peers if p not in allowed]
     if bad:
-        raise ValueError(f"unknown peer(s) {', '.join(bad)}: allowed {', '.join(PEERS)}")
+        raise ValueError(f"unknown peer(s) {', '.join(bad)}: allowed {', '.join(allowed)}")
     cols = [
         Column(column_name(k, p), "fmu" if fmu else "fusion_core", k, p, loaded[p][k])
         for k in estimators for p in presets
@@ -150,15 +154,17 @@ def collect_paths(paths: Iterable[str | Path]) -> list[Path]:
 
 
 # ----- running one column on one trial ------------------------------------------------------------
-def with_sampling(params: dict[str, Any], trial: BroadTrial) -> dict[str, Any]:
-    """params with the trial's gyro_sampling unless they set one themselves."""
-    return {"gyro_sampling": trial.gyro_sampling, **params}
+def with_sensor(params: dict[str, Any], trial: BroadTrial) -> dict[str, Any]:
+    """params with the properties of the trial's sensor (gyro_sampling, sensor_delay) unless
+    they set them themselves."""
+    return {"gyro_sampling": trial.gyro_sampling, "sensor_delay": trial.sensor_delay, **params}
 
 
 def run_fusion_core(key: str, params: dict[str, Any], trial: BroadTrial) -> dict[str, np.ndarray]:
     """roll, pitch [N] (and rejected) of fusion_core's estimator on the trial (integrating the
-    gyro by the trial's sampling property unless params say otherwise)."""
-    return ESTIMATORS[key](**with_sampling(params, trial)).run(trial.acc, trial.gyro, trial.dt)
+    gyro by the trial's sampling property and turning its outputs ahead over the sensor's delay
+    unless params say otherwise)."""
+    return ESTIMATORS[key](**with_sensor(params, trial)).run(trial.acc, trial.gyro, trial.dt)
 
 
 def run_fmu(
@@ -167,7 +173,7 @@ def run_fmu(
     """roll, pitch [N] (and rejected) of the estimator's FMU on the trial, in fmpy: one
     set-inputs / doStep / get-outputs per sample, communication step = dt (docs/interface.md)."""
     path = fmu_path(ESTIMATOR_FMUS[key], fmu_dir)
-    params = with_sampling(params, trial)
+    params = with_sensor(params, trial)
     fmu = FmuHandle(path, f"broad-{key}-{time.perf_counter_ns()}")
     n, h = trial.n, trial.dt
     out = np.empty((n, 2))
@@ -196,6 +202,8 @@ def column_gravity(
     col: Column, trial: BroadTrial, fmu_dir: Path | str = DEFAULT_FMU_DIR
 ) -> tuple[np.ndarray, int]:
     """The column's estimated up direction [N, 3] on the trial, and its rejected-sample count."""
+    if col.kind == "peer" and col.key in AHEAD_PEERS:
+        return AHEAD_PEERS[col.key](trial.acc, trial.gyro, trial.rate, trial.sensor_delay), 0
     if col.kind == "peer":
         return PEERS[col.key](trial.acc, trial.gyro, trial.rate), 0
     if col.kind == "fmu":

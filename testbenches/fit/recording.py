@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -40,6 +41,13 @@ class Recording:
     gyro_sampling: str = "point"
     up_ref: np.ndarray | None = None
     counts: np.ndarray | None = None
+    sensor_delay: float = 0.0
+    """How long the samples lag the reference [s] (the estimators' sensor_delay; 0 for a CSV)."""
+
+    @property
+    def sensor(self) -> dict[str, Any]:
+        """The estimators' parameters that describe the recording's sensor."""
+        return {"gyro_sampling": self.gyro_sampling, "sensor_delay": self.sensor_delay}
 
     @property
     def counted(self) -> np.ndarray:
@@ -55,7 +63,7 @@ class Recording:
             self.name, self.acc[start:stop], self.gyro[start:stop], self.dt[start:stop],
             self.rate, self.gyro_sampling,
             None if self.up_ref is None else self.up_ref[start:stop],
-            None if self.counts is None else self.counts[start:stop],
+            None if self.counts is None else self.counts[start:stop], self.sensor_delay,
         )
 
 
@@ -70,7 +78,8 @@ def load(path: str | Path, rate: float | None = None) -> Recording:
         return _load_csv(path, rate)
     up = gravity_from_quat(trial.opt_quat)
     return Recording(trial.name, trial.acc, trial.gyro, np.full(trial.n, trial.dt), trial.rate,
-                     trial.gyro_sampling, up, trial.movement & np.all(np.isfinite(up), axis=1))
+                     trial.gyro_sampling, up, trial.movement & np.all(np.isfinite(up), axis=1),
+                     trial.sensor_delay)
 
 
 def _load_csv(path: Path, rate: float | None) -> Recording:

@@ -129,7 +129,7 @@ def score(key: str, params: dict[str, Any], rec: Recording) -> float:
     if rec.up_ref is None:
         raise RecordingError(f"{rec.name}: no reference (q_w, q_x, q_y, q_z or roll, pitch "
                              "columns, or a BROAD trial): tune cannot score it")
-    est = ESTIMATORS[key](**{"gyro_sampling": rec.gyro_sampling, **params})
+    est = ESTIMATORS[key](**{**rec.sensor, **params})
     out = est.run(rec.acc, rec.gyro, rec.dt)
     g = gravity_from_roll_pitch(out["roll"], out["pitch"])
     return inclination_rmse_deg(g, rec.up_ref, rec.counted)
@@ -237,7 +237,7 @@ def fmu_score(key: str, params: dict[str, Any], recs: Sequence[Recording],
         fmu = FmuHandle(fmu_path(ESTIMATOR_FMUS[key], fmu_dir), f"tune-{key}-{rec.name}")
         out = np.empty((len(rec.dt), 2))
         try:
-            fmu.start({"gyro_sampling": rec.gyro_sampling, **params}, float(np.sum(rec.dt)))
+            fmu.start({**rec.sensor, **params}, float(np.sum(rec.dt)))
             in_vr = fmu.vrs(("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt"))
             out_vr = fmu.vrs(("roll", "pitch"))
             t = 0.0
