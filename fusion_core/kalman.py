@@ -180,7 +180,7 @@ class AngleBiasKalmanFilter(Estimator):
     within 5 % of g (bias_gate, building_blocks.BIAS_GATE_PARAM: Duong Quoc et al.'s real-sensor
     cutoff) and while both innovations are within 10 deg (bias_innovation,
     building_blocks.BIAS_INNOVATION: a larger one is a gross attitude error, not a bias drift).
-    Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 1.16 / 0.95 / 0.94 deg):
+    Q_bias, from a coarse scan on BROAD (1e-6 / 1e-8 / 1e-10 deg^2/s^3: 0.73 / 0.62 / 0.62 deg):
     the accelerometer's error after the pre-filter is coloured (residual linear acceleration),
     so a bias random walk sized from the gyro's real drift (3e-6 deg^2/s^3) lets it steer the
     bias in motion with a time constant of seconds; 1e-8 leaves the bias to the rest updates.

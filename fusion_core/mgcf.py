@@ -89,7 +89,7 @@ class GainScheduledComplementaryFilter(Estimator):
     Ki = w0^2 = 4e-4 s^-2 instead of 0.01: the bias comes from the rest updates, and an integral
     with a 10 s time constant turns every systematic accelerometer error in motion into bias
     (BROAD trial 32: the integral wandered to 0.85 deg/s and back); w0 from a coarse scan on
-    BROAD at Kp = 0.4 (0.1 / 0.05 / 0.02 / 0.01: 0.95 / 0.90 / 0.90 / 0.90 deg), the plateau's
+    BROAD at Kp = 0.4 (0.1 / 0.05 / 0.02 / 0.01: 0.65 / 0.58 / 0.57 / 0.57 deg), the plateau's
     middle. "fixed", not a table: with the pre-filter the linear acceleration is gone before rho
     is taken, and the paper's bands for a calibrated sensor cut the gain of a real one (|a| at
     rest 1.001-1.010 g on BROAD's). The paper's values are presets.PAPER_MGCF.
