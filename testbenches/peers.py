@@ -33,6 +33,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 
@@ -57,13 +58,17 @@ def _import(module: str, what: str) -> ModuleType:
         ) from None
 
 
+def _vqf_batch(acc: np.ndarray, gyro: np.ndarray, rate: float, what: str) -> dict[str, Any]:
+    """VQF's updateBatch with the package's defaults on the recording (quat6D, bias, ...)."""
+    vqf = _import("vqf", what)
+    f = vqf.VQF(1.0 / rate)
+    return dict(f.updateBatch(np.ascontiguousarray(gyro, dtype=float),
+                              np.ascontiguousarray(acc, dtype=float)))
+
+
 def run_vqf(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
     """VQF 6D with the package's defaults: up direction [N, 3]."""
-    vqf = _import("vqf", "the VQF peer")
-    f = vqf.VQF(1.0 / rate)
-    out = f.updateBatch(np.ascontiguousarray(gyro, dtype=float),
-                        np.ascontiguousarray(acc, dtype=float))
-    return gravity_from_quat(out["quat6D"])
+    return gravity_from_quat(_vqf_batch(acc, gyro, rate, "the VQF peer")["quat6D"])
 
 
 def up_ahead(up: np.ndarray, rate: np.ndarray, delay: float) -> np.ndarray:
@@ -77,10 +82,7 @@ def up_ahead(up: np.ndarray, rate: np.ndarray, delay: float) -> np.ndarray:
 def run_vqf_ahead(acc: np.ndarray, gyro: np.ndarray, rate: float, delay: float) -> np.ndarray:
     """VQF 6D as run_vqf, its up direction turned ahead over the sensor's delay [s] by the gyro
     minus VQF's bias estimate (up_ahead): up direction [N, 3]."""
-    vqf = _import("vqf", "the vqf-ahead peer")
-    f = vqf.VQF(1.0 / rate)
-    out = f.updateBatch(np.ascontiguousarray(gyro, dtype=float),
-                        np.ascontiguousarray(acc, dtype=float))
+    out = _vqf_batch(acc, gyro, rate, "the vqf-ahead peer")
     return up_ahead(gravity_from_quat(out["quat6D"]), gyro - out["bias"], delay)
 
 

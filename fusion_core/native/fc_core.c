@@ -355,10 +355,10 @@ void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9])
 void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
                        double mount_pitch, double mount_yaw, double sensor_delay)
 {
-    b->delay = sensor_delay;
     static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
     b->max_dt = max_dt;
     b->max_rate = max_rate;
+    b->delay = sensor_delay;
     b->max_rate2 = pow(max_rate, 2.0);
     fc_mounting_matrix(mount_roll, mount_pitch, mount_yaw, b->mounting);
     b->mounted = 0;

@@ -80,16 +80,26 @@ def _rotvec_between(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
     return np.asarray((rot(qa).inv() * rot(qb)).as_rotvec())
 
 
-def _reference_windows(trial: BroadTrial, w: int, margin: int
-                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Start and end samples a, b = a + w of every window with a reference at both ends, at least
-    margin samples from either end of the trial, and the reference's rotation over each."""
+def _turning_windows(trial: BroadTrial, window_s: float, min_turn: float, margin: int,
+                     fitted: str) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """The window length w [samples], and the start and end samples a, b = a + w and the
+    reference's rotation dphi of every window that has a reference at both ends, lies at least
+    margin samples from either end of the trial and turns by min_turn or more. ValueError,
+    naming what was to be fitted, when fewer than 100 windows turn (a recording at rest measures
+    the bias only)."""
+    w = max(1, round(window_s * trial.rate))
     q = trial.opt_quat
     ok = np.all(np.isfinite(q), axis=1)
     a = np.arange(margin, trial.n - w - margin)
     a = a[ok[a] & ok[a + w]]
-    b = a + w
-    return a, b, _rotvec_between(q[a], q[b])
+    dphi = _rotvec_between(q[a], q[a + w])
+    turning = np.linalg.norm(dphi, axis=1) >= min_turn
+    if int(turning.sum()) < 100:
+        raise ValueError(f"{trial.name}: {int(turning.sum())} windows of {w} samples turn by "
+                         f"{np.degrees(min_turn):.1f} deg or more; at least 100 are needed to fit "
+                         f"{fitted}")
+    a = a[turning]
+    return w, a, a + w, dphi[turning]
 
 
 def _gyro_cumulative(trial: BroadTrial) -> np.ndarray:
@@ -121,17 +131,11 @@ def fit_gyro(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = MI
     sensor_delay; fit_delay measures it), so that its lag is not read as scale errors.
     ValueError when fewer than 100 windows turn by min_turn (nothing to fit: a recording at rest
     measures the bias only)."""
-    w = max(1, round(window_s * trial.rate))
     shift = (trial.sensor_delay if delay is None else delay) / trial.dt
-    a, b, dphi = _reference_windows(trial, w, margin=int(np.ceil(abs(shift))) + 1)
-    turning = np.linalg.norm(dphi, axis=1) >= min_turn
-    if int(turning.sum()) < 100:
-        raise ValueError(f"{trial.name}: {int(turning.sum())} windows of {w} samples turn by "
-                         f"{np.degrees(min_turn):.1f} deg or more; at least 100 are needed to fit "
-                         "the gyro's scale and cross-axis errors")
-    a, b = a[turning], b[turning]
+    w, a, b, dphi = _turning_windows(trial, window_s, min_turn, int(np.ceil(abs(shift))) + 1,
+                                     "the gyro's scale and cross-axis errors")
     g_int = _window_integrals(trial, _gyro_cumulative(trial), a, b, shift)
-    x = np.column_stack([dphi[turning], np.full(a.size, w * trial.dt)])
+    x = np.column_stack([dphi, np.full(a.size, w * trial.dt)])
     sol, *_ = np.linalg.lstsq(x, g_int, rcond=None)
     residual = g_int - x @ sol
     return GyroFit(matrix=sol[:3].T.copy(), bias=sol[3].copy(), windows=int(a.size),
@@ -167,16 +171,9 @@ def fit_delay(trial: BroadTrial, window_s: float = WINDOW_S, min_turn: float = M
     lag is the sensor's: its internal low-pass filters' group delay and the time-stamping of its
     samples against the reference, which an estimator's output shares (sensor_delay turns the
     output ahead over it)."""
-    w = max(1, round(window_s * trial.rate))
-    margin = int(np.ceil(max_shift)) + 1
-    a, b, dphi = _reference_windows(trial, w, margin)
-    turning = np.linalg.norm(dphi, axis=1) >= min_turn
-    if int(turning.sum()) < 100:
-        raise ValueError(f"{trial.name}: {int(turning.sum())} windows of {w} samples turn by "
-                         f"{np.degrees(min_turn):.1f} deg or more; at least 100 are needed to fit "
-                         "the gyro's delay")
-    a, b = a[turning], b[turning]
-    x = np.column_stack([dphi[turning], np.full(a.size, w * trial.dt)])
+    w, a, b, dphi = _turning_windows(trial, window_s, min_turn, int(np.ceil(max_shift)) + 1,
+                                     "the gyro's delay")
+    x = np.column_stack([dphi, np.full(a.size, w * trial.dt)])
     cum = _gyro_cumulative(trial)
     shifts = np.arange(-max_shift, max_shift + 0.5 * step, step)
     residuals = np.empty(shifts.size)
