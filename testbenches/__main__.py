@@ -10,6 +10,8 @@
               on others (testbenches.fit).
   campaign    a Monte Carlo campaign of seeded runs on Dask, resumable, with percentiles and
               confidence intervals (testbenches.montecarlo).
+  budget      the sensor's error budget: each scenario's RMSE with one group of the IMU's
+              errors switched off at a time (testbenches.budget).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Any
 from fusion_core.scenarios import SCENARIOS
 
 from .broad.cli import add_broad_parser
+from .budget import add_budget_parser
 from .fit.cli import add_fit_parsers
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .montecarlo.cli import add_campaign_parser
@@ -157,6 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     add_broad_parser(sub)
     add_fit_parsers(sub)
     add_campaign_parser(sub)
+    add_budget_parser(sub)
     args = parser.parse_args(argv)
     try:
         if args.command == "run":
@@ -182,6 +186,10 @@ def main(argv: list[str] | None = None) -> int:
             from .montecarlo.cli import cmd_campaign
 
             return cmd_campaign(args)
+        if args.command == "budget":
+            from .budget import cmd_budget
+
+            return cmd_budget(args)
     except (ValueError, FileNotFoundError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
