@@ -45,6 +45,9 @@ SOURCES: dict[str, tuple[str, dict[str, Any]]] = {
 MOTION_ONLY = {k: v for _, off in SOURCES.values() for k, v in off.items()}
 """Every source off: perfect samples of the motion (saturation and the sampling rule stay)."""
 
+VARIANTS = {"full": {}, **{n: off for n, (_, off) in SOURCES.items()}, "motion only": MOTION_ONLY}
+"""The sensor variants of one budget row, by name: the changes to the full sensor."""
+
 
 @dataclass
 class BudgetRow:
@@ -57,12 +60,13 @@ class BudgetRow:
     without: dict[str, tuple[float, float]]
     motion_only: tuple[float, float]
 
+    def worst(self, rmse: tuple[float, float]) -> float:
+        """A roll/pitch RMSE pair as the worse axis's fraction of its limit."""
+        return max(rmse[0] / self.limit[0], rmse[1] / self.limit[1])
+
     def dominant(self) -> str:
         """The source whose removal lowers the worse axis (relative to its limit) the most."""
-        def worst(v: tuple[float, float]) -> float:
-            return max(v[0] / self.limit[0], v[1] / self.limit[1])
-
-        return min(self.without, key=lambda s: worst(self.without[s]))
+        return min(self.without, key=lambda s: self.worst(self.without[s]))
 
 
 def _rmse(estimator: str, scenario: str, seeds: int, sensor: dict[str, Any],
@@ -88,10 +92,8 @@ def error_budget(estimators: list[str], scenarios: list[str], seeds: int,
     for scenario in scenarios:
         for est in estimators:
             params = dict(preset.get(est, {}))
-            variants = {"full": {}, **{n: off for n, (_, off) in SOURCES.items()},
-                        "motion only": MOTION_ONLY}
             rmse = {}
-            for name, off in variants.items():
+            for name, off in VARIANTS.items():
                 rmse[name] = _rmse(est, scenario, seeds, {**sensor, **off}, params)
                 if progress:
                     progress()
@@ -143,12 +145,8 @@ def _plot(rows: list[BudgetRow], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     labels = ["full", *(f"-{n}" for n in SOURCES), "motion only"]
-
-    def ratio(r: BudgetRow, v: tuple[float, float]) -> float:
-        return max(v[0] / r.limit[0], v[1] / r.limit[1])
-
-    data = np.array([[ratio(r, r.full), *(ratio(r, r.without[n]) for n in SOURCES),
-                      ratio(r, r.motion_only)] for r in rows])
+    data = np.array([[r.worst(r.full), *(r.worst(r.without[n]) for n in SOURCES),
+                      r.worst(r.motion_only)] for r in rows])
     fig, ax = plt.subplots(figsize=(max(6.0, 0.55 * len(rows) * len(labels) / 4), 4.5))
     x = np.arange(len(rows))
     width = 0.85 / len(labels)
@@ -207,7 +205,7 @@ def cmd_budget(args: argparse.Namespace) -> int:
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
     preset, sensor = load_preset(args.preset), load_sensor(args.sensor)
-    total = len(estimators) * len(scenarios) * (len(SOURCES) + 2)
+    total = len(estimators) * len(scenarios) * len(VARIANTS)
     with tqdm(total=total, unit="set", file=sys.stderr) as bar:
         rows = error_budget(estimators, scenarios, args.seeds, sensor, preset, bar.update)
     print(budget_table(rows))
