@@ -6,7 +6,7 @@
 #include <string.h>
 
 #define MIN_COS_PITCH 1e-9   /* kinematics._MIN_COS_PITCH */
-#define SMALL_ANGLE 1e-8     /* kinematics._SMALL_ANGLE */
+#define SERIES_A2 1e-2       /* kinematics._SERIES_A2 */
 
 /* ----- kinematics.py ----------------------------------------------------------------------- */
 
@@ -90,18 +90,23 @@ void fc_quat_gravity_body(const double q[4], double g[3])
     g[2] = w * w - x * x - y * y + z * z;
 }
 
-/* rotvec_terms: cos(a/2), sin(a/2)/a, sin(a)/a, (1 - cos a)/a^2 from one sine-cosine pair */
+/* rotvec_terms: cos(a/2), sin(a/2)/a, sin(a)/a, (1 - cos a)/a^2; below a^2 = SERIES_A2 their
+ * Taylor series through a^8 (exact to double precision there), else from one sine-cosine pair */
 void fc_rotvec_terms(double vx, double vy, double vz, double t[4])
 {
     double a2 = vx * vx + vy * vy + vz * vz;
-    double angle = sqrt(a2);
-    if (angle < SMALL_ANGLE) {
-        t[0] = 1.0 - angle * angle / 8.0;
-        t[1] = 0.5 - angle * angle / 48.0;
-        t[2] = 1.0 - a2 / 6.0;
-        t[3] = 0.5 - a2 / 24.0;
+    if (a2 < SERIES_A2) {
+        t[0] = 1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
+                                                              - a2 * (1.0 / 10321920.0))));
+        t[1] = 0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
+                                                                - a2 * (1.0 / 185794560.0))));
+        t[2] = 1.0 - a2 * (1.0 / 6.0 - a2 * (1.0 / 120.0 - a2 * (1.0 / 5040.0
+                                                              - a2 * (1.0 / 362880.0))));
+        t[3] = 0.5 - a2 * (1.0 / 24.0 - a2 * (1.0 / 720.0 - a2 * (1.0 / 40320.0
+                                                               - a2 * (1.0 / 3628800.0))));
         return;
     }
+    double angle = sqrt(a2);
     double ch = cos(0.5 * angle), sh = sin(0.5 * angle);
     t[0] = ch;
     t[1] = sh / angle;
