@@ -10,6 +10,9 @@ below answers one of them the same way in every estimator:
   force in a frame that turns with the gyro, so linear acceleration averages out (Laidig & Seel
   2023, VQF);
 - rest detection for a zero-angular-rate bias update (REST_PARAMS, rest_step; VQF's detector);
+- adaptive noise of the Kalman filters (ADAPTIVE_NOISE_PARAMS, measured_disturbance): more
+  process noise while the sensor turns (the gyro's scale-factor error), more measurement noise
+  while it accelerates (the linear acceleration the pre-filter has not removed);
 - quaternion propagation of Euler-angle filters (PROPAGATION_PARAM), free of the pitch +-90 deg
   singularity of the Euler rates;
 - the nearest face (FACES, nearest_face): per-axis tilt filters run in the sensor frame turned
@@ -243,6 +246,69 @@ def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_ti
     k = dt / (rest_time + dt)
     bx, by, bz = bias
     return bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz)
+
+
+RECOMMENDED_GYRO_SCALE_STD: Final = 0.005
+"""Recommended gyro_scale_std: the scale-factor errors of BROAD's gyro, fitted against its optical
+reference on the nine trials that turn (testbenches.broad.gyro, no estimator involved), are
+-0.53 to +0.74 % per axis; an MPU-6050's datasheet tolerance is +-3 % (1 % as 3 sigma)."""
+RECOMMENDED_SCALE_TIME: Final = 0.5
+"""Recommended scale_time [s]: how long a scale error adds up in one direction, about one swing
+of a hand-held or robot motion; a coarse scan of the kf on BROAD (0.1 / 0.3 / 0.5 / 1 s: 0.62 /
+0.565 / 0.560 / 0.576 deg), the plateau's middle."""
+
+ADAPTIVE_NOISE_PARAMS: Final = (
+    Param(
+        "gyro_scale_std", RECOMMENDED_GYRO_SCALE_STD,
+        "The gyro's scale-factor uncertainty (1 sigma): while the sensor turns at rate w the "
+        "attitude's process noise grows by gyro_scale_std^2 w^2 scale_time, so the accelerometer "
+        "corrects faster what a scale error adds up (0: the gyro's white noise only, the papers')",
+        low=0.0, high=0.5,
+    ),
+    Param(
+        "scale_time", RECOMMENDED_SCALE_TIME,
+        "How long a scale error adds up in one direction before the motion turns back (the "
+        "correlation time of the rotation-driven process noise)",
+        unit="s", low=0.0,
+    ),
+    Param(
+        "disturbance_time", 1.0,
+        "Averaging time of the measured linear acceleration: the mean square of the "
+        "accelerometer's deviation from its pre-filtered value, above the white noise, is added "
+        "to the measurement variance (over g^2), so the correction slows while the sensor "
+        "accelerates; needs acc_lowpass > 0 (0 = off: the constant measurement noise, the "
+        "papers')",
+        unit="s", low=0.0,
+    ),
+)
+"""The Kalman filters' adaptive noise. Their constant Q and R describe a gyro with white noise
+only and an accelerometer that measures gravity alone; a real sensor breaks both in motion, and
+the balance of the two sets the correction's speed:
+- gyro_scale_std, scale_time: a gyro with a scale-factor error s turns the estimate by s times
+  every rotation, which a white-noise Q does not know. While the sensor turns at rate w the
+  process noise of the attitude grows by gyro_scale_std^2 w^2 scale_time (the variance a scale
+  error of that size adds up over scale_time, taken as a white noise), so the accelerometer
+  takes over faster in fast rotation;
+- disturbance_time: measured_disturbance. 1 s, the pre-filter's own time constant."""
+
+
+def measured_disturbance(dist: float, a: Vec3, f: Vec3, dt: float, tau: float, r: float,
+                         noise: float) -> tuple[float, float]:
+    """One step of the disturbance statistic (ADAPTIVE_NOISE_PARAMS' disturbance_time) and the
+    measurement variance it gives: (new statistic, r + excess / g^2).
+
+    The raw sample a minus the pre-filtered specific force f is the sensor's white noise plus
+    whatever non-gravitational acceleration the pre-filter has not followed. dist is its mean
+    square over tau (a first-order low-pass); less the white noise's share `noise` (3 axes of
+    one sample's variance [m^2/s^4]) it is that acceleration's power d^2, and a gravity
+    direction read from a vector disturbed by d is off by about d / g, so the variance r of the
+    measurement grows by d^2 / g^2: the accelerometer gates' idea (trust it less while it
+    measures more than gravity), continuous and sized by the measured disturbance."""
+    e0, e1, e2 = a[0] - f[0], a[1] - f[1], a[2] - f[2]
+    k = dt / (tau + dt)
+    dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
+    excess = dist - noise
+    return dist, (r + excess / (G * G) if excess > 0.0 else r)
 
 
 BIAS_GATE: Final = 0.05

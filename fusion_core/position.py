@@ -52,7 +52,8 @@ rest, where the specific force is gravity alone, so it may trust each sample as 
 values are for a filter that must trust the accelerometer in motion too."""
 TILT_FIXED = {
     "propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0,
-    "tilt_axes": "body", "bias_innovation": math.pi,
+    "tilt_axes": "body", "bias_innovation": math.pi, "gyro_scale_std": 0.0,
+    "disturbance_time": 0.0,
 }
 """The tilt stage's other kf options: off. This filter drives the stage step by step (propagate,
 correct_innovation, correct_bias) and does its own rest detection and bias updates."""

@@ -49,25 +49,29 @@ w0 = 0.05."""
 
 PAPER_KF: dict[str, Any] = {
     "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
-    "R_loop_time": 0.033, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "init_bias_std": 0.0, "bias_gate": 0.0, "bias_innovation": math.pi, "propagation": "euler",
-    "tilt_axes": "body", "gyro_sampling": "mean", "sensor_delay": 0.0,
+    "R_loop_time": 0.033, "gyro_scale_std": 0.0, "disturbance_time": 0.0, "gate_low": 0.9,
+    "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0, "bias_gate": 0.0,
+    "bias_innovation": math.pi, "propagation": "euler", "tilt_axes": "body",
+    "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
 (times (pi/180)^2 here), tuned at Gui et al.'s loop time of 0.033 s (R_loop_time: the same
 correction time constant at any rate, kalman.AngleBiasKalmanFilter), P = 0 at the start, the
-Euler rates, the rectangle rule."""
+Euler rates, the rectangle rule; their Q and R are constants (gyro_scale_std and
+disturbance_time 0)."""
 
 PAPER_UKF: dict[str, Any] = {
     "gyro_psd": MPU6050_GYRO_DENSITY**2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
     "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
-    "bias_innovation": math.pi, "gyro_sampling": "mean", "sensor_delay": 0.0,
+    "bias_innovation": math.pi, "gyro_scale_std": 0.0, "disturbance_time": 0.0,
+    "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
 simulated MPU-6050 at 100 Hz: the gyro's process noise that sensor's datasheet density (as the
 recommended values take the measured density of theirs), acc_noise 0.06 with an allowance for
-linear acceleration, gate at rho 0.1, the rectangle rule of its eq. 14."""
+linear acceleration, gate at rho 0.1, the rectangle rule of its eq. 14; constant Q and R
+(gyro_scale_std and disturbance_time 0)."""
 
 PAPER_POSKF: dict[str, Any] = {
     "qr_form": "white_jerk", "q": 1.0, "acc_psd": MPU6050_ACC_DENSITY**2, "zupt": False,

@@ -83,10 +83,12 @@ def test_kalman_snapshot_with_two_covariances_follows_each_axis(params: dict) ->
     """The roll and pitch filters share one covariance; a snapshot holding two different ones
     (no filter makes one, but set_state takes it) is followed axis by axis: each covariance and
     gain as a filter whose two axes both started from it (on the sensor's own axes, tilt_axes
-    'body': a change of face, which depends on both angles, would mix them)."""
+    'body': a change of face, which depends on both angles, would mix them; and with constant Q
+    and R: the adaptive noise follows the bias-corrected rate and pre-filter, which both axes'
+    biases move)."""
     rec = noisy_two_axis_recording(3.0)
     acc, gyro, dt = rec["acc_meas"], rec["gyro_meas"], rec["dt"]
-    params = {**params, "tilt_axes": "body"}
+    params = {**params, "tilt_axes": "body", "gyro_scale_std": 0.0, "disturbance_time": 0.0}
     base = make("kf", **params)
     base.run(acc[:100], gyro[:100], dt[:100])
     snapshot = base.get_state()

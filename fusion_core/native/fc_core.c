@@ -237,6 +237,16 @@ void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[
     fc_lowpass_specific_force_terms(f, phi, t, a, dt, tau);
 }
 
+double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
+                               double tau, double r, double noise)
+{
+    double e0 = a[0] - f[0], e1 = a[1] - f[1], e2 = a[2] - f[2];
+    double k = dt / (tau + dt);
+    *dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - *dist);
+    double excess = *dist - noise;
+    return excess > 0.0 ? r + excess / (FC_G * FC_G) : r;
+}
+
 void fc_rest_start(double rest[7], const double gyro[3], const double acc[3])
 {
     rest[0] = gyro[0];

@@ -84,6 +84,11 @@ void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[
                                double tau);
 void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
                                      const double a[3], double dt, double tau);
+/* measured_disturbance: one step of the disturbance statistic *dist (the mean square of the raw
+ * sample a minus the pre-filtered f over tau, a low-pass); returns the measurement variance
+ * r plus its excess over the white noise's share, over g^2 */
+double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
+                               double tau, double r, double noise);
 /* The rest detector's state at the first sample: its means start at that sample, quiet 0. */
 void fc_rest_start(double rest[7], const double gyro[3], const double acc[3]);
 void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,

@@ -71,6 +71,9 @@ void fc_kf_configure(fc_kf *f)
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
+    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
+    f->dist_tau = f->acc_tau > 0.0 ? p->disturbance_time : 0.0;
+    f->dist_noise = 3.0 * f->r * FC_G * FC_G;
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
@@ -115,6 +118,7 @@ void fc_kf_reset(fc_kf *f)
     f->gain_roll[0] = f->gain_roll[1] = f->gain_pitch[0] = f->gain_pitch[1] = 0.0;
     f->face = 0;
     f->r_step = f->r;
+    f->acc_dist = 0.0;
     f->last = fc_kf_estimate(f);
 }
 
@@ -174,15 +178,20 @@ void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_i
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
     if (f->r_loop > 0.0)
         f->r_step = f->r_loop / dt;
+    double q_angle = f->q_angle;
+    if (f->q_rotation > 0.0) {  /* gyro_scale_std: a scale error adds up while the sensor turns */
+        double wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
+        q_angle += f->q_rotation * (wx * wx + wy * wy + wz * wz);
+    }
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
-    predict_covariance(P, dt, f->q_angle, f->q_bias, f->P_roll);
+    predict_covariance(P, dt, q_angle, f->q_bias, f->P_roll);
     if (same4(f->P_pitch, P)) {
         memcpy(f->P_pitch, f->P_roll, sizeof P);
     } else {
         double Pp[4];
         memcpy(Pp, f->P_pitch, sizeof Pp);
-        predict_covariance(Pp, dt, f->q_angle, f->q_bias, f->P_pitch);
+        predict_covariance(Pp, dt, q_angle, f->q_bias, f->P_pitch);
     }
 }
 
@@ -252,6 +261,14 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     }
 }
 
+/* _measure_disturbance: this step's measurement variance from the linear acceleration */
+static void measure_disturbance(fc_kf *f, const double a[3], double dt)
+{
+    double base = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
+    f->r_step = fc_measured_disturbance(&f->acc_dist, a, f->acc_f, dt, f->dist_tau, base,
+                                        f->dist_noise);
+}
+
 /* _update_with_options, in the filters' frame; prev: the previous gyro sample there */
 static void update_with_options(fc_kf *f, const double a_in[3], const double g[3], double dt,
                                 const double prev[3])
@@ -273,6 +290,9 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
     }
     if (f->acc_tau > 0.0) {
         fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, f->acc_tau);
+        if (f->dist_tau > 0.0) {
+            measure_disturbance(f, a, dt);
+        }
         memcpy(a, f->acc_f, sizeof a);
     }
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];

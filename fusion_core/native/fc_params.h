@@ -109,29 +109,32 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 #define FC_KF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_kf_params {
-    double Q_angle;          /* [0.0, inf) [rad2/s] */
-    double Q_bias;           /* [0.0, inf) [rad2/s3] */
-    double R_measure;        /* (0.0, inf) [rad2] */
-    double R_loop_time;      /* [0.0, inf) [s] */
-    double gate_low;         /* (0.0, 1.0] */
-    double gate_high;        /* [1.0, inf) */
-    double acc_lowpass;      /* [0.0, inf) [s] */
-    double rest_time;        /* [0.0, inf) [s] */
-    double rest_gyro;        /* (0.0, inf) [rad/s] */
-    double rest_acc;         /* (0.0, inf) [m/s2] */
-    double gyro_psd;         /* (0.0, inf) [rad2/s] */
-    double init_bias_std;    /* [0.0, inf) [rad/s] */
-    double bias_gate;        /* [0.0, inf) */
-    double bias_innovation;  /* (0.0, 3.141592653589793] [rad] */
-    int propagation;         /* one of 'euler', 'quaternion' */
-    int tilt_axes;           /* one of 'body', 'nearest_face' */
-    int gyro_sampling;       /* one of 'point', 'mean' */
-    double max_dt;           /* (0.0, inf) [s] */
-    double max_rate;         /* (0.0, inf) [rad/s] */
-    double mount_roll;       /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;      /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double sensor_delay;     /* [0.0, 0.1] [s] */
+    double Q_angle;           /* [0.0, inf) [rad2/s] */
+    double Q_bias;            /* [0.0, inf) [rad2/s3] */
+    double R_measure;         /* (0.0, inf) [rad2] */
+    double R_loop_time;       /* [0.0, inf) [s] */
+    double gyro_scale_std;    /* [0.0, 0.5] */
+    double scale_time;        /* [0.0, inf) [s] */
+    double disturbance_time;  /* [0.0, inf) [s] */
+    double gate_low;          /* (0.0, 1.0] */
+    double gate_high;         /* [1.0, inf) */
+    double acc_lowpass;       /* [0.0, inf) [s] */
+    double rest_time;         /* [0.0, inf) [s] */
+    double rest_gyro;         /* (0.0, inf) [rad/s] */
+    double rest_acc;          /* (0.0, inf) [m/s2] */
+    double gyro_psd;          /* (0.0, inf) [rad2/s] */
+    double init_bias_std;     /* [0.0, inf) [rad/s] */
+    double bias_gate;         /* [0.0, inf) */
+    double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
+    int propagation;          /* one of 'euler', 'quaternion' */
+    int tilt_axes;            /* one of 'body', 'nearest_face' */
+    int gyro_sampling;        /* one of 'point', 'mean' */
+    double max_dt;            /* (0.0, inf) [s] */
+    double max_rate;          /* (0.0, inf) [rad/s] */
+    double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_kf_params;
 
 /* The defaults: AngleBiasKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -141,6 +144,9 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->Q_bias = 3.046174197867086e-12;
     p->R_measure = 2.5995528875251195e-05;
     p->R_loop_time = 0.0;
+    p->gyro_scale_std = 0.005;
+    p->scale_time = 0.5;
+    p->disturbance_time = 1.0;
     p->gate_low = 0.5;
     p->gate_high = 2.0;
     p->acc_lowpass = 1.0;
@@ -168,29 +174,32 @@ static inline void fc_kf_params_default(fc_kf_params *p)
 #define FC_UKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_ukf_params {
-    double gyro_psd;         /* (0.0, inf) [rad2/s] */
-    double bias_psd;         /* [0.0, inf) [rad2/s3] */
-    double acc_noise;        /* (0.0, inf) */
-    double norm_noise;       /* (0.0, inf) */
-    double acc_gate;         /* (0.0, inf) */
-    double init_bias_std;    /* (0.0, inf) [rad/s] */
-    double alpha;            /* (0.0, 1.0] */
-    double beta;             /* [0.0, inf) */
-    double kappa;            /* (-5.0, inf) */
-    int gyro_sampling;       /* one of 'point', 'mean' */
-    double acc_lowpass;      /* [0.0, inf) [s] */
-    double rest_time;        /* [0.0, inf) [s] */
-    double rest_gyro;        /* (0.0, inf) [rad/s] */
-    double rest_acc;         /* (0.0, inf) [m/s2] */
-    double zaru_psd;         /* (0.0, inf) [rad2/s] */
-    double bias_gate;        /* [0.0, inf) */
-    double bias_innovation;  /* (0.0, 3.141592653589793] [rad] */
-    double max_dt;           /* (0.0, inf) [s] */
-    double max_rate;         /* (0.0, inf) [rad/s] */
-    double mount_roll;       /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;      /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;        /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double sensor_delay;     /* [0.0, 0.1] [s] */
+    double gyro_psd;          /* (0.0, inf) [rad2/s] */
+    double bias_psd;          /* [0.0, inf) [rad2/s3] */
+    double acc_noise;         /* (0.0, inf) */
+    double norm_noise;        /* (0.0, inf) */
+    double acc_gate;          /* (0.0, inf) */
+    double init_bias_std;     /* (0.0, inf) [rad/s] */
+    double alpha;             /* (0.0, 1.0] */
+    double beta;              /* [0.0, inf) */
+    double kappa;             /* (-5.0, inf) */
+    double gyro_scale_std;    /* [0.0, 0.5] */
+    double scale_time;        /* [0.0, inf) [s] */
+    double disturbance_time;  /* [0.0, inf) [s] */
+    int gyro_sampling;        /* one of 'point', 'mean' */
+    double acc_lowpass;       /* [0.0, inf) [s] */
+    double rest_time;         /* [0.0, inf) [s] */
+    double rest_gyro;         /* (0.0, inf) [rad/s] */
+    double rest_acc;          /* (0.0, inf) [m/s2] */
+    double zaru_psd;          /* (0.0, inf) [rad2/s] */
+    double bias_gate;         /* [0.0, inf) */
+    double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
+    double max_dt;            /* (0.0, inf) [s] */
+    double max_rate;          /* (0.0, inf) [rad/s] */
+    double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_ukf_params;
 
 /* The defaults: UnscentedKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -205,6 +214,9 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->alpha = 1.0;
     p->beta = 2.0;
     p->kappa = 0.0;
+    p->gyro_scale_std = 0.0;
+    p->scale_time = 0.5;
+    p->disturbance_time = 0.0;
     p->gyro_sampling = FC_UKF_GYRO_SAMPLING_POINT;
     p->acc_lowpass = 1.0;
     p->rest_time = 1.5;

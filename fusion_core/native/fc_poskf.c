@@ -135,6 +135,8 @@ void fc_poskf_configure(fc_poskf *f)
     tp.propagation = FC_KF_PROPAGATION_EULER;
     tp.acc_lowpass = 0.0;
     tp.rest_time = 0.0;
+    tp.gyro_scale_std = 0.0;
+    tp.disturbance_time = 0.0;
     tp.init_bias_std = 0.0;
     tp.tilt_axes = FC_KF_TILT_AXES_BODY;
     tp.bias_innovation = FC_PI;

@@ -322,6 +322,9 @@ void fc_ukf_configure(fc_ukf *f)
     f->q_bias = p->bias_psd;
     f->r_acc = pow(p->acc_noise, 2.0);
     f->r_norm = pow(p->norm_noise, 2.0);
+    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
+    f->dist_tau = p->acc_lowpass > 0.0 ? p->disturbance_time : 0.0;
+    f->dist_noise = 3.0 * f->r_acc * FC_G * FC_G;
     f->gate = p->acc_gate;
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
     f->options = p->acc_lowpass > 0.0 || p->rest_time > 0.0;
@@ -348,6 +351,7 @@ void fc_ukf_reset(fc_ukf *f)
     memset(f->P, 0, sizeof f->P);
     memset(f->acc_f, 0, sizeof f->acc_f);
     memset(f->rest, 0, sizeof f->rest);
+    f->acc_dist = 0.0;
     f->last = fc_ukf_estimate(f);
 }
 
@@ -418,7 +422,7 @@ static void zero_rate_update(fc_ukf *f, const double z[3], double r)
 
 /* _filter_update: one sample of the paper's UKF (eq. 14-17) */
 static void filter_update(fc_ukf *f, double ax, double ay, double az, const double g[3],
-                          double dt, int learn_bias)
+                          double dt, int learn_bias, double r)
 {
     double X0 = f->x[0], X1 = f->x[1], X2 = f->x[2], b0 = f->x[3], b1 = f->x[4], b2 = f->x[5];
     const double *P = f->P;
@@ -526,7 +530,12 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
     double n = sqrt(X0 * X0 + X1 * X1 + X2 * X2);
     double inv = 1.0 / n;
     double h0 = X0 * inv, h1 = X1 * inv, h2 = X2 * inv;
-    double qg = f->q_gyro * dt, qb = f->q_bias * dt;
+    double q_gyro = f->q_gyro;
+    if (f->q_rotation > 0.0) {  /* gyro_scale_std: a scale error adds up while the sensor turns */
+        double wx = gx - b0, wy = gy - b1, wz = gz - b2;
+        q_gyro += f->q_rotation * (wx * wx + wy * wy + wz * wz);
+    }
+    double qg = q_gyro * dt, qb = f->q_bias * dt;
     double Pn[21] = {
         a00 + qg * (1.0 - h0 * h0),
         a10 - qg * (h1 * h0), a11 + qg * (1.0 - h1 * h1),
@@ -543,7 +552,6 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
         double sv0 = w * ev0 + w_mu * mu0 * mu_v;
         double sv1 = w * ev1 + w_mu * mu1 * mu_v;
         double sv2 = w * ev2 + w_mu * mu2 * mu_v;
-        double r = f->r_acc;
         const double S[10] = {
             a00 + r, a10, a11 + r, a20, a21, a22 + r,
             sv0, sv1, sv2, w * vv + w_mu * mu_v * mu_v + f->r_norm,
@@ -580,16 +588,21 @@ static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
     double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2;
     if (!f->options) {
-        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias);
+        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);
         return;
     }
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
         double phi[3], b[3] = {f->x[3], f->x[4], f->x[5]};
         fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
         fc_lowpass_specific_force(f->acc_f, phi, a, dt, p->acc_lowpass);
-        filter_update(f, f->acc_f[0], f->acc_f[1], f->acc_f[2], g, dt, learn_bias);
+        double r = f->r_acc;
+        if (f->dist_tau > 0.0) {
+            r = fc_measured_disturbance(&f->acc_dist, a, f->acc_f, dt, f->dist_tau, r,
+                                        f->dist_noise);
+        }
+        filter_update(f, f->acc_f[0], f->acc_f[1], f->acc_f[2], g, dt, learn_bias, r);
     } else {
-        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias);
+        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);
     }
     if (p->rest_time > 0.0) {
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, p->rest_gyro, p->rest_acc);

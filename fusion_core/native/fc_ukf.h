@@ -16,9 +16,11 @@ typedef struct fc_ukf {
     double P[21];     /* the covariance's lower triangle, row by row */
     double acc_f[3];
     double rest[7];
+    double acc_dist;  /* mean square of raw - pre-filtered specific force (disturbance_time) */
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
     double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
+    double q_rotation, dist_tau, dist_noise;  /* UnscentedKalmanFilter._adaptive */
     double bias_lo2, bias_hi2, cos_innovation;
     int trapezoid, options;
 } fc_ukf;
