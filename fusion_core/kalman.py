@@ -35,6 +35,7 @@ from .building_blocks import (
     REST_PARAMS,
     ZERO3,
     Vec3,
+    adaptive_prefilter_time,
     bias_band2,
     body_rotation,
     gate_bounds2,
@@ -197,14 +198,17 @@ class AngleBiasKalmanFilter(Estimator):
 
     Adaptive noise (recommended; off in the papers' filter): building_blocks.ADAPTIVE_NOISE_PARAMS.
     Q_angle grows by gyro_scale_std^2 w^2 scale_time while the sensor turns at rate w (BROAD's
-    gyro: 0.5 % scale errors), and each step's measurement variance by the measured linear
-    acceleration's power over g^2 (the raw sample's deviation from the pre-filtered vector,
-    above the white noise, over disturbance_time). The second is what holds sustained
-    accelerations off (high_dynamics 6.9/6.6 -> 2.2/1.4 deg, translation_2m's pitch 1.13 ->
-    0.07; BROAD's translation trials 0.51 -> 0.39), the first takes the rotation trials 0.70 ->
-    0.61 deg; BROAD's mean 0.619 -> 0.560. An uncalibrated gyro (6.7 deg/s) costs more than
-    before on moderate_dynamics (2.2/5.6 against 1.3/1.4 deg): the bias is learned only where
-    the accelerometer measures little besides gravity.
+    gyro: 0.5 % scale errors); each step's measurement variance grows by the measured linear
+    acceleration's power over g^2 (the raw sample's deviation from a full pre-filter, acc_ref,
+    above the white noise, over disturbance_time); and the pre-filter whose vector is measured
+    shortens to nothing where that power is down to the white noise's
+    (building_blocks.adaptive_prefilter_time). On the testbench (realistic sensor, seed 0,
+    against constant Q, R and pre-filter) high_dynamics 6.9/6.6 -> 1.1/1.0 deg, roll_sweep
+    0.30/0.18 -> 0.11/0.07, moderate_dynamics 0.27/0.26 -> 0.27/0.19, vibration 0.38/0.64 ->
+    0.55/1.59 (its tones raise R: the filter leans on the gyro); on BROAD 0.619 -> 0.560 deg
+    (translation 0.51 -> 0.39, rotation 0.70 -> 0.61). A gyro left uncalibrated (6.7 deg/s)
+    costs more than before on moderate_dynamics (3.2/3.7 against 1.3/1.4 deg): its bias is
+    learned only where the accelerometer measures little besides gravity.
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2], R_loop_time [s];
     gyro_scale_std, scale_time [s], disturbance_time [s]; gate_low, gate_high;
@@ -266,7 +270,7 @@ class AngleBiasKalmanFilter(Estimator):
     )
     STATE = (
         "roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch", "bias_z", "P_z", "acc_f", "rest",
-        "q_att", "face", "acc_dist",
+        "q_att", "face", "acc_dist", "acc_ref",
     )
 
     def _configure(self) -> None:
@@ -318,7 +322,8 @@ class AngleBiasKalmanFilter(Estimator):
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
         self.face = 0  # index into FACES of the filters' frame (tilt_axes); 0: the sensor's own
-        self.acc_dist = 0.0  # mean square of raw - pre-filtered specific force (disturbance_time)
+        self.acc_dist = 0.0  # mean square of raw - acc_ref (disturbance_time)
+        self.acc_ref = ZERO3  # the specific force pre-filtered with the full acc_lowpass
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         if self._faces:
@@ -328,7 +333,7 @@ class AngleBiasKalmanFilter(Estimator):
                 ax, ay, az = mat_vec(C, (ax, ay, az))
                 gx, gy, gz = mat_vec(C, (gx, gy, gz))
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
-        self.acc_f = (ax, ay, az)
+        self.acc_f = self.acc_ref = (ax, ay, az)
         self.rest = (gx, gy, gz, ax, ay, az, 0.0)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         p_b = self._params["init_bias_std"] ** 2
@@ -390,23 +395,29 @@ class AngleBiasKalmanFilter(Estimator):
             self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
         if self._acc_tau > 0.0:
             assert phi is not None  # computed above whenever acc_tau > 0
-            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, self._acc_tau,
-                                                terms)
+            tau = self._acc_tau
             if self._adaptive[1] > 0.0:
-                self._measure_disturbance(ax, ay, az, dt)
+                tau = self._measure_disturbance(ax, ay, az, dt, phi, terms)
+            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau, terms)
             ax, ay, az = self.acc_f
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             self.correct(ax, ay, az, learn_bias)
         if self._quaternion and (self.roll, self.pitch) != predicted:
             self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
 
-    def _measure_disturbance(self, ax: float, ay: float, az: float, dt: float) -> None:
-        """This step's measurement variance from the linear acceleration (disturbance_time,
-        building_blocks.measured_disturbance) on top of R_measure's."""
+    def _measure_disturbance(self, ax: float, ay: float, az: float, dt: float, phi: Vec3,
+                             terms: tuple[float, float, float, float]) -> float:
+        """The linear acceleration against acc_ref, the full pre-filter (disturbance_time,
+        building_blocks.measured_disturbance): this step's measurement variance on top of
+        R_measure's; returns the pre-filter's time constant for this step
+        (building_blocks.adaptive_prefilter_time)."""
+        self.acc_ref = lowpass_specific_force(self.acc_ref, phi, (ax, ay, az), dt, self._acc_tau,
+                                              terms)
         base = self._r_loop / dt if self._r_loop > 0.0 else self._r
         _, tau, noise = self._adaptive
         self.acc_dist, self.r_step = measured_disturbance(self.acc_dist, (ax, ay, az),
-                                                          self.acc_f, dt, tau, base, noise)
+                                                          self.acc_ref, dt, tau, base, noise)
+        return adaptive_prefilter_time(self._acc_tau, self.acc_dist, noise)
 
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -540,6 +551,7 @@ class AngleBiasKalmanFilter(Estimator):
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         self.bias_x, self.bias_y, self.bias_z = turn((self.bias_x, self.bias_y, self.bias_z))
         self.acc_f = turn(self.acc_f)
+        self.acc_ref = turn(self.acc_ref)
         r = self.rest
         self.rest = (*turn((r[0], r[1], r[2])), *turn((r[3], r[4], r[5])), r[6])
         P_roll, P_pitch, P_z = self.P_roll, self.P_pitch, self.P_z

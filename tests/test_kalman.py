@@ -9,7 +9,7 @@ import pytest
 import scipy.linalg
 from helpers import paper
 
-from fusion_core import DEG, G
+from fusion_core import DEG, G, synthetic
 from fusion_core.kalman import AngleBiasKalmanFilter
 from fusion_core.presets import PAPER_KF
 from fusion_core.synthetic import Trajectory, add, sine
@@ -238,3 +238,36 @@ def test_sustained_acceleration_is_held_off_on_the_realistic_sensor() -> None:
         "t", "kf", "high_dynamics", 0, None, load_sensor("realistic"),
         {"disturbance_time": 0.0, "gyro_scale_std": 0.0}, {})))
     assert with_constant_r["rmse_roll_deg"] > limit[0]
+
+
+def test_the_prefilter_follows_the_measured_disturbance() -> None:
+    """adaptive_prefilter_time: no pre-filter up to the white noise's power, the full one from
+    PREFILTER_FULL times it on, linear between."""
+    from fusion_core.building_blocks import PREFILTER_FULL, adaptive_prefilter_time
+
+    tau, noise = 1.0, 0.0075
+    assert adaptive_prefilter_time(tau, 0.0, noise) == 0.0
+    assert adaptive_prefilter_time(tau, noise, noise) == 0.0
+    assert adaptive_prefilter_time(tau, noise * (1 + PREFILTER_FULL), noise) == tau
+    assert adaptive_prefilter_time(tau, 100.0, noise) == tau
+    half = noise * (1 + PREFILTER_FULL / 2)
+    assert adaptive_prefilter_time(tau, half, noise) == pytest.approx(tau / 2, rel=1e-12)
+
+
+def test_in_pure_rotation_the_measurement_is_the_raw_sample() -> None:
+    """A noise-free roll sweep (no linear acceleration): the full pre-filter, turned with the
+    gyro, agrees with each sample, the disturbance stays at the noise floor, and the vector the
+    filter measures is the raw sample itself. With a gyro 1 % off in scale, the raw sample is
+    what keeps the roll error small: the 1 s pre-filter would have turned with that gyro."""
+    trajectory = Trajectory(roll=sine(45 * DEG, 0.32))
+    rec = synthetic.record(trajectory, 20.0, 100.0, noise=None, seed=0)
+    acc, gyro, dt = rec["acc_meas"], rec["gyro_meas"], rec["dt"]
+    adaptive = AngleBiasKalmanFilter(rest_time=0.0)
+    adaptive.run(acc, gyro, dt, backend="python")
+    assert adaptive.acc_dist < adaptive._adaptive[2]
+    assert np.allclose(adaptive.acc_f, acc[-1], rtol=0.0, atol=1e-12)
+    errors = {}
+    for name, params in (("adaptive", {}), ("fixed", {"disturbance_time": 0.0})):
+        out = AngleBiasKalmanFilter(rest_time=0.0, **params).run(acc, gyro * 1.01, dt)
+        errors[name] = np.sqrt(np.mean((out["roll"] - rec["roll"])[1000:] ** 2)) / DEG
+    assert errors["adaptive"] < 0.5 * errors["fixed"], errors

@@ -7,6 +7,7 @@
 
 #define MIN_COS_PITCH 1e-9   /* kinematics._MIN_COS_PITCH */
 #define SERIES_A2 1e-2       /* kinematics._SERIES_A2 */
+#define PREFILTER_FULL 4.0   /* building_blocks.PREFILTER_FULL */
 
 /* ----- kinematics.py ----------------------------------------------------------------------- */
 
@@ -245,6 +246,19 @@ double fc_measured_disturbance(double *dist, const double a[3], const double f[3
     *dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - *dist);
     double excess = *dist - noise;
     return excess > 0.0 ? r + excess / (FC_G * FC_G) : r;
+}
+
+double fc_adaptive_prefilter_time(double tau, double dist, double noise)
+{
+    double excess = dist - noise;
+    if (excess <= 0.0) {
+        return 0.0;
+    }
+    double full = PREFILTER_FULL * noise;
+    if (excess >= full) {
+        return tau;
+    }
+    return tau * (excess / full);
 }
 
 void fc_rest_start(double rest[7], const double gyro[3], const double acc[3])

@@ -89,6 +89,9 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
  * r plus its excess over the white noise's share, over g^2 */
 double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
                                double tau, double r, double noise);
+/* adaptive_prefilter_time: tau times the disturbance's excess over the noise, in units of
+ * PREFILTER_FULL times the noise, between 0 and tau */
+double fc_adaptive_prefilter_time(double tau, double dist, double noise);
 /* The rest detector's state at the first sample: its means start at that sample, quiet 0. */
 void fc_rest_start(double rest[7], const double gyro[3], const double acc[3]);
 void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,

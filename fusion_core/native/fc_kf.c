@@ -112,6 +112,7 @@ void fc_kf_reset(fc_kf *f)
     memset(f->P_pitch, 0, sizeof f->P_pitch);
     f->bias_z = f->P_z = 0.0;
     memset(f->acc_f, 0, sizeof f->acc_f);
+    memset(f->acc_ref, 0, sizeof f->acc_ref);
     memset(f->rest, 0, sizeof f->rest);
     f->q_att[0] = 1.0;
     f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
@@ -136,6 +137,7 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
     }
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
     memcpy(f->acc_f, a, sizeof a);
+    memcpy(f->acc_ref, a, sizeof a);
     fc_rest_start(f->rest, g, a);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
     double p_b = pow(f->params.init_bias_std, 2.0);
@@ -261,12 +263,16 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     }
 }
 
-/* _measure_disturbance: this step's measurement variance from the linear acceleration */
-static void measure_disturbance(fc_kf *f, const double a[3], double dt)
+/* _measure_disturbance: this step's measurement variance from the linear acceleration against
+ * acc_ref; returns the pre-filter's time constant for this step */
+static double measure_disturbance(fc_kf *f, const double a[3], double dt, const double phi[3],
+                                  const double terms[4])
 {
+    fc_lowpass_specific_force_terms(f->acc_ref, phi, terms, a, dt, f->acc_tau);
     double base = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
-    f->r_step = fc_measured_disturbance(&f->acc_dist, a, f->acc_f, dt, f->dist_tau, base,
+    f->r_step = fc_measured_disturbance(&f->acc_dist, a, f->acc_ref, dt, f->dist_tau, base,
                                         f->dist_noise);
+    return fc_adaptive_prefilter_time(f->acc_tau, f->acc_dist, f->dist_noise);
 }
 
 /* _update_with_options, in the filters' frame; prev: the previous gyro sample there */
@@ -289,10 +295,11 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
         zero_rate_update(f, a, g, dt);
     }
     if (f->acc_tau > 0.0) {
-        fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, f->acc_tau);
+        double tau = f->acc_tau;
         if (f->dist_tau > 0.0) {
-            measure_disturbance(f, a, dt);
+            tau = measure_disturbance(f, a, dt, phi, terms);
         }
+        fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau);
         memcpy(a, f->acc_f, sizeof a);
     }
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
@@ -329,6 +336,8 @@ static void switch_face(fc_kf *f)
     double acc_f[3];
     TURN(f->acc_f, acc_f);
     memcpy(f->acc_f, acc_f, sizeof acc_f);
+    TURN(f->acc_ref, acc_f);
+    memcpy(f->acc_ref, acc_f, sizeof acc_f);
     double w[3] = {f->rest[0], f->rest[1], f->rest[2]}, sf[3] = {f->rest[3], f->rest[4], f->rest[5]};
     double w2[3], sf2[3];
     TURN(w, w2);

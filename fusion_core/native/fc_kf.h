@@ -21,7 +21,8 @@ typedef struct fc_kf {
     double gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
     fc_estimate last;
     double r_step;  /* this step's measurement variance (R_loop_time, disturbance_time) */
-    double acc_dist;  /* mean square of raw - pre-filtered specific force (disturbance_time) */
+    double acc_dist;  /* mean square of raw - acc_ref (disturbance_time) */
+    double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     /* derived from params (AngleBiasKalmanFilter._configure) */
     double q_angle, q_bias, r, r_loop, gate_low2, gate_high2, acc_tau;
     double q_rotation, dist_tau, dist_noise;  /* AngleBiasKalmanFilter._adaptive */

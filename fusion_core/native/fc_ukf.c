@@ -350,6 +350,7 @@ void fc_ukf_reset(fc_ukf *f)
     memcpy(f->x, x0, sizeof x0);
     memset(f->P, 0, sizeof f->P);
     memset(f->acc_f, 0, sizeof f->acc_f);
+    memset(f->acc_ref, 0, sizeof f->acc_ref);
     memset(f->rest, 0, sizeof f->rest);
     f->acc_dist = 0.0;
     f->last = fc_ukf_estimate(f);
@@ -369,6 +370,7 @@ static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _i
     f->P[0] = f->P[2] = f->P[5] = p_x;
     f->P[9] = f->P[14] = f->P[20] = p_b;
     memcpy(f->acc_f, a, sizeof f->acc_f);
+    memcpy(f->acc_ref, a, sizeof f->acc_ref);
     fc_rest_start(f->rest, g, a);
 }
 
@@ -594,12 +596,14 @@ static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
         double phi[3], b[3] = {f->x[3], f->x[4], f->x[5]};
         fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
-        fc_lowpass_specific_force(f->acc_f, phi, a, dt, p->acc_lowpass);
-        double r = f->r_acc;
-        if (f->dist_tau > 0.0) {
-            r = fc_measured_disturbance(&f->acc_dist, a, f->acc_f, dt, f->dist_tau, r,
+        double tau = p->acc_lowpass, r = f->r_acc;
+        if (f->dist_tau > 0.0) {  /* building_blocks.ADAPTIVE_NOISE_PARAMS */
+            fc_lowpass_specific_force(f->acc_ref, phi, a, dt, tau);
+            r = fc_measured_disturbance(&f->acc_dist, a, f->acc_ref, dt, f->dist_tau, r,
                                         f->dist_noise);
+            tau = fc_adaptive_prefilter_time(tau, f->acc_dist, f->dist_noise);
         }
+        fc_lowpass_specific_force(f->acc_f, phi, a, dt, tau);
         filter_update(f, f->acc_f[0], f->acc_f[1], f->acc_f[2], g, dt, learn_bias, r);
     } else {
         filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);

@@ -16,7 +16,8 @@ typedef struct fc_ukf {
     double P[21];     /* the covariance's lower triangle, row by row */
     double acc_f[3];
     double rest[7];
-    double acc_dist;  /* mean square of raw - pre-filtered specific force (disturbance_time) */
+    double acc_dist;  /* mean square of raw - acc_ref (disturbance_time) */
+    double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
     double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
