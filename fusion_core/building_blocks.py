@@ -313,6 +313,39 @@ def measured_disturbance(dist: float, a: Vec3, f: Vec3, dt: float, tau: float, r
     return dist, (r + excess / (G * G) if excess > 0.0 else r)
 
 
+MAX_CORRECTION_TIME_PARAM: Final = Param(
+    "max_correction_time", 3.0,
+    "The longest correction time constant the adaptive noise may stretch the filter's to while "
+    "the sensor accelerates (never shorter than the filter's own): the gyro bias the filter has "
+    "not learned leaves an error of that bias times it",
+    unit="s", low=0.0,
+)
+"""Recommended 3 s: the complementary filters learn their bias at rest (cf) or over minutes (mgcf),
+so a bias b left by the usual start-up calibration (0.16 deg/s on the realistic MPU-6050, its
+datasheet's temperature drift over 1 K of warm-up) costs b times this, 0.5 deg at 3 s. A coarse
+scan of the cf on BROAD (2 / 3 / 4 / 5 / 10 s: 0.590 / 0.559 / 0.554 / 0.555 / 0.568 deg) has its
+plateau at 3-5 s; 3 keeps that bias error smallest on it."""
+
+
+def correction_time(tau: float, r_ratio: float, q_rotation: float, w2: float, r: float,
+                    dt: float, longest: float) -> float:
+    """A complementary filter's correction time constant for this step under the adaptive noise
+    (ADAPTIVE_NOISE_PARAMS): shorter while the sensor turns with a clean accelerometer, longer
+    while it accelerates, up to the larger of tau and longest (MAX_CORRECTION_TIME_PARAM).
+
+    A filter blending gyro and accelerometer with time constant tau is the steady state of a
+    Kalman filter with measurement variance r (one sample's) and angle process noise
+    q = r dt / tau^2, since tau = sqrt(r dt / q). With the kf's adaptive noise, r grows by the
+    ratio r_ratio (measured_disturbance over r) and q by q_rotation w2 (the gyro's scale
+    uncertainty while it turns at w), and the time constant by sqrt(r_ratio / q_ratio). It is
+    stretched at most to `longest`: a filter that has not learned its gyro bias leaves an error
+    of that bias times its time constant."""
+    q_ratio = 1.0 + q_rotation * w2 * tau * tau / (r * dt)
+    t = tau * math.sqrt(r_ratio / q_ratio)
+    cap = longest if longest > tau else tau
+    return t if t < cap else cap
+
+
 PREFILTER_FULL: Final = 4.0
 """adaptive_prefilter_time reaches the full pre-filter where the disturbance's power is this many
 times the white noise's (its RMS twice the noise's). 1 to 8 give the same BROAD mean and the same

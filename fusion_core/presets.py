@@ -32,15 +32,17 @@ KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
 
 PAPER_CF: dict[str, Any] = {
     "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0,
+    "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0, "gyro_scale_std": 0.0,
+    "disturbance_time": 0.0,
 }
 """Gui et al. eq. 1-2: tau = 0.75 s (a = 0.96 at their 30 ms loop), the Euler rates, the
-rectangle rule (gyro_sampling="mean"). Their gate has no bounds in the text: 0.9-1.1 g is our
-reading (complementary.ComplementaryFilter)."""
+rectangle rule (gyro_sampling="mean"), a constant tau (gyro_scale_std and disturbance_time 0).
+Their gate has no bounds in the text: 0.9-1.1 g is our reading
+(complementary.ComplementaryFilter)."""
 
 PAPER_MGCF: dict[str, Any] = {
     "schedule": "simulation", "w0": 0.1, "zeta": 2.0, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "gyro_sampling": "mean", "sensor_delay": 0.0,
+    "gyro_sampling": "mean", "sensor_delay": 0.0, "gyro_scale_std": 0.0, "disturbance_time": 0.0,
 }
 """Duong Quoc et al. eq. 7-13 with their simulation table (section 4.1) and zeta = 2; Mahony's
 reference order (error from the previous attitude, first-order step: gyro_sampling="mean").

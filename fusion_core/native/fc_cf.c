@@ -14,6 +14,11 @@ void fc_cf_configure(fc_cf *f)
     f->acc_tau = p->acc_lowpass;
     f->quaternion = p->propagation == FC_CF_PROPAGATION_QUATERNION;
     f->rotating = f->quaternion || f->acc_tau > 0.0;
+    f->r_ref = pow(p->acc_noise, 2.0);
+    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
+    f->dist_tau = f->acc_tau > 0.0 ? p->disturbance_time : 0.0;
+    f->dist_noise = 3.0 * f->r_ref * FC_G * FC_G;
+    f->longest = p->max_correction_time;
 }
 
 fc_estimate fc_cf_estimate(const fc_cf *f)
@@ -35,6 +40,8 @@ void fc_cf_reset(fc_cf *f)
     f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
     memset(f->bias, 0, sizeof f->bias);
     memset(f->rest, 0, sizeof f->rest);
+    f->acc_dist = 0.0;
+    memset(f->acc_ref, 0, sizeof f->acc_ref);
     f->last = fc_cf_estimate(f);
 }
 
@@ -44,6 +51,7 @@ static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _in
 {
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
     memcpy(f->acc_f, a, sizeof f->acc_f);
+    memcpy(f->acc_ref, a, sizeof f->acc_ref);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
     fc_rest_start(f->rest, g, a);
 }
@@ -62,11 +70,19 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
         }
     }
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
+    double r = f->r_ref;
     if (f->rotating) {
         fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
         if (f->acc_tau > 0.0) {
-            fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, f->acc_tau);
+            double tau_f = f->acc_tau;
+            if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
+                fc_lowpass_specific_force_terms(f->acc_ref, phi, terms, a, dt, tau_f);
+                r = fc_measured_disturbance(&f->acc_dist, a, f->acc_ref, dt, f->dist_tau,
+                                            f->r_ref, f->dist_noise);
+                tau_f = fc_adaptive_prefilter_time(tau_f, f->acc_dist, f->dist_noise);
+            }
+            fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau_f);
             memcpy(a, f->acc_f, sizeof a);
         }
     }
@@ -84,7 +100,13 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
         double acc_roll, acc_pitch;
         fc_accel_roll_pitch(a[0], a[1], a[2], &acc_roll, &acc_pitch);
-        double k = dt / (f->tau + dt);  /* 1 - a, Gui et al. eq. 2 */
+        double tau = f->tau;
+        if (f->q_rotation > 0.0 || r != f->r_ref) {  /* the adaptive noise */
+            double wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
+            tau = fc_correction_time(tau, r / f->r_ref, f->q_rotation,
+                                     wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
+        }
+        double k = dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
         double y = acc_roll - roll;
         roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
         pitch += k * (acc_pitch - pitch);

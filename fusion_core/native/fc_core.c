@@ -248,6 +248,15 @@ double fc_measured_disturbance(double *dist, const double a[3], const double f[3
     return excess > 0.0 ? r + excess / (FC_G * FC_G) : r;
 }
 
+double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
+                          double dt, double longest)
+{
+    double q_ratio = 1.0 + q_rotation * w2 * tau * tau / (r * dt);
+    double t = tau * sqrt(r_ratio / q_ratio);
+    double cap = longest > tau ? longest : tau;
+    return t < cap ? t : cap;
+}
+
 double fc_adaptive_prefilter_time(double tau, double dist, double noise)
 {
     double excess = dist - noise;

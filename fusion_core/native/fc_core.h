@@ -89,6 +89,10 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
  * r plus its excess over the white noise's share, over g^2 */
 double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
                                double tau, double r, double noise);
+/* correction_time: a complementary filter's time constant under the adaptive noise, at most the
+ * larger of tau and longest */
+double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
+                          double dt, double longest);
 /* adaptive_prefilter_time: tau times the disturbance's excess over the noise, in units of
  * PREFILTER_FULL times the noise, between 0 and tau */
 double fc_adaptive_prefilter_time(double tau, double dist, double noise);

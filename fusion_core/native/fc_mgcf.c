@@ -50,6 +50,11 @@ void fc_mgcf_configure(fc_mgcf *f)
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
     f->options = f->rest_time > 0.0 || f->acc_tau > 0.0;
+    f->r_ref = pow(p->acc_noise, 2.0);
+    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
+    f->dist_tau = f->acc_tau > 0.0 ? p->disturbance_time : 0.0;
+    f->dist_noise = 3.0 * f->r_ref * FC_G * FC_G;
+    f->longest = p->max_correction_time;
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
@@ -70,6 +75,8 @@ void fc_mgcf_reset(fc_mgcf *f)
     f->w0_now = 0.0;
     memset(f->acc_f, 0, sizeof f->acc_f);
     memset(f->rest, 0, sizeof f->rest);
+    f->acc_dist = 0.0;
+    memset(f->acc_ref, 0, sizeof f->acc_ref);
     f->last = fc_mgcf_estimate(f);
 }
 
@@ -81,6 +88,7 @@ static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _
     fc_accel_roll_pitch(a[0], a[1], a[2], &roll, &pitch);
     fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, f->q);
     memcpy(f->acc_f, a, sizeof f->acc_f);
+    memcpy(f->acc_ref, a, sizeof f->acc_ref);
     fc_rest_start(f->rest, g, a);
 }
 
@@ -88,6 +96,7 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
 {
     double ax = a_in[0], ay = a_in[1], az = a_in[2];
     double gx = g[0], gy = g[1], gz = g[2];
+    double r = f->r_ref;
     if (f->options) {  /* _real_sensor_options */
         if (f->rest_time > 0.0) {
             fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, dt, f->rest_gyro, f->rest_acc);
@@ -98,7 +107,14 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         if (f->acc_tau > 0.0) {
             double phi[3];
             fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
-            fc_lowpass_specific_force(f->acc_f, phi, a_in, dt, f->acc_tau);
+            double tau_f = f->acc_tau;
+            if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
+                fc_lowpass_specific_force(f->acc_ref, phi, a_in, dt, tau_f);
+                r = fc_measured_disturbance(&f->acc_dist, a_in, f->acc_ref, dt, f->dist_tau,
+                                            f->r_ref, f->dist_noise);
+                tau_f = fc_adaptive_prefilter_time(tau_f, f->acc_dist, f->dist_noise);
+            }
+            fc_lowpass_specific_force(f->acc_f, phi, a_in, dt, tau_f);
             ax = f->acc_f[0];
             ay = f->acc_f[1];
             az = f->acc_f[2];
@@ -112,6 +128,15 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     }
     f->w0_now = w0;
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
+    double gain = 1.0;  /* of Kp: the adaptive noise shortens the correction */
+    double kp0 = f->two_zeta * w0;
+    if (kp0 > 0.0 && (f->q_rotation > 0.0 || r != f->r_ref)) {
+        double wx = gx - bx, wy = gy - by, wz = gz - bz;
+        double tau = 1.0 / kp0;
+        gain = tau / fc_correction_time(tau, r / f->r_ref, f->q_rotation,
+                                         wx * wx + wy * wy + wz * wz, f->r_ref, dt,
+                                         f->longest);
+    }
     double q[4];
     memcpy(q, f->q, sizeof q);
     if (f->trapezoid) {
@@ -139,10 +164,10 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         f->bias[2] = bz;
     }
     if (!f->trapezoid) {
-        double kp = f->two_zeta * w0;
+        double kp = f->two_zeta * w0 * gain;
         quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz, dt);
     } else if (w0 > 0.0) {
-        double kp_dt = f->two_zeta * w0 * dt;
+        double kp_dt = f->two_zeta * w0 * gain * dt;
         fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
     }
     memcpy(f->q, q, sizeof q);

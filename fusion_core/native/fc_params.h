@@ -18,21 +18,26 @@
 #define FC_CF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_cf_params {
-    double tau;           /* (0.0, inf) [s] */
-    double gate_low;      /* (0.0, 1.0] */
-    double gate_high;     /* [1.0, inf) */
-    double acc_lowpass;   /* [0.0, inf) [s] */
-    double rest_time;     /* [0.0, inf) [s] */
-    double rest_gyro;     /* (0.0, inf) [rad/s] */
-    double rest_acc;      /* (0.0, inf) [m/s2] */
-    int propagation;      /* one of 'euler', 'quaternion' */
-    int gyro_sampling;    /* one of 'point', 'mean' */
-    double max_dt;        /* (0.0, inf) [s] */
-    double max_rate;      /* (0.0, inf) [rad/s] */
-    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double sensor_delay;  /* [0.0, 0.1] [s] */
+    double tau;                  /* (0.0, inf) [s] */
+    double gate_low;             /* (0.0, 1.0] */
+    double gate_high;            /* [1.0, inf) */
+    double acc_lowpass;          /* [0.0, inf) [s] */
+    double rest_time;            /* [0.0, inf) [s] */
+    double rest_gyro;            /* (0.0, inf) [rad/s] */
+    double rest_acc;             /* (0.0, inf) [m/s2] */
+    int propagation;             /* one of 'euler', 'quaternion' */
+    int gyro_sampling;           /* one of 'point', 'mean' */
+    double acc_noise;            /* (0.0, inf) */
+    double gyro_scale_std;       /* [0.0, 0.5] */
+    double scale_time;           /* [0.0, inf) [s] */
+    double disturbance_time;     /* [0.0, inf) [s] */
+    double max_correction_time;  /* [0.0, inf) [s] */
+    double max_dt;               /* (0.0, inf) [s] */
+    double max_rate;             /* (0.0, inf) [rad/s] */
+    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_cf_params;
 
 /* The defaults: ComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
@@ -47,6 +52,11 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->rest_acc = 0.5;
     p->propagation = FC_CF_PROPAGATION_QUATERNION;
     p->gyro_sampling = FC_CF_GYRO_SAMPLING_POINT;
+    p->acc_noise = 0.005;
+    p->gyro_scale_std = 0.005;
+    p->scale_time = 0.5;
+    p->disturbance_time = 1.0;
+    p->max_correction_time = 3.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
@@ -64,20 +74,25 @@ static inline void fc_cf_params_default(fc_cf_params *p)
 #define FC_MGCF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_mgcf_params {
-    int schedule;         /* one of 'simulation', 'experimental', 'fixed' */
-    double w0;            /* [0.0, inf) [rad/s] */
-    double zeta;          /* [0.0, inf) */
-    double acc_lowpass;   /* [0.0, inf) [s] */
-    double rest_time;     /* [0.0, inf) [s] */
-    double rest_gyro;     /* (0.0, inf) [rad/s] */
-    double rest_acc;      /* (0.0, inf) [m/s2] */
-    int gyro_sampling;    /* one of 'point', 'mean' */
-    double max_dt;        /* (0.0, inf) [s] */
-    double max_rate;      /* (0.0, inf) [rad/s] */
-    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double sensor_delay;  /* [0.0, 0.1] [s] */
+    int schedule;                /* one of 'simulation', 'experimental', 'fixed' */
+    double w0;                   /* [0.0, inf) [rad/s] */
+    double zeta;                 /* [0.0, inf) */
+    double acc_lowpass;          /* [0.0, inf) [s] */
+    double rest_time;            /* [0.0, inf) [s] */
+    double rest_gyro;            /* (0.0, inf) [rad/s] */
+    double rest_acc;             /* (0.0, inf) [m/s2] */
+    int gyro_sampling;           /* one of 'point', 'mean' */
+    double acc_noise;            /* (0.0, inf) */
+    double gyro_scale_std;       /* [0.0, 0.5] */
+    double scale_time;           /* [0.0, inf) [s] */
+    double disturbance_time;     /* [0.0, inf) [s] */
+    double max_correction_time;  /* [0.0, inf) [s] */
+    double max_dt;               /* (0.0, inf) [s] */
+    double max_rate;             /* (0.0, inf) [rad/s] */
+    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_mgcf_params;
 
 /* The defaults: GainScheduledComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
@@ -91,6 +106,11 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
     p->gyro_sampling = FC_MGCF_GYRO_SAMPLING_POINT;
+    p->acc_noise = 0.005;
+    p->gyro_scale_std = 0.005;
+    p->scale_time = 0.5;
+    p->disturbance_time = 1.0;
+    p->max_correction_time = 3.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
