@@ -122,17 +122,18 @@ def noise_preset(gyro_density: float, acc_density: float,
     (acc_sample_std / g)^2, gyro_psd (its zero-rate update) the gyro's PSD; ukf: gyro_psd and
     zaru_psd the gyro's PSD, acc_noise = acc_sample_std / g; poskf: acc_psd the accelerometer's
     PSD and gyro_psd the gyro's (its tilt stage keeps the papers' Q and R, which the position
-    contract was met with). cf and mgcf have no noise-derived value (their time constants come
-    from the bias a correction must hold off and from scans, see their docstrings): {}.
+    contract was met with); cf and mgcf: acc_noise = acc_sample_std / g, the reference their
+    adaptive noise is measured against (their time constants come from the bias a correction must
+    hold off and from scans, see their docstrings).
 
     The recommended defaults are this function at the reference sensor, kalman.REAL_GYRO_DENSITY,
     position.REAL_ACC_DENSITY and REFERENCE_ACC_SAMPLE_STD (tests/test_presets.py holds them to
-    it; ukf's acc_noise is rounded to 0.005)."""
+    it; the acc_noise of cf, mgcf and ukf is rounded to 0.005)."""
     gyro_psd = gyro_density * gyro_density
     r = (acc_sample_std / G) ** 2
     return {
-        "cf": {},
-        "mgcf": {},
+        "cf": {"acc_noise": acc_sample_std / G},
+        "mgcf": {"acc_noise": acc_sample_std / G},
         "kf": {"Q_angle": gyro_psd, "R_measure": r, "gyro_psd": gyro_psd},
         "ukf": {"gyro_psd": gyro_psd, "zaru_psd": gyro_psd, "acc_noise": acc_sample_std / G},
         "poskf": {"acc_psd": acc_density * acc_density, "gyro_psd": gyro_psd},

@@ -128,7 +128,7 @@ def test_poskf_outputs_the_recommended_kf_attitude() -> None:
 def test_the_recommended_defaults_are_the_noise_derivation_at_the_reference_sensor():
     """presets.noise_preset (what `testbenches noise` writes for a user's sensor) and the
     classes' defaults cannot drift apart: at the reference sensor it gives the defaults (ukf's
-    acc_noise rounded to 0.005)."""
+    acc_noise, and cf's and mgcf's, rounded to 0.005)."""
     from fusion_core.building_blocks import REAL_GYRO_DENSITY
     from fusion_core.position import REAL_ACC_DENSITY
     from fusion_core.presets import REFERENCE_ACC_SAMPLE_STD, noise_preset
@@ -138,5 +138,5 @@ def test_the_recommended_defaults_are_the_noise_derivation_at_the_reference_sens
     for key, params in derived.items():
         specs = ESTIMATORS[key].param_specs()
         for name, value in params.items():
-            rel = 0.02 if (key, name) == ("ukf", "acc_noise") else 1e-12
+            rel = 0.02 if name == "acc_noise" else 1e-12
             assert value == pytest.approx(specs[name].default, rel=rel), (key, name)
