@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from math import cos, sin
-from typing import Final
+from typing import Any, Final
 
 from .kinematics import (
     rotate_back,
@@ -325,6 +325,31 @@ so a bias b left by the usual start-up calibration (0.16 deg/s on the realistic 
 datasheet's temperature drift over 1 K of warm-up) costs b times this, 0.5 deg at 3 s. A coarse
 scan of the cf on BROAD (2 / 3 / 4 / 5 / 10 s: 0.590 / 0.559 / 0.554 / 0.555 / 0.568 deg) has its
 plateau at 3-5 s; 3 keeps that bias error smallest on it."""
+
+
+COMPLEMENTARY_ADAPTIVE_PARAMS: Final = (
+    Param(
+        "acc_noise", 0.005,
+        "Standard deviation of one accelerometer sample divided by g, the reference of the "
+        "adaptive noise (the measured sample noise of a real MEMS IMU)",
+        low=0.0, low_open=True,
+    ),
+    *ADAPTIVE_NOISE_PARAMS,
+    MAX_CORRECTION_TIME_PARAM,
+)
+"""The adaptive noise of the complementary filters (cf, mgcf): ADAPTIVE_NOISE_PARAMS, the sample
+noise they are measured against and the longest correction time."""
+
+
+def complementary_adaptive(p: Any, acc_tau: float) -> tuple[float, float, float, float, float]:
+    """The constants of COMPLEMENTARY_ADAPTIVE_PARAMS from a filter's parameters p: one sample's
+    variance r, the rotation term per (rad/s)^2, the disturbance's averaging time (0: off, also
+    without the pre-filter acc_tau), the white noise's share of the disturbance statistic
+    (3 axes of r g^2) and the longest correction time."""
+    r = float(p["acc_noise"]) ** 2
+    return (r, float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
+            float(p["disturbance_time"]) if acc_tau > 0.0 else 0.0, 3.0 * r * G * G,
+            float(p["max_correction_time"]))
 
 
 def correction_time(tau: float, r_ratio: float, q_rotation: float, w2: float, r: float,

@@ -13,15 +13,15 @@ from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
-    ADAPTIVE_NOISE_PARAMS,
+    COMPLEMENTARY_ADAPTIVE_PARAMS,
     GYRO_SAMPLING_PARAM,
-    MAX_CORRECTION_TIME_PARAM,
     PROPAGATION_PARAM,
     REST_PARAMS,
     ZERO3,
     adaptive_prefilter_time,
     bias_at_rest,
     body_rotation,
+    complementary_adaptive,
     correction_time,
     gate_bounds2,
     lowpass_specific_force,
@@ -42,7 +42,7 @@ from .kinematics import (
     rotvec_terms,
     wrap_angle,
 )
-from .types import Estimate, G, Param
+from .types import Estimate, Param
 
 
 class ComplementaryFilter(Estimator):
@@ -107,14 +107,7 @@ class ComplementaryFilter(Estimator):
         *REST_PARAMS,
         PROPAGATION_PARAM,
         GYRO_SAMPLING_PARAM,
-        Param(
-            "acc_noise", 0.005,
-            "Standard deviation of one accelerometer sample divided by g, the reference of the "
-            "adaptive noise (the measured sample noise of a real MEMS IMU)",
-            low=0.0, low_open=True,
-        ),
-        *ADAPTIVE_NOISE_PARAMS,
-        MAX_CORRECTION_TIME_PARAM,
+        *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
     STATE = ("roll", "pitch", "acc_f", "q_att", "bias", "rest", "acc_dist", "acc_ref")
 
@@ -131,12 +124,7 @@ class ComplementaryFilter(Estimator):
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): one sample's variance, the
         # rotation term per (rad/s)^2, the disturbance's averaging time (0: off), the white
         # noise's share of the disturbance statistic and the longest correction time
-        r = float(p["acc_noise"]) ** 2
-        self._adaptive = (
-            r, float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
-            float(p["disturbance_time"]) if self._acc_tau > 0.0 else 0.0, 3.0 * r * G * G,
-            float(p["max_correction_time"]),
-        )
+        self._adaptive = complementary_adaptive(p, self._acc_tau)
 
     def _reset(self) -> None:
         self.roll = 0.0

@@ -21,14 +21,14 @@ import math
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
-    ADAPTIVE_NOISE_PARAMS,
+    COMPLEMENTARY_ADAPTIVE_PARAMS,
     GYRO_SAMPLING_PARAM,
-    MAX_CORRECTION_TIME_PARAM,
     REST_PARAMS,
     ZERO3,
     adaptive_prefilter_time,
     bias_at_rest,
     body_rotation,
+    complementary_adaptive,
     correction_time,
     lowpass_specific_force,
     measured_disturbance,
@@ -130,14 +130,7 @@ class GainScheduledComplementaryFilter(Estimator):
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         GYRO_SAMPLING_PARAM,
-        Param(
-            "acc_noise", 0.005,
-            "Standard deviation of one accelerometer sample divided by g, the reference of the "
-            "adaptive noise (the measured sample noise of a real MEMS IMU)",
-            low=0.0, low_open=True,
-        ),
-        *ADAPTIVE_NOISE_PARAMS,
-        MAX_CORRECTION_TIME_PARAM,
+        *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
     STATE = ("q", "bias", "w0_now", "acc_f", "rest", "acc_dist", "acc_ref")
 
@@ -155,12 +148,7 @@ class GainScheduledComplementaryFilter(Estimator):
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS), as in the cf: one sample's
         # variance, the rotation term per (rad/s)^2, the disturbance's averaging time (0: off),
         # the white noise's share of the disturbance statistic, the longest correction time
-        r = float(p["acc_noise"]) ** 2
-        self._adaptive = (
-            r, float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
-            float(p["disturbance_time"]) if self._acc_tau > 0.0 else 0.0, 3.0 * r * G * G,
-            float(p["max_correction_time"]),
-        )
+        self._adaptive = complementary_adaptive(p, self._acc_tau)
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)
