@@ -10,9 +10,10 @@ below answers one of them the same way in every estimator:
   force in a frame that turns with the gyro, so linear acceleration averages out (Laidig & Seel
   2023, VQF);
 - rest detection for a zero-angular-rate bias update (REST_PARAMS, rest_step; VQF's detector);
-- adaptive noise of the Kalman filters (ADAPTIVE_NOISE_PARAMS, measured_disturbance): more
-  process noise while the sensor turns (the gyro's scale-factor error), more measurement noise
-  while it accelerates (the linear acceleration the pre-filter has not removed);
+- adaptive noise (ADAPTIVE_NOISE_PARAMS, disturbance_step; correction_time for the
+  complementary filters): more process noise while the sensor turns (the gyro's scale-factor
+  error), more measurement noise while it accelerates (the linear acceleration the pre-filter
+  has not removed), the raw sample where it measures none;
 - quaternion propagation of Euler-angle filters (PROPAGATION_PARAM), free of the pitch +-90 deg
   singularity of the Euler rates;
 - the nearest face (FACES, nearest_face): per-axis tilt filters run in the sensor frame turned
@@ -203,10 +204,11 @@ def body_rotation(g0: Vec3, g1: Vec3, bias: Vec3, dt: float, trapezoid: bool) ->
 
 
 def lowpass_specific_force(f: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
-                           terms: tuple[float, float, float, float] | None = None) -> Vec3:
+                           terms: tuple[float, float, float, float]) -> Vec3:
     """One step of the accelerometer pre-filter (ACC_LOWPASS_PARAM): the filtered specific force
     f turned with the body by phi, then blended with the new sample a, k = dt / (tau + dt);
-    terms: kinematics.rotvec_terms(*phi) when the caller has them."""
+    terms: kinematics.rotvec_terms(*phi), which the caller also turns its attitude or a second
+    pre-filter with."""
     f0, f1, f2 = rotate_back(f, phi, terms)
     k = dt / (tau + dt)
     return f0 + k * (a[0] - f0), f1 + k * (a[1] - f1), f2 + k * (a[2] - f2)
@@ -281,17 +283,26 @@ ADAPTIVE_NOISE_PARAMS: Final = (
         unit="s", low=0.0,
     ),
 )
-"""The Kalman filters' adaptive noise. Their constant Q and R describe a gyro with white noise
-only and an accelerometer that measures gravity alone; a real sensor breaks both in motion, and
-the balance of the two sets the correction's speed:
+"""The adaptive noise (kf, ukf; cf and mgcf through COMPLEMENTARY_ADAPTIVE_PARAMS). A constant Q
+and R describe a gyro with white noise only and an accelerometer that measures gravity alone; a
+real sensor breaks both in motion, and the balance of the two sets the correction's speed:
 - gyro_scale_std, scale_time: a gyro with a scale-factor error s turns the estimate by s times
   every rotation, which a white-noise Q does not know. While the sensor turns at rate w the
   process noise of the attitude grows by gyro_scale_std^2 w^2 scale_time (the variance a scale
   error of that size adds up over scale_time, taken as a white noise), so the accelerometer
   takes over faster in fast rotation;
-- disturbance_time: measured_disturbance, against a second pre-filter of the full acc_lowpass
-  (acc_ref), and adaptive_prefilter_time for the pre-filter whose vector is measured. 1 s, the
-  pre-filter's own time constant."""
+- disturbance_time: disturbance_step (measured_disturbance against a second pre-filter of the
+  full acc_lowpass, acc_ref, and adaptive_prefilter_time for the pre-filter whose vector is
+  measured). 1 s, the pre-filter's own time constant."""
+
+
+def adaptive_noise_constants(p: Any, acc_tau: float, r: float) -> tuple[float, float, float]:
+    """The constants of ADAPTIVE_NOISE_PARAMS from a filter's parameters p, its pre-filter's time
+    constant acc_tau and one accelerometer sample's variance r (over g^2): the rotation term of
+    the process noise per (rad/s)^2, the disturbance's averaging time (0: off, also without the
+    pre-filter) and the white noise's share of the disturbance statistic (3 axes of r g^2)."""
+    return (float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
+            float(p["disturbance_time"]) if acc_tau > 0.0 else 0.0, 3.0 * r * G * G)
 
 
 def measured_disturbance(dist: float, a: Vec3, f: Vec3, dt: float, tau: float, r: float,
@@ -311,6 +322,19 @@ def measured_disturbance(dist: float, a: Vec3, f: Vec3, dt: float, tau: float, r
     dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
     excess = dist - noise
     return dist, (r + excess / (G * G) if excess > 0.0 else r)
+
+
+def disturbance_step(ref: Vec3, dist: float, a: Vec3, phi: Vec3,
+                     terms: tuple[float, float, float, float], dt: float, tau: float,
+                     dist_tau: float, r: float, noise: float) -> tuple[Vec3, float, float, float]:
+    """The measurement side of the adaptive noise for one sample a (ADAPTIVE_NOISE_PARAMS'
+    disturbance_time): the full pre-filter ref (time constant tau, turned by phi with its
+    kinematics.rotvec_terms), the disturbance statistic against it and the measurement variance
+    it gives from r (measured_disturbance), and the time constant of the pre-filter whose vector
+    is measured (adaptive_prefilter_time). Returns (ref, dist, r, that time constant)."""
+    ref = lowpass_specific_force(ref, phi, a, dt, tau, terms)
+    dist, r = measured_disturbance(dist, a, ref, dt, dist_tau, r, noise)
+    return ref, dist, r, adaptive_prefilter_time(tau, dist, noise)
 
 
 MAX_CORRECTION_TIME_PARAM: Final = Param(
@@ -347,9 +371,7 @@ def complementary_adaptive(p: Any, acc_tau: float) -> tuple[float, float, float,
     without the pre-filter acc_tau), the white noise's share of the disturbance statistic
     (3 axes of r g^2) and the longest correction time."""
     r = float(p["acc_noise"]) ** 2
-    return (r, float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
-            float(p["disturbance_time"]) if acc_tau > 0.0 else 0.0, 3.0 * r * G * G,
-            float(p["max_correction_time"]))
+    return (r, *adaptive_noise_constants(p, acc_tau, r), float(p["max_correction_time"]))
 
 
 def correction_time(tau: float, r_ratio: float, q_rotation: float, w2: float, r: float,

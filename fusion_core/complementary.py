@@ -18,14 +18,13 @@ from .building_blocks import (
     PROPAGATION_PARAM,
     REST_PARAMS,
     ZERO3,
-    adaptive_prefilter_time,
     bias_at_rest,
     body_rotation,
     complementary_adaptive,
     correction_time,
+    disturbance_step,
     gate_bounds2,
     lowpass_specific_force,
-    measured_disturbance,
     quat_from_roll_pitch,
     rest_step,
 )
@@ -161,12 +160,9 @@ class ComplementaryFilter(Estimator):
             if self._acc_tau > 0.0:  # the filter and its gate use the pre-filtered vector
                 tau_f = self._acc_tau
                 if dist_tau > 0.0:  # the adaptive noise: disturbance against the full pre-filter
-                    self.acc_ref = lowpass_specific_force(self.acc_ref, phi, (ax, ay, az), dt,
-                                                          tau_f, terms)
-                    self.acc_dist, r = measured_disturbance(self.acc_dist, (ax, ay, az),
-                                                            self.acc_ref, dt, dist_tau, r_ref,
-                                                            noise)
-                    tau_f = adaptive_prefilter_time(tau_f, self.acc_dist, noise)
+                    self.acc_ref, self.acc_dist, r, tau_f = disturbance_step(
+                        self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau_f,
+                        dist_tau, r_ref, noise)
                 self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau_f,
                                                     terms)
                 ax, ay, az = self.acc_f

@@ -35,14 +35,14 @@ from .building_blocks import (
     REST_PARAMS,
     ZERO3,
     Vec3,
-    adaptive_prefilter_time,
+    adaptive_noise_constants,
     bias_band2,
     body_rotation,
+    disturbance_step,
     gate_bounds2,
     lowpass_specific_force,
     mat_t_vec,
     mat_vec,
-    measured_disturbance,
     nearest_face,
     quat_from_roll_pitch,
     rest_step,
@@ -283,20 +283,14 @@ class AngleBiasKalmanFilter(Estimator):
         self._gate2 = gate_bounds2(p)
         self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
-        # the zero-rate update's constants in one attribute: CPython 3.11 gives an instance of at
-        # most 29 attributes its faster shared-key dict, and this class is at 29
+        # the zero-rate update's constants, read together
         self._rest_cfg = (
             float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]),
             float(p["gyro_psd"]),
         )
-        # the adaptive noise in one attribute (the shared-key dict limit above): Q's rotation
-        # term per (rad/s)^2, the disturbance's averaging time (0: off) and the white noise's
-        # share of the disturbance statistic, 3 axes of one sample's variance R g^2
-        self._adaptive = (
-            float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
-            float(p["disturbance_time"]) if self._acc_tau > 0.0 else 0.0,
-            3.0 * self._r * G * G,
-        )
+        # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): Q's rotation term per
+        # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share
+        self._adaptive = adaptive_noise_constants(p, self._acc_tau, self._r)
         self._quaternion: bool = p["propagation"] == "quaternion"
         # the faces need the attitude quaternion to carry the state across (with the Euler rates
         # the filters stay on the sensor's axes)
@@ -394,30 +388,20 @@ class AngleBiasKalmanFilter(Estimator):
         if self._rest_cfg[0] > 0.0:  # rest_time
             self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
         if self._acc_tau > 0.0:
-            assert phi is not None  # computed above whenever acc_tau > 0
+            assert phi is not None and terms is not None  # computed above whenever acc_tau > 0
             tau = self._acc_tau
-            if self._adaptive[1] > 0.0:
-                tau = self._measure_disturbance(ax, ay, az, dt, phi, terms)
+            _, dist_tau, noise = self._adaptive
+            if dist_tau > 0.0:  # the measured disturbance: this step's R and pre-filter
+                base = self._r_loop / dt if self._r_loop > 0.0 else self._r
+                self.acc_ref, self.acc_dist, self.r_step, tau = disturbance_step(
+                    self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau, dist_tau,
+                    base, noise)
             self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau, terms)
             ax, ay, az = self.acc_f
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             self.correct(ax, ay, az, learn_bias)
         if self._quaternion and (self.roll, self.pitch) != predicted:
             self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
-
-    def _measure_disturbance(self, ax: float, ay: float, az: float, dt: float, phi: Vec3,
-                             terms: tuple[float, float, float, float]) -> float:
-        """The linear acceleration against acc_ref, the full pre-filter (disturbance_time,
-        building_blocks.measured_disturbance): this step's measurement variance on top of
-        R_measure's; returns the pre-filter's time constant for this step
-        (building_blocks.adaptive_prefilter_time)."""
-        self.acc_ref = lowpass_specific_force(self.acc_ref, phi, (ax, ay, az), dt, self._acc_tau,
-                                              terms)
-        base = self._r_loop / dt if self._r_loop > 0.0 else self._r
-        _, tau, noise = self._adaptive
-        self.acc_dist, self.r_step = measured_disturbance(self.acc_dist, (ax, ay, az),
-                                                          self.acc_ref, dt, tau, base, noise)
-        return adaptive_prefilter_time(self._acc_tau, self.acc_dist, noise)
 
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float

@@ -25,13 +25,12 @@ from .building_blocks import (
     GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     ZERO3,
-    adaptive_prefilter_time,
     bias_at_rest,
     body_rotation,
     complementary_adaptive,
     correction_time,
+    disturbance_step,
     lowpass_specific_force,
-    measured_disturbance,
     rest_step,
 )
 from .kinematics import (
@@ -41,6 +40,7 @@ from .kinematics import (
     quat_mul_rotvec,
     quat_roll_pitch,
     rotation_increment,
+    rotvec_terms,
 )
 from .types import Estimate, G, Param
 
@@ -180,14 +180,14 @@ class GainScheduledComplementaryFilter(Estimator):
         r_ref, _, dist_tau, noise, _ = self._adaptive
         if self._acc_tau > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), self.bias, dt, self._trapezoid)
+            terms = rotvec_terms(*phi)  # once, for both pre-filters
             tau_f, r = self._acc_tau, r_ref
             if dist_tau > 0.0:  # the adaptive noise: disturbance against the full pre-filter
-                self.acc_ref = lowpass_specific_force(self.acc_ref, phi, (ax, ay, az), dt, tau_f)
-                self.acc_dist, r = measured_disturbance(self.acc_dist, (ax, ay, az),
-                                                        self.acc_ref, dt, dist_tau, r_ref, noise)
-                tau_f = adaptive_prefilter_time(tau_f, self.acc_dist, noise)
+                self.acc_ref, self.acc_dist, r, tau_f = disturbance_step(
+                    self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau_f, dist_tau,
+                    r_ref, noise)
             f0, f1, f2 = self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
-                                                             tau_f)
+                                                             tau_f, terms)
             return f0, f1, f2, r
         return ax, ay, az, r_ref
 

@@ -54,15 +54,15 @@ from .building_blocks import (
     GYRO_SAMPLING_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
-    adaptive_prefilter_time,
+    adaptive_noise_constants,
     bias_band2,
     body_rotation,
+    disturbance_step,
     lowpass_specific_force,
-    measured_disturbance,
     rest_step,
     zero_rate_psd_param,
 )
-from .kinematics import accel_roll_pitch, rotate_back
+from .kinematics import accel_roll_pitch, rotate_back, rotvec_terms
 from .types import DEG, Estimate, G, Param
 
 N_STATE: Final = 6  # X (3), gyro bias b (3)
@@ -177,11 +177,7 @@ class UnscentedKalmanFilter(Estimator):
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): Q's rotation term per
         # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share of the
         # disturbance statistic (3 axes of one sample's variance, (acc_noise g)^2)
-        self._adaptive = (
-            float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
-            float(p["disturbance_time"]) if float(p["acc_lowpass"]) > 0.0 else 0.0,
-            3.0 * self._r_acc * G * G,
-        )
+        self._adaptive = adaptive_noise_constants(p, float(p["acc_lowpass"]), self._r_acc)
         self._gate = float(p["acc_gate"])
         self._trapezoid: bool = p["gyro_sampling"] == "point"
         # any real-sensor option on (else the paper's filter alone: the short path of _advance)
@@ -242,15 +238,15 @@ class UnscentedKalmanFilter(Estimator):
         if p["acc_lowpass"] > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), (self.x[3], self.x[4], self.x[5]),
                                 dt, self._trapezoid)
+            terms = rotvec_terms(*phi)  # once, for both pre-filters
             tau = p["acc_lowpass"]
             r = self._r_acc
             _, dist_tau, noise = self._adaptive
             if dist_tau > 0.0:  # building_blocks.ADAPTIVE_NOISE_PARAMS
-                self.acc_ref = lowpass_specific_force(self.acc_ref, phi, (ax, ay, az), dt, tau)
-                self.acc_dist, r = measured_disturbance(
-                    self.acc_dist, (ax, ay, az), self.acc_ref, dt, dist_tau, r, noise)
-                tau = adaptive_prefilter_time(tau, self.acc_dist, noise)
-            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau)
+                self.acc_ref, self.acc_dist, r, tau = disturbance_step(
+                    self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau, dist_tau, r,
+                    noise)
+            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau, terms)
             self._filter_update(*self.acc_f, gx, gy, gz, dt, learn_bias, r)
         else:
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)

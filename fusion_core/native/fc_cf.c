@@ -77,10 +77,8 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
         if (f->acc_tau > 0.0) {
             double tau_f = f->acc_tau;
             if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
-                fc_lowpass_specific_force_terms(f->acc_ref, phi, terms, a, dt, tau_f);
-                r = fc_measured_disturbance(&f->acc_dist, a, f->acc_ref, dt, f->dist_tau,
-                                            f->r_ref, f->dist_noise);
-                tau_f = fc_adaptive_prefilter_time(tau_f, f->acc_dist, f->dist_noise);
+                tau_f = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt, tau_f,
+                                            f->dist_tau, &r, f->dist_noise);
             }
             fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau_f);
             memcpy(a, f->acc_f, sizeof a);

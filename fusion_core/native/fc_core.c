@@ -230,14 +230,6 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
     f[2] = t[2] + k * (a[2] - t[2]);
 }
 
-void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
-                               double tau)
-{
-    double t[4];
-    fc_rotvec_terms(phi[0], phi[1], phi[2], t);
-    fc_lowpass_specific_force_terms(f, phi, t, a, dt, tau);
-}
-
 double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
                                double tau, double r, double noise)
 {
@@ -246,6 +238,15 @@ double fc_measured_disturbance(double *dist, const double a[3], const double f[3
     *dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - *dist);
     double excess = *dist - noise;
     return excess > 0.0 ? r + excess / (FC_G * FC_G) : r;
+}
+
+double fc_disturbance_step(double ref[3], double *dist, const double a[3], const double phi[3],
+                           const double terms[4], double dt, double tau, double dist_tau,
+                           double *r, double noise)
+{
+    fc_lowpass_specific_force_terms(ref, phi, terms, a, dt, tau);
+    *r = fc_measured_disturbance(dist, a, ref, dt, dist_tau, *r, noise);
+    return fc_adaptive_prefilter_time(tau, *dist, noise);
 }
 
 double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,

@@ -80,8 +80,6 @@ void fc_quat_from_roll_pitch(double roll, double pitch, double q[4]);
 void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2);
 void fc_body_rotation(const double g0[3], const double g1[3], const double bias[3], double dt,
                       int trapezoid, double phi[3]);
-void fc_lowpass_specific_force(double f[3], const double phi[3], const double a[3], double dt,
-                               double tau);
 void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
                                      const double a[3], double dt, double tau);
 /* measured_disturbance: one step of the disturbance statistic *dist (the mean square of the raw
@@ -89,6 +87,12 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
  * r plus its excess over the white noise's share, over g^2 */
 double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
                                double tau, double r, double noise);
+/* disturbance_step: the full pre-filter ref (tau) turned by phi (its terms) and blended with a,
+ * the statistic *dist against it and the measurement variance *r it gives, and the returned
+ * time constant of the pre-filter whose vector is measured */
+double fc_disturbance_step(double ref[3], double *dist, const double a[3], const double phi[3],
+                           const double terms[4], double dt, double tau, double dist_tau,
+                           double *r, double noise);
 /* correction_time: a complementary filter's time constant under the adaptive noise, at most the
  * larger of tau and longest */
 double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,

@@ -263,18 +263,6 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     }
 }
 
-/* _measure_disturbance: this step's measurement variance from the linear acceleration against
- * acc_ref; returns the pre-filter's time constant for this step */
-static double measure_disturbance(fc_kf *f, const double a[3], double dt, const double phi[3],
-                                  const double terms[4])
-{
-    fc_lowpass_specific_force_terms(f->acc_ref, phi, terms, a, dt, f->acc_tau);
-    double base = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
-    f->r_step = fc_measured_disturbance(&f->acc_dist, a, f->acc_ref, dt, f->dist_tau, base,
-                                        f->dist_noise);
-    return fc_adaptive_prefilter_time(f->acc_tau, f->acc_dist, f->dist_noise);
-}
-
 /* _update_with_options, in the filters' frame; prev: the previous gyro sample there */
 static void update_with_options(fc_kf *f, const double a_in[3], const double g[3], double dt,
                                 const double prev[3])
@@ -296,8 +284,10 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
     }
     if (f->acc_tau > 0.0) {
         double tau = f->acc_tau;
-        if (f->dist_tau > 0.0) {
-            tau = measure_disturbance(f, a, dt, phi, terms);
+        if (f->dist_tau > 0.0) {  /* the measured disturbance: this step's R and pre-filter */
+            f->r_step = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
+            tau = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt, tau,
+                                      f->dist_tau, &f->r_step, f->dist_noise);
         }
         fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau);
         memcpy(a, f->acc_f, sizeof a);

@@ -105,16 +105,15 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
             }
         }
         if (f->acc_tau > 0.0) {
-            double phi[3];
+            double phi[3], terms[4];
             fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+            fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both pre-filters */
             double tau_f = f->acc_tau;
             if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
-                fc_lowpass_specific_force(f->acc_ref, phi, a_in, dt, tau_f);
-                r = fc_measured_disturbance(&f->acc_dist, a_in, f->acc_ref, dt, f->dist_tau,
-                                            f->r_ref, f->dist_noise);
-                tau_f = fc_adaptive_prefilter_time(tau_f, f->acc_dist, f->dist_noise);
+                tau_f = fc_disturbance_step(f->acc_ref, &f->acc_dist, a_in, phi, terms, dt,
+                                            tau_f, f->dist_tau, &r, f->dist_noise);
             }
-            fc_lowpass_specific_force(f->acc_f, phi, a_in, dt, tau_f);
+            fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a_in, dt, tau_f);
             ax = f->acc_f[0];
             ay = f->acc_f[1];
             az = f->acc_f[2];

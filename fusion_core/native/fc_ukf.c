@@ -594,16 +594,15 @@ static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
         return;
     }
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
-        double phi[3], b[3] = {f->x[3], f->x[4], f->x[5]};
+        double phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
         fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
+        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both pre-filters */
         double tau = p->acc_lowpass, r = f->r_acc;
         if (f->dist_tau > 0.0) {  /* building_blocks.ADAPTIVE_NOISE_PARAMS */
-            fc_lowpass_specific_force(f->acc_ref, phi, a, dt, tau);
-            r = fc_measured_disturbance(&f->acc_dist, a, f->acc_ref, dt, f->dist_tau, r,
-                                        f->dist_noise);
-            tau = fc_adaptive_prefilter_time(tau, f->acc_dist, f->dist_noise);
+            tau = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt, tau,
+                                      f->dist_tau, &r, f->dist_noise);
         }
-        fc_lowpass_specific_force(f->acc_f, phi, a, dt, tau);
+        fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau);
         filter_update(f, f->acc_f[0], f->acc_f[1], f->acc_f[2], g, dt, learn_bias, r);
     } else {
         filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);
