@@ -41,7 +41,6 @@ P is kept as its lower triangle (21 floats, row by row); the `P` attribute shows
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Final
 
@@ -70,16 +69,6 @@ UpdateResult = tuple[float, float, float, float, float, float, tuple[float, ...]
 """The updated state x (6 floats) and the packed covariance P (21 floats)."""
 
 
-UKF_ADAPTIVE_OFF = ("gyro_scale_std", "disturbance_time")
-"""The adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS) is off in the recommended UKF. On
-the testbench it does for this filter what it does for the kf (roll_sweep 0.30/0.34 -> 0.10/0.06,
-high_dynamics 6.3/8.3 -> 1.6/1.8, moderate_dynamics 0.27/0.31 -> 0.24/0.20 deg), but it fails
-vibration (2.7/6.3 deg against a 3 deg bound: the first sample, taken in 0.3 g of vibration, sets
-X 24 deg off, and with R raised by the vibration the filter explains that start by its bias
-states for 20 s) and takes BROAD's mean from 0.600 to 0.878 deg (trial 28, turning at 300-420
-deg/s: 0.95 -> 3.5). They stay parameters, for a sensor where they help."""
-
-
 class UnscentedKalmanFilter(Estimator):
     """Duong Quoc et al. UKF (gravity direction) with three gyro-bias states.
 
@@ -87,9 +76,10 @@ class UnscentedKalmanFilter(Estimator):
     Predict: each sigma point is rotated by its own bias-corrected rotation increment
       (exp(-[phi_i]x) X_i), b_i unchanged; Q = gyro_psd dt (I - X X^T) for X (the gyro noise
       turns X only perpendicular to itself) and bias_psd dt I for b.
-    Update: z = [acc/g; 1], h(x) = [X; |X|^2], R = diag(acc_noise^2 I3, norm_noise^2); the
-      accelerometer update is skipped while rho = ||acc|/g - 1| >= acc_gate (the accelerometer
-      then measures more than gravity). After the update X is renormalised to unit length.
+    Update: z = [acc/g; 1], h(x) = [X; |X|^2], R = diag(acc_noise^2 I3, norm_noise^2) (with
+      norm_noise 0, z = acc/g and h(x) = X alone); the accelerometer update is skipped while
+      rho = ||acc|/g - 1| >= acc_gate (the accelerometer then measures more than gravity).
+      After the update X is renormalised to unit length.
     Recommended values (the defaults), with the real-sensor options of building_blocks on (the
     accelerometer pre-filter, 1 s, and the zero-rate update at rest, VQF's thresholds): from
     sensor physics, gyro_psd and zaru_psd = the gyro's measured noise PSD,
@@ -98,9 +88,22 @@ class UnscentedKalmanFilter(Estimator):
     and no gate is needed (acc_gate 1.0: off); bias_psd (1e-4 deg/s/sqrt(s))^2, the gyro's drift
     over a 150 s recording, the rest updates doing the rest; the bias learns only while the
     measured and the predicted gravity direction are within 10 deg (bias_innovation,
-    building_blocks.BIAS_INNOVATION). The paper gives no values; the ones
+    building_blocks.BIAS_INNOVATION); the adaptive noise of building_blocks.ADAPTIVE_NOISE_PARAMS
+    (the gyro's scale uncertainty while it turns, R from the measured disturbance), as the kf's.
+    No unit-norm pseudo-measurement (norm_noise 0): X is renormalised after every update, so
+    |X|^2 = 1 tells the filter nothing about X, but the unscented transform of |X|^2 reacts to
+    the sigma points' spread (points X +- gamma s with s across X lie gamma^2 |s|^2 off the
+    sphere) and the update reads that spread as information and takes it out of P_XX. The filter
+    then holds X more certain than it is and explains its innovations by its bias states. This
+    shows where the adaptive noise raises R: on the vibration testbench, started from a sample
+    taken in 0.3 g of vibration, pitch RMSE is 6.3 deg with the row (X still 17 deg off after
+    4 s) and 1.5 deg without it (7 deg off after 4 s, as the kf); on BROAD's trial 28
+    (300-420 deg/s) 3.5 against 0.95 deg. Over norm_noise 0.01 / 0.03 / 0.1 / 0.3 / 1 with the
+    adaptive noise on: BROAD 0.878 / 0.642 / 0.567 / 0.551 / 0.548 deg, vibration pitch 6.3 / 3.2
+    / 1.9 / 1.6 / 1.5 deg, monotone towards no row at all. The paper gives no values; the ones
     we used to reproduce its Table 1 (the MPU-6050's datasheet gyro density, acc_noise 0.06
-    with an allowance for linear acceleration, gate at rho 0.1) are presets.PAPER_UKF.
+    with an allowance for linear acceleration, gate at rho 0.1, norm_noise 0.01) are
+    presets.PAPER_UKF.
     Output: roll = atan2(X2, X3), pitch = atan2(-X1, sqrt(X2^2 + X3^2)); bias = b.
 
     Parameters: gyro_psd [rad^2/s] (the gyro's noise density squared), bias_psd [rad^2/s^3]
@@ -131,8 +134,10 @@ class UnscentedKalmanFilter(Estimator):
             low=0.0, low_open=True,
         ),
         Param(
-            "norm_noise", 0.01, "Standard deviation of the unit-norm pseudo-measurement |X|^2 = 1",
-            low=0.0, low_open=True,
+            "norm_noise", 0.0,
+            "Standard deviation of the unit-norm pseudo-measurement |X|^2 = 1 (0: no such "
+            "measurement; X is renormalised after every update either way)",
+            low=0.0,
         ),
         Param(
             "acc_gate", 1.0,
@@ -148,8 +153,7 @@ class UnscentedKalmanFilter(Estimator):
         Param("beta", 2.0, "Prior-distribution parameter (2 is optimal for Gaussians)", low=0.0),
         Param("kappa", 0.0, "Secondary scaling parameter (> -5 keeps n + lambda > 0 for n = 6)",
               low=-5.0, low_open=True),
-        *(dataclasses.replace(p, default=0.0) if p.name in UKF_ADAPTIVE_OFF else p
-          for p in ADAPTIVE_NOISE_PARAMS),
+        *ADAPTIVE_NOISE_PARAMS,
         GYRO_SAMPLING_PARAM,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
@@ -316,6 +320,7 @@ class UnscentedKalmanFilter(Estimator):
         Y0, Y1, Y2 = rotate_back((X0, X1, X2), (f0, f1, f2))  # the central point
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         update = abs(norm / G - 1.0) < self._gate and norm > 0.0  # rho < acc_gate
+        norm_row = update and self._r_norm > 0.0  # the pseudo-measurement |X|^2 = 1 (norm_noise)
         # Sums over the outer points, e = Y_i - Y_0: sum e (m), sum e e^T (e..),
         # sum_j (e_j+ - e_j-) (s_j^b)^T (x..), and for the pseudo-measurement
         # nu = |X_i|^2 - |X_0|^2 = +-2 X_0.s + |s|^2: sum nu, sum nu^2, sum e nu,
@@ -352,7 +357,7 @@ class UnscentedKalmanFilter(Estimator):
             x20 += u2 * s3
             x21 += u2 * s4
             x22 += u2 * s5
-            if update and (s0 or s1 or s2):
+            if norm_row and (s0 or s1 or s2):
                 a = 2.0 * (X0 * s0 + X1 * s1 + X2 * s2)
                 q = s0 * s0 + s1 * s1 + s2 * s2
                 vp, vm = q + a, q - a
@@ -410,15 +415,18 @@ class UnscentedKalmanFilter(Estimator):
             sv2 = w * ev2 + w_mu * mu2 * mu_v
             if r is None:
                 r = self._r_acc
-            S = (
-                a00 + r, a10, a11 + r, a20, a21, a22 + r,
-                sv0, sv1, sv2, w * vv + w_mu * mu_v * mu_v + self._r_norm,
-            )
+            if norm_row:
+                s33 = w * vv + w_mu * mu_v * mu_v + self._r_norm
+                y3 = 1.0 - (v_prior + mu_v)
+            else:  # no pseudo-measurement: with its sums 0, s33 = 1 and a zero innovation the
+                # last row is independent of the others and changes nothing (exactly)
+                s33, y3 = 1.0, 0.0
+            S = (a00 + r, a10, a11 + r, a20, a21, a22 + r, sv0, sv1, sv2, s33)
             rows = (
                 (a00, a10, a20, sv0), (a10, a11, a21, sv1), (a20, a21, a22, sv2),
                 (x00, x10, x20, w * bv0), (x01, x11, x21, w * bv1), (x02, x12, x22, w * bv2),
             )
-            innovation = (ax / G - X0, ay / G - X1, az / G - X2, 1.0 - (v_prior + mu_v))
+            innovation = (ax / G - X0, ay / G - X1, az / G - X2, y3)
             X0, X1, X2, b0, b1, b2, P = _kalman_update(
                 (X0, X1, X2, b0, b1, b2), P, S, rows, innovation, learn_bias
             )

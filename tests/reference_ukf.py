@@ -1,7 +1,8 @@
 """The numpy UKF as it was before the plain-float rewrite: the reference for test_ukf_equivalence.
 
 A verbatim copy of the numerical core of fusion_core/ukf.py at commit ab4a9e4 (numpy on 6x6
-matrices, 13 sigma points as rows). Parameters (names, defaults, ranges) are taken from
+matrices, 13 sigma points as rows), and the textbook update without the pseudo-measurement row
+|X|^2 = 1 where norm_noise is 0. Parameters (names, defaults, ranges) are taken from
 fusion_core's class, so the two always run with the same values.
 """
 
@@ -36,7 +37,8 @@ class ReferenceUnscentedKalmanFilter(Estimator):
         self._wm, self._wc = wm, wc
         self._q_gyro = p["gyro_psd"]
         self._q_bias = p["bias_psd"]
-        self._R = np.diag([p["acc_noise"] ** 2] * 3 + [p["norm_noise"] ** 2])
+        self._norm_row = p["norm_noise"] > 0.0
+        self._R = np.diag([p["acc_noise"] ** 2] * 3 + [p["norm_noise"] ** 2] * self._norm_row)
         self._gate = p["acc_gate"]
         self._trapezoid = p["gyro_sampling"] == "point"
 
@@ -77,13 +79,15 @@ class ReferenceUnscentedKalmanFilter(Estimator):
         P_pred[3:, 3:] += self._q_bias * dt * np.eye(3)
         rho = abs(math.sqrt(ax * ax + ay * ay + az * az) / G - 1.0)
         if rho < self._gate:
-            Z = np.column_stack([chi[:, :3], np.einsum("ij,ij->i", chi[:, :3], chi[:, :3])])
+            Z = chi[:, :3]
+            if self._norm_row:
+                Z = np.column_stack([Z, np.einsum("ij,ij->i", chi[:, :3], chi[:, :3])])
             z_pred = self._wm @ Z
             dz = Z - z_pred
             S = (dz.T * self._wc) @ dz + self._R
             Pxz = (d.T * self._wc) @ dz
             K = np.linalg.solve(S, Pxz.T).T
-            z = np.array([ax / G, ay / G, az / G, 1.0])
+            z = np.array([ax / G, ay / G, az / G, 1.0][:Z.shape[1]])
             x_pred = x_pred + K @ (z - z_pred)
             P_pred = P_pred - K @ S @ K.T
         x_pred[:3] /= np.linalg.norm(x_pred[:3])

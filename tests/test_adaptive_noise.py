@@ -1,5 +1,6 @@
-"""The adaptive noise shared by cf, mgcf and kf (building_blocks.ADAPTIVE_NOISE_PARAMS): the
-correction time of the complementary filters, and the sweeps it is for."""
+"""The adaptive noise shared by cf, mgcf, kf and ukf (building_blocks.ADAPTIVE_NOISE_PARAMS): the
+correction time of the complementary filters, the sweeps it is for, and what the UKF needs
+besides (no unit-norm pseudo-measurement)."""
 
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ def rmse(key: str, scenario: str, params: dict) -> tuple[float, float]:
     return m["rmse_roll_deg"], m["rmse_pitch_deg"]
 
 
-@pytest.mark.parametrize("key", ["cf", "mgcf", "kf"])
+@pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
 @pytest.mark.parametrize("scenario", ["roll_sweep", "pitch_sweep", "roll_pitch"])
 def test_the_sweeps_pass_on_the_realistic_sensor(key: str, scenario: str) -> None:
     """Pure rotation with the realistic gyro (1 % scale, 0.67 % cross-axis, 0.16 deg/s of bias
@@ -46,10 +47,29 @@ def test_the_sweeps_pass_on_the_realistic_sensor(key: str, scenario: str) -> Non
     assert roll <= limit[0] and pitch <= limit[1], (roll, pitch)
 
 
-@pytest.mark.parametrize("key", ["cf", "mgcf", "kf"])
+@pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
 def test_without_the_adaptive_noise_the_roll_sweep_fails(key: str) -> None:
     """The same filter with constant noise, as the papers' presets have it, fails roll_sweep."""
     constant = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
     roll, pitch = rmse(key, "roll_sweep", constant)
     assert max(roll, pitch) > 0.25, (roll, pitch)
     assert {k: PRESETS["paper"][key][k] for k in constant} == constant  # the papers' filters
+
+
+@pytest.mark.parametrize("scenario", ["vibration", "high_dynamics"])
+def test_the_ukf_passes_the_disturbed_scenarios_with_the_defaults(scenario: str) -> None:
+    """vibration starts from a sample taken in 0.3 g of vibration, high_dynamics accelerates at
+    0.73 g for seconds: the adaptive noise raises R, and X still converges (contract seed 0)."""
+    limit = accuracy_limits("ukf", scenario)
+    roll, pitch = rmse("ukf", scenario, {})
+    assert roll <= limit[0] and pitch <= limit[1], (roll, pitch)
+
+
+def test_the_unit_norm_pseudo_measurement_fails_the_ukf_on_vibration() -> None:
+    """With the paper's |X|^2 = 1 row (norm_noise 0.01) the sigma points' spread off the unit
+    sphere is read as information: P_XX shrinks, and X, set 24 deg off by the first vibrating
+    sample, takes 20 s instead of 4 to converge under the raised R (ukf's docstring)."""
+    limit = accuracy_limits("ukf", "vibration")
+    roll, pitch = rmse("ukf", "vibration", {"norm_noise": 0.01})
+    assert pitch > limit[1], (roll, pitch)
+    assert PRESETS["paper"]["ukf"]["norm_noise"] == 0.01

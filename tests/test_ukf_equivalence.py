@@ -68,8 +68,9 @@ def test_defaults_match_the_numpy_reference_at_every_sample() -> None:
         {"gyro_sampling": "mean"},
         {"alpha": 0.5, "beta": 0.0, "kappa": 1.0},
         {"acc_gate": 10.0, "acc_noise": 0.01},
+        {"norm_noise": 0.0},
     ],
-    ids=["rectangle", "other-sigma-weights", "always-update"],
+    ids=["rectangle", "other-sigma-weights", "always-update", "no-norm-row"],
 )
 def test_other_parameters_match_the_numpy_reference(params: dict[str, object]) -> None:
     rec = moderate_dynamics_recording()

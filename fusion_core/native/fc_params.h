@@ -197,7 +197,7 @@ typedef struct fc_ukf_params {
     double gyro_psd;          /* (0.0, inf) [rad2/s] */
     double bias_psd;          /* [0.0, inf) [rad2/s3] */
     double acc_noise;         /* (0.0, inf) */
-    double norm_noise;        /* (0.0, inf) */
+    double norm_noise;        /* [0.0, inf) */
     double acc_gate;          /* (0.0, inf) */
     double init_bias_std;     /* (0.0, inf) [rad/s] */
     double alpha;             /* (0.0, 1.0] */
@@ -228,15 +228,15 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->gyro_psd = 1.949551486634935e-08;
     p->bias_psd = 3.0461741978670863e-12;
     p->acc_noise = 0.005;
-    p->norm_noise = 0.01;
+    p->norm_noise = 0.0;
     p->acc_gate = 1.0;
     p->init_bias_std = 0.017453292519943295;
     p->alpha = 1.0;
     p->beta = 2.0;
     p->kappa = 0.0;
-    p->gyro_scale_std = 0.0;
+    p->gyro_scale_std = 0.005;
     p->scale_time = 0.5;
-    p->disturbance_time = 0.0;
+    p->disturbance_time = 1.0;
     p->gyro_sampling = FC_UKF_GYRO_SAMPLING_POINT;
     p->acc_lowpass = 1.0;
     p->rest_time = 1.5;

@@ -455,6 +455,7 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
     double Y0 = Yc[0], Y1 = Yc[1], Y2 = Yc[2];
     double norm = sqrt(ax * ax + ay * ay + az * az);
     int update = fabs(norm / FC_G - 1.0) < f->gate && norm > 0.0;
+    int norm_row = update && f->r_norm > 0.0;  /* the pseudo-measurement |X|^2 = 1 */
     double m0 = 0.0, m1 = 0.0, m2 = 0.0;
     double e00 = 0.0, e10 = 0.0, e11 = 0.0, e20 = 0.0, e21 = 0.0, e22 = 0.0;
     double x00 = 0.0, x01 = 0.0, x02 = 0.0, x10 = 0.0, x11 = 0.0, x12 = 0.0;
@@ -493,7 +494,7 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
         x20 += u2 * s3;
         x21 += u2 * s4;
         x22 += u2 * s5;
-        if (update && (s0 != 0.0 || s1 != 0.0 || s2 != 0.0)) {
+        if (norm_row && (s0 != 0.0 || s1 != 0.0 || s2 != 0.0)) {
             double a = 2.0 * (X0 * s0 + X1 * s1 + X2 * s2);
             double q = s0 * s0 + s1 * s1 + s2 * s2;
             double vp = q + a, vm = q - a;
@@ -554,16 +555,20 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
         double sv0 = w * ev0 + w_mu * mu0 * mu_v;
         double sv1 = w * ev1 + w_mu * mu1 * mu_v;
         double sv2 = w * ev2 + w_mu * mu2 * mu_v;
-        const double S[10] = {
-            a00 + r, a10, a11 + r, a20, a21, a22 + r,
-            sv0, sv1, sv2, w * vv + w_mu * mu_v * mu_v + f->r_norm,
-        };
+        /* no pseudo-measurement: with its sums 0, s33 = 1 and a zero innovation the last row
+         * is independent of the others and changes nothing (exactly) */
+        double s33 = 1.0, y3 = 0.0;
+        if (norm_row) {
+            s33 = w * vv + w_mu * mu_v * mu_v + f->r_norm;
+            y3 = 1.0 - (v_prior + mu_v);
+        }
+        const double S[10] = {a00 + r, a10, a11 + r, a20, a21, a22 + r, sv0, sv1, sv2, s33};
         const double rows[6][4] = {
             {a00, a10, a20, sv0}, {a10, a11, a21, sv1}, {a20, a21, a22, sv2},
             {x00, x10, x20, w * bv0}, {x01, x11, x21, w * bv1}, {x02, x12, x22, w * bv2},
         };
         const double innovation[4] = {
-            ax / FC_G - X0, ay / FC_G - X1, az / FC_G - X2, 1.0 - (v_prior + mu_v),
+            ax / FC_G - X0, ay / FC_G - X1, az / FC_G - X2, y3,
         };
         double xs[6] = {X0, X1, X2, b0, b1, b2};
         kalman_update(xs, Pn, S, rows, innovation, learn_bias);
