@@ -296,6 +296,11 @@ real sensor breaks both in motion, and the balance of the two sets the correctio
   measured). 1 s, the pre-filter's own time constant."""
 
 
+CONSTANT_NOISE: Final = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
+"""ADAPTIVE_NOISE_PARAMS off: a constant Q and R and a pre-filter of fixed length, as the papers'
+filters have them."""
+
+
 def adaptive_noise_constants(p: Any, acc_tau: float, r: float) -> tuple[float, float, float]:
     """The constants of ADAPTIVE_NOISE_PARAMS from a filter's parameters p, its pre-filter's time
     constant acc_tau and one accelerometer sample's variance r (over g^2): the rotation term of

@@ -23,7 +23,7 @@ from math import cos, sin, sqrt
 from typing import Any
 
 from .base import ESTIMATE, Estimator, tuple_new
-from .building_blocks import zero_rate_psd_param
+from .building_blocks import CONSTANT_NOISE, zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
 from .presets import PAPER_KF
@@ -52,8 +52,7 @@ rest, where the specific force is gravity alone, so it may trust each sample as 
 values are for a filter that must trust the accelerometer in motion too."""
 TILT_FIXED = {
     "propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0,
-    "tilt_axes": "body", "bias_innovation": math.pi, "gyro_scale_std": 0.0,
-    "disturbance_time": 0.0,
+    "tilt_axes": "body", "bias_innovation": math.pi, **CONSTANT_NOISE,
 }
 """The tilt stage's other kf options: off. This filter drives the stage step by step (propagate,
 correct_innovation, correct_bias) and does its own rest detection and bias updates."""

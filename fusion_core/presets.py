@@ -25,6 +25,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from .building_blocks import CONSTANT_NOISE
 from .types import DEG, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
 
 DEG2 = DEG * DEG
@@ -32,8 +33,7 @@ KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
 
 PAPER_CF: dict[str, Any] = {
     "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0, "gyro_scale_std": 0.0,
-    "disturbance_time": 0.0,
+    "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE,
 }
 """Gui et al. eq. 1-2: tau = 0.75 s (a = 0.96 at their 30 ms loop), the Euler rates, the
 rectangle rule (gyro_sampling="mean"), a constant tau (gyro_scale_std and disturbance_time 0).
@@ -42,7 +42,7 @@ Their gate has no bounds in the text: 0.9-1.1 g is our reading
 
 PAPER_MGCF: dict[str, Any] = {
     "schedule": "simulation", "w0": 0.1, "zeta": 2.0, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "gyro_sampling": "mean", "sensor_delay": 0.0, "gyro_scale_std": 0.0, "disturbance_time": 0.0,
+    "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE,
 }
 """Duong Quoc et al. eq. 7-13 with their simulation table (section 4.1) and zeta = 2; Mahony's
 reference order (error from the previous attitude, first-order step: gyro_sampling="mean").
@@ -51,7 +51,7 @@ w0 = 0.05."""
 
 PAPER_KF: dict[str, Any] = {
     "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
-    "R_loop_time": 0.033, "gyro_scale_std": 0.0, "disturbance_time": 0.0, "gate_low": 0.9,
+    "R_loop_time": 0.033, **CONSTANT_NOISE, "gate_low": 0.9,
     "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0, "bias_gate": 0.0,
     "bias_innovation": math.pi, "propagation": "euler", "tilt_axes": "body",
     "gyro_sampling": "mean", "sensor_delay": 0.0,
@@ -66,8 +66,7 @@ PAPER_UKF: dict[str, Any] = {
     "gyro_psd": MPU6050_GYRO_DENSITY**2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
     "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
-    "bias_innovation": math.pi, "gyro_scale_std": 0.0, "disturbance_time": 0.0,
-    "gyro_sampling": "mean", "sensor_delay": 0.0,
+    "bias_innovation": math.pi, **CONSTANT_NOISE, "gyro_sampling": "mean", "sensor_delay": 0.0,
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
 simulated MPU-6050 at 100 Hz: the gyro's process noise that sensor's datasheet density (as the

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from fusion_core.building_blocks import correction_time
+from fusion_core.building_blocks import CONSTANT_NOISE, correction_time
 from fusion_core.presets import PRESETS
 from testbenches.campaign import load_sensor
 from testbenches.contract import accuracy_limits, compute_metrics
@@ -50,10 +50,9 @@ def test_the_sweeps_pass_on_the_realistic_sensor(key: str, scenario: str) -> Non
 @pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
 def test_without_the_adaptive_noise_the_roll_sweep_fails(key: str) -> None:
     """The same filter with constant noise, as the papers' presets have it, fails roll_sweep."""
-    constant = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
-    roll, pitch = rmse(key, "roll_sweep", constant)
+    roll, pitch = rmse(key, "roll_sweep", CONSTANT_NOISE)
     assert max(roll, pitch) > 0.25, (roll, pitch)
-    assert {k: PRESETS["paper"][key][k] for k in constant} == constant  # the papers' filters
+    assert {k: PRESETS["paper"][key][k] for k in CONSTANT_NOISE} == CONSTANT_NOISE
 
 
 @pytest.mark.parametrize("scenario", ["vibration", "high_dynamics"])

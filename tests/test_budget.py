@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+from fusion_core.building_blocks import CONSTANT_NOISE
 from fusion_core.sensor import SENSOR_PARAMS, sensor_preset
 from testbenches.__main__ import main
 from testbenches.budget import MOTION_ONLY, SOURCES, BudgetRow, budget_table, error_budget
@@ -33,8 +34,8 @@ def test_the_gyro_scale_error_is_what_limits_the_roll_sweep():
     # each swing, more than the accelerometer corrects at that frequency with constant noise
     # (the recommended filters' adaptive noise is what removes it); perfect samples of the same
     # motion leave almost nothing
-    constant = {"ukf": {"gyro_scale_std": 0.0, "disturbance_time": 0.0}}
-    (row,) = error_budget(["ukf"], ["roll_sweep"], 1, sensor_preset("realistic"), constant)
+    (row,) = error_budget(["ukf"], ["roll_sweep"], 1, sensor_preset("realistic"),
+                          {"ukf": CONSTANT_NOISE})
     assert row.without["gyro_scale"][0] < 0.5 * row.full[0]
     assert row.without["dlpf"][0] > 0.8 * row.full[0]
     assert max(row.motion_only) < 0.02

@@ -10,6 +10,7 @@ import scipy.linalg
 from helpers import paper
 
 from fusion_core import DEG, G, synthetic
+from fusion_core.building_blocks import CONSTANT_NOISE
 from fusion_core.kalman import AngleBiasKalmanFilter
 from fusion_core.presets import PAPER_KF
 from fusion_core.synthetic import Trajectory, add, sine
@@ -236,7 +237,7 @@ def test_sustained_acceleration_is_held_off_on_the_realistic_sensor() -> None:
     assert m["rmse_roll_deg"] <= limit[0] and m["rmse_pitch_deg"] <= limit[1], m
     with_constant_r = compute_metrics(simulate(Run(
         "t", "kf", "high_dynamics", 0, None, load_sensor("realistic"),
-        {"disturbance_time": 0.0, "gyro_scale_std": 0.0}, {})))
+        CONSTANT_NOISE, {})))
     assert with_constant_r["rmse_roll_deg"] > limit[0]
 
 

@@ -13,6 +13,7 @@ from helpers import KEYS, make, noisy_two_axis_recording
 
 from fusion_core import G, InvalidSample
 from fusion_core.base import Estimator
+from fusion_core.building_blocks import CONSTANT_NOISE
 from fusion_core.types import Estimate
 
 DT = 0.01
@@ -88,7 +89,7 @@ def test_kalman_snapshot_with_two_covariances_follows_each_axis(params: dict) ->
     biases move)."""
     rec = noisy_two_axis_recording(3.0)
     acc, gyro, dt = rec["acc_meas"], rec["gyro_meas"], rec["dt"]
-    params = {**params, "tilt_axes": "body", "gyro_scale_std": 0.0, "disturbance_time": 0.0}
+    params = {**params, "tilt_axes": "body", **CONSTANT_NOISE}
     base = make("kf", **params)
     base.run(acc[:100], gyro[:100], dt[:100])
     snapshot = base.get_state()

@@ -17,6 +17,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from fusion_core import DEG, ESTIMATORS, G
+from fusion_core.building_blocks import CONSTANT_NOISE
 from fusion_core.kinematics import euler_rates
 from fusion_core.scenarios import SCENARIOS
 from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel
@@ -125,10 +126,6 @@ def test_t4_same_seed_gives_a_bit_identical_trace(fmu_dir: Path) -> None:
 
 
 # ----- every check can fail ----------------------------------------------------------------------
-CONSTANT_NOISE = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
-"""The papers' constant noise (building_blocks.ADAPTIVE_NOISE_PARAMS off)."""
-
-
 def test_a_one_sample_lag_fails_t1_by_about_omega_h(fmu_dir: Path) -> None:
     """The estimate shifted by one sample (a hidden delay) fails T1 with ~|omega| h of error."""
     r = run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir,
@@ -286,8 +283,9 @@ def test_cli_runs_the_paper_preset_through_the_fmus(fmu_dir: Path, tmp_path: Pat
 
 def test_cli_exits_1_on_a_failed_check(fmu_dir: Path, tmp_path: Path) -> None:
     proc = _cli("--estimator", "cf", "--scenario", "roll_sweep", "--duration", "5",
-                "--param", "gyro_sampling=mean", "--param", "gyro_scale_std=0",
-                "--param", "disturbance_time=0", fmu_dir=fmu_dir, out=tmp_path)
+                "--param", "gyro_sampling=mean",
+                *[a for k, v in CONSTANT_NOISE.items() for a in ("--param", f"{k}={v:g}")],
+                fmu_dir=fmu_dir, out=tmp_path)
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert "FAIL: accuracy roll RMSE" in proc.stdout
 
