@@ -205,13 +205,13 @@ class GainScheduledComplementaryFilter(Estimator):
             w0 = 0.0
         self.w0_now = w0
         bx, by, bz = self.bias
-        gain = 1.0  # of Kp: the adaptive noise shortens the correction (building_blocks)
         kp = self._two_zeta * w0
+        # the adaptive noise: 1/Kp follows building_blocks.correction_time
         if kp > 0.0 and (q_rotation > 0.0 or r != r_ref):
             wx, wy, wz = gx - bx, gy - by, gz - bz
             tau = 1.0 / kp
-            gain = tau / correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,
-                                         r_ref, dt, longest)
+            kp *= tau / correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,
+                                        r_ref, dt, longest)
         if self._trapezoid:
             # Predict with the gyro over the interval, then correct with this sample's
             # accelerometer against the attitude at this sample's time: the same continuous-time
@@ -234,10 +234,9 @@ class GainScheduledComplementaryFilter(Estimator):
             ki_dt = w0 * w0 * dt
             bx, by, bz = self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
         if not self._trapezoid:  # then one Euler step with the PI-corrected rate
-            kp = self._two_zeta * w0 * gain
             q = _quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
         elif w0 > 0.0:
-            kp_dt = self._two_zeta * w0 * gain * dt
+            kp_dt = kp * dt
             q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)

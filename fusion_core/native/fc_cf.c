@@ -15,9 +15,9 @@ void fc_cf_configure(fc_cf *f)
     f->quaternion = p->propagation == FC_CF_PROPAGATION_QUATERNION;
     f->rotating = f->quaternion || f->acc_tau > 0.0;
     f->r_ref = pow(p->acc_noise, 2.0);
-    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
-    f->dist_tau = f->acc_tau > 0.0 ? p->disturbance_time : 0.0;
-    f->dist_noise = 3.0 * f->r_ref * FC_G * FC_G;
+    fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
+                                f->acc_tau, f->r_ref, &f->q_rotation, &f->dist_tau,
+                                &f->dist_noise);
     f->longest = p->max_correction_time;
 }
 

@@ -230,6 +230,15 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
     f[2] = t[2] + k * (a[2] - t[2]);
 }
 
+void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
+                                 double disturbance_time, double acc_tau, double r,
+                                 double *q_rotation, double *dist_tau, double *noise)
+{
+    *q_rotation = pow(gyro_scale_std, 2.0) * scale_time;
+    *dist_tau = acc_tau > 0.0 ? disturbance_time : 0.0;
+    *noise = 3.0 * r * FC_G * FC_G;
+}
+
 double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
                                double tau, double r, double noise)
 {

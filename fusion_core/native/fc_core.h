@@ -82,6 +82,12 @@ void fc_body_rotation(const double g0[3], const double g1[3], const double bias[
                       int trapezoid, double phi[3]);
 void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
                                      const double a[3], double dt, double tau);
+/* adaptive_noise_constants: the rotation term of the process noise per (rad/s)^2, the
+ * disturbance's averaging time (0: off, also without the pre-filter acc_tau) and the white
+ * noise's share of the disturbance statistic (3 axes of r g^2) */
+void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
+                                 double disturbance_time, double acc_tau, double r,
+                                 double *q_rotation, double *dist_tau, double *noise);
 /* measured_disturbance: one step of the disturbance statistic *dist (the mean square of the raw
  * sample a minus the pre-filtered f over tau, a low-pass); returns the measurement variance
  * r plus its excess over the white noise's share, over g^2 */

@@ -71,9 +71,8 @@ void fc_kf_configure(fc_kf *f)
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
-    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
-    f->dist_tau = f->acc_tau > 0.0 ? p->disturbance_time : 0.0;
-    f->dist_noise = 3.0 * f->r * FC_G * FC_G;
+    fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
+                                f->acc_tau, f->r, &f->q_rotation, &f->dist_tau, &f->dist_noise);
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;

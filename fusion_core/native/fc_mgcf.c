@@ -51,9 +51,9 @@ void fc_mgcf_configure(fc_mgcf *f)
     f->rest_acc = p->rest_acc;
     f->options = f->rest_time > 0.0 || f->acc_tau > 0.0;
     f->r_ref = pow(p->acc_noise, 2.0);
-    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
-    f->dist_tau = f->acc_tau > 0.0 ? p->disturbance_time : 0.0;
-    f->dist_noise = 3.0 * f->r_ref * FC_G * FC_G;
+    fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
+                                f->acc_tau, f->r_ref, &f->q_rotation, &f->dist_tau,
+                                &f->dist_noise);
     f->longest = p->max_correction_time;
 }
 
@@ -127,14 +127,13 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     }
     f->w0_now = w0;
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
-    double gain = 1.0;  /* of Kp: the adaptive noise shortens the correction */
-    double kp0 = f->two_zeta * w0;
-    if (kp0 > 0.0 && (f->q_rotation > 0.0 || r != f->r_ref)) {
+    double kp = f->two_zeta * w0;
+    /* the adaptive noise: 1/Kp follows correction_time */
+    if (kp > 0.0 && (f->q_rotation > 0.0 || r != f->r_ref)) {
         double wx = gx - bx, wy = gy - by, wz = gz - bz;
-        double tau = 1.0 / kp0;
-        gain = tau / fc_correction_time(tau, r / f->r_ref, f->q_rotation,
-                                         wx * wx + wy * wy + wz * wz, f->r_ref, dt,
-                                         f->longest);
+        double tau = 1.0 / kp;
+        kp *= tau / fc_correction_time(tau, r / f->r_ref, f->q_rotation,
+                                       wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
     }
     double q[4];
     memcpy(q, f->q, sizeof q);
@@ -163,10 +162,9 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         f->bias[2] = bz;
     }
     if (!f->trapezoid) {
-        double kp = f->two_zeta * w0 * gain;
         quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz, dt);
     } else if (w0 > 0.0) {
-        double kp_dt = f->two_zeta * w0 * gain * dt;
+        double kp_dt = kp * dt;
         fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
     }
     memcpy(f->q, q, sizeof q);

@@ -322,9 +322,9 @@ void fc_ukf_configure(fc_ukf *f)
     f->q_bias = p->bias_psd;
     f->r_acc = pow(p->acc_noise, 2.0);
     f->r_norm = pow(p->norm_noise, 2.0);
-    f->q_rotation = pow(p->gyro_scale_std, 2.0) * p->scale_time;
-    f->dist_tau = p->acc_lowpass > 0.0 ? p->disturbance_time : 0.0;
-    f->dist_noise = 3.0 * f->r_acc * FC_G * FC_G;
+    fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
+                                p->acc_lowpass, f->r_acc, &f->q_rotation, &f->dist_tau,
+                                &f->dist_noise);
     f->gate = p->acc_gate;
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
     f->options = p->acc_lowpass > 0.0 || p->rest_time > 0.0;
