@@ -135,7 +135,8 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
             "campaign.samples_per_s", camp["samples_per_s"], f">= {SAMPLES_PER_S_TARGET:.0e}",
             camp["samples_per_s"] >= SAMPLES_PER_S_TARGET,
             f"per sample on one worker: the estimators' batch runs {per['estimators']:.2f} us "
-            f"(libm's trigonometry in every step), the sensor's share {per['sensor']:.2f} us, "
+            f"(the UKF's 13 sigma-point rotations the dearest), the sensor's share "
+            f"{per['sensor']:.2f} us, "
             f"the rest {per['rest']:.2f} us; the estimators alone on every core reach "
             f"{camp['estimator_ceiling_samples_per_s']:.3g} samples/s",
         ))
