@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -64,6 +65,71 @@ def contract_table(result: CampaignResult) -> str:
     return "\n".join(lines)
 
 
+@dataclass(frozen=True)
+class SeedSummary:
+    """One estimator or peer on one scenario over the campaign's seeds (sensor parts): roll and
+    pitch RMSE [deg] as mean, median and 95th percentile, and the share of seeds within the
+    scenario's bound (None where there is none: a peer on moderate_dynamics)."""
+
+    name: str
+    peer: bool
+    scenario: str
+    seeds: int
+    mean: tuple[float, float]
+    median: tuple[float, float]
+    p95: tuple[float, float]
+    within: float | None
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def _summary(name: str, peer: bool, scenario: str, rmse: np.ndarray,
+             bound: tuple[float, float] | None) -> SeedSummary:
+    def pair(values: np.ndarray) -> tuple[float, float]:
+        return float(values[0]), float(values[1])
+
+    within = None if bound is None else float(np.mean(
+        (rmse[:, 0] <= bound[0]) & (rmse[:, 1] <= bound[1])))
+    return SeedSummary(name, peer, scenario, len(rmse), pair(rmse.mean(axis=0)),
+                       pair(np.median(rmse, axis=0)), pair(np.percentile(rmse, 95, axis=0)),
+                       within)
+
+
+def seed_summaries(result: CampaignResult, peers: list[PeerRun] | None = None
+                   ) -> list[SeedSummary]:
+    """Each estimator (and peer) on each scenario over its seeds: one seed is one sensor part,
+    and the tails over parts are what one seed cannot show. The estimators' bound is their
+    accuracy check's (contract.accuracy_limits), the peers' their PeerRun's."""
+    groups: dict[tuple[str, bool, str], list[tuple[float, float]]] = {}
+    bounds: dict[tuple[str, bool, str], tuple[float, float] | None] = {}
+    for r in result.runs:
+        key = (r.estimator, False, r.scenario)
+        groups.setdefault(key, []).append((r.metrics["rmse_roll_deg"],
+                                           r.metrics["rmse_pitch_deg"]))
+        bounds[key] = contract.accuracy_limits(r.estimator, r.scenario)
+    for p in peers or []:
+        key = (p.peer, True, p.scenario)
+        groups.setdefault(key, []).append((p.rmse_roll_deg, p.rmse_pitch_deg))
+        bounds[key] = p.allowed
+    return [_summary(*key, np.array(v, dtype=float), bounds[key]) for key, v in groups.items()]
+
+
+def seed_summary_table(rows: list[SeedSummary]) -> str:
+    """The summaries as a text table: RMSE roll/pitch [deg] over the seeds."""
+    head = (f"{'':<11} {'scenario':<18} {'seeds':>5} {'mean':>11} {'median':>11} {'p95':>11} "
+            f" within bound")
+    lines = ["Over the seeds (each seed another sensor part): RMSE roll/pitch [deg]", head,
+             "-" * len(head)]
+    for s in rows:
+        within = "-" if s.within is None else f"{100.0 * s.within:.0f} %"
+        name = f"{s.name} (peer)" if s.peer else s.name
+        lines.append(f"{name:<11} {s.scenario:<18} {s.seeds:>5} "
+                     + " ".join(f"{a:>5.2f}/{b:<5.2f}" for a, b in (s.mean, s.median, s.p95))
+                     + f"  {within}")
+    return "\n".join(lines)
+
+
 def plot_run(r: TestbenchResult, path: Path) -> None:
     """Truth vs estimate, error, and gyro bias of one run."""
     import matplotlib
@@ -100,7 +166,8 @@ def plot_run(r: TestbenchResult, path: Path) -> None:
 def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True,
                   peers: list[PeerRun] | None = None) -> None:
     """report.json, report.md and, with plots, a PNG per run under out_dir/plots; with peers,
-    the public filters' rows on the same samples (peer_runs) in both."""
+    the public filters' rows on the same samples (peer_runs) in both; with several seeds, the
+    summaries over them (seed_summaries)."""
     out_dir.mkdir(parents=True, exist_ok=True)
     records = []
     for r in result.runs:
@@ -118,11 +185,17 @@ def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True,
     }
     if peers is not None:
         report["peers"] = [r.as_dict() for r in peers]
+    summaries = seed_summaries(result, peers)
+    several = any(sm.seeds > 1 for sm in summaries)
+    if several:
+        report["over_seeds"] = [sm.as_dict() for sm in summaries]
     (out_dir / "report.json").write_text(json.dumps(report, indent=1))
     md = ["# Testbench report", "", f"Contract v{contract.CONTRACT_VERSION}: "
           f"{'PASS' if result.passed else 'FAIL'}", "", "```", contract_table(result), "```", ""]
     if peers is not None:
         md += ["```", peer_table(peers), "```", ""]
+    if several:
+        md += ["```", seed_summary_table(summaries), "```", ""]
     for rec in records:
         if rec["plot"]:
             md += [f"## {rec['estimator']} on {rec['scenario']} (seed {rec['seed']})", "",
