@@ -3,7 +3,13 @@
 samples_per_s: simulated IMU samples per second over a whole campaign (plant -> sensor ->
 estimator through the native core, every run's samples counted, the LocalCluster's start and
 the Parquet writes included) on this machine's cores (WORKERS); samples_per_s_1_worker the
-same campaign on one worker; scaling their ratio (target >= 1.7 on two cores).
+same campaign on one worker; scaling their ratio (target >= 1.7 on two cores). Each is the
+fastest of CAMPAIGN_PASSES campaigns, the two worker counts taking turns.
+overhead_seconds (and _1_worker): the campaign's time less its runs' own (their rows' seconds,
+summed, over the workers): the cluster's start and stop, the workers' first imports, the last
+batches' imbalance, which a longer campaign spreads over more runs; runs_scaling: the runs' own
+time on one worker over theirs on WORKERS, times WORKERS (how the runs alone scale, where the
+workers share the cores' caches and the client).
 
 per_sample_us: where one worker's time goes, per simulated sample: `estimators` the native batch
 runs (the mean over the campaign's estimators and scenarios, best of a few passes), `sensor` the
@@ -29,9 +35,11 @@ WORKERS = 2
 ESTIMATORS = ("cf", "mgcf", "kf", "ukf", "poskf")
 SCENARIOS = ("moderate_dynamics", "vibration")
 PASSES = 3
+CAMPAIGN_PASSES = 2
+"""Campaigns per worker count, interleaved (2, 1, 2, 1 workers); the fastest of each counts."""
 
 
-def _throughput(workers: int, seeds: int) -> tuple[float, int, float]:
+def _throughput(workers: int, seeds: int) -> tuple[float, int, float, float]:
     from testbenches.campaign import load_sensor
     from testbenches.montecarlo.plan import parse_variation, plan
     from testbenches.montecarlo.runner import execute
@@ -41,8 +49,10 @@ def _throughput(workers: int, seeds: int) -> tuple[float, int, float]:
                 [parse_variation("gyro_scale_std=0:0.03")], sensor=load_sensor("realistic"))
     with tempfile.TemporaryDirectory(prefix="bench_campaign_") as tmp:
         stats = execute(runs, Path(tmp), "local", workers, log=lambda s: None)
-        samples = sum(r["samples"] for r in read_rows(Path(tmp)))
-    return samples / stats["seconds"], len(runs), stats["seconds"]
+        rows = read_rows(Path(tmp))
+        samples = sum(r["samples"] for r in rows)
+        run_seconds = sum(r["seconds"] for r in rows)
+    return samples / stats["seconds"], len(runs), stats["seconds"], run_seconds
 
 
 def _best_seconds(fn: Any, *args: Any) -> float:
@@ -83,11 +93,16 @@ def campaign_section(seeds: int) -> dict[str, Any]:
         import distributed  # noqa: F401
     except ImportError as err:
         return {"available": False, "reason": f"ImportError: {err}"}
-    two, runs, seconds = _throughput(WORKERS, seeds)
-    one, _, seconds_1 = _throughput(1, seeds)
+    # interleaved, the fastest of each: a shared VM's neighbours come and go within a minute,
+    # and two back-to-back campaigns can see different machines
+    passes = [(_throughput(WORKERS, seeds), _throughput(1, seeds)) for _ in range(CAMPAIGN_PASSES)]
+    two, runs, seconds, run_s = max((p[0] for p in passes), key=lambda m: m[0])
+    one, _, seconds_1, run_s_1 = max((p[1] for p in passes), key=lambda m: m[0])
     est_us, sensor_us = _per_sample_us()
     return {"available": True, "runs": runs, "samples_per_s": two, "seconds": seconds,
             "samples_per_s_1_worker": one, "seconds_1_worker": seconds_1, "scaling": two / one,
+            "overhead_seconds": seconds - run_s / WORKERS, "overhead_seconds_1_worker":
+            seconds_1 - run_s_1, "runs_scaling": WORKERS * run_s_1 / run_s,
             "per_sample_us": {"estimators": est_us, "sensor": sensor_us,
                               "rest": 1e6 / one - est_us - sensor_us},
             "estimator_ceiling_samples_per_s": WORKERS * 1e6 / est_us}
