@@ -17,6 +17,7 @@ from .building_blocks import (
     GYRO_SAMPLING_PARAM,
     PROPAGATION_PARAM,
     REST_PARAMS,
+    REST_START,
     ZERO3,
     bias_at_rest,
     body_rotation,
@@ -119,7 +120,8 @@ class ComplementaryFilter(Estimator):
         self._quaternion: bool = p["propagation"] == "quaternion"
         # both options need the rotation vector of each interval; the papers' filter does not
         self._rotating = self._quaternion or self._acc_tau > 0.0
-        self._rest = (float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]))
+        self._rest = (float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]),
+                      float(p["rest_bias_bound"]))
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): one sample's variance, the
         # rotation term per (rad/s)^2, the disturbance's averaging time (0: off), the white
         # noise's share of the disturbance statistic and the longest correction time
@@ -131,7 +133,7 @@ class ComplementaryFilter(Estimator):
         self.acc_f = ZERO3  # the pre-filtered specific force (acc_lowpass > 0)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
         self.bias = ZERO3  # gyro bias measured at rest (rest_time > 0)
-        self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
+        self.rest = REST_START  # rest detector (building_blocks.RestState)
         self.acc_dist = 0.0  # mean square of raw - acc_ref (disturbance_time)
         self.acc_ref = ZERO3  # the specific force pre-filtered with the full acc_lowpass
 
@@ -139,15 +141,15 @@ class ComplementaryFilter(Estimator):
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
         self.acc_f = self.acc_ref = (ax, ay, az)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
 
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
         rest_time = self._rest[0]
         if rest_time > 0.0:  # at rest the gyro reads its bias: follow it (time constant rest_time)
-            self.rest = rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, self._rest[1],
-                                         self._rest[2])
+            self.rest = rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, self.bias, dt,
+                                         self._rest[1], self._rest[2], rest_time, self._rest[3])
             if rest[6] >= rest_time:
                 self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, rest_time)
         bias = self.bias

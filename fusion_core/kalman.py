@@ -33,6 +33,7 @@ from .building_blocks import (
     PROPAGATION_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
+    REST_START,
     ZERO3,
     Vec3,
     adaptive_noise_constants,
@@ -286,7 +287,7 @@ class AngleBiasKalmanFilter(Estimator):
         # the zero-rate update's constants, read together
         self._rest_cfg = (
             float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]),
-            float(p["gyro_psd"]),
+            float(p["gyro_psd"]), float(p["rest_bias_bound"]),
         )
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): Q's rotation term per
         # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share
@@ -311,7 +312,7 @@ class AngleBiasKalmanFilter(Estimator):
         self.bias_z = 0.0  # only with rest detection (rest_time > 0); else 0: unobservable
         self.P_z = 0.0
         self.acc_f = ZERO3  # pre-filtered specific force (acc_lowpass > 0)
-        self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
+        self.rest = REST_START  # rest detector (building_blocks.RestState)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
@@ -328,7 +329,7 @@ class AngleBiasKalmanFilter(Estimator):
                 gx, gy, gz = mat_vec(C, (gx, gy, gz))
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
         self.acc_f = self.acc_ref = (ax, ay, az)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         p_b = self._params["init_bias_std"] ** 2
         if p_b > 0.0:
@@ -408,8 +409,10 @@ class AngleBiasKalmanFilter(Estimator):
     ) -> None:
         """Rest detection; at rest the gyro sample measures the bias (variance gyro_psd/dt):
         the x and y biases through the [angle, bias] filters, bias_z through its own state."""
-        rest_time, rest_gyro, rest_acc, gyro_var = self._rest_cfg
-        self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, rest_gyro, rest_acc)
+        rest_time, rest_gyro, rest_acc, gyro_var, bound = self._rest_cfg
+        self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az,
+                              (self.bias_x, self.bias_y, self.bias_z), dt, rest_gyro, rest_acc,
+                              rest_time, bound)
         self.P_z += self._q_bias * dt
         if self.rest[6] >= rest_time:
             r = gyro_var / dt
@@ -537,7 +540,7 @@ class AngleBiasKalmanFilter(Estimator):
         self.acc_f = turn(self.acc_f)
         self.acc_ref = turn(self.acc_ref)
         r = self.rest
-        self.rest = (*turn((r[0], r[1], r[2])), *turn((r[3], r[4], r[5])), r[6])
+        self.rest = (*turn((r[0], r[1], r[2])), *turn((r[3], r[4], r[5])), r[6], r[7])
         P_roll, P_pitch, P_z = self.P_roll, self.P_pitch, self.P_z
         vertical = (max(P_roll[0], P_pitch[0]), 0.0, 0.0, P_z)
         old = (P_roll, P_pitch, vertical)

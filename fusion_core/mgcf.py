@@ -24,6 +24,7 @@ from .building_blocks import (
     COMPLEMENTARY_ADAPTIVE_PARAMS,
     GYRO_SAMPLING_PARAM,
     REST_PARAMS,
+    REST_START,
     ZERO3,
     bias_at_rest,
     body_rotation,
@@ -143,6 +144,7 @@ class GainScheduledComplementaryFilter(Estimator):
         self._acc_tau = float(p["acc_lowpass"])
         self._rest_time = float(p["rest_time"])
         self._rest_gyro = float(p["rest_gyro"])
+        self._rest_bias_bound = float(p["rest_bias_bound"])
         self._rest_acc = float(p["rest_acc"])
         self._options = self._rest_time > 0.0 or self._acc_tau > 0.0
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS), as in the cf: one sample's
@@ -155,7 +157,7 @@ class GainScheduledComplementaryFilter(Estimator):
         self.bias = ZERO3
         self.w0_now = 0.0
         self.acc_f = ZERO3  # pre-filtered specific force (acc_lowpass > 0)
-        self.rest = (0.0,) * 7  # rest detector: mean rate, mean specific force, quiet time
+        self.rest = REST_START  # rest detector (building_blocks.RestState)
         self.acc_dist = 0.0  # mean square of raw - acc_ref (disturbance_time)
         self.acc_ref = ZERO3  # the specific force pre-filtered with the full acc_lowpass
 
@@ -163,7 +165,7 @@ class GainScheduledComplementaryFilter(Estimator):
         roll, pitch = accel_roll_pitch(ax, ay, az)
         self.q = quat_from_roll_pitch_yaw(roll, pitch, 0.0)
         self.acc_f = self.acc_ref = (ax, ay, az)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
 
     def _real_sensor_options(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -173,7 +175,8 @@ class GainScheduledComplementaryFilter(Estimator):
         measurement variance (the adaptive noise's; acc_noise^2 without it)."""
         if self._rest_time > 0.0:
             self.rest = rest_step(
-                self.rest, gx, gy, gz, ax, ay, az, dt, self._rest_gyro, self._rest_acc
+                self.rest, gx, gy, gz, ax, ay, az, self.bias, dt, self._rest_gyro,
+                self._rest_acc, self._rest_time, self._rest_bias_bound,
             )
             if self.rest[6] >= self._rest_time:
                 self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, self._rest_time)

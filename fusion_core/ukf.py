@@ -53,6 +53,7 @@ from .building_blocks import (
     GYRO_SAMPLING_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
+    REST_START,
     adaptive_noise_constants,
     bias_band2,
     body_rotation,
@@ -195,7 +196,7 @@ class UnscentedKalmanFilter(Estimator):
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
         self._P: tuple[float, ...] = (0.0,) * 21  # packed lower triangle of the 6x6 P
         self.acc_f = (0.0, 0.0, 0.0)  # the pre-filtered specific force (acc_lowpass > 0)
-        self.rest = (0.0,) * 7  # the rest detector's means and quiet time (rest_time > 0)
+        self.rest = REST_START  # the rest detector's means, quiet time, measured (rest_time > 0)
         self.acc_dist = 0.0  # mean square of raw - acc_ref (disturbance_time)
         self.acc_ref = (0.0, 0.0, 0.0)  # the specific force pre-filtered with the full acc_lowpass
 
@@ -207,7 +208,7 @@ class UnscentedKalmanFilter(Estimator):
         p_b = self._params["init_bias_std"] ** 2
         self._P = _packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
         self.acc_f = self.acc_ref = (ax, ay, az)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0)
+        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
 
     @property
     def P(self) -> list[list[float]]:
@@ -255,8 +256,10 @@ class UnscentedKalmanFilter(Estimator):
         else:
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
         if p["rest_time"] > 0.0:
-            self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, dt, p["rest_gyro"],
-                                  p["rest_acc"])
+            x = self.x
+            self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, (x[3], x[4], x[5]), dt,
+                                  p["rest_gyro"], p["rest_acc"], p["rest_time"],
+                                  p["rest_bias_bound"])
             if self.rest[6] >= p["rest_time"]:
                 self._zero_rate_update((gx, gy, gz), p["zaru_psd"] / dt)
 

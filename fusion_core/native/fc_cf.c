@@ -63,8 +63,8 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     double rest_time = p->rest_time;
     double roll, pitch, phi[3], terms[4];
     if (rest_time > 0.0) {
-        fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, p->rest_gyro,
-                     p->rest_acc);
+        fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], f->bias, dt, p->rest_gyro,
+                     p->rest_acc, rest_time, p->rest_bias_bound);
         if (f->rest[6] >= rest_time) {
             fc_bias_at_rest(f->bias, g[0], g[1], g[2], dt, rest_time);
         }

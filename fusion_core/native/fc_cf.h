@@ -15,7 +15,7 @@ typedef struct fc_cf {
     double acc_f[3];
     double q_att[4];
     double bias[3];
-    double rest[7];
+    double rest[8];
     double acc_dist;    /* mean square of raw - acc_ref (disturbance_time) */
     double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;

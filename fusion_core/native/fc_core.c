@@ -280,7 +280,7 @@ double fc_adaptive_prefilter_time(double tau, double dist, double noise)
     return tau * (excess / full);
 }
 
-void fc_rest_start(double rest[7], const double gyro[3], const double acc[3])
+void fc_rest_start(double rest[8], const double gyro[3], const double acc[3])
 {
     rest[0] = gyro[0];
     rest[1] = gyro[1];
@@ -289,12 +289,15 @@ void fc_rest_start(double rest[7], const double gyro[3], const double acc[3])
     rest[4] = acc[1];
     rest[5] = acc[2];
     rest[6] = 0.0;
+    rest[7] = 0.0;
 }
 
-void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,
-                  double az, double dt, double th_gyro, double th_acc)
+void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, double ay,
+                  double az, const double bias[3], double dt, double th_gyro, double th_acc,
+                  double rest_time, double bound)
 {
     double wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
+    double quiet = rest[6], measured = rest[7];
     double k = dt / (FC_REST_MEAN_TAU + dt);
     wx += k * (gx - wx);
     wy += k * (gy - wy);
@@ -306,15 +309,21 @@ void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, do
     double dx = gx - wx, dy = gy - wy, dz = gz - wz;
     double ex = ax - fx, ey = ay - fy, ez = az - fz;
     int still = dx * dx + dy * dy + dz * dz < th_g2
-        && wx * wx + wy * wy + wz * wz < th_g2
         && ex * ex + ey * ey + ez * ez < th_acc * th_acc;
+    if (still && quiet < rest_time) {  /* only a mean rate the bias explains may start a rest */
+        double mx = wx - bias[0], my = wy - bias[1], mz = wz - bias[2];
+        double lim = measured == 0.0 ? th_gyro + bound : th_gyro;
+        still = mx * mx + my * my + mz * mz < lim * lim;
+    }
+    quiet = still ? quiet + dt : 0.0;
     rest[0] = wx;
     rest[1] = wy;
     rest[2] = wz;
     rest[3] = fx;
     rest[4] = fy;
     rest[5] = fz;
-    rest[6] = still ? rest[6] + dt : 0.0;
+    rest[6] = quiet;
+    rest[7] = quiet >= rest_time ? 1.0 : measured;
 }
 
 void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,

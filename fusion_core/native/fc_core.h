@@ -106,10 +106,13 @@ double fc_correction_time(double tau, double r_ratio, double q_rotation, double 
 /* adaptive_prefilter_time: tau times the disturbance's excess over the noise, in units of
  * PREFILTER_FULL times the noise, between 0 and tau */
 double fc_adaptive_prefilter_time(double tau, double dist, double noise);
-/* The rest detector's state at the first sample: its means start at that sample, quiet 0. */
-void fc_rest_start(double rest[7], const double gyro[3], const double acc[3]);
-void fc_rest_step(double rest[7], double gx, double gy, double gz, double ax, double ay,
-                  double az, double dt, double th_gyro, double th_acc);
+/* The rest detector's state at the first sample: its means start at that sample, quiet 0, the
+ * bias not measured yet. */
+void fc_rest_start(double rest[8], const double gyro[3], const double acc[3]);
+/* rest_step: bias is the filter's gyro bias estimate in the frame of g */
+void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, double ay,
+                  double az, const double bias[3], double dt, double th_gyro, double th_acc,
+                  double rest_time, double bound);
 void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
                      double rest_time);
 void fc_bias_band2(double gate, double *lo, double *hi);

@@ -76,6 +76,7 @@ void fc_kf_configure(fc_kf *f)
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
+    f->rest_bias_bound = p->rest_bias_bound;
     f->gyro_var = p->gyro_psd;
     f->quaternion = p->propagation == FC_KF_PROPAGATION_QUATERNION;
     f->faces = p->tilt_axes == FC_KF_TILT_AXES_NEAREST_FACE && f->quaternion;
@@ -251,7 +252,9 @@ int fc_kf_accel_trusted(const fc_kf *f, double norm2)
 /* _zero_rate_update: at rest the gyro measures the bias */
 static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], double dt)
 {
-    fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, f->rest_gyro, f->rest_acc);
+    double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], b, dt, f->rest_gyro, f->rest_acc,
+                 f->rest_time, f->rest_bias_bound);
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
         double r = f->gyro_var / dt;

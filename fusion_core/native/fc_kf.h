@@ -15,7 +15,7 @@ typedef struct fc_kf {
     double P_roll[4], P_pitch[4];   /* [P00, P01, P10, P11] of each axis */
     double bias_z, P_z;
     double acc_f[3];
-    double rest[7];
+    double rest[8];
     double q_att[4];
     int face;
     double gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
@@ -26,7 +26,7 @@ typedef struct fc_kf {
     /* derived from params (AngleBiasKalmanFilter._configure) */
     double q_angle, q_bias, r, r_loop, gate_low2, gate_high2, acc_tau;
     double q_rotation, dist_tau, dist_noise;  /* AngleBiasKalmanFilter._adaptive */
-    double rest_time, rest_gyro, rest_acc, gyro_var;
+    double rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;
     double bias_lo2, bias_hi2;
     int trapezoid, quaternion, faces, options;
 } fc_kf;

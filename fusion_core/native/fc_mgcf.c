@@ -49,6 +49,7 @@ void fc_mgcf_configure(fc_mgcf *f)
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
+    f->rest_bias_bound = p->rest_bias_bound;
     f->options = f->rest_time > 0.0 || f->acc_tau > 0.0;
     f->r_ref = pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
@@ -99,7 +100,8 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     double r = f->r_ref;
     if (f->options) {  /* _real_sensor_options */
         if (f->rest_time > 0.0) {
-            fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, dt, f->rest_gyro, f->rest_acc);
+            fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, f->bias, dt, f->rest_gyro, f->rest_acc,
+                         f->rest_time, f->rest_bias_bound);
             if (f->rest[6] >= f->rest_time) {
                 fc_bias_at_rest(f->bias, gx, gy, gz, dt, f->rest_time);
             }

@@ -15,14 +15,14 @@ typedef struct fc_mgcf {
     double bias[3];
     double w0_now;
     double acc_f[3];
-    double rest[7];
+    double rest[8];
     double acc_dist;    /* mean square of raw - acc_ref (disturbance_time) */
     double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
     const double (*table)[2];  /* the schedule's (rho bound, w0) rows; NULL: fixed w0 */
     int table_rows;
-    double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc;
+    double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
     double r_ref, q_rotation, dist_tau, dist_noise, longest;  /* _adaptive */
     int trapezoid, options;
 } fc_mgcf;

@@ -25,6 +25,7 @@ typedef struct fc_cf_params {
     double rest_time;            /* [0.0, inf) [s] */
     double rest_gyro;            /* (0.0, inf) [rad/s] */
     double rest_acc;             /* (0.0, inf) [m/s2] */
+    double rest_bias_bound;      /* [0.0, inf) [rad/s] */
     int propagation;             /* one of 'euler', 'quaternion' */
     int gyro_sampling;           /* one of 'point', 'mean' */
     double acc_noise;            /* (0.0, inf) */
@@ -50,6 +51,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
+    p->rest_bias_bound = 0.3490658503988659;
     p->propagation = FC_CF_PROPAGATION_QUATERNION;
     p->gyro_sampling = FC_CF_GYRO_SAMPLING_POINT;
     p->acc_noise = 0.005;
@@ -81,6 +83,7 @@ typedef struct fc_mgcf_params {
     double rest_time;            /* [0.0, inf) [s] */
     double rest_gyro;            /* (0.0, inf) [rad/s] */
     double rest_acc;             /* (0.0, inf) [m/s2] */
+    double rest_bias_bound;      /* [0.0, inf) [rad/s] */
     int gyro_sampling;           /* one of 'point', 'mean' */
     double acc_noise;            /* (0.0, inf) */
     double gyro_scale_std;       /* [0.0, 0.5] */
@@ -105,6 +108,7 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
+    p->rest_bias_bound = 0.3490658503988659;
     p->gyro_sampling = FC_MGCF_GYRO_SAMPLING_POINT;
     p->acc_noise = 0.005;
     p->gyro_scale_std = 0.005;
@@ -142,6 +146,7 @@ typedef struct fc_kf_params {
     double rest_time;         /* [0.0, inf) [s] */
     double rest_gyro;         /* (0.0, inf) [rad/s] */
     double rest_acc;          /* (0.0, inf) [m/s2] */
+    double rest_bias_bound;   /* [0.0, inf) [rad/s] */
     double gyro_psd;          /* (0.0, inf) [rad2/s] */
     double init_bias_std;     /* [0.0, inf) [rad/s] */
     double bias_gate;         /* [0.0, inf) */
@@ -173,6 +178,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
+    p->rest_bias_bound = 0.3490658503988659;
     p->gyro_psd = 1.949551486634935e-08;
     p->init_bias_std = 0.017453292519943295;
     p->bias_gate = 0.05;
@@ -211,6 +217,7 @@ typedef struct fc_ukf_params {
     double rest_time;         /* [0.0, inf) [s] */
     double rest_gyro;         /* (0.0, inf) [rad/s] */
     double rest_acc;          /* (0.0, inf) [m/s2] */
+    double rest_bias_bound;   /* [0.0, inf) [rad/s] */
     double zaru_psd;          /* (0.0, inf) [rad2/s] */
     double bias_gate;         /* [0.0, inf) */
     double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
@@ -242,6 +249,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
+    p->rest_bias_bound = 0.3490658503988659;
     p->zaru_psd = 1.949551486634935e-08;
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;

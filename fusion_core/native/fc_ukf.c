@@ -613,7 +613,8 @@ static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
         filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);
     }
     if (p->rest_time > 0.0) {
-        fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], dt, p->rest_gyro, p->rest_acc);
+        fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], &f->x[3], dt, p->rest_gyro,
+                     p->rest_acc, p->rest_time, p->rest_bias_bound);
         if (f->rest[6] >= p->rest_time) {
             zero_rate_update(f, g, p->zaru_psd / dt);
         }

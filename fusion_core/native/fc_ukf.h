@@ -15,7 +15,7 @@ typedef struct fc_ukf {
     double x[6];      /* X (the gravity direction, 3), b (the gyro bias, 3) */
     double P[21];     /* the covariance's lower triangle, row by row */
     double acc_f[3];
-    double rest[7];
+    double rest[8];
     double acc_dist;  /* mean square of raw - acc_ref (disturbance_time) */
     double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;

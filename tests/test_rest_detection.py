@@ -1,0 +1,85 @@
+"""The rest detector (building_blocks.REST_PARAMS, rest_step): a still gyro's bias is measured
+whatever its size up to rest_bias_bound, while a steady rotation is not taken for rest.
+
+Every case runs the four attitude filters on constructed samples of a sensor whose z axis points
+up (the specific force (0, 0, g) at rest and under any rotation about the vertical), in Python
+and, where it is built, in the C twin, which must agree with it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fusion_core import ESTIMATORS, native
+from fusion_core.building_blocks import REST_PARAMS
+from fusion_core.types import DEG, G
+
+RATE = 100.0
+REST_TIME = next(p.default for p in REST_PARAMS if p.name == "rest_time")
+FILTERS = ("cf", "mgcf", "kf", "ukf")
+BACKENDS = ["python", pytest.param("native", marks=pytest.mark.skipif(
+    native.reason() is not None, reason=f"no C twin: {native.reason()}"))]
+
+
+def samples(gyro: list[tuple[float, float, float]], seconds: list[float]
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Segments of constant gyro readings [rad/s] for the given seconds, accelerometer (0, 0, g)."""
+    counts = [round(s * RATE) for s in seconds]
+    g = np.concatenate([np.tile(w, (n, 1)) for w, n in zip(gyro, counts, strict=True)])
+    acc = np.tile((0.0, 0.0, G), (len(g), 1))
+    return acc, g, np.full(len(g), 1.0 / RATE)
+
+
+def final_bias(key: str, backend: str, gyro: list[tuple[float, float, float]],
+               seconds: list[float], **params: float) -> np.ndarray:
+    out = ESTIMATORS[key](**params).run(*samples(gyro, seconds), backend=backend)
+    return np.asarray(out["bias"][-1])
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("key", FILTERS)
+def test_a_still_gyro_with_a_bias_beyond_rest_gyro_is_measured(key: str, backend: str) -> None:
+    """An uncalibrated MPU-6050 at rest: 8 deg/s of bias, four times rest_gyro. The mean rate
+    alone (VQF's rule, rest_bias_bound 0) refuses the rest and the bias is never measured; within
+    the turn-on bound the rest starts and lasts, and the bias is the gyro's."""
+    bias = (8.0 * DEG, -5.0 * DEG, 3.0 * DEG)
+    measured = final_bias(key, backend, [bias], [20.0])
+    assert measured == pytest.approx(bias, abs=0.01 * DEG)
+    refused = final_bias(key, backend, [bias], [20.0], rest_bias_bound=0.0)
+    assert abs(refused[2]) < 0.5 * DEG  # about z the accelerometer sees nothing of it
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("key", FILTERS)
+def test_a_steady_rotation_about_the_vertical_is_not_taken_for_rest(key: str, backend: str
+                                                                   ) -> None:
+    """A rotation about the vertical changes neither the gyro reading nor the specific force, so
+    only the mean rate tells it from rest. After a rest has measured the bias, 5 deg/s is a
+    rotation (more than rest_gyro from the bias); before any rest, 30 deg/s is one too (more than
+    rest_gyro plus rest_bias_bound)."""
+    b = (0.1 * DEG, -0.1 * DEG, 0.05 * DEG)
+    turn = (b[0], b[1], b[2] + 5.0 * DEG)
+    after_rest = final_bias(key, backend, [b, turn], [5.0, 20.0])
+    assert after_rest[2] == pytest.approx(b[2], abs=0.01 * DEG)
+    fast = (b[0], b[1], b[2] + 30.0 * DEG)
+    assert abs(final_bias(key, backend, [fast], [20.0])[2]) < 0.01 * DEG
+
+
+@pytest.mark.parametrize("key", FILTERS)
+def test_a_rest_under_way_lasts_while_the_sensor_stays_still(key: str) -> None:
+    """The mean-rate test only starts a rest: once it has begun with the turn-on bound, the bias
+    estimate converges in it instead of ending the rest the moment the bound no longer applies."""
+    est = ESTIMATORS[key]()
+    bias = (0.0, 0.0, 8.0 * DEG)
+    acc, gyro, dt = samples([bias], [10.0])
+    quiet = []
+    for k in range(len(dt)):
+        est.step(acc[k], gyro[k], dt[k])
+        quiet.append(est.rest[6])
+    start = next(i for i, q in enumerate(quiet) if q >= REST_TIME)
+    assert start < 2.0 * RATE  # begun within the first 2 s
+    assert all(q >= REST_TIME for q in quiet[start:])  # and never ended
+    assert est.rest[7] == 1.0
+    assert math.isclose(est.rest[6], len(dt) / RATE, rel_tol=0.05)
