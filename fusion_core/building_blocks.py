@@ -236,6 +236,12 @@ def lowpass_specific_force(f: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
     return f0 + k * (a[0] - f0), f1 + k * (a[1] - f1), f2 + k * (a[2] - f2)
 
 
+def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
+    """The rest detector's state at the first sample: its means start at that sample, quiet time
+    0, the bias not measured yet."""
+    return gx, gy, gz, ax, ay, az, 0.0, 0.0
+
+
 def rest_step(
     rest: RestState, gx: float, gy: float, gz: float, ax: float, ay: float, az: float,
     bias: Vec3, dt: float, th_gyro: float, th_acc: float, rest_time: float, bound: float,

@@ -27,6 +27,7 @@ from .building_blocks import (
     gate_bounds2,
     lowpass_specific_force,
     quat_from_roll_pitch,
+    rest_start,
     rest_step,
 )
 from .kinematics import (
@@ -141,7 +142,7 @@ class ComplementaryFilter(Estimator):
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
         self.acc_f = self.acc_ref = (ax, ay, az)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
+        self.rest = rest_start(gx, gy, gz, ax, ay, az)
 
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float

@@ -46,6 +46,7 @@ from .building_blocks import (
     mat_vec,
     nearest_face,
     quat_from_roll_pitch,
+    rest_start,
     rest_step,
     zero_rate_psd_param,
 )
@@ -329,7 +330,7 @@ class AngleBiasKalmanFilter(Estimator):
                 gx, gy, gz = mat_vec(C, (gx, gy, gz))
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
         self.acc_f = self.acc_ref = (ax, ay, az)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
+        self.rest = rest_start(gx, gy, gz, ax, ay, az)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         p_b = self._params["init_bias_std"] ** 2
         if p_b > 0.0:

@@ -32,6 +32,7 @@ from .building_blocks import (
     correction_time,
     disturbance_step,
     lowpass_specific_force,
+    rest_start,
     rest_step,
 )
 from .kinematics import (
@@ -165,7 +166,7 @@ class GainScheduledComplementaryFilter(Estimator):
         roll, pitch = accel_roll_pitch(ax, ay, az)
         self.q = quat_from_roll_pitch_yaw(roll, pitch, 0.0)
         self.acc_f = self.acc_ref = (ax, ay, az)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
+        self.rest = rest_start(gx, gy, gz, ax, ay, az)
 
     def _real_sensor_options(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float

@@ -59,6 +59,7 @@ from .building_blocks import (
     body_rotation,
     disturbance_step,
     lowpass_specific_force,
+    rest_start,
     rest_step,
     zero_rate_psd_param,
 )
@@ -208,7 +209,7 @@ class UnscentedKalmanFilter(Estimator):
         p_b = self._params["init_bias_std"] ** 2
         self._P = _packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
         self.acc_f = self.acc_ref = (ax, ay, az)
-        self.rest = (gx, gy, gz, ax, ay, az, 0.0, 0.0)
+        self.rest = rest_start(gx, gy, gz, ax, ay, az)
 
     @property
     def P(self) -> list[list[float]]:
