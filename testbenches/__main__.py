@@ -56,7 +56,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from .campaign import plan, run_campaign
-    from .report import contract_table, seed_summaries, seed_summary_table, write_reports
+    from .report import (
+        contract_table,
+        over_several_seeds,
+        seed_summaries,
+        seed_summary_table,
+        write_reports,
+    )
 
     estimators = choose(args.estimator, list(ESTIMATOR_FMUS), "estimator")
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
@@ -86,9 +92,11 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         peer_rows = run_peers(peers, scenarios, args.seeds, sensor, args.duration)
         print("\n" + peer_table(peer_rows))
-    if args.seeds > 1:
-        print("\n" + seed_summary_table(seed_summaries(result, peer_rows)))
-    write_reports(result, args.out, plots=not args.no_plots, peers=peer_rows)
+    summaries = seed_summaries(result, peer_rows)
+    if over_several_seeds(summaries):
+        print("\n" + seed_summary_table(summaries))
+    write_reports(result, args.out, plots=not args.no_plots, peers=peer_rows,
+                  summaries=summaries)
     print(f"\nreports: {args.out / 'report.md'}, {args.out / 'report.json'}")
     return 0 if result.passed else 1
 

@@ -115,6 +115,11 @@ def seed_summaries(result: CampaignResult, peers: list[PeerRun] | None = None
     return [_summary(*key, np.array(v, dtype=float), bounds[key]) for key, v in groups.items()]
 
 
+def over_several_seeds(rows: list[SeedSummary]) -> bool:
+    """Whether the summaries say more than the per-run rows: some run had a second seed."""
+    return any(s.seeds > 1 for s in rows)
+
+
 def seed_summary_table(rows: list[SeedSummary]) -> str:
     """The summaries as a text table: RMSE roll/pitch [deg] over the seeds."""
     head = (f"{'':<11} {'scenario':<18} {'seeds':>5} {'mean':>11} {'median':>11} {'p95':>11} "
@@ -164,10 +169,11 @@ def plot_run(r: TestbenchResult, path: Path) -> None:
 
 
 def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True,
-                  peers: list[PeerRun] | None = None) -> None:
+                  peers: list[PeerRun] | None = None,
+                  summaries: list[SeedSummary] | None = None) -> None:
     """report.json, report.md and, with plots, a PNG per run under out_dir/plots; with peers,
     the public filters' rows on the same samples (peer_runs) in both; with several seeds, the
-    summaries over them (seed_summaries)."""
+    summaries over them (seed_summaries, unless given)."""
     out_dir.mkdir(parents=True, exist_ok=True)
     records = []
     for r in result.runs:
@@ -185,8 +191,9 @@ def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True,
     }
     if peers is not None:
         report["peers"] = [r.as_dict() for r in peers]
-    summaries = seed_summaries(result, peers)
-    several = any(sm.seeds > 1 for sm in summaries)
+    if summaries is None:
+        summaries = seed_summaries(result, peers)
+    several = over_several_seeds(summaries)
     if several:
         report["over_seeds"] = [sm.as_dict() for sm in summaries]
     (out_dir / "report.json").write_text(json.dumps(report, indent=1))
