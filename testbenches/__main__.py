@@ -200,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
             from .budget import cmd_budget
 
             return cmd_budget(args)
-    except (ValueError, FileNotFoundError) as err:
+    except (ValueError, FileNotFoundError, ConnectionError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     return 2

@@ -10,7 +10,7 @@ import pytest
 
 from testbenches.campaign import load_sensor
 from testbenches.montecarlo.plan import parse_variation, plan
-from testbenches.montecarlo.runner import execute
+from testbenches.montecarlo.runner import connect, execute
 from testbenches.montecarlo.simulate import run_row, simulate
 from testbenches.montecarlo.store import read_rows
 from testbenches.montecarlo.summary import summarise
@@ -98,6 +98,16 @@ def test_a_variation_must_name_a_numeric_parameter_and_a_range():
     with pytest.raises(ValueError, match="LOW must be below HIGH"):
         parse_variation("tau=2:1")
     assert parse_variation("R_measure=1e-6:1e-4:log").target == "estimator"
+
+
+def test_an_address_where_no_scheduler_answers_is_an_error_that_says_what_to_do():
+    import socket
+
+    with socket.socket() as s:  # a port that was free a moment ago: nothing listens there
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(ConnectionError, match=r"no Dask scheduler answers.*dask scheduler"):
+        connect(f"127.0.0.1:{port}", timeout=1)
 
 
 def test_a_campaign_run_is_the_fmu_testbench_run(built_fmus):

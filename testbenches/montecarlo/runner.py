@@ -25,6 +25,8 @@ from .store import done_keys, write_batch
 BATCHES_PER_WORKER = 8
 """Enough batches per worker to balance the load and show progress, few enough to stay cheap."""
 MAX_BATCH = 200
+CONNECT_TIMEOUT_S = 10
+"""How long to wait for the user's own scheduler before saying it does not answer [s]."""
 
 
 def failed_row(run: Run, error: str, attempts: int) -> dict[str, Any]:
@@ -56,8 +58,10 @@ def run_batch(runs: Sequence[Run], retries: int, fmu_dir: str | None = None
     return rows
 
 
-def connect(scheduler: str = "local", workers: int = 2) -> tuple[Any, Any]:
-    """A Dask client (and its LocalCluster, or None for the user's own scheduler)."""
+def connect(scheduler: str = "local", workers: int = 2, timeout: float = CONNECT_TIMEOUT_S
+            ) -> tuple[Any, Any]:
+    """A Dask client (and its LocalCluster, or None for the user's own scheduler); a
+    ConnectionError that says what to do where no scheduler answers at the address."""
     from dask.distributed import Client, LocalCluster
 
     if scheduler == "local":
@@ -65,7 +69,14 @@ def connect(scheduler: str = "local", workers: int = 2) -> tuple[Any, Any]:
                                dashboard_address=":0", silence_logs=logging.ERROR)
         return Client(cluster), cluster
     address = scheduler if "://" in scheduler else f"tcp://{scheduler}"
-    return Client(address, timeout="10s"), None
+    try:
+        return Client(address, timeout=f"{timeout}s"), None
+    except OSError as err:  # refused, unknown host, timed out
+        raise ConnectionError(
+            f"--scheduler {scheduler}: no Dask scheduler answers at {address} within "
+            f"{timeout:g} s ({err}). Start one there (`dask scheduler`, then `dask "
+            "worker ADDRESS` on each machine) or use --scheduler local for a LocalCluster"
+        ) from err
 
 
 def batches(runs: Sequence[Run], workers: int, size: int | None = None) -> list[list[Run]]:
