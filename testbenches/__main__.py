@@ -28,7 +28,7 @@ from .budget import add_budget_parser
 from .fit.cli import add_fit_parsers
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .montecarlo.cli import add_campaign_parser
-from .options import choose
+from .options import choose, jitter_fraction, positive_float, positive_int
 
 
 def parse_params(items: list[str]) -> dict[str, object]:
@@ -136,10 +136,11 @@ def main(argv: list[str] | None = None) -> int:
                      help="ImuSensor parameters for the runs: realistic (the defaults: an "
                      "MPU-6050 as a user meets it), ideal (white noise only, the papers' "
                      "simulations), or a JSON file of sensor parameters")
-    run.add_argument("--seeds", type=int, default=1, help="seeds per estimator x scenario (1)")
-    run.add_argument("--jitter", type=float, default=0.0,
+    run.add_argument("--seeds", type=positive_int, default=1,
+                     help="seeds per estimator x scenario (1)")
+    run.add_argument("--jitter", type=jitter_fraction, default=0.0,
                      help="communication-step jitter, fraction of the period (0)")
-    run.add_argument("--duration", type=float, default=None,
+    run.add_argument("--duration", type=positive_float, default=None,
                      help="seconds per run instead of each scenario's own duration")
     run.add_argument("--out", type=Path, default=Path("reports"), help="report folder (reports)")
     run.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
@@ -147,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
                      help="FMUs to run: native (FMI 2.0 from the C twin, FMU_DIR/native/fmi2), "
                      "pythonfmu (FMU_DIR), or auto: native where built (default)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    run.add_argument("--jobs", type=int, default=2,
+    run.add_argument("--jobs", type=positive_int, default=2,
                      help="worker processes (2: the campaign on two cores; 1: all in this one)")
     run.add_argument("--no-timing-check", action="store_true",
                      help="report T3 (the compute budget, in CPU time) but leave it out of the "

@@ -27,7 +27,7 @@ import numpy as np
 from fusion_core.scenarios import SCENARIOS
 
 from .contract import accuracy_limits, compute_metrics
-from .options import choose
+from .options import choose, positive_int
 
 SOURCES: dict[str, tuple[str, dict[str, Any]]] = {
     "gyro_scale": ("gyro scale-factor error", {"gyro_scale_std": 0.0}),
@@ -182,7 +182,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
                    help="all or a comma list of cf, mgcf, kf, ukf, poskf (all)")
     p.add_argument("--scenario", default="all",
                    help=f"all or a comma list of {', '.join(SCENARIOS)} (all)")
-    p.add_argument("--seeds", type=int, default=3, help="seeds per row, averaged (3)")
+    p.add_argument("--seeds", type=positive_int, default=3, help="seeds per row, averaged (3)")
     p.add_argument("--preset", default="recommended",
                    help="estimator parameters: recommended, paper or a JSON file (recommended)")
     p.add_argument("--sensor", default="realistic",
@@ -200,8 +200,6 @@ def cmd_budget(args: argparse.Namespace) -> int:
 
     from .campaign import load_sensor
 
-    if args.seeds < 1:
-        raise ValueError(f"--seeds {args.seeds}: at least 1")
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
     preset, sensor = load_preset(args.preset), load_sensor(args.sensor)

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
+import math
+from collections.abc import Callable
+from typing import Any
+
 
 def choose(value: str, allowed: list[str], what: str) -> list[str]:
     """'all' or a comma list of names from `allowed`; ValueError naming the unknown ones."""
@@ -13,3 +18,39 @@ def choose(value: str, allowed: list[str], what: str) -> list[str]:
         raise ValueError(f"unknown {what} {', '.join(bad) or value!r}: allowed all, "
                          f"{', '.join(allowed)}")
     return names
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer of at least 1 (seeds, workers, jobs, batch sizes)."""
+    return _number(text, int, "an integer of at least 1", lambda v: v >= 1)
+
+
+def non_negative_int(text: str) -> int:
+    """argparse type: an integer of at least 0 (retries)."""
+    return _number(text, int, "an integer of at least 0", lambda v: v >= 0)
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number above 0 (durations [s], rates [Hz])."""
+    return _number(text, float, "a finite number above 0", lambda v: 0.0 < v < math.inf)
+
+
+def non_negative_float(text: str) -> float:
+    """argparse type: a finite number of at least 0 (fractions)."""
+    return _number(text, float, "a finite number of at least 0", lambda v: 0.0 <= v < math.inf)
+
+
+def jitter_fraction(text: str) -> float:
+    """argparse type: a fraction of the period in [0, 1) (a step of 1 + jitter or more would
+    reach zero or below)."""
+    return _number(text, float, "a fraction in [0, 1)", lambda v: 0.0 <= v < 1.0)
+
+
+def _number(text: str, kind: type, allowed: str, ok: Callable[[Any], bool]) -> Any:
+    try:
+        value = kind(text)
+    except ValueError:
+        value = None
+    if value is None or not ok(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: allowed {allowed}")
+    return value

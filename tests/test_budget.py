@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from fusion_core.building_blocks import CONSTANT_NOISE
 from fusion_core.sensor import SENSOR_PARAMS, sensor_preset
 from testbenches.__main__ import main
@@ -63,7 +65,9 @@ def test_the_command_writes_json_markdown_and_plot(tmp_path, capsys):
 
 
 def test_bad_options_say_what_is_allowed(capsys):
-    assert main(["budget", "--seeds", "0"]) == 2
-    assert "at least 1" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:  # argparse's refusal, before any run
+        main(["budget", "--seeds", "0"])
+    assert stop.value.code == 2
+    assert "an integer of at least 1" in capsys.readouterr().err
     assert main(["budget", "--scenario", "nope"]) == 2
     assert "allowed" in capsys.readouterr().err

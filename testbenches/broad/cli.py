@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..fmus import DEFAULT_FMU_DIR
-from ..options import choose
+from ..options import choose, positive_float
 
 if TYPE_CHECKING:
     from .data import BroadTrial
@@ -48,7 +48,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--trials-json", type=Path, default=None,
                    help="BROAD's trials.json for the groups (default: the one beside the files; "
                    "else the groups in the trial names)")
-    p.add_argument("--head", type=float, default=None, metavar="SECONDS",
+    p.add_argument("--head", type=positive_float, default=None, metavar="SECONDS",
                    help="use only the first SECONDS of every trial (a quick look)")
     p.add_argument("--out", type=Path, default=Path("reports/broad"),
                    help="report folder (reports/broad)")

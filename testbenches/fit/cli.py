@@ -8,6 +8,8 @@ from pathlib import Path
 
 from fusion_core import ESTIMATORS
 
+from ..options import non_negative_float, positive_float, positive_int
+
 
 def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     noise = sub.add_parser(
@@ -16,7 +18,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     noise.add_argument("file", type=Path, help="a static recording: CSV (acc_x..z [m/s2], "
                        "gyro_x..z [rad/s], optional time or dt [s]) or a BROAD trial (its rest "
                        "segment is used)")
-    noise.add_argument("--rate", type=float, default=None,
+    noise.add_argument("--rate", type=positive_float, default=None,
                        help="sampling rate [Hz] of a CSV without time or dt columns")
     noise.add_argument("--out", type=Path, default=Path("reports/noise"),
                        help="folder for noise.json, preset.json, sensor.json, allan.png")
@@ -38,12 +40,12 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
                       help="comma list of the parameters to fit, or all (every tunable one); "
                       "default: those the recommended preset took from a scan (cf tau, mgcf "
                       "w0 and zeta, kf Q_bias, ukf bias_psd, poskf q)")
-    tune.add_argument("--max-evaluations", type=int, default=300,
+    tune.add_argument("--max-evaluations", type=positive_int, default=300,
                       help="runs of the estimator over the fit set at most (300)")
-    tune.add_argument("--max-worse", type=float, default=0.03,
+    tune.add_argument("--max-worse", type=non_negative_float, default=0.03,
                       help="how much worse than at the start any one fit recording may end, a "
                       "fraction (0.03)")
-    tune.add_argument("--rate", type=float, default=None,
+    tune.add_argument("--rate", type=positive_float, default=None,
                       help="sampling rate [Hz] of CSV files without time or dt columns")
     tune.add_argument("--fmu", action="store_true",
                       help="confirm the fitted preset through the estimator's FMU")

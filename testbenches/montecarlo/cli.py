@@ -10,6 +10,7 @@ from pathlib import Path
 from fusion_core.scenarios import SCENARIOS
 
 from ..fmus import ESTIMATOR_FMUS
+from ..options import non_negative_int, positive_float, positive_int
 from .plan import DESIGNS
 
 
@@ -21,9 +22,9 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
                    help=f"all or a comma list of {', '.join(ESTIMATOR_FMUS)}")
     p.add_argument("--scenario", default="moderate_dynamics",
                    help=f"all or a comma list of {', '.join(SCENARIOS)} (moderate_dynamics)")
-    p.add_argument("--seeds", type=int, default=100,
+    p.add_argument("--seeds", type=positive_int, default=100,
                    help="runs per estimator and scenario: seed i, design point i (100)")
-    p.add_argument("--duration", type=float, default=None,
+    p.add_argument("--duration", type=positive_float, default=None,
                    help="seconds per run instead of each scenario's own duration")
     p.add_argument("--vary", action="append", default=[], metavar="NAME=LOW:HIGH[:log]",
                    help="a sensor or estimator parameter drawn over the runs (repeatable)")
@@ -37,10 +38,10 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scheduler", default="local",
                    help="local (a LocalCluster, the default) or the address HOST:PORT of your "
                    "own Dask scheduler")
-    p.add_argument("--workers", type=int, default=2, help="LocalCluster processes (2)")
-    p.add_argument("--batch-size", type=int, default=None,
+    p.add_argument("--workers", type=positive_int, default=2, help="LocalCluster processes (2)")
+    p.add_argument("--batch-size", type=positive_int, default=None,
                    help="runs per Dask task (default: about 8 tasks per worker, at most 200)")
-    p.add_argument("--retries", type=int, default=2,
+    p.add_argument("--retries", type=non_negative_int, default=2,
                    help="tries of a failing run after the first, before it is recorded as "
                    "failed (2)")
     p.add_argument("--fmu", action="store_true",
@@ -66,8 +67,6 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     estimators = choose(args.estimator, list(ESTIMATOR_FMUS), "estimator")
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
     variations = [parse_variation(v) for v in args.vary]
-    if args.seeds < 1:
-        raise ValueError(f"--seeds {args.seeds}: at least 1")
     runs = plan(estimators, scenarios, args.seeds, variations, args.duration,
                 load_sensor(args.sensor), load_preset(args.preset), args.design,
                 args.campaign_seed, args.fmu)

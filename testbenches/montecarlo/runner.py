@@ -93,6 +93,9 @@ def execute(runs: Sequence[Run], out_dir: Path, scheduler: str = "local", worker
 
     from dask.distributed import as_completed
 
+    if workers < 1 or retries < 0 or (batch_size is not None and batch_size < 1):
+        raise ValueError(f"workers={workers}, retries={retries}, batch_size={batch_size}: "
+                         "allowed workers and batch_size of at least 1, retries of at least 0")
     done = done_keys(out_dir)
     todo = [r for r in runs if r.key not in done]
     stats: dict[str, Any] = {"planned": len(runs), "already_done": len(runs) - len(todo),
