@@ -31,6 +31,19 @@ from .montecarlo.cli import add_campaign_parser
 from .options import choose, jitter_fraction, positive_float, positive_int
 
 
+def check_params(params: dict[str, object], estimators: list[str],
+                 preset: dict[str, dict[str, Any]]) -> None:
+    """--param values go to every chosen estimator: each must have them, in range, on top of
+    its preset (a ValueError that names the estimator, before any run starts)."""
+    from fusion_core import ESTIMATORS
+
+    for key in estimators if params else []:
+        try:
+            ESTIMATORS[key](**{**preset.get(key, {}), **params})
+        except ValueError as err:
+            raise ValueError(f"--param, {key}: {err}") from None
+
+
 def parse_params(items: list[str]) -> dict[str, object]:
     """NAME=VALUE strings to a dict: numbers as float or int, true/false, else the string."""
     out: dict[str, object] = {}
@@ -72,6 +85,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     preset = load_preset(args.preset)
     sensor = load_sensor(args.sensor)
+    params = parse_params(args.param)
+    check_params(params, estimators, preset)
     peers = _peers(args)  # checked before the runs: a missing package fails at once
     jobs = plan(estimators, scenarios, args.seeds, args.jitter, not args.no_contract)
     fmu_dir = kind_dir(args.fmu_dir, args.kind)
@@ -82,7 +97,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             bar.update()
 
         result = run_campaign(estimators, scenarios, args.seeds, args.jitter, fmu_dir,
-                              progress, not args.no_contract, parse_params(args.param),
+                              progress, not args.no_contract, params,
                               args.duration, not args.no_timing_check, args.jobs,
                               preset=preset, sensor=sensor)
     print(contract_table(result))

@@ -294,7 +294,13 @@ def test_cli_exits_2_with_a_message_for_an_unknown_parameter(fmu_dir: Path, tmp_
     proc = _cli("--estimator", "cf", "--scenario", "static_level", "--duration", "1",
                 "--param", "nope=1", fmu_dir=fmu_dir, out=tmp_path)
     assert proc.returncode == 2
-    assert "has no parameter 'nope'" in proc.stderr
+    assert "--param, cf: unknown parameter(s) nope for ComplementaryFilter: allowed tau" \
+        in proc.stderr
+    assert "0/1" not in proc.stderr  # refused before the first run, not during it
+    proc = _cli("--estimator", "cf", "--scenario", "static_level", "--duration", "1",
+                "--param", "tau=abc", fmu_dir=fmu_dir, out=tmp_path)
+    assert proc.returncode == 2
+    assert "--param, cf: parameter 'tau'='abc' is not a number" in proc.stderr
 
 
 def test_reports_hold_a_plot_per_run_and_the_checks(fmu_dir: Path, tmp_path: Path) -> None:
