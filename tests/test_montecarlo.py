@@ -10,7 +10,7 @@ import pytest
 
 from testbenches.campaign import load_sensor
 from testbenches.montecarlo.plan import parse_variation, plan
-from testbenches.montecarlo.runner import connect, execute
+from testbenches.montecarlo.runner import MAX_BATCH, MIN_BATCH, batches, connect, execute
 from testbenches.montecarlo.simulate import run_row, simulate
 from testbenches.montecarlo.store import read_rows
 from testbenches.montecarlo.summary import summarise
@@ -98,6 +98,19 @@ def test_a_variation_must_name_a_numeric_parameter_and_a_range():
     with pytest.raises(ValueError, match="LOW must be below HIGH"):
         parse_variation("tau=2:1")
     assert parse_variation("R_measure=1e-6:1e-4:log").target == "estimator"
+
+
+@pytest.mark.parametrize(("runs", "workers"), [(3000, 2), (10500, 2), (3000, 1), (20, 2), (3, 4)])
+def test_batches_hold_every_run_once_in_order_and_shrink_to_the_end(runs, workers):
+    parts = batches(list(range(runs)), workers)
+    assert [r for part in parts for r in part] == list(range(runs))
+    sizes = [len(p) for p in parts]
+    assert sizes[:-1] == sorted(sizes[:-1], reverse=True)  # the last takes what is left
+    assert max(sizes) <= MAX_BATCH
+    assert len(parts) >= min(runs, workers)  # a small campaign still gives every worker work
+    if runs >= 8 * MIN_BATCH * workers:  # the last batches are the smallest, not as large as
+        assert sizes[-2] == MIN_BATCH < sizes[0]  # the first: the workers finish together
+    assert len(batches(list(range(runs)), workers, size=7)[0]) == min(7, runs)
 
 
 def test_an_address_where_no_scheduler_answers_is_an_error_that_says_what_to_do():

@@ -4,10 +4,10 @@
 CPU-bound and the estimators hold no lock to share); an address ("HOST:PORT" or
 "tcp://HOST:PORT") connects to a scheduler the user runs (`dask scheduler`, `dask worker
 ADDRESS` on each machine, with this project installed there). Runs go in batches, one task per
-batch, so that the scheduler's per-task cost (about a millisecond) stays small beside the runs
-(about ten milliseconds each natively). Each run is tried 1 + retries times inside its batch;
-a run that still raises becomes a "failed" row with its error. Dask itself retries a batch
-whose worker died. Every batch is written as Parquet the moment it returns (store.py).
+batch, that shrink as the campaign goes (BATCHES_PER_WORKER). Each run is tried 1 + retries
+times inside its batch; a run that still raises becomes a "failed" row with its error. Dask
+itself retries a batch whose worker died. Every batch is written as Parquet the moment it
+returns (store.py).
 """
 
 from __future__ import annotations
@@ -22,8 +22,14 @@ from .plan import Run
 from .simulate import METRICS, run_row
 from .store import done_keys, write_batch
 
-BATCHES_PER_WORKER = 8
-"""Enough batches per worker to balance the load and show progress, few enough to stay cheap."""
+BATCHES_PER_WORKER = 4
+"""Guided batches: each takes 1/(BATCHES_PER_WORKER x workers) of the runs not yet handed out,
+so they shrink as the campaign goes, at most MAX_BATCH runs and at least MIN_BATCH (fewer in a
+campaign too small to give every worker that many). The large
+first ones keep the scheduler's per-task cost (about a millisecond) small beside the runs
+(milliseconds each natively); the small last ones let the workers finish together, instead of
+one idling while another works through a last batch as large as the first."""
+MIN_BATCH = 8
 MAX_BATCH = 200
 CONNECT_TIMEOUT_S = 10
 """How long to wait for the user's own scheduler before saying it does not answer [s]."""
@@ -80,8 +86,15 @@ def connect(scheduler: str = "local", workers: int = 2, timeout: float = CONNECT
 
 
 def batches(runs: Sequence[Run], workers: int, size: int | None = None) -> list[list[Run]]:
-    size = size or max(1, min(MAX_BATCH, math.ceil(len(runs) / (workers * BATCHES_PER_WORKER))))
-    return [list(runs[i:i + size]) for i in range(0, len(runs), size)]
+    """The runs in Dask tasks: guided sizes (BATCHES_PER_WORKER), or `size` runs each."""
+    share = BATCHES_PER_WORKER * workers
+    smallest = min(MIN_BATCH, math.ceil(len(runs) / share))
+    out, start = [], 0
+    while start < len(runs):
+        n = size or min(MAX_BATCH, max(smallest, math.ceil((len(runs) - start) / share)))
+        out.append(list(runs[start:start + n]))
+        start += n
+    return out
 
 
 def execute(runs: Sequence[Run], out_dir: Path, scheduler: str = "local", workers: int = 2,
