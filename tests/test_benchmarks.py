@@ -28,6 +28,7 @@ TINY = dict(
     testbench_estimators=("kf",),
     scaling_sizes=(300, 600),
     scaling_estimators=("cf",),
+    campaign_seeds=4,  # 40 runs a campaign: the section's fields, not its figures
 )
 
 
@@ -51,6 +52,18 @@ def test_json_holds_every_section_of_the_issue(bench_json: dict) -> None:
         assert key in bench_json, key
     assert bench_json["repeats"] == 1
     assert bench_json["machine"]["cpu_count"] >= 1
+
+
+def test_campaign_section_measures_both_worker_counts_or_says_why_not(bench_json: dict) -> None:
+    c = bench_json["campaign"]
+    if not c["available"]:
+        assert c["reason"]
+        return
+    assert c["runs"] == 4 * 5 * 2  # seeds x estimators x scenarios
+    assert c["samples_per_s"] > 0.0 and c["samples_per_s_1_worker"] > 0.0
+    assert c["scaling"] == pytest.approx(c["samples_per_s"] / c["samples_per_s_1_worker"])
+    names = {t["name"] for t in bench_json["targets"]}
+    assert {"campaign.samples_per_s", "campaign.scaling"} <= names
 
 
 def test_per_sample_has_every_estimator_and_every_peer_or_its_reason(bench_json: dict) -> None:
