@@ -4,8 +4,6 @@ fmi2FreeInstance, and gets exactly the outputs of the fmpy run."""
 
 from __future__ import annotations
 
-import os
-import shutil
 import subprocess
 import sys
 import sysconfig
@@ -17,6 +15,7 @@ import pytest
 from fmpy import extract
 
 from fmu_src.host import INPUTS, FmuInstance
+from fusion_core.native import compiler
 
 HOST_SOURCE = Path(__file__).parent / "fmu_host" / "fmu_host.c"
 N_STEPS = 500
@@ -34,10 +33,11 @@ def shared_libpython() -> Path | None:
     return None
 
 
-COMPILER = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+COMPILER = compiler()  # the one the C twin is built with: $CC, else cc, gcc or clang
 LIBPYTHON = shared_libpython()
 pytestmark = [
-    pytest.mark.skipif(COMPILER is None, reason="no C compiler (cc or gcc) on PATH"),
+    pytest.mark.skipif(COMPILER is None,
+                       reason="no C compiler (set CC, or install cc, gcc or clang)"),
     pytest.mark.skipif(
         LIBPYTHON is None,
         reason=f"no shared libpython for {sys.version.split()[0]}: a pythonfmu FMU needs one in "
