@@ -31,6 +31,7 @@ from math import cos, sin
 from typing import Any, Final
 
 from .kinematics import (
+    accel_roll_pitch,
     rotate_back,
     rotation_increment,
 )
@@ -177,10 +178,12 @@ refuses the rest of a still gyro whose bias exceeds the threshold: an MPU-6050 a
 filter, which learns its bias nowhere else, stays 23/15 deg off at rest (static_tilted, 40 such
 parts; VQF 14/10). So here the mean rate is taken less the filter's bias estimate, and before
 the first rest a mean rate the turn-on bias can explain (rest_bias_bound: the datasheet's 20
-deg/s) may start one: cf then 2.3/2.0 deg, kf 0.81/0.88, ukf 0.79/0.85 (the same 40 parts). A
-rest under way lasts while the deviations stay small, so that the bias estimate can converge in
-it. With the start-up calibration (the default sensor; the contract's scenarios, seeds 0-2 checked)
-and on BROAD's 13 trials the outputs are the same to the last bit as with VQF's rule."""
+deg/s) may start one: kf then 0.81/0.88 deg, ukf 0.79/0.85 (the same 40 parts), and cf 2.3/2.0,
+or 0.78/0.85 with the alignment at such a first rest (uncalibrated_first_rest), which is the
+floor the parts' uncalibrated accelerometers leave. A rest under way lasts while the deviations
+stay small, so that the bias estimate can converge in it. With the start-up calibration (the
+default sensor; the contract's scenarios, seeds 0-2 checked) and on BROAD's 13 trials the outputs
+are the same to the last bit as with VQF's rule and without the alignment."""
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
@@ -270,6 +273,36 @@ def rest_step(
         still = mx * mx + my * my + mz * mz < lim * lim
     quiet = quiet + dt if still else 0.0
     return wx, wy, wz, fx, fy, fz, quiet, (1.0 if quiet >= rest_time else measured)
+
+
+def uncalibrated_first_rest(measured_before: float, rest: RestState, bias: Vec3,
+                            th_gyro: float) -> bool:
+    """True at the sample a first rest begins (rest_step's quiet time has just reached
+    rest_time; no rest before it: measured_before, the flag before that step, is 0) with a mean
+    rate that the bias estimate misses by th_gyro or more: a gyro that was not calibrated, whose
+    rest only REST_PARAMS' rest_bias_bound admitted. Such a bias, up to the datasheet's 20 deg/s,
+    has turned the tilt by up to its size times the time before this rest (a few degrees to tens)
+    and would take rest_time more to learn by bias_at_rest, while the tilt error it leaves in the
+    attitude and the turned accelerometer pre-filter decays only with the correction's time
+    constant (cf 23/15 -> 2.3/2.0 deg with the rest alone, 0.78/0.85 with this alignment: the
+    floor of the 40 uncalibrated parts' accelerometers, which are not calibrated either). So a
+    filter without a bias covariance (cf, mgcf) then aligns, as an inertial system does at
+    standstill: the rest's mean rate is its bias and its mean specific force is gravity
+    (rest_alignment). A calibrated gyro (a residual of tenths of a deg/s, and BROAD's) never
+    meets this, so its outputs are the same to the last bit."""
+    if measured_before != 0.0 or rest[7] == 0.0:
+        return False
+    mx, my, mz = rest[0] - bias[0], rest[1] - bias[1], rest[2] - bias[2]
+    return mx * mx + my * my + mz * mz >= th_gyro * th_gyro
+
+
+def rest_alignment(rest: RestState) -> tuple[Vec3, float, float, Vec3]:
+    """The alignment at an uncalibrated first rest (uncalibrated_first_rest): the gyro bias (the
+    rest's mean rate), roll and pitch (accel_roll_pitch of its mean specific force, Gui et al.
+    eq. 3-4) and that specific force, which the accelerometer pre-filters start again from."""
+    f = (rest[3], rest[4], rest[5])
+    roll, pitch = accel_roll_pitch(rest[3], rest[4], rest[5])
+    return (rest[0], rest[1], rest[2]), roll, pitch, f
 
 
 def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_time: float

@@ -27,8 +27,10 @@ from .building_blocks import (
     gate_bounds2,
     lowpass_specific_force,
     quat_from_roll_pitch,
+    rest_alignment,
     rest_start,
     rest_step,
+    uncalibrated_first_rest,
 )
 from .kinematics import (
     HALF_PI,
@@ -67,7 +69,9 @@ class ComplementaryFilter(Estimator):
     - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
       still, the gyro reads its own bias, and a bias estimate b follows it with time constant
       rest_time; the filter integrates gyro - b and outputs b (BROAD: 0.95 -> 0.75 deg mean, the
-      uncalibrated gyro's b tau gone);
+      uncalibrated gyro's b tau gone). A first rest that b misses by rest_gyro or more (a gyro
+      never calibrated) aligns the filter instead: b becomes the rest's mean rate and the tilt
+      its mean specific force's (building_blocks.uncalibrated_first_rest);
     - propagation="quaternion" carries roll and pitch through an attitude quaternion instead of
       the Euler rates (building_blocks.PROPAGATION_PARAM), so that pitch +-90 deg is no
       singularity.
@@ -149,9 +153,15 @@ class ComplementaryFilter(Estimator):
     ) -> Estimate:
         rest_time = self._rest[0]
         if rest_time > 0.0:  # at rest the gyro reads its bias: follow it (time constant rest_time)
+            measured = self.rest[7]
             self.rest = rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, self.bias, dt,
                                          self._rest[1], self._rest[2], rest_time, self._rest[3])
-            if rest[6] >= rest_time:
+            if uncalibrated_first_rest(measured, rest, self.bias, self._rest[1]):
+                self.bias, self.roll, self.pitch, f = rest_alignment(rest)
+                self.acc_f = self.acc_ref = f
+                if self._quaternion:
+                    self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
+            elif rest[6] >= rest_time:
                 self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, rest_time)
         bias = self.bias
         bx, by, bz = bias

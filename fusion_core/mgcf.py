@@ -32,8 +32,11 @@ from .building_blocks import (
     correction_time,
     disturbance_step,
     lowpass_specific_force,
+    quat_from_roll_pitch,
+    rest_alignment,
     rest_start,
     rest_step,
+    uncalibrated_first_rest,
 )
 from .kinematics import (
     accel_roll_pitch,
@@ -89,7 +92,9 @@ class GainScheduledComplementaryFilter(Estimator):
     - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
       still, the gyro reads its own bias, and b follows the gyro with time constant rest_time (a
       zero-angular-rate update of the integral term; Mahony's integral alone needs minutes, and
-      cannot see the bias about the vertical at all).
+      cannot see the bias about the vertical at all). A first rest that b misses by rest_gyro
+      or more (a gyro never calibrated) aligns the filter instead: b becomes the rest's mean
+      rate and q its mean specific force's tilt (building_blocks.uncalibrated_first_rest).
 
     Recommended: schedule "fixed" with Kp = 2 zeta w0 = 0.4 rad/s (w0 = 0.02, zeta = 10), a
     2.5 s correction time constant as in the paper's top band (w0 = 0.1, zeta = 2), and
@@ -175,11 +180,16 @@ class GainScheduledComplementaryFilter(Estimator):
         docstring); returns the specific force the correction is to use and this step's
         measurement variance (the adaptive noise's; acc_noise^2 without it)."""
         if self._rest_time > 0.0:
+            measured = self.rest[7]
             self.rest = rest_step(
                 self.rest, gx, gy, gz, ax, ay, az, self.bias, dt, self._rest_gyro,
                 self._rest_acc, self._rest_time, self._rest_bias_bound,
             )
-            if self.rest[6] >= self._rest_time:
+            if uncalibrated_first_rest(measured, self.rest, self.bias, self._rest_gyro):
+                self.bias, roll, pitch, f = rest_alignment(self.rest)
+                self.acc_f = self.acc_ref = f
+                self.q = quat_from_roll_pitch(roll, pitch)
+            elif self.rest[6] >= self._rest_time:
                 self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, self._rest_time)
         r_ref, _, dist_tau, noise, _ = self._adaptive
         if self._acc_tau > 0.0:

@@ -83,3 +83,47 @@ def test_a_rest_under_way_lasts_while_the_sensor_stays_still(key: str) -> None:
     assert all(q >= REST_TIME for q in quiet[start:])  # and never ended
     assert est.rest[7] == 1.0
     assert math.isclose(est.rest[6], len(dt) / RATE, rel_tol=0.05)
+
+
+def tilted_still(gyro: tuple[float, float, float], roll: float, pitch: float, seconds: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sensor still at the given roll and pitch [rad], its gyro reading a constant bias."""
+    n = round(seconds * RATE)
+    f = G * np.array([-math.sin(pitch), math.sin(roll) * math.cos(pitch),
+                      math.cos(roll) * math.cos(pitch)])
+    return np.tile(f, (n, 1)), np.tile(gyro, (n, 1)), np.full(n, 1.0 / RATE)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("key", ("cf", "mgcf"))
+def test_an_uncalibrated_first_rest_aligns_the_filters_without_a_bias_covariance(
+        key: str, backend: str) -> None:
+    """8 deg/s of bias turns the tilt of cf and mgcf by degrees before the first rest is
+    recognised (they learn the bias only at rest); at that rest they take its mean rate as the
+    bias and its mean specific force as gravity, so the tilt is right from then on instead of
+    decaying over the correction's time constant (uncalibrated_first_rest, rest_alignment)."""
+    roll, pitch = 20.0 * DEG, -10.0 * DEG
+    bias = (8.0 * DEG, -5.0 * DEG, 3.0 * DEG)
+    acc, gyro, dt = tilted_still(bias, roll, pitch, 2.0 * REST_TIME)
+    out = ESTIMATORS[key]().run(acc, gyro, dt, backend=backend)
+    err = np.maximum(np.abs(out["roll"] - roll), np.abs(out["pitch"] - pitch))
+    before = round(REST_TIME * RATE) - 5  # the rest's quiet time starts with the second sample
+    assert err[before] > 1.0 * DEG  # what the bias did before the rest
+    assert err[before + 10:].max() < 0.05 * DEG
+    assert out["bias"][-1] == pytest.approx(bias, abs=1e-3 * DEG)
+    if backend == "native":  # the twins agree through the alignment
+        ref = ESTIMATORS[key]().run(acc, gyro, dt, backend="python")
+        for name in ("roll", "pitch", "bias"):
+            np.testing.assert_allclose(out[name], ref[name], rtol=0, atol=1e-12)
+
+
+def test_only_a_first_rest_that_the_bias_estimate_misses_by_rest_gyro_aligns() -> None:
+    from fusion_core.building_blocks import uncalibrated_first_rest
+
+    th = next(p.default for p in REST_PARAMS if p.name == "rest_gyro")
+    mean = (3.0 * th, 0.0, 0.0)
+    rest = (*mean, 0.0, 0.0, G, REST_TIME, 1.0)  # a rest just measured
+    assert uncalibrated_first_rest(0.0, rest, (0.0, 0.0, 0.0), th)
+    assert not uncalibrated_first_rest(1.0, rest, (0.0, 0.0, 0.0), th)  # not the first rest
+    assert not uncalibrated_first_rest(0.0, rest, (2.5 * th, 0.0, 0.0), th)  # calibrated enough
+    assert not uncalibrated_first_rest(0.0, (*rest[:7], 0.0), (0.0, 0.0, 0.0), th)  # no rest yet

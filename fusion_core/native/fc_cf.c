@@ -63,9 +63,16 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     double rest_time = p->rest_time;
     double roll, pitch, phi[3], terms[4];
     if (rest_time > 0.0) {
+        double measured = f->rest[7];
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], f->bias, dt, p->rest_gyro,
                      p->rest_acc, rest_time, p->rest_bias_bound);
-        if (f->rest[6] >= rest_time) {
+        if (fc_uncalibrated_first_rest(measured, f->rest, f->bias, p->rest_gyro)) {
+            fc_rest_alignment(f->rest, f->bias, &f->roll, &f->pitch, f->acc_f);
+            memcpy(f->acc_ref, f->acc_f, sizeof f->acc_ref);
+            if (f->quaternion) {
+                fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
+            }
+        } else if (f->rest[6] >= rest_time) {
             fc_bias_at_rest(f->bias, g[0], g[1], g[2], dt, rest_time);
         }
     }

@@ -326,6 +326,28 @@ void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, do
     rest[7] = quiet >= rest_time ? 1.0 : measured;
 }
 
+int fc_uncalibrated_first_rest(double measured_before, const double rest[8], const double bias[3],
+                               double th_gyro)
+{
+    if (measured_before != 0.0 || rest[7] == 0.0) {
+        return 0;
+    }
+    double mx = rest[0] - bias[0], my = rest[1] - bias[1], mz = rest[2] - bias[2];
+    return mx * mx + my * my + mz * mz >= th_gyro * th_gyro;
+}
+
+void fc_rest_alignment(const double rest[8], double bias[3], double *roll, double *pitch,
+                       double f[3])
+{
+    f[0] = rest[3];
+    f[1] = rest[4];
+    f[2] = rest[5];
+    fc_accel_roll_pitch(rest[3], rest[4], rest[5], roll, pitch);
+    bias[0] = rest[0];
+    bias[1] = rest[1];
+    bias[2] = rest[2];
+}
+
 void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
                      double rest_time)
 {

@@ -113,6 +113,12 @@ void fc_rest_start(double rest[8], const double gyro[3], const double acc[3]);
 void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, double ay,
                   double az, const double bias[3], double dt, double th_gyro, double th_acc,
                   double rest_time, double bound);
+/* uncalibrated_first_rest: measured_before is rest[7] before this sample's fc_rest_step */
+int fc_uncalibrated_first_rest(double measured_before, const double rest[8], const double bias[3],
+                               double th_gyro);
+/* rest_alignment: bias, roll, pitch and the specific force f from the rest's means */
+void fc_rest_alignment(const double rest[8], double bias[3], double *roll, double *pitch,
+                       double f[3]);
 void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
                      double rest_time);
 void fc_bias_band2(double gate, double *lo, double *hi);

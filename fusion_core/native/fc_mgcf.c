@@ -100,9 +100,15 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     double r = f->r_ref;
     if (f->options) {  /* _real_sensor_options */
         if (f->rest_time > 0.0) {
+            double measured = f->rest[7];
             fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, f->bias, dt, f->rest_gyro, f->rest_acc,
                          f->rest_time, f->rest_bias_bound);
-            if (f->rest[6] >= f->rest_time) {
+            if (fc_uncalibrated_first_rest(measured, f->rest, f->bias, f->rest_gyro)) {
+                double roll, pitch;
+                fc_rest_alignment(f->rest, f->bias, &roll, &pitch, f->acc_f);
+                memcpy(f->acc_ref, f->acc_f, sizeof f->acc_ref);
+                fc_quat_from_roll_pitch(roll, pitch, f->q);
+            } else if (f->rest[6] >= f->rest_time) {
                 fc_bias_at_rest(f->bias, gx, gy, gz, dt, f->rest_time);
             }
         }
