@@ -394,6 +394,29 @@ def measured_disturbance(dist: float, a: Vec3, f: Vec3, dt: float, tau: float, r
     return dist, (r + excess / (G * G) if excess > 0.0 else r)
 
 
+def alignment_time(n_samples: int, dt: float, tau: float) -> tuple[float, bool]:
+    """The accelerometer pre-filter's time constant over its first tau (ACC_LOWPASS_PARAM), and
+    whether the filter is still aligning: n_samples dt while that is below tau, so that the gain
+    dt / (tau + dt) is 1/n and the pre-filter is the running mean of the n turned samples so far
+    (VQF's initialisation of its low-pass filters, Laidig & Seel 2023); tau after that.
+
+    The filter starts from one sample's tilt, which a vibration of 0.3 g puts 24 deg off
+    (vibration), and a low-pass that starts there carries it for its time constant, which the
+    measured disturbance lengthens: cf 0.64/1.50 deg on vibration (seed 0), 4-6 deg still at
+    5 s. While aligning, the complementary filters (cf, mgcf) take the mean's tilt as their
+    attitude, since nothing they hold is better; then they go on from it as usual. On
+    vibration cf gives 0.11/0.66 (seed 0) and 0.51/0.52 over 100 parts (0.82/1.72 before),
+    mgcf the same; the other contract scenarios move by at most 0.006 deg (4 seeds),
+    translation_2m, scored from 2 s, by 0.045, and BROAD not in the third decimal. The Kalman
+    filters keep the plain low-pass: their bias states learn from the steps an aligning
+    attitude takes (ukf on moderate_dynamics, seed 0: 0.24/0.20 -> 0.27/0.32 deg with an
+    alignment of this kind)."""
+    start = n_samples * dt
+    if start < tau:
+        return start, True
+    return tau, False
+
+
 def disturbance_step(ref: Vec3, dist: float, a: Vec3, phi: Vec3,
                      terms: tuple[float, float, float, float], dt: float, tau: float,
                      dist_tau: float, r: float, noise: float) -> tuple[Vec3, float, float, float]:

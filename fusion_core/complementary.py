@@ -19,6 +19,7 @@ from .building_blocks import (
     REST_PARAMS,
     REST_START,
     ZERO3,
+    alignment_time,
     bias_at_rest,
     body_rotation,
     complementary_adaptive,
@@ -65,7 +66,8 @@ class ComplementaryFilter(Estimator):
     the filter is exactly the papers'):
     - acc_lowpass > 0: the accelerometer is first low-passed in a frame that turns with the gyro
       (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and the gate and the blend
-      use that vector;
+      use that vector; over its first time constant it is the running mean of the turned
+      samples, and the attitude is its tilt (building_blocks.alignment_time);
     - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
       still, the gyro reads its own bias, and a bias estimate b follows it with time constant
       rest_time; the filter integrates gyro - b and outputs b (BROAD: 0.95 -> 0.75 deg mean, the
@@ -167,15 +169,17 @@ class ComplementaryFilter(Estimator):
         bx, by, bz = bias
         r_ref, q_rotation, dist_tau, noise, longest = self._adaptive
         r = r_ref
+        aligning = False
         if self._rotating:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
             terms = rotvec_terms(*phi)  # once, for the pre-filter and the propagation
             if self._acc_tau > 0.0:  # the filter and its gate use the pre-filtered vector
-                tau_f = self._acc_tau
+                tau_f, aligning = alignment_time(self.n_samples, dt, self._acc_tau)
                 if dist_tau > 0.0:  # the adaptive noise: disturbance against the full pre-filter
-                    self.acc_ref, self.acc_dist, r, tau_f = disturbance_step(
+                    self.acc_ref, self.acc_dist, r, tau_d = disturbance_step(
                         self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau_f,
                         dist_tau, r_ref, noise)
+                    tau_f = tau_f if aligning else tau_d
                 self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau_f,
                                                     terms)
                 ax, ay, az = self.acc_f
@@ -195,7 +199,7 @@ class ComplementaryFilter(Estimator):
                 wx, wy, wz = gx - bx, gy - by, gz - bz
                 tau = correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,
                                       r_ref, dt, longest)
-            k = dt / (tau + dt)  # 1 - a, Gui et al. eq. 2
+            k = 1.0 if aligning else dt / (tau + dt)  # 1 - a, Gui et al. eq. 2
             y = acc_roll - roll
             roll += k * (y if -PI <= y <= PI else wrap_angle(y))
             pitch += k * (acc_pitch - pitch)

@@ -26,6 +26,7 @@ from .building_blocks import (
     REST_PARAMS,
     REST_START,
     ZERO3,
+    alignment_time,
     bias_at_rest,
     body_rotation,
     complementary_adaptive,
@@ -88,7 +89,8 @@ class GainScheduledComplementaryFilter(Estimator):
     - acc_lowpass > 0: a is first low-passed in a frame that turns with the bias-corrected gyro
       (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and e and rho use that
       vector: linear acceleration averages out instead of reading as tilt, and the schedule sees
-      the norm of what the correction uses;
+      the norm of what the correction uses; over its first time constant it is the running mean
+      of the turned samples, and q is its tilt (building_blocks.alignment_time);
     - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
       still, the gyro reads its own bias, and b follows the gyro with time constant rest_time (a
       zero-angular-rate update of the integral term; Mahony's integral alone needs minutes, and
@@ -175,10 +177,11 @@ class GainScheduledComplementaryFilter(Estimator):
 
     def _real_sensor_options(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> tuple[float, float, float, float]:
+    ) -> tuple[float, float, float, float, bool]:
         """The zero-angular-rate update at rest and the accelerometer pre-filter (see the class
-        docstring); returns the specific force the correction is to use and this step's
-        measurement variance (the adaptive noise's; acc_noise^2 without it)."""
+        docstring); returns the specific force the correction is to use, this step's
+        measurement variance (the adaptive noise's; acc_noise^2 without it) and whether the
+        pre-filter is still a running mean (building_blocks.alignment_time)."""
         if self._rest_time > 0.0:
             measured = self.rest[7]
             self.rest = rest_step(
@@ -195,29 +198,36 @@ class GainScheduledComplementaryFilter(Estimator):
         if self._acc_tau > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), self.bias, dt, self._trapezoid)
             terms = rotvec_terms(*phi)  # once, for both pre-filters
-            tau_f, r = self._acc_tau, r_ref
+            r = r_ref
+            tau_f, aligning = alignment_time(self.n_samples, dt, self._acc_tau)
             if dist_tau > 0.0:  # the adaptive noise: disturbance against the full pre-filter
-                self.acc_ref, self.acc_dist, r, tau_f = disturbance_step(
+                self.acc_ref, self.acc_dist, r, tau_d = disturbance_step(
                     self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau_f, dist_tau,
                     r_ref, noise)
+                tau_f = tau_f if aligning else tau_d
             f0, f1, f2 = self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt,
                                                              tau_f, terms)
-            return f0, f1, f2, r
-        return ax, ay, az, r_ref
+            return f0, f1, f2, r, aligning
+        return ax, ay, az, r_ref, False
 
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
         r_ref, q_rotation, _, _, longest = self._adaptive
         r = r_ref
+        aligning = False
         if self._options:
-            ax, ay, az, r = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
+            ax, ay, az, r, aligning = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         table = self._table
         w0 = self._w0_fixed if table is None else scheduled_w0(abs(norm / G - 1.0), table)
         if not norm > 0.0:  # no gravity direction in this sample: gyro only
             w0 = 0.0
         self.w0_now = w0
+        if aligning and w0 > 0.0:  # building_blocks.alignment_time: the mean's tilt
+            self.q = q = quat_from_roll_pitch(*accel_roll_pitch(ax, ay, az))
+            roll, pitch = quat_roll_pitch(*q)
+            return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
         bx, by, bz = self.bias
         kp = self._two_zeta * w0
         # the adaptive noise: 1/Kp follows building_blocks.correction_time

@@ -78,14 +78,16 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     }
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
     double r = f->r_ref;
+    int aligning = 0;
     if (f->rotating) {
         fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
         if (f->acc_tau > 0.0) {
-            double tau_f = f->acc_tau;
+            double tau_f = fc_alignment_time(f->base.n_samples, dt, f->acc_tau, &aligning);
             if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
-                tau_f = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt, tau_f,
-                                            f->dist_tau, &r, f->dist_noise);
+                double tau_d = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt,
+                                                   tau_f, f->dist_tau, &r, f->dist_noise);
+                tau_f = aligning ? tau_f : tau_d;
             }
             fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau_f);
             memcpy(a, f->acc_f, sizeof a);
@@ -111,7 +113,7 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
             tau = fc_correction_time(tau, r / f->r_ref, f->q_rotation,
                                      wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
         }
-        double k = dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
+        double k = aligning ? 1.0 : dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
         double y = acc_roll - roll;
         roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
         pitch += k * (acc_pitch - pitch);

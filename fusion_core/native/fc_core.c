@@ -249,6 +249,13 @@ double fc_measured_disturbance(double *dist, const double a[3], const double f[3
     return excess > 0.0 ? r + excess / (FC_G * FC_G) : r;
 }
 
+double fc_alignment_time(long n_samples, double dt, double tau, int *aligning)
+{
+    double start = (double)n_samples * dt;
+    *aligning = start < tau;
+    return *aligning ? start : tau;
+}
+
 double fc_disturbance_step(double ref[3], double *dist, const double a[3], const double phi[3],
                            const double terms[4], double dt, double tau, double dist_tau,
                            double *r, double noise)

@@ -98,6 +98,7 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     double ax = a_in[0], ay = a_in[1], az = a_in[2];
     double gx = g[0], gy = g[1], gz = g[2];
     double r = f->r_ref;
+    int aligning = 0;
     if (f->options) {  /* _real_sensor_options */
         if (f->rest_time > 0.0) {
             double measured = f->rest[7];
@@ -116,10 +117,11 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
             double phi[3], terms[4];
             fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
             fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both pre-filters */
-            double tau_f = f->acc_tau;
+            double tau_f = fc_alignment_time(f->base.n_samples, dt, f->acc_tau, &aligning);
             if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
-                tau_f = fc_disturbance_step(f->acc_ref, &f->acc_dist, a_in, phi, terms, dt,
-                                            tau_f, f->dist_tau, &r, f->dist_noise);
+                double tau_d = fc_disturbance_step(f->acc_ref, &f->acc_dist, a_in, phi, terms,
+                                                   dt, tau_f, f->dist_tau, &r, f->dist_noise);
+                tau_f = aligning ? tau_f : tau_d;
             }
             fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a_in, dt, tau_f);
             ax = f->acc_f[0];
@@ -134,6 +136,12 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         w0 = 0.0;
     }
     f->w0_now = w0;
+    if (aligning && w0 > 0.0) {  /* alignment_time: the attitude is the mean's tilt */
+        double roll, pitch;
+        fc_accel_roll_pitch(ax, ay, az, &roll, &pitch);
+        fc_quat_from_roll_pitch(roll, pitch, f->q);
+        return;
+    }
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
     double kp = f->two_zeta * w0;
     /* the adaptive noise: 1/Kp follows correction_time */
