@@ -183,7 +183,7 @@ or 0.78/0.85 with the alignment at such a first rest (uncalibrated_first_rest), 
 floor the parts' uncalibrated accelerometers leave. A rest under way lasts while the deviations
 stay small, so that the bias estimate can converge in it. With the start-up calibration (the
 default sensor; the contract's scenarios, seeds 0-2 checked) and on BROAD's 13 trials the outputs
-are the same to the last bit as with VQF's rule and without the alignment."""
+are the same to the last bit as with VQF's rule and without the alignment at a first rest."""
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
