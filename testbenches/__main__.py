@@ -37,7 +37,9 @@ def check_params(params: dict[str, object], estimators: list[str],
     its preset (a ValueError that names the estimator, before any run starts)."""
     from fusion_core import ESTIMATORS
 
-    for key in estimators if params else []:
+    if not params:
+        return
+    for key in estimators:
         try:
             ESTIMATORS[key](**{**preset.get(key, {}), **params})
         except ValueError as err:

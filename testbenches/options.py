@@ -41,8 +41,8 @@ def non_negative_float(text: str) -> float:
 
 
 def jitter_fraction(text: str) -> float:
-    """argparse type: a fraction of the period in [0, 1) (a step of 1 + jitter or more would
-    reach zero or below)."""
+    """argparse type: a fraction of the period in [0, 1) (at 1 or more the shortest step,
+    1 - jitter of the period, would reach zero)."""
     return _number(text, float, "a fraction in [0, 1)", lambda v: 0.0 <= v < 1.0)
 
 

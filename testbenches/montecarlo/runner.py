@@ -25,10 +25,10 @@ from .store import done_keys, write_batch
 BATCHES_PER_WORKER = 4
 """Guided batches: each takes 1/(BATCHES_PER_WORKER x workers) of the runs not yet handed out,
 so they shrink as the campaign goes, at most MAX_BATCH runs and at least MIN_BATCH (fewer in a
-campaign too small to give every worker that many). The large
-first ones keep the scheduler's per-task cost (about a millisecond) small beside the runs
-(milliseconds each natively); the small last ones let the workers finish together, instead of
-one idling while another works through a last batch as large as the first."""
+campaign too small to give every worker that many). The large first ones keep the scheduler's
+per-task cost (about a millisecond) small beside the runs (milliseconds each natively); the
+small last ones let the workers finish together, instead of one idling while another works
+through a last batch as large as the first."""
 MIN_BATCH = 8
 MAX_BATCH = 200
 CONNECT_TIMEOUT_S = 10
