@@ -136,7 +136,13 @@ class Check:
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
-    return np.remainder(x + math.pi, 2 * math.pi) - math.pi
+    """x wrapped to [-pi, pi): remainder(x + pi, 2 pi) - pi. Where every x + pi already lies in
+    [0, 2 pi), as a roll error nearly always does, remainder returns it unchanged, so the result
+    is (x + pi) - pi to the bit without numpy's remainder, the dearest part of the metrics."""
+    shifted = x + math.pi
+    if np.all((shifted >= 0.0) & (shifted < 2 * math.pi)):
+        return shifted - math.pi
+    return np.remainder(shifted, 2 * math.pi) - math.pi
 
 
 def _percentile(x: np.ndarray, q: float) -> float:

@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy.fmi1 import FMICallException
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fusion_core import DEG, ESTIMATORS, G
 from fusion_core.building_blocks import CONSTANT_NOISE
@@ -386,3 +388,18 @@ def test_cli_peers_scores_vqf_on_the_same_samples_beside_the_contract(
     assert (row["peer"], row["scenario"], row["seed"]) == ("vqf", "roll_sweep", 0)
     assert row["rmse_roll_deg"] == direct.rmse_roll_deg
     assert "vqf       roll_sweep" in (tmp_path / "report.md").read_text()
+
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.one_of(st.floats(-3.2, 3.2), st.floats(width=64)), min_size=1, max_size=40))
+def test_the_roll_error_wrap_is_numpys_remainder_to_the_bit(values: list[float]) -> None:
+    # the metrics' fast path (every x + pi already in [0, 2 pi): roll errors within about
+    # +-180 deg) against the remainder it stands for, and the fallback on any double
+    x = np.array(values)
+    with np.errstate(invalid="ignore", over="ignore"):
+        want = np.remainder(x + math.pi, 2 * math.pi) - math.pi
+        got = contract._wrap(x)
+    nan = np.isnan(want)
+    assert np.array_equal(np.isnan(got), nan)
+    assert np.array_equal(got[~nan].view(np.uint64), want[~nan].view(np.uint64))
