@@ -135,7 +135,7 @@ class Check:
                 "allowed": self.allowed, "unit": self.unit, "detail": self.detail}
 
 
-def _wrap(x: np.ndarray) -> np.ndarray:
+def wrap_angles(x: np.ndarray) -> np.ndarray:
     """x wrapped to [-pi, pi): remainder(x + pi, 2 pi) - pi. Where every x + pi already lies in
     [0, 2 pi), as a roll error nearly always does, remainder returns it unchanged, so the result
     is (x + pi) - pi to the bit without numpy's remainder, the dearest part of the metrics."""
@@ -158,7 +158,7 @@ def attitude_errors(
     """Roll and pitch errors [deg] of an estimate against the truth (roll wrapped to +-180 deg)
     and the mask of the samples the contract scores: from SETTLE_S (or the scenario's own
     settling time) on."""
-    err_roll = _wrap(roll - truth["roll"]) / DEG
+    err_roll = wrap_angles(roll - truth["roll"]) / DEG
     err_pitch = (pitch - truth["pitch"]) / DEG
     keep = t >= SETTLE_BY_SCENARIO.get(scenario, SETTLE_S)
     if not keep.any():

@@ -147,7 +147,7 @@ def plot_run(r: TestbenchResult, path: Path) -> None:
     for name, color in (("roll", "C0"), ("pitch", "C1")):
         ax[0].plot(t, r.truth[name] / DEG, color=color, lw=2.0, alpha=0.4, label=f"{name} truth")
         ax[0].plot(t, r.estimate[name] / DEG, color=color, lw=0.8, label=f"{name} estimate")
-        err = np.remainder(r.estimate[name] - r.truth[name] + math.pi, 2 * math.pi) - math.pi
+        err = contract.wrap_angles(r.estimate[name] - r.truth[name])
         ax[1].plot(t, err / DEG, color=color, lw=0.8, label=f"{name} error")
     for i, a in enumerate("xyz"):
         ax[2].plot(t, r.estimate[f"bias_{a}"] / DEG, color=f"C{i + 2}", lw=0.8,

@@ -399,7 +399,7 @@ def test_the_roll_error_wrap_is_numpys_remainder_to_the_bit(values: list[float])
     x = np.array(values)
     with np.errstate(invalid="ignore", over="ignore"):
         want = np.remainder(x + math.pi, 2 * math.pi) - math.pi
-        got = contract._wrap(x)
+        got = contract.wrap_angles(x)
     nan = np.isnan(want)
     assert np.array_equal(np.isnan(got), nan)
     assert np.array_equal(got[~nan].view(np.uint64), want[~nan].view(np.uint64))
