@@ -74,7 +74,7 @@ ACC_GATE_PARAMS: tuple[Param, ...] = (
         "gate_high", 2.0,
         "Accelerometer gate, upper bound of |acc|/g: above it the accelerometer correction is "
         "skipped (strong linear acceleration)",
-        low=1.0,
+        low=1.0, high=1000.0,  # a reading beyond 1000 g is no reading (base.MAX_ACC_NORM)
     ),
 )
 """Gui et al.'s accelerometer-magnitude gate. The papers give no bounds. Recommended, 0.5 g to
@@ -449,7 +449,7 @@ COMPLEMENTARY_ADAPTIVE_PARAMS: Final = (
         "acc_noise", 0.005,
         "Standard deviation of one accelerometer sample divided by g, the reference of the "
         "adaptive noise (the measured sample noise of a real MEMS IMU)",
-        low=0.0, low_open=True,
+        low=1e-6, high=10.0,  # 1 ug, below any accelerometer's noise; its square a normal double
     ),
     *ADAPTIVE_NOISE_PARAMS,
     MAX_CORRECTION_TIME_PARAM,
@@ -484,6 +484,12 @@ def correction_time(tau: float, r_ratio: float, q_rotation: float, w2: float, r:
     t = tau * math.sqrt(r_ratio / q_ratio)
     cap = longest if longest > tau else tau
     return t if t < cap else cap
+
+
+SLOWEST_CORRECTION: Final = 1e9
+"""Longest correction time constant [s] the adaptive noise stretches (correction_time): a gain
+whose time constant is longer (30 years) corrects nothing, and correction_time squares the time
+constant, which overflows beyond 1e154 s (a Kp of a subnormal w0)."""
 
 
 PREFILTER_FULL: Final = 4.0
@@ -526,7 +532,7 @@ BIAS_GATE_PARAM = Param(
     "Bias learning gate on rho = ||a|/g - 1| of the raw accelerometer sample: at or above it "
     "the accelerometer update leaves the gyro bias alone (the sample measures linear "
     "acceleration, not the drift of the tilt); 0 = off, every update moves the bias (the papers)",
-    low=0.0,
+    low=0.0, high=1000.0,
 )
 
 

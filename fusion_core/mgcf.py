@@ -26,6 +26,7 @@ from .building_blocks import (
     REST_PARAMS,
     REST_START,
     ZERO3,
+    SLOWEST_CORRECTION,
     alignment_time,
     bias_at_rest,
     body_rotation,
@@ -135,7 +136,7 @@ class GainScheduledComplementaryFilter(Estimator):
             unit="rad/s", low=0.0,
         ),
         Param("zeta", 10.0, "Damping ratio of the PI correction (Kp = 2 zeta w0; the paper's 2)",
-              low=0.0),
+              low=0.0, high=1000.0),
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         GYRO_SAMPLING_PARAM,
@@ -231,7 +232,7 @@ class GainScheduledComplementaryFilter(Estimator):
         bx, by, bz = self.bias
         kp = self._two_zeta * w0
         # the adaptive noise: 1/Kp follows building_blocks.correction_time
-        if kp > 0.0 and (q_rotation > 0.0 or r != r_ref):
+        if kp * SLOWEST_CORRECTION > 1.0 and (q_rotation > 0.0 or r != r_ref):
             wx, wy, wz = gx - bx, gy - by, gz - bz
             tau = 1.0 / kp
             kp *= tau / correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,

@@ -130,9 +130,9 @@ SENSOR_PARAMS: tuple[Param, ...] = (
           "5 Hz, delay 0-19 ms; 0 is the register's reset value), or -1 for no filter",
           low=-1, high=6, tunable=False),
     Param("gyro_range", 2000.0 * DEG, "Gyro full-scale range (outputs saturate at +-range)",
-          unit="rad/s", low=0.0, low_open=True, display_unit="deg/s"),
+          unit="rad/s", low=1e-3, display_unit="deg/s"),  # a converter step stays a double
     Param("acc_range", 16.0 * G, "Accelerometer full-scale range (outputs saturate at +-range)",
-          unit="m/s2", low=0.0, low_open=True),
+          unit="m/s2", low=1e-2),
     Param("bits", 16, "Converter resolution; 0 turns quantisation off", low=0, high=32),
     Param("jitter", 0.0,
           "Standard deviation of the sample-time error: the reported dt is the interval plus the "

@@ -42,6 +42,23 @@ class InvalidSample(ValueError):
     """A sample that the estimator refused; the estimator state is exactly as before the call."""
 
 
+UNIT_LIMITS: Final[dict[str, float]] = {
+    "s": 1e6,        # a time constant, window or interval of 11.6 days acts as "never"
+    "rad/s": 1e4,    # 573,000 deg/s: ten times the largest accepted gyro reading by default
+    "m/s2": 1e4,     # about 1,000 g, beyond which a reading is no reading (base.MAX_ACC_NORM)
+    "m/s": 1e3,      # a speed threshold or noise of 1 km/s
+    "rad2": 1e2,     # an angle's variance: a standard deviation of 10 rad knows no angle
+    "rad2/s": 1.0,   # a rate noise density of 57 deg/s/sqrt(Hz), 10^4 times a MEMS gyro's
+    "rad2/s3": 1.0,  # a rate random walk of 57 deg/s/sqrt(s)
+    "m2/s3": 1e4,    # an acceleration noise density of 100 m/s^2/sqrt(Hz)
+    "m2/s5": 1e4,    # a jerk (or acceleration random walk) density of 100 m/s^3/sqrt(Hz)
+}
+"""The range of a numeric parameter of each unit that states none of its own: far beyond any
+physical value, and small enough that the filters' arithmetic (squares, products of a few such
+values) cannot overflow. Every numeric parameter's range is finite, so that any value a host may
+set keeps every estimate finite (tests/test_params.py sweeps each range's ends)."""
+
+
 @dataclass(frozen=True)
 class Param:
     """Declarative description of one tuning parameter, shared by fusion_core and fmu_src.
@@ -49,7 +66,8 @@ class Param:
     A numeric parameter is valid when low <(=) value <(=) high (open or closed bounds); a string
     parameter when it is one of `choices`. `unit` is an SI unit string ("1" when dimensionless),
     `display_unit` a friendlier unit for tools (for example "deg2/s"), `tunable` whether it may be
-    changed between samples of a running filter.
+    changed between samples of a running filter. A bound left out is the unit's limit
+    (UNIT_LIMITS): -limit below, +limit above.
     """
 
     name: str
@@ -63,6 +81,14 @@ class Param:
     choices: tuple[str, ...] | None = None
     display_unit: str | None = None
     tunable: bool = True
+
+    def __post_init__(self) -> None:
+        limit = UNIT_LIMITS.get(self.unit)
+        if limit is not None and self.choices is None and not isinstance(self.default, bool):
+            if self.high is None:
+                object.__setattr__(self, "high", limit)
+            if self.low is None:
+                object.__setattr__(self, "low", -limit)
 
     @property
     def kind(self) -> type:

@@ -133,28 +133,29 @@ class UnscentedKalmanFilter(Estimator):
             "acc_noise", 0.005,
             "Standard deviation of one accelerometer sample divided by g (noise and unmodelled "
             "linear acceleration)",
-            low=0.0, low_open=True,
+            low=1e-6, high=10.0,  # 1 ug, below any accelerometer's noise
         ),
         Param(
             "norm_noise", 0.0,
             "Standard deviation of the unit-norm pseudo-measurement |X|^2 = 1 (0: no such "
             "measurement; X is renormalised after every update either way)",
-            low=0.0,
+            low=0.0, high=10.0,
         ),
         Param(
             "acc_gate", 1.0,
             "Skip the accelerometer update while ||acc|/g - 1| is at or above this value",
-            low=0.0, low_open=True,
+            low=0.0, low_open=True, high=1000.0,
         ),
         Param(
             "init_bias_std", 1.0 * DEG, "Initial standard deviation of each gyro-bias state",
             unit="rad/s", low=0.0, low_open=True, tunable=False,
         ),
-        Param("alpha", 1.0, "Sigma-point spread (scaled unscented transform)", low=0.0,
-              low_open=True, high=1.0),
-        Param("beta", 2.0, "Prior-distribution parameter (2 is optimal for Gaussians)", low=0.0),
+        Param("alpha", 1.0, "Sigma-point spread (scaled unscented transform; Wan and van der "
+              "Merwe's range 1e-4 to 1)", low=1e-4, high=1.0),
+        Param("beta", 2.0, "Prior-distribution parameter (2 is optimal for Gaussians)", low=0.0,
+              high=1000.0),
         Param("kappa", 0.0, "Secondary scaling parameter (> -5 keeps n + lambda > 0 for n = 6)",
-              low=-5.0, low_open=True),
+              low=-5.0, low_open=True, high=1000.0),
         *ADAPTIVE_NOISE_PARAMS,
         GYRO_SAMPLING_PARAM,
         ACC_LOWPASS_PARAM,

@@ -74,6 +74,7 @@ void fc_rotate_back_terms(const double v[3], const double phi[3], const double t
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 #define FC_REST_MEAN_TAU 0.5
+#define FC_SLOWEST_CORRECTION 1e9
 #define FC_FACE_SWITCH_COS 0.5
 extern const double FC_FACES[6][9];
 void fc_quat_from_roll_pitch(double roll, double pitch, double q[4]);

@@ -145,7 +145,7 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
     double kp = f->two_zeta * w0;
     /* the adaptive noise: 1/Kp follows correction_time */
-    if (kp > 0.0 && (f->q_rotation > 0.0 || r != f->r_ref)) {
+    if (kp * FC_SLOWEST_CORRECTION > 1.0 && (f->q_rotation > 0.0 || r != f->r_ref)) {
         double wx = gx - bx, wy = gy - by, wz = gz - bz;
         double tau = 1.0 / kp;
         kp *= tau / fc_correction_time(tau, r / f->r_ref, f->q_rotation,

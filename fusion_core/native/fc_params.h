@@ -18,23 +18,23 @@
 #define FC_CF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_cf_params {
-    double tau;                  /* (0.0, inf) [s] */
+    double tau;                  /* (0.0, 1000000.0] [s] */
     double gate_low;             /* (0.0, 1.0] */
-    double gate_high;            /* [1.0, inf) */
-    double acc_lowpass;          /* [0.0, inf) [s] */
-    double rest_time;            /* [0.0, inf) [s] */
-    double rest_gyro;            /* (0.0, inf) [rad/s] */
-    double rest_acc;             /* (0.0, inf) [m/s2] */
-    double rest_bias_bound;      /* [0.0, inf) [rad/s] */
+    double gate_high;            /* [1.0, 1000.0] */
+    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    double rest_time;            /* [0.0, 1000000.0] [s] */
+    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
     int propagation;             /* one of 'euler', 'quaternion' */
     int gyro_sampling;           /* one of 'point', 'mean' */
-    double acc_noise;            /* (0.0, inf) */
+    double acc_noise;            /* [1e-06, 10.0] */
     double gyro_scale_std;       /* [0.0, 0.5] */
-    double scale_time;           /* [0.0, inf) [s] */
-    double disturbance_time;     /* [0.0, inf) [s] */
-    double max_correction_time;  /* [0.0, inf) [s] */
-    double max_dt;               /* (0.0, inf) [s] */
-    double max_rate;             /* (0.0, inf) [rad/s] */
+    double scale_time;           /* [0.0, 1000000.0] [s] */
+    double disturbance_time;     /* [0.0, 1000000.0] [s] */
+    double max_correction_time;  /* [0.0, 1000000.0] [s] */
+    double max_dt;               /* (0.0, 1000000.0] [s] */
+    double max_rate;             /* (0.0, 10000.0] [rad/s] */
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -77,21 +77,21 @@ static inline void fc_cf_params_default(fc_cf_params *p)
 
 typedef struct fc_mgcf_params {
     int schedule;                /* one of 'simulation', 'experimental', 'fixed' */
-    double w0;                   /* [0.0, inf) [rad/s] */
-    double zeta;                 /* [0.0, inf) */
-    double acc_lowpass;          /* [0.0, inf) [s] */
-    double rest_time;            /* [0.0, inf) [s] */
-    double rest_gyro;            /* (0.0, inf) [rad/s] */
-    double rest_acc;             /* (0.0, inf) [m/s2] */
-    double rest_bias_bound;      /* [0.0, inf) [rad/s] */
+    double w0;                   /* [0.0, 10000.0] [rad/s] */
+    double zeta;                 /* [0.0, 1000.0] */
+    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    double rest_time;            /* [0.0, 1000000.0] [s] */
+    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
     int gyro_sampling;           /* one of 'point', 'mean' */
-    double acc_noise;            /* (0.0, inf) */
+    double acc_noise;            /* [1e-06, 10.0] */
     double gyro_scale_std;       /* [0.0, 0.5] */
-    double scale_time;           /* [0.0, inf) [s] */
-    double disturbance_time;     /* [0.0, inf) [s] */
-    double max_correction_time;  /* [0.0, inf) [s] */
-    double max_dt;               /* (0.0, inf) [s] */
-    double max_rate;             /* (0.0, inf) [rad/s] */
+    double scale_time;           /* [0.0, 1000000.0] [s] */
+    double disturbance_time;     /* [0.0, 1000000.0] [s] */
+    double max_correction_time;  /* [0.0, 1000000.0] [s] */
+    double max_dt;               /* (0.0, 1000000.0] [s] */
+    double max_rate;             /* (0.0, 10000.0] [rad/s] */
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -133,29 +133,29 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 #define FC_KF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_kf_params {
-    double Q_angle;           /* [0.0, inf) [rad2/s] */
-    double Q_bias;            /* [0.0, inf) [rad2/s3] */
-    double R_measure;         /* (0.0, inf) [rad2] */
-    double R_loop_time;       /* [0.0, inf) [s] */
+    double Q_angle;           /* [0.0, 1.0] [rad2/s] */
+    double Q_bias;            /* [0.0, 1.0] [rad2/s3] */
+    double R_measure;         /* (0.0, 100.0] [rad2] */
+    double R_loop_time;       /* [0.0, 1000000.0] [s] */
     double gyro_scale_std;    /* [0.0, 0.5] */
-    double scale_time;        /* [0.0, inf) [s] */
-    double disturbance_time;  /* [0.0, inf) [s] */
+    double scale_time;        /* [0.0, 1000000.0] [s] */
+    double disturbance_time;  /* [0.0, 1000000.0] [s] */
     double gate_low;          /* (0.0, 1.0] */
-    double gate_high;         /* [1.0, inf) */
-    double acc_lowpass;       /* [0.0, inf) [s] */
-    double rest_time;         /* [0.0, inf) [s] */
-    double rest_gyro;         /* (0.0, inf) [rad/s] */
-    double rest_acc;          /* (0.0, inf) [m/s2] */
-    double rest_bias_bound;   /* [0.0, inf) [rad/s] */
-    double gyro_psd;          /* (0.0, inf) [rad2/s] */
-    double init_bias_std;     /* [0.0, inf) [rad/s] */
-    double bias_gate;         /* [0.0, inf) */
+    double gate_high;         /* [1.0, 1000.0] */
+    double acc_lowpass;       /* [0.0, 1000000.0] [s] */
+    double rest_time;         /* [0.0, 1000000.0] [s] */
+    double rest_gyro;         /* (0.0, 10000.0] [rad/s] */
+    double rest_acc;          /* (0.0, 10000.0] [m/s2] */
+    double rest_bias_bound;   /* [0.0, 10000.0] [rad/s] */
+    double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
+    double init_bias_std;     /* [0.0, 10000.0] [rad/s] */
+    double bias_gate;         /* [0.0, 1000.0] */
     double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
     int propagation;          /* one of 'euler', 'quaternion' */
     int tilt_axes;            /* one of 'body', 'nearest_face' */
     int gyro_sampling;        /* one of 'point', 'mean' */
-    double max_dt;            /* (0.0, inf) [s] */
-    double max_rate;          /* (0.0, inf) [rad/s] */
+    double max_dt;            /* (0.0, 1000000.0] [s] */
+    double max_rate;          /* (0.0, 10000.0] [rad/s] */
     double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -200,29 +200,29 @@ static inline void fc_kf_params_default(fc_kf_params *p)
 #define FC_UKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_ukf_params {
-    double gyro_psd;          /* (0.0, inf) [rad2/s] */
-    double bias_psd;          /* [0.0, inf) [rad2/s3] */
-    double acc_noise;         /* (0.0, inf) */
-    double norm_noise;        /* [0.0, inf) */
-    double acc_gate;          /* (0.0, inf) */
-    double init_bias_std;     /* (0.0, inf) [rad/s] */
-    double alpha;             /* (0.0, 1.0] */
-    double beta;              /* [0.0, inf) */
-    double kappa;             /* (-5.0, inf) */
+    double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
+    double bias_psd;          /* [0.0, 1.0] [rad2/s3] */
+    double acc_noise;         /* [1e-06, 10.0] */
+    double norm_noise;        /* [0.0, 10.0] */
+    double acc_gate;          /* (0.0, 1000.0] */
+    double init_bias_std;     /* (0.0, 10000.0] [rad/s] */
+    double alpha;             /* [0.0001, 1.0] */
+    double beta;              /* [0.0, 1000.0] */
+    double kappa;             /* (-5.0, 1000.0] */
     double gyro_scale_std;    /* [0.0, 0.5] */
-    double scale_time;        /* [0.0, inf) [s] */
-    double disturbance_time;  /* [0.0, inf) [s] */
+    double scale_time;        /* [0.0, 1000000.0] [s] */
+    double disturbance_time;  /* [0.0, 1000000.0] [s] */
     int gyro_sampling;        /* one of 'point', 'mean' */
-    double acc_lowpass;       /* [0.0, inf) [s] */
-    double rest_time;         /* [0.0, inf) [s] */
-    double rest_gyro;         /* (0.0, inf) [rad/s] */
-    double rest_acc;          /* (0.0, inf) [m/s2] */
-    double rest_bias_bound;   /* [0.0, inf) [rad/s] */
-    double zaru_psd;          /* (0.0, inf) [rad2/s] */
-    double bias_gate;         /* [0.0, inf) */
+    double acc_lowpass;       /* [0.0, 1000000.0] [s] */
+    double rest_time;         /* [0.0, 1000000.0] [s] */
+    double rest_gyro;         /* (0.0, 10000.0] [rad/s] */
+    double rest_acc;          /* (0.0, 10000.0] [m/s2] */
+    double rest_bias_bound;   /* [0.0, 10000.0] [rad/s] */
+    double zaru_psd;          /* (0.0, 1.0] [rad2/s] */
+    double bias_gate;         /* [0.0, 1000.0] */
     double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
-    double max_dt;            /* (0.0, inf) [s] */
-    double max_rate;          /* (0.0, inf) [rad/s] */
+    double max_dt;            /* (0.0, 1000000.0] [s] */
+    double max_rate;          /* (0.0, 10000.0] [rad/s] */
     double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -275,29 +275,29 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
 
 typedef struct fc_poskf_params {
     int qr_form;              /* one of 'white_jerk', 'piecewise_jerk', 'diagonal' */
-    double q;                 /* (0.0, inf) [m2/s5] */
-    double acc_psd;           /* (0.0, inf) [m2/s3] */
+    double q;                 /* (0.0, 10000.0] [m2/s5] */
+    double acc_psd;           /* (0.0, 10000.0] [m2/s3] */
     int zupt;                 /* True or False */
-    double zupt_acc;          /* (0.0, inf) [m/s2] */
-    double zupt_level_acc;    /* (0.0, inf) [m/s2] */
-    double zupt_gyro;         /* (0.0, inf) [rad/s] */
-    double zupt_window;       /* [0.0, inf) [s] */
-    double zupt_speed;        /* [0.0, inf) [m/s] */
-    double zupt_force_after;  /* [0.0, inf) [s] */
-    double zupt_noise;        /* (0.0, inf) [m/s] */
+    double zupt_acc;          /* (0.0, 10000.0] [m/s2] */
+    double zupt_level_acc;    /* (0.0, 10000.0] [m/s2] */
+    double zupt_gyro;         /* (0.0, 10000.0] [rad/s] */
+    double zupt_window;       /* [0.0, 1000000.0] [s] */
+    double zupt_speed;        /* [0.0, 1000.0] [m/s] */
+    double zupt_force_after;  /* [0.0, 1000000.0] [s] */
+    double zupt_noise;        /* (0.0, 1000.0] [m/s] */
     int zaru;                 /* True or False */
-    double gyro_psd;          /* (0.0, inf) [rad2/s] */
+    double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
     int tilt_update;          /* one of 'stationary', 'always' */
     int attitude;             /* one of 'kf', 'tilt_stage' */
-    double Q_angle;           /* [0.0, inf) [rad2/s] */
-    double Q_bias;            /* [0.0, inf) [rad2/s3] */
-    double R_measure;         /* (0.0, inf) [rad2] */
-    double R_loop_time;       /* [0.0, inf) [s] */
+    double Q_angle;           /* [0.0, 1.0] [rad2/s] */
+    double Q_bias;            /* [0.0, 1.0] [rad2/s3] */
+    double R_measure;         /* (0.0, 100.0] [rad2] */
+    double R_loop_time;       /* [0.0, 1000000.0] [s] */
     double gate_low;          /* (0.0, 1.0] */
-    double gate_high;         /* [1.0, inf) */
+    double gate_high;         /* [1.0, 1000.0] */
     int gyro_sampling;        /* one of 'point', 'mean' */
-    double max_dt;            /* (0.0, inf) [s] */
-    double max_rate;          /* (0.0, inf) [rad/s] */
+    double max_dt;            /* (0.0, 1000000.0] [s] */
+    double max_rate;          /* (0.0, 10000.0] [rad/s] */
     double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -348,27 +348,27 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
 typedef struct fc_sensor_params {
     long seed;                     /* [0, 2147483647] */
     int gyro_sampling;             /* one of 'point', 'mean' */
-    double gyro_psd;               /* [0.0, inf) [rad2/s] */
-    double acc_psd;                /* [0.0, inf) [m2/s3] */
+    double gyro_psd;               /* [0.0, 1.0] [rad2/s] */
+    double acc_psd;                /* [0.0, 10000.0] [m2/s3] */
     int calibration;               /* one of 'startup', 'none', 'perfect' */
-    double gyro_bias_x;            /* (-inf, inf) [rad/s] */
-    double gyro_bias_y;            /* (-inf, inf) [rad/s] */
-    double gyro_bias_z;            /* (-inf, inf) [rad/s] */
-    double acc_bias_x;             /* (-inf, inf) [m/s2] */
-    double acc_bias_y;             /* (-inf, inf) [m/s2] */
-    double acc_bias_z;             /* (-inf, inf) [m/s2] */
-    double gyro_bias_instability;  /* [0.0, inf) [rad/s] */
-    double acc_bias_instability;   /* [0.0, inf) [m/s2] */
-    double bias_time_constant;     /* (0.0, inf) [s] */
-    double gyro_bias_psd;          /* [0.0, inf) [rad2/s3] */
-    double acc_bias_psd;           /* [0.0, inf) [m2/s5] */
+    double gyro_bias_x;            /* [-10000.0, 10000.0] [rad/s] */
+    double gyro_bias_y;            /* [-10000.0, 10000.0] [rad/s] */
+    double gyro_bias_z;            /* [-10000.0, 10000.0] [rad/s] */
+    double acc_bias_x;             /* [-10000.0, 10000.0] [m/s2] */
+    double acc_bias_y;             /* [-10000.0, 10000.0] [m/s2] */
+    double acc_bias_z;             /* [-10000.0, 10000.0] [m/s2] */
+    double gyro_bias_instability;  /* [0.0, 10000.0] [rad/s] */
+    double acc_bias_instability;   /* [0.0, 10000.0] [m/s2] */
+    double bias_time_constant;     /* (0.0, 1000000.0] [s] */
+    double gyro_bias_psd;          /* [0.0, 1.0] [rad2/s3] */
+    double acc_bias_psd;           /* [0.0, 10000.0] [m2/s5] */
     double gyro_scale_std;         /* [0.0, 0.5] */
     double gyro_cross_axis_std;    /* [0.0, 0.5] */
     long dlpf_cfg;                 /* [-1, 6] */
-    double gyro_range;             /* (0.0, inf) [rad/s] */
-    double acc_range;              /* (0.0, inf) [m/s2] */
+    double gyro_range;             /* [0.001, 10000.0] [rad/s] */
+    double acc_range;              /* [0.01, 10000.0] [m/s2] */
     long bits;                     /* [0, 32] */
-    double jitter;                 /* [0.0, inf) [s] */
+    double jitter;                 /* [0.0, 1000000.0] [s] */
 } fc_sensor_params;
 
 /* The defaults: ImuSensorModel.PARAMS (for an estimator, the recommended preset). */
