@@ -28,5 +28,5 @@ static int step(void *data, double *values, double t, double h, char *message, s
 }
 
 const fmu_model FMU_MODEL = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, 1, setup, tune, step,
+    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, 1, NULL, setup, tune, step, NULL,
 };

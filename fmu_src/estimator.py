@@ -1,6 +1,6 @@
 """The estimator helper: everything the five estimator FMUs share, on top of FmuSlave.
 
-Variables (../shared/INTERFACE.md): inputs acc_x..z [m/s2], gyro_x..z [rad/s], dt [s];
+Variables (docs/interface.md): inputs acc_x..z [m/s2], gyro_x..z [rad/s], dt [s];
 outputs roll, pitch [rad], bias_x..z [rad/s], invalid_samples [1] and, for the position filter,
 pos_x..z [m], vel_x..z [m/s]; one parameter per fusion_core `Param` of the estimator class.
 
@@ -8,8 +8,8 @@ Sample semantics: the inputs set before doStep(t, h) are one new IMU sample (tak
 the time since the previous sample, and the estimator integrates over dt, not over h); the
 first doStep's sample initialises the estimator from the accelerometer; values set during
 initialisation are not a sample; the outputs after doStep(t, h) are the estimate for that
-sample. A rejected sample (NaN/inf, dt <= 0, dt > max_dt, |acc| < 0.1 g) leaves the filter
-state exactly as it was, counts in invalid_samples, logs a warning and the step returns OK.
+sample. A rejected sample (NaN/inf, dt <= 0, dt > max_dt, a rate above max_rate) leaves the
+filter state exactly as it was, counts in invalid_samples, logs a warning and the step returns OK.
 """
 
 from __future__ import annotations
@@ -258,8 +258,11 @@ class EstimatorModel:
         return {"estimator": self.estimator.get_state(), "invalid_samples": self.invalid_samples}
 
     def set_state(self, state: dict[str, Any]) -> None:
-        self.estimator.set_state(state["estimator"])
-        self.invalid_samples = int(state["invalid_samples"])
+        count = state.get("invalid_samples")
+        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+            raise ValueError(f"state field invalid_samples = {count!r} is not a count")
+        self.estimator.set_state(state.get("estimator"))
+        self.invalid_samples = count
         if self._stepper is not None:
             self._stepper.load()
 

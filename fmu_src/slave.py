@@ -31,6 +31,7 @@ get_state, set_state). Everything FMI is done here, once:
 from __future__ import annotations
 
 import json
+import math
 import sys
 import traceback
 from collections.abc import Mapping
@@ -65,6 +66,26 @@ class FmiLog:
 
     def error(self, message: str) -> None:
         self._log(_printf_safe(message), Fmi2Status.error)
+
+
+def _check_state_value(var: Variable, value: Any) -> None:
+    """ValueError naming the variable unless a restored value is of its type and, for a parameter
+    or an output, in its range (an output finite too; an input may hold anything a host may set,
+    NaN included, since a bad sample is the model's to reject)."""
+    types = {"Real": (int, float), "Integer": (int,), "Enumeration": (int,), "Boolean": (bool,)}
+    boolean = isinstance(value, bool)
+    if not isinstance(value, types[var.type]) or (var.type != "Boolean" and boolean):
+        raise ValueError(f"state value of {var.name} is {value!r}, not a {var.type}")
+    if var.causality == "input":
+        return
+    if var.causality == "output" and not math.isfinite(value):
+        raise ValueError(f"state value of output {var.name} = {value!r} is not finite")
+    try:
+        var.check(value)
+        if var.type == "Enumeration":
+            var.to_model(value)
+    except ValueError as err:
+        raise ValueError(f"state value of {var.causality} {var.name}: {err}") from None
 
 
 def _printf_safe(message: str) -> str:
@@ -343,9 +364,13 @@ class FmuSlave(Fmi2Slave):
                 f"state of {state.get('fmu')!r} (format {state.get('format')!r}) does not fit "
                 f"{type(self).__name__} (format {STATE_FORMAT})"
             )
-        values = state["values"]
-        if set(values) != set(self._values):
+        values = state.get("values")
+        if not isinstance(values, dict) or set(values) != set(self._values):
             raise ValueError("state variables differ from this FMU's variables")
+        for name, var in self._variables.items():
+            _check_state_value(var, values[name])
+        if not isinstance(state.get("running"), bool):
+            raise ValueError(f"state field 'running' = {state.get('running')!r} is not a bool")
         params = {
             name: var.to_model(var.coerce(values[name]))
             for name, var in self._variables.items()

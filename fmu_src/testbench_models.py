@@ -47,7 +47,9 @@ class PlantModel:
         return {"scenario": self.scenario.id}  # the truth is a function of time only
 
     def set_state(self, state: dict[str, Any]) -> None:
-        self.__init__({"scenario": state["scenario"]})
+        if state.get("scenario") != self.scenario.id:
+            raise ValueError(f"a state of scenario {state.get('scenario')!r} does not fit "
+                             f"parameter scenario = {self.scenario.id}")
 
 
 class SensorModel:

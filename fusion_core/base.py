@@ -1,11 +1,11 @@
 """The step API that every estimator shares: parameters, input checks, run, state.
 
-A subclass declares PARAMS (its tuning parameters) and STATE (the names of the attributes that
-make up its internal state), and implements `_reset()`, `_init(...)`, `_estimate()` and
-`_update(ax, ay, az, gx, gy, gz, dt)`, or instead of `_update` the hot-path form
-`_advance(ax, ay, az, gx, gy, gz, dt)`, which also returns the estimate (one call less per
-sample). Everything else (validation, the first-sample rule, batch runs, json state) is written
-once here.
+A subclass declares PARAMS (its tuning parameters) and STATE (the attributes that make up its
+internal state, each with the check a restored value must pass: fusion_core.state), and
+implements `_reset()`, `_init(...)`, `_estimate()` and `_update(ax, ay, az, gx, gy, gz, dt)`, or
+instead of `_update` the hot-path form `_advance(ax, ay, az, gx, gy, gz, dt)`, which also
+returns the estimate (one call less per sample). Everything else (validation, the first-sample
+rule, batch runs, json state) is written once here.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import Any, ClassVar, Final
 import numpy as np
 
 from .kinematics import roll_pitch_ahead
+from .state import BASE_STATE, NESTED, StateSpec, check_field
 from .types import Estimate, G, InvalidSample, Param, check_param_names
 
 MAX_RATE_DEFAULT: Final = 1000.0
@@ -127,6 +128,10 @@ def _restore(template: Any, value: Any) -> Any:
     if isinstance(template, list):  # a list may change length (queues): match what is there
         n = len(template)
         return [_restore(template[i] if i < n else None, v) for i, v in enumerate(value)]
+    if isinstance(template, bool):  # (before int: a bool is an int)
+        return bool(value)
+    if isinstance(template, int):
+        return int(value)
     if isinstance(template, float):
         return float(value)
     return value
@@ -136,7 +141,7 @@ class Estimator:
     """Base class of the five estimators. See the module docstring."""
 
     PARAMS: ClassVar[tuple[Param, ...]] = ()
-    STATE: ClassVar[tuple[str, ...]] = ()
+    STATE: ClassVar[StateSpec] = {}
     HAS_POSITION: ClassVar[bool] = False
 
     def __init__(self, **params: Any) -> None:
@@ -387,7 +392,7 @@ class Estimator:
         return out
 
     # ----- state ------------------------------------------------------------------------------
-    _BASE_STATE: ClassVar[tuple[str, ...]] = ("initialized", "n_samples", "n_rejected", "gyro_prev")
+    _BASE_STATE: ClassVar[StateSpec] = BASE_STATE
 
     def get_state(self) -> dict[str, Any]:
         """The whole filter state and parameters as plain floats, ints, bools, strings and lists."""
@@ -395,25 +400,56 @@ class Estimator:
         return {"estimator": type(self).__name__, "params": dict(self._params), "state": state}
 
     def set_state(self, snapshot: dict[str, Any]) -> None:
-        """Restore a get_state() snapshot: continuing from it is bit-identical."""
-        if snapshot.get("estimator") != type(self).__name__:
-            raise ValueError(
-                f"state of {snapshot.get('estimator')!r} cannot be restored into "
-                f"{type(self).__name__}"
-            )
-        names = (*self._BASE_STATE, *self.STATE)
-        state = snapshot["state"]
-        missing = sorted(set(names) - set(state))
-        if missing:
-            raise ValueError(f"state snapshot lacks {', '.join(missing)}")
-        specs = self.param_specs()
-        params = {k: specs[k].validate(v) for k, v in snapshot["params"].items()}
-        self._check_params(params)
+        """Restore a get_state() snapshot: continuing from it is bit-identical.
+
+        Everything is checked before anything is taken (check_state): a snapshot that fails
+        raises ValueError naming the parameter or the state field, and the filter is unchanged.
+        """
+        params = self.check_state(snapshot)
         self._set_params(params)
-        for name in names:
+        state = snapshot["state"]
+        for name in (*self._BASE_STATE, *self.STATE):
             setattr(self, name, _restore(getattr(self, name), state[name]))
         self._restored()
         self.last = self.output()
+
+    def check_state(self, snapshot: Any) -> dict[str, Any]:
+        """The parameters of a get_state() snapshot, checked, after checking the whole snapshot:
+        this estimator's, every parameter named and in its range, every state field present, of
+        its shape and passing its check (fusion_core.state). ValueError naming what is wrong."""
+        name = type(self).__name__
+        if not isinstance(snapshot, dict) or snapshot.get("estimator") != name:
+            owner = snapshot.get("estimator") if isinstance(snapshot, dict) else snapshot
+            raise ValueError(f"state of {owner!r} cannot be restored into {name}")
+        params, state = snapshot.get("params"), snapshot.get("state")
+        if not isinstance(params, dict) or not isinstance(state, dict):
+            raise ValueError(f"a state of {name} holds 'params' and 'state' dicts")
+        specs = self.param_specs()
+        check_param_names(params, specs, name)
+        missing = sorted(set(specs) - set(params))
+        if missing:
+            raise ValueError(f"state snapshot lacks the parameter(s) {', '.join(missing)}")
+        checked = {k: specs[k].validate(params[k]) for k in specs}
+        self._check_params(checked)
+        fields = {**self._BASE_STATE, **self.STATE}
+        unknown = sorted(set(state) - set(fields))
+        missing = sorted(set(fields) - set(state))
+        if missing or unknown:
+            raise ValueError(f"state snapshot of {name}: "
+                             + "; ".join(([f"lacks {', '.join(missing)}"] if missing else [])
+                                         + ([f"has unknown {', '.join(unknown)}"] if unknown
+                                            else [])))
+        for field, check in fields.items():
+            check_field(field, check, state[field], getattr(self, field))
+            if check is NESTED:
+                self._check_nested(field, state[field], checked)
+        return checked
+
+    def _check_nested(self, field: str, snapshot: dict[str, Any], params: dict[str, Any]
+                      ) -> None:
+        """Check the snapshot of a nested estimator's state (a NESTED field), given the checked
+        parameters of this one."""
+        raise NotImplementedError(f"{type(self).__name__} has no nested state {field!r}")
 
     def _restored(self) -> None:
         """Hook for subclasses whose state holds nested estimators."""

@@ -9,6 +9,8 @@ References:
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
@@ -46,6 +48,7 @@ from .kinematics import (
     rotvec_terms,
     wrap_angle,
 )
+from .state import ANGLE, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec
 from .types import Estimate, Param
 
 
@@ -116,7 +119,10 @@ class ComplementaryFilter(Estimator):
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
-    STATE = ("roll", "pitch", "acc_f", "q_att", "bias", "rest", "acc_dist", "acc_ref")
+    STATE: ClassVar[StateSpec] = {
+        "roll": ANGLE, "pitch": HALF_ANGLE, "acc_f": REAL, "q_att": UNIT, "bias": REAL,
+        "rest": REST, "acc_dist": NONNEG, "acc_ref": REAL,
+    }
 
     def _configure(self) -> None:
         p = self._params

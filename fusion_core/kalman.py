@@ -18,7 +18,7 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 from __future__ import annotations
 
 from math import cos, sin
-from typing import Final
+from typing import ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
@@ -63,6 +63,7 @@ from .kinematics import (
     rotvec_terms,
     wrap_angle,
 )
+from .state import ANGLE, COV, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec, index
 from .types import DEG, Estimate, G, Param
 
 DEG2: Final = DEG * DEG
@@ -270,10 +271,11 @@ class AngleBiasKalmanFilter(Estimator):
         ),
         GYRO_SAMPLING_PARAM,
     )
-    STATE = (
-        "roll", "pitch", "bias_x", "bias_y", "P_roll", "P_pitch", "bias_z", "P_z", "acc_f", "rest",
-        "q_att", "face", "acc_dist", "acc_ref",
-    )
+    STATE: ClassVar[StateSpec] = {
+        "roll": ANGLE, "pitch": HALF_ANGLE, "bias_x": REAL, "bias_y": REAL, "P_roll": COV,
+        "P_pitch": COV, "bias_z": REAL, "P_z": NONNEG, "acc_f": REAL, "rest": REST,
+        "q_att": UNIT, "face": index(len(FACES)), "acc_dist": NONNEG, "acc_ref": REAL,
+    }
 
     def _configure(self) -> None:
         p = self._params

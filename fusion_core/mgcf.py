@@ -17,6 +17,7 @@ Reference:
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
@@ -25,6 +26,7 @@ from .building_blocks import (
     GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     REST_START,
+    SLOWEST_CORRECTION,
     ZERO3,
     SLOWEST_CORRECTION,
     alignment_time,
@@ -49,6 +51,7 @@ from .kinematics import (
     rotation_increment,
     rotvec_terms,
 )
+from .state import NONNEG, REAL, REST, UNIT, StateSpec
 from .types import Estimate, G, Param
 
 SCHEDULES: dict[str, tuple[tuple[float, float], ...]] = {
@@ -142,7 +145,10 @@ class GainScheduledComplementaryFilter(Estimator):
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
-    STATE = ("q", "bias", "w0_now", "acc_f", "rest", "acc_dist", "acc_ref")
+    STATE: ClassVar[StateSpec] = {
+        "q": UNIT, "bias": REAL, "w0_now": NONNEG, "acc_f": REAL, "rest": REST,
+        "acc_dist": NONNEG, "acc_ref": REAL,
+    }
 
     def _configure(self) -> None:
         p = self._params

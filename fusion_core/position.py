@@ -20,13 +20,14 @@ from __future__ import annotations
 import dataclasses
 import math
 from math import cos, sin, sqrt
-from typing import Any
+from typing import Any, ClassVar
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import CONSTANT_NOISE, zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
 from .presets import PAPER_KF
+from .state import ANGLE, COV, FLAG, NESTED, NONNEG, REAL, Queue, Segments, StateSpec
 from .types import DEG, Estimate, G, Param
 
 REAL_ACC_DENSITY = 0.0033
@@ -278,10 +279,11 @@ class PositionKalmanFilter(Estimator):
             for p in AngleBiasKalmanFilter.PARAMS if p.name in TILT_PARAMS
         ),
     )
-    STATE = (
-        "yaw", "states", "P", "quiet_time", "stationary", "pending", "turned", "f_mean",
-        "tilt_state", "attitude_state",
-    )
+    STATE: ClassVar[StateSpec] = {
+        "yaw": ANGLE, "states": REAL, "P": COV, "quiet_time": NONNEG, "stationary": FLAG,
+        "pending": Queue(Segments(((NONNEG, 1), (REAL, 4))), 5, PENDING_MAX), "turned": REAL,
+        "f_mean": REAL, "tilt_state": NESTED, "attitude_state": NESTED,
+    }
     _x: AxisStates  # [p, v, a] of x, y, z
     _P: Sym3  # the covariance the three axes share, packed
 
@@ -372,6 +374,18 @@ class PositionKalmanFilter(Estimator):
         self.pending: list[tuple[float, float, float, float, float]] = []
         self.turned = (0.0, 0.0)
         self.f_mean = (0.0, 0.0, 0.0)
+
+    def _check_nested(self, field: str, snapshot: dict[str, Any], params: dict[str, Any]
+                      ) -> None:
+        """The tilt stage's and the attitude filter's states: each checked by its filter, with
+        the parameters this filter's `params` give them (they are derived, never free)."""
+        probe = PositionKalmanFilter(**params)
+        nested = probe.tilt if field == "tilt_state" else probe.att
+        checked = nested.check_state(snapshot)
+        if checked != nested.params:
+            diff = sorted(k for k in checked if checked[k] != nested.params[k])
+            raise ValueError(f"state field {field!r}: the parameter(s) {', '.join(diff)} differ "
+                             "from what the position filter's parameters give")
 
     def _restored(self) -> None:
         # a json snapshot holds the queue's entries as lists: make them tuples again

@@ -42,9 +42,10 @@ filter -> saturation -> quantisation.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Final
 
 from .noise import NormalBlocks, normals
+from .state import COUNT, REAL, StateSpec, check_field
 from .types import (
     DEG,
     MPU6050_ACC_DENSITY,
@@ -348,25 +349,56 @@ class ImuSensorModel:
             raise ValueError(f"sensor parameter {name!r} is fixed after the start")
         self.params[name] = spec.validate(value)
 
-    _STATE = ("k", "gyro_turn_on", "acc_turn_on", "gyro_matrix", "acc_matrix", "gyro_walk",
-              "acc_walk", "gyro_gm", "acc_gm", "omega_prev", "time_error")
+    STATE: Final[StateSpec] = {
+        "k": COUNT, "gyro_turn_on": REAL, "acc_turn_on": REAL, "gyro_matrix": REAL,
+        "acc_matrix": REAL, "gyro_walk": REAL, "acc_walk": REAL, "gyro_gm": REAL, "acc_gm": REAL,
+        "omega_prev": REAL, "time_error": REAL,
+    }
+    """The model's state, each field with the check a restored value must pass
+    (fusion_core.state; omega_prev may also be None, before the first sample); besides it, the
+    DLPF's state: None before the first sample, else 3 channels of 4 values."""
 
     def get_state(self) -> dict[str, Any]:
-        state = {name: _copy(getattr(self, name)) for name in self._STATE}
+        state = {name: _copy(getattr(self, name)) for name in self.STATE}
         for name in ("gyro_filter", "acc_filter"):
             filt = getattr(self, name)
             state[name] = None if filt is None or filt.state is None else _copy(filt.state)
         return {"params": dict(self.params), **state}
 
     def set_state(self, state: dict[str, Any]) -> None:
-        self.params = dict(state["params"])
+        """Restore a get_state() result. Everything is checked first (parameters by their
+        ranges, every state field by its check): ValueError naming what is wrong, and the model
+        is unchanged."""
+        if not isinstance(state, dict) or not isinstance(state.get("params"), dict):
+            raise ValueError("a sensor state is a dict with the 'params' dict")
+        params = state["params"]
+        check_param_names(params, _SPECS, "the IMU sensor model")
+        missing = sorted(set(_SPECS) - set(params))
+        if missing:
+            raise ValueError(f"sensor state lacks the parameter(s) {', '.join(missing)}")
+        checked = {k: _SPECS[k].validate(v) for k, v in params.items()}
+        fresh = ImuSensorModel(**checked)
+        for name, check in self.STATE.items():
+            if name not in state:
+                raise ValueError(f"sensor state lacks {name}")
+            if name == "omega_prev" and state[name] is None:
+                continue
+            template = [0.0, 0.0, 0.0] if name == "omega_prev" else getattr(fresh, name)
+            check_field(name, check, state[name], template)
+        for name in ("gyro_filter", "acc_filter"):
+            value = state.get(name)
+            if value is not None:
+                if getattr(fresh, name) is None:
+                    raise ValueError(f"sensor state holds {name} but dlpf_cfg is off")
+                check_field(name, REAL, value, [[0.0] * 4] * 3)
+        self.params = checked
         self.reset()
-        for name in self._STATE:
+        for name in self.STATE:
             setattr(self, name, _copy(state[name]))
         for name in ("gyro_filter", "acc_filter"):
             filt = getattr(self, name)
             if filt is not None:
-                filt.state = _copy(state[name])
+                filt.state = _copy(state.get(name))
 
 
 def _copy(value: Any) -> Any:

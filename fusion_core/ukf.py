@@ -42,7 +42,7 @@ P is kept as its lower triangle (21 floats, row by row); the `P` attribute shows
 from __future__ import annotations
 
 import math
-from typing import Final
+from typing import ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
@@ -64,6 +64,7 @@ from .building_blocks import (
     zero_rate_psd_param,
 )
 from .kinematics import accel_roll_pitch, rotate_back, rotvec_terms
+from .state import COV, NONNEG, REAL, REST, UNIT, Segments, StateSpec
 from .types import DEG, Estimate, G, Param
 
 N_STATE: Final = 6  # X (3), gyro bias b (3)
@@ -164,7 +165,10 @@ class UnscentedKalmanFilter(Estimator):
         BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
     )
-    STATE = ("x", "P", "acc_f", "rest", "acc_dist", "acc_ref")
+    STATE: ClassVar[StateSpec] = {
+        "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "acc_f": REAL, "rest": REST,
+        "acc_dist": NONNEG, "acc_ref": REAL,
+    }
 
     def _configure(self) -> None:
         p = self._params

@@ -61,11 +61,12 @@ LOG_CATEGORIES = (
     ("logEvents", "Other messages"),
 )
 KIND_SOURCES = {
-    "estimator": ("fc_core.c",),
+    "estimator": ("fc_core.c", "fc_state_tables.c"),
     "plant": ("fc_plant.c",),
-    "sensor": ("fc_sensor.c", "fc_noise.c"),
+    "sensor": ("fc_sensor.c", "fc_noise.c", "fc_state_tables.c"),
 }
-"""The C twin's sources each kind of model needs besides its own file."""
+"""The C twin's sources each kind of model needs besides its own file (and fc_state.c, which the
+FMU state of every model needs)."""
 
 
 @dataclass(frozen=True)
@@ -193,6 +194,8 @@ def render_config(model: NativeModel) -> str:
             f"#define FC_INIT {model.prefix}_init",
             f"#define FC_CONFIGURE {model.prefix}_configure",
             f"#define FC_STEP {model.prefix}_step",
+            f"#define FC_RESTORED {model.prefix}_restored",
+            f"#define FC_LAYOUT {model.prefix.upper()}_LAYOUT",
             f"#define HAS_POSITION {int('pos_x' in names)}",
             "",
         ]
@@ -397,7 +400,7 @@ def stage_sources(model: NativeModel, version: str, folder: Path) -> list[str]:
     plumbing = f"{version}Functions.c"
     source = model.source or HERE / "models" / f"{model.kind}.c"
     own = source.name
-    compiled = [plumbing, "fmu_instance.c", own, *model.twin_sources()]
+    compiled = [plumbing, "fmu_instance.c", "fc_state.c", own, *model.twin_sources()]
     shutil.copy2(HERE / plumbing, folder / plumbing)
     shutil.copy2(HERE / "fmu_instance.c", folder / "fmu_instance.c")
     shutil.copy2(HERE / "fmu_model.h", folder / "fmu_model.h")
@@ -406,7 +409,7 @@ def stage_sources(model: NativeModel, version: str, folder: Path) -> list[str]:
         shutil.copy2(header, folder / header.name)
     for path in TWIN_DIR.glob("*.h"):
         shutil.copy2(path, folder / path.name)
-    for name in model.twin_sources():
+    for name in ("fc_state.c", *model.twin_sources()):
         shutil.copy2(TWIN_DIR / name, folder / name)
     (folder / "config.h").write_text(render_config(model))
     return compiled

@@ -10,27 +10,6 @@
 
 #include "fmu_model.h"
 
-#define STATE_MAGIC "IMUFMUST"
-#define STATE_FORMAT 1u
-#define MODEL_NAME_SIZE 48
-
-/* The header every FMU state starts with. */
-typedef struct state_header {
-    char magic[8];
-    char model[MODEL_NAME_SIZE];
-    uint32_t format;
-    uint32_t n_variables;
-    uint64_t data_size;
-    uint64_t length;                /* of the whole state, header included */
-    uint64_t checksum;              /* FNV-1a of everything after the header */
-} state_header;
-
-typedef struct state_body {
-    int32_t state;
-    int32_t reserved;
-    double time;
-} state_body;
-
 static const char *type_name(fmu_type t)
 {
     static const char *const names[] = {"Real", "Integer", "Boolean", "Enumeration"};
@@ -164,6 +143,20 @@ int fmu_get(const fmu_instance *inst, const char *call, const uint32_t vr[], siz
     return FMU_OK;
 }
 
+/* Whether a parameter's value is in its variable's range: fusion_core's Param.validate, finite
+ * or +inf where the range has no upper bound. */
+static int in_range(const fmu_variable *v, double value)
+{
+    int ok = isfinite(value) || (value == HUGE_VAL && v->high == HUGE_VAL);
+    if (v->low != -HUGE_VAL) {
+        ok = ok && (v->low_open ? value > v->low : value >= v->low);
+    }
+    if (v->high != HUGE_VAL) {
+        ok = ok && (v->high_open ? value < v->high : value <= v->high);
+    }
+    return ok;
+}
+
 /* Why the value cannot be taken (a log line), or FMU_OK. */
 static int check_value(const fmu_instance *inst, const char *call, const fmu_variable *v,
                        double value)
@@ -184,14 +177,7 @@ static int check_value(const fmu_instance *inst, const char *call, const fmu_var
     if (v->causality == FMU_INPUT || v->type == FMU_BOOLEAN) {
         return FMU_OK;  /* an input sample is the model's to judge (a bad one is rejected) */
     }
-    /* fusion_core's Param.validate: finite, or +inf where the range has no upper bound */
-    ok = isfinite(value) || (value == HUGE_VAL && v->high == HUGE_VAL);
-    if (v->low != -HUGE_VAL) {
-        ok = ok && (v->low_open ? value > v->low : value >= v->low);
-    }
-    if (v->high != HUGE_VAL) {
-        ok = ok && (v->high_open ? value < v->high : value <= v->high);
-    }
+    ok = in_range(v, value);
     if (!ok) {
         fmu_log(inst, FMU_ERROR, "%s: parameter %s = %.17g is out of range: allowed %s%.17g, "
                 "%.17g%s; it keeps %.17g", call, v->name, value, v->low_open ? "(" : "[",
@@ -275,20 +261,54 @@ int fmu_do_step(fmu_instance *inst, double t, double h)
 
 /* ----- FMU state ----------------------------------------------------------------------------- */
 
+#define STATE_MAGIC "IMUFMUST"
+#define STATE_FORMAT 2u  /* 2: values and the model's state fields, as doubles (fmu_model.h) */
+#define MODEL_NAME_SIZE 48
+
+/* The header every FMU state starts with. */
+typedef struct state_header {
+    char magic[8];
+    char model[MODEL_NAME_SIZE];
+    uint32_t format;
+    uint32_t n_variables;
+    uint64_t n_state;               /* the model's state fields, in doubles */
+    uint64_t length;                /* of the whole state, header included */
+    uint64_t checksum;              /* fnv1a of everything after the header */
+} state_header;
+
+/* Then the body: this, the values (n_variables doubles) and the state fields (n_state). */
+typedef struct state_body {
+    int32_t state;
+    int32_t reserved;
+    double time;
+} state_body;
+
+/* FNV-1a over 64-bit words (memcpy'ed: the bytes may lie anywhere), then the last bytes one by
+ * one: a state of the position filter is 83 kB, checked at every deserialize and set. */
 static uint64_t fnv1a(const unsigned char *p, size_t n)
 {
-    uint64_t h = 14695981039346656037ull;
-    size_t i;
-    for (i = 0; i < n; i++) {
+    uint64_t h = 14695981039346656037ull, w;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        memcpy(&w, p + i, 8);
+        h ^= w;
+        h *= 1099511628211ull;
+    }
+    for (; i < n; i++) {
         h ^= p[i];
         h *= 1099511628211ull;
     }
     return h;
 }
 
+static size_t state_doubles(void)
+{
+    return FMU_MODEL.state ? (size_t)fc_state_size(FMU_MODEL.state) : 0;
+}
+
 static size_t body_size(void)
 {
-    return sizeof(state_body) + FMU_MODEL.n_variables * sizeof(double) + FMU_MODEL.data_size;
+    return sizeof(state_body) + (FMU_MODEL.n_variables + state_doubles()) * sizeof(double);
 }
 
 size_t fmu_state_size(void)
@@ -296,41 +316,123 @@ size_t fmu_state_size(void)
     return sizeof(state_header) + body_size();
 }
 
+void fmu_state_seal(unsigned char *state)
+{
+    state_header h;
+    memcpy(&h, state, sizeof h);
+    h.checksum = fnv1a(state + sizeof h, body_size());
+    memcpy(state, &h, sizeof h);
+}
+
 void fmu_state_write(const fmu_instance *inst, unsigned char *out)
 {
     state_header h;
     state_body b;
     unsigned char *body = out + sizeof h;
+    size_t n_values = FMU_MODEL.n_variables * sizeof(double);
     memset(&h, 0, sizeof h);
     memset(&b, 0, sizeof b);
     b.state = inst->state;
     b.time = inst->time;
     memcpy(body, &b, sizeof b);
-    memcpy(body + sizeof b, inst->values, FMU_MODEL.n_variables * sizeof(double));
-    memcpy(body + sizeof b + FMU_MODEL.n_variables * sizeof(double), inst->data,
-           FMU_MODEL.data_size);
+    memcpy(body + sizeof b, inst->values, n_values);
+    if (FMU_MODEL.state) {
+        /* body + sizeof b is 8-byte aligned: the state is malloc'ed and the header's size is a
+         * multiple of 8 */
+        fc_state_save(FMU_MODEL.state, inst->data, (double *)(void *)(body + sizeof b + n_values));
+    }
     memcpy(h.magic, STATE_MAGIC, sizeof h.magic);
     strncpy(h.model, FMU_MODEL.name, MODEL_NAME_SIZE - 1);
     h.format = STATE_FORMAT;
     h.n_variables = FMU_MODEL.n_variables;
-    h.data_size = FMU_MODEL.data_size;
+    h.n_state = state_doubles();
     h.length = fmu_state_size();
-    h.checksum = fnv1a(body, body_size());
     memcpy(out, &h, sizeof h);
+    fmu_state_seal(out);
 }
 
-int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned char *in,
-                    size_t size)
+/* Why a restored value does not fit its variable (into why), or 0: of its type (an Integer or
+ * Enumeration whole, a Boolean 0 or 1), a parameter in its range, an output finite and in its
+ * range; an input may hold anything a host may set (a bad sample is the model's to reject). */
+static int value_problem(const fmu_variable *v, double x, char *why, size_t size)
+{
+    if (v->type == FMU_BOOLEAN && x != 0.0 && x != 1.0) {
+        snprintf(why, size, "the value of %s is %.17g, not a Boolean", v->name, x);
+        return 1;
+    }
+    if ((v->type == FMU_INTEGER || v->type == FMU_ENUMERATION) &&
+        (!isfinite(x) || x != floor(x) || x < -2147483648.0 || x > 2147483647.0)) {
+        snprintf(why, size, "the value of %s is %.17g, not an Integer", v->name, x);
+        return 1;
+    }
+    if (v->causality == FMU_INPUT || v->type == FMU_BOOLEAN) {
+        return 0;
+    }
+    if (!in_range(v, x) || (v->causality == FMU_OUTPUT && !isfinite(x))) {
+        snprintf(why, size, "the value of %s %s is %.17g: allowed %s%.17g, %.17g%s",
+                 v->causality == FMU_OUTPUT ? "output" : "parameter", v->name, x,
+                 v->low_open ? "(" : "[", v->low, v->high, v->high_open ? ")" : "]");
+        return 1;
+    }
+    return 0;
+}
+
+/* The body's values and state fields as doubles: an aligned copy of bytes that may lie anywhere
+ * in the host's memory; NULL when out of memory. */
+static double *body_doubles(const unsigned char *body)
+{
+    size_t n = FMU_MODEL.n_variables + state_doubles();
+    double *d = malloc(n ? n * sizeof(double) : sizeof(double));
+    if (d) {
+        memcpy(d, body + sizeof(state_body), n * sizeof(double));
+    }
+    return d;
+}
+
+/* Why the body's FMI state, time, values and state fields do not pass (into why), or 0. */
+static int body_problem(const fmu_instance *inst, const unsigned char *body, const double *d,
+                        char *why, size_t size)
+{
+    state_body b;
+    unsigned i;
+    memcpy(&b, body, sizeof b);
+    if ((b.state != FMU_INSTANTIATED && b.state != FMU_CONFIGURATION &&
+         b.state != FMU_INITIALIZATION && b.state != FMU_STEP && b.state != FMU_TERMINATED) ||
+        (b.state == FMU_CONFIGURATION && inst->time_vr < 0) || b.reserved != 0) {
+        snprintf(why, size, "it holds no FMI state of this standard (%ld)", (long)b.state);
+        return 1;
+    }
+    if (!isfinite(b.time)) {
+        snprintf(why, size, "its time %.17g is not finite", b.time);
+        return 1;
+    }
+    for (i = 0; i < FMU_MODEL.n_variables; i++) {
+        if (value_problem(&FMU_MODEL.variables[i], d[i], why, size)) {
+            return 1;
+        }
+    }
+    if (FMU_MODEL.state &&
+        fc_state_check(FMU_MODEL.state, d + FMU_MODEL.n_variables, why, size) != 0) {
+        return 1;
+    }
+    return 0;
+}
+
+/* The checked values and state fields of a state (malloc'ed: the caller frees them), or NULL
+ * with a log line naming what is wrong. */
+static double *checked_body(const fmu_instance *inst, const char *call, const unsigned char *in,
+                            size_t size)
 {
     state_header h;
-    state_body b;
-    const unsigned char *body = in + sizeof h;
+    const unsigned char *body;
     char model[MODEL_NAME_SIZE];
+    char why[512];
+    double *d;
     if (!in || size < sizeof h) {
         fmu_log(inst, FMU_ERROR, "%s: %lu bytes are not an FMU state of %s (a state is %lu "
                 "bytes): the FMU keeps its state", call, (unsigned long)size, FMU_MODEL.name,
                 (unsigned long)fmu_state_size());
-        return FMU_ERROR;
+        return NULL;
     }
     memcpy(&h, in, sizeof h);
     memset(model, 0, sizeof model);
@@ -338,45 +440,82 @@ int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned c
     if (memcmp(h.magic, STATE_MAGIC, sizeof h.magic) != 0) {
         fmu_log(inst, FMU_ERROR, "%s: not an FMU state of this project (wrong magic): the FMU "
                 "keeps its state", call);
-        return FMU_ERROR;
+        return NULL;
     }
     if (memcmp(h.model, model, MODEL_NAME_SIZE) != 0 || h.format != STATE_FORMAT ||
-        h.n_variables != FMU_MODEL.n_variables || h.data_size != FMU_MODEL.data_size) {
+        h.n_variables != FMU_MODEL.n_variables || h.n_state != state_doubles()) {
         h.model[MODEL_NAME_SIZE - 1] = '\0';
         fmu_log(inst, FMU_ERROR, "%s: a state of model '%s', format %lu, does not fit %s, format "
                 "%lu: the FMU keeps its state", call, h.model, (unsigned long)h.format,
                 FMU_MODEL.name, (unsigned long)STATE_FORMAT);
-        return FMU_ERROR;
+        return NULL;
     }
+    body = in + sizeof h;
     if (h.length != fmu_state_size() || size < h.length ||
         h.checksum != fnv1a(body, body_size())) {
         fmu_log(inst, FMU_ERROR, "%s: the state is truncated or corrupted (length %lu of %lu "
                 "bytes, or its checksum differs): the FMU keeps its state", call,
                 (unsigned long)size, (unsigned long)fmu_state_size());
-        return FMU_ERROR;
+        return NULL;
     }
-    memcpy(&b, body, sizeof b);
-    if (!(b.state & FMU_ANY_STATE)) {
-        fmu_log(inst, FMU_ERROR, "%s: the state holds no valid FMI state: the FMU keeps its "
-                "state", call);
-        return FMU_ERROR;
+    d = body_doubles(body);
+    if (!d) {
+        fmu_log(inst, FMU_ERROR, "%s: out of memory: the FMU keeps its state", call);
+        return NULL;
     }
-    return FMU_OK;
+    if (body_problem(inst, body, d, why, sizeof why)) {
+        free(d);
+        fmu_log(inst, FMU_ERROR, "%s: the state is refused, the FMU keeps its state: %s", call,
+                why);
+        return NULL;
+    }
+    return d;
+}
+
+int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned char *in,
+                    size_t size)
+{
+    double *d = checked_body(inst, call, in, size);
+    free(d);
+    return d ? FMU_OK : FMU_ERROR;
 }
 
 int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size)
 {
     state_body b;
-    const unsigned char *body = in + sizeof(state_header);
-    if (fmu_state_check(inst, call, in, size) != FMU_OK) {
+    size_t n_values = FMU_MODEL.n_variables * sizeof(double);
+    double *d = checked_body(inst, call, in, size), *scratch;
+    void *data;
+    if (!d) {
         return FMU_ERROR;
     }
-    memcpy(&b, body, sizeof b);
+    scratch = malloc(n_values ? n_values : 1);
+    data = calloc(1, FMU_MODEL.data_size ? FMU_MODEL.data_size : 1);
+    if (!scratch || !data) {
+        free(d);
+        free(scratch);
+        free(data);
+        fmu_log(inst, FMU_ERROR, "%s: out of memory: the FMU keeps its state", call);
+        return FMU_ERROR;
+    }
+    /* the model from the restored parameters (setup may write outputs: into a scratch copy of
+     * the values), then its state fields */
+    memcpy(scratch, d, n_values);
+    FMU_MODEL.setup(data, scratch);
+    if (FMU_MODEL.state) {
+        fc_state_load(FMU_MODEL.state, data, d + FMU_MODEL.n_variables);
+    }
+    if (FMU_MODEL.restored) {
+        FMU_MODEL.restored(data);
+    }
+    memcpy(&b, in + sizeof(state_header), sizeof b);
     inst->state = b.state;
     inst->time = b.time;
-    memcpy(inst->values, body + sizeof b, FMU_MODEL.n_variables * sizeof(double));
-    memcpy(inst->data, body + sizeof b + FMU_MODEL.n_variables * sizeof(double),
-           FMU_MODEL.data_size);
+    memcpy(inst->values, d, n_values);
+    memcpy(inst->data, data, FMU_MODEL.data_size);
+    free(d);
+    free(scratch);
+    free(data);
     return FMU_OK;
 }
 

@@ -3,11 +3,20 @@
  *
  * A model is plain C behind this interface, as in the Modelica Association's Reference-FMUs: a
  * table of variables indexed by value reference (generated into the model's config.h from the
- * same variable table as the pythonfmu FMUs), the size of its data (a plain struct: no pointers,
- * so an FMU state is a copy of its bytes) and three functions. Every variable's value lives in
- * one array of doubles indexed by value reference (Real, Integer, Boolean and Enumeration values
- * all fit a double exactly); the plumbing checks every call against the FMI state machine, the
- * variables' causality, variability and range, and only then calls the model.
+ * same variable table as the pythonfmu FMUs), the size of its data (a plain struct without
+ * pointers), the layout of its state (fc_state.h) and four functions. Every variable's value
+ * lives in one array of doubles indexed by value reference (Real, Integer, Boolean and
+ * Enumeration values all fit a double exactly); the plumbing checks every call against the FMI
+ * state machine, the variables' causality, variability and range, and only then calls the model.
+ *
+ * An FMU state holds values only: the FMI state, the time, every variable's value and the model
+ * data's state fields as doubles (its layout), never the data's bytes. So it holds no pointer
+ * and no value derived from the parameters, and bytes written by one process (or platform)
+ * restore in another. A restore checks everything before the instance takes anything: the
+ * header and checksum, the FMI state, every value against its variable (a parameter in its
+ * range, an output finite, an Integer whole), every state field against its check; then it sets
+ * the model up from the restored parameters (which derives everything else), takes the state
+ * fields and lets the model recompute what follows from them.
  *
  * No global mutable state: everything lives in the instance.
  */
@@ -16,6 +25,8 @@
 
 #include <stddef.h>
 #include <stdint.h>
+
+#include "fc_state.h"
 
 typedef enum fmu_type { FMU_REAL, FMU_INTEGER, FMU_BOOLEAN, FMU_ENUMERATION } fmu_type;
 typedef enum fmu_causality { FMU_PARAMETER, FMU_INPUT, FMU_OUTPUT } fmu_causality;
@@ -37,6 +48,9 @@ typedef struct fmu_model {
     const fmu_variable *variables;  /* by value reference 0 .. n_variables - 1 */
     unsigned n_variables;
     size_t data_size;               /* bytes of the model's data */
+    /* The fields of the data that make up its state (offsets from the data's start; NULL: none,
+     * the data is all derived from the parameters). Only these are saved. */
+    const fc_layout *state;
     /* A model built from the parameter values (at instantiation, exitInitializationMode and
      * reset); it may write output values (their start values stay otherwise). */
     void (*setup)(void *data, double *values);
@@ -45,6 +59,8 @@ typedef struct fmu_model {
     /* One communication step [t, t+h] with the inputs in values; writes the outputs into values.
      * Returns 0, or 1 when the step's sample was rejected (message says why, for the log). */
     int (*step)(void *data, double *values, double t, double h, char *message, size_t size);
+    /* After a restore took the state fields: recompute what follows from them (NULL: nothing). */
+    void (*restored)(void *data);
 } fmu_model;
 
 extern const fmu_model FMU_MODEL;  /* the one model of this FMU (the model's .c file) */
@@ -118,13 +134,19 @@ int fmu_no_variables(const fmu_instance *inst, const char *call, const char *typ
 int fmu_exit_initialization(fmu_instance *inst);
 int fmu_do_step(fmu_instance *inst, double t, double h);
 
-/* FMU states: a header (magic, model, format, sizes, checksum) then the instance's state, time,
- * values and model data. A state that this FMU and format did not write is refused. */
+/* FMU states: a header (magic, model, format, sizes, checksum) then the instance's FMI state and
+ * time, the values and the model data's state fields, all as doubles (see the top). */
 size_t fmu_state_size(void);
 void fmu_state_write(const fmu_instance *inst, unsigned char *out);
-/* FMU_OK if `in` is a whole state this FMU wrote, else FMU_ERROR with a log line. */
+/* The checksum of a state's body written into its header (fmu_state_write does it; a test that
+ * alters a state's fields calls it so that the alteration reaches the field checks). */
+void fmu_state_seal(unsigned char *state);
+/* FMU_OK if `in` is a whole state of this FMU and format whose every value passes its check,
+ * else FMU_ERROR with a log line naming what is wrong. */
 int fmu_state_check(const fmu_instance *inst, const char *call, const unsigned char *in,
                     size_t size);
+/* The instance takes a checked state; FMU_ERROR with a log line (and the instance as it was)
+ * when it fails a check. */
 int fmu_state_read(fmu_instance *inst, const char *call, const unsigned char *in, size_t size);
 /* The FMU-state functions of both standards: get (allocating *state when NULL), size, serialize,
  * deserialize (checked), free. */

@@ -38,16 +38,16 @@ from ..base import RUN_CHUNK
 HERE = Path(__file__).resolve().parent
 SOURCES = (
     "fc_core.c", "fc_noise.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c",
-    "fc_sensor.c", "fc_plant.c",
+    "fc_sensor.c", "fc_plant.c", "fc_state.c", "fc_state_tables.c",
 )
 """The C sources, in link order."""
 HEADERS = (
-    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h", "fc_ukf.h",
-    "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
+    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_state.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h",
+    "fc_ukf.h", "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
 )
+"""The headers, in the order the binding declares them."""
 DATA_HEADERS = ("fc_scenarios.h",)
 """Headers of tables the binding does not declare (the scenarios' signal nodes), compiled in."""
-"""The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
 Python's does, which is what makes the twins equal."""
@@ -66,12 +66,12 @@ ESTIMATE_FIELDS = 11
 _ESTIMATE_DOUBLES = struct.Struct("=11d")
 """An fc_estimate's memory, read as Python floats."""
 BASE_STATE = ("initialized", "n_samples", "n_rejected", "gyro_prev")
+"""Estimator._BASE_STATE: these live in the twin's `base` member."""
 STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}}
 """Where a twin's state field is kept under another Python attribute: the UKF's P is its packed
 lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
 POSKF_PENDING_MAX = 2048
 """fc_poskf.h's FC_POSKF_PENDING_MAX (position.PENDING_MAX)."""
-"""Estimator._BASE_STATE: these live in the twin's `base` member."""
 
 PREBUILT = HERE / "libfusion_core.so"
 """A library built beside the sources, as the pythonfmu FMUs ship it (fmu_src.build): loaded
@@ -260,9 +260,7 @@ def _fill(lib: Any, twin: Any, estimator: Any) -> None:
         attrs = STATE_ATTRIBUTES.get(name, {})
         for field in estimator.STATE:
             _set_field(twin, field, getattr(estimator, attrs.get(field, field)))
-    _, ffi = lib_and_ffi()
-    twin.last = lib.fc_base_output(ffi.addressof(twin, "base"),
-                                   getattr(lib, f"{TWINS[name]}_estimate")(twin))
+    getattr(lib, f"{TWINS[name]}_restored")(twin)
 
 
 def take_state(estimator: Any, twin: Any) -> None:

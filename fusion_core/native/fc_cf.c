@@ -46,6 +46,7 @@ void fc_cf_reset(fc_cf *f)
 }
 
 FC_DEFINE_INIT(fc_cf)
+FC_DEFINE_RESTORED(fc_cf)
 
 static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _init */
 {

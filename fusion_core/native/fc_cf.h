@@ -41,5 +41,7 @@ fc_status fc_cf_step(fc_cf *f, const double acc[3], const double gyro[3], double
 long fc_cf_run(fc_cf *f, long n, const double *acc, const double *gyro, const double *dt,
                fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_cf_estimate(const fc_cf *f);
+/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
+void fc_cf_restored(fc_cf *f);
 
 #endif /* FC_CF_H */

@@ -177,6 +177,14 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
         T##_reset(f);                                                                         \
     }
 
+/* T_restored(f) for an estimator T: after its state fields were restored (fc_state_load), the
+ * last estimate, which follows from them (Estimator.set_state: last = output()). */
+#define FC_DEFINE_RESTORED(T)                                                                 \
+    void T##_restored(T *f)                                                                   \
+    {                                                                                         \
+        f->last = fc_base_output(&f->base, T##_estimate(f));                                  \
+    }
+
 /* The fc_ops glue of an estimator T (fc_cf, ...), written once: defines T_step and T_run from the
  * file's static first_sample(T *, acc, gyro) and advance(T *, acc, gyro, dt) and its public
  * T_estimate. */

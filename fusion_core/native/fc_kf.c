@@ -124,6 +124,7 @@ void fc_kf_reset(fc_kf *f)
 }
 
 FC_DEFINE_INIT(fc_kf)
+FC_DEFINE_RESTORED(fc_kf)
 
 static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  /* _init */
 {

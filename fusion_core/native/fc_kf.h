@@ -39,6 +39,8 @@ fc_status fc_kf_step(fc_kf *f, const double acc[3], const double gyro[3], double
 long fc_kf_run(fc_kf *f, long n, const double *acc, const double *gyro, const double *dt,
                fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_kf_estimate(const fc_kf *f);
+/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
+void fc_kf_restored(fc_kf *f);
 
 /* The parts the position filter drives one by one (AngleBiasKalmanFilter's methods of the same
  * names): the time update (phi: the interval's rotation vector, or NULL to compute it from

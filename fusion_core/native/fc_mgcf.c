@@ -4,15 +4,20 @@
 #include <math.h>
 #include <string.h>
 
-/* mgcf.SCHEDULES: (rho upper bound, w0 [rad/s]); rho at or above the last bound: w0 = 0 */
-static const double SIMULATION[3][2] = {{0.01, 0.1}, {0.25, 0.07}, {0.35, 0.035}};
-static const double EXPERIMENTAL[3][2] = {{0.025, 0.1}, {0.035, 0.07}, {0.05, 0.05}};
+/* mgcf.SCHEDULES by schedule (FC_MGCF_SCHEDULE_SIMULATION, _EXPERIMENTAL): (rho upper bound,
+ * w0 [rad/s]) rows; rho at or above the last bound: w0 = 0 */
+static const double SCHEDULES[2][3][2] = {
+    {{0.01, 0.1}, {0.25, 0.07}, {0.35, 0.035}},
+    {{0.025, 0.1}, {0.035, 0.07}, {0.05, 0.05}},
+};
 
-static double scheduled_w0(double rho, const double (*table)[2], int rows)
+/* scheduled_w0: the table is chosen here, by its index, so the filter's struct holds no
+ * pointer (fc_state.h) */
+static double scheduled_w0(double rho, int schedule)
 {
-    for (int i = 0; i < rows; i++) {
-        if (rho < table[i][0]) {
-            return table[i][1];
+    for (int i = 0; i < 3; i++) {
+        if (rho < SCHEDULES[schedule][i][0]) {
+            return SCHEDULES[schedule][i][1];
         }
     }
     return 0.0;
@@ -39,9 +44,6 @@ void fc_mgcf_configure(fc_mgcf *f)
     const fc_mgcf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
                       p->mount_yaw, p->sensor_delay);
-    f->table = p->schedule == FC_MGCF_SCHEDULE_SIMULATION ? SIMULATION
-        : p->schedule == FC_MGCF_SCHEDULE_EXPERIMENTAL ? EXPERIMENTAL : NULL;
-    f->table_rows = f->table ? 3 : 0;
     f->w0_fixed = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;
@@ -82,6 +84,7 @@ void fc_mgcf_reset(fc_mgcf *f)
 }
 
 FC_DEFINE_INIT(fc_mgcf)
+FC_DEFINE_RESTORED(fc_mgcf)
 
 static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _init */
 {
@@ -130,8 +133,10 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         }
     }
     double norm = sqrt(ax * ax + ay * ay + az * az);
-    double w0 = f->table ? scheduled_w0(fabs(norm / FC_G - 1.0), f->table, f->table_rows)
-        : f->w0_fixed;
+    int schedule = f->params.schedule;
+    int scheduled = schedule == FC_MGCF_SCHEDULE_SIMULATION ||
+                    schedule == FC_MGCF_SCHEDULE_EXPERIMENTAL;
+    double w0 = scheduled ? scheduled_w0(fabs(norm / FC_G - 1.0), schedule) : f->w0_fixed;
     if (!(norm > 0.0)) {  /* no gravity direction in this sample: gyro only */
         w0 = 0.0;
     }

@@ -20,8 +20,6 @@ typedef struct fc_mgcf {
     double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
-    const double (*table)[2];  /* the schedule's (rho bound, w0) rows; NULL: fixed w0 */
-    int table_rows;
     double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
     double r_ref, q_rotation, dist_tau, dist_noise, longest;  /* _adaptive */
     int trapezoid, options;
@@ -35,5 +33,7 @@ fc_status fc_mgcf_step(fc_mgcf *f, const double acc[3], const double gyro[3], do
 long fc_mgcf_run(fc_mgcf *f, long n, const double *acc, const double *gyro, const double *dt,
                  fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f);
+/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
+void fc_mgcf_restored(fc_mgcf *f);
 
 #endif /* FC_MGCF_H */

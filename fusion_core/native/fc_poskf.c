@@ -207,6 +207,13 @@ void fc_poskf_reset(fc_poskf *f)
 
 FC_DEFINE_INIT(fc_poskf)
 
+void fc_poskf_restored(fc_poskf *f)  /* the nested filters' last estimates too (_restored) */
+{
+    fc_kf_restored(&f->tilt);
+    fc_kf_restored(&f->att);
+    f->last = fc_base_output(&f->base, fc_poskf_estimate(f));
+}
+
 static void first_sample(fc_poskf *f, const double a[3], const double g[3])  /* _init */
 {
     fc_kf_step(&f->tilt, a, g, f->params.max_dt, NULL);

@@ -41,5 +41,7 @@ fc_status fc_poskf_step(fc_poskf *f, const double acc[3], const double gyro[3], 
 long fc_poskf_run(fc_poskf *f, long n, const double *acc, const double *gyro, const double *dt,
                   fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_poskf_estimate(const fc_poskf *f);
+/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
+void fc_poskf_restored(fc_poskf *f);
 
 #endif /* FC_POSKF_H */

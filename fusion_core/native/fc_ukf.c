@@ -357,6 +357,7 @@ void fc_ukf_reset(fc_ukf *f)
 }
 
 FC_DEFINE_INIT(fc_ukf)
+FC_DEFINE_RESTORED(fc_ukf)
 
 static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _init */
 {

@@ -34,5 +34,7 @@ fc_status fc_ukf_step(fc_ukf *f, const double acc[3], const double gyro[3], doub
 long fc_ukf_run(fc_ukf *f, long n, const double *acc, const double *gyro, const double *dt,
                 fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_ukf_estimate(const fc_ukf *f);
+/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
+void fc_ukf_restored(fc_ukf *f);
 
 #endif /* FC_UKF_H */

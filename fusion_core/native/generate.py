@@ -1,28 +1,46 @@
 """Generate the C twin's tables from their Python source: fc_params.h, the parameter structs, from
 the PARAMS tables of the estimators and of the sensor model; fc_scenarios.h, the plant's
-scenarios, from their signals.
+scenarios, from their signals; fc_state_tables.c, each twin's state layout (fc_state.h), from the
+STATE declarations with their checks (fusion_core.state), the C types and sizes read from the
+twin's own headers.
 
 One source of truth: every estimator's parameters (names, defaults, ranges, units, choices) are
 declared once, in its Python class; this script writes them as C so that the two languages
 cannot disagree. tests/test_native.py fails when the file in the repository is stale.
 
-    python -m fusion_core.native.generate           # rewrite fc_params.h
-    python -m fusion_core.native.generate --check   # exit 1 if it is stale
+    python -m fusion_core.native.generate           # rewrite the generated files
+    python -m fusion_core.native.generate --check   # exit 1 if one is stale
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
+from typing import Any
 
 from fusion_core import ESTIMATORS
+from fusion_core.position import PENDING_MAX
 from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
+from fusion_core.state import (
+    BASE_STATE,
+    COV_LOWER,
+    COV_UPPER,
+    FLAG,
+    NONNEG,
+    REAL,
+    Check,
+    Segments,
+    count,
+    index,
+)
 from fusion_core.types import Param
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "fc_params.h"
 SCENARIOS_OUTPUT = HERE / "fc_scenarios.h"
+STATE_OUTPUT = HERE / "fc_state_tables.c"
 KINDS = ("constant", "sine", "add", "min_jerk", "product", "swelling_sine")
 """The signal kinds of fusion_core.synthetic (and scenarios.swelling_sine), by their C number."""
 PREFIX = {"cf": "fc_cf", "mgcf": "fc_mgcf", "kf": "fc_kf", "ukf": "fc_ukf", "poskf": "fc_poskf",
@@ -184,13 +202,158 @@ def render_scenarios() -> str:
     return "\n".join(lines)
 
 
+# ----- fc_state_tables.c -------------------------------------------------------------------------
+
+Entry = tuple[str, str, Check, int | None]
+"""One field of a C layout: its name, its member path in the twin's struct, its check, and its
+number of values (None: the member's whole size)."""
+
+C_CHECKS: dict[tuple[str, str], Check] = {("fc_ukf", "P"): COV_LOWER}
+"""Where the C twin stores a state field in another form than the Python class: the UKF's P is
+its packed lower triangle (UnscentedKalmanFilter._P), the Python state its 6x6 matrix."""
+
+
+def _entries(spec: dict[str, Any], prefix: str = "") -> list[Entry]:
+    """The layout entries of a STATE declaration: a field per name, a Segments field split into
+    its runs of elements."""
+    out: list[Entry] = []
+    for name, check in spec.items():
+        if isinstance(check, Segments):
+            start = 0
+            for part, n in check.parts:
+                label = f"{name}[{start}]" if n == 1 else f"{name}[{start}:{start + n}]"
+                out.append((prefix + label, f"{prefix}{name}[{start}]", part, n))
+                start += n
+        else:
+            out.append((prefix + name, prefix + name, check, None))
+    return out
+
+
+def _base_entries(prefix: str = "") -> list[Entry]:
+    return _entries(BASE_STATE, prefix + "base.")
+
+
+def state_layouts() -> dict[str, list[Entry]]:
+    """Every twin's state layout: the base state, then the class's STATE (the position filter's
+    and the sensor's, whose C twins hold theirs in other forms, written out here)."""
+    layouts: dict[str, list[Entry]] = {}
+    for key in ("cf", "mgcf", "kf", "ukf"):
+        prefix = PREFIX[key]
+        entries = _base_entries() + _entries(ESTIMATORS[key].STATE)
+        layouts[prefix] = [(n, path, C_CHECKS.get((prefix, path), check), size)
+                           for n, path, check, size in entries]
+    kf = layouts["fc_kf"]
+    layouts["fc_poskf"] = [
+        *_base_entries(),
+        *_entries({"yaw": ESTIMATORS["poskf"].STATE["yaw"], "x": REAL, "P": COV_UPPER,
+                   "quiet_time": NONNEG, "stationary": FLAG, "pending": REAL,
+                   "pending_head": index(PENDING_MAX), "pending_count": count(PENDING_MAX),
+                   "turned": REAL, "f_mean": REAL}),
+        *[(f"{nested}.{n}", f"{nested}.{path}", check, size)
+          for nested in ("tilt", "att") for n, path, check, size in kf],
+    ]
+    sensor = dict(ImuSensorModel.STATE)
+    del sensor["omega_prev"]  # None in Python before the first sample: has_omega_prev in C
+    layouts["fc_sensor"] = _entries({**sensor, "has_omega_prev": FLAG, "omega_prev": REAL,
+                                     "gyro_filter.started": FLAG, "gyro_filter.state": REAL,
+                                     "acc_filter.started": FLAG, "acc_filter.state": REAL})
+    return layouts
+
+
+def _member(ffi: Any, struct: str, path: str) -> tuple[str, int]:
+    """The C type name of a member path's values and how many there are from it to the end of
+    its member (`x[3]` of a double x[6]: 3)."""
+    t = ffi.typeof(struct)
+    rows = 1
+    for part in path.split("."):
+        m = re.fullmatch(r"(\w+)(?:\[(\d+)\])?", part)
+        if m is None:
+            raise ValueError(f"{struct}: cannot read member path {path!r}")
+        t = dict(t.fields)[m.group(1)].type
+        if m.group(2) is not None:
+            rows = t.length - int(m.group(2))
+            t = t.item
+    n = rows
+    while t.kind == "array":
+        n *= t.length
+        t = t.item
+    return t.cname, n
+
+
+C_TYPES = {"double": "FC_DOUBLE", "int": "FC_INT", "long": "FC_LONG"}
+
+
+def render_state_tables() -> str:
+    """fc_state_tables.c: every twin's layout as data for fc_state.c."""
+    import cffi  # type: ignore[import-untyped]
+
+    from fusion_core.native import cdef
+
+    ffi = cffi.FFI()
+    ffi.cdef(cdef())
+    lines = [
+        "/* fc_state_tables.c: every twin's state layout (fc_state.h): the fields a saved state",
+        " * holds, in order, each with its check.",
+        " *",
+        " * GENERATED by `python -m fusion_core.native.generate` from the STATE declarations of",
+        " * the Python classes (fusion_core/state.py), the types and sizes from the twins'",
+        " * headers: do not edit by hand.",
+        " */",
+        "#include <stddef.h>",
+        "#include <string.h>",
+        "",
+        '#include "fc_cf.h"',
+        '#include "fc_kf.h"',
+        '#include "fc_mgcf.h"',
+        '#include "fc_poskf.h"',
+        '#include "fc_sensor.h"',
+        '#include "fc_state.h"',
+        '#include "fc_ukf.h"',
+        "",
+    ]
+    for prefix, entries in state_layouts().items():
+        table = prefix.upper()[3:] + "_FIELDS"
+        lines.append(f"static const fc_field {table}[] = {{")
+        for name, path, check, size in entries:
+            cname, n = _member(ffi, prefix, path)
+            if cname not in C_TYPES:
+                raise ValueError(f"{prefix}.{path} is {cname}: a state field is a double, an "
+                                 "int or a long")
+            if size is not None and size > n:
+                raise ValueError(f"{prefix}.{path}: {size} values, the member has {n}")
+            lines.append(f'    {{"{name}", offsetof({prefix}, {path}), {C_TYPES[cname]}, '
+                         f"{size or n}, FC_CHECK_{check.kind.upper()}, "
+                         f"{c_double(check.high)}}},")
+        lines.append("};")
+        lines.append(f"const fc_layout {prefix.upper()}_LAYOUT = {{\"{prefix}\", {table}, "
+                     f"(int)(sizeof {table} / sizeof {table}[0])}};")
+        lines.append("")
+    lines += [
+        "const fc_layout *fc_state_layout(const char *twin)",
+        "{",
+        "    const fc_layout *all[] = {"
+        + ", ".join(f"&{p.upper()}_LAYOUT" for p in state_layouts()) + "};",
+        "    size_t i;",
+        "    for (i = 0; twin && i < sizeof all / sizeof all[0]; i++) {",
+        "        if (strcmp(all[i]->twin, twin) == 0) {",
+        "            return all[i];",
+        "        }",
+        "    }",
+        "    return NULL;",
+        "}",
+        "",
+    ]
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true",
                         help="exit 1 (and say so) if a generated header is not what the Python "
                         "sources give")
     args = parser.parse_args(argv)
-    files = {OUTPUT: render(), SCENARIOS_OUTPUT: render_scenarios()}
+    files = {OUTPUT: render(), SCENARIOS_OUTPUT: render_scenarios(),
+             STATE_OUTPUT: render_state_tables()}
     if args.check:
         stale = [p for p, text in files.items()
                  if not p.is_file() or p.read_text() != text]

@@ -75,6 +75,13 @@ static int step(void *data, double *v, double t, double h, char *message, size_t
     return 0;
 }
 
+static void restored(void *data)
+{
+    FC_RESTORED(&((model_data *)data)->filter);
+}
+
+/* The twin is model_data's first member: its layout's offsets are the data's. */
 const fmu_model FMU_MODEL = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), setup, tune, step,
+    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), &FC_LAYOUT,
+    setup, tune, step, restored,
 };

@@ -36,6 +36,8 @@ static int step(void *data, double *v, double t, double h, char *message, size_t
     return 0;
 }
 
+/* No state: the truth is a function of time, and the scenario a parameter. */
 const fmu_model FMU_MODEL = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), setup, tune, step,
+    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), NULL, setup, tune,
+    step, NULL,
 };

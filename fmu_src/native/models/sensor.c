@@ -53,6 +53,8 @@ static int step(void *data, double *v, double t, double h, char *message, size_t
     return 0;
 }
 
+/* The sensor is model_data's first member: its layout's offsets are the data's. */
 const fmu_model FMU_MODEL = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), setup, tune, step,
+    MODEL_IDENTIFIER, MODEL_TOKEN, VARIABLES, N_VARIABLES, sizeof(model_data), &FC_SENSOR_LAYOUT,
+    setup, tune, step, NULL,
 };

@@ -1,0 +1,177 @@
+"""The rule for the C twin's structs (fusion_core/native/fc_state.h): no pointer anywhere; a
+saved state is the layout's fields only, and a twin set up from its parameters takes them and
+continues bit for bit, so nothing outside the layout carries what the samples made; the layout
+holds every field of the Python class's STATE; and the two twins refuse the same values."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import numpy as np
+import pytest
+from helpers import KEYS, estimator_class
+
+from fusion_core import native
+from fusion_core.presets import preset_params
+from fusion_core.state import BASE_STATE
+
+pytestmark = pytest.mark.skipif(not native.available(),
+                                reason=f"the C twin is unavailable: {native.reason()}")
+
+TWIN_STRUCTS = ("fc_cf", "fc_mgcf", "fc_kf", "fc_ukf", "fc_poskf", "fc_sensor")
+OPTIONS: dict[str, list[dict]] = {
+    "cf": [{}, {"propagation": "euler"}, {"gyro_sampling": "mean"}],
+    "mgcf": [{}, {"schedule": "simulation"}, {"schedule": "experimental"}],
+    "kf": [{}, {"tilt_axes": "body"}, {"propagation": "euler", "gyro_sampling": "mean"}],
+    "ukf": [{}, {"gyro_sampling": "mean"}],
+    "poskf": [{}, {"tilt_update": "always", "attitude": "tilt_stage"}],
+}
+"""Options that change what configure derives, besides the two presets."""
+
+
+def _pointers(ffi, ctype, path: str) -> list[str]:
+    """The pointer members reachable in a C type (through structs and arrays)."""
+    if ctype.kind == "pointer":
+        return [path]
+    if ctype.kind == "array":
+        return _pointers(ffi, ctype.item, path + "[]")
+    if ctype.kind == "struct":
+        return [p for name, field in ctype.fields
+                for p in _pointers(ffi, field.type, f"{path}.{name}")]
+    return []
+
+
+@pytest.mark.parametrize("struct", TWIN_STRUCTS)
+def test_no_twin_struct_holds_a_pointer(struct: str) -> None:
+    _, ffi = native.lib_and_ffi()
+    assert _pointers(ffi, ffi.typeof(struct), struct) == []
+
+
+def _layout(prefix: str):
+    lib, ffi = native.lib_and_ffi()
+    layout = lib.fc_state_layout(prefix.encode())
+    assert layout != ffi.NULL
+    fields = [(ffi.string(layout.fields[i].name).decode(), int(layout.fields[i].count))
+              for i in range(layout.n_fields)]
+    return layout, fields
+
+
+@pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
+def test_the_c_layout_holds_every_state_field_of_the_python_class(key: str) -> None:
+    cls = estimator_class(key)
+    _, fields = _layout(native.TWINS[cls.__name__])
+    names = [n.split("[")[0] for n, _ in fields]
+    expected = [f"base.{n}" for n in BASE_STATE] + list(cls.STATE)
+    assert list(dict.fromkeys(names)) == expected
+    est = cls()
+    for _ in range(50):
+        est.step((0.1, 0.2, 9.8), (0.01, 0.02, 0.03), 0.01)
+    sizes = {}
+    for n, count in fields:
+        sizes[n.split("[")[0]] = sizes.get(n.split("[")[0], 0) + count
+    for name in cls.STATE:
+        value = np.asarray(getattr(est, "_P" if (key, name) == ("ukf", "P") else name),
+                           dtype=float)
+        assert sizes[name] == value.size, name
+
+
+def _samples(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    t = 0.01 * np.arange(n)
+    acc = np.stack([np.sin(0.5 * t), 2.0 * np.cos(0.3 * t), 9.5 + 0 * t], axis=1)
+    acc += rng.normal(0.0, 0.3, acc.shape)
+    gyro = np.stack([0.4 * np.cos(0.5 * t), -0.3 * np.sin(0.3 * t), 0.05 + 0 * t], axis=1)
+    rest = (t > 1.0) & (t < 3.5)
+    acc[rest] = (0.0, 0.0, 9.80665)
+    gyro[rest] = (0.004, -0.003, 0.002)
+    return acc, gyro
+
+
+def _configs(key: str) -> list[dict]:
+    return [preset_params("paper", key), *OPTIONS[key]]
+
+
+@pytest.mark.parametrize("key", KEYS)
+def test_a_twin_set_up_from_its_parameters_continues_bit_for_bit_from_the_layout(key: str
+                                                                                  ) -> None:
+    """Restore the way a native FMU does: T_init(params), fc_state_load, T_restored."""
+    lib, ffi = native.lib_and_ffi()
+    prefix = native.TWINS[estimator_class(key).__name__]
+    layout, _ = _layout(prefix)
+    size = lib.fc_state_size(layout)
+    step = getattr(lib, f"{prefix}_step")
+    acc, gyro = _samples(600, 3)
+    a, g = ffi.new("double[3]"), ffi.new("double[3]")
+    out_a, out_b = ffi.new("fc_estimate *"), ffi.new("fc_estimate *")
+    for params in _configs(key):
+        est = estimator_class(key)(**params)
+        for at in (0, 40, 150, 320, 500):
+            twin = native.new_twin(est)
+            for k in range(at):
+                a[0:3], g[0:3] = acc[k].tolist(), gyro[k].tolist()
+                step(twin, a, g, 0.01, out_a)
+            saved = ffi.new("double[]", size)
+            lib.fc_state_save(layout, twin, saved)
+            why = ffi.new("char[]", 256)
+            assert lib.fc_state_check(layout, saved, why, 256) == 0, ffi.string(why)
+            fresh = native.new_twin(estimator_class(key)(**params))
+            lib.fc_state_load(layout, fresh, saved)
+            getattr(lib, f"{prefix}_restored")(fresh)
+            for k in range(at, 600):
+                a[0:3], g[0:3] = acc[k].tolist(), gyro[k].tolist()
+                sa, sb = step(twin, a, g, 0.01, out_a), step(fresh, a, g, 0.01, out_b)
+                assert sa == sb and bytes(ffi.buffer(out_a)) == bytes(ffi.buffer(out_b)), (
+                    params, at, k)
+
+
+EXTREMES = (math.nan, math.inf, -1.0, 0.5, 2.0, 3.2, 1.6, 6.0, 1e80, -1e80, 2.0**53 + 2, 0.0)
+
+
+@pytest.mark.parametrize("key", ["cf", "mgcf", "kf"])
+def test_both_twins_refuse_the_same_values(key: str) -> None:
+    """A field of a running filter set to an extreme value: Python's set_state refuses it exactly
+    when the C layout's check does (the fields these classes hold alike in both twins)."""
+    lib, ffi = native.lib_and_ffi()
+    cls = estimator_class(key)
+    prefix = native.TWINS[cls.__name__]
+    layout, fields = _layout(prefix)
+    size = lib.fc_state_size(layout)
+    est = cls()
+    acc, gyro = _samples(200, 1)
+    for k in range(200):
+        est.step(acc[k], gyro[k], 0.01)
+    snapshot = est.get_state()
+    rng = random.Random(key)
+    positions = []  # (python field, element index, C position)
+    at = 0
+    for name, count in fields:
+        base = name.split("[")[0].removeprefix("base.")
+        start = int(name.split("[")[1].split(":")[0].rstrip("]")) if "[" in name else 0
+        positions += [(base, start + i, at + i) for i in range(count)]
+        at += count
+    disagreements = []
+    why = ffi.new("char[]", 256)
+    for field, element, position in positions:
+        for value in EXTREMES:
+            state = {**snapshot, "state": dict(snapshot["state"])}
+            old = state["state"][field]
+            if isinstance(old, list):
+                new = list(old)
+                new[element] = value
+                state["state"][field] = new
+            else:
+                state["state"][field] = value
+            try:
+                cls().set_state(state)
+                python_ok = True
+            except ValueError:
+                python_ok = False
+            doubles = ffi.new("double[]", size)
+            lib.fc_state_save(layout, native.new_twin(est), doubles)
+            doubles[position] = float(value)
+            c_ok = lib.fc_state_check(layout, doubles, why, 256) == 0
+            if python_ok != c_ok:
+                disagreements.append((field, element, value, python_ok, c_ok))
+    rng.shuffle(disagreements)
+    assert not disagreements, disagreements[:5]
