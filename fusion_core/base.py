@@ -18,12 +18,19 @@ import numpy as np
 
 from .kinematics import roll_pitch_ahead
 from .state import BASE_STATE, NESTED, StateSpec, check_field
-from .types import Estimate, G, InvalidSample, Param, check_param_names
+from .types import DEG, Estimate, G, InvalidSample, Param, check_param_names
 
 MAX_RATE_DEFAULT: Final = 1000.0
 """Default max_rate [rad/s] (57,300 deg/s): about three times the widest full-scale range of any
 MEMS gyro we know of (Analog Devices ADXRS649, +-20,000 deg/s; consumer parts such as the
 MPU-6050 end at +-2000 deg/s). A larger reading is no measurement."""
+GYRO_RANGE_DEFAULT: Final = 2000.0 * DEG
+"""Default gyro_range [rad/s]: +-2000 deg/s, the widest setting of the MPU-6050 class of consumer
+MEMS gyros (the realistic sensor model's range)."""
+RAIL_MARGIN: Final = 1e-3
+"""A gyro reading within this fraction of gyro_range is at the rail: a 16-bit converter's last
+code is 0.003 % below its range, and no rate the sensor measured sits that close to it unless it
+clipped."""
 MOUNTING_PARAMS: tuple[Param, ...] = tuple(
     Param(
         f"mount_{axis}", 0.0,
@@ -49,6 +56,14 @@ COMMON_PARAMS: tuple[Param, ...] = (
         unit="rad/s", low=0.0, low_open=True, display_unit="deg/s",
     ),
     *MOUNTING_PARAMS,
+    Param(
+        "gyro_range", GYRO_RANGE_DEFAULT,
+        "The gyro's full-scale range: a sample with an axis at it (within 0.1 %) is at the rail, "
+        "no measurement of the rate, which may be anything beyond it; the filters learn no bias "
+        "from it, their attitude's uncertainty grows, and their accelerometer pre-filter starts "
+        "again after it (a sensor property, default the MPU-6050's +-2000 deg/s)",
+        unit="rad/s", low=1e-3, display_unit="deg/s", tunable=False,
+    ),
     Param(
         "sensor_delay", 0.0,
         "How long the sensor's samples lag the instants they are read at (its internal "
@@ -122,9 +137,11 @@ def _plain(value: Any) -> Any:
 
 
 def _restore(template: Any, value: Any) -> Any:
-    """value in the shape of template (lists back to tuples where the state holds tuples)."""
+    """value in the shape of template (lists back to tuples where the state holds tuples, named
+    tuples to their own type)."""
     if isinstance(template, tuple):
-        return tuple(_restore(t, v) for t, v in zip(template, value, strict=True))
+        items = tuple(_restore(t, v) for t, v in zip(template, value, strict=True))
+        return type(template)(*items) if hasattr(template, "_fields") else items
     if isinstance(template, list):  # a list may change length (queues): match what is there
         n = len(template)
         return [_restore(template[i] if i < n else None, v) for i, v in enumerate(value)]
@@ -184,6 +201,7 @@ class Estimator:
                                          float(values["mount_yaw"]))
         self._mounted: bool = self._mounting != IDENTITY
         self._delay = float(values["sensor_delay"])
+        self._rail = float(values["gyro_range"]) * (1.0 - RAIL_MARGIN)
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:
@@ -199,6 +217,7 @@ class Estimator:
         self.n_samples = 0
         self.n_rejected = 0
         self.gyro_prev = (0.0, 0.0, 0.0)
+        self.clipped = False  # whether this sample's gyro is at its rail (gyro_range)
         self._reset()
         self.last = self.output()
 
@@ -268,6 +287,8 @@ class Estimator:
             and 0.0 < dt <= self._max_dt
         ):
             self._check_values(ax, ay, az, gx, gy, gz, dt)
+        rail = self._rail  # on the sensor's own axes, before the mounting (gyro_range)
+        self.clipped = not (-rail < gx < rail and -rail < gy < rail and -rail < gz < rail)
         if self._mounted:  # into the filter frame (MOUNTING_PARAMS)
             m00, m01, m02, m10, m11, m12, m20, m21, m22 = self._mounting
             ax, ay, az = (m00 * ax + m01 * ay + m02 * az, m10 * ax + m11 * ay + m12 * az,

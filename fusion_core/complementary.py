@@ -21,14 +21,11 @@ from .building_blocks import (
     REST_PARAMS,
     REST_START,
     ZERO3,
-    alignment_time,
     bias_at_rest,
     body_rotation,
     complementary_adaptive,
     correction_time,
-    disturbance_step,
     gate_bounds2,
-    lowpass_specific_force,
     quat_from_roll_pitch,
     rest_alignment,
     rest_start,
@@ -48,7 +45,15 @@ from .kinematics import (
     rotvec_terms,
     wrap_angle,
 )
-from .state import ANGLE, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec
+from .measured_vector import (
+    BAND_PARAM,
+    MEASURE_CHECK,
+    measure_clipped,
+    measure_constants,
+    measure_start,
+    measure_step,
+)
+from .state import ANGLE, HALF_ANGLE, REAL, REST, UNIT, StateSpec
 from .types import Estimate, Param
 
 
@@ -67,10 +72,10 @@ class ComplementaryFilter(Estimator):
     A constant gyro bias b leaves a steady-state error b*tau: the papers' filter has no bias
     state. Options for real sensors, on by default (the `paper` preset turns them off, and then
     the filter is exactly the papers'):
-    - acc_lowpass > 0: the accelerometer is first low-passed in a frame that turns with the gyro
-      (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and the gate and the blend
-      use that vector; over its first time constant it is the running mean of the turned
-      samples, and the attitude is its tilt (building_blocks.alignment_time);
+    - acc_lowpass > 0: the gate and the blend use the measured vector (fusion_core.
+      measured_vector: the accelerometer low-passed in a frame that turns with the gyro, second
+      order, after Laidig & Seel 2023); while it fills (after the first sample, and after a gyro
+      sample at its rail) it is the mean of the samples so far, and the attitude is its tilt;
     - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
       still, the gyro reads its own bias, and a bias estimate b follows it with time constant
       rest_time; the filter integrates gyro - b and outputs b (BROAD: 0.95 -> 0.75 deg mean, the
@@ -90,15 +95,13 @@ class ComplementaryFilter(Estimator):
     presets.PAPER_CF.
 
     Adaptive noise (recommended; off in the papers' filter: building_blocks.ADAPTIVE_NOISE_PARAMS,
-    the kf's, with acc_noise the sample noise they are measured against): the pre-filter
-    shortens to the raw sample where no linear acceleration above the white noise is measured,
-    and tau follows the Kalman balance of the gyro's scale uncertainty against the measured
-    disturbance (building_blocks.correction_time): shorter while the sensor turns with a clean
-    accelerometer, longer while it accelerates, up to max_correction_time (3 s: this filter
-    learns its bias only at rest, and a bias b costs b tau; without the cap vibration fails at
-    8/16 deg). On the realistic sensor, seed 0: roll_sweep 0.29/0.35 -> 0.12/0.08, pitch_sweep
-    0.17/0.40 -> 0.10/0.07, roll_pitch 0.23/0.36 -> 0.11/0.08, high_dynamics 6.7/7.5 -> 3.3/4.5
-    deg, vibration 0.11/0.36 -> 0.62/1.51; BROAD 0.750 -> 0.559.
+    the kf's, with acc_noise the sample noise they are measured against): tau follows the Kalman
+    balance of the gyro's scale uncertainty against the measured vector's noise, the slow
+    linear acceleration that reaches it (measured_vector; building_blocks.correction_time):
+    shorter while the sensor turns with a clean accelerometer, longer while it accelerates, up to
+    max_correction_time (3 s: this filter learns its bias only at rest, and a bias b costs b
+    tau). A gyro sample at its rail (gyro_range) measures no bias at rest and restarts the
+    measured vector, whose tilt the attitude takes while it fills again.
 
     Parameters: tau [s] time constant (1; papers 0.75); gate_low, gate_high accelerometer gate
     (|acc|/g); acc_lowpass [s] (0: off); rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2];
@@ -118,10 +121,11 @@ class ComplementaryFilter(Estimator):
         PROPAGATION_PARAM,
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
+        BAND_PARAM,
     )
     STATE: ClassVar[StateSpec] = {
-        "roll": ANGLE, "pitch": HALF_ANGLE, "acc_f": REAL, "q_att": UNIT, "bias": REAL,
-        "rest": REST, "acc_dist": NONNEG, "acc_ref": REAL,
+        "roll": ANGLE, "pitch": HALF_ANGLE, "meas": MEASURE_CHECK, "q_att": UNIT, "bias": REAL,
+        "rest": REST,
     }
 
     def _configure(self) -> None:
@@ -139,20 +143,20 @@ class ComplementaryFilter(Estimator):
         # rotation term per (rad/s)^2, the disturbance's averaging time (0: off), the white
         # noise's share of the disturbance statistic and the longest correction time
         self._adaptive = complementary_adaptive(p, self._acc_tau)
+        self._measure = measure_constants(self._acc_tau, self._adaptive[2],
+                                          float(p["slow_band_time"]), self._adaptive[0])
 
     def _reset(self) -> None:
         self.roll = 0.0
         self.pitch = 0.0
-        self.acc_f = ZERO3  # the pre-filtered specific force (acc_lowpass > 0)
+        self.meas = measure_start(ZERO3, self._measure)  # the measured vector (acc_lowpass > 0)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
         self.bias = ZERO3  # gyro bias measured at rest (rest_time > 0)
         self.rest = REST_START  # rest detector (building_blocks.RestState)
-        self.acc_dist = 0.0  # mean square of raw - acc_ref (disturbance_time)
-        self.acc_ref = ZERO3  # the specific force pre-filtered with the full acc_lowpass
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
-        self.acc_f = self.acc_ref = (ax, ay, az)
+        self.meas = measure_start((ax, ay, az), self._measure)
         self.q_att = quat_from_roll_pitch_yaw(self.roll, self.pitch, 0.0)
         self.rest = rest_start(gx, gy, gz, ax, ay, az)
 
@@ -160,35 +164,31 @@ class ComplementaryFilter(Estimator):
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
         rest_time = self._rest[0]
-        if rest_time > 0.0:  # at rest the gyro reads its bias: follow it (time constant rest_time)
+        clipped = self.clipped  # at the gyro's rail: no rate measured (gyro_range)
+        if rest_time > 0.0 and not clipped:  # at rest the gyro reads its bias: follow it
             measured = self.rest[7]
             self.rest = rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, self.bias, dt,
                                          self._rest[1], self._rest[2], rest_time, self._rest[3])
             if uncalibrated_first_rest(measured, rest, self.bias, self._rest[1]):
                 self.bias, self.roll, self.pitch, f = rest_alignment(rest)
-                self.acc_f = self.acc_ref = f
+                self.meas = self.meas._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f)
                 if self._quaternion:
                     self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
             elif rest[6] >= rest_time:
                 self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, rest_time)
         bias = self.bias
         bx, by, bz = bias
-        r_ref, q_rotation, dist_tau, noise, longest = self._adaptive
+        r_ref, q_rotation, _, _, longest = self._adaptive
         r = r_ref
         aligning = False
         if self._rotating:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
             terms = rotvec_terms(*phi)  # once, for the pre-filter and the propagation
-            if self._acc_tau > 0.0:  # the filter and its gate use the pre-filtered vector
-                tau_f, aligning = alignment_time(self.n_samples, dt, self._acc_tau)
-                if dist_tau > 0.0:  # the adaptive noise: disturbance against the full pre-filter
-                    self.acc_ref, self.acc_dist, r, tau_d = disturbance_step(
-                        self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau_f,
-                        dist_tau, r_ref, noise)
-                    tau_f = tau_f if aligning else tau_d
-                self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau_f,
-                                                    terms)
-                ax, ay, az = self.acc_f
+            if self._acc_tau > 0.0:  # the filter and its gate use the measured vector
+                m = measure_clipped(self.meas) if clipped else self.meas
+                self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
+                                                      self._measure)
+                ax, ay, az = self.meas.f
         if self._quaternion:  # (then self._rotating: phi is this interval's rotation)
             self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
             roll, pitch = quat_roll_pitch(*self.q_att)

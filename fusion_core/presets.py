@@ -29,11 +29,15 @@ from .building_blocks import CONSTANT_NOISE
 from .types import DEG, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
 
 DEG2 = DEG * DEG
+NO_RAIL: dict[str, Any] = {"gyro_range": 1e4}
+"""The papers' filters know no gyro range: at 10^4 rad/s (the largest gyro_range) every sample
+that max_rate lets through is below the rail, and none is treated as clipped."""
 KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
 
 PAPER_CF: dict[str, Any] = {
     "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
     "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE,
+    **NO_RAIL,
 }
 """Gui et al. eq. 1-2: tau = 0.75 s (a = 0.96 at their 30 ms loop), the Euler rates, the
 rectangle rule (gyro_sampling="mean"), a constant tau (gyro_scale_std and disturbance_time 0).
@@ -42,7 +46,7 @@ Their gate has no bounds in the text: 0.9-1.1 g is our reading
 
 PAPER_MGCF: dict[str, Any] = {
     "schedule": "simulation", "w0": 0.1, "zeta": 2.0, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE,
+    "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE, **NO_RAIL,
 }
 """Duong Quoc et al. eq. 7-13 with their simulation table (section 4.1) and zeta = 2; Mahony's
 reference order (error from the previous attitude, first-order step: gyro_sampling="mean").
@@ -54,7 +58,7 @@ PAPER_KF: dict[str, Any] = {
     "R_loop_time": 0.033, **CONSTANT_NOISE, "gate_low": 0.9,
     "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0, "bias_gate": 0.0,
     "bias_innovation": math.pi, "propagation": "euler", "tilt_axes": "body",
-    "gyro_sampling": "mean", "sensor_delay": 0.0,
+    "gyro_sampling": "mean", "sensor_delay": 0.0, **NO_RAIL,
 }
 """Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
 (times (pi/180)^2 here), tuned at Gui et al.'s loop time of 0.033 s (R_loop_time: the same
@@ -67,6 +71,7 @@ PAPER_UKF: dict[str, Any] = {
     "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
     "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
     "bias_innovation": math.pi, **CONSTANT_NOISE, "gyro_sampling": "mean", "sensor_delay": 0.0,
+    **NO_RAIL,
 }
 """Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
 simulated MPU-6050 at 100 Hz: the gyro's process noise that sensor's datasheet density (as the

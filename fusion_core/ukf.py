@@ -57,14 +57,21 @@ from .building_blocks import (
     adaptive_noise_constants,
     bias_band2,
     body_rotation,
-    disturbance_step,
-    lowpass_specific_force,
     rest_start,
     rest_step,
     zero_rate_psd_param,
 )
+from .kalman import KALMAN_MAX_CORRECTION_TIME, RECOMMENDED_INIT_BIAS_STD
 from .kinematics import accel_roll_pitch, rotate_back, rotvec_terms
-from .state import COV, NONNEG, REAL, REST, UNIT, Segments, StateSpec
+from .measured_vector import (
+    BAND_PARAM,
+    MEASURE_CHECK,
+    measure_clipped,
+    measure_constants,
+    measure_start,
+    measure_step,
+)
+from .state import COV, REAL, REST, UNIT, Segments, StateSpec
 from .types import DEG, Estimate, G, Param
 
 N_STATE: Final = 6  # X (3), gyro bias b (3)
@@ -148,7 +155,8 @@ class UnscentedKalmanFilter(Estimator):
             low=0.0, low_open=True, high=1000.0,
         ),
         Param(
-            "init_bias_std", 1.0 * DEG, "Initial standard deviation of each gyro-bias state",
+            "init_bias_std", RECOMMENDED_INIT_BIAS_STD,
+            "Initial standard deviation of each gyro-bias state",
             unit="rad/s", low=0.0, low_open=True, tunable=False,
         ),
         Param("alpha", 1.0, "Sigma-point spread (scaled unscented transform; Wan and van der "
@@ -164,10 +172,11 @@ class UnscentedKalmanFilter(Estimator):
         zero_rate_psd_param("zaru_psd"),
         BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
+        BAND_PARAM,
+        KALMAN_MAX_CORRECTION_TIME,
     )
     STATE: ClassVar[StateSpec] = {
-        "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "acc_f": REAL, "rest": REST,
-        "acc_dist": NONNEG, "acc_ref": REAL,
+        "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "meas": MEASURE_CHECK, "rest": REST,
     }
 
     def _configure(self) -> None:
@@ -189,6 +198,10 @@ class UnscentedKalmanFilter(Estimator):
         # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share of the
         # disturbance statistic (3 axes of one sample's variance, (acc_noise g)^2)
         self._adaptive = adaptive_noise_constants(p, float(p["acc_lowpass"]), self._r_acc)
+        self._measure = measure_constants(float(p["acc_lowpass"]), self._adaptive[1],
+                                          float(p["slow_band_time"]), self._r_acc)
+        self._longest2 = float(p["max_correction_time"]) ** 2
+        self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._gate = float(p["acc_gate"])
         self._trapezoid: bool = p["gyro_sampling"] == "point"
         # any real-sensor option on (else the paper's filter alone: the short path of _advance)
@@ -201,19 +214,23 @@ class UnscentedKalmanFilter(Estimator):
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
         self._P: tuple[float, ...] = (0.0,) * 21  # packed lower triangle of the 6x6 P
-        self.acc_f = (0.0, 0.0, 0.0)  # the pre-filtered specific force (acc_lowpass > 0)
+        # the measured vector (acc_lowpass > 0)
+        self.meas = measure_start((0.0, 0.0, 0.0), self._measure)
         self.rest = REST_START  # the rest detector's means, quiet time, measured (rest_time > 0)
-        self.acc_dist = 0.0  # mean square of raw - acc_ref (disturbance_time)
-        self.acc_ref = (0.0, 0.0, 0.0)  # the specific force pre-filtered with the full acc_lowpass
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         n = math.sqrt(ax * ax + ay * ay + az * az)
         self.x = [ax / n, ay / n, az / n, 0.0, 0.0, 0.0]
         # X from one accelerometer sample: its noise, per axis; b: the prior on the bias.
+        # A sample whose norm is off g by d carries at least d of linear acceleration: with the
+        # measured vector, its X is as uncertain as d / g more (kalman.AngleBiasKalmanFilter).
         p_x = self._params["acc_noise"] ** 2
+        if self._params["acc_lowpass"] > 0.0:
+            d = (n - G) / G
+            p_x += d * d
         p_b = self._params["init_bias_std"] ** 2
         self._P = _packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
-        self.acc_f = self.acc_ref = (ax, ay, az)
+        self.meas = measure_start((ax, ay, az), self._measure)
         self.rest = rest_start(gx, gy, gz, ax, ay, az)
 
     @property
@@ -240,32 +257,43 @@ class UnscentedKalmanFilter(Estimator):
     def _update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> None:
-        """Real-sensor options around the paper's filter (all off by default): the accelerometer
-        pre-filter (acc_lowpass, building_blocks.ACC_LOWPASS_PARAM: the filter then measures the
-        low-passed specific force) and, at rest, a zero-rate update of the bias states."""
+        """Real-sensor options around the paper's filter (all off by default): the measured
+        vector (acc_lowpass, fusion_core.measured_vector: the filter then measures the low-passed
+        specific force, with the noise that reaches it, up to max_correction_time), a gyro at
+        its rail (gyro_range: no bias learned, X's uncertainty grows) and, at rest, a zero-rate
+        update of the bias states."""
         p = self._params
         lo, hi = self._bias_band2
-        learn_bias = lo < ax * ax + ay * ay + az * az < hi  # the raw sample (bias_gate)
+        clipped = self.clipped
+        # the raw sample (bias_gate); never a sample at the rail
+        learn_bias = lo < ax * ax + ay * ay + az * az < hi and not clipped
         if p["acc_lowpass"] > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), (self.x[3], self.x[4], self.x[5]),
                                 dt, self._trapezoid)
-            terms = rotvec_terms(*phi)  # once, for both pre-filters
-            tau = p["acc_lowpass"]
-            r = self._r_acc
-            _, dist_tau, noise = self._adaptive
-            if dist_tau > 0.0:  # building_blocks.ADAPTIVE_NOISE_PARAMS
-                self.acc_ref, self.acc_dist, r, tau = disturbance_step(
-                    self.acc_ref, self.acc_dist, (ax, ay, az), phi, terms, dt, tau, dist_tau, r,
-                    noise)
-            self.acc_f = lowpass_specific_force(self.acc_f, phi, (ax, ay, az), dt, tau, terms)
-            self._filter_update(*self.acc_f, gx, gy, gz, dt, learn_bias, r)
+            terms = rotvec_terms(*phi)  # once, for the measured vector's low-passes
+            m = measure_clipped(self.meas) if clipped else self.meas
+            self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt, self._measure)
+            # no bias from a vector that is filling (a mean of the first samples, of a motion's
+            # start as likely as of rest) or holds turns the gyro did not measure (gyro_range)
+            learn_bias = learn_bias and not filling and self.meas.settled(self._measure)
+            self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r)
         else:
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
-        if p["rest_time"] > 0.0:
+        if p["rest_time"] > 0.0 and not clipped:
             x = self.x
+            measured = self.rest[7]
             self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, (x[3], x[4], x[5]), dt,
                                   p["rest_gyro"], p["rest_acc"], p["rest_time"],
                                   p["rest_bias_bound"])
+            if p["acc_lowpass"] > 0.0 and measured == 0.0 and self.rest[7] != 0.0:
+                # the first rest: the measured vector, turned with a bias not measured yet,
+                # starts again from the rest's mean specific force, the slow band (which read
+                # the vectors' disagreement as disturbance) from nothing, and X is its direction
+                # (kalman.AngleBiasKalmanFilter, building_blocks.rest_alignment)
+                f = (self.rest[3], self.rest[4], self.rest[5])
+                self.meas = self.meas._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f, slow=0.0)
+                n = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+                self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
             if self.rest[6] >= p["rest_time"]:
                 self._zero_rate_update((gx, gy, gz), p["zaru_psd"] / dt)
 
@@ -403,6 +431,8 @@ class UnscentedKalmanFilter(Estimator):
         if q_rotation > 0.0:  # gyro_scale_std: a scale error adds up while the sensor turns
             wx, wy, wz = gx - b0, gy - b1, gz - b2
             q_gyro += q_rotation * (wx * wx + wy * wy + wz * wz)
+        if self.clipped:  # at the rail the rate beyond it is unknown (gyro_range)
+            q_gyro += self._rail_var * dt
         qg = q_gyro * dt
         qb = self._q_bias * dt
         P = (
@@ -424,6 +454,9 @@ class UnscentedKalmanFilter(Estimator):
             sv2 = w * ev2 + w_mu * mu2 * mu_v
             if r is None:
                 r = self._r_acc
+            else:  # the longest correction time: r at most q T^2 / dt (max_correction_time)
+                cap = q_gyro * self._longest2 / dt
+                r = r if r < cap else (cap if cap > self._r_acc else self._r_acc)
             if norm_row:
                 s33 = w * vv + w_mu * mu_v * mu_v + self._r_norm
                 y3 = 1.0 - (v_prior + mu_v)

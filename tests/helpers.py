@@ -53,3 +53,25 @@ def noisy_two_axis_recording(duration: float, seed: int = 0) -> dict[str, np.nda
     """two_axis_motion() with MPU-6050 noise and a gyro bias, for tests that need a busy state."""
     noise = synthetic.ImuNoise(gyro_bias=(0.01, -0.006, 0.004))
     return synthetic.record(synthetic.two_axis_motion(), duration, RATE, noise=noise, seed=seed)
+
+
+def state_numbers(value: object) -> list:
+    """A state field's numbers in order: a number, a vector, or a Measure (vectors, then
+    numbers) as one flat list."""
+    if isinstance(value, (list, tuple)):
+        return [x for v in value for x in state_numbers(v)]
+    return [value]
+
+
+def with_number(value: object, index: int, new: float) -> object:
+    """value (a number or nested lists/tuples of them) with its index-th number replaced."""
+    numbers = state_numbers(value)
+    numbers[index] = new
+    it = iter(numbers)
+
+    def shaped(template: object) -> object:
+        if isinstance(template, (list, tuple)):
+            return [shaped(t) for t in template]
+        return next(it)
+
+    return shaped(value)

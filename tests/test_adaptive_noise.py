@@ -64,21 +64,22 @@ def test_the_ukf_passes_the_disturbed_scenarios_with_the_defaults(scenario: str)
     assert roll <= limit[0] and pitch <= limit[1], (roll, pitch)
 
 
-def test_the_unit_norm_pseudo_measurement_fails_the_ukf_on_vibration() -> None:
+def test_the_unit_norm_pseudo_measurement_costs_the_ukf_on_vibration() -> None:
     """With the paper's |X|^2 = 1 row (norm_noise 0.01) the sigma points' spread off the unit
-    sphere is read as information: P_XX shrinks, and X, set 24 deg off by the first vibrating
-    sample, takes 20 s instead of 4 to converge under the raised R (ukf's docstring)."""
-    limit = accuracy_limits("ukf", "vibration")
-    roll, pitch = rmse("ukf", "vibration", {"norm_noise": 0.01})
-    assert pitch > limit[1], (roll, pitch)
+    sphere is read as information: P_XX shrinks, and X, set off by the first vibrating sample,
+    converges more slowly (ukf's docstring): at least twice the pitch RMSE of the defaults."""
+    _, pitch = rmse("ukf", "vibration", {})
+    roll_norm, pitch_norm = rmse("ukf", "vibration", {"norm_noise": 0.01})
+    assert pitch_norm > 2.0 * pitch, (roll_norm, pitch_norm, pitch)
     assert PRESETS["paper"]["ukf"]["norm_noise"] == 0.01
 
 
 def test_the_unit_norm_row_shrinks_the_covariance_of_x() -> None:
     """The mechanism behind the test above: the sigma points' spread off the unit sphere, read as
-    information by the |X|^2 = 1 row, takes variance out of P_XX. 3.5 s into vibration (R raised
-    by the disturbance, X still off from its vibrating first sample) the variance of X across
-    the vertical, P_00 + P_11, is 0.68 of what the same filter without the row holds."""
+    information by the |X|^2 = 1 row, takes variance out of P_XX. 3.5 s into vibration (X still
+    off from its vibrating first sample) the variance of X across the vertical, P_00 + P_11, is
+    0.93 of what the same filter without the row holds (the vibration itself no longer raises R:
+    the second-order pre-filter removes it, measured_vector)."""
     from fusion_core.ukf import UnscentedKalmanFilter
     from testbenches.montecarlo.simulate import scenario_samples
 
@@ -90,4 +91,4 @@ def test_the_unit_norm_row_shrinks_the_covariance_of_x() -> None:
         f.run(s["acc"][:n], s["gyro"][:n], s["dt"][:n])
         P = f.P
         traces[norm_noise] = P[0][0] + P[1][1]
-    assert traces[0.01] < 0.8 * traces[0.0], traces
+    assert traces[0.01] < 0.95 * traces[0.0], traces

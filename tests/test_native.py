@@ -75,11 +75,17 @@ def assert_same_snapshot(sa: dict, sb: dict, where: str = "") -> None:
         other = sb["state"][name]
         if isinstance(value, dict):  # a nested estimator (the position filter's Kalman filters)
             assert_same_snapshot(value, other, f"{where}{name}.")
-        elif isinstance(value, list) and (not value or isinstance(value[0], list)):
+        elif isinstance(value, list) and all(isinstance(v, list) for v in value):
             assert len(value) == len(other), where + name  # the position filter's queue
             assert np.allclose(value, other, rtol=0.0, atol=TOL) if value else True, where + name
-        else:
-            assert np.allclose(value, other, rtol=0.0, atol=TOL), where + name
+        else:  # a number, a vector or a Measure (vectors and numbers): compare the numbers
+            assert np.allclose(_numbers(value), _numbers(other), rtol=0.0, atol=TOL), where + name
+
+
+def _numbers(value: object) -> list:
+    if isinstance(value, (list, tuple)):
+        return [x for v in value for x in _numbers(v)]
+    return [value]
 
 
 def assert_same_state(a: object, b: object) -> None:

@@ -10,7 +10,7 @@ import random
 
 import numpy as np
 import pytest
-from helpers import KEYS, estimator_class
+from helpers import KEYS, estimator_class, state_numbers, with_number
 
 from fusion_core import native
 from fusion_core.presets import preset_params
@@ -71,9 +71,8 @@ def test_the_c_layout_holds_every_state_field_of_the_python_class(key: str) -> N
     for n, count in fields:
         sizes[n.split("[")[0]] = sizes.get(n.split("[")[0], 0) + count
     for name in cls.STATE:
-        value = np.asarray(getattr(est, "_P" if (key, name) == ("ukf", "P") else name),
-                           dtype=float)
-        assert sizes[name] == value.size, name
+        value = state_numbers(getattr(est, "_P" if (key, name) == ("ukf", "P") else name))
+        assert sizes[name] == len(value), name
 
 
 def _samples(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -157,9 +156,7 @@ def test_both_twins_refuse_the_same_values(key: str) -> None:
             state = {**snapshot, "state": dict(snapshot["state"])}
             old = state["state"][field]
             if isinstance(old, list):
-                new = list(old)
-                new[element] = value
-                state["state"][field] = new
+                state["state"][field] = with_number(old, element, value)
             else:
                 state["state"][field] = value
             try:

@@ -227,10 +227,26 @@ def has_twin(estimator: object) -> bool:
 
 
 # ----- an estimator's state and parameters, both ways ------------------------------------------
+def _leaves(value: Any) -> list[float]:
+    """A state value's numbers in order (a Measure's vectors one after the other)."""
+    if isinstance(value, (tuple, list)):
+        return [x for v in value for x in _leaves(v)]
+    return [value]
+
+
+def _shaped(template: Any, values: Any) -> Any:
+    """The numbers of the iterator values in the shape of template (named tuples by type)."""
+    if isinstance(template, tuple):
+        items = tuple(_shaped(t, values) for t in template)
+        return type(template)(*items) if hasattr(template, "_fields") else items
+    return float(next(values))
+
+
 def _field_value(cdata: Any, name: str, template: Any) -> Any:
     value = getattr(cdata, name)
     if isinstance(template, tuple):
-        return tuple(float(value[i]) for i in range(len(template)))
+        n = len(_leaves(template))
+        return _shaped(template, iter([value[i] for i in range(n)]))
     if isinstance(template, list):
         return [float(value[i]) for i in range(len(template))]
     if isinstance(template, bool):
@@ -243,7 +259,7 @@ def _field_value(cdata: Any, name: str, template: Any) -> Any:
 def _set_field(cdata: Any, name: str, value: Any) -> None:
     if isinstance(value, (tuple, list)):
         arr = getattr(cdata, name)
-        for i, v in enumerate(value):
+        for i, v in enumerate(_leaves(value)):
             arr[i] = v
     else:
         setattr(cdata, name, value)

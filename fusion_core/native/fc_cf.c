@@ -7,7 +7,7 @@ void fc_cf_configure(fc_cf *f)
 {
     const fc_cf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay);
+                      p->mount_yaw, p->sensor_delay, p->gyro_range);
     f->tau = p->tau;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_CF_GYRO_SAMPLING_POINT;
@@ -19,6 +19,7 @@ void fc_cf_configure(fc_cf *f)
                                 f->acc_tau, f->r_ref, &f->q_rotation, &f->dist_tau,
                                 &f->dist_noise);
     f->longest = p->max_correction_time;
+    fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, &f->measure);
 }
 
 fc_estimate fc_cf_estimate(const fc_cf *f)
@@ -35,13 +36,12 @@ void fc_cf_reset(fc_cf *f)
 {
     fc_base_reset(&f->base);
     f->roll = f->pitch = 0.0;
-    memset(f->acc_f, 0, sizeof f->acc_f);
+    static const double zero[3] = {0.0, 0.0, 0.0};
+    fc_measure_start(f->meas, zero, &f->measure);
     f->q_att[0] = 1.0;
     f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
     memset(f->bias, 0, sizeof f->bias);
     memset(f->rest, 0, sizeof f->rest);
-    f->acc_dist = 0.0;
-    memset(f->acc_ref, 0, sizeof f->acc_ref);
     f->last = fc_cf_estimate(f);
 }
 
@@ -51,8 +51,7 @@ FC_DEFINE_RESTORED(fc_cf)
 static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _init */
 {
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
-    memcpy(f->acc_f, a, sizeof f->acc_f);
-    memcpy(f->acc_ref, a, sizeof f->acc_ref);
+    fc_measure_start(f->meas, a, &f->measure);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
     fc_rest_start(f->rest, g, a);
 }
@@ -63,13 +62,15 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     double a[3] = {a_in[0], a_in[1], a_in[2]};
     double rest_time = p->rest_time;
     double roll, pitch, phi[3], terms[4];
-    if (rest_time > 0.0) {
+    int clipped = f->base.clipped;  /* at the gyro's rail: no rate measured (gyro_range) */
+    if (rest_time > 0.0 && !clipped) {  /* at rest the gyro reads its bias: follow it */
         double measured = f->rest[7];
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], f->bias, dt, p->rest_gyro,
                      p->rest_acc, rest_time, p->rest_bias_bound);
         if (fc_uncalibrated_first_rest(measured, f->rest, f->bias, p->rest_gyro)) {
-            fc_rest_alignment(f->rest, f->bias, &f->roll, &f->pitch, f->acc_f);
-            memcpy(f->acc_ref, f->acc_f, sizeof f->acc_ref);
+            double fa[3];
+            fc_rest_alignment(f->rest, f->bias, &f->roll, &f->pitch, fa);
+            fc_measure_align(f->meas, fa);
             if (f->quaternion) {
                 fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
             }
@@ -83,15 +84,12 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     if (f->rotating) {
         fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
-        if (f->acc_tau > 0.0) {
-            double tau_f = fc_alignment_time(f->base.n_samples, dt, f->acc_tau, &aligning);
-            if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
-                double tau_d = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt,
-                                                   tau_f, f->dist_tau, &r, f->dist_noise);
-                tau_f = aligning ? tau_f : tau_d;
+        if (f->acc_tau > 0.0) {  /* the filter and its gate use the measured vector */
+            if (clipped) {
+                fc_measure_clipped(f->meas);
             }
-            fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau_f);
-            memcpy(a, f->acc_f, sizeof a);
+            r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &aligning);
+            memcpy(a, f->meas + FC_MEAS_F, sizeof a);
         }
     }
     if (f->quaternion) {

@@ -12,16 +12,15 @@ typedef struct fc_cf {
     fc_base base;
     /* ComplementaryFilter.STATE */
     double roll, pitch;
-    double acc_f[3];
+    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
     double q_att[4];
     double bias[3];
     double rest[8];
-    double acc_dist;    /* mean square of raw - acc_ref (disturbance_time) */
-    double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;
     /* derived from params (ComplementaryFilter._configure) */
     double tau, gate_low2, gate_high2, acc_tau;
     double r_ref, q_rotation, dist_tau, dist_noise, longest;  /* ComplementaryFilter._adaptive */
+    fc_meas_constants measure;  /* ComplementaryFilter._measure */
     int trapezoid, quaternion, rotating;
 } fc_cf;
 

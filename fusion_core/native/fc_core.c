@@ -287,6 +287,106 @@ double fc_adaptive_prefilter_time(double tau, double dist, double noise)
     return tau * (excess / full);
 }
 
+/* ----- measured_vector.py ------------------------------------------------------------------ */
+#define DISTURBANCE_ATTACK 0.05 /* measured_vector.DISTURBANCE_ATTACK [s] */
+
+void fc_measure_constants(double acc_lowpass, double disturbance_time, double band, double r,
+                          fc_meas_constants *c)
+{
+    c->stage = 0.5 * acc_lowpass;
+    c->dist_tau = disturbance_time;
+    c->noise = 3.0 * r * FC_G * FC_G;
+    c->band = band;
+    c->r = r;
+}
+
+void fc_measure_start(double m[FC_MEAS_SIZE], const double a[3], const fc_meas_constants *c)
+{
+    fc_measure_align(m, a);
+    m[FC_MEAS_DIST] = m[FC_MEAS_SLOW] = m[FC_MEAS_FILL] = 0.0;
+    m[FC_MEAS_SETTLE] = 2.0 * c->stage;
+}
+
+void fc_measure_align(double m[FC_MEAS_SIZE], const double f[3])
+{
+    for (int v = 0; v < FC_MEAS_DIST; v += 3) {
+        m[v] = f[0];
+        m[v + 1] = f[1];
+        m[v + 2] = f[2];
+    }
+}
+
+static double two_stage_noise(double k)
+{
+    double a2 = (1.0 - k) * (1.0 - k);
+    double d = 1.0 - a2;
+    return k * k * k * k * (1.0 + a2) / (d * d * d);
+}
+
+static void lowpass2(double *s1, double *s, const double phi[3], const double a[3], double dt,
+                     double tau, const double terms[4])
+{
+    fc_lowpass_specific_force_terms(s1, phi, terms, a, dt, tau);
+    fc_lowpass_specific_force_terms(s, phi, terms, s1, dt, tau);
+}
+
+double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double phi[3],
+                       const double terms[4], double dt, const fc_meas_constants *c,
+                       int *filling)
+{
+    double stage = c->stage;
+    double full = 2.0 * stage;
+    if (m[FC_MEAS_SETTLE] < full) {
+        m[FC_MEAS_SETTLE] += dt;
+    }
+    *filling = m[FC_MEAS_FILL] < full;
+    if (*filling) {  /* a mean of the samples so far (each stage half the time since the start) */
+        m[FC_MEAS_FILL] += dt;
+        stage = m[FC_MEAS_FILL] < full ? 0.5 * m[FC_MEAS_FILL] : stage;
+    }
+    double r = c->r;
+    double tau = stage;
+    if (c->dist_tau > 0.0) {
+        double *ref = m + FC_MEAS_REF, *s = m + FC_MEAS_S;
+        lowpass2(m + FC_MEAS_REF1, ref, phi, a, dt, stage, terms);
+        double e0 = a[0] - ref[0], e1 = a[1] - ref[1], e2 = a[2] - ref[2];
+        m[FC_MEAS_DIST] += dt / (c->dist_tau + dt)
+                           * (e0 * e0 + e1 * e1 + e2 * e2 - m[FC_MEAS_DIST]);
+        if (!*filling) {
+            tau = stage * fc_adaptive_prefilter_time(1.0, m[FC_MEAS_DIST], c->noise);
+        }
+        lowpass2(m + FC_MEAS_S1, s, phi, a, dt, c->band, terms);
+        e0 = s[0] - ref[0];
+        e1 = s[1] - ref[1];
+        e2 = s[2] - ref[2];
+        double inst = e0 * e0 + e1 * e1 + e2 * e2;
+        double rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
+        m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
+        double excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
+        if (excess > 0.0) {
+            r += excess / (FC_G * FC_G);
+        }
+    }
+    lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, phi, a, dt, tau, terms);
+    return r;
+}
+
+int fc_measure_settled(const double m[FC_MEAS_SIZE], const fc_meas_constants *c)
+{
+    return m[FC_MEAS_SETTLE] >= 2.0 * c->stage;
+}
+
+double fc_measure_raw_noise(const double m[FC_MEAS_SIZE], const fc_meas_constants *c)
+{
+    double excess = m[FC_MEAS_DIST] - c->noise;
+    return excess > 0.0 ? c->r + excess / (FC_G * FC_G) : c->r;
+}
+
+void fc_measure_clipped(double m[FC_MEAS_SIZE])
+{
+    m[FC_MEAS_SETTLE] = 0.0;
+}
+
 void fc_rest_start(double rest[8], const double gyro[3], const double acc[3])
 {
     rest[0] = gyro[0];
@@ -408,6 +508,7 @@ void fc_mat_t_vec(const double m[9], const double v[3], double out[3])
 
 #define MAX_ACC_NORM (1000.0 * FC_G)   /* base.MAX_ACC_NORM */
 #define MIN_INIT_NORM (0.1 * FC_G)     /* base.MIN_INIT_NORM */
+#define RAIL_MARGIN 1e-3               /* base.RAIL_MARGIN */
 
 /* cos and sin of a, exact 0 and +-1 at multiples of pi/2 (mounting_matrix's cs) */
 static void right_angle_cs(double a, double *c, double *s)
@@ -439,13 +540,16 @@ void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9])
 }
 
 void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
-                       double mount_pitch, double mount_yaw, double sensor_delay)
+                       double mount_pitch, double mount_yaw, double sensor_delay,
+                       double gyro_range)
 {
     static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
     b->max_dt = max_dt;
     b->max_rate = max_rate;
     b->delay = sensor_delay;
     b->max_rate2 = pow(max_rate, 2.0);
+    b->rail = gyro_range * (1.0 - RAIL_MARGIN);
+    b->clipped = 0;
     fc_mounting_matrix(mount_roll, mount_pitch, mount_yaw, b->mounting);
     b->mounted = 0;
     for (int i = 0; i < 9; i++) {
@@ -463,7 +567,7 @@ void fc_base_reset(fc_base *b)
     b->gyro_prev[0] = b->gyro_prev[1] = b->gyro_prev[2] = 0.0;
 }
 
-fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], double dt)
+fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt)
 {
     double ax = acc[0], ay = acc[1], az = acc[2], gx = gyro[0], gy = gyro[1], gz = gyro[2];
     double w2 = gx * gx + gy * gy + gz * gz;
@@ -483,6 +587,8 @@ fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], doubl
             return FC_BAD_RATE;
         }
     }
+    double rail = b->rail;  /* on the sensor's own axes, before the mounting (gyro_range) */
+    b->clipped = !(-rail < gx && gx < rail && -rail < gy && gy < rail && -rail < gz && gz < rail);
     if (b->mounted) {
         fc_mat_vec(b->mounting, acc, acc);
         fc_mat_vec(b->mounting, gyro, gyro);

@@ -48,6 +48,8 @@ typedef struct fc_base {
     double mounting[9];
     int mounted;
     double delay;  /* sensor_delay [s] */
+    double rail;   /* gyro_range (1 - RAIL_MARGIN): a gyro axis at or beyond it is at the rail */
+    int clipped;   /* Estimator.clipped: whether this sample's gyro is at its rail */
 } fc_base;
 
 /* ----- kinematics.py ----------------------------------------------------------------------- */
@@ -109,6 +111,37 @@ double fc_correction_time(double tau, double r_ratio, double q_rotation, double 
 /* adaptive_prefilter_time: tau times the disturbance's excess over the noise, in units of
  * PREFILTER_FULL times the noise, between 0 and tau */
 double fc_adaptive_prefilter_time(double tau, double dist, double noise);
+/* ----- measured_vector.py ------------------------------------------------------------------ */
+/* Measure: the measured vector's state as one array of doubles, in the Python NamedTuple's
+ * order: each second-order low-pass as its two stages (the first stage, then the output), the
+ * disturbance statistics and the two times. */
+enum {
+    FC_MEAS_F1 = 0, FC_MEAS_F = 3, FC_MEAS_REF1 = 6, FC_MEAS_REF = 9, FC_MEAS_S1 = 12,
+    FC_MEAS_S = 15, FC_MEAS_DIST = 18, FC_MEAS_SLOW = 19, FC_MEAS_FILL = 20, FC_MEAS_SETTLE = 21,
+    FC_MEAS_SIZE = 22
+};
+/* MeasureConstants */
+typedef struct fc_meas_constants {
+    double stage, dist_tau, noise, band, r;
+} fc_meas_constants;
+void fc_measure_constants(double acc_lowpass, double disturbance_time, double band, double r,
+                          fc_meas_constants *c);
+/* measure_start: every low-pass at a, no disturbance measured, settled */
+void fc_measure_start(double m[FC_MEAS_SIZE], const double a[3], const fc_meas_constants *c);
+/* measure_step: one sample a; returns the measurement noise r [rad^2], *filling whether the
+ * vector is still filling */
+double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double phi[3],
+                       const double terms[4], double dt, const fc_meas_constants *c,
+                       int *filling);
+/* Measure.settled */
+int fc_measure_settled(const double m[FC_MEAS_SIZE], const fc_meas_constants *c);
+/* raw_noise */
+double fc_measure_raw_noise(const double m[FC_MEAS_SIZE], const fc_meas_constants *c);
+/* measure_clipped */
+void fc_measure_clipped(double m[FC_MEAS_SIZE]);
+/* every vector of the low-passes set to f (a rest alignment) */
+void fc_measure_align(double m[FC_MEAS_SIZE], const double f[3]);
+
 /* The rest detector's state at the first sample: its means start at that sample, quiet 0, the
  * bias not measured yet. */
 void fc_rest_start(double rest[8], const double gyro[3], const double acc[3]);
@@ -132,12 +165,13 @@ void fc_mat_t_vec(const double m[9], const double v[3], double out[3]);
 /* ----- base.py ----------------------------------------------------------------------------- */
 void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9]);
 void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
-                       double mount_pitch, double mount_yaw, double sensor_delay);
+                       double mount_pitch, double mount_yaw, double sensor_delay,
+                       double gyro_range);
 void fc_base_reset(fc_base *b);
 /* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
  * was), turns it into the filter frame (mounting) and takes an absurd accelerometer reading as
  * none. Returns FC_OK with acc and gyro rewritten in place, or the rejection. */
-fc_status fc_base_prepare(const fc_base *b, double acc[3], double gyro[3], double dt);
+fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt);
 /* Estimator.output: e as the outputs give it, its roll and pitch turned ahead over sensor_delay
  * with the last sample's rate minus e's bias (fc_roll_pitch_ahead) once initialised. */
 fc_estimate fc_base_output(const fc_base *b, fc_estimate e);

@@ -62,7 +62,7 @@ void fc_kf_configure(fc_kf *f)
 {
     const fc_kf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay);
+                      p->mount_yaw, p->sensor_delay, p->gyro_range);
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;
@@ -73,6 +73,10 @@ void fc_kf_configure(fc_kf *f)
     f->acc_tau = p->acc_lowpass;
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, f->r, &f->q_rotation, &f->dist_tau, &f->dist_noise);
+    fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, &f->measure);
+    f->longest2 = pow(p->max_correction_time, 2.0);
+    f->rail_var = pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
+    f->q_step = f->q_angle;
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
@@ -111,15 +115,15 @@ void fc_kf_reset(fc_kf *f)
     memset(f->P_roll, 0, sizeof f->P_roll);
     memset(f->P_pitch, 0, sizeof f->P_pitch);
     f->bias_z = f->P_z = 0.0;
-    memset(f->acc_f, 0, sizeof f->acc_f);
-    memset(f->acc_ref, 0, sizeof f->acc_ref);
+    static const double zero[3] = {0.0, 0.0, 0.0};
+    fc_measure_start(f->meas, zero, &f->measure);
     memset(f->rest, 0, sizeof f->rest);
     f->q_att[0] = 1.0;
     f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
     f->gain_roll[0] = f->gain_roll[1] = f->gain_pitch[0] = f->gain_pitch[1] = 0.0;
     f->face = 0;
     f->r_step = f->r;
-    f->acc_dist = 0.0;
+    f->q_step = f->q_angle;
     f->last = fc_kf_estimate(f);
 }
 
@@ -137,13 +141,18 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
         }
     }
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
-    memcpy(f->acc_f, a, sizeof a);
-    memcpy(f->acc_ref, a, sizeof a);
+    fc_measure_start(f->meas, a, &f->measure);
     fc_rest_start(f->rest, g, a);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
     double p_b = pow(f->params.init_bias_std, 2.0);
     if (p_b > 0.0) {
-        f->P_roll[0] = f->r;
+        /* a sample whose norm is off g by d carries at least d of linear acceleration */
+        double p_a = f->r;
+        if (f->acc_tau > 0.0) {
+            double d = (sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) - FC_G) / FC_G;
+            p_a += d * d;
+        }
+        f->P_roll[0] = p_a;
         f->P_roll[1] = f->P_roll[2] = 0.0;
         f->P_roll[3] = p_b;
         memcpy(f->P_pitch, f->P_roll, sizeof f->P_roll);
@@ -186,6 +195,7 @@ void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_i
         double wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
         q_angle += f->q_rotation * (wx * wx + wy * wy + wz * wz);
     }
+    f->q_step = q_angle;
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
     predict_covariance(P, dt, q_angle, f->q_bias, f->P_roll);
@@ -254,8 +264,15 @@ int fc_kf_accel_trusted(const fc_kf *f, double norm2)
 static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], double dt)
 {
     double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    double measured = f->rest[7];
     fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], b, dt, f->rest_gyro, f->rest_acc,
                  f->rest_time, f->rest_bias_bound);
+    if (f->acc_tau > 0.0 && measured == 0.0 && f->rest[7] != 0.0) {
+        /* the first rest: the measured vector starts again from the rest's mean */
+        fc_measure_align(f->meas, f->rest + 3);
+        f->meas[FC_MEAS_SLOW] = 0.0;
+        fc_accel_roll_pitch(f->rest[3], f->rest[4], f->rest[5], &f->roll, &f->pitch);
+    }
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
         double r = f->gyro_var / dt;
@@ -279,21 +296,39 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
         have_phi = 1;
     }
     fc_kf_propagate(f, g, dt, have_phi ? phi : NULL, have_phi ? terms : NULL);
+    int clipped = f->base.clipped;  /* at the gyro's rail: the rate beyond it is unknown */
+    if (clipped) {
+        double grow = f->rail_var * dt * dt;
+        int shared = same4(f->P_pitch, f->P_roll);
+        f->P_roll[0] = f->P_roll[0] + grow;
+        if (shared) {
+            memcpy(f->P_pitch, f->P_roll, sizeof f->P_roll);
+        } else {
+            f->P_pitch[0] = f->P_pitch[0] + grow;
+        }
+    }
     double pred_roll = f->roll, pred_pitch = f->pitch;
     double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2;
-    if (f->rest_time > 0.0) {
+    /* the raw sample, before the pre-filter (bias_gate); never a sample at the rail */
+    int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
+    if (f->rest_time > 0.0 && !clipped) {
         zero_rate_update(f, a, g, dt);
     }
     if (f->acc_tau > 0.0) {
-        double tau = f->acc_tau;
-        if (f->dist_tau > 0.0) {  /* the measured disturbance: this step's R and pre-filter */
-            f->r_step = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
-            tau = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt, tau,
-                                      f->dist_tau, &f->r_step, f->dist_noise);
+        int filling;
+        if (clipped) {
+            fc_measure_clipped(f->meas);
         }
-        fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau);
-        memcpy(a, f->acc_f, sizeof a);
+        double r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
+        /* one sample's variance (or the papers' R_loop_time rule) plus the disturbance that
+         * reaches the measured vector, up to the longest correction time */
+        double base = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
+        r = base + (r - f->measure.r);
+        double cap = f->q_step * f->longest2 / dt;
+        f->r_step = r < cap ? r : (cap > base ? cap : base);
+        /* no bias from a vector that is filling or holds turns the gyro did not measure */
+        learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
+        memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
@@ -326,11 +361,11 @@ static void switch_face(fc_kf *f)
     f->bias_x = b2[0];
     f->bias_y = b2[1];
     f->bias_z = b2[2];
-    double acc_f[3];
-    TURN(f->acc_f, acc_f);
-    memcpy(f->acc_f, acc_f, sizeof acc_f);
-    TURN(f->acc_ref, acc_f);
-    memcpy(f->acc_ref, acc_f, sizeof acc_f);
+    for (int v = 0; v < FC_MEAS_DIST; v += 3) {
+        double turned[3];
+        TURN(f->meas + v, turned);
+        memcpy(f->meas + v, turned, sizeof turned);
+    }
     double w[3] = {f->rest[0], f->rest[1], f->rest[2]}, sf[3] = {f->rest[3], f->rest[4], f->rest[5]};
     double w2[3], sf2[3];
     TURN(w, w2);

@@ -14,18 +14,19 @@ typedef struct fc_kf {
     double roll, pitch, bias_x, bias_y;
     double P_roll[4], P_pitch[4];   /* [P00, P01, P10, P11] of each axis */
     double bias_z, P_z;
-    double acc_f[3];
+    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
     double rest[8];
     double q_att[4];
     int face;
     double gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
     fc_estimate last;
     double r_step;  /* this step's measurement variance (R_loop_time, disturbance_time) */
-    double acc_dist;  /* mean square of raw - acc_ref (disturbance_time) */
-    double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
+    double q_step;  /* this step's angle process noise (propagate) */
     /* derived from params (AngleBiasKalmanFilter._configure) */
     double q_angle, q_bias, r, r_loop, gate_low2, gate_high2, acc_tau;
     double q_rotation, dist_tau, dist_noise;  /* AngleBiasKalmanFilter._adaptive */
+    fc_meas_constants measure;  /* AngleBiasKalmanFilter._measure */
+    double longest2, rail_var;
     double rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;
     double bias_lo2, bias_hi2;
     int trapezoid, quaternion, faces, options;

@@ -43,7 +43,7 @@ void fc_mgcf_configure(fc_mgcf *f)
 {
     const fc_mgcf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay);
+                      p->mount_yaw, p->sensor_delay, p->gyro_range);
     f->w0_fixed = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;
@@ -58,6 +58,7 @@ void fc_mgcf_configure(fc_mgcf *f)
                                 f->acc_tau, f->r_ref, &f->q_rotation, &f->dist_tau,
                                 &f->dist_noise);
     f->longest = p->max_correction_time;
+    fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, &f->measure);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
@@ -76,10 +77,9 @@ void fc_mgcf_reset(fc_mgcf *f)
     f->q[1] = f->q[2] = f->q[3] = 0.0;
     memset(f->bias, 0, sizeof f->bias);
     f->w0_now = 0.0;
-    memset(f->acc_f, 0, sizeof f->acc_f);
+    static const double zero[3] = {0.0, 0.0, 0.0};
+    fc_measure_start(f->meas, zero, &f->measure);
     memset(f->rest, 0, sizeof f->rest);
-    f->acc_dist = 0.0;
-    memset(f->acc_ref, 0, sizeof f->acc_ref);
     f->last = fc_mgcf_estimate(f);
 }
 
@@ -91,8 +91,7 @@ static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _
     double roll, pitch;
     fc_accel_roll_pitch(a[0], a[1], a[2], &roll, &pitch);
     fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, f->q);
-    memcpy(f->acc_f, a, sizeof f->acc_f);
-    memcpy(f->acc_ref, a, sizeof f->acc_ref);
+    fc_measure_start(f->meas, a, &f->measure);
     fc_rest_start(f->rest, g, a);
 }
 
@@ -102,15 +101,16 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     double gx = g[0], gy = g[1], gz = g[2];
     double r = f->r_ref;
     int aligning = 0;
+    int clipped = f->base.clipped;
     if (f->options) {  /* _real_sensor_options */
-        if (f->rest_time > 0.0) {
+        if (f->rest_time > 0.0 && !clipped) {
             double measured = f->rest[7];
             fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, f->bias, dt, f->rest_gyro, f->rest_acc,
                          f->rest_time, f->rest_bias_bound);
             if (fc_uncalibrated_first_rest(measured, f->rest, f->bias, f->rest_gyro)) {
-                double roll, pitch;
-                fc_rest_alignment(f->rest, f->bias, &roll, &pitch, f->acc_f);
-                memcpy(f->acc_ref, f->acc_f, sizeof f->acc_ref);
+                double roll, pitch, fa[3];
+                fc_rest_alignment(f->rest, f->bias, &roll, &pitch, fa);
+                fc_measure_align(f->meas, fa);
                 fc_quat_from_roll_pitch(roll, pitch, f->q);
             } else if (f->rest[6] >= f->rest_time) {
                 fc_bias_at_rest(f->bias, gx, gy, gz, dt, f->rest_time);
@@ -119,17 +119,15 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         if (f->acc_tau > 0.0) {
             double phi[3], terms[4];
             fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
-            fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both pre-filters */
-            double tau_f = fc_alignment_time(f->base.n_samples, dt, f->acc_tau, &aligning);
-            if (f->dist_tau > 0.0) {  /* the adaptive noise: against the full pre-filter */
-                double tau_d = fc_disturbance_step(f->acc_ref, &f->acc_dist, a_in, phi, terms,
-                                                   dt, tau_f, f->dist_tau, &r, f->dist_noise);
-                tau_f = aligning ? tau_f : tau_d;
+            fc_rotvec_terms(phi[0], phi[1], phi[2], terms);
+            if (clipped) {
+                fc_measure_clipped(f->meas);
             }
-            fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a_in, dt, tau_f);
-            ax = f->acc_f[0];
-            ay = f->acc_f[1];
-            az = f->acc_f[2];
+            fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, &aligning);
+            ax = f->meas[FC_MEAS_F];
+            ay = f->meas[FC_MEAS_F + 1];
+            az = f->meas[FC_MEAS_F + 2];
+            r = fc_measure_raw_noise(f->meas, &f->measure);
         }
     }
     double norm = sqrt(ax * ax + ay * ay + az * az);
@@ -174,13 +172,17 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         ex = ny * v[2] - nz * v[1];
         ey = nz * v[0] - nx * v[2];
         ez = nx * v[1] - ny * v[0];
-        double ki_dt = w0 * w0 * dt;
-        bx = bx - ki_dt * ex;
-        by = by - ki_dt * ey;
-        bz = bz - ki_dt * ez;
-        f->bias[0] = bx;
-        f->bias[1] = by;
-        f->bias[2] = bz;
+        /* none from a gyro sample at its rail, nor from a vector still holding its turns */
+        if (!f->options || (!clipped && (f->acc_tau == 0.0 ||
+                                         fc_measure_settled(f->meas, &f->measure)))) {
+            double ki_dt = w0 * w0 * dt;
+            bx = bx - ki_dt * ex;
+            by = by - ki_dt * ey;
+            bz = bz - ki_dt * ez;
+            f->bias[0] = bx;
+            f->bias[1] = by;
+            f->bias[2] = bz;
+        }
     }
     if (!f->trapezoid) {
         quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz, dt);

@@ -14,14 +14,13 @@ typedef struct fc_mgcf {
     double q[4];
     double bias[3];
     double w0_now;
-    double acc_f[3];
+    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
     double rest[8];
-    double acc_dist;    /* mean square of raw - acc_ref (disturbance_time) */
-    double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
     double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
     double r_ref, q_rotation, dist_tau, dist_noise, longest;  /* _adaptive */
+    fc_meas_constants measure;  /* _measure */
     int trapezoid, options;
 } fc_mgcf;
 

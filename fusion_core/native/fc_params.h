@@ -33,11 +33,13 @@ typedef struct fc_cf_params {
     double scale_time;           /* [0.0, 1000000.0] [s] */
     double disturbance_time;     /* [0.0, 1000000.0] [s] */
     double max_correction_time;  /* [0.0, 1000000.0] [s] */
+    double slow_band_time;       /* [0.01, 10.0] [s] */
     double max_dt;               /* (0.0, 1000000.0] [s] */
     double max_rate;             /* (0.0, 10000.0] [rad/s] */
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_cf_params;
 
@@ -47,7 +49,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->tau = 1.0;
     p->gate_low = 0.5;
     p->gate_high = 2.0;
-    p->acc_lowpass = 1.0;
+    p->acc_lowpass = 1.5;
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
@@ -59,11 +61,13 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
+    p->slow_band_time = 0.15;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
 
@@ -90,11 +94,13 @@ typedef struct fc_mgcf_params {
     double scale_time;           /* [0.0, 1000000.0] [s] */
     double disturbance_time;     /* [0.0, 1000000.0] [s] */
     double max_correction_time;  /* [0.0, 1000000.0] [s] */
+    double slow_band_time;       /* [0.01, 10.0] [s] */
     double max_dt;               /* (0.0, 1000000.0] [s] */
     double max_rate;             /* (0.0, 10000.0] [rad/s] */
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_mgcf_params;
 
@@ -115,11 +121,13 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
+    p->slow_band_time = 0.15;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
 
@@ -133,33 +141,36 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 #define FC_KF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_kf_params {
-    double Q_angle;           /* [0.0, 1.0] [rad2/s] */
-    double Q_bias;            /* [0.0, 1.0] [rad2/s3] */
-    double R_measure;         /* (0.0, 100.0] [rad2] */
-    double R_loop_time;       /* [0.0, 1000000.0] [s] */
-    double gyro_scale_std;    /* [0.0, 0.5] */
-    double scale_time;        /* [0.0, 1000000.0] [s] */
-    double disturbance_time;  /* [0.0, 1000000.0] [s] */
-    double gate_low;          /* (0.0, 1.0] */
-    double gate_high;         /* [1.0, 1000.0] */
-    double acc_lowpass;       /* [0.0, 1000000.0] [s] */
-    double rest_time;         /* [0.0, 1000000.0] [s] */
-    double rest_gyro;         /* (0.0, 10000.0] [rad/s] */
-    double rest_acc;          /* (0.0, 10000.0] [m/s2] */
-    double rest_bias_bound;   /* [0.0, 10000.0] [rad/s] */
-    double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
-    double init_bias_std;     /* [0.0, 10000.0] [rad/s] */
-    double bias_gate;         /* [0.0, 1000.0] */
-    double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
-    int propagation;          /* one of 'euler', 'quaternion' */
-    int tilt_axes;            /* one of 'body', 'nearest_face' */
-    int gyro_sampling;        /* one of 'point', 'mean' */
-    double max_dt;            /* (0.0, 1000000.0] [s] */
-    double max_rate;          /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double sensor_delay;      /* [0.0, 0.1] [s] */
+    double Q_angle;              /* [0.0, 1.0] [rad2/s] */
+    double Q_bias;               /* [0.0, 1.0] [rad2/s3] */
+    double R_measure;            /* (0.0, 100.0] [rad2] */
+    double R_loop_time;          /* [0.0, 1000000.0] [s] */
+    double gyro_scale_std;       /* [0.0, 0.5] */
+    double scale_time;           /* [0.0, 1000000.0] [s] */
+    double disturbance_time;     /* [0.0, 1000000.0] [s] */
+    double gate_low;             /* (0.0, 1.0] */
+    double gate_high;            /* [1.0, 1000.0] */
+    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    double rest_time;            /* [0.0, 1000000.0] [s] */
+    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
+    double gyro_psd;             /* (0.0, 1.0] [rad2/s] */
+    double init_bias_std;        /* [0.0, 10000.0] [rad/s] */
+    double bias_gate;            /* [0.0, 1000.0] */
+    double bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
+    int propagation;             /* one of 'euler', 'quaternion' */
+    int tilt_axes;               /* one of 'body', 'nearest_face' */
+    int gyro_sampling;           /* one of 'point', 'mean' */
+    double slow_band_time;       /* [0.01, 10.0] [s] */
+    double max_correction_time;  /* [0.0, 1000000.0] [s] */
+    double max_dt;               /* (0.0, 1000000.0] [s] */
+    double max_rate;             /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
+    double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_kf_params;
 
 /* The defaults: AngleBiasKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -174,23 +185,26 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->disturbance_time = 1.0;
     p->gate_low = 0.5;
     p->gate_high = 2.0;
-    p->acc_lowpass = 1.0;
+    p->acc_lowpass = 1.5;
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
     p->rest_bias_bound = 0.3490658503988659;
     p->gyro_psd = 1.949551486634935e-08;
-    p->init_bias_std = 0.017453292519943295;
+    p->init_bias_std = 0.005235987755982988;
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;
     p->propagation = FC_KF_PROPAGATION_QUATERNION;
     p->tilt_axes = FC_KF_TILT_AXES_NEAREST_FACE;
     p->gyro_sampling = FC_KF_GYRO_SAMPLING_POINT;
+    p->slow_band_time = 0.15;
+    p->max_correction_time = 30.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
 
@@ -200,33 +214,36 @@ static inline void fc_kf_params_default(fc_kf_params *p)
 #define FC_UKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_ukf_params {
-    double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
-    double bias_psd;          /* [0.0, 1.0] [rad2/s3] */
-    double acc_noise;         /* [1e-06, 10.0] */
-    double norm_noise;        /* [0.0, 10.0] */
-    double acc_gate;          /* (0.0, 1000.0] */
-    double init_bias_std;     /* (0.0, 10000.0] [rad/s] */
-    double alpha;             /* [0.0001, 1.0] */
-    double beta;              /* [0.0, 1000.0] */
-    double kappa;             /* (-5.0, 1000.0] */
-    double gyro_scale_std;    /* [0.0, 0.5] */
-    double scale_time;        /* [0.0, 1000000.0] [s] */
-    double disturbance_time;  /* [0.0, 1000000.0] [s] */
-    int gyro_sampling;        /* one of 'point', 'mean' */
-    double acc_lowpass;       /* [0.0, 1000000.0] [s] */
-    double rest_time;         /* [0.0, 1000000.0] [s] */
-    double rest_gyro;         /* (0.0, 10000.0] [rad/s] */
-    double rest_acc;          /* (0.0, 10000.0] [m/s2] */
-    double rest_bias_bound;   /* [0.0, 10000.0] [rad/s] */
-    double zaru_psd;          /* (0.0, 1.0] [rad2/s] */
-    double bias_gate;         /* [0.0, 1000.0] */
-    double bias_innovation;   /* (0.0, 3.141592653589793] [rad] */
-    double max_dt;            /* (0.0, 1000000.0] [s] */
-    double max_rate;          /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double sensor_delay;      /* [0.0, 0.1] [s] */
+    double gyro_psd;             /* (0.0, 1.0] [rad2/s] */
+    double bias_psd;             /* [0.0, 1.0] [rad2/s3] */
+    double acc_noise;            /* [1e-06, 10.0] */
+    double norm_noise;           /* [0.0, 10.0] */
+    double acc_gate;             /* (0.0, 1000.0] */
+    double init_bias_std;        /* (0.0, 10000.0] [rad/s] */
+    double alpha;                /* [0.0001, 1.0] */
+    double beta;                 /* [0.0, 1000.0] */
+    double kappa;                /* (-5.0, 1000.0] */
+    double gyro_scale_std;       /* [0.0, 0.5] */
+    double scale_time;           /* [0.0, 1000000.0] [s] */
+    double disturbance_time;     /* [0.0, 1000000.0] [s] */
+    int gyro_sampling;           /* one of 'point', 'mean' */
+    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    double rest_time;            /* [0.0, 1000000.0] [s] */
+    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
+    double zaru_psd;             /* (0.0, 1.0] [rad2/s] */
+    double bias_gate;            /* [0.0, 1000.0] */
+    double bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
+    double slow_band_time;       /* [0.01, 10.0] [s] */
+    double max_correction_time;  /* [0.0, 1000000.0] [s] */
+    double max_dt;               /* (0.0, 1000000.0] [s] */
+    double max_rate;             /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
+    double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_ukf_params;
 
 /* The defaults: UnscentedKalmanFilter.PARAMS (for an estimator, the recommended preset). */
@@ -237,7 +254,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->acc_noise = 0.005;
     p->norm_noise = 0.0;
     p->acc_gate = 1.0;
-    p->init_bias_std = 0.017453292519943295;
+    p->init_bias_std = 0.005235987755982988;
     p->alpha = 1.0;
     p->beta = 2.0;
     p->kappa = 0.0;
@@ -245,7 +262,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
     p->gyro_sampling = FC_UKF_GYRO_SAMPLING_POINT;
-    p->acc_lowpass = 1.0;
+    p->acc_lowpass = 1.5;
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
@@ -253,11 +270,14 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->zaru_psd = 1.949551486634935e-08;
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;
+    p->slow_band_time = 0.15;
+    p->max_correction_time = 30.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
 
@@ -301,6 +321,7 @@ typedef struct fc_poskf_params {
     double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double gyro_range;        /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_poskf_params;
 
@@ -334,6 +355,7 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
 

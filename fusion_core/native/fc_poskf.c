@@ -128,7 +128,7 @@ void fc_poskf_configure(fc_poskf *f)
 {
     const fc_poskf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay);
+                      p->mount_yaw, p->sensor_delay, p->gyro_range);
     /* the tilt stage: the papers' kf options (TILT_FIXED) and the TILT_PARAMS given */
     fc_kf_params tp;
     fc_kf_params_default(&tp);

@@ -23,14 +23,13 @@ static const fc_field CF_FIELDS[] = {
     {"base.gyro_prev", offsetof(fc_cf, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
     {"roll", offsetof(fc_cf, roll), FC_DOUBLE, 1, FC_CHECK_ANGLE, 0.0},
     {"pitch", offsetof(fc_cf, pitch), FC_DOUBLE, 1, FC_CHECK_HALF_ANGLE, 0.0},
-    {"acc_f", offsetof(fc_cf, acc_f), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"meas[0:18]", offsetof(fc_cf, meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
+    {"meas[18:22]", offsetof(fc_cf, meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
     {"q_att", offsetof(fc_cf, q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"bias", offsetof(fc_cf, bias), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
     {"rest[0:6]", offsetof(fc_cf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_cf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_cf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"acc_dist", offsetof(fc_cf, acc_dist), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"acc_ref", offsetof(fc_cf, acc_ref), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_CF_LAYOUT = {"fc_cf", CF_FIELDS, (int)(sizeof CF_FIELDS / sizeof CF_FIELDS[0])};
 
@@ -42,12 +41,11 @@ static const fc_field MGCF_FIELDS[] = {
     {"q", offsetof(fc_mgcf, q), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"bias", offsetof(fc_mgcf, bias), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
     {"w0_now", offsetof(fc_mgcf, w0_now), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"acc_f", offsetof(fc_mgcf, acc_f), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"meas[0:18]", offsetof(fc_mgcf, meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
+    {"meas[18:22]", offsetof(fc_mgcf, meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
     {"rest[0:6]", offsetof(fc_mgcf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_mgcf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_mgcf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"acc_dist", offsetof(fc_mgcf, acc_dist), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"acc_ref", offsetof(fc_mgcf, acc_ref), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_MGCF_LAYOUT = {"fc_mgcf", MGCF_FIELDS, (int)(sizeof MGCF_FIELDS / sizeof MGCF_FIELDS[0])};
 
@@ -64,14 +62,13 @@ static const fc_field KF_FIELDS[] = {
     {"P_pitch", offsetof(fc_kf, P_pitch), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
     {"bias_z", offsetof(fc_kf, bias_z), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
     {"P_z", offsetof(fc_kf, P_z), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"acc_f", offsetof(fc_kf, acc_f), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"meas[0:18]", offsetof(fc_kf, meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
+    {"meas[18:22]", offsetof(fc_kf, meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
     {"rest[0:6]", offsetof(fc_kf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_kf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_kf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
     {"q_att", offsetof(fc_kf, q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"face", offsetof(fc_kf, face), FC_INT, 1, FC_CHECK_INDEX, 6.0},
-    {"acc_dist", offsetof(fc_kf, acc_dist), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"acc_ref", offsetof(fc_kf, acc_ref), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_KF_LAYOUT = {"fc_kf", KF_FIELDS, (int)(sizeof KF_FIELDS / sizeof KF_FIELDS[0])};
 
@@ -83,12 +80,11 @@ static const fc_field UKF_FIELDS[] = {
     {"x[0:3]", offsetof(fc_ukf, x[0]), FC_DOUBLE, 3, FC_CHECK_UNIT, 0.0},
     {"x[3:6]", offsetof(fc_ukf, x[3]), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
     {"P", offsetof(fc_ukf, P), FC_DOUBLE, 21, FC_CHECK_COV_LOWER, 0.0},
-    {"acc_f", offsetof(fc_ukf, acc_f), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"meas[0:18]", offsetof(fc_ukf, meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
+    {"meas[18:22]", offsetof(fc_ukf, meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
     {"rest[0:6]", offsetof(fc_ukf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_ukf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_ukf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"acc_dist", offsetof(fc_ukf, acc_dist), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"acc_ref", offsetof(fc_ukf, acc_ref), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_UKF_LAYOUT = {"fc_ukf", UKF_FIELDS, (int)(sizeof UKF_FIELDS / sizeof UKF_FIELDS[0])};
 
@@ -119,14 +115,13 @@ static const fc_field POSKF_FIELDS[] = {
     {"tilt.P_pitch", offsetof(fc_poskf, tilt.P_pitch), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
     {"tilt.bias_z", offsetof(fc_poskf, tilt.bias_z), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
     {"tilt.P_z", offsetof(fc_poskf, tilt.P_z), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"tilt.acc_f", offsetof(fc_poskf, tilt.acc_f), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"tilt.meas[0:18]", offsetof(fc_poskf, tilt.meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
+    {"tilt.meas[18:22]", offsetof(fc_poskf, tilt.meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
     {"tilt.rest[0:6]", offsetof(fc_poskf, tilt.rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"tilt.rest[6]", offsetof(fc_poskf, tilt.rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"tilt.rest[7]", offsetof(fc_poskf, tilt.rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
     {"tilt.q_att", offsetof(fc_poskf, tilt.q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"tilt.face", offsetof(fc_poskf, tilt.face), FC_INT, 1, FC_CHECK_INDEX, 6.0},
-    {"tilt.acc_dist", offsetof(fc_poskf, tilt.acc_dist), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"tilt.acc_ref", offsetof(fc_poskf, tilt.acc_ref), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
     {"att.base.initialized", offsetof(fc_poskf, att.base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"att.base.n_samples", offsetof(fc_poskf, att.base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
     {"att.base.n_rejected", offsetof(fc_poskf, att.base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
@@ -139,14 +134,13 @@ static const fc_field POSKF_FIELDS[] = {
     {"att.P_pitch", offsetof(fc_poskf, att.P_pitch), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
     {"att.bias_z", offsetof(fc_poskf, att.bias_z), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
     {"att.P_z", offsetof(fc_poskf, att.P_z), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"att.acc_f", offsetof(fc_poskf, att.acc_f), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"att.meas[0:18]", offsetof(fc_poskf, att.meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
+    {"att.meas[18:22]", offsetof(fc_poskf, att.meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
     {"att.rest[0:6]", offsetof(fc_poskf, att.rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"att.rest[6]", offsetof(fc_poskf, att.rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"att.rest[7]", offsetof(fc_poskf, att.rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
     {"att.q_att", offsetof(fc_poskf, att.q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"att.face", offsetof(fc_poskf, att.face), FC_INT, 1, FC_CHECK_INDEX, 6.0},
-    {"att.acc_dist", offsetof(fc_poskf, att.acc_dist), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"att.acc_ref", offsetof(fc_poskf, att.acc_ref), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_POSKF_LAYOUT = {"fc_poskf", POSKF_FIELDS, (int)(sizeof POSKF_FIELDS / sizeof POSKF_FIELDS[0])};
 

@@ -312,7 +312,7 @@ void fc_ukf_configure(fc_ukf *f)
 {
     const fc_ukf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay);
+                      p->mount_yaw, p->sensor_delay, p->gyro_range);
     double alpha2 = pow(p->alpha, 2.0);
     double lam = alpha2 * (N_STATE + p->kappa) - N_STATE;
     f->gamma = sqrt(N_STATE + lam);
@@ -325,6 +325,9 @@ void fc_ukf_configure(fc_ukf *f)
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 p->acc_lowpass, f->r_acc, &f->q_rotation, &f->dist_tau,
                                 &f->dist_noise);
+    fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc, &f->measure);
+    f->longest2 = pow(p->max_correction_time, 2.0);
+    f->rail_var = pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->gate = p->acc_gate;
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
     f->options = p->acc_lowpass > 0.0 || p->rest_time > 0.0;
@@ -349,10 +352,9 @@ void fc_ukf_reset(fc_ukf *f)
     const double x0[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
     memcpy(f->x, x0, sizeof x0);
     memset(f->P, 0, sizeof f->P);
-    memset(f->acc_f, 0, sizeof f->acc_f);
-    memset(f->acc_ref, 0, sizeof f->acc_ref);
+    static const double zero[3] = {0.0, 0.0, 0.0};
+    fc_measure_start(f->meas, zero, &f->measure);
     memset(f->rest, 0, sizeof f->rest);
-    f->acc_dist = 0.0;
     f->last = fc_ukf_estimate(f);
 }
 
@@ -366,12 +368,17 @@ static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _i
     f->x[1] = a[1] / n;
     f->x[2] = a[2] / n;
     f->x[3] = f->x[4] = f->x[5] = 0.0;
-    double p_x = pow(f->params.acc_noise, 2.0), p_b = pow(f->params.init_bias_std, 2.0);
+    /* a sample whose norm is off g by d carries at least d of linear acceleration */
+    double p_x = pow(f->params.acc_noise, 2.0);
+    if (f->params.acc_lowpass > 0.0) {
+        double d = (n - FC_G) / FC_G;
+        p_x += d * d;
+    }
+    double p_b = pow(f->params.init_bias_std, 2.0);
     memset(f->P, 0, sizeof f->P);
     f->P[0] = f->P[2] = f->P[5] = p_x;
     f->P[9] = f->P[14] = f->P[20] = p_b;
-    memcpy(f->acc_f, a, sizeof f->acc_f);
-    memcpy(f->acc_ref, a, sizeof f->acc_ref);
+    fc_measure_start(f->meas, a, &f->measure);
     fc_rest_start(f->rest, g, a);
 }
 
@@ -425,7 +432,7 @@ static void zero_rate_update(fc_ukf *f, const double z[3], double r)
 
 /* _filter_update: one sample of the paper's UKF (eq. 14-17) */
 static void filter_update(fc_ukf *f, double ax, double ay, double az, const double g[3],
-                          double dt, int learn_bias, double r)
+                          double dt, int learn_bias, double r, int capped)
 {
     double X0 = f->x[0], X1 = f->x[1], X2 = f->x[2], b0 = f->x[3], b1 = f->x[4], b2 = f->x[5];
     const double *P = f->P;
@@ -539,6 +546,9 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
         double wx = gx - b0, wy = gy - b1, wz = gz - b2;
         q_gyro += f->q_rotation * (wx * wx + wy * wy + wz * wz);
     }
+    if (f->base.clipped) {  /* at the rail the rate beyond it is unknown (gyro_range) */
+        q_gyro += f->rail_var * dt;
+    }
     double qg = q_gyro * dt, qb = f->q_bias * dt;
     double Pn[21] = {
         a00 + qg * (1.0 - h0 * h0),
@@ -558,6 +568,10 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
         double sv2 = w * ev2 + w_mu * mu2 * mu_v;
         /* no pseudo-measurement: with its sums 0, s33 = 1 and a zero innovation the last row
          * is independent of the others and changes nothing (exactly) */
+        if (capped) {  /* the longest correction time: r at most q T^2 / dt */
+            double cap = q_gyro * f->longest2 / dt;
+            r = r < cap ? r : (cap > f->r_acc ? cap : f->r_acc);
+        }
         double s33 = 1.0, y3 = 0.0;
         if (norm_row) {
             s33 = w * vv + w_mu * mu_v * mu_v + f->r_norm;
@@ -596,26 +610,41 @@ static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
     double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2;
     if (!f->options) {
-        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);
+        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0);
         return;
     }
+    int clipped = f->base.clipped;
+    learn_bias = learn_bias && !clipped;  /* never a sample at the rail */
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
         double phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
         fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
-        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both pre-filters */
-        double tau = p->acc_lowpass, r = f->r_acc;
-        if (f->dist_tau > 0.0) {  /* building_blocks.ADAPTIVE_NOISE_PARAMS */
-            tau = fc_disturbance_step(f->acc_ref, &f->acc_dist, a, phi, terms, dt, tau,
-                                      f->dist_tau, &r, f->dist_noise);
+        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for the low-passes */
+        int filling;
+        if (clipped) {
+            fc_measure_clipped(f->meas);
         }
-        fc_lowpass_specific_force_terms(f->acc_f, phi, terms, a, dt, tau);
-        filter_update(f, f->acc_f[0], f->acc_f[1], f->acc_f[2], g, dt, learn_bias, r);
+        double r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
+        /* no bias from a vector that is filling or holds turns the gyro did not measure */
+        learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
+        const double *m = f->meas + FC_MEAS_F;
+        filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1);
     } else {
-        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc);
+        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0);
     }
-    if (p->rest_time > 0.0) {
+    if (p->rest_time > 0.0 && !clipped) {
+        double measured = f->rest[7];
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], &f->x[3], dt, p->rest_gyro,
                      p->rest_acc, p->rest_time, p->rest_bias_bound);
+        if (p->acc_lowpass > 0.0 && measured == 0.0 && f->rest[7] != 0.0) {
+            /* the first rest: the measured vector starts again from the rest's mean */
+            const double *m = f->rest + 3;
+            fc_measure_align(f->meas, m);
+            f->meas[FC_MEAS_SLOW] = 0.0;
+            double n = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            f->x[0] = m[0] / n;
+            f->x[1] = m[1] / n;
+            f->x[2] = m[2] / n;
+        }
         if (f->rest[6] >= p->rest_time) {
             zero_rate_update(f, g, p->zaru_psd / dt);
         }

@@ -14,14 +14,14 @@ typedef struct fc_ukf {
     /* UnscentedKalmanFilter.STATE */
     double x[6];      /* X (the gravity direction, 3), b (the gyro bias, 3) */
     double P[21];     /* the covariance's lower triangle, row by row */
-    double acc_f[3];
+    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
     double rest[8];
-    double acc_dist;  /* mean square of raw - acc_ref (disturbance_time) */
-    double acc_ref[3];  /* the specific force pre-filtered with the full acc_lowpass */
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
     double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
     double q_rotation, dist_tau, dist_noise;  /* UnscentedKalmanFilter._adaptive */
+    fc_meas_constants measure;  /* UnscentedKalmanFilter._measure */
+    double longest2, rail_var;
     double bias_lo2, bias_hi2, cos_innovation;
     int trapezoid, options;
 } fc_ukf;

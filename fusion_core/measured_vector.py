@@ -1,0 +1,203 @@
+"""The vector the filters measure, and its measurement noise: the accelerometer side of every
+recommended estimator (cf, mgcf, kf, ukf), one mechanism with named state.
+
+An accelerometer sample is gravity plus the body's linear acceleration plus white noise. The
+filters do not measure the raw sample; they measure a low-passed specific force that turns with
+the gyro (Laidig & Seel 2023, VQF: in an almost inertial frame gravity is constant and the linear
+acceleration of a body that ends where it started averages to its velocity change over time).
+Three things follow, and this module is each of them:
+
+1. The measured vector `f` is a second-order low-pass: two first-order stages of time constant
+   acc_lowpass / 2 each, every stage turned by the gyro's rotation increment. A second-order
+   filter passes a disturbance at frequency w with (w tau)^-2 where a first-order one passes
+   (w tau)^-1: a hand shaking the sensor at 3 Hz reaches the vector at a few thousandths of its
+   amplitude instead of a few hundredths (VQF's own pre-filter is a second-order Butterworth).
+   Its length adapts as the first-order pre-filter's did: it shortens towards the raw sample
+   where the disturbance it should average is no more than the white noise
+   (building_blocks.adaptive_prefilter_time), since then the raw sample carries no memory of the
+   gyro's scale errors. While it first fills (the first acc_lowpass after the first sample) each
+   stage's time constant is half the time since then, so the vector is a mean of the samples so
+   far, never one sample's tilt.
+2. Its measurement noise `r` (a tilt variance, rad^2) is one sample's white variance plus the
+   disturbance that reaches the vector: the linear acceleration slower than what the
+   pre-filter removes. That part is measured as the mean square difference between a short
+   second-order low-pass (BAND_PARAM: two stages of slow_band_time) and the full-length
+   reference, less the white noise's share that passes the short one: shaking and vibration,
+   which the pre-filter removes, do not count; the slow swing of a translation or of a combined
+   motion does, in full, since a filter that assumes white measurement noise cannot average a
+   disturbance that stays for seconds. The statistic rises within DISTURBANCE_ATTACK (a
+   disturbance that starts counts before a filter learns a gyro bias from it) and decays over
+   disturbance_time.
+3. A gyro sample at its rail (the sensor's gyro_range, base.Estimator) is no measurement of the
+   rate: the vectors turned with it are wrong by the rate beyond the rail, as the attitude is.
+   `settle` then counts the time since (measure_clipped), and a filter learns no gyro bias from
+   the accelerometer until it has reached the full length: until then the vector holds samples
+   turned by the rotation the gyro did not measure. The vector itself goes on: started again
+   from the sample at the rail it would be that one sample's tilt, and on the synthetic
+   gyro_clipping scenario the complementary filter's error was three times larger so.
+
+The statistic of the adaptive length (`dist`: the raw sample against the full-length reference)
+is the first-order pre-filter's, kept: it decides whether there is anything to average.
+"""
+
+from __future__ import annotations
+
+from typing import Final, NamedTuple
+
+from .building_blocks import Vec3, adaptive_prefilter_time, lowpass_specific_force
+from .state import NONNEG, REAL, Segments
+from .types import G, Param
+
+DISTURBANCE_ATTACK: Final = 0.05
+"""Time constant [s] with which the slow-band statistic rises. A disturbance that starts (the
+onset of a move, a burst of linear acceleration) must count in the measurement noise before a
+Kalman filter takes its apparent tilt for a gyro bias's drift: with the statistic's
+disturbance_time of 1 s both ways, the kf learned 1.6 deg/s of bias in the first half second of
+the contract's high_dynamics moves. It falls over disturbance_time, as before."""
+BAND_PARAM: Final = Param(
+    "slow_band_time", 0.15,
+    "Time constant of each stage of the short low-pass that splits the measured linear "
+    "acceleration: the part it passes (below about 1/(4 pi slow_band_time) Hz) reaches the "
+    "pre-filtered vector and counts in its measurement noise; faster disturbance (shaking, "
+    "vibration) the second-order pre-filter removes",
+    unit="s", low=0.01, high=10.0,
+)
+"""Recommended 0.15 s: a corner near 0.5 Hz, below hand shaking (3-8 Hz) and vibration, above
+the swing of a translation or a combined motion. Chosen by cross-validation over BROAD's groups of
+trials (`python -m testbenches broad --cv`), with the synthetic shaking scenario as the check of
+the fast side."""
+MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 4)))
+"""The state check of a Measure (fusion_core.state): six vectors, two mean squares, two
+times."""
+
+
+class Measure(NamedTuple):
+    """The measured vector's state: each second-order low-pass as its two stages (the first
+    stage, then the output), all turned with the gyro, and the two disturbance statistics."""
+
+    f1: Vec3
+    f: Vec3
+    """The measured vector: the pre-filtered specific force (adaptive length)."""
+    ref1: Vec3
+    ref: Vec3
+    """The full-length reference of both statistics (acc_lowpass, not adaptive)."""
+    s1: Vec3
+    s: Vec3
+    """The short low-pass of the slow band (slow_band_time)."""
+    dist: float
+    """Mean square of raw - ref [m^2/s^4] over disturbance_time: the adaptive length's."""
+    slow: float
+    """Mean square of s - ref [m^2/s^4]: the slow band that reaches f."""
+    fill: float
+    """Time [s] since the first sample, counted up to the full length (acc_lowpass)."""
+    settle: float
+    """Time [s] since the last gyro sample at its rail, counted up to the full length (the full
+    length from the start)."""
+
+    def settled(self, c: MeasureConstants) -> bool:
+        """Whether the vector holds no sample turned by a rotation the gyro did not measure (no
+        sample at the rail, or a full length since the last one): a filter may learn a gyro bias
+        from it."""
+        return self.settle >= 2.0 * c.stage
+
+
+def measure_start(a: Vec3, c: MeasureConstants) -> Measure:
+    """The state at a first sample a: every low-pass starts at it, no disturbance measured, and
+    settled (no gyro sample at its rail yet: the vector holds no rotation the gyro missed)."""
+    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage)
+
+
+class MeasureConstants(NamedTuple):
+    """What measure_step needs of the parameters, derived once (measure_constants)."""
+
+    stage: float
+    """acc_lowpass / 2: each stage's time constant [s]."""
+    dist_tau: float
+    """disturbance_time [s] (0: no statistics; the full-length, constant pre-filter)."""
+    noise: float
+    """The white noise's share of the raw statistic: 3 axes of one sample's variance
+    [m^2/s^4]."""
+    band: float
+    """slow_band_time [s]."""
+    r: float
+    """One sample's tilt variance [rad^2], the white part of the measurement noise."""
+
+
+def measure_constants(acc_lowpass: float, disturbance_time: float, band: float,
+                      r: float) -> MeasureConstants:
+    """The constants of measure_step from the parameters and one sample's tilt variance r."""
+    return MeasureConstants(0.5 * acc_lowpass, disturbance_time, 3.0 * r * G * G, band, r)
+
+
+def two_stage_noise(k: float) -> float:
+    """The share of white noise's variance that passes two first-order stages of gain k each:
+    k^4 (1 + a^2) / (1 - a^2)^3 with a = 1 - k (about k / 4 for a small k)."""
+    a2 = (1.0 - k) * (1.0 - k)
+    d = 1.0 - a2
+    return k * k * k * k * (1.0 + a2) / (d * d * d)
+
+
+def _lowpass2(s1: Vec3, s: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
+              terms: tuple[float, float, float, float]) -> tuple[Vec3, Vec3]:
+    """One step of a second-order low-pass: two first-order stages of time constant tau, each
+    turned by phi (building_blocks.lowpass_specific_force)."""
+    s1 = lowpass_specific_force(s1, phi, a, dt, tau, terms)
+    return s1, lowpass_specific_force(s, phi, s1, dt, tau, terms)
+
+
+def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, float, float],
+                 dt: float, c: MeasureConstants) -> tuple[Measure, float, bool]:
+    """One sample a of the measured vector (the module docstring), phi the interval's rotation
+    vector with its rotvec_terms. Returns the new state (its f is the measured vector), the
+    measurement noise r [rad^2] and whether the vector is still filling."""
+    f1, f, ref1, ref, s1, s, dist, slow, fill, settle = m
+    stage = c.stage
+    full = 2.0 * stage
+    if settle < full:
+        settle += dt
+    filling = fill < full
+    if filling:  # a mean of the samples so far (each stage half the time since the start)
+        fill += dt
+        stage = 0.5 * fill if fill < full else stage
+    r = c.r
+    tau = stage
+    if c.dist_tau > 0.0:
+        ref1, ref = _lowpass2(ref1, ref, phi, a, dt, stage, terms)
+        e0, e1, e2 = a[0] - ref[0], a[1] - ref[1], a[2] - ref[2]
+        dist += dt / (c.dist_tau + dt) * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
+        if not filling:
+            tau = stage * adaptive_prefilter_time(1.0, dist, c.noise)
+        s1, s = _lowpass2(s1, s, phi, a, dt, c.band, terms)
+        e0, e1, e2 = s[0] - ref[0], s[1] - ref[1], s[2] - ref[2]
+        inst = e0 * e0 + e1 * e1 + e2 * e2
+        rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
+        slow += dt / (rise + dt) * (inst - slow)
+        excess = slow - c.noise * two_stage_noise(dt / (c.band + dt))
+        if excess > 0.0:
+            r += excess / (G * G)
+    f1, f = _lowpass2(f1, f, phi, a, dt, tau, terms)
+    return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle), r, filling
+
+
+def raw_noise(m: Measure, c: MeasureConstants) -> float:
+    """The measurement noise [rad^2] sized by the raw sample's disturbance (`dist`, all of the
+    linear acceleration against the full-length reference, fast or slow) instead of the slow band
+    alone: one sample's white variance plus that disturbance's excess over the white noise, over
+    g^2. An upper bound of what reaches the vector, for a filter that learns its bias from every
+    error its correction passes (mgcf.GainScheduledComplementaryFilter)."""
+    excess = m.dist - c.noise
+    return c.r + excess / (G * G) if excess > 0.0 else c.r
+
+
+def measure_clipped(m: Measure) -> Measure:
+    """The state after a gyro sample at its rail: the vector goes on (starting it again from one
+    sample costs more than the turn it carries), but the settle time starts again, so the
+    filters learn no bias until the turned samples have left its memory."""
+    return m._replace(settle=0.0)
+
+
+def measure_turned(m: Measure, turn) -> Measure:  # type: ignore[no-untyped-def]
+    """The state with every vector turned by turn (a function of a vector: the kf's face
+    switch)."""
+    return Measure(turn(m.f1), turn(m.f), turn(m.ref1), turn(m.ref), turn(m.s1), turn(m.s),
+                   m.dist, m.slow, m.fill, m.settle)
