@@ -24,13 +24,13 @@ run: setup
 	  if [ $$status -eq 1 ]; then echo "make run: some contract checks FAIL (see the table above and reports/report.md)"; \
 	  elif [ $$status -ne 0 ]; then exit $$status; fi
 
-# A Monte Carlo campaign on a local Dask cluster (two workers): 5 estimators x 3 scenarios x 700
+# A Monte Carlo campaign on a local Dask cluster (two workers): 5 estimators x 5 scenarios x 700
 # seeds, each seed another sensor part with its bias instability and gyro scale error drawn from a
 # Latin hypercube; percentiles with confidence intervals in reports/campaign/summary.md.
 # Run it again and it runs only what is missing.
 campaign: setup
 	$(BIN)/python -m testbenches campaign --estimator all \
-	  --scenario moderate_dynamics,vibration,high_dynamics --seeds 700 \
+	  --scenario moderate_dynamics,vibration,high_dynamics,shaking,gyro_clipping --seeds 700 \
 	  --vary gyro_bias_instability=1e-5:1e-3:log --vary gyro_scale_std=0:0.03 \
 	  --out reports/campaign
 

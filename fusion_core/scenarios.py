@@ -16,6 +16,10 @@ new ids.
 | 6  | vibration         | slow tilt plus 61.3/122.6/183.9 Hz vibration of 0.3 g per tone (motor) |
 | 7  | high_dynamics     | tilt plus sustained 0.5 g accelerations lasting seconds                 |
 | 8  | translation_2m    | 2 m along x, minimum jerk over 3 s, 2 s at rest before and after        |
+| 9  | shaking           | a handheld sensor shaken for 90 s: 2.6 g RMS of linear acceleration at |
+|    |                   | 2.7-5.2 Hz (peaks near 6 g) while it turns by 20-40 deg                 |
+| 10 | gyro_clipping     | fast swings whose rate exceeds +-2000 deg/s for about 8 % of the       |
+|    |                   | samples (the realistic sensor's gyro range), over slow tilts            |
 """
 
 from __future__ import annotations
@@ -101,6 +105,35 @@ def _high_dynamics() -> Trajectory:
     )
 
 
+def _shaking() -> Trajectory:
+    # A hand shaking the sensor (the 2-3 Hz of a wrist, the 4-5 Hz of a tremor), two tones per
+    # axis of 1.5 g each: 2.6 g RMS of linear acceleration, 95th percentile 3.8 g, |f| up to
+    # 5.6 g, while the sensor turns slowly by 20-40 deg with 5-8 deg of wobble at 3-4 Hz.
+    a = 1.5 * G
+    return Trajectory(
+        roll=add(sine(30 * DEG, 0.23), sine(8 * DEG, 3.1, 0.4)),
+        pitch=add(sine(20 * DEG, 0.17, 1.0), sine(6 * DEG, 3.7, 1.1)),
+        yaw=add(sine(40 * DEG, 0.05), sine(5 * DEG, 2.9)),
+        pos=(
+            add(_accel_sine(a, 2.7), _accel_sine(a, 4.1, 0.5)),
+            add(_accel_sine(a, 3.3, 1.0), _accel_sine(a, 5.2, 2.0)),
+            add(_accel_sine(a, 2.9, 0.3), _accel_sine(a, 4.6, 1.4)),
+        ),
+    )
+
+
+def _gyro_clipping() -> Trajectory:
+    # Swings of 95 deg at 4 Hz (roll) and 55 deg at 3.4 Hz (pitch) whose envelopes swell every
+    # 6 and 9 s: peak rates of 2390 and 1170 deg/s, so the roll rate is beyond +-2000 deg/s for
+    # about 8 % of the samples, over slow tilts and a slow sway of the position.
+    return Trajectory(
+        roll=add(sine(20 * DEG, 0.2), swelling_sine(95 * DEG, 4.0, 6.0)),
+        pitch=add(sine(15 * DEG, 0.15, 0.7), swelling_sine(55 * DEG, 3.4, 9.0, 1.0)),
+        yaw=sine(30 * DEG, 0.05),
+        pos=(sine(0.1, 0.4), sine(0.1, 0.3, 1.0), constant()),
+    )
+
+
 @dataclass(frozen=True)
 class Scenario:
     id: int
@@ -167,6 +200,14 @@ SCENARIOS: dict[str, Scenario] = {
             8, "translation_2m", 7.0,
             lambda: Trajectory(pos=(min_jerk(0.0, 2.0, 2.0, 3.0), constant(), constant())),
             "2 m along x, minimum jerk over 3 s, 2 s at rest before and after",
+        ),
+        Scenario(
+            9, "shaking", 90.0, _shaking,
+            "handheld shaking: 2.6 g RMS of linear acceleration at 3-5 Hz, turning 20-40 deg",
+        ),
+        Scenario(
+            10, "gyro_clipping", 60.0, _gyro_clipping,
+            "swings beyond the gyro's +-2000 deg/s range for about 8 % of the samples",
         ),
     )
 }
