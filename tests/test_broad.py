@@ -304,3 +304,31 @@ def test_cli_gyro_fit_writes_each_trials_gyro_errors_and_the_oracle_rmse(
     assert all(abs(v) < 2.0 for v in fit["scale_error_pct"])  # a calibrated gyro: percents
     assert fit["windows"] >= 100
     assert 0.0 < fit["rmse_deg"]["kf"] < 5.0 and 0.0 < fit["rmse_scale_removed_deg"]["kf"] < 5.0
+
+
+def test_the_motion_folds_of_the_cross_validation() -> None:
+    from testbenches.broad.cv import fold_of
+
+    assert fold_of(["undisturbed", "rotation", "slow"]) == "slow_rotation"
+    assert fold_of(["undisturbed", "rotation", "fast", "with_breaks"]) == "fast_rotation"
+    assert fold_of(["undisturbed", "translation", "fast"]) == "translation"
+    assert fold_of(["disturbed", "tapping"]) == "disturbed_combined"
+    assert fold_of(["undisturbed", "combined", "slow"]) == "disturbed_combined"
+
+
+def test_cv_on_two_folds_chooses_without_the_held_out_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`broad --cv` on a rotation and a translation slice: each held-out trial's error is the
+    grid point chosen on the other one's, and report.json gains the cross-validated means."""
+    a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
+    b = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL)
+    out = tmp_path / "report"
+    assert main(["broad", str(a), str(b), "--estimator", "kf", "--cv", "--no-plot",
+                 "--out", str(out)]) == 0
+    assert "leave one motion fold out" in capsys.readouterr().out
+    report = json.loads((out / "report.json").read_text())
+    cv = json.loads((out / "cv.json").read_text())["estimators"]["kf"]
+    assert report["cv_mean_inclination_rmse_deg"]["kf"] == pytest.approx(cv["cv_mean_deg"])
+    assert set(cv["chosen_per_fold"]) == {"slow_rotation", "translation"}
+    assert cv["in_sample_mean_deg"] == pytest.approx(report["mean_inclination_rmse_deg"]["kf"])

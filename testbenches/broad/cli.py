@@ -53,6 +53,12 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--out", type=Path, default=Path("reports/broad"),
                    help="report folder (reports/broad)")
     p.add_argument("--no-plot", action="store_true", help="skip the bar chart")
+    p.add_argument("--cv", action="store_true",
+                   help="cross-validate the defaults: each parameter a scan chooses (acc_lowpass, "
+                   "slow_band_time) chosen again without each motion fold (slow rotation, fast "
+                   "rotation, translation, disturbed/combined) and scored on it; prints the "
+                   "cross-validated mean beside the in-sample one (and VQF's with --peers) and "
+                   "adds cv_mean_inclination_rmse_deg to report.json (testbenches.broad.cv)")
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
                    "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
@@ -100,9 +106,41 @@ def cmd_broad(args: argparse.Namespace) -> int:
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
+    if args.cv:
+        print(f"\n{cv_report(trials, result, estimators, args.out, args.peers)}")
     if args.gyro_fit:
         print(f"\n{gyro_fit_table(trials, result, args.out)}")
     return 0
+
+
+def cv_report(trials: list[BroadTrial], result: BroadResult, estimators: list[str], out: Path,
+              peers: bool) -> str:
+    """The cross-validation (testbenches.broad.cv) of the estimators that have one, as a table;
+    report.json gains cv_mean_inclination_rmse_deg and DIR/cv.json holds the details."""
+    import json
+
+    from tqdm import tqdm
+
+    from ..peers import AHEAD_PEERS
+    from .cv import CV_ESTIMATORS, cross_validate, cv_table
+
+    keys = [k for k in estimators if k in CV_ESTIMATORS]
+    if not keys:
+        return "cross-validation: none of the chosen estimators has a scanned parameter"
+    groups = [t.groups for t in result.trials]
+    with tqdm(desc="cross-validation", unit="trial", file=sys.stderr,
+              total=len(trials) * (len(keys) + (1 if peers else 0))) as bar:
+        cv = cross_validate(trials, groups, keys,
+                            {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]} if peers else None,
+                            lambda label: bar.update())
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
+    report = out / "report.json"
+    if report.is_file():
+        data = json.loads(report.read_text())
+        data["cv_mean_inclination_rmse_deg"] = cv.cv_means()
+        report.write_text(json.dumps(data, indent=1))
+    return cv_table(cv)
 
 
 def gyro_fit_table(trials: list[BroadTrial], result: BroadResult, out: Path) -> str:
