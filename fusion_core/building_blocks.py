@@ -10,7 +10,7 @@ below answers one of them the same way in every estimator:
   force in a frame that turns with the gyro, so linear acceleration averages out (Laidig & Seel
   2023, VQF);
 - rest detection for a zero-angular-rate bias update (REST_PARAMS, rest_step; VQF's detector);
-- adaptive noise (ADAPTIVE_NOISE_PARAMS, disturbance_step; correction_time for the
+- adaptive noise (ADAPTIVE_NOISE_PARAMS, fusion_core.measured_vector; correction_time for the
   complementary filters): more process noise while the sensor turns (the gyro's scale-factor
   error), more measurement noise while it accelerates (the linear acceleration the pre-filter
   has not removed), the raw sample where it measures none;
@@ -360,9 +360,9 @@ real sensor breaks both in motion, and the balance of the two sets the correctio
   process noise of the attitude grows by gyro_scale_std^2 w^2 scale_time (the variance a scale
   error of that size adds up over scale_time, taken as a white noise), so the accelerometer
   takes over faster in fast rotation;
-- disturbance_time: disturbance_step (measured_disturbance against a second pre-filter of the
-  full acc_lowpass, acc_ref, and adaptive_prefilter_time for the pre-filter whose vector is
-  measured). 1 s, the pre-filter's own time constant."""
+- disturbance_time: the averaging time of the measured vector's disturbance statistics
+  (fusion_core.measured_vector: the linear acceleration that reaches the vector sizes the
+  measurement noise, and adaptive_prefilter_time the vector's length). 1 s."""
 
 
 CONSTANT_NOISE: Final = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
@@ -377,61 +377,6 @@ def adaptive_noise_constants(p: Any, acc_tau: float, r: float) -> tuple[float, f
     pre-filter) and the white noise's share of the disturbance statistic (3 axes of r g^2)."""
     return (float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
             float(p["disturbance_time"]) if acc_tau > 0.0 else 0.0, 3.0 * r * G * G)
-
-
-def measured_disturbance(dist: float, a: Vec3, f: Vec3, dt: float, tau: float, r: float,
-                         noise: float) -> tuple[float, float]:
-    """One step of the disturbance statistic (ADAPTIVE_NOISE_PARAMS' disturbance_time) and the
-    measurement variance it gives: (new statistic, r + excess / g^2).
-
-    The raw sample a minus the pre-filtered specific force f is the sensor's white noise plus
-    whatever non-gravitational acceleration the pre-filter has not followed. dist is its mean
-    square over tau (a first-order low-pass); less the white noise's share `noise` (3 axes of
-    one sample's variance [m^2/s^4]) it is that acceleration's power d^2, and a gravity
-    direction read from a vector disturbed by d is off by about d / g, so the variance r of the
-    measurement grows by d^2 / g^2: the accelerometer gates' idea (trust it less while it
-    measures more than gravity), continuous and sized by the measured disturbance."""
-    e0, e1, e2 = a[0] - f[0], a[1] - f[1], a[2] - f[2]
-    k = dt / (tau + dt)
-    dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
-    excess = dist - noise
-    return dist, (r + excess / (G * G) if excess > 0.0 else r)
-
-
-def alignment_time(n_samples: int, dt: float, tau: float) -> tuple[float, bool]:
-    """The accelerometer pre-filter's time constant over its first tau (ACC_LOWPASS_PARAM), and
-    whether the filter is still aligning: n_samples dt while that is below tau, so that the gain
-    dt / (tau + dt) is 1/n and the pre-filter is the running mean of the n turned samples so far
-    (VQF's initialisation of its low-pass filters, Laidig & Seel 2023); tau after that.
-
-    The filter starts from one sample's tilt, which a vibration of 0.3 g puts 24 deg off
-    (vibration), and a low-pass that starts there carries it for its time constant, which the
-    measured disturbance lengthens: cf 0.64/1.50 deg on vibration (seed 0), 4-6 deg still at
-    5 s. While aligning, the complementary filters (cf, mgcf) take the mean's tilt as their
-    attitude, since nothing they hold is better; then they go on from it as usual. On
-    vibration cf gives 0.11/0.66 (seed 0) and 0.51/0.52 over 100 parts (0.82/1.72 before),
-    mgcf the same; the other contract scenarios move by at most 0.006 deg (4 seeds),
-    translation_2m, scored from 2 s, by 0.045, and BROAD not in the third decimal. The Kalman
-    filters keep the plain low-pass: their bias states learn from the steps an aligning
-    attitude takes (ukf on moderate_dynamics, seed 0: 0.24/0.20 -> 0.27/0.32 deg with an
-    alignment of this kind)."""
-    start = n_samples * dt
-    if start < tau:
-        return start, True
-    return tau, False
-
-
-def disturbance_step(ref: Vec3, dist: float, a: Vec3, phi: Vec3,
-                     terms: tuple[float, float, float, float], dt: float, tau: float,
-                     dist_tau: float, r: float, noise: float) -> tuple[Vec3, float, float, float]:
-    """The measurement side of the adaptive noise for one sample a (ADAPTIVE_NOISE_PARAMS'
-    disturbance_time): the full pre-filter ref (time constant tau, turned by phi with its
-    kinematics.rotvec_terms), the disturbance statistic against it and the measurement variance
-    it gives from r (measured_disturbance), and the time constant of the pre-filter whose vector
-    is measured (adaptive_prefilter_time). Returns (ref, dist, r, that time constant)."""
-    ref = lowpass_specific_force(ref, phi, a, dt, tau, terms)
-    dist, r = measured_disturbance(dist, a, ref, dt, dist_tau, r, noise)
-    return ref, dist, r, adaptive_prefilter_time(tau, dist, noise)
 
 
 MAX_CORRECTION_TIME_PARAM: Final = Param(
@@ -480,10 +425,10 @@ def correction_time(tau: float, r_ratio: float, q_rotation: float, w2: float, r:
     A filter blending gyro and accelerometer with time constant tau is the steady state of a
     Kalman filter with measurement variance r (one sample's) and angle process noise
     q = r dt / tau^2, since tau = sqrt(r dt / q). With the kf's adaptive noise, r grows by the
-    ratio r_ratio (measured_disturbance over r) and q by q_rotation w2 (the gyro's scale
-    uncertainty while it turns at w), and the time constant by sqrt(r_ratio / q_ratio). It is
-    stretched at most to `longest`: a filter that has not learned its gyro bias leaves an error
-    of that bias times its time constant."""
+    ratio r_ratio (the measured vector's noise over r, measured_vector) and q by q_rotation w2
+    (the gyro's scale uncertainty while it turns at w), and the time constant by
+    sqrt(r_ratio / q_ratio). It is stretched at most to `longest`: a filter that has not learned
+    its gyro bias leaves an error of that bias times its time constant."""
     q_ratio = 1.0 + q_rotation * w2 * tau * tau / (r * dt)
     t = tau * math.sqrt(r_ratio / q_ratio)
     cap = longest if longest > tau else tau
@@ -510,7 +455,7 @@ def adaptive_prefilter_time(tau: float, dist: float, noise: float) -> float:
     units of PREFILTER_FULL times the noise, at most tau.
 
     The pre-filter is there to average linear acceleration away. Where the disturbance statistic
-    (measured_disturbance, against a pre-filter of the full tau) finds none above the white
+    (measured_vector's raw statistic, against the full-length reference) finds none above the white
     noise, there is nothing for it to average that the filter's own measurement variance does
     not already weigh, and the vector it would give has turned with the gyro for tau, carrying
     the gyro's scale and bias errors of that time: the raw sample is then the better

@@ -202,8 +202,8 @@ class AngleBiasKalmanFilter(Estimator):
     R_measure = the variance of one accelerometer sample's tilt (RECOMMENDED_R), which together
     give a correction time constant sqrt(R dt / Q_angle) of 2.2 s at 285.7 Hz and 3.7 s at 100
     Hz (the papers' numbers, tuned at 30 Hz, give 0.3 s at 285.7 Hz); gyro_psd (the zero-rate
-    update) the same PSD; init_bias_std = 1 deg/s, an uncalibrated MEMS gyro's turn-on bias
-    (BROAD's: up to 0.5 deg/s), with the angles' first variance R (one sample's); the
+    update) the same PSD; init_bias_std = 0.3 deg/s (RECOMMENDED_INIT_BIAS_STD), with the angles'
+    first variance R (one sample's) plus ((|a| - g) / g)^2; the
     pre-filter, rest detection and quaternion propagation as building_blocks recommends, on the
     nearest face; the bias learns from the accelerometer only while the raw sample's norm is
     within 5 % of g (bias_gate, building_blocks.BIAS_GATE_PARAM: Duong Quoc et al.'s real-sensor
@@ -223,25 +223,25 @@ class AngleBiasKalmanFilter(Estimator):
     The recommended R_measure is a measured per-sample variance (R_loop_time = 0).
 
     Adaptive noise (recommended; off in the papers' filter): building_blocks.ADAPTIVE_NOISE_PARAMS.
-    Q_angle grows by gyro_scale_std^2 w^2 scale_time while the sensor turns at rate w (BROAD's
-    gyro: 0.5 % scale errors); each step's measurement variance grows by the measured linear
-    acceleration's power over g^2 (the raw sample's deviation from a full pre-filter, acc_ref,
-    above the white noise, over disturbance_time); and the pre-filter whose vector is measured
-    shortens to nothing where that power is down to the white noise's
-    (building_blocks.adaptive_prefilter_time). On the testbench (realistic sensor, seed 0,
-    against constant Q, R and pre-filter) high_dynamics 6.9/6.6 -> 1.1/1.0 deg, roll_sweep
-    0.30/0.18 -> 0.11/0.07, moderate_dynamics 0.27/0.26 -> 0.27/0.19, vibration 0.38/0.64 ->
-    0.55/1.59 (its tones raise R: the filter leans on the gyro); on BROAD 0.619 -> 0.560 deg
-    (translation 0.51 -> 0.39, rotation 0.70 -> 0.61). A gyro left uncalibrated (6.7 deg/s)
-    costs more than before on moderate_dynamics (3.2/3.7 against 1.3/1.4 deg): its bias is
-    learned only where the accelerometer measures little besides gravity.
+    Q_angle grows by gyro_scale_std^2 w^2 scale_time while the sensor turns at rate w (the gyro's
+    scale uncertainty); the filter measures the vector of fusion_core.measured_vector, a
+    second-order low-pass of the gyro-turned specific force, and each step's R is one sample's
+    variance plus the linear acceleration slow enough to reach that vector, over g^2 (shaking
+    and vibration, which the low-pass removes, do not count), capped at Q T^2 / dt so that the
+    correction time never exceeds T = max_correction_time; the vector shortens to the raw
+    sample where no disturbance above the white noise is measured
+    (building_blocks.adaptive_prefilter_time). No bias is learned from a vector that is still
+    filling, or that holds samples turned by a gyro at its rail (gyro_range), and a clipped
+    sample grows the angles' variance by the rate beyond the rail. On the testbench (realistic
+    sensor, seed 0, against constant Q, R and pre-filter) high_dynamics 6.9/6.6 -> 2.8/4.2 deg
+    (`python -m testbenches run --estimator kf`); on BROAD 0.512 deg in sample, 0.532
+    cross-validated (`python -m testbenches broad DIR --cv`).
 
     Parameters: Q_angle [rad^2/s], Q_bias [rad^2/s^3], R_measure [rad^2], R_loop_time [s];
-    gyro_scale_std, scale_time [s], disturbance_time [s]; gate_low, gate_high;
-    acc_lowpass [s]; rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2], gyro_psd
-    [rad^2/s]; init_bias_std [rad/s]; bias_gate; bias_innovation [rad]; propagation; tilt_axes;
-    gyro_sampling;
-    max_dt [s], max_rate [rad/s].
+    gyro_scale_std, scale_time [s], disturbance_time [s], slow_band_time [s],
+    max_correction_time [s]; gate_low, gate_high; acc_lowpass [s]; rest_time [s], rest_gyro
+    [rad/s], rest_acc [m/s^2], gyro_psd [rad^2/s]; init_bias_std [rad/s]; bias_gate;
+    bias_innovation [rad]; propagation; tilt_axes; gyro_sampling; max_dt [s], max_rate [rad/s].
     """
 
     PARAMS = (

@@ -16,8 +16,8 @@ Three things follow, and this module is each of them:
    where the disturbance it should average is no more than the white noise
    (building_blocks.adaptive_prefilter_time), since then the raw sample carries no memory of the
    gyro's scale errors. While it first fills (the first acc_lowpass after the first sample) each
-   stage's time constant is half the time since then, so the vector is a mean of the samples so
-   far, never one sample's tilt.
+   stage's time constant is half the time since then, so the vector is a weighted mean of the
+   samples so far in which none weighs more than 1.5 / n, never one sample's tilt.
 2. Its measurement noise `r` (a tilt variance, rad^2) is one sample's white variance plus the
    disturbance that reaches the vector: the linear acceleration slower than what the
    pre-filter removes. That part is measured as the mean square difference between a short
@@ -118,7 +118,7 @@ class MeasureConstants(NamedTuple):
     """The white noise's share of the raw statistic: 3 axes of one sample's variance
     [m^2/s^4]."""
     band: float
-    """slow_band_time [s]."""
+    """slow_band_time [s] (0: no slow band measured)."""
     r: float
     """One sample's tilt variance [rad^2], the white part of the measurement noise."""
 
@@ -167,14 +167,15 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
         dist += dt / (c.dist_tau + dt) * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
         if not filling:
             tau = stage * adaptive_prefilter_time(1.0, dist, c.noise)
-        s1, s = _lowpass2(s1, s, phi, a, dt, c.band, terms)
-        e0, e1, e2 = s[0] - ref[0], s[1] - ref[1], s[2] - ref[2]
-        inst = e0 * e0 + e1 * e1 + e2 * e2
-        rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
-        slow += dt / (rise + dt) * (inst - slow)
-        excess = slow - c.noise * two_stage_noise(dt / (c.band + dt))
-        if excess > 0.0:
-            r += excess / (G * G)
+        if c.band > 0.0:  # the slow band (band 0: not measured, r stays white: raw_noise's users)
+            s1, s = _lowpass2(s1, s, phi, a, dt, c.band, terms)
+            e0, e1, e2 = s[0] - ref[0], s[1] - ref[1], s[2] - ref[2]
+            inst = e0 * e0 + e1 * e1 + e2 * e2
+            rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
+            slow += dt / (rise + dt) * (inst - slow)
+            excess = slow - c.noise * two_stage_noise(dt / (c.band + dt))
+            if excess > 0.0:
+                r += excess / (G * G)
     f1, f = _lowpass2(f1, f, phi, a, dt, tau, terms)
     return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle), r, filling
 

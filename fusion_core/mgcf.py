@@ -49,7 +49,6 @@ from .kinematics import (
     rotvec_terms,
 )
 from .measured_vector import (
-    BAND_PARAM,
     MEASURE_CHECK,
     measure_clipped,
     measure_constants,
@@ -109,7 +108,7 @@ class GainScheduledComplementaryFilter(Estimator):
       (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and e and rho use that
       vector: linear acceleration averages out instead of reading as tilt, and the schedule sees
       the norm of what the correction uses; over its first time constant it is the running mean
-      of the turned samples, and q is its tilt (building_blocks.alignment_time);
+      of the turned samples, and q is its tilt (measured_vector: while it fills);
     - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
       still, the gyro reads its own bias, and b follows the gyro with time constant rest_time (a
       zero-angular-rate update of the integral term; Mahony's integral alone needs minutes, and
@@ -159,7 +158,6 @@ class GainScheduledComplementaryFilter(Estimator):
         *REST_PARAMS,
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
-        BAND_PARAM,
     )
     STATE: ClassVar[StateSpec] = {
         "q": UNIT, "bias": REAL, "w0_now": NONNEG, "meas": MEASURE_CHECK, "rest": REST,
@@ -181,8 +179,9 @@ class GainScheduledComplementaryFilter(Estimator):
         # variance, the rotation term per (rad/s)^2, the disturbance's averaging time (0: off),
         # the white noise's share of the disturbance statistic, the longest correction time
         self._adaptive = complementary_adaptive(p, self._acc_tau)
-        self._measure = measure_constants(self._acc_tau, self._adaptive[2],
-                                          float(p["slow_band_time"]), self._adaptive[0])
+        # no slow band: the mgcf's noise is the raw disturbance (measured_vector.raw_noise)
+        self._measure = measure_constants(self._acc_tau, self._adaptive[2], 0.0,
+                                          self._adaptive[0])
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)
@@ -242,7 +241,7 @@ class GainScheduledComplementaryFilter(Estimator):
         if not norm > 0.0:  # no gravity direction in this sample: gyro only
             w0 = 0.0
         self.w0_now = w0
-        if aligning and w0 > 0.0:  # building_blocks.alignment_time: the mean's tilt
+        if aligning and w0 > 0.0:  # the vector still fills (measured_vector): the mean's tilt
             self.q = q = quat_from_roll_pitch(*accel_roll_pitch(ax, ay, az))
             roll, pitch = quat_roll_pitch(*q)
             return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))

@@ -1,5 +1,5 @@
-"""The complementary filters' start (building_blocks.alignment_time): over the pre-filter's first
-time constant they take the tilt of the running mean of the turned samples, so a first sample
+"""The complementary filters' start (measured_vector: while the vector fills): over the pre-filter's
+first length they take the tilt of the running mean of the turned samples, so a first sample
 taken in vibration does not set the attitude for seconds. Both backends; the C twin must agree."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fusion_core import ESTIMATORS, native
-from fusion_core.building_blocks import alignment_time
+from fusion_core.measured_vector import measure_constants, measure_start, measure_step
 from fusion_core.types import DEG, G
 
 RATE = 100.0
@@ -44,13 +44,24 @@ def test_a_first_sample_in_vibration_is_averaged_away_within_the_first_second(
     if backend == "native":
         ref = ESTIMATORS[key]().run(acc, gyro, dt, backend="python")
         for name in ("roll", "pitch", "bias"):
-            np.testing.assert_allclose(out[name], ref[name], rtol=0, atol=1e-12)
+            np.testing.assert_array_equal(out[name], ref[name])  # the twins, bit for bit
 
 
-def test_the_pre_filter_is_the_running_mean_for_its_first_time_constant() -> None:
+def test_the_measured_vector_is_a_mean_of_the_samples_while_it_fills() -> None:
+    """Without rotation, after n samples of the fill the vector is a weighted mean of them
+    (weights summing to 1) in which no sample weighs more than 1.5 / n: never one sample's tilt.
+    (Two stages each of half the time since the start weigh the middle samples most.)"""
     dt = 0.01
-    for n in (1, 2, 50, 99):
-        tau, aligning = alignment_time(n, dt, 1.0)
-        assert aligning and dt / (tau + dt) == pytest.approx(1.0 / (n + 1))
-    assert alignment_time(100, dt, 1.0) == (1.0, False)
-    assert alignment_time(10_000, dt, 1.0) == (1.0, False)
+    c = measure_constants(1.0, 0.0, 0.15, 1e-5)
+    zero, terms = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
+    for n in (2, 5, 20, 60, 99):
+        weights = []
+        for j in range(n):  # the vector is linear in the samples: each one's weight alone
+            samples = [(1.0 if i == j else 0.0, 0.0, 0.0) for i in range(n)]
+            m = measure_start(samples[0], c)
+            for a in samples[1:]:
+                m, _, filling = measure_step(m, a, zero, terms, dt, c)
+                assert filling
+            weights.append(m.f[0])
+        assert sum(weights) == pytest.approx(1.0, abs=1e-12)
+        assert min(weights) > 0.0 and max(weights) <= 1.5 / n, (n, max(weights) * n)

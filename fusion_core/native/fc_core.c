@@ -239,32 +239,6 @@ void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
     *noise = 3.0 * r * FC_G * FC_G;
 }
 
-double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
-                               double tau, double r, double noise)
-{
-    double e0 = a[0] - f[0], e1 = a[1] - f[1], e2 = a[2] - f[2];
-    double k = dt / (tau + dt);
-    *dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - *dist);
-    double excess = *dist - noise;
-    return excess > 0.0 ? r + excess / (FC_G * FC_G) : r;
-}
-
-double fc_alignment_time(long n_samples, double dt, double tau, int *aligning)
-{
-    double start = (double)n_samples * dt;
-    *aligning = start < tau;
-    return *aligning ? start : tau;
-}
-
-double fc_disturbance_step(double ref[3], double *dist, const double a[3], const double phi[3],
-                           const double terms[4], double dt, double tau, double dist_tau,
-                           double *r, double noise)
-{
-    fc_lowpass_specific_force_terms(ref, phi, terms, a, dt, tau);
-    *r = fc_measured_disturbance(dist, a, ref, dt, dist_tau, *r, noise);
-    return fc_adaptive_prefilter_time(tau, *dist, noise);
-}
-
 double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
                           double dt, double longest)
 {
@@ -355,16 +329,18 @@ double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double p
         if (!*filling) {
             tau = stage * fc_adaptive_prefilter_time(1.0, m[FC_MEAS_DIST], c->noise);
         }
-        lowpass2(m + FC_MEAS_S1, s, phi, a, dt, c->band, terms);
-        e0 = s[0] - ref[0];
-        e1 = s[1] - ref[1];
-        e2 = s[2] - ref[2];
-        double inst = e0 * e0 + e1 * e1 + e2 * e2;
-        double rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
-        m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
-        double excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
-        if (excess > 0.0) {
-            r += excess / (FC_G * FC_G);
+        if (c->band > 0.0) {  /* the slow band (band 0: not measured) */
+            lowpass2(m + FC_MEAS_S1, s, phi, a, dt, c->band, terms);
+            e0 = s[0] - ref[0];
+            e1 = s[1] - ref[1];
+            e2 = s[2] - ref[2];
+            double inst = e0 * e0 + e1 * e1 + e2 * e2;
+            double rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
+            m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
+            double excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
+            if (excess > 0.0) {
+                r += excess / (FC_G * FC_G);
+            }
         }
     }
     lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, phi, a, dt, tau, terms);

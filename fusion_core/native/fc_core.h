@@ -91,19 +91,6 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
 void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
                                  double disturbance_time, double acc_tau, double r,
                                  double *q_rotation, double *dist_tau, double *noise);
-/* measured_disturbance: one step of the disturbance statistic *dist (the mean square of the raw
- * sample a minus the pre-filtered f over tau, a low-pass); returns the measurement variance
- * r plus its excess over the white noise's share, over g^2 */
-double fc_measured_disturbance(double *dist, const double a[3], const double f[3], double dt,
-                               double tau, double r, double noise);
-/* alignment_time: returns the pre-filter's time constant, *aligning 1 while n dt < tau */
-double fc_alignment_time(long n_samples, double dt, double tau, int *aligning);
-/* disturbance_step: the full pre-filter ref (tau) turned by phi (its terms) and blended with a,
- * the statistic *dist against it and the measurement variance *r it gives, and the returned
- * time constant of the pre-filter whose vector is measured */
-double fc_disturbance_step(double ref[3], double *dist, const double a[3], const double phi[3],
-                           const double terms[4], double dt, double tau, double dist_tau,
-                           double *r, double noise);
 /* correction_time: a complementary filter's time constant under the adaptive noise, at most the
  * larger of tau and longest */
 double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,

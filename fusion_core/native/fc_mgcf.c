@@ -58,7 +58,8 @@ void fc_mgcf_configure(fc_mgcf *f)
                                 f->acc_tau, f->r_ref, &f->q_rotation, &f->dist_tau,
                                 &f->dist_noise);
     f->longest = p->max_correction_time;
-    fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, &f->measure);
+    /* no slow band: the mgcf's noise is the raw disturbance (fc_measure_raw_noise) */
+    fc_measure_constants(f->acc_tau, f->dist_tau, 0.0, f->r_ref, &f->measure);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
@@ -139,7 +140,7 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         w0 = 0.0;
     }
     f->w0_now = w0;
-    if (aligning && w0 > 0.0) {  /* alignment_time: the attitude is the mean's tilt */
+    if (aligning && w0 > 0.0) {  /* the vector still fills: the attitude is the mean's tilt */
         double roll, pitch;
         fc_accel_roll_pitch(ax, ay, az, &roll, &pitch);
         fc_quat_from_roll_pitch(roll, pitch, f->q);

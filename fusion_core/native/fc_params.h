@@ -94,7 +94,6 @@ typedef struct fc_mgcf_params {
     double scale_time;           /* [0.0, 1000000.0] [s] */
     double disturbance_time;     /* [0.0, 1000000.0] [s] */
     double max_correction_time;  /* [0.0, 1000000.0] [s] */
-    double slow_band_time;       /* [0.01, 10.0] [s] */
     double max_dt;               /* (0.0, 1000000.0] [s] */
     double max_rate;             /* (0.0, 10000.0] [rad/s] */
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -121,7 +120,6 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
-    p->slow_band_time = 0.15;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;

@@ -112,7 +112,7 @@ class CvResult:
         return {
             "method": "leave one motion fold out: each CV_GRID parameter chosen on the other "
                       "folds' trials, scored on the held-out fold's",
-            "grid": {k: list(v) for k, v in CV_GRID.items()},
+            "grid": {k: list(v) for k, v in CV_GRID.items()},  # each estimator: those it has
             "folds": self.folds,
             "estimators": {k: e.as_dict() for k, e in self.estimators.items()},
             "peers": self.peers,
@@ -139,13 +139,15 @@ def cross_validate(
     if len(present) < 2:
         raise ValueError(f"cross-validation needs trials of at least two motion folds "
                          f"({', '.join(FOLDS)}); these are all {present[0] if present else '-'}")
-    keys = list(CV_GRID)
-    grid = [dict(zip(keys, values, strict=True)) for values in itertools.product(*CV_GRID.values())]
     out: dict[str, EstimatorCv] = {}
     for key in estimators:
         if key not in CV_ESTIMATORS:
             raise ValueError(f"--cv covers {', '.join(CV_ESTIMATORS)}, not {key}")
-        defaults = {k: float(ESTIMATORS[key].param_specs()[k].default) for k in keys}
+        specs = ESTIMATORS[key].param_specs()
+        keys = [k for k in CV_GRID if k in specs]  # the mgcf has no slow band
+        grid = [dict(zip(keys, values, strict=True))
+                for values in itertools.product(*(CV_GRID[k] for k in keys))]
+        defaults = {k: float(specs[k].default) for k in keys}
         cv = EstimatorCv(key, defaults, grid=grid, errors=np.zeros((len(grid), len(trials))))
         for j, trial in enumerate(trials):
             r = run_fusion_core(key, {}, trial)
@@ -192,7 +194,8 @@ def cv_table(result: CvResult) -> str:
         cells = " ".join(f"{result.fold_mean(values, f):18.3f}" for f in present)
         lines.append(f"{name:10s} {'(no fit)':10s} {cells} {np.mean(list(values.values())):7.3f}")
     lines.append("")
-    lines.append("chosen without each fold (" + ", ".join(CV_GRID) + "):")
+    lines.append("chosen without each fold (" + ", ".join(CV_GRID) + " where the estimator "
+                 "has it):")
     for key, e in result.estimators.items():
         chosen = "; ".join(f"{f}: " + "/".join(f"{v:g}" for v in e.chosen[f].values())
                            for f in present)
