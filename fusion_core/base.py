@@ -18,15 +18,12 @@ import numpy as np
 
 from .kinematics import roll_pitch_ahead
 from .state import BASE_STATE, NESTED, StateSpec, check_field
-from .types import DEG, Estimate, G, InvalidSample, Param, check_param_names
+from .types import GYRO_RANGE_DEFAULT, Estimate, G, InvalidSample, Param, check_param_names
 
 MAX_RATE_DEFAULT: Final = 1000.0
 """Default max_rate [rad/s] (57,300 deg/s): about three times the widest full-scale range of any
 MEMS gyro we know of (Analog Devices ADXRS649, +-20,000 deg/s; consumer parts such as the
 MPU-6050 end at +-2000 deg/s). A larger reading is no measurement."""
-GYRO_RANGE_DEFAULT: Final = 2000.0 * DEG
-"""Default gyro_range [rad/s]: +-2000 deg/s, the widest setting of the MPU-6050 class of consumer
-MEMS gyros (the realistic sensor model's range)."""
 RAIL_MARGIN: Final = 1e-3
 """A gyro reading within this fraction of gyro_range is at the rail: a 16-bit converter's last
 code is 0.003 % below its range, and no rate the sensor measured sits that close to it unless it

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from .building_blocks import CONSTANT_NOISE
-from .types import DEG, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
+from .types import DEG, GYRO_RANGE_DEFAULT, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
 
 DEG2 = DEG * DEG
 NO_RAIL: dict[str, Any] = {"gyro_range": 1e4}
@@ -114,8 +114,8 @@ REFERENCE_ACC_SAMPLE_STD = 0.05
 recommended values are derived for (BROAD's myon aktos-t: 0.045-0.07 m/s^2 per axis)."""
 
 
-def noise_preset(gyro_density: float, acc_density: float,
-                 acc_sample_std: float) -> dict[str, dict[str, float]]:
+def noise_preset(gyro_density: float, acc_density: float, acc_sample_std: float,
+                 gyro_range: float = GYRO_RANGE_DEFAULT) -> dict[str, dict[str, float]]:
     """The recommended values that follow from a sensor's noise, per estimator: the derivations
     of the classes' docstrings as one function, which `python -m testbenches noise` applies to
     a user's own sensor. gyro_density [rad/s/sqrt(Hz)] and acc_density [m/s^2/sqrt(Hz)] are
@@ -128,20 +128,23 @@ def noise_preset(gyro_density: float, acc_density: float,
     PSD and gyro_psd the gyro's (its tilt stage keeps the papers' Q and R, which the position
     contract was met with); cf and mgcf: acc_noise = acc_sample_std / g, the reference their
     adaptive noise is measured against (their time constants come from the bias a correction must
-    hold off and from scans, see their docstrings).
+    hold off and from scans, see their docstrings). gyro_range [rad/s], the gyro's full-scale
+    setting (a datasheet value no static recording shows), goes to every estimator: a sample at
+    it is clipped (base.Estimator).
 
     The recommended defaults are this function at the reference sensor, kalman.REAL_GYRO_DENSITY,
     position.REAL_ACC_DENSITY and REFERENCE_ACC_SAMPLE_STD (tests/test_presets.py holds them to
     it; the acc_noise of cf, mgcf and ukf is rounded to 0.005)."""
     gyro_psd = gyro_density * gyro_density
     r = (acc_sample_std / G) ** 2
-    return {
+    own = {
         "cf": {"acc_noise": acc_sample_std / G},
         "mgcf": {"acc_noise": acc_sample_std / G},
         "kf": {"Q_angle": gyro_psd, "R_measure": r, "gyro_psd": gyro_psd},
         "ukf": {"gyro_psd": gyro_psd, "zaru_psd": gyro_psd, "acc_noise": acc_sample_std / G},
         "poskf": {"acc_psd": acc_density * acc_density, "gyro_psd": gyro_psd},
     }
+    return {key: {**params, "gyro_range": gyro_range} for key, params in own.items()}
 
 
 def preset_params(preset: str, key: str) -> dict[str, Any]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
@@ -11,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fusion_core import DEG, G
+from fusion_core import DEG, ESTIMATORS, G
 from fusion_core.presets import load_preset, noise_preset
 from testbenches.fit.noise import analyse, run_noise
 from testbenches.fit.recording import Recording, RecordingError, load
@@ -186,3 +187,20 @@ def test_the_tune_command_on_csv_recordings_with_roll_and_pitch(tmp_path):
     assert result["validation_rmse_deg"] is not None and result["evaluations"] <= 25
     assert (tmp_path / "out" / "tune.png").is_file()
     assert "tau" in load_preset(tmp_path / "out" / "preset.json")["cf"]
+
+
+def test_noise_gives_the_gyro_range_to_every_estimator_and_the_sensor(tmp_path, capsys):
+    """`noise --gyro-range 500`: a gyro set to +-500 deg/s clips there, so every estimator of
+    preset.json and the sensor model of sensor.json take gyro_range = 500 deg/s in rad/s."""
+    from testbenches.__main__ import main
+
+    path = static_csv(tmp_path / "static.csv", 60.0, 100.0)
+    assert main(["noise", str(path), "--gyro-range", "500", "--no-plots",
+                 "--out", str(tmp_path / "out")]) == 0
+    assert "+-500 deg/s" in capsys.readouterr().out
+    preset = load_preset(tmp_path / "out" / "preset.json")
+    assert {p["gyro_range"] for p in preset.values()} == {math.radians(500.0)}
+    sensor = json.loads((tmp_path / "out" / "sensor.json").read_text())
+    assert sensor["gyro_range"] == math.radians(500.0)
+    kf = ESTIMATORS["kf"](**preset["kf"])  # an estimator takes it
+    assert kf.params["gyro_range"] == math.radians(500.0)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -22,6 +23,10 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
                        help="sampling rate [Hz] of a CSV without time or dt columns")
     noise.add_argument("--out", type=Path, default=Path("reports/noise"),
                        help="folder for noise.json, preset.json, sensor.json, allan.png")
+    noise.add_argument("--gyro-range", type=positive_float, default=2000.0, metavar="DEG_S",
+                       help="the gyro's full-scale range setting [deg/s] from its datasheet or "
+                       "its configuration (a static recording cannot show it): every estimator "
+                       "treats a sample at it as clipped (2000, the MPU-6050 class's widest)")
     noise.add_argument("--no-plots", action="store_true", help="skip allan.png")
 
     tune = sub.add_parser(
@@ -60,13 +65,15 @@ def cmd_noise(args: argparse.Namespace) -> int:
     from .recording import load, rest
 
     rec = rest(load(args.file, args.rate))
-    noise = run_noise(rec, args.out, plots=not args.no_plots)
+    noise = run_noise(rec, args.out, plots=not args.no_plots,
+                      gyro_range=math.radians(args.gyro_range))
     g, a = noise["gyro_density"]["mean"], noise["acc_density"]["mean"]
     print(f"{rec.name}: {rec.duration:.0f} s at {rec.rate:g} Hz")
     print(f"  gyro white noise {noise['gyro_density_deg_s_sqrt_hz']:.4g} deg/s/sqrt(Hz) "
           f"(gyro_psd {g * g:.4g} rad2/s)")
     print(f"  acc white noise {noise['acc_density_ug_sqrt_hz']:.4g} ug/sqrt(Hz) "
           f"(acc_psd {a * a:.4g} m2/s3)")
+    print(f"  gyro range +-{args.gyro_range:g} deg/s (gyro_range {noise['gyro_range']:.6g} rad/s)")
     if "note" in noise:
         print(f"  note: {noise['note']}")
     print(f"wrote {args.out}/noise.json, preset.json, sensor.json"

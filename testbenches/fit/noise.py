@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from fusion_core.presets import noise_preset
-from fusion_core.types import DEG, G
+from fusion_core.types import DEG, GYRO_RANGE_DEFAULT, G
 
 from .allan import AllanFit, allan_deviation, fit
 from .recording import Recording, RecordingError
@@ -114,14 +114,15 @@ def analyse(rec: Recording) -> tuple[dict[str, Any], dict[str, list[AllanFit]]]:
 def preset_for(noise: dict[str, Any]) -> dict[str, dict[str, float]]:
     """The recommended-style preset for every estimator (fusion_core.presets.noise_preset)."""
     return noise_preset(noise["gyro_density"]["mean"], noise["acc_density"]["mean"],
-                        noise["acc_sample_std"])
+                        noise["acc_sample_std"], noise.get("gyro_range", GYRO_RANGE_DEFAULT))
 
 
 def sensor_params(noise: dict[str, Any]) -> dict[str, float]:
     """The sensor FMU's (ImuSensor's) parameters for this sensor: its white noise, and its bias
     instability and random walk where the recording resolved them (the per-run calibration
     residual, scale and cross-axis errors keep the model's defaults)."""
-    out = {"gyro_psd": noise["gyro_psd"]["mean"], "acc_psd": noise["acc_psd"]["mean"]}
+    out = {"gyro_psd": noise["gyro_psd"]["mean"], "acc_psd": noise["acc_psd"]["mean"],
+           "gyro_range": noise.get("gyro_range", GYRO_RANGE_DEFAULT)}
     for sig in ("gyro", "acc"):
         b = noise[f"{sig}_bias_instability"]["mean"]
         if b is not None:
@@ -165,10 +166,14 @@ def plot(fits: dict[str, list[AllanFit]], path: Path, title: str) -> None:
     plt.close(fig)
 
 
-def run_noise(rec: Recording, out_dir: Path, plots: bool = True) -> dict[str, Any]:
+def run_noise(rec: Recording, out_dir: Path, plots: bool = True,
+              gyro_range: float = GYRO_RANGE_DEFAULT) -> dict[str, Any]:
     """Write noise.json, preset.json, sensor.json (and allan.png) into out_dir; return the
-    noise.json content."""
+    noise.json content. gyro_range [rad/s]: the gyro's full-scale setting, which goes to every
+    estimator and to the sensor model."""
     noise, fits = analyse(rec)
+    noise["gyro_range"] = gyro_range
+    noise["units"]["gyro_range"] = "rad/s"
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "noise.json").write_text(json.dumps(noise, indent=1))
     (out_dir / "preset.json").write_text(json.dumps(preset_for(noise), indent=1))
