@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup run demo test test-slow lint fmus native campaign clean
+.PHONY: setup run demo test test-fast test-slow lint fmus native campaign clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -46,6 +46,10 @@ native: setup
 
 test: setup
 	$(BIN)/python -m pytest -q
+
+# The fast tier: everything but the tests that need built FMUs and the slow campaigns.
+test-fast: setup
+	$(BIN)/python -m pytest -q -m 'not slow and not fmu'
 
 test-slow: setup
 	$(BIN)/python -m pytest -q -m slow

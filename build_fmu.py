@@ -18,7 +18,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from fmu_src.build import KINDS, build_all, default_kind, format_table, model_names
+from fmu_src.build import KINDS, build_all, default_kind, format_table
+from fmu_src.names import model_names
 
 
 def main(argv: list[str] | None = None) -> int:

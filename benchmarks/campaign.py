@@ -28,11 +28,13 @@ import time
 from pathlib import Path
 from typing import Any
 
+from fusion_core.registry import KEYS
+
 SAMPLES_PER_S_TARGET = 5e6
 SCALING_TARGET = 1.7
 WORKERS = 2
 """This machine's cores, one worker each."""
-ESTIMATORS = ("cf", "mgcf", "kf", "ukf", "poskf")
+ESTIMATORS = KEYS
 SCENARIOS = ("moderate_dynamics", "vibration")
 PASSES = 3
 CAMPAIGN_PASSES = 2

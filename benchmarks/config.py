@@ -6,7 +6,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 ESTIMATOR_KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
-"""Our estimators, by fusion_core.ESTIMATORS key."""
+"""fusion_core.registry.KEYS, written out: the command line chooses its CPU core before any
+fusion_core module is imported (tests/test_benchmarks.py holds the two equal)."""
 
 
 @dataclass(frozen=True)

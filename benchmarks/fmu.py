@@ -28,19 +28,13 @@ from typing import Any
 from fmpy.fmi2 import fmi2Real, fmi2True, fmi2ValueReference
 
 from fmu_src.host import INPUTS, FmuInstance
+from fusion_core.registry import FMU_NAMES
 from testbenches.fmus import direct_calls
 
 from .common import time_interleaved
 from .estimators import fmu_core_pass
 
 REPO = Path(__file__).resolve().parents[1]
-FMU_NAMES = {
-    "cf": "ComplementaryFilter",
-    "mgcf": "GainScheduledComplementaryFilter",
-    "kf": "AngleBiasKalmanFilter",
-    "ukf": "UnscentedKalmanFilter",
-    "poskf": "PositionKalmanFilter",
-}
 OUTPUTS = ("roll", "pitch", "bias_x", "bias_y", "bias_z")
 POSITION_OUTPUTS = ("pos_x", "pos_y", "pos_z", "vel_x", "vel_y", "vel_z")
 FLOOR_NAME = "FmuFloor"

@@ -26,9 +26,9 @@ from pathlib import Path
 from unittest import mock
 
 from .estimator import PRESET_ENV
+from .names import script_path
 
 HERE = Path(__file__).resolve().parent
-MODELS_DIR = HERE / "models"
 RUNTIME_FILES = (
     "__init__.py", "variables.py", "slave.py", "estimator.py", "model_description.py",
     "testbench_models.py",
@@ -36,27 +36,6 @@ RUNTIME_FILES = (
 """The part of fmu_src an FMU needs at run time (not the build code, not the other models)."""
 REQUIREMENTS = "numpy>=1.24\nscipy>=1.10\ncffi>=1.15\n"
 """What the host's Python must provide (resources/requirements.txt); pythonfmu is bundled."""
-
-
-def model_names() -> list[str]:
-    """Every FMU of the project, by model name."""
-    return sorted(_camel(p.name[: -len("_fmu.py")]) for p in MODELS_DIR.glob("*_fmu.py"))
-
-
-def _camel(snake: str) -> str:
-    return "".join(part.capitalize() for part in snake.split("_"))
-
-
-def _snake(camel: str) -> str:
-    return "".join("_" + c.lower() if c.isupper() else c for c in camel).lstrip("_")
-
-
-def script_path(name: str) -> Path:
-    """The slave module of the FMU called name."""
-    path = MODELS_DIR / f"{_snake(name)}_fmu.py"
-    if not path.is_file():
-        raise ValueError(f"no FMU called {name!r}: the FMUs are {', '.join(model_names())}")
-    return path
 
 
 def fusion_core_dir() -> Path:

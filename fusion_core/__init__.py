@@ -2,7 +2,8 @@
 
 Every estimator has the same API: `Estimator(**params)`, `reset()`, `step(acc, gyro, dt)`,
 `run(acc, gyro, dt)`, `get_state()` / `set_state()`, and a declarative `PARAMS` table that the
-FMU layer (fmu_src) turns into FMU parameters.
+FMU layer (fmu_src) turns into FMU parameters. The estimators are listed once, in
+fusion_core.registry.
 """
 
 from .base import Estimator
@@ -10,20 +11,14 @@ from .complementary import ComplementaryFilter
 from .kalman import AngleBiasKalmanFilter
 from .mgcf import GainScheduledComplementaryFilter
 from .position import PositionKalmanFilter
+from .registry import ESTIMATORS, REGISTRY
 from .types import DEG, Estimate, G, InvalidSample, Param
 from .ukf import UnscentedKalmanFilter
-
-ESTIMATORS: dict[str, type[Estimator]] = {
-    "cf": ComplementaryFilter,
-    "mgcf": GainScheduledComplementaryFilter,
-    "kf": AngleBiasKalmanFilter,
-    "ukf": UnscentedKalmanFilter,
-    "poskf": PositionKalmanFilter,
-}
 
 __all__ = [
     "DEG",
     "ESTIMATORS",
+    "REGISTRY",
     "AngleBiasKalmanFilter",
     "ComplementaryFilter",
     "Estimate",

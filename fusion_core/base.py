@@ -18,7 +18,15 @@ import numpy as np
 
 from .kinematics import roll_pitch_ahead
 from .state import BASE_STATE, NESTED, StateSpec, check_field
-from .types import GYRO_RANGE_DEFAULT, Estimate, G, InvalidSample, Param, check_param_names
+from .types import (
+    GYRO_RANGE_DEFAULT,
+    RUN_CHUNK,
+    Estimate,
+    G,
+    InvalidSample,
+    Param,
+    check_param_names,
+)
 
 MAX_RATE_DEFAULT: Final = 1000.0
 """Default max_rate [rad/s] (57,300 deg/s): about three times the widest full-scale range of any
@@ -81,8 +89,6 @@ like a sample in free fall: far beyond any MEMS accelerometer's range (+-16 g fo
 gyro of such a sample is still integrated."""
 BACKENDS: Final = ("auto", "python", "native")
 """Estimator.run's backends."""
-RUN_CHUNK: Final = 1024
-"""Samples that run() converts to Python floats and collects at a time."""
 _MIN_INIT_NORM2: Final = MIN_INIT_NORM * MIN_INIT_NORM
 _MAX_ACC_NORM2: Final = MAX_ACC_NORM * MAX_ACC_NORM
 tuple_new: Final = tuple.__new__
@@ -156,6 +162,9 @@ class Estimator:
 
     PARAMS: ClassVar[tuple[Param, ...]] = ()
     STATE: ClassVar[StateSpec] = {}
+    TWIN: ClassVar[str | None] = None
+    """The C twin's prefix (fusion_core/native: fc_cf for fc_cf_step, fc_cf_run, ...) where this
+    exact class has one; a subclass, which may change the Python methods, has none of its own."""
     HAS_POSITION: ClassVar[bool] = False
 
     def __init__(self, **params: Any) -> None:
@@ -372,8 +381,8 @@ class Estimator:
             if native.has_twin(self) and native.available():
                 return native.run(self, acc, gyro, dts)
             if backend == "native":
-                why = (f"{type(self).__name__} has no C twin (twins: "
-                       f"{', '.join(native.TWINS)})" if not native.has_twin(self)
+                why = (f"{type(self).__name__} has no C twin of its own (the estimators of "
+                       "fusion_core.ESTIMATORS have one)" if not native.has_twin(self)
                        else f"the C twin is unavailable: {native.reason()}")
                 raise ValueError(f"backend='native': {why}")
         out = {

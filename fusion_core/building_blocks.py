@@ -368,6 +368,10 @@ real sensor breaks both in motion, and the balance of the two sets the correctio
 CONSTANT_NOISE: Final = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
 """ADAPTIVE_NOISE_PARAMS off: a constant Q and R and a pre-filter of fixed length, as the papers'
 filters have them."""
+NO_RAIL: Final[dict[str, Any]] = {"gyro_range": 1e4}
+"""The papers' filters know no gyro range: at 10^4 rad/s (the largest gyro_range) every sample
+that max_rate lets through is below the rail, and none is treated as clipped."""
+
 
 
 def adaptive_noise_constants(p: Any, acc_tau: float, r: float) -> tuple[float, float, float]:

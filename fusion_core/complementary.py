@@ -123,6 +123,7 @@ class ComplementaryFilter(Estimator):
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
     )
+    TWIN: ClassVar[str | None] = "fc_cf"
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "meas": MEASURE_CHECK, "q_att": UNIT, "bias": REAL,
         "rest": REST,

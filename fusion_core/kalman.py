@@ -18,8 +18,8 @@ biases are exactly the degree filter's times pi/180 (tests/test_kalman.py checks
 from __future__ import annotations
 
 import dataclasses
-from math import cos, sin, sqrt
-from typing import ClassVar, Final
+from math import cos, pi, sin, sqrt
+from typing import Any, ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import (
@@ -28,10 +28,12 @@ from .building_blocks import (
     ADAPTIVE_NOISE_PARAMS,
     BIAS_GATE_PARAM,
     BIAS_INNOVATION_PARAM,
+    CONSTANT_NOISE,
     FACE_SWITCH_COS,
     FACES,
     GYRO_SAMPLING_PARAM,
     MAX_CORRECTION_TIME_PARAM,
+    NO_RAIL,
     PROPAGATION_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
@@ -90,6 +92,19 @@ RECOMMENDED_INIT_BIAS_STD: Final = 0.3 * DEG
 realistic MPU-6050's 0.16 deg/s, 1 sigma, its datasheet's drift over 1 K of warm-up), about two
 standard deviations. A larger prior lets the first seconds of motion (a slow translation, a
 ramp of linear acceleration the statistic has not yet measured) into the bias."""
+PAPER_KF: Final[dict[str, Any]] = {
+    "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
+    "R_loop_time": 0.033, **CONSTANT_NOISE, "gate_low": 0.9,
+    "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0, "bias_gate": 0.0,
+    "bias_innovation": pi, "propagation": "euler", "tilt_axes": "body",
+    "gyro_sampling": "mean", "sensor_delay": 0.0, **NO_RAIL,
+}
+"""Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
+(times (pi/180)^2 here), tuned at Gui et al.'s loop time of 0.033 s (R_loop_time: the same
+correction time constant at any rate, AngleBiasKalmanFilter), P = 0 at the start, the
+Euler rates, the rectangle rule; their Q and R are constants (gyro_scale_std and
+disturbance_time 0)."""
+
 RECOMMENDED_R: Final = (0.05 / G) ** 2
 """Recommended R_measure [rad^2]: the variance of one accelerometer sample's tilt, (0.05 m/s^2 /
 g)^2 = (0.29 deg)^2, from the accelerometer's noise measured at rest on a real MEMS IMU
@@ -296,6 +311,7 @@ class AngleBiasKalmanFilter(Estimator):
         BAND_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
+    TWIN: ClassVar[str | None] = "fc_kf"
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "bias_x": REAL, "bias_y": REAL, "P_roll": COV,
         "P_pitch": COV, "bias_z": REAL, "P_z": NONNEG, "meas": MEASURE_CHECK, "rest": REST,

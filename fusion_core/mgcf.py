@@ -159,6 +159,7 @@ class GainScheduledComplementaryFilter(Estimator):
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
+    TWIN: ClassVar[str | None] = "fc_mgcf"
     STATE: ClassVar[StateSpec] = {
         "q": UNIT, "bias": REAL, "w0_now": NONNEG, "meas": MEASURE_CHECK, "rest": REST,
     }

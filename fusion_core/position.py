@@ -24,9 +24,8 @@ from typing import Any, ClassVar
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import CONSTANT_NOISE, zero_rate_psd_param
-from .kalman import AngleBiasKalmanFilter
+from .kalman import PAPER_KF, AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
-from .presets import PAPER_KF
 from .state import ANGLE, COV, FLAG, NESTED, NONNEG, REAL, Queue, Segments, StateSpec
 from .types import DEG, Estimate, G, Param
 
@@ -279,6 +278,7 @@ class PositionKalmanFilter(Estimator):
             for p in AngleBiasKalmanFilter.PARAMS if p.name in TILT_PARAMS
         ),
     )
+    TWIN: ClassVar[str | None] = "fc_poskf"
     STATE: ClassVar[StateSpec] = {
         "yaw": ANGLE, "states": REAL, "P": COV, "quiet_time": NONNEG, "stationary": FLAG,
         "pending": Queue(Segments(((NONNEG, 1), (REAL, 4))), 5, PENDING_MAX), "turned": REAL,

@@ -25,14 +25,12 @@ import math
 from pathlib import Path
 from typing import Any
 
-from .building_blocks import CONSTANT_NOISE
+from .building_blocks import CONSTANT_NOISE, NO_RAIL
+from .kalman import PAPER_KF
+from .registry import ESTIMATORS, KEYS
 from .types import DEG, GYRO_RANGE_DEFAULT, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
 
 DEG2 = DEG * DEG
-NO_RAIL: dict[str, Any] = {"gyro_range": 1e4}
-"""The papers' filters know no gyro range: at 10^4 rad/s (the largest gyro_range) every sample
-that max_rate lets through is below the rail, and none is treated as clipped."""
-KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
 
 PAPER_CF: dict[str, Any] = {
     "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
@@ -52,19 +50,6 @@ PAPER_MGCF: dict[str, Any] = {
 reference order (error from the previous attitude, first-order step: gyro_sampling="mean").
 Their experiment (section 4.2) is schedule="experimental"; their CCF is schedule="fixed",
 w0 = 0.05."""
-
-PAPER_KF: dict[str, Any] = {
-    "Q_angle": 0.001 * DEG2, "Q_bias": 0.003 * DEG2, "R_measure": 0.03 * DEG2,
-    "R_loop_time": 0.033, **CONSTANT_NOISE, "gate_low": 0.9,
-    "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0, "bias_gate": 0.0,
-    "bias_innovation": math.pi, "propagation": "euler", "tilt_axes": "body",
-    "gyro_sampling": "mean", "sensor_delay": 0.0, **NO_RAIL,
-}
-"""Gui et al. eq. 5-26, Das & Mary eq. 16-27: Q_angle 0.001, Q_bias 0.003, R 0.03 in degrees
-(times (pi/180)^2 here), tuned at Gui et al.'s loop time of 0.033 s (R_loop_time: the same
-correction time constant at any rate, kalman.AngleBiasKalmanFilter), P = 0 at the start, the
-Euler rates, the rectangle rule; their Q and R are constants (gyro_scale_std and
-disturbance_time 0)."""
 
 PAPER_UKF: dict[str, Any] = {
     "gyro_psd": MPU6050_GYRO_DENSITY**2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
@@ -162,8 +147,6 @@ def load_preset(spec: str | Path) -> dict[str, dict[str, Any]]:
     """Every estimator's parameters of a preset given by name ("recommended", "paper") or as a
     JSON file {"kf": {...}, ...} (estimators it leaves out get {}: their recommended values).
     Each parameter set is checked by building its estimator: a ValueError names what is wrong."""
-    from . import ESTIMATORS
-
     text = str(spec)
     if text in PRESETS:
         return {k: dict(v) for k, v in PRESETS[text].items()}

@@ -22,6 +22,8 @@ MPU6050_GYRO_DENSITY: Final = 0.005 * DEG
 """MPU-6050 datasheet gyro rate-noise density [rad/s/sqrt(Hz)]; its square is the PSD [rad2/s]."""
 MPU6050_ACC_DENSITY: Final = 400e-6 * G
 """MPU-6050 datasheet accelerometer noise density, 400 ug/sqrt(Hz) [m/s^2/sqrt(Hz)]."""
+RUN_CHUNK: Final = 1024
+"""Samples that run() converts to Python floats and collects at a time."""
 GYRO_RANGE_DEFAULT: Final = 2000.0 * DEG
 """Default gyro_range [rad/s]: +-2000 deg/s, the widest setting of the MPU-6050 class of consumer
 MEMS gyros (the realistic sensor model's range)."""

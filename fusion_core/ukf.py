@@ -174,6 +174,7 @@ class UnscentedKalmanFilter(Estimator):
         BAND_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
+    TWIN: ClassVar[str | None] = "fc_ukf"
     STATE: ClassVar[StateSpec] = {
         "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "meas": MEASURE_CHECK, "rest": REST,
     }

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from fusion_core.registry import keys_help
 from fusion_core.scenarios import SCENARIOS
 
 from .contract import accuracy_limits, compute_metrics
@@ -179,7 +180,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     p = sub.add_parser("budget", help="which sensor error costs how much accuracy",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("--estimator", default="all",
-                   help="all or a comma list of cf, mgcf, kf, ukf, poskf (all)")
+                   help=f"all or a comma list of {keys_help()} (all)")
     p.add_argument("--scenario", default="all",
                    help=f"all or a comma list of {', '.join(SCENARIOS)} (all)")
     p.add_argument("--seeds", type=positive_int, default=3, help="seeds per row, averaged (3)")

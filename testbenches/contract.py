@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from fusion_core.registry import KEYS
 from fusion_core.sensor import SENSOR_PRESETS
 from fusion_core.types import DEG
 
@@ -59,7 +60,7 @@ T3_RATE = 100.0
 POSITION_SEEDS = 10
 POSITION_LIMIT_M = {"x": 0.0385, "y": 0.21}
 
-ATTITUDE = ("cf", "mgcf", "kf", "ukf", "poskf")
+ATTITUDE = KEYS
 NOISE_FREE = {**SENSOR_PRESETS["ideal"], "gyro_psd": 0.0, "acc_psd": 0.0, "bits": 0}
 """ImuSensor parameters of a noise-free sensor (contract checks T1 and T2): the ideal sensor with
 its white noise and quantisation off too."""

@@ -20,13 +20,9 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
-ESTIMATOR_FMUS = {
-    "cf": "ComplementaryFilter",
-    "mgcf": "GainScheduledComplementaryFilter",
-    "kf": "AngleBiasKalmanFilter",
-    "ukf": "UnscentedKalmanFilter",
-    "poskf": "PositionKalmanFilter",
-}
+from fusion_core.registry import FMU_NAMES
+
+ESTIMATOR_FMUS = FMU_NAMES
 """fusion_core.ESTIMATORS key -> FMU model name."""
 PLANT_FMU = "ImuPlant"
 SENSOR_FMU = "ImuSensor"

@@ -56,6 +56,19 @@ class BuiltFmus:
         return path
 
 
+FMU_BUILDING_FILES = ("test_fmu_state_fuzz.py", "test_fmu_state_processes.py", "test_fmu_c_host.py",
+                      "test_native_fmu.py", "test_fmu_build.py")
+"""Test files that build FMUs of their own (beside the session's built_fmus)."""
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark `fmu` every test that needs built FMUs: `make test-fast` leaves them out."""
+    for item in items:
+        if ("built_fmus" in getattr(item, "fixturenames", ())
+                or item.path.name in FMU_BUILDING_FILES):
+            item.add_marker(pytest.mark.fmu)
+
+
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     if "fmu_name" in metafunc.fixturenames:
         metafunc.parametrize("fmu_name", list(ESTIMATOR_FMUS))

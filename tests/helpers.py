@@ -8,9 +8,7 @@ import pytest
 import fusion_core
 from fusion_core import synthetic
 from fusion_core.base import Estimator
-
-KEYS = ("cf", "mgcf", "kf", "ukf", "poskf")
-"""Every estimator of the project, by its fusion_core.ESTIMATORS key."""
+from fusion_core.registry import KEYS  # noqa: F401  (every estimator; tests import it from here)
 
 RATE = 100.0
 """Sample rate of the synthetic recordings [Hz] (the contract's T1 rate)."""

@@ -174,6 +174,13 @@ def test_run_memory_beyond_the_outputs_does_not_grow_with_n(tmp_path: Path) -> N
     assert large - small < 0.25 * 41 * 6_000
 
 
+def test_the_benchmarks_list_the_registrys_estimators() -> None:
+    from benchmarks.config import ESTIMATOR_KEYS
+    from fusion_core.registry import KEYS
+
+    assert ESTIMATOR_KEYS == KEYS
+
+
 def test_the_command_line_chooses_its_core_before_fusion_core_is_imported() -> None:
     """Importing the benchmarks package and its command line imports no fusion_core module (the
     suite imports it when it runs)."""

@@ -26,7 +26,7 @@ from pathlib import Path
 import pytest
 from conftest import REPO
 
-from fmu_src.build import model_names
+from fmu_src.names import model_names
 from fmu_src.native.build import native_model, stage_sources
 from fusion_core.native import compiler
 

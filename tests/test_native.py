@@ -23,7 +23,7 @@ NATIVE = REPO / "fusion_core" / "native"
 TOL = 0.0
 """The twins agree bit for bit (the same operations in the same order, no fused multiply-add):
 every comparison of their numbers is an equality."""
-TWIN_KEYS = [k for k, cls in ESTIMATORS.items() if cls.__name__ in native.TWINS]
+TWIN_KEYS = [k for k, cls in ESTIMATORS.items() if cls.TWIN is not None]
 
 needs_twin = pytest.mark.skipif(not native.available(),
                                 reason=f"no native backend: {native.reason()}")
@@ -123,7 +123,7 @@ def test_available_and_reason_agree() -> None:
 @pytest.mark.parametrize("key", TWIN_KEYS)
 def test_the_c_defaults_are_the_python_defaults(key: str) -> None:
     lib, ffi = native.lib_and_ffi()
-    prefix = native.TWINS[ESTIMATORS[key].__name__]
+    prefix = ESTIMATORS[key].TWIN
     twin = ffi.new(f"{prefix} *")
     getattr(lib, f"{prefix}_init")(twin, ffi.NULL)
     for name, spec in ESTIMATORS[key].param_specs().items():

@@ -22,7 +22,8 @@ from fmpy.util import read_csv
 from fmpy.validation import validate_fmu
 from native_fmu import NativeFmu, refused
 
-from fmu_src.build import check, model_names
+from fmu_src.build import check
+from fmu_src.names import model_names
 
 VERSIONS = ("fmi2", "fmi3")
 EXAMPLES = {name: "tilt_motion.csv" for name in ESTIMATOR_FMUS}

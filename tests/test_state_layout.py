@@ -60,7 +60,7 @@ def _layout(prefix: str):
 @pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
 def test_the_c_layout_holds_every_state_field_of_the_python_class(key: str) -> None:
     cls = estimator_class(key)
-    _, fields = _layout(native.TWINS[cls.__name__])
+    _, fields = _layout(cls.TWIN)
     names = [n.split("[")[0] for n, _ in fields]
     expected = [f"base.{n}" for n in BASE_STATE] + list(cls.STATE)
     assert list(dict.fromkeys(names)) == expected
@@ -96,7 +96,7 @@ def test_a_twin_set_up_from_its_parameters_continues_bit_for_bit_from_the_layout
                                                                                   ) -> None:
     """Restore the way a native FMU does: T_init(params), fc_state_load, T_restored."""
     lib, ffi = native.lib_and_ffi()
-    prefix = native.TWINS[estimator_class(key).__name__]
+    prefix = estimator_class(key).TWIN
     layout, _ = _layout(prefix)
     size = lib.fc_state_size(layout)
     step = getattr(lib, f"{prefix}_step")
@@ -133,7 +133,7 @@ def test_both_twins_refuse_the_same_values(key: str) -> None:
     when the C layout's check does (the fields these classes hold alike in both twins)."""
     lib, ffi = native.lib_and_ffi()
     cls = estimator_class(key)
-    prefix = native.TWINS[cls.__name__]
+    prefix = cls.TWIN
     layout, fields = _layout(prefix)
     size = lib.fc_state_size(layout)
     est = cls()

@@ -37,6 +37,7 @@ from fusion_core.native import compiler as twin_compiler
 from fusion_core.native.generate import c_double
 
 from ..model_description import project_version, type_definitions, unit_definitions
+from ..names import script_path
 from ..variables import Variable
 
 HERE = Path(__file__).resolve().parent
@@ -98,10 +99,8 @@ class NativeModel:
 def native_model(name: str) -> NativeModel:
     """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the start
     values of the preset being built (fmu_src.estimator.PRESET_ENV)."""
-    from fusion_core.native import TWINS
     from fusion_core.sensor import SENSOR_PARAMS
 
-    from ..build import script_path
     from ..estimator import estimator_variables
 
     module = importlib.import_module(f"fmu_src.models.{script_path(name).stem}")
@@ -111,7 +110,7 @@ def native_model(name: str) -> NativeModel:
         variables = estimator_variables(estimator, cls.zero_bias)
         params = tuple(estimator.param_specs().values())
         return NativeModel(name, cls.description, variables, "estimator",
-                           TWINS[estimator.__name__], params)
+                           estimator.TWIN, params)
     if name == "ImuSensor":
         return NativeModel(name, cls.description, cls.VARIABLES, "sensor", "", SENSOR_PARAMS)
     if name == "ImuPlant":

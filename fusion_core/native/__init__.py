@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..base import RUN_CHUNK
+from ..types import RUN_CHUNK
 
 HERE = Path(__file__).resolve().parent
 SOURCES = (
@@ -51,14 +51,6 @@ DATA_HEADERS = ("fc_scenarios.h",)
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
 Python's does, which is what makes the twins equal."""
-TWINS = {
-    "ComplementaryFilter": "fc_cf",
-    "GainScheduledComplementaryFilter": "fc_mgcf",
-    "AngleBiasKalmanFilter": "fc_kf",
-    "UnscentedKalmanFilter": "fc_ukf",
-    "PositionKalmanFilter": "fc_poskf",
-}
-"""The estimators that have a C twin, by class name, and the twin's C prefix."""
 FC_SKIPPED = 1
 """fc_status: FC_OK 0 and FC_SKIPPED 1 took the sample, the larger values rejected it."""
 ESTIMATE_FIELDS = 11
@@ -222,8 +214,8 @@ def lib_and_ffi() -> tuple[Any, Any]:
 def has_twin(estimator: object) -> bool:
     """Whether this estimator's exact class has a C twin (a subclass may change its Python
     methods, so it never runs natively)."""
-    return type(estimator).__name__ in TWINS and type(estimator).__module__.startswith(
-        "fusion_core.")
+    cls = type(estimator)
+    return cls.__dict__.get("TWIN") is not None and cls.__module__.startswith("fusion_core.")
 
 
 # ----- an estimator's state and parameters, both ways ------------------------------------------
@@ -276,7 +268,7 @@ def _fill(lib: Any, twin: Any, estimator: Any) -> None:
         attrs = STATE_ATTRIBUTES.get(name, {})
         for field in estimator.STATE:
             _set_field(twin, field, getattr(estimator, attrs.get(field, field)))
-    getattr(lib, f"{TWINS[name]}_restored")(twin)
+    getattr(lib, f"{type(estimator).TWIN}_restored")(twin)
 
 
 def take_state(estimator: Any, twin: Any) -> None:
@@ -337,7 +329,7 @@ def _take_position(twin: Any, est: Any) -> None:
 def new_twin(estimator: Any) -> Any:
     """A C twin holding the estimator's parameters and its whole state."""
     lib, ffi = lib_and_ffi()
-    prefix = TWINS[type(estimator).__name__]
+    prefix = type(estimator).TWIN
     twin = ffi.new(f"{prefix} *")
     params = ffi.new(f"{prefix}_params *")
     specs = estimator.param_specs()
@@ -356,7 +348,7 @@ def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
     that, as in the Python run, memory beyond the outputs does not grow with N."""
     lib, ffi = lib_and_ffi()
     twin = new_twin(estimator)
-    run_twin = getattr(lib, f"{TWINS[type(estimator).__name__]}_run")
+    run_twin = getattr(lib, f"{type(estimator).TWIN}_run")
     n = acc.shape[0]
     out = {"roll": np.empty(n), "pitch": np.empty(n), "bias": np.empty((n, 3)),
            "rejected": np.zeros(n, dtype=bool)}
@@ -398,7 +390,7 @@ class Stepper:
     def __init__(self, estimator: Any) -> None:
         lib, ffi = lib_and_ffi()
         self.estimator = estimator
-        self._step = getattr(lib, f"{TWINS[type(estimator).__name__]}_step")
+        self._step = getattr(lib, f"{type(estimator).TWIN}_step")
         self._acc = ffi.new("double[3]")
         self._gyro = ffi.new("double[3]")
         self._null = ffi.NULL  # no estimate copied out: last() reads the twin's own
@@ -452,11 +444,9 @@ SENSOR_LISTS = ("gyro_turn_on", "acc_turn_on", "gyro_walk", "acc_walk", "gyro_gm
 
 def _sensor_twin(model: Any) -> Any:
     lib, ffi = lib_and_ffi()
-    from fusion_core.sensor import SENSOR_PARAMS
-
     twin = ffi.new("fc_sensor *")
     params = ffi.new("fc_sensor_params *")
-    for spec in SENSOR_PARAMS:
+    for spec in type(model).PARAMS:  # sensor.SENSOR_PARAMS
         value = model.params[spec.name]
         setattr(params, spec.name, spec.choices.index(value) if spec.choices else value)
     lib.fc_sensor_init(twin, params)

@@ -20,8 +20,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from fusion_core import ESTIMATORS
 from fusion_core.position import PENDING_MAX
+from fusion_core.registry import ATTITUDE_FILTERS, ESTIMATORS
 from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
 from fusion_core.state import (
     BASE_STATE,
@@ -43,9 +43,10 @@ SCENARIOS_OUTPUT = HERE / "fc_scenarios.h"
 STATE_OUTPUT = HERE / "fc_state_tables.c"
 KINDS = ("constant", "sine", "add", "min_jerk", "product", "swelling_sine")
 """The signal kinds of fusion_core.synthetic (and scenarios.swelling_sine), by their C number."""
-PREFIX = {"cf": "fc_cf", "mgcf": "fc_mgcf", "kf": "fc_kf", "ukf": "fc_ukf", "poskf": "fc_poskf",
+PREFIX = {**{key: cls.TWIN for key, cls in ESTIMATORS.items() if cls.TWIN is not None},
           "sensor": "fc_sensor"}
-"""The C name of each estimator (fusion_core.ESTIMATORS key -> prefix) and of the sensor model."""
+"""The C name of each estimator (fusion_core.ESTIMATORS key -> its class's TWIN) and of the
+sensor model."""
 
 
 def c_double(x: float) -> str:
@@ -237,7 +238,7 @@ def state_layouts() -> dict[str, list[Entry]]:
     """Every twin's state layout: the base state, then the class's STATE (the position filter's
     and the sensor's, whose C twins hold theirs in other forms, written out here)."""
     layouts: dict[str, list[Entry]] = {}
-    for key in ("cf", "mgcf", "kf", "ukf"):
+    for key in ATTITUDE_FILTERS:
         prefix = PREFIX[key]
         entries = _base_entries() + _entries(ESTIMATORS[key].STATE)
         layouts[prefix] = [(n, path, C_CHECKS.get((prefix, path), check), size)

@@ -12,6 +12,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from fusion_core.registry import keys_help
+
 from ..fmus import DEFAULT_FMU_DIR
 from ..options import choose, positive_float
 
@@ -33,7 +35,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("paths", nargs="+", type=Path, metavar="PATH",
                    help="BROAD trial files (.hdf5, .mat) or folders of them")
     p.add_argument("--estimator", default="all",
-                   help="all or a comma list of cf, mgcf, kf, ukf, poskf (all)")
+                   help=f"all or a comma list of {keys_help()} (all)")
     p.add_argument("--preset", default="recommended",
                    help="recommended (the defaults, for real MEMS sensors), paper (the seed "
                    "papers' values), a JSON file of parameters per estimator, all (both named "

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from fusion_core import ESTIMATORS
+from fusion_core.registry import ATTITUDE_FILTERS, ESTIMATORS
 
 from .data import BroadTrial
 from .metric import gravity_from_quat, gravity_from_roll_pitch, inclination_rmse_deg
@@ -39,7 +39,7 @@ vector's length (VQF's 3 s time constant sits at the long end once its gain is c
 slow_band_time: the corner between the disturbance the pre-filter removes and the one that
 reaches the vector (measured_vector.BAND_PARAM). Every other default comes from the sensor's
 physics (its noise densities, its range) or is a bound (max_correction_time)."""
-CV_ESTIMATORS: tuple[str, ...] = ("cf", "mgcf", "kf", "ukf")
+CV_ESTIMATORS: tuple[str, ...] = ATTITUDE_FILTERS
 """The estimators with a measured vector (the position filter's attitude is the kf's)."""
 FOLDS: tuple[str, ...] = ("slow_rotation", "fast_rotation", "translation", "disturbed_combined")
 """The motion folds, from BROAD's groups (fold_of)."""
