@@ -15,8 +15,13 @@ fmu_src.build.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import sys
 from pathlib import Path
+
+if [m for m in ("fmpy", "pythonfmu") if importlib.util.find_spec(m) is None]:
+    sys.exit("build_fmu.py needs fmpy and pythonfmu, the testbench extra: "
+             "pip install 'imu-fusion-fmu[testbench]'")
 
 from fmu_src.build import KINDS, build_all, default_kind, format_table
 from fmu_src.names import model_names

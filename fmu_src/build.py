@@ -9,7 +9,8 @@ A pythonfmu FMU carries in resources/ its slave module, fusion_core (the Python 
 where a C compiler built it, the C twin's library beside them: its estimators then step through
 the twin, fusion_core.native.Stepper), the runtime part of fmu_src, pythonfmu (added by
 pythonfmu's builder) and a requirements.txt with what the host interpreter must provide (numpy,
-scipy, cffi). A host of another platform, or without cffi, runs the Python sources.
+cffi: nothing the FMUs run imports more). A host of another platform, or without cffi, runs the
+Python sources.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ RUNTIME_FILES = (
     "testbench_models.py",
 )
 """The part of fmu_src an FMU needs at run time (not the build code, not the other models)."""
-REQUIREMENTS = "numpy>=1.24\nscipy>=1.10\ncffi>=1.15\n"
+REQUIREMENTS = "numpy>=1.24\ncffi>=1.15\n"
 """What the host's Python must provide (resources/requirements.txt); pythonfmu is bundled."""
 
 

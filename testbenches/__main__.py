@@ -16,8 +16,16 @@
 
 from __future__ import annotations
 
-import argparse
 import sys
+
+from . import INSTALL_HINT, missing_modules
+
+if missing_modules():  # one line instead of a traceback from deep inside a command
+    print(f"python -m testbenches needs the testbench extra ({INSTALL_HINT}); not installed: "
+          f"{', '.join(missing_modules())}", file=sys.stderr)
+    sys.exit(2)
+
+import argparse
 from pathlib import Path
 from typing import Any
 

@@ -195,7 +195,7 @@ def test_fmu_carries_fusion_core_and_requirements(fmu_path):
     assert "resources/fmu_src/slave.py" in names
     assert f"resources/{module}.py" in names
     assert "binaries/linux64/" + fmu_path.stem + ".so" in names
-    assert sorted(r.split(">=")[0] for r in requirements) == ["cffi", "numpy", "scipy"]
+    assert sorted(r.split(">=")[0] for r in requirements) == ["cffi", "numpy"]
 
 
 def test_slave_modules_have_unique_names(built_fmus):

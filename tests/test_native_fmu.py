@@ -441,3 +441,23 @@ def test_the_windows_binary_of_every_native_fmu_runs_under_wine(built_fmus, wind
         b = np.array(linux.stdout.split(), dtype=float)
         assert a.shape == b.shape == (len(reals),)
         assert np.max(np.abs(a - b)) <= 1e-12
+
+
+def test_the_build_gives_no_compiler_warning(built_fmus):
+    """A user's compiler may warn where ours does not, so a warning does not stop a build
+    (fmu_src.native.build.CompilerWarning); here, in CI, it fails the suite."""
+    assert built_fmus.returncode == 0
+    assert "CompilerWarning" not in built_fmus.output, built_fmus.output
+
+
+def test_the_binaries_go_where_the_host_platform_says(monkeypatch):
+    import platform
+
+    from fmu_src.native import build
+
+    monkeypatch.setattr(platform, "system", lambda: "Linux")
+    monkeypatch.setattr(platform, "machine", lambda: "x86_64")
+    assert build.host_platform()["fmi2"] == "linux64"
+    monkeypatch.setattr(platform, "machine", lambda: "riscv64")
+    with pytest.raises(RuntimeError, match="no FMU binary folder is known for Linux on riscv64"):
+        build.host_platform()
