@@ -47,9 +47,10 @@ native: setup
 test: setup
 	$(BIN)/python -m pytest -q
 
-# The fast tier: everything but the tests that need built FMUs and the slow campaigns.
+# The fast tier: everything but the tests that need built FMUs, the heavy integration runs and
+# the slow campaigns, on two workers.
 test-fast: setup
-	$(BIN)/python -m pytest -q -m 'not slow and not fmu'
+	$(BIN)/python -m pytest -q -n 2 -m 'not slow and not fmu and not heavy'
 
 test-slow: setup
 	$(BIN)/python -m pytest -q -m slow

@@ -207,6 +207,7 @@ ALL_TRIALS = sorted(p for p in DATA.glob("*") if p.suffix in (".hdf5", ".mat"))
 
 @pytest.mark.skipif(len(ALL_TRIALS) != 13, reason=f"the 13 shared BROAD trials are not all in "
                     f"{DATA} (found {len(ALL_TRIALS)})")
+@pytest.mark.heavy
 def test_the_defaults_meet_the_broad_targets_on_the_13_shared_trials() -> None:
     """The interface's accuracy targets with the defaults: the best estimator <= 0.65 deg mean
     inclination RMSE (VQF as published: 0.689), cf, mgcf, kf and ukf <= 0.9, poskf <= 1.5 and
@@ -251,6 +252,7 @@ def test_cli_refuses_a_file_that_is_not_a_broad_trial(
     assert "not a BROAD trial" in capsys.readouterr().err
 
 
+@pytest.mark.heavy
 def test_cli_runs_the_peers_on_the_same_trial(tmp_path: Path) -> None:
     pytest.importorskip("vqf")
     pytest.importorskip("ahrs")

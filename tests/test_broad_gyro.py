@@ -58,6 +58,7 @@ def synthetic_trial(gyro_sampling: str, seconds: float = 30.0, lag: float = 0.0)
                       sensor_delay=lag)
 
 
+@pytest.mark.heavy
 @pytest.mark.parametrize("sampling", ["mean", "point"])
 def test_the_fit_recovers_a_known_sensitivity_matrix_and_bias(sampling: str) -> None:
     fit = fit_gyro(synthetic_trial(sampling))

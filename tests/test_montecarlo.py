@@ -24,6 +24,7 @@ def small_plan(seeds: int = 4, design: str = "lhs") -> list:
                 sensor=load_sensor("realistic"), kind=design)
 
 
+@pytest.mark.heavy
 def test_a_small_campaign_on_two_local_workers_writes_one_row_per_run(tmp_path):
     runs = small_plan()
     stats = execute(runs, tmp_path, "local", workers=2, batch_size=3, log=lambda s: None)
@@ -49,6 +50,7 @@ def test_the_same_campaign_again_runs_nothing_and_keeps_each_run_once(tmp_path):
 
 
 
+@pytest.mark.heavy
 def test_a_sobol_campaign_grows_by_running_only_the_new_seeds(tmp_path):
     """A Sobol sequence's first N points are those of any longer one, so more seeds add runs
     (a Latin hypercube of another size is another design: it runs anew)."""
@@ -152,6 +154,7 @@ def test_an_fmu_in_the_loop_run_scores_as_the_native_core_run(built_fmus):
         assert a[metric] == b[metric]
 
 
+@pytest.mark.heavy
 def test_the_campaign_command_writes_its_summary_and_plots(tmp_path):
     import json
     import subprocess

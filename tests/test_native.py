@@ -219,6 +219,7 @@ def test_random_short_recordings_give_equal_outputs(samples: list, key: str, pre
     assert_same(out_py, out_c)
 
 
+@pytest.mark.heavy
 @needs_twin
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind is not installed")
 def test_valgrind_finds_no_memory_error_in_a_native_run(tmp_path: Path) -> None:

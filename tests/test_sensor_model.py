@@ -40,6 +40,7 @@ def test_uncalibrated_turn_on_bias_reaches_the_datasheet_tolerance() -> None:
     assert biases.std() == pytest.approx(20.0 / 3.0 * DEG, rel=0.1)
 
 
+@pytest.mark.heavy
 @pytest.mark.parametrize("cfg", [3, 4, 5])
 def test_the_dlpf_corner_frequency_from_a_sine_sweep_is_the_datasheets(cfg: int) -> None:
     """At 1 kHz the gyro's DLPF passes a sine at its datasheet bandwidth at -3 dB (1/sqrt 2)."""
