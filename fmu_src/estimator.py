@@ -135,8 +135,8 @@ def estimator_variables(
     outputs.append(
         integer_output(
             "invalid_samples",
-            "Samples rejected so far (NaN or infinite values, dt <= 0, dt > max_dt, "
-            "|acc| < 0.1 g); a rejected sample leaves the filter state unchanged",
+            "Samples rejected so far (a NaN or infinite value, dt <= 0, dt > max_dt, a gyro "
+            "rate above max_rate); a rejected sample leaves the filter state unchanged",
         )
     )
     if cls.HAS_POSITION:

@@ -108,7 +108,7 @@ removes most of it, without the lag that a body-frame low-pass has while the sen
 the filtered vector is kept in body axes and turned with the gyro's rotation increment each
 sample (a world-fixed vector seen from the body), which is the same filter. Each paper's filter is
 then unchanged: it takes the filtered vector where it took the raw sample. Measured on BROAD's
-real recordings (testbenches/broad.py): the fast-translation trials, whose raw accelerometer
+real recordings (testbenches/broad): the fast-translation trials, whose raw accelerometer
 swings between 0.02 g and 5 g, drop from tens of degrees to below 1 deg of inclination error."""
 
 PROPAGATION_PARAM = Param(

@@ -92,14 +92,15 @@ class GainScheduledComplementaryFilter(Estimator):
     Per sample (a valid one after the first):
       v   = R(q)^T e_z, the estimated gravity direction in the body frame;
       e   = a/|a| x v (Mahony's correction term), v taken after the gyro prediction to this
-            sample's time (trapezoid) or from the previous attitude (rectangle, Mahony's code);
+            sample's time (gyro_sampling="point") or from the previous attitude
+            (gyro_sampling="mean", Mahony's code);
       rho = | |a|/g - 1 |; w0 = schedule(rho) (or the parameter w0 with schedule="fixed");
       Kp  = 2 zeta w0, Ki = w0^2;
       b  <- b - Ki e dt (the integral term; b is the gyro-bias estimate, output as bias_*);
       the body rate gyro - b + Kp e rotates q over dt. With gyro_sampling="point" the rate is
       taken linear between the previous and the current gyro sample and integrated with the
-      two-sample coning correction (kinematics.rotation_increment); with "rectangle" q is
-      advanced with the current rate by first-order quaternion integration (the papers' rule).
+      two-sample coning correction (kinematics.rotation_increment); with "mean" q is advanced
+      with the current rate by first-order quaternion integration (the papers' rule).
     Roll and pitch come from the quaternion; yaw is carried along but unobservable.
 
     Options for real sensors, both on by default (the `paper` preset turns them off, and then

@@ -117,9 +117,10 @@ def noise_preset(gyro_density: float, acc_density: float, acc_sample_std: float,
     setting (a datasheet value no static recording shows), goes to every estimator: a sample at
     it is clipped (base.Estimator).
 
-    The recommended defaults are this function at the reference sensor, kalman.REAL_GYRO_DENSITY,
-    position.REAL_ACC_DENSITY and REFERENCE_ACC_SAMPLE_STD (tests/test_presets.py holds them to
-    it; the acc_noise of cf, mgcf and ukf is rounded to 0.005)."""
+    The recommended defaults are this function at the reference sensor,
+    building_blocks.REAL_GYRO_DENSITY, position.REAL_ACC_DENSITY and REFERENCE_ACC_SAMPLE_STD
+    (tests/test_presets.py holds them to it; the acc_noise of cf, mgcf and ukf is rounded to
+    0.005)."""
     gyro_psd = gyro_density * gyro_density
     r = (acc_sample_std / G) ** 2
     own = {

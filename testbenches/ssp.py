@@ -10,9 +10,10 @@ the previous communication point, and connectors start at 0. So, against our Gau
 (docs/interface.md), the sensor sees the plant one step late and the estimator the sensor one step
 late: the estimator's output in row k (labelled with the step's start time) is the master's
 estimate of step k - 2. The first two samples reaching the estimator are all-zero (the connectors'
-start values): the estimator rejects them (|acc| < 0.1 g) and counts 2 invalid samples. With a
-noise-free sensor the shifted traces are bit-identical (tests/test_testbench.py); with noise they
-differ because the sensor's first noise draw goes to the zero sample.
+start values): the first is rejected (dt = 0; 1 invalid sample) and the second skipped (no
+gravity to start from). With a noise-free sensor the shifted traces are bit-identical
+(tests/test_testbench.py); with noise they differ because the sensor's first noise draw goes to
+the zero sample.
 
 fmpy 0.3.32's SSP reader sets Boolean parameters to true whatever their value and does not map
 enumeration item names; export only Real and Integer parameters for it (other tools read the SSV

@@ -1,0 +1,163 @@
+"""The C twin as a library: its sources, the compiler, the build (cached by content and flags)
+and the cffi binding whose declarations are the headers' (fusion_core.native)."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+SOURCES = (
+    "fc_core.c", "fc_noise.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c",
+    "fc_sensor.c", "fc_plant.c", "fc_state.c", "fc_state_tables.c",
+)
+"""The C sources, in link order."""
+HEADERS = (
+    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_state.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h",
+    "fc_ukf.h", "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
+)
+"""The headers, in the order the binding declares them."""
+DATA_HEADERS = ("fc_scenarios.h",)
+"""Headers of tables the binding does not declare (the scenarios' signal nodes), compiled in."""
+CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
+"""No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
+Python's does, which is what makes the twins equal."""
+PREBUILT = HERE / "libfusion_core.so"
+"""A library built beside the sources, as the pythonfmu FMUs ship it (fmu_src.build): loaded
+first where it loads (same platform); elsewhere the library is built or Python runs."""
+
+_lib: Any = None
+_ffi: Any = None
+_reason: str | None = "not loaded yet"
+_tried = False
+
+
+def cache_dir() -> Path:
+    """Where the built library is kept: FUSION_CORE_NATIVE_CACHE, else build/native in a source
+    checkout, else the user's cache folder."""
+    env = os.environ.get("FUSION_CORE_NATIVE_CACHE")
+    if env:
+        return Path(env)
+    repo = HERE.parents[1]
+    if (repo / "pyproject.toml").is_file():
+        return repo / "build" / "native"
+    return Path.home() / ".cache" / "imu-fusion-fmu" / "native"
+
+
+def compiler() -> str | None:
+    """The C compiler to build with: $CC, else cc, gcc or clang on the PATH."""
+    cc = os.environ.get("CC")
+    if cc:
+        return shutil.which(cc)
+    for name in ("cc", "gcc", "clang"):
+        found = shutil.which(name)
+        if found:
+            return found
+    return None
+
+
+def _key(cc: str) -> str:
+    h = hashlib.sha256()
+    for name in (*SOURCES, *HEADERS, *DATA_HEADERS):
+        h.update(name.encode() + b"\0" + (HERE / name).read_bytes())
+    h.update(" ".join((cc, *CFLAGS)).encode())
+    return h.hexdigest()[:16]
+
+
+def build(force: bool = False) -> Path:
+    """Compile the library (unless cached) and return its path; RuntimeError saying why not."""
+    cc = compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler found (set CC, or install cc, gcc or clang)")
+    target = cache_dir() / _key(cc) / "libfusion_core.so"
+    if target.is_file() and not force:
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
+    os.close(fd)
+    cmd = [cc, *CFLAGS, "-o", tmp, *(str(HERE / s) for s in SOURCES), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        os.unlink(tmp)
+        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-10:])
+        raise RuntimeError(f"building the C twin failed ({' '.join(cmd)}):\n{tail}")
+    os.replace(tmp, target)  # atomic: a parallel build never sees half a library
+    return target
+
+
+def cdef() -> str:
+    """The headers as cffi declarations: comments, include guards, #includes, macros and the
+    static inline default functions left out; integer #defines kept, and written into the
+    declarations that use them (array sizes)."""
+    out: list[str] = []
+    defines: dict[str, str] = {}
+    for name in HEADERS:
+        text = re.sub(r"/\*.*?\*/", "", (HERE / name).read_text(), flags=re.S)
+        text = text.replace("\\\n", " ")  # a macro's continued lines into one
+        text = re.sub(r"static inline[^{]*\{.*?\n\}\n", "", text, flags=re.S)
+        for line in text.splitlines():
+            line = line.rstrip()
+            define = re.match(r"#define (\w+) (-?\d+)$", line)
+            if define:
+                defines[define.group(1)] = define.group(2)
+            elif line.startswith("#"):
+                continue
+            elif defines:
+                line = re.sub(r"\b(" + "|".join(defines) + r")\b",
+                              lambda m: defines[m.group(1)], line)
+            out.append(line)
+    return "\n".join(out)
+
+
+def _load() -> None:
+    global _lib, _ffi, _reason, _tried
+    _tried = True
+    try:
+        import cffi  # type: ignore[import-untyped]
+    except ImportError as err:
+        _reason = f"cffi is not installed ({err})"
+        return
+    ffi = cffi.FFI()
+    try:
+        ffi.cdef(cdef())
+    except (cffi.CDefError, cffi.FFIError) as err:
+        _reason = str(err)
+        return
+    if PREBUILT.is_file():  # an FMU's copy: the library built with it, if it loads here
+        try:
+            _lib, _ffi, _reason = ffi.dlopen(str(PREBUILT)), ffi, None
+            return
+        except OSError:
+            pass
+    try:
+        _lib = ffi.dlopen(str(build()))
+        _ffi = ffi
+        _reason = None
+    except (RuntimeError, OSError) as err:
+        _reason = str(err)
+
+
+def available() -> bool:
+    """Whether the C twin is built and loaded (building it on first use)."""
+    if not _tried:
+        _load()
+    return _lib is not None
+
+
+def reason() -> str | None:
+    """Why the C twin is not available (no compiler, build failed, ...); None when it is."""
+    available()
+    return _reason
+
+
+def lib_and_ffi() -> tuple[Any, Any]:
+    """The loaded library and its cffi FFI; RuntimeError with the reason where unavailable."""
+    if not available():
+        raise RuntimeError(f"the native backend is unavailable: {reason()}")
+    return _lib, _ffi
