@@ -319,6 +319,26 @@ def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_ti
     return bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz)
 
 
+def complementary_rest(
+    rest: RestState, bias: Vec3, gx: float, gy: float, gz: float, ax: float, ay: float,
+    az: float, dt: float, rest_time: float, rest_gyro: float, rest_acc: float, bound: float,
+) -> tuple[RestState, Vec3, tuple[float, float, Vec3] | None]:
+    """The rest detection of the filters without a bias covariance (cf, mgcf), one sample: the
+    detector steps (rest_step); at an uncalibrated first rest they align (rest_alignment),
+    otherwise at rest their bias follows the gyro (bias_at_rest). Returns the detector's state,
+    the bias and, where they aligned, (roll, pitch, the specific force the accelerometer
+    vector starts again from)."""
+    measured = rest[7]
+    rest = rest_step(rest, gx, gy, gz, ax, ay, az, bias, dt, rest_gyro, rest_acc, rest_time,
+                     bound)
+    if uncalibrated_first_rest(measured, rest, bias, rest_gyro):
+        bias, roll, pitch, f = rest_alignment(rest)
+        return rest, bias, (roll, pitch, f)
+    if rest[6] >= rest_time:
+        bias = bias_at_rest(bias, gx, gy, gz, dt, rest_time)
+    return rest, bias, None
+
+
 RECOMMENDED_GYRO_SCALE_STD: Final = 0.005
 """Recommended gyro_scale_std: the scale-factor errors of BROAD's gyro, fitted against its optical
 reference on the nine trials that turn (testbenches.broad.gyro, no estimator involved), are

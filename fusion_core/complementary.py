@@ -21,16 +21,13 @@ from .building_blocks import (
     REST_PARAMS,
     REST_START,
     ZERO3,
-    bias_at_rest,
     body_rotation,
     complementary_adaptive,
+    complementary_rest,
     correction_time,
     gate_bounds2,
     quat_from_roll_pitch,
-    rest_alignment,
     rest_start,
-    rest_step,
-    uncalibrated_first_rest,
 )
 from .kinematics import (
     HALF_PI,
@@ -48,6 +45,7 @@ from .kinematics import (
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    measure_aligned,
     measure_clipped,
     measure_constants,
     measure_start,
@@ -167,16 +165,14 @@ class ComplementaryFilter(Estimator):
         rest_time = self._rest[0]
         clipped = self.clipped  # at the gyro's rail: no rate measured (gyro_range)
         if rest_time > 0.0 and not clipped:  # at rest the gyro reads its bias: follow it
-            measured = self.rest[7]
-            self.rest = rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, self.bias, dt,
-                                         self._rest[1], self._rest[2], rest_time, self._rest[3])
-            if uncalibrated_first_rest(measured, rest, self.bias, self._rest[1]):
-                self.bias, self.roll, self.pitch, f = rest_alignment(rest)
-                self.meas = self.meas._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f)
+            self.rest, self.bias, aligned = complementary_rest(
+                self.rest, self.bias, gx, gy, gz, ax, ay, az, dt, rest_time, self._rest[1],
+                self._rest[2], self._rest[3])
+            if aligned is not None:  # an uncalibrated first rest: the attitude is its tilt
+                self.roll, self.pitch, f = aligned
+                self.meas = measure_aligned(self.meas, f)
                 if self._quaternion:
                     self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
-            elif rest[6] >= rest_time:
-                self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, rest_time)
         bias = self.bias
         bx, by, bz = bias
         r_ref, q_rotation, _, _, longest = self._adaptive

@@ -68,6 +68,7 @@ from .kinematics import (
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    measure_aligned,
     measure_clipped,
     measure_constants,
     measure_start,
@@ -485,7 +486,7 @@ class AngleBiasKalmanFilter(Estimator):
             # starts again from the rest's mean specific force, the slow band (which read the
             # vectors' disagreement as disturbance) from nothing (building_blocks.rest_alignment)
             f = (self.rest[3], self.rest[4], self.rest[5])
-            self.meas = self.meas._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f, slow=0.0)
+            self.meas = measure_aligned(self.meas, f)._replace(slow=0.0)
             self.roll, self.pitch = accel_roll_pitch(*f)
         self.P_z += self._q_bias * dt
         if self.rest[6] >= rest_time:

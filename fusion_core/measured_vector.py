@@ -190,6 +190,12 @@ def raw_noise(m: Measure, c: MeasureConstants) -> float:
     return c.r + excess / (G * G) if excess > 0.0 else c.r
 
 
+def measure_aligned(m: Measure, f: Vec3) -> Measure:
+    """The state with every low-pass at f (a rest alignment: the rest's mean specific force),
+    the statistics kept."""
+    return m._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f)
+
+
 def measure_clipped(m: Measure) -> Measure:
     """The state after a gyro sample at its rail: the vector goes on (starting it again from one
     sample costs more than the turn it carries), but the settle time starts again, so the

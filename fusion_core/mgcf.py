@@ -29,15 +29,12 @@ from .building_blocks import (
     REST_START,
     SLOWEST_CORRECTION,
     ZERO3,
-    bias_at_rest,
     body_rotation,
     complementary_adaptive,
+    complementary_rest,
     correction_time,
     quat_from_roll_pitch,
-    rest_alignment,
     rest_start,
-    rest_step,
-    uncalibrated_first_rest,
 )
 from .kinematics import (
     accel_roll_pitch,
@@ -50,6 +47,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     MEASURE_CHECK,
+    measure_aligned,
     measure_clipped,
     measure_constants,
     measure_start,
@@ -207,17 +205,13 @@ class GainScheduledComplementaryFilter(Estimator):
         whether the vector is still filling (measured_vector)."""
         clipped = self.clipped
         if self._rest_time > 0.0 and not clipped:
-            measured = self.rest[7]
-            self.rest = rest_step(
-                self.rest, gx, gy, gz, ax, ay, az, self.bias, dt, self._rest_gyro,
-                self._rest_acc, self._rest_time, self._rest_bias_bound,
-            )
-            if uncalibrated_first_rest(measured, self.rest, self.bias, self._rest_gyro):
-                self.bias, roll, pitch, f = rest_alignment(self.rest)
-                self.meas = self.meas._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f)
+            self.rest, self.bias, aligned = complementary_rest(
+                self.rest, self.bias, gx, gy, gz, ax, ay, az, dt, self._rest_time,
+                self._rest_gyro, self._rest_acc, self._rest_bias_bound)
+            if aligned is not None:  # an uncalibrated first rest: the attitude is its tilt
+                roll, pitch, f = aligned
+                self.meas = measure_aligned(self.meas, f)
                 self.q = quat_from_roll_pitch(roll, pitch)
-            elif self.rest[6] >= self._rest_time:
-                self.bias = bias_at_rest(self.bias, gx, gy, gz, dt, self._rest_time)
         r_ref = self._adaptive[0]
         if self._acc_tau > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), self.bias, dt, self._trapezoid)

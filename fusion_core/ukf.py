@@ -66,6 +66,7 @@ from .kinematics import accel_roll_pitch, rotate_back, rotvec_terms
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    measure_aligned,
     measure_clipped,
     measure_constants,
     measure_start,
@@ -291,7 +292,7 @@ class UnscentedKalmanFilter(Estimator):
                 # the vectors' disagreement as disturbance) from nothing, and X is its direction
                 # (kalman.AngleBiasKalmanFilter, building_blocks.rest_alignment)
                 f = (self.rest[3], self.rest[4], self.rest[5])
-                self.meas = self.meas._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f, slow=0.0)
+                self.meas = measure_aligned(self.meas, f)._replace(slow=0.0)
                 n = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
                 self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
             if self.rest[6] >= p["rest_time"]:

@@ -63,19 +63,13 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     double rest_time = p->rest_time;
     double roll, pitch, phi[3], terms[4];
     int clipped = f->base.clipped;  /* at the gyro's rail: no rate measured (gyro_range) */
-    if (rest_time > 0.0 && !clipped) {  /* at rest the gyro reads its bias: follow it */
-        double measured = f->rest[7];
-        fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], f->bias, dt, p->rest_gyro,
-                     p->rest_acc, rest_time, p->rest_bias_bound);
-        if (fc_uncalibrated_first_rest(measured, f->rest, f->bias, p->rest_gyro)) {
-            double fa[3];
-            fc_rest_alignment(f->rest, f->bias, &f->roll, &f->pitch, fa);
-            fc_measure_align(f->meas, fa);
-            if (f->quaternion) {
-                fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
-            }
-        } else if (f->rest[6] >= rest_time) {
-            fc_bias_at_rest(f->bias, g[0], g[1], g[2], dt, rest_time);
+    double fa[3];
+    if (rest_time > 0.0 && !clipped &&  /* at rest the gyro reads its bias: follow it */
+        fc_complementary_rest(f->rest, f->bias, g, a, dt, rest_time, p->rest_gyro, p->rest_acc,
+                              p->rest_bias_bound, &f->roll, &f->pitch, fa)) {
+        fc_measure_align(f->meas, fa);  /* an uncalibrated first rest: its tilt */
+        if (f->quaternion) {
+            fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
         }
     }
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];

@@ -440,6 +440,23 @@ void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
     bias[2] = bias[2] + k * (gz - bias[2]);
 }
 
+int fc_complementary_rest(double rest[8], double bias[3], const double g[3], const double a[3],
+                          double dt, double rest_time, double rest_gyro, double rest_acc,
+                          double bound, double *roll, double *pitch, double f[3])
+{
+    double measured = rest[7];
+    fc_rest_step(rest, g[0], g[1], g[2], a[0], a[1], a[2], bias, dt, rest_gyro, rest_acc,
+                 rest_time, bound);
+    if (fc_uncalibrated_first_rest(measured, rest, bias, rest_gyro)) {
+        fc_rest_alignment(rest, bias, roll, pitch, f);
+        return 1;
+    }
+    if (rest[6] >= rest_time) {
+        fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time);
+    }
+    return 0;
+}
+
 void fc_bias_band2(double gate, double *lo, double *hi)
 {
     if (!(gate > 0.0)) {

@@ -144,6 +144,11 @@ void fc_rest_alignment(const double rest[8], double bias[3], double *roll, doubl
                        double f[3]);
 void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
                      double rest_time);
+/* complementary_rest: the rest detection of cf and mgcf, one sample; returns 1 where they
+ * aligned (*roll, *pitch and f, the specific force the vector starts again from, set), else 0 */
+int fc_complementary_rest(double rest[8], double bias[3], const double g[3], const double a[3],
+                          double dt, double rest_time, double rest_gyro, double rest_acc,
+                          double bound, double *roll, double *pitch, double f[3]);
 void fc_bias_band2(double gate, double *lo, double *hi);
 int fc_nearest_face(double ux, double uy, double uz);
 void fc_mat_vec(const double m[9], const double v[3], double out[3]);

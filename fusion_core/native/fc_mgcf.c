@@ -104,18 +104,12 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     int aligning = 0;
     int clipped = f->base.clipped;
     if (f->options) {  /* _real_sensor_options */
-        if (f->rest_time > 0.0 && !clipped) {
-            double measured = f->rest[7];
-            fc_rest_step(f->rest, gx, gy, gz, ax, ay, az, f->bias, dt, f->rest_gyro, f->rest_acc,
-                         f->rest_time, f->rest_bias_bound);
-            if (fc_uncalibrated_first_rest(measured, f->rest, f->bias, f->rest_gyro)) {
-                double roll, pitch, fa[3];
-                fc_rest_alignment(f->rest, f->bias, &roll, &pitch, fa);
-                fc_measure_align(f->meas, fa);
-                fc_quat_from_roll_pitch(roll, pitch, f->q);
-            } else if (f->rest[6] >= f->rest_time) {
-                fc_bias_at_rest(f->bias, gx, gy, gz, dt, f->rest_time);
-            }
+        double roll, pitch, fa[3];
+        if (f->rest_time > 0.0 && !clipped &&
+            fc_complementary_rest(f->rest, f->bias, g, a_in, dt, f->rest_time, f->rest_gyro,
+                                  f->rest_acc, f->rest_bias_bound, &roll, &pitch, fa)) {
+            fc_measure_align(f->meas, fa);  /* an uncalibrated first rest: its tilt */
+            fc_quat_from_roll_pitch(roll, pitch, f->q);
         }
         if (f->acc_tau > 0.0) {
             double phi[3], terms[4];
