@@ -190,7 +190,8 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
                    help="the full sensor: realistic, ideal or a JSON file (realistic)")
     p.add_argument("--out", type=Path, default=Path("reports/budget"),
                    help="report folder (reports/budget)")
-    p.add_argument("--no-plot", action="store_true", help="skip the bar chart")
+    p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
+                   help="skip the bar chart")
 
 
 def cmd_budget(args: argparse.Namespace) -> int:
@@ -211,6 +212,6 @@ def cmd_budget(args: argparse.Namespace) -> int:
     command = (f"python -m testbenches budget --estimator {args.estimator} --scenario "
                f"{args.scenario} --seeds {args.seeds} --preset {args.preset} --sensor "
                f"{args.sensor}")
-    write_budget(rows, args.out, command, plot=not args.no_plot)
+    write_budget(rows, args.out, command, plot=not args.no_plots)
     print(f"\nreports: {args.out / 'budget.md'}, {args.out / 'budget.json'}")
     return 0

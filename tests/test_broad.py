@@ -258,7 +258,7 @@ def test_cli_runs_the_peers_on_the_same_trial(tmp_path: Path) -> None:
     pytest.importorskip("ahrs")
     path = write_slice(tmp_path / "slice.hdf5")
     out = tmp_path / "report"
-    assert main(["broad", str(path), "--estimator", "mgcf", "--peers", "--no-plot",
+    assert main(["broad", str(path), "--estimator", "mgcf", "--peers", "--no-plots",
                  "--out", str(out)]) == 0
     means = json.loads((out / "report.json").read_text())["mean_inclination_rmse_deg"]
     assert set(means) == {"mgcf", "vqf", "madgwick", "mahony", "vqf-ahead"}
@@ -297,7 +297,7 @@ def test_cli_gyro_fit_writes_each_trials_gyro_errors_and_the_oracle_rmse(
 ) -> None:
     path = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 90.0, MAT_TRIAL)
     out = tmp_path / "report"
-    assert main(["broad", str(path), "--estimator", "kf", "--gyro-fit", "--no-plot",
+    assert main(["broad", str(path), "--estimator", "kf", "--gyro-fit", "--no-plot",  # old name
                  "--out", str(out)]) == 0
     text = capsys.readouterr().out
     assert "gyro against the reference" in text and "kf " in text
@@ -326,7 +326,7 @@ def test_cv_on_two_folds_chooses_without_the_held_out_one(
     a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
     b = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL)
     out = tmp_path / "report"
-    assert main(["broad", str(a), str(b), "--estimator", "kf", "--cv", "--no-plot",
+    assert main(["broad", str(a), str(b), "--estimator", "kf", "--cv", "--no-plots",
                  "--out", str(out)]) == 0
     assert "leave one motion fold out" in capsys.readouterr().out
     report = json.loads((out / "report.json").read_text())

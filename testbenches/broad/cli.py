@@ -54,7 +54,8 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="use only the first SECONDS of every trial (a quick look)")
     p.add_argument("--out", type=Path, default=Path("reports/broad"),
                    help="report folder (reports/broad)")
-    p.add_argument("--no-plot", action="store_true", help="skip the bar chart")
+    p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
+                   help="skip the bar chart")
     p.add_argument("--cv", action="store_true",
                    help="cross-validate the defaults: each parameter a scan chooses (acc_lowpass, "
                    "slow_band_time) chosen again without each motion fold (slow rotation, fast "
@@ -104,7 +105,7 @@ def cmd_broad(args: argparse.Namespace) -> int:
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
                           progress=progress)
     print(table(result))
-    paths = write_reports(result, args.out, plot=not args.no_plot)
+    paths = write_reports(result, args.out, plot=not args.no_plots)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
