@@ -279,6 +279,12 @@ def rest_step(
     return wx, wy, wz, fx, fy, fz, quiet, (1.0 if quiet >= rest_time else measured)
 
 
+def first_rest(measured_before: float, rest: RestState) -> bool:
+    """True at the sample the first rest is measured: rest_step's flag rest[7] is on and was off
+    (measured_before) before that step."""
+    return measured_before == 0.0 and rest[7] != 0.0
+
+
 def uncalibrated_first_rest(measured_before: float, rest: RestState, bias: Vec3,
                             th_gyro: float) -> bool:
     """True at the sample a first rest begins (rest_step's quiet time has just reached
@@ -294,7 +300,7 @@ def uncalibrated_first_rest(measured_before: float, rest: RestState, bias: Vec3,
     standstill: the rest's mean rate is its bias and its mean specific force is gravity
     (rest_alignment). A calibrated gyro (a residual of tenths of a deg/s, and BROAD's) never
     meets this, so its outputs are the same to the last bit."""
-    if measured_before != 0.0 or rest[7] == 0.0:
+    if not first_rest(measured_before, rest):
         return False
     mx, my, mz = rest[0] - bias[0], rest[1] - bias[1], rest[2] - bias[2]
     return mx * mx + my * my + mz * mz >= th_gyro * th_gyro
@@ -394,13 +400,13 @@ that max_rate lets through is below the rail, and none is treated as clipped."""
 
 
 
-def adaptive_noise_constants(p: Any, acc_tau: float, r: float) -> tuple[float, float, float]:
-    """The constants of ADAPTIVE_NOISE_PARAMS from a filter's parameters p, its pre-filter's time
-    constant acc_tau and one accelerometer sample's variance r (over g^2): the rotation term of
-    the process noise per (rad/s)^2, the disturbance's averaging time (0: off, also without the
-    pre-filter) and the white noise's share of the disturbance statistic (3 axes of r g^2)."""
+def adaptive_noise_constants(p: Any, acc_tau: float) -> tuple[float, float]:
+    """The constants of ADAPTIVE_NOISE_PARAMS from a filter's parameters p and its pre-filter's
+    time constant acc_tau: the rotation term of the process noise per (rad/s)^2 and the
+    disturbance's averaging time (0: off, also without the pre-filter). The white noise's share
+    of the disturbance statistics is the measured vector's (measured_vector.measure_constants)."""
     return (float(p["gyro_scale_std"]) ** 2 * float(p["scale_time"]),
-            float(p["disturbance_time"]) if acc_tau > 0.0 else 0.0, 3.0 * r * G * G)
+            float(p["disturbance_time"]) if acc_tau > 0.0 else 0.0)
 
 
 MAX_CORRECTION_TIME_PARAM: Final = Param(
@@ -431,13 +437,12 @@ COMPLEMENTARY_ADAPTIVE_PARAMS: Final = (
 noise they are measured against and the longest correction time."""
 
 
-def complementary_adaptive(p: Any, acc_tau: float) -> tuple[float, float, float, float, float]:
+def complementary_adaptive(p: Any, acc_tau: float) -> tuple[float, float, float, float]:
     """The constants of COMPLEMENTARY_ADAPTIVE_PARAMS from a filter's parameters p: one sample's
     variance r, the rotation term per (rad/s)^2, the disturbance's averaging time (0: off, also
-    without the pre-filter acc_tau), the white noise's share of the disturbance statistic
-    (3 axes of r g^2) and the longest correction time."""
+    without the pre-filter acc_tau) and the longest correction time."""
     r = float(p["acc_noise"]) ** 2
-    return (r, *adaptive_noise_constants(p, acc_tau, r), float(p["max_correction_time"]))
+    return (r, *adaptive_noise_constants(p, acc_tau), float(p["max_correction_time"]))
 
 
 def correction_time(tau: float, r_ratio: float, q_rotation: float, w2: float, r: float,

@@ -175,7 +175,7 @@ class ComplementaryFilter(Estimator):
                     self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
         bias = self.bias
         bx, by, bz = bias
-        r_ref, q_rotation, _, _, longest = self._adaptive
+        r_ref, q_rotation, _, longest = self._adaptive
         r = r_ref
         aligning = False
         if self._rotating:

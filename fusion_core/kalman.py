@@ -43,6 +43,7 @@ from .building_blocks import (
     adaptive_noise_constants,
     bias_band2,
     body_rotation,
+    first_rest,
     gate_bounds2,
     mat_t_vec,
     mat_vec,
@@ -68,9 +69,9 @@ from .kinematics import (
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
-    measure_aligned,
     measure_clipped,
     measure_constants,
+    measure_restarted,
     measure_start,
     measure_step,
     measure_turned,
@@ -336,12 +337,11 @@ class AngleBiasKalmanFilter(Estimator):
         )
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): Q's rotation term per
         # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share
-        self._adaptive = adaptive_noise_constants(p, self._acc_tau, self._r)
+        self._adaptive = adaptive_noise_constants(p, self._acc_tau)
         self._measure = measure_constants(self._acc_tau, self._adaptive[1],
                                           float(p["slow_band_time"]), self._r)
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
-        self.q_step = self._q_angle  # this step's angle process noise (propagate)
         self._quaternion: bool = p["propagation"] == "quaternion"
         # the faces need the attitude quaternion to carry the state across (with the Euler rates
         # the filters stay on the sensor's axes)
@@ -367,7 +367,7 @@ class AngleBiasKalmanFilter(Estimator):
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
         self.face = 0  # index into FACES of the filters' frame (tilt_axes); 0: the sensor's own
-        self.q_step = self._q_angle
+        self.q_step = self._q_angle  # this step's angle process noise (propagate sets it)
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
         if self._faces:
@@ -481,12 +481,12 @@ class AngleBiasKalmanFilter(Estimator):
         bias = (self.bias_x, self.bias_y, self.bias_z)
         self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, bias, dt, rest_gyro, rest_acc,
                               rest_time, bound)
-        if self._acc_tau > 0.0 and measured == 0.0 and self.rest[7] != 0.0:
-            # the first rest: the measured vector was turned with a bias not measured yet, and
-            # starts again from the rest's mean specific force, the slow band (which read the
-            # vectors' disagreement as disturbance) from nothing (building_blocks.rest_alignment)
+        if self._acc_tau > 0.0 and first_rest(measured, self.rest):
+            # the measured vector was turned with a bias not measured yet: it starts again from
+            # the rest's mean specific force (measured_vector.measure_restarted), the angles
+            # from its tilt
             f = (self.rest[3], self.rest[4], self.rest[5])
-            self.meas = measure_aligned(self.meas, f)._replace(slow=0.0)
+            self.meas = measure_restarted(self.meas, f)
             self.roll, self.pitch = accel_roll_pitch(*f)
         self.P_z += self._q_bias * dt
         if self.rest[6] >= rest_time:

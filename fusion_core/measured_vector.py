@@ -196,6 +196,13 @@ def measure_aligned(m: Measure, f: Vec3) -> Measure:
     return m._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f)
 
 
+def measure_restarted(m: Measure, f: Vec3) -> Measure:
+    """The state at the first rest of a Kalman filter: every low-pass at the rest's mean
+    specific force f, and the slow band from nothing (it read the vectors' disagreement, turned
+    with a bias not yet measured, as disturbance)."""
+    return measure_aligned(m, f)._replace(slow=0.0)
+
+
 def measure_clipped(m: Measure) -> Measure:
     """The state after a gyro sample at its rail: the vector goes on (starting it again from one
     sample costs more than the turn it carries), but the settle time starts again, so the

@@ -226,7 +226,7 @@ class GainScheduledComplementaryFilter(Estimator):
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
-        r_ref, q_rotation, _, _, longest = self._adaptive
+        r_ref, q_rotation, _, longest = self._adaptive
         r = r_ref
         aligning = False
         if self._options:

@@ -57,6 +57,7 @@ from .building_blocks import (
     adaptive_noise_constants,
     bias_band2,
     body_rotation,
+    first_rest,
     rest_start,
     rest_step,
     zero_rate_psd_param,
@@ -66,9 +67,9 @@ from .kinematics import accel_roll_pitch, rotate_back, rotvec_terms
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
-    measure_aligned,
     measure_clipped,
     measure_constants,
+    measure_restarted,
     measure_start,
     measure_step,
 )
@@ -198,7 +199,7 @@ class UnscentedKalmanFilter(Estimator):
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): Q's rotation term per
         # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share of the
         # disturbance statistic (3 axes of one sample's variance, (acc_noise g)^2)
-        self._adaptive = adaptive_noise_constants(p, float(p["acc_lowpass"]), self._r_acc)
+        self._adaptive = adaptive_noise_constants(p, float(p["acc_lowpass"]))
         self._measure = measure_constants(float(p["acc_lowpass"]), self._adaptive[1],
                                           float(p["slow_band_time"]), self._r_acc)
         self._longest2 = float(p["max_correction_time"]) ** 2
@@ -286,13 +287,12 @@ class UnscentedKalmanFilter(Estimator):
             self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, (x[3], x[4], x[5]), dt,
                                   p["rest_gyro"], p["rest_acc"], p["rest_time"],
                                   p["rest_bias_bound"])
-            if p["acc_lowpass"] > 0.0 and measured == 0.0 and self.rest[7] != 0.0:
-                # the first rest: the measured vector, turned with a bias not measured yet,
-                # starts again from the rest's mean specific force, the slow band (which read
-                # the vectors' disagreement as disturbance) from nothing, and X is its direction
-                # (kalman.AngleBiasKalmanFilter, building_blocks.rest_alignment)
+            if p["acc_lowpass"] > 0.0 and first_rest(measured, self.rest):
+                # the measured vector was turned with a bias not measured yet: it starts again
+                # from the rest's mean specific force (measured_vector.measure_restarted), X
+                # from its direction
                 f = (self.rest[3], self.rest[4], self.rest[5])
-                self.meas = measure_aligned(self.meas, f)._replace(slow=0.0)
+                self.meas = measure_restarted(self.meas, f)
                 n = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
                 self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
             if self.rest[6] >= p["rest_time"]:

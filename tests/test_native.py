@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import make
+from helpers import make, state_numbers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -81,13 +81,8 @@ def assert_same_snapshot(sa: dict, sb: dict, where: str = "") -> None:
             assert len(value) == len(other), where + name  # the position filter's queue
             assert np.allclose(value, other, rtol=0.0, atol=TOL) if value else True, where + name
         else:  # a number, a vector or a Measure (vectors and numbers): compare the numbers
-            assert np.allclose(_numbers(value), _numbers(other), rtol=0.0, atol=TOL), where + name
-
-
-def _numbers(value: object) -> list:
-    if isinstance(value, (list, tuple)):
-        return [x for v in value for x in _numbers(v)]
-    return [value]
+            assert np.allclose(state_numbers(value), state_numbers(other), rtol=0.0,
+                               atol=TOL), where + name
 
 
 def assert_same_state(a: object, b: object) -> None:

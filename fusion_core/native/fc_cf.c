@@ -16,8 +16,7 @@ void fc_cf_configure(fc_cf *f)
     f->rotating = f->quaternion || f->acc_tau > 0.0;
     f->r_ref = pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
-                                f->acc_tau, f->r_ref, &f->q_rotation, &f->dist_tau,
-                                &f->dist_noise);
+                                f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, &f->measure);
 }

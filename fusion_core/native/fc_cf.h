@@ -19,7 +19,7 @@ typedef struct fc_cf {
     fc_estimate last;
     /* derived from params (ComplementaryFilter._configure) */
     double tau, gate_low2, gate_high2, acc_tau;
-    double r_ref, q_rotation, dist_tau, dist_noise, longest;  /* ComplementaryFilter._adaptive */
+    double r_ref, q_rotation, dist_tau, longest;  /* ComplementaryFilter._adaptive */
     fc_meas_constants measure;  /* ComplementaryFilter._measure */
     int trapezoid, quaternion, rotating;
 } fc_cf;

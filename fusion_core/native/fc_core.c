@@ -231,12 +231,11 @@ void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const dou
 }
 
 void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
-                                 double disturbance_time, double acc_tau, double r,
-                                 double *q_rotation, double *dist_tau, double *noise)
+                                 double disturbance_time, double acc_tau, double *q_rotation,
+                                 double *dist_tau)
 {
     *q_rotation = pow(gyro_scale_std, 2.0) * scale_time;
     *dist_tau = acc_tau > 0.0 ? disturbance_time : 0.0;
-    *noise = 3.0 * r * FC_G * FC_G;
 }
 
 double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
@@ -358,6 +357,12 @@ double fc_measure_raw_noise(const double m[FC_MEAS_SIZE], const fc_meas_constant
     return excess > 0.0 ? c->r + excess / (FC_G * FC_G) : c->r;
 }
 
+void fc_measure_restart(double m[FC_MEAS_SIZE], const double f[3])
+{
+    fc_measure_align(m, f);
+    m[FC_MEAS_SLOW] = 0.0;
+}
+
 void fc_measure_clipped(double m[FC_MEAS_SIZE])
 {
     m[FC_MEAS_SETTLE] = 0.0;
@@ -409,10 +414,15 @@ void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, do
     rest[7] = quiet >= rest_time ? 1.0 : measured;
 }
 
+int fc_first_rest(double measured_before, const double rest[8])
+{
+    return measured_before == 0.0 && rest[7] != 0.0;
+}
+
 int fc_uncalibrated_first_rest(double measured_before, const double rest[8], const double bias[3],
                                double th_gyro)
 {
-    if (measured_before != 0.0 || rest[7] == 0.0) {
+    if (!fc_first_rest(measured_before, rest)) {
         return 0;
     }
     double mx = rest[0] - bias[0], my = rest[1] - bias[1], mz = rest[2] - bias[2];

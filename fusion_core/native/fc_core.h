@@ -85,12 +85,11 @@ void fc_body_rotation(const double g0[3], const double g1[3], const double bias[
                       int trapezoid, double phi[3]);
 void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
                                      const double a[3], double dt, double tau);
-/* adaptive_noise_constants: the rotation term of the process noise per (rad/s)^2, the
- * disturbance's averaging time (0: off, also without the pre-filter acc_tau) and the white
- * noise's share of the disturbance statistic (3 axes of r g^2) */
+/* adaptive_noise_constants: the rotation term of the process noise per (rad/s)^2 and the
+ * disturbance's averaging time (0: off, also without the pre-filter acc_tau) */
 void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
-                                 double disturbance_time, double acc_tau, double r,
-                                 double *q_rotation, double *dist_tau, double *noise);
+                                 double disturbance_time, double acc_tau, double *q_rotation,
+                                 double *dist_tau);
 /* correction_time: a complementary filter's time constant under the adaptive noise, at most the
  * larger of tau and longest */
 double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
@@ -124,6 +123,8 @@ double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double p
 int fc_measure_settled(const double m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* raw_noise */
 double fc_measure_raw_noise(const double m[FC_MEAS_SIZE], const fc_meas_constants *c);
+/* measure_restarted: aligned at f, the slow band from nothing */
+void fc_measure_restart(double m[FC_MEAS_SIZE], const double f[3]);
 /* measure_clipped */
 void fc_measure_clipped(double m[FC_MEAS_SIZE]);
 /* every vector of the low-passes set to f (a rest alignment) */
@@ -136,6 +137,8 @@ void fc_rest_start(double rest[8], const double gyro[3], const double acc[3]);
 void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, double ay,
                   double az, const double bias[3], double dt, double th_gyro, double th_acc,
                   double rest_time, double bound);
+/* first_rest: measured_before is rest[7] before this sample's fc_rest_step */
+int fc_first_rest(double measured_before, const double rest[8]);
 /* uncalibrated_first_rest: measured_before is rest[7] before this sample's fc_rest_step */
 int fc_uncalibrated_first_rest(double measured_before, const double rest[8], const double bias[3],
                                double th_gyro);

@@ -72,11 +72,10 @@ void fc_kf_configure(fc_kf *f)
     f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
-                                f->acc_tau, f->r, &f->q_rotation, &f->dist_tau, &f->dist_noise);
+                                f->acc_tau, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, &f->measure);
     f->longest2 = pow(p->max_correction_time, 2.0);
     f->rail_var = pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
-    f->q_step = f->q_angle;
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
@@ -267,10 +266,9 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     double measured = f->rest[7];
     fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], b, dt, f->rest_gyro, f->rest_acc,
                  f->rest_time, f->rest_bias_bound);
-    if (f->acc_tau > 0.0 && measured == 0.0 && f->rest[7] != 0.0) {
-        /* the first rest: the measured vector starts again from the rest's mean */
-        fc_measure_align(f->meas, f->rest + 3);
-        f->meas[FC_MEAS_SLOW] = 0.0;
+    if (f->acc_tau > 0.0 && fc_first_rest(measured, f->rest)) {
+        /* the measured vector starts again from the rest's mean, the angles from its tilt */
+        fc_measure_restart(f->meas, f->rest + 3);
         fc_accel_roll_pitch(f->rest[3], f->rest[4], f->rest[5], &f->roll, &f->pitch);
     }
     f->P_z += f->q_bias * dt;

@@ -24,7 +24,7 @@ typedef struct fc_kf {
     double q_step;  /* this step's angle process noise (propagate) */
     /* derived from params (AngleBiasKalmanFilter._configure) */
     double q_angle, q_bias, r, r_loop, gate_low2, gate_high2, acc_tau;
-    double q_rotation, dist_tau, dist_noise;  /* AngleBiasKalmanFilter._adaptive */
+    double q_rotation, dist_tau;  /* AngleBiasKalmanFilter._adaptive */
     fc_meas_constants measure;  /* AngleBiasKalmanFilter._measure */
     double longest2, rail_var;
     double rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;

@@ -19,7 +19,7 @@ typedef struct fc_mgcf {
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
     double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
-    double r_ref, q_rotation, dist_tau, dist_noise, longest;  /* _adaptive */
+    double r_ref, q_rotation, dist_tau, longest;  /* _adaptive */
     fc_meas_constants measure;  /* _measure */
     int trapezoid, options;
 } fc_mgcf;

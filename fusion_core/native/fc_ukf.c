@@ -323,8 +323,7 @@ void fc_ukf_configure(fc_ukf *f)
     f->r_acc = pow(p->acc_noise, 2.0);
     f->r_norm = pow(p->norm_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
-                                p->acc_lowpass, f->r_acc, &f->q_rotation, &f->dist_tau,
-                                &f->dist_noise);
+                                p->acc_lowpass, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc, &f->measure);
     f->longest2 = pow(p->max_correction_time, 2.0);
     f->rail_var = pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
@@ -635,11 +634,10 @@ static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
         double measured = f->rest[7];
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], &f->x[3], dt, p->rest_gyro,
                      p->rest_acc, p->rest_time, p->rest_bias_bound);
-        if (p->acc_lowpass > 0.0 && measured == 0.0 && f->rest[7] != 0.0) {
-            /* the first rest: the measured vector starts again from the rest's mean */
+        if (p->acc_lowpass > 0.0 && fc_first_rest(measured, f->rest)) {
+            /* the measured vector starts again from the rest's mean, X from its direction */
             const double *m = f->rest + 3;
-            fc_measure_align(f->meas, m);
-            f->meas[FC_MEAS_SLOW] = 0.0;
+            fc_measure_restart(f->meas, m);
             double n = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
             f->x[0] = m[0] / n;
             f->x[1] = m[1] / n;

@@ -19,7 +19,7 @@ typedef struct fc_ukf {
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
     double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
-    double q_rotation, dist_tau, dist_noise;  /* UnscentedKalmanFilter._adaptive */
+    double q_rotation, dist_tau;  /* UnscentedKalmanFilter._adaptive */
     fc_meas_constants measure;  /* UnscentedKalmanFilter._measure */
     double longest2, rail_var;
     double bias_lo2, bias_hi2, cos_innovation;

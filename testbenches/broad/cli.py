@@ -18,6 +18,7 @@ from ..fmus import DEFAULT_FMU_DIR
 from ..options import choose, positive_float
 
 if TYPE_CHECKING:
+    from .cv import CvResult
     from .data import BroadTrial
     from .run import BroadResult
 
@@ -105,45 +106,47 @@ def cmd_broad(args: argparse.Namespace) -> int:
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
                           progress=progress)
     print(table(result))
-    paths = write_reports(result, args.out, plot=not args.no_plots)
+    cv = cross_validation(trials, result, estimators, args.out, args.peers) if args.cv else None
+    extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
+    paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
     if args.cv:
-        print(f"\n{cv_report(trials, result, estimators, args.out, args.peers)}")
+        from .cv import cv_table
+
+        print("\n" + (cv_table(cv) if cv is not None else
+                      "cross-validation: none of the chosen estimators has a scanned parameter"))
     if args.gyro_fit:
         print(f"\n{gyro_fit_table(trials, result, args.out)}")
     return 0
 
 
-def cv_report(trials: list[BroadTrial], result: BroadResult, estimators: list[str], out: Path,
-              peers: bool) -> str:
-    """The cross-validation (testbenches.broad.cv) of the estimators that have one, as a table;
-    report.json gains cv_mean_inclination_rmse_deg and DIR/cv.json holds the details."""
+def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
+                     out: Path, peers: bool) -> CvResult | None:
+    """The cross-validation (testbenches.broad.cv) of the estimators that have one, written to
+    DIR/cv.json; None where none has. The peer the evaluation ran already is taken from it."""
     import json
 
     from tqdm import tqdm
 
     from ..peers import AHEAD_PEERS
-    from .cv import CV_ESTIMATORS, cross_validate, cv_table
+    from .cv import CV_ESTIMATORS, cross_validate
 
     keys = [k for k in estimators if k in CV_ESTIMATORS]
     if not keys:
-        return "cross-validation: none of the chosen estimators has a scanned parameter"
+        return None
     groups = [t.groups for t in result.trials]
+    measured = {c.name: {t.name: t.rmse_deg[c.name] for t in result.trials}
+                for c in result.columns if c.kind == "peer"}
     with tqdm(desc="cross-validation", unit="trial", file=sys.stderr,
-              total=len(trials) * (len(keys) + (1 if peers else 0))) as bar:
+              total=len(trials) * len(keys) + (len(trials) if peers else 0)) as bar:
         cv = cross_validate(trials, groups, keys,
                             {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]} if peers else None,
-                            lambda label: bar.update())
+                            lambda label: bar.update(), measured)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
-    report = out / "report.json"
-    if report.is_file():
-        data = json.loads(report.read_text())
-        data["cv_mean_inclination_rmse_deg"] = cv.cv_means()
-        report.write_text(json.dumps(data, indent=1))
-    return cv_table(cv)
+    return cv
 
 
 def gyro_fit_table(trials: list[BroadTrial], result: BroadResult, out: Path) -> str:

@@ -129,10 +129,14 @@ def cross_validate(
     estimators: Sequence[str] = CV_ESTIMATORS,
     peers: dict[str, Callable[..., np.ndarray]] | None = None,
     progress: Callable[[str], None] | None = None,
+    measured: dict[str, dict[str, float]] | None = None,
 ) -> CvResult:
     """The cross-validation of every estimator's CV_GRID parameters over the trials (groups:
     each trial's BROAD groups). peers: name -> f(acc, gyro, rate, delay) giving the up
-    direction, scored on the same trials. progress(label) is called after each run."""
+    direction, scored on the same trials. progress(label) is called after each trial.
+    measured: peer name -> trial -> RMSE already measured on these trials (the evaluation's
+    own columns), which are not run again."""
+    measured = measured or {}
     names = [t.name for t in trials]
     folds = {t.name: fold_of(g) for t, g in zip(trials, groups, strict=True)}
     present = [f for f in FOLDS if f in folds.values()]
@@ -149,12 +153,16 @@ def cross_validate(
                 for values in itertools.product(*(CV_GRID[k] for k in keys))]
         defaults = {k: float(specs[k].default) for k in keys}
         cv = EstimatorCv(key, defaults, grid=grid, errors=np.zeros((len(grid), len(trials))))
+        at_default = grid.index(defaults) if defaults in grid else None
         for j, trial in enumerate(trials):
-            r = run_fusion_core(key, {}, trial)
-            cv.in_sample[trial.name] = _rmse(trial, r["roll"], r["pitch"])
             for i, point in enumerate(grid):
                 r = run_fusion_core(key, point, trial)
                 cv.errors[i, j] = _rmse(trial, r["roll"], r["pitch"])
+            if at_default is None:  # defaults off the grid: run them too
+                r = run_fusion_core(key, {}, trial)
+                cv.in_sample[trial.name] = _rmse(trial, r["roll"], r["pitch"])
+            else:
+                cv.in_sample[trial.name] = float(cv.errors[at_default, j])
             if progress is not None:
                 progress(f"{key} {trial.name[:28]}")
         cv.scan_choice = grid[int(np.argmin(cv.errors.mean(axis=1)))]
@@ -168,6 +176,9 @@ def cross_validate(
         out[key] = cv
     peer_rows: dict[str, dict[str, float]] = {}
     for name, peer in (peers or {}).items():
+        if name in measured:
+            peer_rows[name] = {t.name: measured[name][t.name] for t in trials}
+            continue
         peer_rows[name] = {}
         for trial in trials:
             up = peer(trial.acc, trial.gyro, trial.rate, trial.sensor_delay)

@@ -115,12 +115,14 @@ def plot_bars(result: BroadResult, path: Path) -> None:
     plt.close(fig)
 
 
-def write_reports(result: BroadResult, out_dir: Path, plot: bool = True) -> dict[str, Path]:
-    """report.json, report.md and (with plot) broad_inclination_rmse.png under out_dir."""
+def write_reports(result: BroadResult, out_dir: Path, plot: bool = True,
+                  extra: dict[str, Any] | None = None) -> dict[str, Path]:
+    """report.json (with the entries of extra beside the evaluation's), report.md and (with
+    plot) broad_inclination_rmse.png under out_dir."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = {"json": out_dir / "report.json", "md": out_dir / "report.md"}
-    paths["json"].write_text(json.dumps(report_dict(result), indent=1))
+    paths["json"].write_text(json.dumps({**report_dict(result), **(extra or {})}, indent=1))
     md = [
         "# BROAD: inclination error on real recordings", "",
         METRIC + ".", "",
