@@ -16,6 +16,8 @@ bits, and the same normals but for the last bit of libm's log and cos against nu
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 GOLDEN = np.uint64(0x9E3779B97F4A7C15)
@@ -47,7 +49,12 @@ def normals(seed: int, stream: int, k0: int, n: int, channels: int) -> np.ndarra
     d = np.arange(2 * channels, dtype=np.uint64)[None, :]
     u = splitmix64(per_sample ^ d)
     U = ((u >> _S11).astype(np.float64) + 0.5) * _TWO_53
-    return np.sqrt(-2.0 * np.log(U[:, 0::2])) * np.cos(2.0 * np.pi * U[:, 1::2])
+    # log and cos by libm (math), as the C twin computes them: numpy's own vectorised log and
+    # cos may differ from libm's in the last bit
+    count = n * channels
+    log_u = np.fromiter(map(math.log, U[:, 0::2].ravel().tolist()), float, count)
+    cos_v = np.fromiter(map(math.cos, (2.0 * np.pi * U[:, 1::2]).ravel().tolist()), float, count)
+    return (np.sqrt(-2.0 * log_u) * cos_v).reshape(n, channels)
 
 
 class NormalBlocks:
