@@ -1,6 +1,7 @@
 /* Step fusion_core's Kalman filter from C, as firmware would: one IMU sample per call.
  * cc -std=c99 -O2 -ffp-contract=off -Ifusion_core/native examples/embedded_kf.c \
- *    fusion_core/native/fc_core.c fusion_core/native/fc_kf.c -lm -o embedded_kf */
+ *    fusion_core/native/fc_core.c fusion_core/native/fc_paper_kf.c fusion_core/native/fc_kf.c \
+ *    -lm -o embedded_kf */
 #include <math.h>
 #include <stdio.h>
 
@@ -10,7 +11,7 @@ int main(void)
 {
     fc_kf kf;                    /* all the filter's state: no globals, no malloc */
     fc_kf_params p;
-    fc_kf_params_default(&p);    /* the recommended preset */
+    fc_kf_params_default(&p);    /* the recommended values */
     p.gyro_sampling = FC_KF_GYRO_SAMPLING_MEAN;  /* an integrating IMU */
     fc_kf_init(&kf, &p);
     for (int i = 0; i < 500; i++) {              /* 5 s at 100 Hz, tilted 10 deg in roll */

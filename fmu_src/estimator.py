@@ -53,6 +53,23 @@ NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STAT
 """zero_bias of a filter without a bias state: all three bias outputs are 0."""
 Z_BIAS_AT_REST_ONLY: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_REST_ONLY})
 """zero_bias of the per-axis [angle, bias] Kalman filters: bias_z can stay 0."""
+NO_Z_BIAS: Mapping[str, str] = MappingProxyType({
+    "bias_z": "always 0: the papers' filter has no bias state about z, which no accelerometer "
+              "tilt observes"})
+"""zero_bias of the papers' per-axis [angle, bias] Kalman filter (and of their position filter,
+whose attitude is that filter's)."""
+ZERO_BIAS: Mapping[str, Mapping[str, str]] = MappingProxyType({
+    "AngleBiasKalmanFilter": Z_BIAS_AT_REST_ONLY,
+    "PositionKalmanFilter": Z_BIAS_AT_REST_ONLY,
+    "PaperComplementaryFilter": NO_BIAS_OUTPUTS,
+    "PaperKalmanFilter": NO_Z_BIAS,
+    "PaperPositionKalmanFilter": NO_Z_BIAS,
+})
+"""The bias outputs each estimator class leaves at 0 whatever it is given, with the reason, for
+their descriptions (by class name; a class not named here estimates all three)."""
+PAPER_NOTE = (" Built with the preset 'paper': the paper's own filter at its values "
+              "(fusion_core.papers.{name}).")
+"""What a paper's filter adds to its FMU's description."""
 
 
 PRESET_ENV = "FUSION_FMU_PRESET"
@@ -62,29 +79,52 @@ PRESET_FILE = "preset.json"
 """The preset an FMU was built with, in its resources folder."""
 
 
-def preset_starts(cls: type[Estimator], resources: str | None = None) -> dict[str, Any]:
-    """The start values an FMU of estimator class cls was built with (its entry of the preset
-    file, checked when the file was written; {} for the recommended values, the defaults): from
-    the FMU's resources folder when it runs, from PRESET_ENV while it is built."""
+def preset_starts(key: str, resources: str | None = None) -> dict[str, Any]:
+    """The preset entry an FMU of estimator key was built with (checked when the file was
+    written; {} for the recommended values, the defaults; "filter": "paper" chooses the paper's
+    filter, fusion_core.registry): from the FMU's resources folder when it runs, from PRESET_ENV
+    while it is built."""
     path = Path(resources) / PRESET_FILE if resources else None
     if path is None or not path.is_file():
         env = os.environ.get(PRESET_ENV)
         if not env:
             return {}
         path = Path(env)
-    from fusion_core import ESTIMATORS
-
-    key = next(k for k, c in ESTIMATORS.items() if c is cls)
     return dict(json.loads(path.read_text()).get(key, {}))
 
 
+def estimator_table(key: str, entry: Mapping[str, Any]
+                    ) -> tuple[type[Estimator], tuple[Variable, ...]]:
+    """The estimator class a preset entry chooses for key and its FMU's variable table, the
+    entry's values as start values; built once per process for each class and entry."""
+    from fusion_core.registry import FILTER, estimator_class
+
+    cls = estimator_class(key, dict(entry))
+    starts = {k: v for k, v in entry.items() if k != FILTER}
+    table = variable_table(
+        f"{cls.__name__} {json.dumps(starts, sort_keys=True)}",
+        partial(estimator_variables, cls, ZERO_BIAS.get(cls.__name__), starts))
+    return cls, table
+
+
+def model_description(text: str, cls: type[Estimator]) -> str:
+    """An estimator FMU's description: its model's text, and for a paper's filter a note."""
+    from fusion_core.registry import REFERENCES
+
+    paper = cls in REFERENCES.values()
+    return text + (PAPER_NOTE.format(name=cls.__name__) if paper else "")
+
+
 def estimator_variables(
-    cls: type[Estimator], zero_bias: Mapping[str, str] | None = None
+    cls: type[Estimator], zero_bias: Mapping[str, str] | None = None,
+    starts: Mapping[str, Any] | None = None,
 ) -> tuple[Variable, ...]:
     """The variable table of an estimator FMU: INTERFACE.md's inputs and outputs, then one
-    parameter per `cls.param_specs()` entry. zero_bias maps bias outputs that are always 0 to
-    the reason, which goes into their description."""
+    parameter per `cls.param_specs()` entry, starting at starts' value where it names one.
+    zero_bias maps bias outputs that are always 0 to the reason, which goes into their
+    description."""
     zero_bias = dict(zero_bias or {})
+    starts = dict(starts or {})
     first = cls().last
     axis_word = {"x": "x (forward)", "y": "y (left)", "z": "z (up)"}
     inputs = (
@@ -151,7 +191,6 @@ def estimator_variables(
             real_output(f"vel_{a}", "m/s", f"Velocity estimate along level-frame {a}", v)
             for a, v in zip(AXES, vel, strict=True)
         ]
-    starts = preset_starts(cls)
     params = tuple(
         parameter_variable(dataclasses.replace(p, default=starts.get(p.name, p.default)))
         for p in cls.param_specs().values()
@@ -268,33 +307,28 @@ class EstimatorModel:
 
 
 class EstimatorSlave(FmuSlave):
-    """Base of the estimator FMUs: a subclass names its fusion_core class and its paper.
+    """Base of the estimator FMUs: a subclass names its estimator and its paper.
 
-    Class attributes of a subclass: `estimator` (the fusion_core class), `description` (the
-    modelDescription text naming the paper) and `zero_bias` (bias outputs that are always 0,
-    with the reason).
+    Class attributes of a subclass: `key` (the estimator's key, fusion_core.registry) and
+    `description` (the modelDescription text naming the paper). Which class it runs (the
+    recommended one or the paper's, fusion_core.papers) and its start values are the preset it
+    was built with (preset_starts), read per instance from the FMU's own resources, so that
+    they hold even where another FMU's fmu_src was imported first in the same process.
     """
 
-    estimator: ClassVar[type[Estimator]]
-    zero_bias: ClassVar[Mapping[str, str]] = MappingProxyType({})
+    key: ClassVar[str]
 
-    def __init_subclass__(cls, **kwargs: Any) -> None:
-        super().__init_subclass__(**kwargs)
-        if "estimator" in cls.__dict__:
-            cls.VARIABLES = variable_table(
-                cls.estimator.__name__, partial(estimator_variables, cls.estimator, cls.zero_bias)
-            )
-
-    def start_values(self) -> dict[str, Any]:
-        """The preset this FMU was built with (preset_starts), in FMI form: read per instance
-        from the FMU's own resources, so that it holds even where another FMU's fmu_src was
-        imported first in the same process."""
-        out = {}
-        for name, value in preset_starts(self.estimator, self.resources).items():
-            var = self._variables[name]
-            out[name] = var.items.index(value) + 1 if var.items and isinstance(value, str) \
-                else value
-        return out
+    def __init__(self, **kwargs: Any) -> None:
+        entry = preset_starts(self.key, kwargs.get("resources"))
+        self.estimator, self.VARIABLES = estimator_table(self.key, entry)
+        super().__init__(**kwargs)
+        self.description = model_description(type(self).description, self.estimator)
 
     def create_model(self, params: dict[str, Any]) -> EstimatorModel:
         return EstimatorModel(self.estimator, params)
+
+    def to_xml(self, model_options: dict[str, Any] | None = None) -> Any:
+        """FmuSlave's, with this instance's description (pythonfmu takes the class's)."""
+        root = super().to_xml(model_options)
+        root.set("description", self.description)
+        return root

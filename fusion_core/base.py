@@ -166,6 +166,9 @@ class Estimator:
     """The C twin's prefix (fusion_core/native: fc_cf for fc_cf_step, fc_cf_run, ...) where this
     exact class has one; a subclass, which may change the Python methods, has none of its own."""
     HAS_POSITION: ClassVar[bool] = False
+    COMMON: ClassVar[tuple[Param, ...]] = COMMON_PARAMS
+    """The parameters every estimator shares (a paper's reference filter, which knows no gyro
+    range, leaves gyro_range out: fusion_core.papers)."""
 
     def __init__(self, **params: Any) -> None:
         specs = self.param_specs()
@@ -180,7 +183,7 @@ class Estimator:
     @classmethod
     def param_specs(cls) -> dict[str, Param]:
         """Every parameter of this estimator by name, in declaration order."""
-        return {p.name: p for p in (*cls.PARAMS, *COMMON_PARAMS)}
+        return {p.name: p for p in (*cls.PARAMS, *cls.COMMON)}
 
     @property
     def params(self) -> dict[str, Any]:
@@ -207,7 +210,8 @@ class Estimator:
                                          float(values["mount_yaw"]))
         self._mounted: bool = self._mounting != IDENTITY
         self._delay = float(values["sensor_delay"])
-        self._rail = float(values["gyro_range"]) * (1.0 - RAIL_MARGIN)
+        # without gyro_range (COMMON) no sample is at a rail
+        self._rail = float(values.get("gyro_range", math.inf)) * (1.0 - RAIL_MARGIN)
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:

@@ -14,14 +14,24 @@ below answers one of them the same way in every estimator:
   complementary filters): more process noise while the sensor turns (the gyro's scale-factor
   error), more measurement noise while it accelerates (the linear acceleration the pre-filter
   has not removed), the raw sample where it measures none;
-- quaternion propagation of Euler-angle filters (PROPAGATION_PARAM), free of the pitch +-90 deg
-  singularity of the Euler rates;
+- quaternion propagation of Euler-angle filters (quat_from_roll_pitch), free of the pitch
+  +-90 deg singularity of the Euler rates;
 - the nearest face (FACES, nearest_face): per-axis tilt filters run in the sensor frame turned
   by the right-angle rotation that brings the axis nearest to up onto z, so that a sensor resting
   on any face is the level case for them.
 
 An accelerometer sample whose norm is zero (or that base.Estimator.step took as no reading)
 carries no gravity direction: every block below skips it, and so does every correction.
+
+Quaternion propagation: the papers integrate the Euler rates (Duong Quoc eq. 2), whose
+tan(pitch) term is singular at pitch +-90 deg: a sensor that turns through the vertical (every
+rotation trial of BROAD does) loses the attitude there, and the innovation of roll, which the
+accelerometer cannot observe near pitch +-90 deg, cannot bring it back. The recommended cf and kf
+keep an attitude quaternion q (yaw free, unobservable), turn it by the bias-corrected rotation
+vector of each interval (the quaternion filters' rule, kinematics.rotation_increment), take roll
+and pitch from it, apply their paper's correction to roll and pitch, and rebuild q from the
+corrected roll and pitch with yaw 0 (quat_from_roll_pitch: the free yaw does not change roll or
+pitch). The correction law, its gains and its covariance are the paper's.
 """
 
 from __future__ import annotations
@@ -80,10 +90,10 @@ ACC_GATE_PARAMS: tuple[Param, ...] = (
 """Gui et al.'s accelerometer-magnitude gate. The papers give no bounds. Recommended, 0.5 g to
 2 g: with the pre-filter on (ACC_LOWPASS_PARAM) the gate sees the filtered vector, whose norm
 stays near g while the raw one swings, so only gross disturbances need closing it; a narrow gate
-then only adds rejections (BROAD, kf: 1.35 deg mean with 0.5-2 g, 1.46 deg with 0.9-1.1 g). The
-paper preset's 0.9-1.1 g is our reading for the raw accelerometer: it skips samples with 0.1 g
-or more of linear acceleration along gravity, yet stays open at rest for an uncalibrated MEMS
-accelerometer (scale error up to about 3 %)."""
+then only adds rejections. The papers' filters' 0.9-1.1 g (fusion_core.papers.common) is our
+reading for the raw accelerometer: it skips samples with 0.1 g or more of linear acceleration
+along gravity, yet stays open at rest for an uncalibrated MEMS accelerometer (scale error up to
+about 3 %)."""
 
 ACC_LOWPASS_PARAM = Param(
     "acc_lowpass", 1.5,
@@ -93,12 +103,12 @@ ACC_LOWPASS_PARAM = Param(
     "the filter and its gate then use the filtered vector. 0 = off: each raw sample (the papers)",
     unit="s", low=0.0,
 )
-"""Recommended: 1.5 s, chosen by leave-one-motion-fold-out cross-validation on BROAD (`python -m
-testbenches broad DIR --cv`, testbenches.broad.cv): of 1, 1.5 and 2 s, the scans of cf, kf and
-ukf without each fold chose 1.5 or 2 s, never 1 s (kf: 0.573 deg in sample at 1 s, 0.512 at
-1.5 s). Physics brackets it: long enough to average the swing of a hand-held translation (a
-second or more), short against the drift that a gyro scale error of 1-3 % turns into the vector
-while the sensor turns. The mgcf keeps 1 s (mgcf.MGCF_ACC_LOWPASS)."""
+"""Recommended: 1.5 s. Physics brackets it: long enough to average the swing of a hand-held
+translation (a second or more), short against the drift that a gyro scale error of 1-3 % turns
+into the vector while the sensor turns; within that bracket the value is the one
+leave-one-motion-fold-out cross-validation on BROAD chooses for cf, kf and ukf (`python -m
+testbenches broad DIR --cv`, testbenches.broad.cv, whose report gives the figures). The mgcf
+keeps 1 s (mgcf.MGCF_ACC_LOWPASS)."""
 """The accelerometer pre-filter. Laidig & Seel (VQF: Highly accurate IMU orientation estimation
 with bias estimation and magnetic disturbance rejection, Information Fusion 91, 2023) low-pass
 filter the accelerometer in an almost inertial frame given by the gyro strapdown integration:
@@ -110,25 +120,6 @@ sample (a world-fixed vector seen from the body), which is the same filter. Each
 then unchanged: it takes the filtered vector where it took the raw sample. Measured on BROAD's
 real recordings (testbenches/broad): the fast-translation trials, whose raw accelerometer
 swings between 0.02 g and 5 g, drop from tens of degrees to below 1 deg of inclination error."""
-
-PROPAGATION_PARAM = Param(
-    "propagation", "quaternion",
-    "How the gyro carries roll and pitch between samples: 'euler' (the Z-Y-X Euler-rate "
-    "kinematics, singular at pitch +-90 deg) or 'quaternion' (an attitude quaternion with a free "
-    "yaw, turned by each interval's rotation vector: exact in every orientation)",
-    choices=("euler", "quaternion"), tunable=False,
-)
-"""Propagation of the Euler-angle filters (cf, kf). The papers integrate the Euler rates
-(Duong Quoc eq. 2), whose tan(pitch) term is singular at pitch +-90 deg: a sensor that turns
-through the vertical (every rotation trial of BROAD does) loses the attitude there, and the
-innovation of roll, which the accelerometer cannot observe near pitch +-90 deg, cannot bring it
-back. With 'quaternion' the filter keeps an attitude quaternion q (yaw free, unobservable), turns
-it by the bias-corrected rotation vector of each interval (the same integration rule as the
-quaternion filters, kinematics.rotation_increment), takes roll and pitch from it, applies its
-paper's correction to roll and pitch, and rebuilds q from the corrected roll and pitch with yaw 0
-(quat_from_roll_pitch: the free yaw does not change roll or pitch). The correction law, its
-gains and its covariance are the paper's. Recommended: 'quaternion' (no orientation is singular
-for it); 'euler' is the papers'."""
 
 RestState = tuple[float, float, float, float, float, float, float, float]
 """The rest detector's state: running means of the rate (3) and of the specific force (3), the
@@ -167,8 +158,8 @@ REST_PARAMS: tuple[Param, ...] = (
     ),
 )
 """Rest detection for a zero-angular-rate bias update. A still sensor's gyro reads its bias: an
-uncalibrated MEMS gyro's turn-on bias (0.1-0.5 deg/s on BROAD's IMU, 0.5 deg/s about z) times a
-correction time constant of seconds is a tilt error of tenths of a degree, and about z the bias is
+uncalibrated MEMS gyro's turn-on bias (tenths of a deg/s) times a correction time constant of
+seconds is a tilt error of tenths of a degree, and about z the bias is
 not observable from the accelerometer at all while the sensor is level. The detector is VQF's
 (Laidig & Seel 2023): the rate and the specific force must stay within the thresholds of their
 running means (time constant REST_MEAN_TAU) for rest_time; its defaults (2 deg/s, 0.5 m/s^2,
@@ -179,15 +170,13 @@ VQF also requires the mean rate itself to be below restThGyr, so that a slow ste
 which the deviations do not see, is not taken for rest. Against the raw rate that rule also
 refuses the rest of a still gyro whose bias exceeds the threshold: an MPU-6050 as delivered
 (turn-on bias +-20 deg/s in its datasheet) is then never measured at rest, and a complementary
-filter, which learns its bias nowhere else, stays 23/15 deg off at rest (static_tilted, 40 such
-parts; VQF 14/10). So here the mean rate is taken less the filter's bias estimate, and before
-the first rest a mean rate the turn-on bias can explain (rest_bias_bound: the datasheet's 20
-deg/s) may start one: kf then 0.81/0.88 deg, ukf 0.79/0.85 (the same 40 parts), and cf 2.3/2.0,
-or 0.78/0.85 with the alignment at such a first rest (uncalibrated_first_rest), which is the
-floor the parts' uncalibrated accelerometers leave. A rest under way lasts while the deviations
-stay small, so that the bias estimate can converge in it. With the start-up calibration (the
-default sensor; the contract's scenarios, seeds 0-2 checked) and on BROAD's 13 trials the outputs
-are the same to the last bit as with VQF's rule and without the alignment at a first rest."""
+filter, which learns its bias nowhere else, stays degrees off at rest. So here the mean rate is
+taken less the filter's bias estimate, and before the first rest a mean rate the turn-on bias
+can explain (rest_bias_bound: the datasheet's 20 deg/s) may start one; a filter without a bias
+covariance then aligns at such a first rest (uncalibrated_first_rest). A rest under way lasts
+while the deviations stay small, so that the bias estimate can converge in it. A gyro calibrated
+at start-up never meets either rule: its outputs are those of VQF's rule to the last bit
+(tests/test_rest_detection.py)."""
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
@@ -204,7 +193,7 @@ def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
 
 
 def quat_from_roll_pitch(roll: float, pitch: float) -> tuple[float, float, float, float]:
-    """The attitude quaternion (w, x, y, z) of roll and pitch with yaw 0 (PROPAGATION_PARAM):
+    """The attitude quaternion (w, x, y, z) of roll and pitch with yaw 0 (the module docstring):
     kinematics.quat_from_roll_pitch_yaw(roll, pitch, 0.0), written without the yaw's terms (the
     same doubles, two sine-cosine pairs instead of three). The yaw of the filters' quaternion is
     free: a turn about world z changes only the first two rows of the rotation matrix, and roll
@@ -294,10 +283,9 @@ def uncalibrated_first_rest(measured_before: float, rest: RestState, bias: Vec3,
     has turned the tilt by up to its size times the time before this rest (a few degrees to tens)
     and would take rest_time more to learn by bias_at_rest, while the tilt error it leaves in the
     attitude and the turned accelerometer pre-filter decays only with the correction's time
-    constant (cf 23/15 -> 2.3/2.0 deg with the rest alone, 0.78/0.85 with this alignment: the
-    floor of the 40 uncalibrated parts' accelerometers, which are not calibrated either). So a
-    filter without a bias covariance (cf, mgcf) then aligns, as an inertial system does at
-    standstill: the rest's mean rate is its bias and its mean specific force is gravity
+    constant. So a filter without a bias covariance (cf, mgcf) then aligns, as an inertial
+    system does at standstill: the rest's mean rate is its bias and its mean specific force is
+    gravity
     (rest_alignment). A calibrated gyro (a residual of tenths of a deg/s, and BROAD's) never
     meets this, so its outputs are the same to the last bit."""
     if not first_rest(measured_before, rest):
@@ -351,8 +339,8 @@ reference on the nine trials that turn (testbenches.broad.gyro, no estimator inv
 -0.53 to +0.74 % per axis; an MPU-6050's datasheet tolerance is +-3 % (1 % as 3 sigma)."""
 RECOMMENDED_SCALE_TIME: Final = 0.5
 """Recommended scale_time [s]: how long a scale error adds up in one direction, about one swing
-of a hand-held or robot motion; a coarse scan of the kf on BROAD (0.1 / 0.3 / 0.5 / 1 s: 0.62 /
-0.565 / 0.560 / 0.576 deg), the plateau's middle."""
+of a hand-held or robot motion (physics leaves its exact value open: a coarse scan of the kf on
+BROAD has a plateau around it, whose middle this is)."""
 
 ADAPTIVE_NOISE_PARAMS: Final = (
     Param(
@@ -394,12 +382,6 @@ real sensor breaks both in motion, and the balance of the two sets the correctio
 CONSTANT_NOISE: Final = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
 """ADAPTIVE_NOISE_PARAMS off: a constant Q and R and a pre-filter of fixed length, as the papers'
 filters have them."""
-NO_RAIL: Final[dict[str, Any]] = {"gyro_range": 1e4}
-"""The papers' filters know no gyro range: at 10^4 rad/s (the largest gyro_range) every sample
-that max_rate lets through is below the rail, and none is treated as clipped."""
-
-
-
 def adaptive_noise_constants(p: Any, acc_tau: float) -> tuple[float, float]:
     """The constants of ADAPTIVE_NOISE_PARAMS from a filter's parameters p and its pre-filter's
     time constant acc_tau: the rotation term of the process noise per (rad/s)^2 and the
@@ -419,8 +401,7 @@ MAX_CORRECTION_TIME_PARAM: Final = Param(
 """Recommended 3 s: the complementary filters learn their bias at rest (cf) or over minutes (mgcf),
 so a bias b left by the usual start-up calibration (0.16 deg/s on the realistic MPU-6050, its
 datasheet's temperature drift over 1 K of warm-up) costs b times this, 0.5 deg at 3 s. A coarse
-scan of the cf on BROAD (2 / 3 / 4 / 5 / 10 s: 0.590 / 0.559 / 0.554 / 0.555 / 0.568 deg) has its
-plateau at 3-5 s; 3 keeps that bias error smallest on it."""
+scan of the cf on BROAD has its plateau at 3-5 s; 3 keeps that bias error smallest on it."""
 
 
 COMPLEMENTARY_ADAPTIVE_PARAMS: Final = (

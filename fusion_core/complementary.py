@@ -1,10 +1,6 @@
-"""Complementary filter for roll and pitch.
-
-References:
-  W. Gui, Y. Tang, S. Mukhopadhyay (2015), complementary filter vs Kalman filter for tilt,
-  eq. 1-2: angle = a (angle + gyro dt) + (1 - a) acc_angle, a = tau / (tau + dt),
-  tau = 0.75 s (a = 0.96 at their loop time dt = 0.03 s).
-  Das & Mary, low-cost IMU filtering, eq. 1 (the same filter).
+"""The recommended complementary filter for roll and pitch: the papers' filter
+(fusion_core.papers.complementary: Gui et al. 2015 eq. 1-2, Das & Mary eq. 1) with the
+mechanisms of building_blocks and fusion_core.measured_vector around it (ComplementaryFilter).
 """
 
 from __future__ import annotations
@@ -17,7 +13,6 @@ from .building_blocks import (
     ACC_LOWPASS_PARAM,
     COMPLEMENTARY_ADAPTIVE_PARAMS,
     GYRO_SAMPLING_PARAM,
-    PROPAGATION_PARAM,
     REST_PARAMS,
     REST_START,
     ZERO3,
@@ -34,8 +29,6 @@ from .kinematics import (
     PI,
     accel_roll_pitch,
     clamp_pitch,
-    euler_step,
-    heun_euler_step,
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
     quat_roll_pitch,
@@ -56,55 +49,38 @@ from .types import Estimate, Param
 
 
 class ComplementaryFilter(Estimator):
-    """Complementary filter (Gui et al. 2015 eq. 1-2; Das & Mary eq. 1) for roll and pitch.
+    """The recommended complementary filter (Gui et al. 2015 eq. 1-2; Das & Mary eq. 1).
 
-    Per sample: the gyro propagates roll and pitch through the Z-Y-X Euler-rate kinematics
-    (Heun's method on the rate linear between the previous and the current sample for point
-    samples, or the rectangle rule for mean samples, gyro_sampling="mean", the papers' rule);
-    then, when gate_low <= |acc|/g <= gate_high, the angles are
-    blended with the accelerometer's roll and pitch:  angle = a*angle_pred + (1-a)*acc_angle with
-    a = tau/(tau + dt) computed from each sample's own dt (written as
-    angle_pred + (1-a)*wrap(acc_angle - angle_pred), the same number, so roll does not jump at
-    +-180 deg).
+    Per sample: the gyro turns an attitude quaternion (with a free yaw) by the interval's
+    rotation vector (the trapezoid rate with the coning term for point samples, the rectangle
+    rule for mean samples: building_blocks.GYRO_SAMPLING_PARAM), so that pitch +-90 deg is no
+    singularity; then, when gate_low <= |f|/g <= gate_high, roll and pitch are blended with the
+    measured vector's: angle = a angle_pred + (1 - a) acc_angle with a = tau / (tau + dt) from
+    each sample's own dt (written as angle_pred + (1 - a) wrap(acc_angle - angle_pred), the same
+    number, so roll does not jump at +-180 deg). Around the papers' blend, for real IMUs:
+    - the measured vector (acc_lowpass > 0; fusion_core.measured_vector): the gate and the
+      blend use the accelerometer low-passed in a frame that turns with the gyro (second
+      order, after Laidig & Seel 2023); while it fills (after the first sample, and after a
+      gyro sample at its rail) it is the mean of the samples so far, and the attitude is its
+      tilt;
+    - rest detection (rest_time > 0; building_blocks.REST_PARAMS): at rest the gyro reads its
+      own bias, and a bias estimate b follows it with time constant rest_time; the filter
+      integrates gyro - b and outputs b, so an uncalibrated gyro's error b tau is gone. A first
+      rest that b misses by rest_gyro or more (a gyro never calibrated) aligns the filter
+      instead: b becomes the rest's mean rate and the tilt its mean specific force's
+      (building_blocks.uncalibrated_first_rest);
+    - adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS, the kf's, with acc_noise the sample
+      noise they are measured against): tau follows the Kalman balance of the gyro's scale
+      uncertainty against the measured vector's noise (building_blocks.correction_time):
+      shorter while the sensor turns with a clean accelerometer, longer while it accelerates,
+      up to max_correction_time. A gyro sample at its rail (gyro_range) measures no bias at rest
+      and restarts the measured vector.
 
-    A constant gyro bias b leaves a steady-state error b*tau: the papers' filter has no bias
-    state. Options for real sensors, on by default (the `paper` preset turns them off, and then
-    the filter is exactly the papers'):
-    - acc_lowpass > 0: the gate and the blend use the measured vector (fusion_core.
-      measured_vector: the accelerometer low-passed in a frame that turns with the gyro, second
-      order, after Laidig & Seel 2023); while it fills (after the first sample, and after a gyro
-      sample at its rail) it is the mean of the samples so far, and the attitude is its tilt;
-    - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
-      still, the gyro reads its own bias, and a bias estimate b follows it with time constant
-      rest_time; the filter integrates gyro - b and outputs b (BROAD: 0.95 -> 0.75 deg mean, the
-      uncalibrated gyro's b tau gone). A first rest that b misses by rest_gyro or more (a gyro
-      never calibrated) aligns the filter instead: b becomes the rest's mean rate and the tilt
-      its mean specific force's (building_blocks.uncalibrated_first_rest);
-    - propagation="quaternion" carries roll and pitch through an attitude quaternion instead of
-      the Euler rates (building_blocks.PROPAGATION_PARAM), so that pitch +-90 deg is no
-      singularity.
-
-    Recommended tau = 1 s: a gyro bias b the rest updates have not seen leaves an error b tau
-    (0.5 deg/s x 1 s = 0.5 deg on an uncalibrated MEMS gyro), while a shorter tau lets the
-    pre-filtered accelerometer's residual acceleration through. A coarse scan on BROAD
-    (0.75 / 1 / 1.5 / 2 s: 0.86 / 0.75 / 0.65 / 0.62 deg) still falls at 2 s, where BROAD's
-    trials all begin at rest and the bias is known; a gyro whose bias the rest updates have not
-    seen would be left with 1 deg there, so the default keeps 1 s. The papers' values are
-    presets.PAPER_CF.
-
-    Adaptive noise (recommended; off in the papers' filter: building_blocks.ADAPTIVE_NOISE_PARAMS,
-    the kf's, with acc_noise the sample noise they are measured against): tau follows the Kalman
-    balance of the gyro's scale uncertainty against the measured vector's noise, the slow
-    linear acceleration that reaches it (measured_vector; building_blocks.correction_time):
-    shorter while the sensor turns with a clean accelerometer, longer while it accelerates, up to
-    max_correction_time (3 s: this filter learns its bias only at rest, and a bias b costs b
-    tau). A gyro sample at its rail (gyro_range) measures no bias at rest and restarts the
-    measured vector, whose tilt the attitude takes while it fills again.
-
-    Parameters: tau [s] time constant (1; papers 0.75); gate_low, gate_high accelerometer gate
-    (|acc|/g); acc_lowpass [s] (0: off); rest_time [s], rest_gyro [rad/s], rest_acc [m/s^2];
-    propagation; gyro_sampling; acc_noise, gyro_scale_std, scale_time [s], disturbance_time [s],
-    max_correction_time [s]; max_dt, max_rate.
+    tau = 1 s: a gyro bias b the rest updates have not seen leaves an error b tau (0.5 deg at
+    0.5 deg/s, an uncalibrated MEMS gyro), while a shorter tau lets the measured vector's
+    residual acceleration through; a longer one would suit recordings that start at rest (whose
+    bias the rest updates know) and fail a gyro they have not seen. max_correction_time 3 s:
+    this filter learns its bias only at rest, and a bias b costs b tau.
     """
 
     PARAMS = (
@@ -116,7 +92,6 @@ class ComplementaryFilter(Estimator):
         *ACC_GATE_PARAMS,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
-        PROPAGATION_PARAM,
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
@@ -133,9 +108,6 @@ class ComplementaryFilter(Estimator):
         self._gate_low2, self._gate_high2 = gate_bounds2(p)
         self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
-        self._quaternion: bool = p["propagation"] == "quaternion"
-        # both options need the rotation vector of each interval; the papers' filter does not
-        self._rotating = self._quaternion or self._acc_tau > 0.0
         self._rest = (float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]),
                       float(p["rest_bias_bound"]))
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS): one sample's variance, the
@@ -149,7 +121,7 @@ class ComplementaryFilter(Estimator):
         self.roll = 0.0
         self.pitch = 0.0
         self.meas = measure_start(ZERO3, self._measure)  # the measured vector (acc_lowpass > 0)
-        self.q_att = (1.0, 0.0, 0.0, 0.0)  # attitude, propagation="quaternion" only
+        self.q_att = (1.0, 0.0, 0.0, 0.0)  # the attitude, with a free yaw
         self.bias = ZERO3  # gyro bias measured at rest (rest_time > 0)
         self.rest = REST_START  # rest detector (building_blocks.RestState)
 
@@ -171,30 +143,21 @@ class ComplementaryFilter(Estimator):
             if aligned is not None:  # an uncalibrated first rest: the attitude is its tilt
                 self.roll, self.pitch, f = aligned
                 self.meas = measure_aligned(self.meas, f)
-                if self._quaternion:
-                    self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
+                self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
         bias = self.bias
         bx, by, bz = bias
         r_ref, q_rotation, _, longest = self._adaptive
         r = r_ref
         aligning = False
-        if self._rotating:
-            phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
-            terms = rotvec_terms(*phi)  # once, for the pre-filter and the propagation
-            if self._acc_tau > 0.0:  # the filter and its gate use the measured vector
-                m = measure_clipped(self.meas) if clipped else self.meas
-                self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
-                                                      self._measure)
-                ax, ay, az = self.meas.f
-        if self._quaternion:  # (then self._rotating: phi is this interval's rotation)
-            self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
-            roll, pitch = quat_roll_pitch(*self.q_att)
-        elif self._trapezoid:
-            p0, q0, r0 = self.gyro_prev
-            roll, pitch = heun_euler_step(self.roll, self.pitch, p0 - bx, q0 - by, r0 - bz,
-                                          gx - bx, gy - by, gz - bz, dt)
-        else:
-            roll, pitch = euler_step(self.roll, self.pitch, gx - bx, gy - by, gz - bz, dt)
+        phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
+        terms = rotvec_terms(*phi)  # once, for the pre-filter and the propagation
+        if self._acc_tau > 0.0:  # the filter and its gate use the measured vector
+            m = measure_clipped(self.meas) if clipped else self.meas
+            self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
+                                                  self._measure)
+            ax, ay, az = self.meas.f
+        self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
+        roll, pitch = quat_roll_pitch(*self.q_att)
         if self._gate_low2 <= ax * ax + ay * ay + az * az <= self._gate_high2:
             acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
             tau = self._tau
@@ -206,8 +169,7 @@ class ComplementaryFilter(Estimator):
             y = acc_roll - roll
             roll += k * (y if -PI <= y <= PI else wrap_angle(y))
             pitch += k * (acc_pitch - pitch)
-            if self._quaternion:
-                self.q_att = quat_from_roll_pitch(roll, pitch)
+            self.q_att = quat_from_roll_pitch(roll, pitch)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         return tuple_new(ESTIMATE, (roll, pitch, bias, None, None))

@@ -3,8 +3,7 @@
 Two recordings, both with MPU-6050 noise and a constant gyro bias of (0.5, -0.3, 0.2) deg/s:
   tilt  60 s of two-axis tilt with yaw and small linear acceleration (synthetic.demo_motion);
   move  2 m along x, minimum jerk over 3 s, 2 s still before and after (Safitri et al.'s test).
-RMSE is taken after a 5 s convergence period. This stands in for the testbench campaign until the
-FMU testbench lands.
+RMSE is taken after a 5 s convergence period.
 """
 
 from __future__ import annotations
@@ -75,9 +74,9 @@ def format_table(rows: list[dict[str, object]]) -> str:
         )
     lines.append("angles in deg after 5 s, bias error in deg/s (largest of x, y), position in m")
     lines.append(
-        "poskf on 'tilt': its tilt stage trusts the accelerometer only at confirmed rest, and this "
-        "recording never rests,\nso roll and pitch are the gyro's (bias included); "
-        "tilt_update='always' restores the papers' behaviour."
+        "poskf on 'tilt': its roll and pitch are those of the kf it runs beside; the tilt stage "
+        "that levels its\naccelerometer trusts the accelerometer only at confirmed rest, and "
+        "this recording never rests: the position drifts."
     )
     return "\n".join(lines)
 

@@ -51,9 +51,9 @@ from .types import G, Param
 DISTURBANCE_ATTACK: Final = 0.05
 """Time constant [s] with which the slow-band statistic rises. A disturbance that starts (the
 onset of a move, a burst of linear acceleration) must count in the measurement noise before a
-Kalman filter takes its apparent tilt for a gyro bias's drift: with the statistic's
-disturbance_time of 1 s both ways, the kf learned 1.6 deg/s of bias in the first half second of
-the contract's high_dynamics moves. It falls over disturbance_time, as before."""
+Kalman filter takes its apparent tilt for a gyro bias's drift (a statistic that rose as slowly
+as it falls, over disturbance_time, let the kf learn a bias of degrees per second at the onset of
+the contract's high_dynamics moves). It falls over disturbance_time."""
 BAND_PARAM: Final = Param(
     "slow_band_time", 0.15,
     "Time constant of each stage of the short low-pass that splits the measured linear "

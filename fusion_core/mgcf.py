@@ -1,17 +1,7 @@
-"""Gain-scheduled (modified-gain) complementary filter: a Mahony-style quaternion PI filter.
-
-Reference:
-  Duong Quoc et al., complementary filter gain, eq. 7-13: the attitude quaternion is driven by
-  the gyro plus a PI correction from the accelerometer error e = a_n x v (measured x estimated
-  gravity direction in the body frame); Kp = 2 zeta w0, Ki = w0^2 (the PI loop as a second-order
-  system with natural frequency w0 and damping zeta = 2); w0 is switched by
-  rho = | |a|/g - 1 | so that the accelerometer is trusted less the further its norm is from g.
-  Their simulation table (section 4.1): rho < 0.01 -> w0 = 0.1 rad/s, < 0.25 -> 0.07,
-  < 0.35 -> 0.035, else 0 (gyro only); their experimental table for the MPU-6050 (section 4.2):
-  rho < 0.025 -> 0.1, < 0.035 -> 0.07, < 0.05 -> 0.05, else 0. With a fixed w0 the filter is
-  their conventional CF (CCF): w0 = 0.05 rad/s in their experiment.
-  Mahony, Hamel, Pflimlin (2008), "Nonlinear complementary filters on the special orthogonal
-  group", give the PI law this filter uses: omega = gyro - b + Kp e, b_dot = -Ki e.
+"""The recommended modified-gain complementary filter: the paper's Mahony-style quaternion PI
+filter (fusion_core.papers.mgcf: Duong Quoc et al. eq. 7-13) with a fixed gain and the
+mechanisms of building_blocks and fusion_core.measured_vector around it
+(GainScheduledComplementaryFilter).
 """
 
 from __future__ import annotations
@@ -54,101 +44,62 @@ from .measured_vector import (
     measure_step,
     raw_noise,
 )
+from .papers.mgcf import quat_first_order
 from .state import NONNEG, REAL, REST, UNIT, StateSpec
-from .types import Estimate, G, Param
-
-SCHEDULES: dict[str, tuple[tuple[float, float], ...]] = {
-    # (rho upper bound, w0 [rad/s]); rho at or above the last bound gives w0 = 0.
-    # Duong Quoc et al. section 4.1 (simulated data, zeta = 2).
-    "simulation": ((0.01, 0.1), (0.25, 0.07), (0.35, 0.035)),
-    # Duong Quoc et al. section 4.2 (their MPU-6050, low and medium dynamics, zeta = 2); their
-    # conventional CF (CCF) in that experiment is schedule="fixed" with w0 = 0.05 rad/s.
-    "experimental": ((0.025, 0.1), (0.035, 0.07), (0.05, 0.05)),
-}
-
-
-def scheduled_w0(rho: float, table: tuple[tuple[float, float], ...]) -> float:
-    """w0 for accelerometer-norm deviation rho from a (bound, w0) table (Duong Quoc et al.)."""
-    for bound, w0 in table:
-        if rho < bound:
-            return w0
-    return 0.0
-
+from .types import Estimate, Param
 
 MGCF_ACC_LOWPASS = dataclasses.replace(ACC_LOWPASS_PARAM, default=1.0)
 """The mgcf's acc_lowpass: 1 s, not the 1.5 s of the others. Its integral term (Ki = w0^2)
 learns a bias from every error its correction passes, and a longer vector turned by a gyro with
-scale errors carries more of them: on moderate_dynamics (realistic sensor, seed 0) its pitch RMSE
-is 0.63 deg at 1 s and 0.69 at 1.5 s, against the 0.66 deg of half the paper's row
-(tests/test_paper_rows.py). On BROAD the cross-validation's folds chose 1, 1.5 and 2 s for it
-(`python -m testbenches broad DIR --cv`), 0.538 against 0.526 deg in sample."""
+scale errors carries more of them (tests/test_paper_rows.py holds it to half the paper's row on
+moderate_dynamics); on BROAD the cross-validation's folds do not prefer a longer one
+(`python -m testbenches broad DIR --cv`)."""
 
 
 class GainScheduledComplementaryFilter(Estimator):
-    """Duong Quoc et al. modified-gain complementary filter (quaternion PI, scheduled w0).
+    """The recommended modified-gain complementary filter (Duong Quoc et al. eq. 7-13:
+    quaternion PI after Mahony et al. 2008).
 
     Per sample (a valid one after the first):
       v   = R(q)^T e_z, the estimated gravity direction in the body frame;
-      e   = a/|a| x v (Mahony's correction term), v taken after the gyro prediction to this
-            sample's time (gyro_sampling="point") or from the previous attitude
-            (gyro_sampling="mean", Mahony's code);
-      rho = | |a|/g - 1 |; w0 = schedule(rho) (or the parameter w0 with schedule="fixed");
-      Kp  = 2 zeta w0, Ki = w0^2;
+      e   = f/|f| x v (Mahony's correction term), f the measured vector (below), v taken after
+            the gyro prediction to this sample's time (gyro_sampling="point") or from the
+            previous attitude (gyro_sampling="mean", Mahony's code);
+      Kp  = 2 zeta w0, Ki = w0^2 (w0 fixed: the paper's bands of |a|/g are for a calibrated
+            sensor, and with the pre-filter the linear acceleration is gone before they could
+            see it);
       b  <- b - Ki e dt (the integral term; b is the gyro-bias estimate, output as bias_*);
-      the body rate gyro - b + Kp e rotates q over dt. With gyro_sampling="point" the rate is
+      the body rate gyro - b + Kp e rotates q over dt: with gyro_sampling="point" the rate is
       taken linear between the previous and the current gyro sample and integrated with the
       two-sample coning correction (kinematics.rotation_increment); with "mean" q is advanced
-      with the current rate by first-order quaternion integration (the papers' rule).
-    Roll and pitch come from the quaternion; yaw is carried along but unobservable.
+      with the current rate by the first-order quaternion rule (papers.mgcf.quat_first_order).
+    Roll and pitch come from the quaternion; yaw is carried along but unobservable. Around the
+    paper's filter, for real IMUs:
+    - the measured vector (acc_lowpass > 0; fusion_core.measured_vector): f is the
+      accelerometer low-passed in a frame that turns with the bias-corrected gyro (after Laidig
+      & Seel 2023), so linear acceleration averages out instead of reading as tilt; over its
+      first time constant it is the running mean of the turned samples, and q is its tilt;
+    - rest detection (rest_time > 0; building_blocks.REST_PARAMS): at rest the gyro reads its
+      own bias, and b follows the gyro with time constant rest_time (a zero-angular-rate update
+      of the integral term; Mahony's integral alone needs minutes, and cannot see the bias about
+      the vertical at all). A first rest that b misses by rest_gyro or more (a gyro never
+      calibrated) aligns the filter instead (building_blocks.uncalibrated_first_rest);
+    - adaptive noise, as the cf has it: the pre-filter shortens to the raw sample where no
+      linear acceleration above the white noise is measured, and 1/Kp follows
+      building_blocks.correction_time (Ki as it is): Kp grows while the sensor turns with a
+      clean accelerometer and falls while it accelerates, to 1/max_correction_time;
+    - no bias is learned from a gyro sample at its rail (gyro_range) nor from a measured vector
+      that still holds its turns.
 
-    Options for real sensors, both on by default (the `paper` preset turns them off, and then
-    the filter is exactly the paper's):
-    - acc_lowpass > 0: a is first low-passed in a frame that turns with the bias-corrected gyro
-      (building_blocks.ACC_LOWPASS_PARAM, after Laidig & Seel 2023), and e and rho use that
-      vector: linear acceleration averages out instead of reading as tilt, and the schedule sees
-      the norm of what the correction uses; over its first time constant it is the running mean
-      of the turned samples, and q is its tilt (measured_vector: while it fills);
-    - rest_time > 0: while a rest detector (building_blocks.REST_PARAMS) says the sensor is
-      still, the gyro reads its own bias, and b follows the gyro with time constant rest_time (a
-      zero-angular-rate update of the integral term; Mahony's integral alone needs minutes, and
-      cannot see the bias about the vertical at all). A first rest that b misses by rest_gyro
-      or more (a gyro never calibrated) aligns the filter instead: b becomes the rest's mean
-      rate and q its mean specific force's tilt (building_blocks.uncalibrated_first_rest).
-
-    Recommended: schedule "fixed" with Kp = 2 zeta w0 = 0.4 rad/s (w0 = 0.02, zeta = 10), a
-    2.5 s correction time constant as in the paper's top band (w0 = 0.1, zeta = 2), and
-    Ki = w0^2 = 4e-4 s^-2 instead of 0.01: the bias comes from the rest updates, and an integral
-    with a 10 s time constant turns every systematic accelerometer error in motion into bias
-    (BROAD trial 32: the integral wandered to 0.85 deg/s and back); w0 from a coarse scan on
-    BROAD at Kp = 0.4 (0.1 / 0.05 / 0.02 / 0.01: 0.65 / 0.58 / 0.57 / 0.57 deg), the plateau's
-    middle. "fixed", not a table: with the pre-filter the linear acceleration is gone before rho
-    is taken, and the paper's bands for a calibrated sensor cut the gain of a real one (|a| at
-    rest 1.001-1.010 g on BROAD's). The paper's values are presets.PAPER_MGCF.
-
-    Adaptive noise (recommended; off in the paper's filter), as the cf has it: the pre-filter
-    shortens to the raw sample where no linear acceleration above the white noise is measured,
-    and 1/Kp follows building_blocks.correction_time (Ki as it is): Kp grows while the sensor
-    turns with a clean accelerometer and falls while it accelerates, to 1/max_correction_time.
-    On the realistic sensor, seed 0: roll_sweep 0.28/0.53 -> 0.12/0.08, pitch_sweep 0.17/0.61 ->
-    0.10/0.07, roll_pitch 0.25/0.56 -> 0.11/0.08 deg (the turn-on bias's error b / Kp shrinks
-    with the faster correction), high_dynamics 3.9/5.0 -> 3.4/4.5, vibration 0.45/1.13 ->
-    0.62/1.51; BROAD 0.565 -> 0.545.
-
-    Parameters: schedule ("simulation", "experimental", "fixed"), w0 [rad/s] (used when
-    schedule="fixed"), zeta, acc_lowpass [s], rest_time [s], rest_gyro [rad/s],
-    rest_acc [m/s^2], gyro_sampling, acc_noise, gyro_scale_std, scale_time [s],
-    disturbance_time [s], max_correction_time [s], max_dt [s], max_rate [rad/s].
+    w0 = 0.02 rad/s, zeta = 10: Kp = 0.4 rad/s, a 2.5 s correction time constant as in the
+    paper's top band (w0 = 0.1, zeta = 2), and Ki = 4e-4 s^-2 instead of 0.01: the bias comes
+    from the rest updates, and an integral with a 10 s time constant turns every systematic
+    accelerometer error in motion into bias.
     """
 
     PARAMS = (
         Param(
-            "schedule", "fixed",
-            "w0 schedule over rho = ||a|/g - 1|: 'simulation' (Duong Quoc et al. table), "
-            "'experimental', or 'fixed' (constant w0: the paper's conventional CF)",
-            choices=("simulation", "experimental", "fixed"),
-        ),
-        Param(
-            "w0", 0.02, "Natural frequency of the PI correction when schedule='fixed'",
+            "w0", 0.02, "Natural frequency of the PI correction (Kp = 2 zeta w0, Ki = w0^2)",
             unit="rad/s", low=0.0,
         ),
         Param("zeta", 10.0, "Damping ratio of the PI correction (Kp = 2 zeta w0; the paper's 2)",
@@ -165,8 +116,7 @@ class GainScheduledComplementaryFilter(Estimator):
 
     def _configure(self) -> None:
         p = self._params
-        self._table = SCHEDULES.get(p["schedule"])
-        self._w0_fixed = float(p["w0"])
+        self._w0 = float(p["w0"])
         self._two_zeta = 2.0 * float(p["zeta"])
         self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
@@ -174,7 +124,6 @@ class GainScheduledComplementaryFilter(Estimator):
         self._rest_gyro = float(p["rest_gyro"])
         self._rest_bias_bound = float(p["rest_bias_bound"])
         self._rest_acc = float(p["rest_acc"])
-        self._options = self._rest_time > 0.0 or self._acc_tau > 0.0
         # the adaptive noise (building_blocks.ADAPTIVE_NOISE_PARAMS), as in the cf: one sample's
         # variance, the rotation term per (rad/s)^2, the disturbance's averaging time (0: off),
         # the white noise's share of the disturbance statistic, the longest correction time
@@ -228,12 +177,9 @@ class GainScheduledComplementaryFilter(Estimator):
     ) -> Estimate:
         r_ref, q_rotation, _, longest = self._adaptive
         r = r_ref
-        aligning = False
-        if self._options:
-            ax, ay, az, r, aligning = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
+        ax, ay, az, r, aligning = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
-        table = self._table
-        w0 = self._w0_fixed if table is None else scheduled_w0(abs(norm / G - 1.0), table)
+        w0 = self._w0
         if not norm > 0.0:  # no gravity direction in this sample: gyro only
             w0 = 0.0
         self.w0_now = w0
@@ -269,12 +215,11 @@ class GainScheduledComplementaryFilter(Estimator):
             ex, ey, ez = ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
             # b <- b - Ki e dt, Ki = w0^2: the integral term, whose negative is the gyro bias;
             # none from a gyro sample at its rail, nor from a vector still holding its turns
-            if not self._options or (not self.clipped and (
-                    self._acc_tau == 0.0 or self.meas.settled(self._measure))):
+            if not self.clipped and (self._acc_tau == 0.0 or self.meas.settled(self._measure)):
                 ki_dt = w0 * w0 * dt
                 bx, by, bz = self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
         if not self._trapezoid:  # then one Euler step with the PI-corrected rate
-            q = _quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
+            q = quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
         elif w0 > 0.0:
             kp_dt = kp * dt
             q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
@@ -285,17 +230,3 @@ class GainScheduledComplementaryFilter(Estimator):
     def _estimate(self) -> Estimate:
         roll, pitch = quat_roll_pitch(*self.q)
         return Estimate(roll, pitch, self.bias)
-
-
-def _quat_first_order(
-    q: tuple[float, float, float, float], w: tuple[float, float, float], dt: float
-) -> tuple[float, float, float, float]:
-    """q + dt/2 q (x) (0, w), renormalised: the first-order rule of Mahony's reference code."""
-    qw, qx, qy, qz = q
-    wx, wy, wz = 0.5 * dt * w[0], 0.5 * dt * w[1], 0.5 * dt * w[2]
-    rw = qw - qx * wx - qy * wy - qz * wz
-    rx = qx + qw * wx + qy * wz - qz * wy
-    ry = qy + qw * wy - qx * wz + qz * wx
-    rz = qz + qw * wz + qx * wy - qy * wx
-    n = 1.0 / math.sqrt(rw * rw + rx * rx + ry * ry + rz * rz)
-    return rw * n, rx * n, ry * n, rz * n

@@ -1,179 +1,66 @@
-"""Position Kalman filter: tilt from the 2-state Kalman filter, then a [p, v, a] filter per axis.
-
-Reference:
-  Safitri, Cahyadi, Firmansyah, UAV position estimation, eq. 20-29: per axis the state is
-  [p, v, a] with F = [[1, dt, dt^2/2], [0, 1, dt], [0, 0, 1]] (eq. 23), the accelerometer
-  observes a (H = [0 0 1]), and the process noise is white jerk of density q (eq. 29):
-    Q = q [[dt^5/20, dt^4/8, dt^3/6], [dt^4/8, dt^3/3, dt^2/2], [dt^3/6, dt^2/2, dt]].
-  They compare three Q/R forms; their best final error on a 2 m move is 0.0385 m in x.
-  The tilt that turns the body specific force into the level frame comes from the
-  AngleBiasKalmanFilter (Gui et al. / Das & Mary) run on the same samples.
-
-Implementation: plain floats. The three axes share F, Q, R and their updates, so they share one
-covariance P (and one gain per update), kept as its upper triangle
-(p00, p01, p02, p11, p12, p22); the `P` attribute shows it as a 3x3 tuple of tuples and the
-`states` attribute the per-axis [p, v, a] as lists.
+"""The recommended position Kalman filter: the paper's [p, v, a] filter per axis
+(fusion_core.papers.position: Safitri et al. eq. 20-29, whose equations it uses) with a
+zero-velocity update at rest, a tilt stage that takes the accelerometer only at confirmed rest,
+and the recommended attitude filter's roll and pitch as its attitude outputs
+(PositionKalmanFilter).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from math import cos, sin, sqrt
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
-from .building_blocks import CONSTANT_NOISE, zero_rate_psd_param
-from .kalman import PAPER_KF, AngleBiasKalmanFilter
+from .building_blocks import GYRO_SAMPLING_PARAM, zero_rate_psd_param
+from .kalman import AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, wrap_angle
+from .papers.kalman import PAPER_KF_PARAMS, PaperKalmanFilter
+from .papers.position import (
+    JERK_PARAMS,
+    AxisStates,
+    Mat3,
+    Sym3,
+    axis_filters,
+    axis_lists,
+    axis_tuple,
+    first_axis_states,
+    level_acceleration,
+    process_noise,
+    sym3_matrix,
+    sym3_packed,
+)
 from .state import ANGLE, COV, FLAG, NESTED, NONNEG, REAL, Queue, Segments, StateSpec
-from .types import DEG, Estimate, G, Param
+from .types import DEG, Estimate, Param
 
-REAL_ACC_DENSITY = 0.0033
+REAL_ACC_DENSITY: Final = 0.0033
 """Accelerometer white-noise density [m/s^2/sqrt(Hz)] of a real MEMS IMU at rest, the
-recommended acc_psd's root: the Allan deviation at tau = 1 s on the rest segments of 13 BROAD
-trials (myon aktos-t; `python -m testbenches noise`: 0.0031-0.0039, median 0.0033), the
-convention of the sensor model (one sample's standard deviation = density sqrt(rate))."""
+recommended acc_psd's root: the Allan deviation at tau = 1 s on the rest segments of BROAD's
+trials (myon aktos-t; `python -m testbenches noise`), the convention of the sensor model (one
+sample's standard deviation = density sqrt(rate))."""
 
-PENDING_MAX = 2048
-"""Most accelerometer samples the stationary queue holds (tilt_update="stationary"); when full
-the oldest is dropped unapplied. The queue holds zupt_window seconds of samples: 250 at 1 kHz
-with the default window, so the bound is met up to 8 kHz. A fixed bound lets the C twin keep
-the queue in its state without allocating."""
+PENDING_MAX: Final = 2048
+"""Most accelerometer samples the stationary queue holds; when full the oldest is dropped
+unapplied. The queue holds zupt_window seconds of samples: 250 at 1 kHz with the default window,
+so the bound is met up to 8 kHz. A fixed bound lets the C twin keep the queue in its state
+without allocating."""
 
-TILT_PARAMS = ("Q_angle", "Q_bias", "R_measure", "R_loop_time", "gate_low", "gate_high",
-               "gyro_sampling")
-"""Parameters passed through to the tilt stage (AngleBiasKalmanFilter)."""
-TILT_DEFAULTS = {k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "gate_low",
-                                          "gate_high")}
-"""The tilt stage's defaults: the papers' values. It sees the accelerometer only at confirmed
-rest, where the specific force is gravity alone, so it may trust each sample as the papers do
-(R 0.03 deg^2: it converges within a rest of a fraction of a second); the recommended kf's
-values are for a filter that must trust the accelerometer in motion too."""
-TILT_FIXED = {
-    "propagation": "euler", "acc_lowpass": 0.0, "rest_time": 0.0, "init_bias_std": 0.0,
-    "tilt_axes": "body", "bias_innovation": math.pi, **CONSTANT_NOISE,
-}
-"""The tilt stage's other kf options: off. This filter drives the stage step by step (propagate,
-correct_innovation, correct_bias) and does its own rest detection and bias updates."""
-
-Sym3 = tuple[float, float, float, float, float, float]
-"""A symmetric 3x3 matrix as its upper triangle (m00, m01, m02, m11, m12, m22)."""
-Mat3 = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
-AxisStates = tuple[float, float, float, float, float, float, float, float, float]
-"""[p, v, a] of the x, y and z axes, one after the other."""
-
-
-def process_noise(form: str, q: float, dt: float) -> Sym3:
-    """Q of one axis for the named form (Safitri et al.'s three Q/R forms, our reading):
-
-    white_jerk      continuous white jerk of density q, discretised exactly (eq. 29);
-    piecewise_jerk  jerk constant over each interval with variance q/dt:
-                    q/dt * G G^T, G = [dt^3/6, dt^2/2, dt];
-    diagonal        the diagonal of white_jerk only (no correlation between p, v, a).
-    """
-    d2, d3, d4, d5 = dt * dt, dt**3, dt**4, dt**5
-    if form == "piecewise_jerk":
-        g0, g1, g2 = d3 / 6.0, d2 / 2.0, dt
-        s = q / dt
-        return (s * g0 * g0, s * g0 * g1, s * g0 * g2, s * g1 * g1, s * g1 * g2, s * g2 * g2)
-    q00, q11, q22 = q * d5 / 20.0, q * d3 / 3.0, q * dt
-    if form == "diagonal":
-        return (q00, 0.0, 0.0, q11, 0.0, q22)
-    return (q00, q * d4 / 8.0, q * d3 / 6.0, q11, q * d2 / 2.0, q22)
-
-
-def axis_filters(
-    x: AxisStates, P: Sym3, Q: Sym3, dt: float, acc: tuple[float, float, float], r: float,
-    zupt_r: float | None,
-) -> tuple[AxisStates, Sym3]:
-    """One sample of the three [p, v, a] filters (eq. 20-29), written out; returns (x, P).
-
-    Predict: x <- F x, P <- F P F^T + Q (F of eq. 23). Update with the level-frame acceleration
-    acc (H = [0 0 1], variance r per axis) and, unless zupt_r is None, with velocity 0
-    (H = [0 1 0], variance zupt_r). Each update is the standard scalar one, shared by the axes:
-    c = P H^T, K = c / (H c + r), x += K (z - H x), P <- P - K c^T.
-    """
-    p0, v0, a0, p1, v1, a1, p2, v2, a2 = x
-    h = 0.5 * dt * dt
-    p0 += dt * v0 + h * a0
-    v0 += dt * a0
-    p1 += dt * v1 + h * a1
-    v1 += dt * a1
-    p2 += dt * v2 + h * a2
-    v2 += dt * a2
-    # F P F^T + Q: first R = F P (rows of F times P), then R F^T
-    m00, m01, m02, m11, m12, m22 = P
-    r00 = m00 + dt * m01 + h * m02
-    r01 = m01 + dt * m11 + h * m12
-    r02 = m02 + dt * m12 + h * m22
-    r11 = m11 + dt * m12
-    r12 = m12 + dt * m22
-    q00, q01, q02, q11, q12, q22 = Q
-    m00 = r00 + dt * r01 + h * r02 + q00
-    m01 = r01 + dt * r02 + q01
-    m02 = r02 + q02
-    m11 = r11 + dt * r12 + q11
-    m12 = r12 + q12
-    m22 = m22 + q22
-    # acceleration update: c = (m02, m12, m22)
-    s = m22 + r
-    k0, k1, k2 = m02 / s, m12 / s, m22 / s
-    y = acc[0] - a0
-    p0 += k0 * y
-    v0 += k1 * y
-    a0 += k2 * y
-    y = acc[1] - a1
-    p1 += k0 * y
-    v1 += k1 * y
-    a1 += k2 * y
-    y = acc[2] - a2
-    p2 += k0 * y
-    v2 += k1 * y
-    a2 += k2 * y
-    # P - K c^T; its column 1 (the zero-velocity update's c) has the entry m12 - k2 m12 below
-    # the diagonal (= m12 - k1 m22 above it, but for rounding)
-    c2 = m12 - k2 * m12
-    m00, m01, m02 = m00 - k0 * m02, m01 - k0 * m12, m02 - k0 * m22
-    m11, m12, m22 = m11 - k1 * m12, m12 - k1 * m22, m22 - k2 * m22
-    if zupt_r is not None:
-        # zero-velocity update: c = (m01, m11, c2), z = 0
-        s = m11 + zupt_r
-        k0, k1, k2 = m01 / s, m11 / s, c2 / s
-        y = 0.0 - v0
-        p0 += k0 * y
-        v0 += k1 * y
-        a0 += k2 * y
-        y = 0.0 - v1
-        p1 += k0 * y
-        v1 += k1 * y
-        a1 += k2 * y
-        y = 0.0 - v2
-        p2 += k0 * y
-        v2 += k1 * y
-        a2 += k2 * y
-        c0, c1 = m01, m11
-        m00, m01, m02 = m00 - k0 * c0, m01 - k0 * c1, m02 - k0 * c2
-        m11, m12, m22 = m11 - k1 * c1, m12 - k1 * c2, m22 - k2 * c2
-    return (p0, v0, a0, p1, v1, a1, p2, v2, a2), (m00, m01, m02, m11, m12, m22)
-
-
-def level_acceleration(
-    ax: float, ay: float, az: float,
-    sr: float, cr: float, sp: float, cp: float, sy: float, cy: float,
-) -> tuple[float, float, float]:
-    """R f - g e_z, R = Rz Ry Rx (body to level frame), for the specific force f; sr, cr, sp, cp,
-    sy, cy are the sines and cosines of roll, pitch and yaw."""
-    # Ry Rx f
-    w = sr * ay + cr * az
-    u0 = cp * ax + sp * w
-    u1 = cr * ay - sr * az
-    u2 = -sp * ax + cp * w
-    return cy * u0 - sy * u1, sy * u0 + cy * u1, u2 - G
-
+TILT_PARAMS: Final[tuple[Param, ...]] = tuple(
+    {"R_loop_time": dataclasses.replace(p, default=0.0),
+     "gyro_sampling": GYRO_SAMPLING_PARAM}.get(p.name, p)
+    for p in PAPER_KF_PARAMS
+)
+"""The tilt stage's parameters (a PaperKalmanFilter, passed through): the papers' Q and R. It
+sees the accelerometer only at confirmed rest, where the specific force is gravity alone, so it
+may trust each sample as the papers do (R 0.03 deg^2 per sample, R_loop_time 0: it converges
+within a rest of a fraction of a second); the recommended kf's values are for a filter that
+must trust the accelerometer in motion too. The gyro sampling is the sensor's (point samples by
+default, as every recommended estimator)."""
+TILT_PARAM_NAMES: Final = tuple(p.name for p in TILT_PARAMS)
 
 class PositionKalmanFilter(Estimator):
-    """Safitri et al. position Kalman filter with a zero-velocity update.
+    """The recommended position filter: Safitri et al.'s [p, v, a] filters with a zero-velocity
+    update.
 
     Per sample:
       1. stationary detector: the sample is quiet when the specific force differs from its
@@ -181,47 +68,38 @@ class PositionKalmanFilter(Estimator):
          acceleration is below zupt_level_acc and the bias-corrected rate below zupt_gyro;
          the platform is stationary after zupt_window seconds of quiet samples, unless the
          filter is sure it is gliding (see _slow_enough);
-      2. tilt: an AngleBiasKalmanFilter (same samples) propagates roll and pitch. With
-         tilt_update="stationary" (default) it uses only accelerometer samples confirmed
-         stationary: a quiet sample waits zupt_window seconds in a queue and is applied (its
-         innovation taken against the tilt of its own time) only if every sample since was
-         quiet too, because the first tens of milliseconds of a smooth move are too small to
-         detect and would otherwise be taken for tilt. "always" is the papers' behaviour.
-         Yaw is the gyro's integral (unobservable: positions are in the start-heading frame);
+      2. tilt: the papers' Kalman filter (PaperKalmanFilter, driven step by step through its
+         tilt-stage methods) propagates roll and pitch with every sample but takes only
+         accelerometer samples confirmed stationary: a quiet sample waits zupt_window seconds in
+         a queue and is applied (its innovation taken against the tilt of its own time) only if
+         every sample since was quiet too, because the first tens of milliseconds of a smooth
+         move are too small to detect and would otherwise be taken for tilt. Yaw is the gyro's
+         integral (unobservable: positions are in the start-heading frame);
       3. level-frame acceleration a = R(roll, pitch, yaw) f - g e_z;
-      4. per axis [p, v, a]: predict (F eq. 23, Q of the chosen form), update with a
+      4. per axis [p, v, a]: predict (F eq. 23, the white-jerk Q of eq. 29), update with a
          (H = [0 0 1], R = acc_psd / dt), and while stationary a zero-velocity update
          (H = [0 1 0], z = 0, variance zupt_noise^2) so that velocity does not drift at rest;
-         while stationary the gyro also updates the tilt stage's biases (zero-angular-rate
-         update, zaru), so the tilt does not drift during the next move.
+         while stationary the gyro also updates the tilt stage's biases (a zero-angular-rate
+         update, variance gyro_psd / dt), so the tilt does not drift during the next move.
     The filter starts at position 0 and velocity 0 (the platform at rest, as in the paper).
 
-    Outputs pos, vel [m, m/s] plus roll, pitch and bias. With attitude="kf" (recommended) they
-    come from an AngleBiasKalmanFilter with its recommended values run on the same samples: the
-    tilt stage above is right for levelling the accelerometer between rests (it never takes
-    linear acceleration for tilt), but in continuous motion it is gyro-only integration, and an
-    attitude output must be as good as the best attitude filter here. With "tilt_stage" (the
-    papers') they are the tilt stage's (bias_z = 0). The recommended acc_psd and gyro_psd are
-    the noise densities measured on a real MEMS IMU, squared.
+    Outputs pos, vel [m, m/s] plus roll, pitch and bias, these from the recommended
+    AngleBiasKalmanFilter run on the same samples: the tilt stage is right for levelling the
+    accelerometer between rests (it never takes linear acceleration for tilt), but in continuous
+    motion it is gyro-only integration, and an attitude output must be as good as the best
+    attitude filter here. The recommended acc_psd and gyro_psd are the noise densities measured
+    on a real MEMS IMU, squared.
     """
 
     HAS_POSITION = True
     PARAMS = (
-        Param(
-            "qr_form", "white_jerk",
-            "Process-noise form (Safitri et al. Q/R forms): 'white_jerk' (eq. 29), "
-            "'piecewise_jerk', 'diagonal'",
-            choices=("white_jerk", "piecewise_jerk", "diagonal"),
-        ),
-        Param("q", 1.0, "Jerk noise power spectral density per axis", unit="m2/s5", low=0.0,
-              low_open=True),
+        *JERK_PARAMS,
         Param(
             "acc_psd", REAL_ACC_DENSITY**2,
             "Accelerometer white-noise power spectral density, R = acc_psd/dt (measured on a real "
             "MEMS IMU: (0.0033 m/s2/sqrt(Hz))^2; MPU-6050 datasheet (400 ug/sqrt(Hz))^2)",
             unit="m2/s3", low=0.0, low_open=True,
         ),
-        Param("zupt", True, "Zero-velocity update while the platform is stationary"),
         Param(
             "zupt_acc", 0.2,
             "Stationary detector: threshold on the specific force's change from its running mean",
@@ -255,28 +133,8 @@ class PositionKalmanFilter(Estimator):
             "zupt_noise", 0.005, "Standard deviation of the zero-velocity pseudo-measurement",
             unit="m/s", low=0.0, low_open=True,
         ),
-        Param(
-            "zaru", True,
-            "Zero-angular-rate update of the tilt stage's gyro biases while stationary",
-        ),
         zero_rate_psd_param(),
-        Param(
-            "tilt_update", "stationary",
-            "When the tilt filter uses the accelerometer: 'stationary' or 'always' (the papers')",
-            choices=("stationary", "always"),
-        ),
-        Param(
-            "attitude", "kf",
-            "Where the roll, pitch and bias outputs come from: 'kf' (an AngleBiasKalmanFilter with "
-            "its recommended values on the same samples: accurate in continuous motion) or "
-            "'tilt_stage' (the tilt that levels the accelerometer for the position filter; the "
-            "papers')",
-            choices=("kf", "tilt_stage"), tunable=False,
-        ),
-        *(
-            dataclasses.replace(p, default=TILT_DEFAULTS.get(p.name, p.default))
-            for p in AngleBiasKalmanFilter.PARAMS if p.name in TILT_PARAMS
-        ),
+        *TILT_PARAMS,
     )
     TWIN: ClassVar[str | None] = "fc_poskf"
     STATE: ClassVar[StateSpec] = {
@@ -289,11 +147,11 @@ class PositionKalmanFilter(Estimator):
 
     def _configure(self) -> None:
         p = self._params
-        tilt_params = {k: p[k] for k in TILT_PARAMS}
+        tilt_params = {k: p[k] for k in TILT_PARAM_NAMES}
         if not hasattr(self, "tilt"):
-            self.tilt = AngleBiasKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
-                                              **TILT_FIXED, **tilt_params)
-            # the attitude output (attitude="kf"): the recommended kf on the same samples
+            self.tilt = PaperKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
+                                          **tilt_params)
+            # the attitude outputs: the recommended kf on the same samples
             self.att = AngleBiasKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
                                              gyro_sampling=p["gyro_sampling"])
         else:
@@ -303,7 +161,6 @@ class PositionKalmanFilter(Estimator):
             for f in (self.tilt, self.att):
                 f.set_param("max_dt", p["max_dt"])
                 f.set_param("max_rate", p["max_rate"])
-        self._own_attitude: bool = p["attitude"] == "kf"
         self._acc_var_density = float(p["acc_psd"])
         self._zupt_var = float(p["zupt_noise"]) ** 2
         self._gyro_var_density = float(p["gyro_psd"])
@@ -313,11 +170,8 @@ class PositionKalmanFilter(Estimator):
         self._zupt_gyro = float(p["zupt_gyro"])
         self._window = float(p["zupt_window"])
         self._force_after = float(p["zupt_force_after"])
-        self._zupt = bool(p["zupt"])
-        self._zaru = bool(p["zaru"])
-        self._always: bool = p["tilt_update"] == "always"
-        # the dt of Q = process_noise(qr_form, q, dt) and R = acc_psd / dt (0: none yet, since
-        # every accepted dt is > 0)
+        # the dt of Q = process_noise("white_jerk", q, dt) and R = acc_psd / dt (0: none yet,
+        # since every accepted dt is > 0)
         self._Q_dt = 0.0
 
     @property
@@ -339,27 +193,20 @@ class PositionKalmanFilter(Estimator):
     @property
     def states(self) -> list[list[float]]:
         """[p, v, a] of the x, y and z axes (a copy)."""
-        x = self._x
-        return [list(x[0:3]), list(x[3:6]), list(x[6:9])]
+        return axis_lists(self._x)
 
     @states.setter
     def states(self, value: list[list[float]]) -> None:
-        (p0, v0, a0), (p1, v1, a1), (p2, v2, a2) = value
-        self._x = (
-            float(p0), float(v0), float(a0), float(p1), float(v1), float(a1),
-            float(p2), float(v2), float(a2),
-        )
+        self._x = axis_tuple(value)
 
     @property
     def P(self) -> Mat3:
         """The covariance shared by the three axes, 3x3 (of [p, v, a])."""
-        m00, m01, m02, m11, m12, m22 = self._P
-        return ((m00, m01, m02), (m01, m11, m12), (m02, m12, m22))
+        return sym3_matrix(self._P)
 
     @P.setter
     def P(self, value: Mat3) -> None:
-        (m00, m01, m02), (_, m11, m12), (_, _, m22) = value
-        self._P = (float(m00), float(m01), float(m02), float(m11), float(m12), float(m22))
+        self._P = sym3_packed(value)
 
     def _reset(self) -> None:
         self.tilt.reset()
@@ -395,19 +242,12 @@ class PositionKalmanFilter(Estimator):
         ]
 
     def _init(self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float) -> None:
-        # The first sample's dt is not used; pass one the tilt stage accepts.
-        tilt = self.tilt
-        tilt.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
-        if self._own_attitude:
-            self.att.step((ax, ay, az), (gx, gy, gz), self._params["max_dt"])
+        # The first sample's dt is not used; pass one the filters accept.
+        max_dt = self._params["max_dt"]
+        self._x, self._P = first_axis_states(self.tilt, ax, ay, az, gx, gy, gz, max_dt,
+                                             self._acc_var_density)
+        self.att.step((ax, ay, az), (gx, gy, gz), max_dt)
         self.f_mean = (ax, ay, az)
-        roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
-        lx, ly, lz = level_acceleration(
-            ax, ay, az, sin(roll), cos(roll), sin(pitch), cos(pitch), sin(yaw), cos(yaw)
-        )
-        r = self._acc_var_density * 100.0  # one sample's variance at a nominal 100 Hz
-        self._P = (0.0, 0.0, 0.0, 0.0, 0.0, r)
-        self._x = (0.0, 0.0, lx, 0.0, 0.0, ly, 0.0, 0.0, lz)
 
     def _slow_enough(self) -> bool:
         """Whether the estimated speed allows a zero-velocity update.
@@ -455,17 +295,13 @@ class PositionKalmanFilter(Estimator):
             quiet_time >= self._force_after or self._slow_enough()
         )
         # 2. tilt stage; yaw from the gyro (Euler kinematics, Duong Quoc et al. eq. 2)
-        tilt.gyro_prev = self.gyro_prev
-        tilt.propagate(gx, gy, gz, dt)
+        tilt.propagate(self.gyro_prev, (gx, gy, gz), dt)
         d_roll = tilt.roll - roll
         turned_roll, turned_pitch = self.turned
         turned_roll += d_roll if -PI <= d_roll <= PI else wrap_angle(d_roll)
         turned_pitch = turned_pitch + tilt.pitch - pitch
         self.turned = (turned_roll, turned_pitch)
-        if self._always:
-            if tilt.accel_trusted(ax * ax + ay * ay + az * az):
-                tilt.correct(ax, ay, az)
-        elif not quiet:
+        if not quiet:
             if self.pending:
                 self.pending = []
         else:
@@ -485,12 +321,10 @@ class PositionKalmanFilter(Estimator):
                     wrap_angle(acc_roll - tilt.roll + turned_roll - then_roll),
                     acc_pitch - tilt.pitch + turned_pitch - then_pitch,
                 )
-        if stationary and self._zaru:
+        if stationary:
             tilt.correct_bias(gx, gy, self._gyro_var_density / dt)
-        tilt.gyro_prev = (gx, gy, gz)
-        tilt.n_samples += 1
-        if self._own_attitude:
-            self.att.step((ax, ay, az), (gx, gy, gz), dt)
+        tilt.took_sample((gx, gy, gz))
+        self.att.step((ax, ay, az), (gx, gy, gz), dt)
         roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
         sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
         if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
@@ -501,22 +335,17 @@ class PositionKalmanFilter(Estimator):
         # 4. [p, v, a] filter per axis (eq. 20-29)
         if dt != self._Q_dt:
             p = self._params
-            self._Q = process_noise(p["qr_form"], p["q"], dt)
+            self._Q = process_noise("white_jerk", p["q"], dt)
             self._R = self._acc_var_density / dt
             self._Q_dt = dt
         x, self._P = axis_filters(
             self._x, self._P, self._Q, dt, acc, self._R,
-            self._zupt_var if stationary and self._zupt else None,
+            self._zupt_var if stationary else None,
         )
         self._x = x
         return self._estimate()
 
     def _estimate(self) -> Estimate:
         x = self._x
-        if self._own_attitude:  # the attitude kf's own output (in the sensor frame)
-            a = self.att.last
-            roll, pitch, bias = a[0], a[1], a[2]
-        else:
-            t = self.tilt
-            roll, pitch, bias = t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0)
-        return tuple_new(ESTIMATE, (roll, pitch, bias, (x[0], x[3], x[6]), (x[1], x[4], x[7])))
+        a = self.att.last  # the attitude kf's own output (in the sensor frame)
+        return tuple_new(ESTIMATE, (a[0], a[1], a[2], (x[0], x[3], x[6]), (x[1], x[4], x[7])))

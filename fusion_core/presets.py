@@ -1,4 +1,4 @@
-"""Named parameter sets of the estimators: `preset_params(name, key)` -> `ESTIMATORS[key](**p)`.
+"""Named parameter sets of the estimators: `create(key, preset_params(name, key))`.
 
 Two sets, as the interface contract names them:
 
@@ -7,76 +7,34 @@ Two sets, as the interface contract names them:
   docstring of its estimator class, in this order of sources: sensor physics (noise densities,
   sampling, the accelerometer's trust), then, only where physics fixes nothing, a coarse scan
   whose plateau's middle was taken, never its minimum.
-- "paper": the seed papers' own values and rules (PAPER below), to reproduce their results.
-  The papers tune for one calibrated sensor at one loop rate and integrate the gyro with the
-  rectangle rule; on a real IMU at another rate their gains are far off (README, "Presets").
-  None of them turns its output ahead over the sensor's delay: sensor_delay 0 in each, also
-  where a recording states the delay of its sensor.
+- "paper": the seed papers' own filters (fusion_core.papers, chosen by "filter": "paper"), at
+  their values and rules, to reproduce their results. The papers tune for one calibrated sensor
+  at one loop rate and integrate the gyro with the rectangle rule; on a real IMU at another rate
+  their gains are far off (docs, "Presets"). None of them turns its output ahead over the
+  sensor's delay: sensor_delay 0 in each, also where a recording states the delay of its
+  sensor.
 
 A preset may also be a JSON file with the same shape, {"kf": {"R_measure": 1e-4, ...}, ...},
-for any subset of the estimators (load_preset); `python -m testbenches tune` and `noise` write
+for any subset of the estimators, a paper's filter chosen by "filter": "paper" in its entry
+(load_preset); `python -m testbenches tune` and `noise` write
 such files.
 """
 
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import Any
 
-from .building_blocks import CONSTANT_NOISE, NO_RAIL
-from .kalman import PAPER_KF
-from .registry import ESTIMATORS, KEYS
-from .types import DEG, GYRO_RANGE_DEFAULT, MPU6050_ACC_DENSITY, MPU6050_GYRO_DENSITY, G
+from .registry import FILTER, KEYS, create
+from .types import GYRO_RANGE_DEFAULT, G
 
-DEG2 = DEG * DEG
-
-PAPER_CF: dict[str, Any] = {
-    "tau": 0.75, "gate_low": 0.9, "gate_high": 1.1, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "propagation": "euler", "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE,
-    **NO_RAIL,
-}
-"""Gui et al. eq. 1-2: tau = 0.75 s (a = 0.96 at their 30 ms loop), the Euler rates, the
-rectangle rule (gyro_sampling="mean"), a constant tau (gyro_scale_std and disturbance_time 0).
-Their gate has no bounds in the text: 0.9-1.1 g is our reading
-(complementary.ComplementaryFilter)."""
-
-PAPER_MGCF: dict[str, Any] = {
-    "schedule": "simulation", "w0": 0.1, "zeta": 2.0, "acc_lowpass": 0.0, "rest_time": 0.0,
-    "gyro_sampling": "mean", "sensor_delay": 0.0, **CONSTANT_NOISE, **NO_RAIL,
-}
-"""Duong Quoc et al. eq. 7-13 with their simulation table (section 4.1) and zeta = 2; Mahony's
-reference order (error from the previous attitude, first-order step: gyro_sampling="mean").
-Their experiment (section 4.2) is schedule="experimental"; their CCF is schedule="fixed",
-w0 = 0.05."""
-
-PAPER_UKF: dict[str, Any] = {
-    "gyro_psd": MPU6050_GYRO_DENSITY**2, "bias_psd": (0.002 * DEG) ** 2, "acc_noise": 0.06,
-    "norm_noise": 0.01, "acc_gate": 0.1, "init_bias_std": 1.0 * DEG, "alpha": 1.0, "beta": 2.0,
-    "kappa": 0.0, "acc_lowpass": 0.0, "rest_time": 0.0, "bias_gate": 0.0,
-    "bias_innovation": math.pi, **CONSTANT_NOISE, "gyro_sampling": "mean", "sensor_delay": 0.0,
-    **NO_RAIL,
-}
-"""Duong Quoc et al. eq. 14-17. The paper gives no noise values; these are ours for its
-simulated MPU-6050 at 100 Hz: the gyro's process noise that sensor's datasheet density (as the
-recommended values take the measured density of theirs), acc_noise 0.06 with an allowance for
-linear acceleration, gate at rho 0.1, the rectangle rule of its eq. 14; constant Q and R
-(gyro_scale_std and disturbance_time 0)."""
-
-PAPER_POSKF: dict[str, Any] = {
-    "qr_form": "white_jerk", "q": 1.0, "acc_psd": MPU6050_ACC_DENSITY**2, "zupt": False,
-    "zaru": False, "tilt_update": "always", "attitude": "tilt_stage",
-    **{k: PAPER_KF[k] for k in ("Q_angle", "Q_bias", "R_measure", "R_loop_time", "gate_low",
-                                "gate_high", "gyro_sampling", "sensor_delay")},
-}
-"""Safitri et al. eq. 20-29 (their white-jerk Q, eq. 29) without the zero-velocity and
-zero-angular-rate updates, which the paper does not have; the tilt from the papers' Kalman filter
-with every accelerometer sample, and the attitude output that tilt stage's."""
-
-PAPER: dict[str, dict[str, Any]] = {
-    "cf": PAPER_CF, "mgcf": PAPER_MGCF, "kf": PAPER_KF, "ukf": PAPER_UKF, "poskf": PAPER_POSKF,
-}
+PAPER_RULES: dict[str, Any] = {"gyro_sampling": "mean", "sensor_delay": 0.0}
+"""What every paper's filter keeps whatever the recording's sensor says: the rectangle rule, and
+outputs not turned ahead over the sensor's delay (a recording's sensor properties fill in only
+what a parameter set leaves open: testbenches.broad)."""
+PAPER: dict[str, dict[str, Any]] = {k: {FILTER: "paper", **PAPER_RULES} for k in KEYS}
+"""The papers' filters (fusion_core.papers), each at its paper's values (their defaults)."""
 
 PRESETS: dict[str, dict[str, dict[str, Any]]] = {
     "recommended": {k: {} for k in KEYS},
@@ -168,7 +126,7 @@ def load_preset(spec: str | Path) -> dict[str, dict[str, Any]]:
     out = {k: dict(data.get(k, {})) for k in KEYS}
     for key, params in out.items():
         try:
-            ESTIMATORS[key](**params)
+            create(key, params)
         except ValueError as err:
             raise ValueError(f"preset file {path}, {key}: {err}") from None
     return out

@@ -1,22 +1,39 @@
 """The one list of the project's estimators: every other list, table, help string and test
 parametrisation derives from REGISTRY.
 
-An entry names an estimator's key (the short name the commands and presets use), its class, what
-it estimates and whether its attitude comes from a measured vector of its own (the four attitude
-filters; the position filter's attitude is a kf's). The C twin's prefix is the class's TWIN and
-the FMU's model name is the class's name.
+An entry names an estimator's key (the short name the commands and presets use), its class (the
+recommended filter), its reference class (the seed paper's filter, fusion_core.papers), what it
+estimates and whether its attitude comes from a measured vector of its own (the four attitude
+filters; the position filter's attitude is a kf's). Each class's C twin prefix is its TWIN; the
+FMU's model name is the recommended class's name, whichever of the two an FMU runs.
+
+A parameter set chooses between the two classes with the key FILTER ("filter": "paper" runs the
+reference; create, estimator_class), so that the choice travels with the parameters through
+presets, campaigns and FMU builds.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from .base import Estimator
 from .complementary import ComplementaryFilter
 from .kalman import AngleBiasKalmanFilter
 from .mgcf import GainScheduledComplementaryFilter
+from .papers import (
+    PaperComplementaryFilter,
+    PaperGainScheduledFilter,
+    PaperKalmanFilter,
+    PaperPositionKalmanFilter,
+    PaperUnscentedKalmanFilter,
+)
 from .position import PositionKalmanFilter
 from .ukf import UnscentedKalmanFilter
+
+FILTER = "filter"
+"""The key of a parameter set that chooses the class: FILTERS[0] (the default) or FILTERS[1]."""
+FILTERS = ("recommended", "paper")
 
 
 @dataclass(frozen=True)
@@ -25,6 +42,8 @@ class Entry:
 
     key: str
     cls: type[Estimator]
+    reference: type[Estimator]
+    """The seed paper's filter (fusion_core.papers)."""
     title: str
     """What it is, for help strings and tables."""
     attitude_filter: bool
@@ -43,13 +62,16 @@ class Entry:
 
 
 REGISTRY: tuple[Entry, ...] = (
-    Entry("cf", ComplementaryFilter, "complementary filter (Gui et al. 2015)", True),
-    Entry("mgcf", GainScheduledComplementaryFilter,
+    Entry("cf", ComplementaryFilter, PaperComplementaryFilter,
+          "complementary filter (Gui et al. 2015)", True),
+    Entry("mgcf", GainScheduledComplementaryFilter, PaperGainScheduledFilter,
           "modified-gain complementary filter (Duong Quoc et al.)", True),
-    Entry("kf", AngleBiasKalmanFilter, "2-state angle/bias Kalman filter (Gui et al., Das & Mary)",
-          True),
-    Entry("ukf", UnscentedKalmanFilter, "unscented Kalman filter (Duong Quoc et al.)", True),
-    Entry("poskf", PositionKalmanFilter, "position Kalman filter (Safitri et al.)", False),
+    Entry("kf", AngleBiasKalmanFilter, PaperKalmanFilter,
+          "2-state angle/bias Kalman filter (Gui et al., Das & Mary)", True),
+    Entry("ukf", UnscentedKalmanFilter, PaperUnscentedKalmanFilter,
+          "unscented Kalman filter (Duong Quoc et al.)", True),
+    Entry("poskf", PositionKalmanFilter, PaperPositionKalmanFilter,
+          "position Kalman filter (Safitri et al.)", False),
 )
 """Every estimator, in the order of the tables."""
 
@@ -63,10 +85,46 @@ FMU_NAMES: dict[str, str] = {e.key: e.fmu for e in REGISTRY}
 """key -> FMU model name."""
 
 
+REFERENCES: dict[str, type[Estimator]] = {e.key: e.reference for e in REGISTRY}
+"""key -> reference class (the seed paper's filter)."""
+ENTRY: dict[str, Entry] = {e.key: e for e in REGISTRY}
+CLASSES: tuple[type[Estimator], ...] = tuple(c for e in REGISTRY for c in (e.cls, e.reference))
+"""Every estimator class, recommended and reference (each has a C twin)."""
+
+
+def estimator_class(key: str, params: dict[str, Any] | None = None) -> type[Estimator]:
+    """The class a parameter set for estimator key runs: the reference where params say
+    "filter": "paper", else the recommended class. ValueError for an unknown key or filter."""
+    if key not in ENTRY:
+        raise ValueError(f"unknown estimator {key!r}: allowed {keys_help()}")
+    choice = (params or {}).get(FILTER, FILTERS[0])
+    if choice not in FILTERS:
+        raise ValueError(f"{key}: {FILTER}={choice!r} is not allowed: expected "
+                         f"{' or '.join(repr(f) for f in FILTERS)}")
+    entry = ENTRY[key]
+    return entry.reference if choice == FILTERS[1] else entry.cls
+
+
+def create(key: str, params: dict[str, Any] | None = None) -> Estimator:
+    """A new estimator of key with params (their FILTER entry chooses the class)."""
+    params = dict(params or {})
+    cls = estimator_class(key, params)
+    params.pop(FILTER, None)
+    return cls(**params)
+
+
+def key_of(cls: type[Estimator]) -> str:
+    """The key of a recommended or reference class."""
+    for e in REGISTRY:
+        if cls is e.cls or cls is e.reference:
+            return e.key
+    raise ValueError(f"{cls.__name__} is not a registered estimator class")
+
+
 def keys_help() -> str:
     """The estimator keys as a help string lists them: "cf, mgcf, kf, ukf, poskf"."""
     return ", ".join(KEYS)
 
 
-__all__ = ["ATTITUDE_FILTERS", "ESTIMATORS", "FMU_NAMES", "KEYS", "REGISTRY", "Entry",
-           "keys_help"]
+__all__ = ["ATTITUDE_FILTERS", "CLASSES", "ESTIMATORS", "FILTER", "FILTERS", "FMU_NAMES", "KEYS",
+           "REFERENCES", "REGISTRY", "Entry", "create", "estimator_class", "key_of", "keys_help"]

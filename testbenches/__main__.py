@@ -36,20 +36,20 @@ from .budget import add_budget_parser
 from .fit.cli import add_fit_parsers
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .montecarlo.cli import add_campaign_parser
-from .options import choose, jitter_fraction, positive_float, positive_int
+from .options import add_preset, add_sensor, choose, jitter_fraction, positive_float, positive_int
 
 
 def check_params(params: dict[str, object], estimators: list[str],
                  preset: dict[str, dict[str, Any]]) -> None:
     """--param values go to every chosen estimator: each must have them, in range, on top of
     its preset (a ValueError that names the estimator, before any run starts)."""
-    from fusion_core import ESTIMATORS
+    from fusion_core.registry import create
 
     if not params:
         return
     for key in estimators:
         try:
-            ESTIMATORS[key](**{**preset.get(key, {}), **params})
+            create(key, {**preset.get(key, {}), **params})
         except ValueError as err:
             raise ValueError(f"--param, {key}: {err}") from None
 
@@ -154,13 +154,8 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                      help="estimator FMU parameter for every run (repeatable); an enumeration "
                      "by item name, e.g. --param gyro_sampling=mean")
-    run.add_argument("--preset", default="recommended",
-                     help="estimator parameters: recommended (the defaults), paper, or a JSON "
-                     "file of parameters per estimator")
-    run.add_argument("--sensor", default="realistic",
-                     help="ImuSensor parameters for the runs: realistic (the defaults: an "
-                     "MPU-6050 as a user meets it), ideal (white noise only, the papers' "
-                     "simulations), or a JSON file of sensor parameters")
+    add_preset(run)
+    add_sensor(run)
     run.add_argument("--seeds", type=positive_int, default=1,
                      help="seeds per estimator x scenario (1)")
     run.add_argument("--jitter", type=jitter_fraction, default=0.0,

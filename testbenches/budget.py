@@ -28,7 +28,7 @@ from fusion_core.registry import keys_help
 from fusion_core.scenarios import SCENARIOS
 
 from .contract import accuracy_limits, compute_metrics
-from .options import choose, positive_int
+from .options import add_preset, add_sensor, choose, positive_int
 
 SOURCES: dict[str, tuple[str, dict[str, Any]]] = {
     "gyro_scale": ("gyro scale-factor error", {"gyro_scale_std": 0.0}),
@@ -184,10 +184,8 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     p.add_argument("--scenario", default="all",
                    help=f"all or a comma list of {', '.join(SCENARIOS)} (all)")
     p.add_argument("--seeds", type=positive_int, default=3, help="seeds per row, averaged (3)")
-    p.add_argument("--preset", default="recommended",
-                   help="estimator parameters: recommended, paper or a JSON file (recommended)")
-    p.add_argument("--sensor", default="realistic",
-                   help="the full sensor: realistic, ideal or a JSON file (realistic)")
+    add_preset(p)
+    add_sensor(p)
     p.add_argument("--out", type=Path, default=Path("reports/budget"),
                    help="report folder (reports/budget)")
     p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",

@@ -20,7 +20,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
-from fusion_core.registry import FMU_NAMES
+from fusion_core.registry import FILTER, FMU_NAMES, REFERENCES, estimator_class
 
 ESTIMATOR_FMUS = FMU_NAMES
 """fusion_core.ESTIMATORS key -> FMU model name."""
@@ -167,3 +167,19 @@ class FmuHandle:
                 self.fmu.terminate()
         finally:
             self.fmu.freeInstance()
+
+
+def estimator_parameters(fmu: FmuHandle, key: str, params: Mapping[str, Any]) -> dict[str, Any]:
+    """params for estimator key's FMU: without the choice of the filter ("filter": "paper"),
+    which the FMU's build made. ValueError, saying how to build the right one, where the FMU
+    runs another class than params choose (its parameters are not that class's)."""
+    cls = estimator_class(key, dict(params))
+    have = {v.name for v in fmu.md.modelVariables if v.causality == "parameter"}
+    if have != set(cls.param_specs()):
+        paper = cls in REFERENCES.values()
+        raise ValueError(
+            f"the {fmu.name} FMU in this folder does not run the "
+            f"{'paper' if paper else 'recommended'} filter ({cls.__name__}) these parameters "
+            f"choose: build its FMUs with python build_fmu.py --preset "
+            f"{'paper' if paper else 'recommended'} --out DIR and pass --fmu-dir DIR")
+    return {k: v for k, v in params.items() if k != FILTER}

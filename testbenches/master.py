@@ -42,6 +42,7 @@ from .fmus import (
     SENSOR_FMU,
     FmuHandle,
     direct_calls,
+    estimator_parameters,
     failed,
     fmu_path,
 )
@@ -145,7 +146,7 @@ def run_testbench(
         stop = float(np.sum(steps))
         plant.start({"scenario": sc.id}, stop)
         sensor.start(sensor_params, stop)
-        est.start(params, stop)
+        est.start(estimator_parameters(est, estimator, params), stop)
         truth_vr = plant.vrs(TRUTH)
         sensor_in_vr = sensor.vrs(SENSOR_IN)
         sample_vr = sensor.vrs(SAMPLE)

@@ -7,6 +7,25 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+PRESET_HELP = ("estimator parameters: recommended (the defaults, for real MEMS sensors), paper "
+               "(the seed papers' own filters, fusion_core.papers), or a JSON file of "
+               "parameters per estimator")
+SENSOR_HELP = ("ImuSensor parameters: realistic (the defaults: an MPU-6050 as a user meets it), "
+               "ideal (white noise only, the papers' simulations), or a JSON file of sensor "
+               "parameters")
+
+
+def add_preset(parser: argparse.ArgumentParser, flag: str = "--preset", more: str = "") -> None:
+    """The --preset option every command that runs estimators takes (default recommended);
+    `more` names what a command accepts beyond PRESET_HELP."""
+    parser.add_argument(flag, default="recommended",
+                        help=f"{PRESET_HELP}{more} (recommended)")
+
+
+def add_sensor(parser: argparse.ArgumentParser) -> None:
+    """The --sensor option every command that simulates the sensor takes (default realistic)."""
+    parser.add_argument("--sensor", default="realistic", help=f"{SENSOR_HELP} (realistic)")
+
 
 def choose(value: str, allowed: list[str], what: str) -> list[str]:
     """'all' or a comma list of names from `allowed`; ValueError naming the unknown ones."""

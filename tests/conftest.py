@@ -64,7 +64,7 @@ FMU_BUILDING_FILES = ("test_fmu_state_fuzz.py", "test_fmu_state_processes.py", "
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Mark `fmu` every test that needs built FMUs: `make test-fast` leaves them out."""
     for item in items:
-        if ("built_fmus" in getattr(item, "fixturenames", ())
+        if ({"built_fmus", "paper_fmus"} & set(getattr(item, "fixturenames", ()))
                 or item.path.name in FMU_BUILDING_FILES):
             item.add_marker(pytest.mark.fmu)
 
@@ -80,6 +80,19 @@ def built_fmus(tmp_path_factory: pytest.TempPathFactory) -> BuiltFmus:
     out = tmp_path_factory.mktemp("fmus")
     proc = subprocess.run(
         [sys.executable, "build_fmu.py", "--out", str(out)],
+        cwd=REPO, capture_output=True, text=True, timeout=600,
+    )
+    return BuiltFmus(out, proc.returncode, proc.stdout + proc.stderr)
+
+
+@pytest.fixture(scope="session")
+def paper_fmus(tmp_path_factory: pytest.TempPathFactory) -> BuiltFmus:
+    """Every FMU built with --preset paper (the estimators the papers' filters,
+    fusion_core.papers; the plant and the sensor as always), once into a session temporary
+    folder."""
+    out = tmp_path_factory.mktemp("paper_fmus")
+    proc = subprocess.run(
+        [sys.executable, "build_fmu.py", "--out", str(out), "--preset", "paper"],
         cwd=REPO, capture_output=True, text=True, timeout=600,
     )
     return BuiltFmus(out, proc.returncode, proc.stdout + proc.stderr)
@@ -117,10 +130,11 @@ def fmu_recording() -> dict:
 
 @pytest.fixture(scope="session")
 def fusion_core_run():
-    """fusion_core's run() of an estimator: fusion_core_run(key, acc, gyro, dt, **params)."""
-    import fusion_core
+    """fusion_core's run() of an estimator: fusion_core_run(key, acc, gyro, dt, **params) (the
+    paper's filter where params say "filter": "paper")."""
+    from fusion_core.registry import create
 
     def run(key: str, acc, gyro, dt, **params) -> dict:
-        return fusion_core.ESTIMATORS[key](**params).run(acc, gyro, dt)
+        return create(key, params).run(acc, gyro, dt)
 
     return run

@@ -24,17 +24,21 @@ def estimator_class(key: str) -> type[Estimator]:
 
 
 def paper(key: str, **params: object) -> dict:
-    """The paper preset of estimator key with the point-sample rule (gyro_sampling="point", the
-    rule for the synthetic recordings' point samples) and the given parameters on top: the tests
-    of the papers' equations run the papers' filters on exact samples."""
-    from fusion_core.presets import PAPER
+    """The parameters of estimator key's paper filter (fusion_core.papers; "filter": "paper",
+    for make) with the point-sample rule (gyro_sampling="point", the rule for the synthetic
+    recordings' point samples) and the given parameters on top: the tests of the papers'
+    equations run the papers' filters on exact samples."""
+    from fusion_core.registry import FILTER
 
-    return {**PAPER[key], "gyro_sampling": "point", **params}
+    return {FILTER: "paper", "gyro_sampling": "point", **params}
 
 
 def make(key: str, **params: object) -> Estimator:
-    """A new estimator of kind key."""
-    return estimator_class(key)(**params)
+    """A new estimator of kind key (its paper filter where params say "filter": "paper")."""
+    from fusion_core.registry import create
+
+    estimator_class(key)
+    return create(key, dict(params))
 
 
 def run_recording(estimator: Estimator, rec: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -1,9 +1,8 @@
-"""The numpy UKF as it was before the plain-float rewrite: the reference for test_ukf_equivalence.
+"""The paper's UKF written with numpy: the reference for test_ukf_equivalence.
 
-A verbatim copy of the numerical core of fusion_core/ukf.py at commit ab4a9e4 (numpy on 6x6
-matrices, 13 sigma points as rows), and the textbook update without the pseudo-measurement row
-|X|^2 = 1 where norm_noise is 0. Parameters (names, defaults, ranges) are taken from
-fusion_core's class, so the two always run with the same values.
+Numpy on 6x6 matrices, 13 sigma points as rows, and the textbook update without the
+pseudo-measurement row |X|^2 = 1 where norm_noise is 0. Parameters (names, defaults, ranges) are
+taken from fusion_core's PaperUnscentedKalmanFilter, so the two always run with the same values.
 """
 
 from __future__ import annotations
@@ -13,16 +12,18 @@ import math
 import numpy as np
 
 from fusion_core.base import Estimator
+from fusion_core.papers import PaperUnscentedKalmanFilter
 from fusion_core.types import Estimate, G
-from fusion_core.ukf import UnscentedKalmanFilter
 
 N_STATE = 6  # X (3), gyro bias b (3)
 
 
 class ReferenceUnscentedKalmanFilter(Estimator):
-    """fusion_core.UnscentedKalmanFilter as it was written with numpy (see the module docstring)."""
+    """fusion_core.papers.PaperUnscentedKalmanFilter written with numpy (see the module
+    docstring)."""
 
-    PARAMS = UnscentedKalmanFilter.PARAMS
+    PARAMS = PaperUnscentedKalmanFilter.PARAMS
+    COMMON = PaperUnscentedKalmanFilter.COMMON
     STATE = ("x", "P")
 
     def _configure(self) -> None:

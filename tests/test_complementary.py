@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import pytest
-from helpers import paper
+from helpers import make, paper
 
 from fusion_core import DEG
-from fusion_core.complementary import ComplementaryFilter
 from fusion_core.synthetic import ImuNoise, Trajectory, constant, record
 
 BIAS = 1.0 * DEG  # rad/s
@@ -26,7 +25,7 @@ def test_static_tilt_with_gyro_bias_settles_at_bias_times_tau(
     """angle = a (angle + (w + b) dt) + (1 - a) acc_angle, a = tau / (tau + dt), settles at
     e = a b dt / (1 - a) = b tau exactly: 0.75 deg for b = 1 deg/s and the default tau = 0.75 s.
     30 s is 40 tau, so the transient is gone (e^-40)."""
-    cf = ComplementaryFilter(**paper("cf"))
+    cf = make("cf", **paper("cf"))
     noise = ImuNoise(gyro_density=0.0, acc_density=0.0, gyro_bias=gyro_bias)
     rec = record(trajectory, 30.0, 100.0, noise=noise)
     out = cf.run(rec["acc_meas"], rec["gyro_meas"], rec["dt"])

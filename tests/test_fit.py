@@ -116,9 +116,13 @@ def test_log_space_where_a_range_spans_decades_and_within_the_allowed_range():
     gate = dimension(specs["gate_low"], 0.5)
     assert not gate.log and gate.low > 0.0 and gate.high <= 1.0
     names = [p.name for p in tunable("mgcf", ["all"])]
-    assert "w0" in names and "max_dt" not in names and "schedule" not in names
+    assert "w0" in names and "max_dt" not in names and "gyro_sampling" not in names
     with pytest.raises(ValueError, match="cannot be fitted"):
-        tunable("mgcf", ["schedule"])
+        tunable("mgcf", ["gyro_sampling"])
+    from fusion_core.papers import PaperGainScheduledFilter
+
+    paper = [p.name for p in tunable("mgcf", None, PaperGainScheduledFilter)]
+    assert "w0" in paper and "schedule" not in paper and "acc_lowpass" not in paper
 
 
 def _tilt_recording(seed: int) -> Recording:

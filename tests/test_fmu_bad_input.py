@@ -133,12 +133,12 @@ def test_fixed_parameter_is_accepted_before_initialisation(
 
 def test_unknown_enumeration_value_is_refused_with_the_items(built_fmus):
     with FmuInstance(built_fmus.path("GainScheduledComplementaryFilter"),
-                     parameters={"schedule": 7}) as fmu:
+                     parameters={"gyro_sampling": 7}) as fmu:
         errors = [m.message for m in fmu.messages if m.status == "ERROR"]
-        assert fmu.get("schedule") == 3
+        assert fmu.get("gyro_sampling") == 1
     assert len(errors) == 1
-    assert "'schedule'=7" in errors[0]
-    assert "1 = simulation, 2 = experimental, 3 = fixed" in errors[0]
+    assert "'gyro_sampling'=7" in errors[0]
+    assert "1 = point, 2 = mean" in errors[0]
 
 
 def test_writing_an_output_is_refused_and_the_fmu_continues(built_fmus, fmu_recording):

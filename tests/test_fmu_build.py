@@ -9,6 +9,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from conftest import ESTIMATOR_FMUS
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
@@ -241,29 +242,53 @@ def test_build_command_exits_non_zero_on_a_validation_problem(
     assert "1: The unit" in capsys.readouterr().out
 
 
-def test_build_with_the_paper_preset_starts_from_the_papers_values(tmp_path, fmu_recording):
-    """build_fmu.py --preset paper: the FMU's start values are the paper preset's, and the FMU
-    run with its own start values gives fusion_core's outputs with that preset."""
-    import subprocess
-    import sys
-
+def test_the_paper_preset_builds_the_papers_filters(paper_fmus, fmu_recording):
+    """build_fmu.py --preset paper: every estimator FMU runs its paper's filter
+    (fusion_core.papers) under the same model name: that class's parameters at the preset's
+    values, and fusion_core's outputs with that preset, pythonfmu and native alike."""
     import numpy as np
 
     from fmu_src.host import FmuInstance
     from fusion_core.presets import preset_params
+    from fusion_core.registry import FILTER, REFERENCES, create
 
-    repo = Path(__file__).resolve().parents[1]
-    proc = subprocess.run(
-        [sys.executable, "build_fmu.py", "--out", str(tmp_path), "--only",
-         "ComplementaryFilter", "--preset", "paper"],
-        cwd=repo, capture_output=True, text=True, timeout=600,
-    )
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    fmu = tmp_path / "ComplementaryFilter.fmu"
-    starts = {v.name: v.start for v in read_model_description(str(fmu)).modelVariables}
-    assert float(starts["tau"]) == 0.75 and float(starts["acc_lowpass"]) == 0.0
     acc, gyro, dt = (fmu_recording[k][:300] for k in ("acc_meas", "gyro_meas", "dt"))
-    with FmuInstance(fmu) as instance:
-        out = instance.run_samples(acc, gyro, dt)
-    want = fusion_core.ComplementaryFilter(**preset_params("paper", "cf")).run(acc, gyro, dt)
-    assert np.array_equal(out["roll"], want["roll"])
+    for name, key in ESTIMATOR_FMUS.items():
+        entry = preset_params("paper", key)
+        want = create(key, entry).run(acc, gyro, dt)
+        specs = REFERENCES[key].param_specs()
+        for fmu in (paper_fmus.path(name), paper_fmus.native("fmi2", name)):
+            md = read_model_description(str(fmu))
+            assert md.modelName == name
+            assert REFERENCES[key].__name__ in md.description
+            starts = {v.name: v.start for v in md.modelVariables if v.causality == "parameter"}
+            assert set(starts) == set(specs), (name, set(starts) ^ set(specs))
+            for p, value in {**{n: s.default for n, s in specs.items()}, **entry}.items():
+                if p != FILTER and not isinstance(value, str):
+                    assert float(starts[p]) == float(value), (name, p)
+            with FmuInstance(fmu) as instance:
+                out = instance.run_samples(acc, gyro, dt)
+            assert np.array_equal(out["roll"], want["roll"]), (name, fmu)
+            assert np.array_equal(out["bias"], want["bias"]), (name, fmu)
+
+
+def test_two_presets_built_in_one_process_keep_their_own_start_values(tmp_path):
+    """build_all for the recommended values, then for the paper's, in this process: each FMU
+    carries its own preset's class and start values (no table of the first build is reused)."""
+    from fmu_src.build import build_all
+    from fusion_core.registry import ESTIMATORS, REFERENCES
+
+    names = ["ComplementaryFilter", "UnscentedKalmanFilter"]
+    for preset, classes in (("recommended", ESTIMATORS), ("paper", REFERENCES),
+                            ("recommended", ESTIMATORS)):
+        out = tmp_path / preset
+        rows = build_all(names, out, preset=preset, kind="pythonfmu")
+        assert all(not r.problems for r in rows), [r.problems for r in rows]
+        for name in names:
+            cls = classes[ESTIMATOR_FMUS[name]]
+            md = read_model_description(str(out / f"{name}.fmu"))
+            starts = {v.name: v.start for v in md.modelVariables if v.causality == "parameter"}
+            assert set(starts) == set(cls.param_specs()), (preset, name)
+            for p, spec in cls.param_specs().items():
+                if isinstance(spec.default, float):
+                    assert float(starts[p]) == spec.default, (preset, name, p)

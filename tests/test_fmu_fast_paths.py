@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from pythonfmu import Fmi2Slave
 
 import fusion_core
-from fmu_src.estimator import NO_BIAS_OUTPUTS, EstimatorSlave
+from fmu_src.estimator import EstimatorSlave
 from fmu_src.host import INPUTS
 from fmu_src.slave import FmuSlave
 from fusion_core import synthetic
@@ -27,17 +27,16 @@ from fusion_core.scenarios import get_scenario
 
 
 class FastCf(EstimatorSlave):
-    """The ComplementaryFilter FMU's slave (Enumeration parameters, no bias state)."""
+    """The ComplementaryFilter FMU's slave (Enumeration parameters)."""
 
-    estimator = fusion_core.ESTIMATORS["cf"]
+    key = "cf"
     description = "fast-path test: complementary filter"
-    zero_bias = NO_BIAS_OUTPUTS
 
 
 class FastPoskf(EstimatorSlave):
-    """The PositionKalmanFilter FMU's slave (Boolean parameters, position outputs)."""
+    """The PositionKalmanFilter FMU's slave (position outputs)."""
 
-    estimator = fusion_core.ESTIMATORS["poskf"]
+    key = "poskf"
     description = "fast-path test: position filter"
 
 
@@ -134,7 +133,7 @@ def test_fast_tables_cover_the_real_inputs_and_every_real_and_integer():
     assert {kinds[n][1] for n in slave._fast_integers.values()} == {"Integer", "Enumeration"}
     assert len(slave._fast_reals) + len(slave._fast_integers) == sum(
         t != "Boolean" for _, t in kinds.values())
-    assert slave.get_integer(vrs_of(slave, "qr_form", "invalid_samples")) == [1, 0]
+    assert slave.get_integer(vrs_of(slave, "gyro_sampling", "invalid_samples")) == [1, 0]
 
 
 def test_a_subclass_with_its_own_input_setter_always_gets_it_called():

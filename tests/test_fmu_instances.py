@@ -21,7 +21,7 @@ INSTANCES = (
     ("AngleBiasKalmanFilter", "kf", {"R_measure": 3e-5, "gyro_sampling": "mean"}, 5),
     ("UnscentedKalmanFilter", "ukf", {}, 6),
     ("PositionKalmanFilter", "poskf", {}, 7),
-    ("PositionKalmanFilter", "poskf", {"qr_form": "diagonal"}, 8),
+    ("PositionKalmanFilter", "poskf", {"zupt_window": 0.5}, 8),
 )
 """8 instances: all five kinds, three of them twice, each with its own parameters and seed."""
 N_SAMPLES = 500

@@ -7,14 +7,15 @@ import math
 import numpy as np
 import pytest
 import scipy.linalg
-from helpers import paper
+from helpers import make, paper
 
 from fusion_core import DEG, G, synthetic
 from fusion_core.building_blocks import CONSTANT_NOISE
 from fusion_core.kalman import AngleBiasKalmanFilter
-from fusion_core.presets import PAPER_KF
+from fusion_core.papers import PaperKalmanFilter
 from fusion_core.synthetic import Trajectory, add, sine
 
+PAPER_KF = PaperKalmanFilter().params
 N_SAMPLES = 6000
 SKIP = 2000
 EXACT_TOL_DEG = 1e-9
@@ -88,7 +89,7 @@ def roll_only_sequence(seed: int = 1) -> dict[str, np.ndarray]:
 def test_rectangle_rule_roll_equals_papers_scalar_filter_to_1e_9_deg() -> None:
     seq = roll_only_sequence()
     assert np.abs(seq["roll"]).max() < 60 * DEG
-    out = AngleBiasKalmanFilter(**PAPER_KF).run(seq["acc"], seq["gyro"], seq["dt"])
+    out = PaperKalmanFilter().run(seq["acc"], seq["gyro"], seq["dt"])
 
     new_angle = np.degrees(np.arctan2(seq["acc"][:, 1], seq["acc"][:, 2]))
     ref_angle, ref_bias = papers_kalman_deg(new_angle, np.degrees(seq["gyro"][:, 0]), seq["dt"],
@@ -116,12 +117,12 @@ def test_at_the_papers_loop_time_r_loop_time_is_the_papers_r_per_sample() -> Non
     loop = PAPER_KF["R_loop_time"]
     for dt, r_per_sample in ((loop, PAPER_KF["R_measure"]), (0.01, PAPER_KF["R_measure"] * 3.3)):
         h = np.full(len(acc), dt)
-        ruled = AngleBiasKalmanFilter(**PAPER_KF).run(acc, gyro, h)["roll"]
-        as_written = AngleBiasKalmanFilter(**{**PAPER_KF, "R_loop_time": 0.0,
-                                              "R_measure": r_per_sample}).run(acc, gyro, h)["roll"]
+        ruled = PaperKalmanFilter().run(acc, gyro, h)["roll"]
+        as_written = PaperKalmanFilter(R_loop_time=0.0, R_measure=r_per_sample).run(
+            acc, gyro, h)["roll"]
         assert np.abs(ruled - as_written).max() / DEG < 1e-9
-    assert AngleBiasKalmanFilter(**PAPER_KF).run(acc, gyro, h)["roll"][-1] != pytest.approx(
-        AngleBiasKalmanFilter(**{**PAPER_KF, "R_loop_time": 0.0}).run(acc, gyro, h)["roll"][-1],
+    assert PaperKalmanFilter().run(acc, gyro, h)["roll"][-1] != pytest.approx(
+        PaperKalmanFilter(R_loop_time=0.0).run(acc, gyro, h)["roll"][-1],
         abs=1e-6)
 
 
@@ -142,7 +143,7 @@ def steady_state_solution(dt: float, q_angle: float, q_bias: float, r: float) ->
 
 def test_converged_covariance_and_gain_equal_the_dare_solution_to_1e_6() -> None:
     dt = 0.01
-    kf = AngleBiasKalmanFilter(**paper("kf"))
+    kf = make("kf", **paper("kf"))
     p = kf.params
     ss = steady_state_solution(dt, p["Q_angle"], p["Q_bias"],
                                p["R_measure"] * p["R_loop_time"] / dt)

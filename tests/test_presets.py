@@ -1,5 +1,5 @@
-"""Presets (recommended = the defaults, paper = the papers'), preset files, the MGCF schedules
-and the gyro sampling property that chooses the integration rule."""
+"""Presets (recommended = the defaults, paper = the papers' filters), preset files, the MGCF
+schedules and the gyro sampling property that chooses the integration rule."""
 
 from __future__ import annotations
 
@@ -12,8 +12,9 @@ import pytest
 from helpers import KEYS, make
 
 from fusion_core import DEG, ESTIMATORS, G
-from fusion_core.mgcf import SCHEDULES, scheduled_w0
-from fusion_core.presets import PAPER, PRESETS, load_preset, preset_params
+from fusion_core.papers.mgcf import SCHEDULES, scheduled_w0
+from fusion_core.presets import PRESETS, load_preset, preset_params
+from fusion_core.registry import REFERENCES, create
 
 
 @pytest.mark.parametrize("key", KEYS)
@@ -23,11 +24,12 @@ def test_the_defaults_are_the_recommended_preset(key: str) -> None:
 
 
 @pytest.mark.parametrize("key", KEYS)
-def test_the_paper_preset_differs_from_the_defaults_in_what_it_names(key: str) -> None:
-    defaults = make(key).params
-    paper = make(key, **preset_params("paper", key)).params
-    assert any(paper[k] != defaults[k] for k in PAPER[key])
-    assert paper["gyro_sampling"] == "mean"  # the papers' rectangle rule
+def test_the_paper_preset_runs_the_papers_filter_at_its_values(key: str) -> None:
+    paper = make(key, **preset_params("paper", key))
+    assert type(paper) is REFERENCES[key]
+    assert paper.params == REFERENCES[key]().params  # the paper's values are its defaults
+    assert paper.params["gyro_sampling"] == "mean"  # the papers' rectangle rule
+    assert paper.params["sensor_delay"] == 0.0
 
 
 def test_old_preset_names_say_what_they_became() -> None:
@@ -53,8 +55,8 @@ def test_a_preset_file_is_loaded_and_checked(tmp_path: Path) -> None:
 
 def test_every_named_preset_builds_every_estimator() -> None:
     for name in PRESETS:
-        for key, cls in ESTIMATORS.items():
-            cls(**preset_params(name, key))
+        for key in ESTIMATORS:
+            create(key, preset_params(name, key))
 
 
 @pytest.mark.parametrize(
@@ -76,10 +78,11 @@ def test_the_simulation_schedule_is_duong_quocs_section_4_1(rho: float, w0: floa
 
 
 ONLY_GYRO = {"cf": {"acc_lowpass": 0.0},
-             "mgcf": {"acc_lowpass": 0.0, "rest_time": 0.0, "schedule": "simulation"},
+             "mgcf": {"filter": "paper"},
              "kf": {"acc_lowpass": 0.0, "rest_time": 0.0},
-             "ukf": {"acc_lowpass": 0.0, "rest_time": 0.0}, "poskf": {"attitude": "tilt_stage"}}
-"""Options that would let the accelerometer in: off, so that only the gyro moves roll."""
+             "ukf": {"acc_lowpass": 0.0, "rest_time": 0.0}, "poskf": {"filter": "paper"}}
+"""Options that would let the accelerometer in: off, so that only the gyro moves roll (the
+papers' mgcf gates a norm of 3 g out, their position filter's attitude is its tilt stage's)."""
 
 
 @pytest.mark.parametrize("key", KEYS)
@@ -120,7 +123,7 @@ def test_poskf_outputs_the_recommended_kf_attitude() -> None:
     pos = make("poskf").run(acc, gyro, 0.01)
     kf = make("kf").run(acc, gyro, 0.01)
     assert np.array_equal(pos["roll"], kf["roll"]) and np.array_equal(pos["pitch"], kf["pitch"])
-    tilt = make("poskf", attitude="tilt_stage").run(acc, gyro, 0.01)
+    tilt = make("poskf", filter="paper").run(acc, gyro, 0.01)  # the paper's: its tilt stage's
     assert not np.array_equal(tilt["roll"], kf["roll"])
     assert math.isfinite(float(np.abs(pos["roll"] - roll).max() / DEG))
 

@@ -20,15 +20,17 @@ DT = 0.01
 LEVEL = (0.0, 0.0, G)
 STILL = (0.0, 0.0, 0.0)
 
+PAPER = {"filter": "paper"}
 OPTION_SETS: dict[str, list[dict]] = {
-    "cf": [{}, {"gyro_sampling": "mean"}, {"propagation": "quaternion"},
-           {"acc_lowpass": 0.5}],
-    "kf": [{}, {"gyro_sampling": "mean"}, {"propagation": "quaternion"},
-           {"acc_lowpass": 0.5}, {"rest_time": 0.3}],
-    "mgcf": [{}, {"gyro_sampling": "mean"}, {"schedule": "fixed", "w0": 0.0},
-             {"acc_lowpass": 0.5}, {"rest_time": 0.3}],
+    "cf": [{}, {"gyro_sampling": "mean"}, {"acc_lowpass": 0.0}, PAPER,
+           {**PAPER, "gyro_sampling": "point"}],
+    "kf": [{}, {"gyro_sampling": "mean"}, {"acc_lowpass": 0.5}, {"rest_time": 0.0}, PAPER,
+           {**PAPER, "gyro_sampling": "point"}],
+    "mgcf": [{}, {"gyro_sampling": "mean"}, {"w0": 0.0}, {"acc_lowpass": 0.0},
+             {"rest_time": 0.0}, PAPER, {**PAPER, "schedule": "fixed", "w0": 0.0}],
 }
-"""Each filter's default (the short path) and every option that takes the general path."""
+"""Each filter's defaults, the options that take another path through its hot step, and its
+paper's filter."""
 
 
 @pytest.mark.parametrize(
@@ -79,17 +81,17 @@ def test_max_dt_follows_set_param_and_set_state(key: str) -> None:
     other.step(LEVEL, STILL, 0.05)
 
 
-@pytest.mark.parametrize("params", [{}, {"rest_time": 0.3}, {"gyro_sampling": "mean"}])
+@pytest.mark.parametrize("params", [{**CONSTANT_NOISE, "acc_lowpass": 0.0},
+                                    {**CONSTANT_NOISE, "acc_lowpass": 0.0, "rest_time": 0.0},
+                                    PAPER, {**PAPER, "gyro_sampling": "point"}])
 def test_kalman_snapshot_with_two_covariances_follows_each_axis(params: dict) -> None:
     """The roll and pitch filters share one covariance; a snapshot holding two different ones
     (no filter makes one, but set_state takes it) is followed axis by axis: each covariance and
-    gain as a filter whose two axes both started from it (on the sensor's own axes, tilt_axes
-    'body': a change of face, which depends on both angles, would mix them; and with constant Q
-    and R: the adaptive noise follows the bias-corrected rate and pre-filter, which both axes'
-    biases move)."""
+    gain as a filter whose two axes both started from it (the recording stays near level, on
+    the sensor's own face; with constant Q and R and no measured vector: the adaptive noise and
+    the vector's noise follow the bias-corrected rate, which both axes' biases move)."""
     rec = noisy_two_axis_recording(3.0)
     acc, gyro, dt = rec["acc_meas"], rec["gyro_meas"], rec["dt"]
-    params = {**params, "tilt_axes": "body", **CONSTANT_NOISE}
     base = make("kf", **params)
     base.run(acc[:100], gyro[:100], dt[:100])
     snapshot = base.get_state()

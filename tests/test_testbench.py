@@ -175,10 +175,11 @@ def test_t4_fails_when_the_traces_differ(fmu_dir: Path) -> None:
     assert not contract.check_t4(a, b).passed
 
 
-def test_position_check_fails_without_the_zero_velocity_update(fmu_dir: Path) -> None:
-    """zupt=False on the 2 m move (3 seeds): the final x error exceeds Safitri's 0.0385 m."""
-    runs = [run_testbench("poskf", "translation_2m", seed=s, fmu_dir=fmu_dir,
-                          params={"zupt": False, "zaru": False}) for s in range(3)]
+def test_position_check_fails_without_the_zero_velocity_update(paper_fmus) -> None:
+    """The paper's filter (no zero-velocity update, the tilt from every accelerometer sample) on
+    the 2 m move (3 seeds): the final x error exceeds Safitri's 0.0385 m."""
+    runs = [run_testbench("poskf", "translation_2m", seed=s, fmu_dir=paper_fmus.directory,
+                          params={"filter": "paper"}) for s in range(3)]
     checks = contract.check_position(runs)
     print("\n" + "\n".join(c.line() for c in checks))
     assert not checks[0].passed
@@ -274,13 +275,19 @@ def test_cli_exits_0_when_every_check_passes(fmu_dir: Path, tmp_path: Path) -> N
     assert (tmp_path / "report.md").is_file()
 
 
-def test_cli_runs_the_paper_preset_through_the_fmus(fmu_dir: Path, tmp_path: Path) -> None:
-    """The FMU host sets the preset's parameters one by one, in its own order: no combination
-    on the way (propagation='euler' before tilt_axes='body') may be refused."""
-    proc = _cli("--estimator", "kf,poskf", "--scenario", "static_level", "--duration", "1",
-                "--preset", "paper", fmu_dir=fmu_dir, out=tmp_path)
+def test_cli_runs_the_paper_preset_through_the_papers_fmus(fmu_dir: Path, paper_fmus,
+                                                          tmp_path: Path) -> None:
+    """The paper preset through FMUs built with --preset paper: no parameter may be refused; on
+    the recommended FMUs the testbench refuses with the command that builds the right ones."""
+    args = ("--estimator", "kf,poskf", "--scenario", "static_level", "--duration", "1",
+            "--preset", "paper")
+    proc = _cli(*args, fmu_dir=paper_fmus.directory, out=tmp_path)
+    assert proc.returncode in (0, 1), proc.stdout + proc.stderr  # 1: a check FAILs
     assert "error" not in proc.stderr.lower(), proc.stderr
     assert "refused" not in proc.stdout + proc.stderr
+    wrong = _cli(*args, fmu_dir=fmu_dir, out=tmp_path)
+    assert wrong.returncode == 2
+    assert "python build_fmu.py --preset paper" in wrong.stderr
 
 
 def test_cli_exits_1_on_a_failed_check(fmu_dir: Path, tmp_path: Path) -> None:

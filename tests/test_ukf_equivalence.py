@@ -1,7 +1,7 @@
-"""The plain-float UKF is the same filter as the numpy implementation it replaced.
+"""The plain-float paper UKF is the same filter as a numpy implementation.
 
-tests/reference_ukf.py keeps that implementation (13 sigma points as rows of a numpy array,
-6x6 covariance, np.linalg.solve); fusion_core.ukf computes the same unscented transform with
+tests/reference_ukf.py is that implementation (13 sigma points as rows of a numpy array, 6x6
+covariance, np.linalg.solve); fusion_core.papers.ukf computes the same unscented transform with
 closed-form sigma-point algebra in Python floats. On a noisy 60 s recording both must agree at
 every sample to 1e-9 rad in roll and pitch and 1e-9 rad/s in the gyro bias.
 """
@@ -12,13 +12,14 @@ import functools
 
 import numpy as np
 import pytest
-from helpers import paper
 from reference_ukf import ReferenceUnscentedKalmanFilter
 
 from fusion_core import synthetic
+from fusion_core.papers import PaperUnscentedKalmanFilter
 from fusion_core.scenarios import get_scenario
-from fusion_core.ukf import UnscentedKalmanFilter
 
+PAPER_POINT = {"gyro_sampling": "point"}
+"""The paper's filter with the rule of the synthetic recordings' point samples."""
 ANGLE_TOL = 1e-9  # rad
 BIAS_TOL = 1e-9  # rad/s
 
@@ -31,11 +32,12 @@ def moderate_dynamics_recording() -> dict[str, np.ndarray]:
 
 
 @functools.cache
-def default_runs() -> tuple[UnscentedKalmanFilter, ReferenceUnscentedKalmanFilter, dict, dict]:
+def default_runs() -> tuple[PaperUnscentedKalmanFilter, ReferenceUnscentedKalmanFilter, dict, dict]:
     """Both filters with default parameters after the whole recording, and their outputs."""
     rec = moderate_dynamics_recording()
     args = (rec["acc_meas"], rec["gyro_meas"], rec["dt"])
-    new, ref = UnscentedKalmanFilter(**paper("ukf")), ReferenceUnscentedKalmanFilter(**paper("ukf"))
+    new = PaperUnscentedKalmanFilter(**PAPER_POINT)
+    ref = ReferenceUnscentedKalmanFilter(**PAPER_POINT)
     return new, ref, new.run(*args), ref.run(*args)
 
 
@@ -50,7 +52,7 @@ def test_reference_is_a_busy_recording() -> None:
     # skipped (gate), and the bias must move, for the comparison to cover every branch.
     rec = moderate_dynamics_recording()
     rho = np.abs(np.linalg.norm(rec["acc_meas"], axis=1) / 9.80665 - 1.0)
-    gate = paper("ukf")["acc_gate"]
+    gate = PaperUnscentedKalmanFilter().params["acc_gate"]
     assert 0.1 < np.mean(rho < gate) < 0.95
     assert np.max(np.abs(default_runs()[3]["bias"])) > 1e-4
 
@@ -76,8 +78,8 @@ def test_other_parameters_match_the_numpy_reference(params: dict[str, object]) -
     rec = moderate_dynamics_recording()
     args = (rec["acc_meas"][:2001], rec["gyro_meas"][:2001], rec["dt"][:2001])  # first 20 s
     diff = differences(
-        UnscentedKalmanFilter(**paper("ukf", **params)).run(*args),
-        ReferenceUnscentedKalmanFilter(**paper("ukf", **params)).run(*args),
+        PaperUnscentedKalmanFilter(**{**PAPER_POINT, **params}).run(*args),
+        ReferenceUnscentedKalmanFilter(**{**PAPER_POINT, **params}).run(*args),
     )
     assert diff["roll"] < ANGLE_TOL
     assert diff["pitch"] < ANGLE_TOL
@@ -94,7 +96,8 @@ def test_covariance_matches_the_numpy_reference_after_60_s() -> None:
 def test_a_covariance_made_indefinite_by_rounding_takes_the_references_square_root() -> None:
     rec = moderate_dynamics_recording()
     acc, gyro, dt = rec["acc_meas"][:200], rec["gyro_meas"][:200], rec["dt"][:200]
-    new, ref = UnscentedKalmanFilter(**paper("ukf")), ReferenceUnscentedKalmanFilter(**paper("ukf"))
+    new = PaperUnscentedKalmanFilter(**PAPER_POINT)
+    ref = ReferenceUnscentedKalmanFilter(**PAPER_POINT)
     new.run(acc, gyro, dt)
     ref.run(acc, gyro, dt)
     # Push the smallest eigenvalue just below zero: Cholesky fails, both fall back to the
@@ -115,7 +118,7 @@ def test_a_covariance_made_indefinite_by_rounding_takes_the_references_square_ro
 
 
 def test_general_update_agrees_with_the_cholesky_update() -> None:
-    from fusion_core import ukf
+    from fusion_core.papers import ukf
 
     rng = np.random.default_rng(1)
     A = rng.standard_normal((10, 10))
@@ -125,7 +128,7 @@ def test_general_update_agrees_with_the_cholesky_update() -> None:
     rows = tuple(tuple(joint[i, 6:]) for i in range(6))
     x = tuple(rng.standard_normal(6))
     y = tuple(rng.standard_normal(4))
-    fast = ukf._kalman_update(x, P, S, rows, y)
-    general = ukf._general_update(x, P, S, rows, y)
+    fast = ukf.kalman_update(x, P, S, rows, y)
+    general = ukf.general_update(x, P, S, rows, y)
     np.testing.assert_allclose(fast[:6], general[:6], rtol=0, atol=1e-12)
     np.testing.assert_allclose(fast[6], general[6], rtol=0, atol=1e-12)

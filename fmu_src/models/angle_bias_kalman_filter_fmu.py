@@ -6,16 +6,14 @@ Implements the two-state [angle, gyro bias] Kalman filter of W. Gui, Y. Tang, S.
 the accelerometer's tilt: it is 0 until rest detection (on by default) estimates it at rest.
 """
 
-import fusion_core
-from fmu_src.estimator import Z_BIAS_AT_REST_ONLY, EstimatorSlave
+from fmu_src.estimator import EstimatorSlave
 
 
 class AngleBiasKalmanFilter(EstimatorSlave):
     """[angle, bias] Kalman filter per axis (Gui, Tang, Mukhopadhyay 2015; Das & Mary)."""
 
-    estimator = fusion_core.ESTIMATORS["kf"]
+    key = "kf"
     description = (
         "Two-state [angle, gyro bias] Kalman filter for roll and pitch: W. Gui, Y. Tang, "
         "S. Mukhopadhyay (2015), eq. 5-26; Das & Mary, eq. 16-27. One IMU sample per doStep."
     )
-    zero_bias = Z_BIAS_AT_REST_ONLY

@@ -6,14 +6,13 @@ Das & Mary, eq. 1. The papers' filter has no gyro-bias state; with rest detectio
 default) the bias outputs are the gyro's reading at rest, which the filter subtracts.
 """
 
-import fusion_core
 from fmu_src.estimator import EstimatorSlave
 
 
 class ComplementaryFilter(EstimatorSlave):
     """Complementary filter for roll and pitch (Gui, Tang, Mukhopadhyay 2015; Das & Mary)."""
 
-    estimator = fusion_core.ESTIMATORS["cf"]
+    key = "cf"
     description = (
         "Complementary filter for roll and pitch from a 6-axis IMU: W. Gui, Y. Tang, "
         "S. Mukhopadhyay (2015), eq. 1-2; Das & Mary, eq. 1. One IMU sample per doStep; "

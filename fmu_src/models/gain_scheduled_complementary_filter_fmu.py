@@ -6,14 +6,13 @@ quaternion PI filter (Mahony, Hamel, Pflimlin 2008) whose natural frequency w0 i
 rho = | |acc|/g - 1 |. The integral term is the gyro-bias estimate (bias outputs, all three axes).
 """
 
-import fusion_core
 from fmu_src.estimator import EstimatorSlave
 
 
 class GainScheduledComplementaryFilter(EstimatorSlave):
     """Gain-scheduled (modified-gain) complementary filter (Duong Quoc et al.)."""
 
-    estimator = fusion_core.ESTIMATORS["mgcf"]
+    key = "mgcf"
     description = (
         "Modified-gain (gain-scheduled) complementary filter for roll and pitch: Duong Quoc "
         "et al., eq. 7-13 (quaternion PI filter of Mahony et al. 2008 with w0 scheduled on "

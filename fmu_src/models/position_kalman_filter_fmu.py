@@ -7,17 +7,15 @@ update at rest. Outputs pos_x..z and vel_x..z besides the attitude and the gyro 
 are the [angle, bias] Kalman filter's.
 """
 
-import fusion_core
-from fmu_src.estimator import Z_BIAS_AT_REST_ONLY, EstimatorSlave
+from fmu_src.estimator import EstimatorSlave
 
 
 class PositionKalmanFilter(EstimatorSlave):
     """[p, v, a] position Kalman filter per axis (Safitri, Cahyadi, Firmansyah)."""
 
-    estimator = fusion_core.ESTIMATORS["poskf"]
+    key = "poskf"
     description = (
         "Position and velocity Kalman filter with a zero-velocity update: Safitri, Cahyadi, "
         "Firmansyah, eq. 20-29; tilt from the Gui, Tang, Mukhopadhyay (2015) [angle, bias] "
         "Kalman filter. One IMU sample per doStep."
     )
-    zero_bias = Z_BIAS_AT_REST_ONLY

@@ -5,14 +5,13 @@ in the body frame, augmented with three gyro-bias states (scaled sigma points of
 Merwe 2000).
 """
 
-import fusion_core
 from fmu_src.estimator import EstimatorSlave
 
 
 class UnscentedKalmanFilter(EstimatorSlave):
     """UKF on the gravity direction with gyro-bias states (Duong Quoc et al.)."""
 
-    estimator = fusion_core.ESTIMATORS["ukf"]
+    key = "ukf"
     description = (
         "Unscented Kalman filter for roll and pitch on the gravity direction with three "
         "gyro-bias states: Duong Quoc et al., eq. 14-17. One IMU sample per doStep."

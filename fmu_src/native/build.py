@@ -22,6 +22,7 @@ import importlib
 import math
 import os
 import platform
+import re
 import shutil
 import subprocess
 import tempfile
@@ -115,26 +116,44 @@ class NativeModel:
         return "{" + str(uuid.uuid5(TOKEN_NAMESPACE, text)) + "}"
 
     def twin_sources(self) -> tuple[str, ...]:
-        own = (f"{self.prefix}.c",) if self.prefix else ()
-        extra = ("fc_kf.c",) if self.prefix == "fc_poskf" else ()
-        return (*KIND_SOURCES.get(self.kind, ()), *own, *extra)
+        kind = KIND_SOURCES.get(self.kind, ())
+        own = tuple(s for s in twin_closure(self.prefix) if s not in kind) if self.prefix else ()
+        return (*kind, *own)
+
+
+def twin_closure(prefix: str) -> tuple[str, ...]:
+    """The C files of an estimator's twin: its own, then those of the twins it includes (a
+    recommended filter is built on its paper's equations, a position filter on its Kalman
+    filters), read off the #include lines of the twins' sources and headers; not fc_core.c and
+    fc_state.c, which every estimator FMU compiles anyway."""
+    out: list[str] = []
+    todo = [prefix]
+    while todo:
+        name = todo.pop(0)
+        if f"{name}.c" in out or name in ("fc_core", "fc_state", "fc_params"):
+            continue
+        out.append(f"{name}.c")
+        text = "".join((TWIN_DIR / f"{name}{ext}").read_text() for ext in (".c", ".h"))
+        todo += [m for m in re.findall(r'#include "(fc_\w+)\.h"', text)
+                 if (TWIN_DIR / f"{m}.c").is_file()]
+    return tuple(out)
 
 
 def native_model(name: str) -> NativeModel:
-    """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the start
-    values of the preset being built (fmu_src.estimator.PRESET_ENV)."""
+    """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the class
+    and start values of the preset being built (fmu_src.estimator.PRESET_ENV)."""
     from fusion_core.sensor import SENSOR_PARAMS
 
-    from ..estimator import estimator_variables
+    from ..estimator import estimator_table, model_description, preset_starts
 
     module = importlib.import_module(f"fmu_src.models.{script_path(name).stem}")
     cls = getattr(module, name)
-    estimator = getattr(cls, "estimator", None)
-    if estimator is not None:
-        variables = estimator_variables(estimator, cls.zero_bias)
+    key = getattr(cls, "key", None)
+    if key is not None:
+        estimator, variables = estimator_table(key, preset_starts(key))
         params = tuple(estimator.param_specs().values())
-        return NativeModel(name, cls.description, variables, "estimator",
-                           estimator.TWIN, params)
+        return NativeModel(name, model_description(cls.description, estimator), variables,
+                           "estimator", estimator.TWIN or "", params)
     if name == "ImuSensor":
         return NativeModel(name, cls.description, cls.VARIABLES, "sensor", "", SENSOR_PARAMS)
     if name == "ImuPlant":

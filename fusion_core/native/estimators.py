@@ -21,8 +21,8 @@ _ESTIMATE_DOUBLES = struct.Struct("=11d")
 BASE_STATE = tuple(STATE_BASE)
 """Estimator._BASE_STATE's fields (fusion_core.state.BASE_STATE): they live in the twin's `base`
 member."""
-STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}}
-"""Where a twin's state field is kept under another Python attribute: the UKF's P is its packed
+STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}, "PaperUnscentedKalmanFilter": {"P": "_P"}}
+"""Where a twin's state field is kept under another Python attribute: the UKFs' P is their packed
 lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
 POSKF_PENDING_MAX = 2048
 """fc_poskf.h's FC_POSKF_PENDING_MAX (position.PENDING_MAX)."""
@@ -79,7 +79,7 @@ def _fill(lib: Any, twin: Any, estimator: Any) -> None:
     name = type(estimator).__name__
     for field in BASE_STATE:
         _set_field(twin.base, field, getattr(estimator, field))
-    if name == "PositionKalmanFilter":
+    if estimator.HAS_POSITION:
         _fill_position(lib, twin, estimator)
     else:
         attrs = STATE_ATTRIBUTES.get(name, {})
@@ -94,7 +94,7 @@ def take_state(estimator: Any, twin: Any) -> None:
     name = type(estimator).__name__
     for field in BASE_STATE:
         setattr(estimator, field, _field_value(twin.base, field, getattr(estimator, field)))
-    if name == "PositionKalmanFilter":
+    if estimator.HAS_POSITION:
         _take_position(twin, estimator)
     else:
         attrs = STATE_ATTRIBUTES.get(name, {})
@@ -105,14 +105,16 @@ def take_state(estimator: Any, twin: Any) -> None:
 
 
 def _fill_position(lib: Any, twin: Any, est: Any) -> None:
-    """The position filter's state: its own fields, its queue and its two nested Kalman filters
-    (whose parameters fc_poskf_configure already set from the position filter's)."""
+    """A position filter's state: its own fields, its nested Kalman filters (whose parameters
+    its configure already set from the position filter's) and the recommended one's queue."""
     _, ffi = lib_and_ffi()
     _fill(lib, ffi.addressof(twin[0], "tilt"), est.tilt)
-    _fill(lib, ffi.addressof(twin[0], "att"), est.att)
     twin.yaw = est.yaw
     _set_field(twin, "x", est._x)
     _set_field(twin, "P", est._P)
+    if not hasattr(est, "att"):  # the paper's: the tilt stage is all
+        return
+    _fill(lib, ffi.addressof(twin[0], "att"), est.att)
     twin.quiet_time = est.quiet_time
     twin.stationary = est.stationary
     if len(est.pending) > POSKF_PENDING_MAX:
@@ -130,10 +132,12 @@ def _fill_position(lib: Any, twin: Any, est: Any) -> None:
 def _take_position(twin: Any, est: Any) -> None:
     _, ffi = lib_and_ffi()
     take_state(est.tilt, ffi.addressof(twin[0], "tilt"))
-    take_state(est.att, ffi.addressof(twin[0], "att"))
     est.yaw = float(twin.yaw)
     est._x = tuple(float(v) for v in twin.x)
     est._P = tuple(float(v) for v in twin.P)
+    if not hasattr(est, "att"):  # the paper's: the tilt stage is all
+        return
+    take_state(est.att, ffi.addressof(twin[0], "att"))
     est.quiet_time = float(twin.quiet_time)
     est.stationary = bool(twin.stationary)
     head, count = twin.pending_head, twin.pending_count

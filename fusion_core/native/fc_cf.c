@@ -12,8 +12,6 @@ void fc_cf_configure(fc_cf *f)
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_CF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
-    f->quaternion = p->propagation == FC_CF_PROPAGATION_QUATERNION;
-    f->rotating = f->quaternion || f->acc_tau > 0.0;
     f->r_ref = pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
@@ -67,34 +65,22 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
         fc_complementary_rest(f->rest, f->bias, g, a, dt, rest_time, p->rest_gyro, p->rest_acc,
                               p->rest_bias_bound, &f->roll, &f->pitch, fa)) {
         fc_measure_align(f->meas, fa);  /* an uncalibrated first rest: its tilt */
-        if (f->quaternion) {
-            fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
-        }
+        fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
     }
     double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
     double r = f->r_ref;
     int aligning = 0;
-    if (f->rotating) {
-        fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
-        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
-        if (f->acc_tau > 0.0) {  /* the filter and its gate use the measured vector */
-            if (clipped) {
-                fc_measure_clipped(f->meas);
-            }
-            r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &aligning);
-            memcpy(a, f->meas + FC_MEAS_F, sizeof a);
+    fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+    fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
+    if (f->acc_tau > 0.0) {  /* the filter and its gate use the measured vector */
+        if (clipped) {
+            fc_measure_clipped(f->meas);
         }
+        r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &aligning);
+        memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
-    if (f->quaternion) {
-        fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
-        fc_quat_roll_pitch(f->q_att, &roll, &pitch);
-    } else if (f->trapezoid) {
-        const double *w0 = f->base.gyro_prev;
-        fc_heun_euler_step(f->roll, f->pitch, w0[0] - bx, w0[1] - by, w0[2] - bz, g[0] - bx,
-                           g[1] - by, g[2] - bz, dt, &roll, &pitch);
-    } else {
-        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2] - bz, dt, &roll, &pitch);
-    }
+    fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
+    fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
         double acc_roll, acc_pitch;
@@ -109,9 +95,7 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
         double y = acc_roll - roll;
         roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
         pitch += k * (acc_pitch - pitch);
-        if (f->quaternion) {
-            fc_quat_from_roll_pitch(roll, pitch, f->q_att);
-        }
+        fc_quat_from_roll_pitch(roll, pitch, f->q_att);
     }
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);

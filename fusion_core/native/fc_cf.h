@@ -1,6 +1,6 @@
-/* fc_cf.h: the complementary filter (fusion_core/complementary.py, ComplementaryFilter), the
- * C twin. Gui et al. 2015 eq. 1-2, Das & Mary eq. 1; the options for real sensors as in the
- * Python class's docstring. */
+/* fc_cf.h: the recommended complementary filter (fusion_core/complementary.py,
+ * ComplementaryFilter), the C twin. Gui et al. 2015 eq. 1-2, Das & Mary eq. 1 (fc_paper_cf.h)
+ * with the mechanisms for real sensors of the Python class's docstring. */
 #ifndef FC_CF_H
 #define FC_CF_H
 
@@ -21,7 +21,7 @@ typedef struct fc_cf {
     double tau, gate_low2, gate_high2, acc_tau;
     double r_ref, q_rotation, dist_tau, longest;  /* ComplementaryFilter._adaptive */
     fc_meas_constants measure;  /* ComplementaryFilter._measure */
-    int trapezoid, quaternion, rotating;
+    int trapezoid;
 } fc_cf;
 
 /* params (NULL: the defaults) in, a filter waiting for its first sample out. */

@@ -1,33 +1,17 @@
 /* fc_kf.c: see fc_kf.h; the twin of fusion_core/kalman.py line by line. */
 #include "fc_kf.h"
 
+#include "fc_paper_kf.h"
+
 #include <math.h>
 #include <string.h>
-
-/* predict_covariance: F P F' + Q (Das & Mary eq. 19-22) */
-static void predict_covariance(const double P[4], double dt, double q_angle, double q_bias,
-                               double out[4])
-{
-    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
-    out[0] = P00 + dt * (dt * P11 - P01 - P10 + q_angle);
-    out[1] = P01 - dt * P11;
-    out[2] = P10 - dt * P11;
-    out[3] = P11 + q_bias * dt;
-}
 
 /* measurement_gain (Das & Mary eq. 23-27) and angle_only_gain (the bias a consider state) */
 static void gain(const double P[4], double r, int learn_bias, double K[2], double out[4])
 {
     double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
     if (learn_bias) {
-        double S = P00 + r;
-        double K0 = P00 / S, K1 = P10 / S;
-        K[0] = K0;
-        K[1] = K1;
-        out[0] = P00 - K0 * P00;
-        out[1] = P01 - K0 * P01;
-        out[2] = P10 - K1 * P00;
-        out[3] = P11 - K1 * P01;
+        fc_paper_kf_measurement_gain(P, r, K, out);
     } else {
         double K0 = P00 / (P00 + r);
         K[0] = K0;
@@ -37,20 +21,6 @@ static void gain(const double P[4], double r, int learn_bias, double K[2], doubl
         out[2] = P10 - K0 * P10;
         out[3] = P11;
     }
-}
-
-/* bias_update: a direct bias measurement, H = [0, 1] */
-static void bias_update(double *angle, double *bias, double P[4], double y, double r)
-{
-    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
-    double S = P11 + r;
-    double K0 = P01 / S, K1 = P11 / S;
-    *angle = *angle + K0 * y;
-    *bias = *bias + K1 * y;
-    P[0] = P00 - K0 * P10;
-    P[1] = P01 - K0 * P11;
-    P[2] = P10 - K1 * P10;
-    P[3] = P11 - K1 * P11;
 }
 
 static int same4(const double a[4], const double b[4])
@@ -66,7 +36,6 @@ void fc_kf_configure(fc_kf *f)
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;
-    f->r_loop = f->r * p->R_loop_time;
     f->r_step = f->r;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
@@ -81,10 +50,7 @@ void fc_kf_configure(fc_kf *f)
     f->rest_acc = p->rest_acc;
     f->rest_bias_bound = p->rest_bias_bound;
     f->gyro_var = p->gyro_psd;
-    f->quaternion = p->propagation == FC_KF_PROPAGATION_QUATERNION;
-    f->faces = p->tilt_axes == FC_KF_TILT_AXES_NEAREST_FACE && f->quaternion;
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
-    f->options = f->quaternion || f->acc_tau > 0.0 || p->rest_time > 0.0;
 }
 
 fc_estimate fc_kf_estimate(const fc_kf *f)  /* _estimate */
@@ -92,7 +58,7 @@ fc_estimate fc_kf_estimate(const fc_kf *f)  /* _estimate */
     fc_estimate e;
     memset(&e, 0, sizeof e);
     double b[3] = {f->bias_x, f->bias_y, f->bias_z};
-    if (f->face) {  /* from the face frame back to the sensor's (tilt_axes) */
+    if (f->face) {  /* from the face frame back to the sensor's */
         const double *C = FC_FACES[f->face];
         double cp = cos(f->pitch);
         double v[3] = {-sin(f->pitch), sin(f->roll) * cp, cos(f->roll) * cp}, up[3];
@@ -132,63 +98,39 @@ FC_DEFINE_RESTORED(fc_kf)
 static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  /* _init */
 {
     double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
-    if (f->faces) {
-        f->face = fc_nearest_face(a[0], a[1], a[2]);
-        if (f->face) {
-            fc_mat_vec(FC_FACES[f->face], a, a);
-            fc_mat_vec(FC_FACES[f->face], g, g);
-        }
+    f->face = fc_nearest_face(a[0], a[1], a[2]);
+    if (f->face) {
+        fc_mat_vec(FC_FACES[f->face], a, a);
+        fc_mat_vec(FC_FACES[f->face], g, g);
     }
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
     fc_measure_start(f->meas, a, &f->measure);
     fc_rest_start(f->rest, g, a);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
     double p_b = pow(f->params.init_bias_std, 2.0);
-    if (p_b > 0.0) {
-        /* a sample whose norm is off g by d carries at least d of linear acceleration */
-        double p_a = f->r;
-        if (f->acc_tau > 0.0) {
-            double d = (sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) - FC_G) / FC_G;
-            p_a += d * d;
-        }
-        f->P_roll[0] = p_a;
-        f->P_roll[1] = f->P_roll[2] = 0.0;
-        f->P_roll[3] = p_b;
-        memcpy(f->P_pitch, f->P_roll, sizeof f->P_roll);
-        f->P_z = p_b;
+    /* a sample whose norm is off g by d carries at least d of linear acceleration */
+    double p_a = f->r;
+    if (f->acc_tau > 0.0) {
+        double d = (sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) - FC_G) / FC_G;
+        p_a += d * d;
     }
+    f->P_roll[0] = p_a;
+    f->P_roll[1] = f->P_roll[2] = 0.0;
+    f->P_roll[3] = p_b;
+    memcpy(f->P_pitch, f->P_roll, sizeof f->P_roll);
+    f->P_z = p_b;
 }
 
-/* propagate: the angles by the Euler rates or the quaternion, P by the papers' F and Q */
-void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_in,
-                     const double *terms)
+/* propagate: the attitude quaternion turned by phi (with its fc_rotvec_terms), P by the papers'
+ * F and Q with the adaptive Q_angle */
+static void propagate(fc_kf *f, const double g[3], double dt, const double phi[3],
+                      const double terms[4])
 {
     double bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
-    if (f->quaternion) {
-        double phi[3];
-        if (phi_in) {
-            memcpy(phi, phi_in, sizeof phi);
-        } else {
-            double b[3] = {bx, by, bz};
-            fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
-        }
-        if (terms) {
-            fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
-        } else {
-            fc_quat_mul_rotvec(f->q_att, phi[0], phi[1], phi[2]);
-        }
-        fc_quat_roll_pitch(f->q_att, &roll, &pitch);
-    } else if (f->trapezoid) {
-        const double *w0 = f->base.gyro_prev;
-        fc_heun_euler_step(f->roll, f->pitch, w0[0] - bx, w0[1] - by, w0[2] - bz, g[0] - bx,
-                           g[1] - by, g[2] - bz, dt, &roll, &pitch);
-    } else {
-        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2] - bz, dt, &roll, &pitch);
-    }
+    fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
+    fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
-    if (f->r_loop > 0.0)
-        f->r_step = f->r_loop / dt;
     double q_angle = f->q_angle;
     if (f->q_rotation > 0.0) {  /* gyro_scale_std: a scale error adds up while the sensor turns */
         double wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
@@ -197,18 +139,18 @@ void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi_i
     f->q_step = q_angle;
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
-    predict_covariance(P, dt, q_angle, f->q_bias, f->P_roll);
+    fc_paper_kf_predict_covariance(P, dt, q_angle, f->q_bias, f->P_roll);
     if (same4(f->P_pitch, P)) {
         memcpy(f->P_pitch, f->P_roll, sizeof P);
     } else {
         double Pp[4];
         memcpy(Pp, f->P_pitch, sizeof Pp);
-        predict_covariance(Pp, dt, q_angle, f->q_bias, f->P_pitch);
+        fc_paper_kf_predict_covariance(Pp, dt, q_angle, f->q_bias, f->P_pitch);
     }
 }
 
 /* correct_innovation */
-void fc_kf_correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
+static void correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
 {
     double P[4];
     memcpy(P, f->P_roll, sizeof P);
@@ -231,7 +173,7 @@ void fc_kf_correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn
 }
 
 /* correct: the accelerometer's roll and pitch */
-void fc_kf_correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
+static void correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
 {
     double acc_roll, acc_pitch;
     fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
@@ -244,19 +186,14 @@ void fc_kf_correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
     if (!(-gate <= y_roll && y_roll <= gate && -gate <= y_pitch && y_pitch <= gate)) {
         learn_bias = 0;  /* grossly off: the angle only (bias_innovation) */
     }
-    fc_kf_correct_innovation(f, y_roll, y_pitch, learn_bias);
+    correct_innovation(f, y_roll, y_pitch, learn_bias);
 }
 
 /* correct_bias: direct measurements of the x and y gyro bias (variance r each) */
-void fc_kf_correct_bias(fc_kf *f, double z_x, double z_y, double r)
+static void correct_bias(fc_kf *f, double z_x, double z_y, double r)
 {
-    bias_update(&f->roll, &f->bias_x, f->P_roll, z_x - f->bias_x, r);
-    bias_update(&f->pitch, &f->bias_y, f->P_pitch, z_y - f->bias_y, r);
-}
-
-int fc_kf_accel_trusted(const fc_kf *f, double norm2)
-{
-    return f->gate_low2 <= norm2 && norm2 <= f->gate_high2;
+    fc_paper_kf_bias_update(&f->roll, &f->bias_x, f->P_roll, z_x - f->bias_x, r);
+    fc_paper_kf_bias_update(&f->pitch, &f->bias_y, f->P_pitch, z_y - f->bias_y, r);
 }
 
 /* _zero_rate_update: at rest the gyro measures the bias */
@@ -274,26 +211,22 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
         double r = f->gyro_var / dt;
-        fc_kf_correct_bias(f, g[0], g[1], r);
+        correct_bias(f, g[0], g[1], r);
         double k = f->P_z / (f->P_z + r);
         f->bias_z += k * (g[2] - f->bias_z);
         f->P_z -= k * f->P_z;
     }
 }
 
-/* _update_with_options, in the filters' frame; prev: the previous gyro sample there */
-static void update_with_options(fc_kf *f, const double a_in[3], const double g[3], double dt,
-                                const double prev[3])
+/* _update, in the filters' frame; prev: the previous gyro sample there */
+static void update(fc_kf *f, const double a_in[3], const double g[3], double dt,
+                   const double prev[3])
 {
     double a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4];
-    int have_phi = 0;
-    if (f->quaternion || f->acc_tau > 0.0) {
-        double b[3] = {f->bias_x, f->bias_y, f->bias_z};
-        fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
-        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
-        have_phi = 1;
-    }
-    fc_kf_propagate(f, g, dt, have_phi ? phi : NULL, have_phi ? terms : NULL);
+    double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
+    fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
+    propagate(f, g, dt, phi, terms);
     int clipped = f->base.clipped;  /* at the gyro's rail: the rate beyond it is unknown */
     if (clipped) {
         double grow = f->rail_var * dt * dt;
@@ -318,9 +251,9 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
             fc_measure_clipped(f->meas);
         }
         double r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
-        /* one sample's variance (or the papers' R_loop_time rule) plus the disturbance that
-         * reaches the measured vector, up to the longest correction time */
-        double base = f->r_loop > 0.0 ? f->r_loop / dt : f->r;
+        /* one sample's variance plus the disturbance that reaches the measured vector, up to
+         * the longest correction time */
+        double base = f->r;
         r = base + (r - f->measure.r);
         double cap = f->q_step * f->longest2 / dt;
         f->r_step = r < cap ? r : (cap > base ? cap : base);
@@ -330,9 +263,9 @@ static void update_with_options(fc_kf *f, const double a_in[3], const double g[3
     }
     double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        fc_kf_correct(f, a[0], a[1], a[2], learn_bias);
+        correct(f, a[0], a[1], a[2], learn_bias);
     }
-    if (f->quaternion && (f->roll != pred_roll || f->pitch != pred_pitch)) {
+    if (f->roll != pred_roll || f->pitch != pred_pitch) {
         fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
     }
 }
@@ -399,29 +332,19 @@ static void switch_face(fc_kf *f)
 
 static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double dt)
 {
-    if (f->options) {
-        double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
-        double prev[3] = {f->base.gyro_prev[0], f->base.gyro_prev[1], f->base.gyro_prev[2]};
-        if (f->face) {  /* into the face frame (tilt_axes) */
-            const double *C = FC_FACES[f->face];
-            fc_mat_vec(C, a, a);
-            fc_mat_vec(C, g, g);
-            fc_mat_vec(C, prev, prev);
-        }
-        update_with_options(f, a, g, dt, prev);
-        /* up's z in the face frame, cos(roll) cos(pitch), read off the attitude quaternion */
-        if (f->faces) {
-            const double *q = f->q_att;
-            if (q[0] * q[0] - q[1] * q[1] - q[2] * q[2] + q[3] * q[3] < FC_FACE_SWITCH_COS) {
-                switch_face(f);
-            }
-        }
-    } else {
-        fc_kf_propagate(f, g_in, dt, NULL, NULL);
-        double n2 = a_in[0] * a_in[0] + a_in[1] * a_in[1] + a_in[2] * a_in[2];
-        if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-            fc_kf_correct(f, a_in[0], a_in[1], a_in[2], f->bias_lo2 < n2 && n2 < f->bias_hi2);
-        }
+    double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
+    double prev[3] = {f->base.gyro_prev[0], f->base.gyro_prev[1], f->base.gyro_prev[2]};
+    if (f->face) {  /* into the face frame */
+        const double *C = FC_FACES[f->face];
+        fc_mat_vec(C, a, a);
+        fc_mat_vec(C, g, g);
+        fc_mat_vec(C, prev, prev);
+    }
+    update(f, a, g, dt, prev);
+    /* up's z in the face frame, cos(roll) cos(pitch), read off the attitude quaternion */
+    const double *q = f->q_att;
+    if (q[0] * q[0] - q[1] * q[1] - q[2] * q[2] + q[3] * q[3] < FC_FACE_SWITCH_COS) {
+        switch_face(f);
     }
 }
 

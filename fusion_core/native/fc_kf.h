@@ -1,6 +1,7 @@
-/* fc_kf.h: the two-state [angle, bias] Kalman filter for roll and for pitch
+/* fc_kf.h: the recommended two-state [angle, bias] Kalman filter for roll and for pitch
  * (fusion_core/kalman.py, AngleBiasKalmanFilter), the C twin. Gui et al. 2015 eq. 5-26, Das &
- * Mary eq. 16-27; the options for real sensors as in the Python class's docstring. */
+ * Mary eq. 16-27 (fc_paper_kf.h) with the mechanisms for real sensors of the Python class's
+ * docstring. */
 #ifndef FC_KF_H
 #define FC_KF_H
 
@@ -20,16 +21,16 @@ typedef struct fc_kf {
     int face;
     double gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
     fc_estimate last;
-    double r_step;  /* this step's measurement variance (R_loop_time, disturbance_time) */
+    double r_step;  /* this step's measurement variance (the measured vector's noise) */
     double q_step;  /* this step's angle process noise (propagate) */
     /* derived from params (AngleBiasKalmanFilter._configure) */
-    double q_angle, q_bias, r, r_loop, gate_low2, gate_high2, acc_tau;
+    double q_angle, q_bias, r, gate_low2, gate_high2, acc_tau;
     double q_rotation, dist_tau;  /* AngleBiasKalmanFilter._adaptive */
     fc_meas_constants measure;  /* AngleBiasKalmanFilter._measure */
     double longest2, rail_var;
     double rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;
     double bias_lo2, bias_hi2;
-    int trapezoid, quaternion, faces, options;
+    int trapezoid;
 } fc_kf;
 
 void fc_kf_init(fc_kf *f, const fc_kf_params *params);
@@ -42,16 +43,5 @@ long fc_kf_run(fc_kf *f, long n, const double *acc, const double *gyro, const do
 fc_estimate fc_kf_estimate(const fc_kf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_kf_restored(fc_kf *f);
-
-/* The parts the position filter drives one by one (AngleBiasKalmanFilter's methods of the same
- * names): the time update (phi: the interval's rotation vector, or NULL to compute it from
- * base.gyro_prev; terms: its fc_rotvec_terms, or NULL), the accelerometer update, an update with given innovations, a direct bias
- * measurement, and the accelerometer gate. */
-void fc_kf_propagate(fc_kf *f, const double g[3], double dt, const double *phi,
-                     const double *terms);
-void fc_kf_correct(fc_kf *f, double ax, double ay, double az, int learn_bias);
-void fc_kf_correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias);
-void fc_kf_correct_bias(fc_kf *f, double z_x, double z_y, double r);
-int fc_kf_accel_trusted(const fc_kf *f, double norm2);
 
 #endif /* FC_KF_H */

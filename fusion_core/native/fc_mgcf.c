@@ -1,50 +1,17 @@
 /* fc_mgcf.c: see fc_mgcf.h; the twin of fusion_core/mgcf.py line by line. */
 #include "fc_mgcf.h"
 
+#include "fc_paper_mgcf.h"
+
 #include <math.h>
 #include <string.h>
-
-/* mgcf.SCHEDULES by schedule (FC_MGCF_SCHEDULE_SIMULATION, _EXPERIMENTAL): (rho upper bound,
- * w0 [rad/s]) rows; rho at or above the last bound: w0 = 0 */
-static const double SCHEDULES[2][3][2] = {
-    {{0.01, 0.1}, {0.25, 0.07}, {0.35, 0.035}},
-    {{0.025, 0.1}, {0.035, 0.07}, {0.05, 0.05}},
-};
-
-/* scheduled_w0: the table is chosen here, by its index, so the filter's struct holds no
- * pointer (fc_state.h) */
-static double scheduled_w0(double rho, int schedule)
-{
-    for (int i = 0; i < 3; i++) {
-        if (rho < SCHEDULES[schedule][i][0]) {
-            return SCHEDULES[schedule][i][1];
-        }
-    }
-    return 0.0;
-}
-
-/* _quat_first_order: q + dt/2 q (x) (0, w), renormalised (Mahony's reference code) */
-static void quat_first_order(double q[4], double w0, double w1, double w2, double dt)
-{
-    double qw = q[0], qx = q[1], qy = q[2], qz = q[3];
-    double wx = 0.5 * dt * w0, wy = 0.5 * dt * w1, wz = 0.5 * dt * w2;
-    double rw = qw - qx * wx - qy * wy - qz * wz;
-    double rx = qx + qw * wx + qy * wz - qz * wy;
-    double ry = qy + qw * wy - qx * wz + qz * wx;
-    double rz = qz + qw * wz + qx * wy - qy * wx;
-    double n = 1.0 / sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
-    q[0] = rw * n;
-    q[1] = rx * n;
-    q[2] = ry * n;
-    q[3] = rz * n;
-}
 
 void fc_mgcf_configure(fc_mgcf *f)
 {
     const fc_mgcf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
                       p->mount_yaw, p->sensor_delay, p->gyro_range);
-    f->w0_fixed = p->w0;
+    f->w0 = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
@@ -52,7 +19,6 @@ void fc_mgcf_configure(fc_mgcf *f)
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
     f->rest_bias_bound = p->rest_bias_bound;
-    f->options = f->rest_time > 0.0 || f->acc_tau > 0.0;
     f->r_ref = pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
@@ -102,39 +68,33 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
     double r = f->r_ref;
     int aligning = 0;
     int clipped = f->base.clipped;
-    if (f->options) {  /* _real_sensor_options */
-        double roll, pitch, fa[3];
-        if (f->rest_time > 0.0 && !clipped &&
-            fc_complementary_rest(f->rest, f->bias, g, a_in, dt, f->rest_time, f->rest_gyro,
-                                  f->rest_acc, f->rest_bias_bound, &roll, &pitch, fa)) {
-            fc_measure_align(f->meas, fa);  /* an uncalibrated first rest: its tilt */
-            fc_quat_from_roll_pitch(roll, pitch, f->q);
+    double roll, pitch, fa[3];  /* _real_sensor_options */
+    if (f->rest_time > 0.0 && !clipped &&
+        fc_complementary_rest(f->rest, f->bias, g, a_in, dt, f->rest_time, f->rest_gyro,
+                              f->rest_acc, f->rest_bias_bound, &roll, &pitch, fa)) {
+        fc_measure_align(f->meas, fa);  /* an uncalibrated first rest: its tilt */
+        fc_quat_from_roll_pitch(roll, pitch, f->q);
+    }
+    if (f->acc_tau > 0.0) {
+        double phi[3], terms[4];
+        fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+        fc_rotvec_terms(phi[0], phi[1], phi[2], terms);
+        if (clipped) {
+            fc_measure_clipped(f->meas);
         }
-        if (f->acc_tau > 0.0) {
-            double phi[3], terms[4];
-            fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
-            fc_rotvec_terms(phi[0], phi[1], phi[2], terms);
-            if (clipped) {
-                fc_measure_clipped(f->meas);
-            }
-            fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, &aligning);
-            ax = f->meas[FC_MEAS_F];
-            ay = f->meas[FC_MEAS_F + 1];
-            az = f->meas[FC_MEAS_F + 2];
-            r = fc_measure_raw_noise(f->meas, &f->measure);
-        }
+        fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, &aligning);
+        ax = f->meas[FC_MEAS_F];
+        ay = f->meas[FC_MEAS_F + 1];
+        az = f->meas[FC_MEAS_F + 2];
+        r = fc_measure_raw_noise(f->meas, &f->measure);
     }
     double norm = sqrt(ax * ax + ay * ay + az * az);
-    int schedule = f->params.schedule;
-    int scheduled = schedule == FC_MGCF_SCHEDULE_SIMULATION ||
-                    schedule == FC_MGCF_SCHEDULE_EXPERIMENTAL;
-    double w0 = scheduled ? scheduled_w0(fabs(norm / FC_G - 1.0), schedule) : f->w0_fixed;
+    double w0 = f->w0;
     if (!(norm > 0.0)) {  /* no gravity direction in this sample: gyro only */
         w0 = 0.0;
     }
     f->w0_now = w0;
     if (aligning && w0 > 0.0) {  /* the vector still fills: the attitude is the mean's tilt */
-        double roll, pitch;
         fc_accel_roll_pitch(ax, ay, az, &roll, &pitch);
         fc_quat_from_roll_pitch(roll, pitch, f->q);
         return;
@@ -167,8 +127,7 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         ey = nz * v[0] - nx * v[2];
         ez = nx * v[1] - ny * v[0];
         /* none from a gyro sample at its rail, nor from a vector still holding its turns */
-        if (!f->options || (!clipped && (f->acc_tau == 0.0 ||
-                                         fc_measure_settled(f->meas, &f->measure)))) {
+        if (!clipped && (f->acc_tau == 0.0 || fc_measure_settled(f->meas, &f->measure))) {
             double ki_dt = w0 * w0 * dt;
             bx = bx - ki_dt * ex;
             by = by - ki_dt * ey;
@@ -179,7 +138,8 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         }
     }
     if (!f->trapezoid) {
-        quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz, dt);
+        fc_paper_mgcf_quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by,
+                                       gz + kp * ez - bz, dt);
     } else if (w0 > 0.0) {
         double kp_dt = kp * dt;
         fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);

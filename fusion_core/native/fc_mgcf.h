@@ -1,6 +1,6 @@
-/* fc_mgcf.h: the gain-scheduled (modified-gain) complementary filter, a Mahony-style quaternion
- * PI filter (fusion_core/mgcf.py, GainScheduledComplementaryFilter), the C twin. Duong Quoc et
- * al. eq. 7-13 with their w0 schedules; Mahony, Hamel, Pflimlin (2008) for the PI law. */
+/* fc_mgcf.h: the recommended modified-gain complementary filter, a Mahony-style quaternion PI
+ * filter (fusion_core/mgcf.py, GainScheduledComplementaryFilter), the C twin. Duong Quoc et al.
+ * eq. 7-13 (fc_paper_mgcf.h) with a fixed gain and the mechanisms for real sensors. */
 #ifndef FC_MGCF_H
 #define FC_MGCF_H
 
@@ -18,10 +18,10 @@ typedef struct fc_mgcf {
     double rest[8];
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
-    double w0_fixed, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
+    double w0, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
     double r_ref, q_rotation, dist_tau, longest;  /* _adaptive */
     fc_meas_constants measure;  /* _measure */
-    int trapezoid, options;
+    int trapezoid;
 } fc_mgcf;
 
 void fc_mgcf_init(fc_mgcf *f, const fc_mgcf_params *params);

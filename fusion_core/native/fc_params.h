@@ -10,10 +10,8 @@
 
 #include <math.h>
 
-/* ----- ComplementaryFilter (cf) --------------------------------------------- */
+/* ----- ComplementaryFilter (fc_cf) ------------------------------------------ */
 
-#define FC_CF_PROPAGATION_EULER 0
-#define FC_CF_PROPAGATION_QUATERNION 1
 #define FC_CF_GYRO_SAMPLING_POINT 0
 #define FC_CF_GYRO_SAMPLING_MEAN 1
 
@@ -26,7 +24,6 @@ typedef struct fc_cf_params {
     double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
     double rest_acc;             /* (0.0, 10000.0] [m/s2] */
     double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
-    int propagation;             /* one of 'euler', 'quaternion' */
     int gyro_sampling;           /* one of 'point', 'mean' */
     double acc_noise;            /* [1e-06, 10.0] */
     double gyro_scale_std;       /* [0.0, 0.5] */
@@ -43,7 +40,7 @@ typedef struct fc_cf_params {
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_cf_params;
 
-/* The defaults: ComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
+/* The defaults: ComplementaryFilter.PARAMS. */
 static inline void fc_cf_params_default(fc_cf_params *p)
 {
     p->tau = 1.0;
@@ -54,7 +51,6 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->rest_gyro = 0.03490658503988659;
     p->rest_acc = 0.5;
     p->rest_bias_bound = 0.3490658503988659;
-    p->propagation = FC_CF_PROPAGATION_QUATERNION;
     p->gyro_sampling = FC_CF_GYRO_SAMPLING_POINT;
     p->acc_noise = 0.005;
     p->gyro_scale_std = 0.005;
@@ -71,16 +67,45 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->sensor_delay = 0.0;
 }
 
-/* ----- GainScheduledComplementaryFilter (mgcf) ------------------------------ */
+/* ----- PaperComplementaryFilter (fc_paper_cf) ------------------------------- */
 
-#define FC_MGCF_SCHEDULE_SIMULATION 0
-#define FC_MGCF_SCHEDULE_EXPERIMENTAL 1
-#define FC_MGCF_SCHEDULE_FIXED 2
+#define FC_PAPER_CF_GYRO_SAMPLING_POINT 0
+#define FC_PAPER_CF_GYRO_SAMPLING_MEAN 1
+
+typedef struct fc_paper_cf_params {
+    double tau;           /* (0.0, 1000000.0] [s] */
+    double gate_low;      /* (0.0, 1.0] */
+    double gate_high;     /* [1.0, 1000.0] */
+    int gyro_sampling;    /* one of 'point', 'mean' */
+    double max_dt;        /* (0.0, 1000000.0] [s] */
+    double max_rate;      /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;  /* [0.0, 0.1] [s] */
+} fc_paper_cf_params;
+
+/* The defaults: PaperComplementaryFilter.PARAMS. */
+static inline void fc_paper_cf_params_default(fc_paper_cf_params *p)
+{
+    p->tau = 0.75;
+    p->gate_low = 0.9;
+    p->gate_high = 1.1;
+    p->gyro_sampling = FC_PAPER_CF_GYRO_SAMPLING_MEAN;
+    p->max_dt = 1.0;
+    p->max_rate = 1000.0;
+    p->mount_roll = 0.0;
+    p->mount_pitch = 0.0;
+    p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
+}
+
+/* ----- GainScheduledComplementaryFilter (fc_mgcf) --------------------------- */
+
 #define FC_MGCF_GYRO_SAMPLING_POINT 0
 #define FC_MGCF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_mgcf_params {
-    int schedule;                /* one of 'simulation', 'experimental', 'fixed' */
     double w0;                   /* [0.0, 10000.0] [rad/s] */
     double zeta;                 /* [0.0, 1000.0] */
     double acc_lowpass;          /* [0.0, 1000000.0] [s] */
@@ -103,10 +128,9 @@ typedef struct fc_mgcf_params {
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_mgcf_params;
 
-/* The defaults: GainScheduledComplementaryFilter.PARAMS (for an estimator, the recommended preset). */
+/* The defaults: GainScheduledComplementaryFilter.PARAMS. */
 static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 {
-    p->schedule = FC_MGCF_SCHEDULE_FIXED;
     p->w0 = 0.02;
     p->zeta = 10.0;
     p->acc_lowpass = 1.0;
@@ -129,12 +153,44 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->sensor_delay = 0.0;
 }
 
-/* ----- AngleBiasKalmanFilter (kf) ------------------------------------------- */
+/* ----- PaperGainScheduledFilter (fc_paper_mgcf) ----------------------------- */
 
-#define FC_KF_PROPAGATION_EULER 0
-#define FC_KF_PROPAGATION_QUATERNION 1
-#define FC_KF_TILT_AXES_BODY 0
-#define FC_KF_TILT_AXES_NEAREST_FACE 1
+#define FC_PAPER_MGCF_SCHEDULE_SIMULATION 0
+#define FC_PAPER_MGCF_SCHEDULE_EXPERIMENTAL 1
+#define FC_PAPER_MGCF_SCHEDULE_FIXED 2
+#define FC_PAPER_MGCF_GYRO_SAMPLING_POINT 0
+#define FC_PAPER_MGCF_GYRO_SAMPLING_MEAN 1
+
+typedef struct fc_paper_mgcf_params {
+    int schedule;         /* one of 'simulation', 'experimental', 'fixed' */
+    double w0;            /* [0.0, 10000.0] [rad/s] */
+    double zeta;          /* [0.0, 1000.0] */
+    int gyro_sampling;    /* one of 'point', 'mean' */
+    double max_dt;        /* (0.0, 1000000.0] [s] */
+    double max_rate;      /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;  /* [0.0, 0.1] [s] */
+} fc_paper_mgcf_params;
+
+/* The defaults: PaperGainScheduledFilter.PARAMS. */
+static inline void fc_paper_mgcf_params_default(fc_paper_mgcf_params *p)
+{
+    p->schedule = FC_PAPER_MGCF_SCHEDULE_SIMULATION;
+    p->w0 = 0.1;
+    p->zeta = 2.0;
+    p->gyro_sampling = FC_PAPER_MGCF_GYRO_SAMPLING_MEAN;
+    p->max_dt = 1.0;
+    p->max_rate = 1000.0;
+    p->mount_roll = 0.0;
+    p->mount_pitch = 0.0;
+    p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
+}
+
+/* ----- AngleBiasKalmanFilter (fc_kf) ---------------------------------------- */
+
 #define FC_KF_GYRO_SAMPLING_POINT 0
 #define FC_KF_GYRO_SAMPLING_MEAN 1
 
@@ -142,7 +198,6 @@ typedef struct fc_kf_params {
     double Q_angle;              /* [0.0, 1.0] [rad2/s] */
     double Q_bias;               /* [0.0, 1.0] [rad2/s3] */
     double R_measure;            /* (0.0, 100.0] [rad2] */
-    double R_loop_time;          /* [0.0, 1000000.0] [s] */
     double gyro_scale_std;       /* [0.0, 0.5] */
     double scale_time;           /* [0.0, 1000000.0] [s] */
     double disturbance_time;     /* [0.0, 1000000.0] [s] */
@@ -154,11 +209,9 @@ typedef struct fc_kf_params {
     double rest_acc;             /* (0.0, 10000.0] [m/s2] */
     double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
     double gyro_psd;             /* (0.0, 1.0] [rad2/s] */
-    double init_bias_std;        /* [0.0, 10000.0] [rad/s] */
+    double init_bias_std;        /* (0.0, 10000.0] [rad/s] */
     double bias_gate;            /* [0.0, 1000.0] */
     double bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
-    int propagation;             /* one of 'euler', 'quaternion' */
-    int tilt_axes;               /* one of 'body', 'nearest_face' */
     int gyro_sampling;           /* one of 'point', 'mean' */
     double slow_band_time;       /* [0.01, 10.0] [s] */
     double max_correction_time;  /* [0.0, 1000000.0] [s] */
@@ -171,13 +224,12 @@ typedef struct fc_kf_params {
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_kf_params;
 
-/* The defaults: AngleBiasKalmanFilter.PARAMS (for an estimator, the recommended preset). */
+/* The defaults: AngleBiasKalmanFilter.PARAMS. */
 static inline void fc_kf_params_default(fc_kf_params *p)
 {
     p->Q_angle = 1.949551486634935e-08;
     p->Q_bias = 3.046174197867086e-12;
     p->R_measure = 2.5995528875251195e-05;
-    p->R_loop_time = 0.0;
     p->gyro_scale_std = 0.005;
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
@@ -192,8 +244,6 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->init_bias_std = 0.005235987755982988;
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;
-    p->propagation = FC_KF_PROPAGATION_QUATERNION;
-    p->tilt_axes = FC_KF_TILT_AXES_NEAREST_FACE;
     p->gyro_sampling = FC_KF_GYRO_SAMPLING_POINT;
     p->slow_band_time = 0.15;
     p->max_correction_time = 30.0;
@@ -206,7 +256,46 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->sensor_delay = 0.0;
 }
 
-/* ----- UnscentedKalmanFilter (ukf) ------------------------------------------ */
+/* ----- PaperKalmanFilter (fc_paper_kf) -------------------------------------- */
+
+#define FC_PAPER_KF_GYRO_SAMPLING_POINT 0
+#define FC_PAPER_KF_GYRO_SAMPLING_MEAN 1
+
+typedef struct fc_paper_kf_params {
+    double Q_angle;       /* [0.0, 1.0] [rad2/s] */
+    double Q_bias;        /* [0.0, 1.0] [rad2/s3] */
+    double R_measure;     /* (0.0, 100.0] [rad2] */
+    double R_loop_time;   /* [0.0, 1000000.0] [s] */
+    double gate_low;      /* (0.0, 1.0] */
+    double gate_high;     /* [1.0, 1000.0] */
+    int gyro_sampling;    /* one of 'point', 'mean' */
+    double max_dt;        /* (0.0, 1000000.0] [s] */
+    double max_rate;      /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;  /* [0.0, 0.1] [s] */
+} fc_paper_kf_params;
+
+/* The defaults: PaperKalmanFilter.PARAMS. */
+static inline void fc_paper_kf_params_default(fc_paper_kf_params *p)
+{
+    p->Q_angle = 3.046174197867086e-07;
+    p->Q_bias = 9.138522593601257e-07;
+    p->R_measure = 9.138522593601256e-06;
+    p->R_loop_time = 0.033;
+    p->gate_low = 0.9;
+    p->gate_high = 1.1;
+    p->gyro_sampling = FC_PAPER_KF_GYRO_SAMPLING_MEAN;
+    p->max_dt = 1.0;
+    p->max_rate = 1000.0;
+    p->mount_roll = 0.0;
+    p->mount_pitch = 0.0;
+    p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
+}
+
+/* ----- UnscentedKalmanFilter (fc_ukf) --------------------------------------- */
 
 #define FC_UKF_GYRO_SAMPLING_POINT 0
 #define FC_UKF_GYRO_SAMPLING_MEAN 1
@@ -215,8 +304,6 @@ typedef struct fc_ukf_params {
     double gyro_psd;             /* (0.0, 1.0] [rad2/s] */
     double bias_psd;             /* [0.0, 1.0] [rad2/s3] */
     double acc_noise;            /* [1e-06, 10.0] */
-    double norm_noise;           /* [0.0, 10.0] */
-    double acc_gate;             /* (0.0, 1000.0] */
     double init_bias_std;        /* (0.0, 10000.0] [rad/s] */
     double alpha;                /* [0.0001, 1.0] */
     double beta;                 /* [0.0, 1000.0] */
@@ -244,14 +331,12 @@ typedef struct fc_ukf_params {
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_ukf_params;
 
-/* The defaults: UnscentedKalmanFilter.PARAMS (for an estimator, the recommended preset). */
+/* The defaults: UnscentedKalmanFilter.PARAMS. */
 static inline void fc_ukf_params_default(fc_ukf_params *p)
 {
     p->gyro_psd = 1.949551486634935e-08;
     p->bias_psd = 3.0461741978670863e-12;
     p->acc_noise = 0.005;
-    p->norm_noise = 0.0;
-    p->acc_gate = 1.0;
     p->init_bias_std = 0.005235987755982988;
     p->alpha = 1.0;
     p->beta = 2.0;
@@ -279,23 +364,59 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->sensor_delay = 0.0;
 }
 
-/* ----- PositionKalmanFilter (poskf) ----------------------------------------- */
+/* ----- PaperUnscentedKalmanFilter (fc_paper_ukf) ---------------------------- */
 
-#define FC_POSKF_QR_FORM_WHITE_JERK 0
-#define FC_POSKF_QR_FORM_PIECEWISE_JERK 1
-#define FC_POSKF_QR_FORM_DIAGONAL 2
-#define FC_POSKF_TILT_UPDATE_STATIONARY 0
-#define FC_POSKF_TILT_UPDATE_ALWAYS 1
-#define FC_POSKF_ATTITUDE_KF 0
-#define FC_POSKF_ATTITUDE_TILT_STAGE 1
+#define FC_PAPER_UKF_GYRO_SAMPLING_POINT 0
+#define FC_PAPER_UKF_GYRO_SAMPLING_MEAN 1
+
+typedef struct fc_paper_ukf_params {
+    double gyro_psd;       /* (0.0, 1.0] [rad2/s] */
+    double bias_psd;       /* [0.0, 1.0] [rad2/s3] */
+    double acc_noise;      /* [1e-06, 10.0] */
+    double norm_noise;     /* [0.0, 10.0] */
+    double acc_gate;       /* (0.0, 1000.0] */
+    double init_bias_std;  /* (0.0, 10000.0] [rad/s] */
+    double alpha;          /* [0.0001, 1.0] */
+    double beta;           /* [0.0, 1000.0] */
+    double kappa;          /* (-5.0, 1000.0] */
+    int gyro_sampling;     /* one of 'point', 'mean' */
+    double max_dt;         /* (0.0, 1000000.0] [s] */
+    double max_rate;       /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;   /* [0.0, 0.1] [s] */
+} fc_paper_ukf_params;
+
+/* The defaults: PaperUnscentedKalmanFilter.PARAMS. */
+static inline void fc_paper_ukf_params_default(fc_paper_ukf_params *p)
+{
+    p->gyro_psd = 7.615435494667716e-09;
+    p->bias_psd = 1.2184696791468344e-09;
+    p->acc_noise = 0.06;
+    p->norm_noise = 0.01;
+    p->acc_gate = 0.1;
+    p->init_bias_std = 0.017453292519943295;
+    p->alpha = 1.0;
+    p->beta = 2.0;
+    p->kappa = 0.0;
+    p->gyro_sampling = FC_PAPER_UKF_GYRO_SAMPLING_MEAN;
+    p->max_dt = 1.0;
+    p->max_rate = 1000.0;
+    p->mount_roll = 0.0;
+    p->mount_pitch = 0.0;
+    p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
+}
+
+/* ----- PositionKalmanFilter (fc_poskf) -------------------------------------- */
+
 #define FC_POSKF_GYRO_SAMPLING_POINT 0
 #define FC_POSKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_poskf_params {
-    int qr_form;              /* one of 'white_jerk', 'piecewise_jerk', 'diagonal' */
     double q;                 /* (0.0, 10000.0] [m2/s5] */
     double acc_psd;           /* (0.0, 10000.0] [m2/s3] */
-    int zupt;                 /* True or False */
     double zupt_acc;          /* (0.0, 10000.0] [m/s2] */
     double zupt_level_acc;    /* (0.0, 10000.0] [m/s2] */
     double zupt_gyro;         /* (0.0, 10000.0] [rad/s] */
@@ -303,10 +424,7 @@ typedef struct fc_poskf_params {
     double zupt_speed;        /* [0.0, 1000.0] [m/s] */
     double zupt_force_after;  /* [0.0, 1000000.0] [s] */
     double zupt_noise;        /* (0.0, 1000.0] [m/s] */
-    int zaru;                 /* True or False */
     double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
-    int tilt_update;          /* one of 'stationary', 'always' */
-    int attitude;             /* one of 'kf', 'tilt_stage' */
     double Q_angle;           /* [0.0, 1.0] [rad2/s] */
     double Q_bias;            /* [0.0, 1.0] [rad2/s3] */
     double R_measure;         /* (0.0, 100.0] [rad2] */
@@ -323,13 +441,11 @@ typedef struct fc_poskf_params {
     double sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_poskf_params;
 
-/* The defaults: PositionKalmanFilter.PARAMS (for an estimator, the recommended preset). */
+/* The defaults: PositionKalmanFilter.PARAMS. */
 static inline void fc_poskf_params_default(fc_poskf_params *p)
 {
-    p->qr_form = FC_POSKF_QR_FORM_WHITE_JERK;
     p->q = 1.0;
     p->acc_psd = 1.0889999999999999e-05;
-    p->zupt = 1;
     p->zupt_acc = 0.2;
     p->zupt_level_acc = 0.5;
     p->zupt_gyro = 0.03490658503988659;
@@ -337,10 +453,7 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->zupt_speed = 0.1;
     p->zupt_force_after = 2.0;
     p->zupt_noise = 0.005;
-    p->zaru = 1;
     p->gyro_psd = 1.949551486634935e-08;
-    p->tilt_update = FC_POSKF_TILT_UPDATE_STATIONARY;
-    p->attitude = FC_POSKF_ATTITUDE_KF;
     p->Q_angle = 3.046174197867086e-07;
     p->Q_bias = 9.138522593601257e-07;
     p->R_measure = 9.138522593601256e-06;
@@ -357,7 +470,55 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->sensor_delay = 0.0;
 }
 
-/* ----- ImuSensorModel (sensor) ---------------------------------------------- */
+/* ----- PaperPositionKalmanFilter (fc_paper_poskf) --------------------------- */
+
+#define FC_PAPER_POSKF_QR_FORM_WHITE_JERK 0
+#define FC_PAPER_POSKF_QR_FORM_PIECEWISE_JERK 1
+#define FC_PAPER_POSKF_QR_FORM_DIAGONAL 2
+#define FC_PAPER_POSKF_GYRO_SAMPLING_POINT 0
+#define FC_PAPER_POSKF_GYRO_SAMPLING_MEAN 1
+
+typedef struct fc_paper_poskf_params {
+    int qr_form;          /* one of 'white_jerk', 'piecewise_jerk', 'diagonal' */
+    double q;             /* (0.0, 10000.0] [m2/s5] */
+    double acc_psd;       /* (0.0, 10000.0] [m2/s3] */
+    double Q_angle;       /* [0.0, 1.0] [rad2/s] */
+    double Q_bias;        /* [0.0, 1.0] [rad2/s3] */
+    double R_measure;     /* (0.0, 100.0] [rad2] */
+    double R_loop_time;   /* [0.0, 1000000.0] [s] */
+    double gate_low;      /* (0.0, 1.0] */
+    double gate_high;     /* [1.0, 1000.0] */
+    int gyro_sampling;    /* one of 'point', 'mean' */
+    double max_dt;        /* (0.0, 1000000.0] [s] */
+    double max_rate;      /* (0.0, 10000.0] [rad/s] */
+    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double sensor_delay;  /* [0.0, 0.1] [s] */
+} fc_paper_poskf_params;
+
+/* The defaults: PaperPositionKalmanFilter.PARAMS. */
+static inline void fc_paper_poskf_params_default(fc_paper_poskf_params *p)
+{
+    p->qr_form = FC_PAPER_POSKF_QR_FORM_WHITE_JERK;
+    p->q = 1.0;
+    p->acc_psd = 1.53872614756e-05;
+    p->Q_angle = 3.046174197867086e-07;
+    p->Q_bias = 9.138522593601257e-07;
+    p->R_measure = 9.138522593601256e-06;
+    p->R_loop_time = 0.033;
+    p->gate_low = 0.9;
+    p->gate_high = 1.1;
+    p->gyro_sampling = FC_PAPER_POSKF_GYRO_SAMPLING_MEAN;
+    p->max_dt = 1.0;
+    p->max_rate = 1000.0;
+    p->mount_roll = 0.0;
+    p->mount_pitch = 0.0;
+    p->mount_yaw = 0.0;
+    p->sensor_delay = 0.0;
+}
+
+/* ----- ImuSensorModel (fc_sensor) ------------------------------------------- */
 
 #define FC_SENSOR_GYRO_SAMPLING_POINT 0
 #define FC_SENSOR_GYRO_SAMPLING_MEAN 1
@@ -391,7 +552,7 @@ typedef struct fc_sensor_params {
     double jitter;                 /* [0.0, 1000000.0] [s] */
 } fc_sensor_params;
 
-/* The defaults: ImuSensorModel.PARAMS (for an estimator, the recommended preset). */
+/* The defaults: ImuSensorModel.PARAMS. */
 static inline void fc_sensor_params_default(fc_sensor_params *p)
 {
     p->seed = 0L;

@@ -1,11 +1,13 @@
-/* fc_poskf.h: the position Kalman filter with a zero-velocity update (fusion_core/position.py,
- * PositionKalmanFilter), the C twin. Safitri, Cahyadi, Firmansyah eq. 20-29, with the tilt from
- * the [angle, bias] Kalman filter (fc_kf) run on the same samples. */
+/* fc_poskf.h: the recommended position Kalman filter with a zero-velocity update
+ * (fusion_core/position.py, PositionKalmanFilter), the C twin. Safitri, Cahyadi, Firmansyah
+ * eq. 20-29 (fc_paper_poskf.h), its tilt stage the papers' Kalman filter (fc_paper_kf) at
+ * confirmed rest, its attitude outputs the recommended one's (fc_kf) on the same samples. */
 #ifndef FC_POSKF_H
 #define FC_POSKF_H
 
 #include "fc_core.h"
 #include "fc_kf.h"
+#include "fc_paper_kf.h"
 #include "fc_params.h"
 
 #define FC_POSKF_PENDING_MAX 2048  /* position.PENDING_MAX */
@@ -24,13 +26,12 @@ typedef struct fc_poskf {
     int pending_head, pending_count;
     double turned[2];
     double f_mean[3];
-    fc_kf tilt;       /* the tilt stage */
-    fc_kf att;        /* the attitude output (attitude="kf") */
+    fc_paper_kf tilt;  /* the tilt stage */
+    fc_kf att;         /* the attitude outputs */
     fc_estimate last;
     /* derived from params (PositionKalmanFilter._configure) */
     double acc_var_density, zupt_var, gyro_var_density;
     double Q[6], R, Q_dt;
-    int own_attitude, always;
 } fc_poskf;
 
 void fc_poskf_init(fc_poskf *f, const fc_poskf_params *params);

@@ -60,6 +60,8 @@ typedef struct fc_layout {
 
 /* Every layout, and one by the twin's prefix (NULL for an unknown one): fc_state_tables.c. */
 extern const fc_layout FC_CF_LAYOUT, FC_MGCF_LAYOUT, FC_KF_LAYOUT, FC_UKF_LAYOUT, FC_POSKF_LAYOUT,
+    FC_PAPER_CF_LAYOUT, FC_PAPER_MGCF_LAYOUT, FC_PAPER_KF_LAYOUT, FC_PAPER_UKF_LAYOUT,
+    FC_PAPER_POSKF_LAYOUT,
     FC_SENSOR_LAYOUT;
 const fc_layout *fc_state_layout(const char *twin);
 

@@ -11,10 +11,15 @@
 #include "fc_cf.h"
 #include "fc_kf.h"
 #include "fc_mgcf.h"
+#include "fc_paper_cf.h"
+#include "fc_paper_kf.h"
+#include "fc_paper_mgcf.h"
+#include "fc_paper_poskf.h"
+#include "fc_paper_ukf.h"
 #include "fc_poskf.h"
 #include "fc_sensor.h"
-#include "fc_state.h"
 #include "fc_ukf.h"
+#include "fc_state.h"
 
 static const fc_field CF_FIELDS[] = {
     {"base.initialized", offsetof(fc_cf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
@@ -33,6 +38,16 @@ static const fc_field CF_FIELDS[] = {
 };
 const fc_layout FC_CF_LAYOUT = {"fc_cf", CF_FIELDS, (int)(sizeof CF_FIELDS / sizeof CF_FIELDS[0])};
 
+static const fc_field PAPER_CF_FIELDS[] = {
+    {"base.initialized", offsetof(fc_paper_cf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"base.n_samples", offsetof(fc_paper_cf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.n_rejected", offsetof(fc_paper_cf, base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.gyro_prev", offsetof(fc_paper_cf, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"roll", offsetof(fc_paper_cf, roll), FC_DOUBLE, 1, FC_CHECK_ANGLE, 0.0},
+    {"pitch", offsetof(fc_paper_cf, pitch), FC_DOUBLE, 1, FC_CHECK_HALF_ANGLE, 0.0},
+};
+const fc_layout FC_PAPER_CF_LAYOUT = {"fc_paper_cf", PAPER_CF_FIELDS, (int)(sizeof PAPER_CF_FIELDS / sizeof PAPER_CF_FIELDS[0])};
+
 static const fc_field MGCF_FIELDS[] = {
     {"base.initialized", offsetof(fc_mgcf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"base.n_samples", offsetof(fc_mgcf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
@@ -48,6 +63,17 @@ static const fc_field MGCF_FIELDS[] = {
     {"rest[7]", offsetof(fc_mgcf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
 };
 const fc_layout FC_MGCF_LAYOUT = {"fc_mgcf", MGCF_FIELDS, (int)(sizeof MGCF_FIELDS / sizeof MGCF_FIELDS[0])};
+
+static const fc_field PAPER_MGCF_FIELDS[] = {
+    {"base.initialized", offsetof(fc_paper_mgcf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"base.n_samples", offsetof(fc_paper_mgcf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.n_rejected", offsetof(fc_paper_mgcf, base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.gyro_prev", offsetof(fc_paper_mgcf, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"q", offsetof(fc_paper_mgcf, q), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
+    {"bias", offsetof(fc_paper_mgcf, bias), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"w0_now", offsetof(fc_paper_mgcf, w0_now), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
+};
+const fc_layout FC_PAPER_MGCF_LAYOUT = {"fc_paper_mgcf", PAPER_MGCF_FIELDS, (int)(sizeof PAPER_MGCF_FIELDS / sizeof PAPER_MGCF_FIELDS[0])};
 
 static const fc_field KF_FIELDS[] = {
     {"base.initialized", offsetof(fc_kf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
@@ -72,6 +98,20 @@ static const fc_field KF_FIELDS[] = {
 };
 const fc_layout FC_KF_LAYOUT = {"fc_kf", KF_FIELDS, (int)(sizeof KF_FIELDS / sizeof KF_FIELDS[0])};
 
+static const fc_field PAPER_KF_FIELDS[] = {
+    {"base.initialized", offsetof(fc_paper_kf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"base.n_samples", offsetof(fc_paper_kf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.n_rejected", offsetof(fc_paper_kf, base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.gyro_prev", offsetof(fc_paper_kf, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"roll", offsetof(fc_paper_kf, roll), FC_DOUBLE, 1, FC_CHECK_ANGLE, 0.0},
+    {"pitch", offsetof(fc_paper_kf, pitch), FC_DOUBLE, 1, FC_CHECK_HALF_ANGLE, 0.0},
+    {"bias_x", offsetof(fc_paper_kf, bias_x), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
+    {"bias_y", offsetof(fc_paper_kf, bias_y), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
+    {"P_roll", offsetof(fc_paper_kf, P_roll), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
+    {"P_pitch", offsetof(fc_paper_kf, P_pitch), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
+};
+const fc_layout FC_PAPER_KF_LAYOUT = {"fc_paper_kf", PAPER_KF_FIELDS, (int)(sizeof PAPER_KF_FIELDS / sizeof PAPER_KF_FIELDS[0])};
+
 static const fc_field UKF_FIELDS[] = {
     {"base.initialized", offsetof(fc_ukf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"base.n_samples", offsetof(fc_ukf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
@@ -87,6 +127,38 @@ static const fc_field UKF_FIELDS[] = {
     {"rest[7]", offsetof(fc_ukf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
 };
 const fc_layout FC_UKF_LAYOUT = {"fc_ukf", UKF_FIELDS, (int)(sizeof UKF_FIELDS / sizeof UKF_FIELDS[0])};
+
+static const fc_field PAPER_UKF_FIELDS[] = {
+    {"base.initialized", offsetof(fc_paper_ukf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"base.n_samples", offsetof(fc_paper_ukf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.n_rejected", offsetof(fc_paper_ukf, base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.gyro_prev", offsetof(fc_paper_ukf, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"x[0:3]", offsetof(fc_paper_ukf, x[0]), FC_DOUBLE, 3, FC_CHECK_UNIT, 0.0},
+    {"x[3:6]", offsetof(fc_paper_ukf, x[3]), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"P", offsetof(fc_paper_ukf, P), FC_DOUBLE, 21, FC_CHECK_COV_LOWER, 0.0},
+};
+const fc_layout FC_PAPER_UKF_LAYOUT = {"fc_paper_ukf", PAPER_UKF_FIELDS, (int)(sizeof PAPER_UKF_FIELDS / sizeof PAPER_UKF_FIELDS[0])};
+
+static const fc_field PAPER_POSKF_FIELDS[] = {
+    {"base.initialized", offsetof(fc_paper_poskf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"base.n_samples", offsetof(fc_paper_poskf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.n_rejected", offsetof(fc_paper_poskf, base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.gyro_prev", offsetof(fc_paper_poskf, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"yaw", offsetof(fc_paper_poskf, yaw), FC_DOUBLE, 1, FC_CHECK_ANGLE, 0.0},
+    {"x", offsetof(fc_paper_poskf, x), FC_DOUBLE, 9, FC_CHECK_REAL, 0.0},
+    {"P", offsetof(fc_paper_poskf, P), FC_DOUBLE, 6, FC_CHECK_COV_UPPER, 0.0},
+    {"tilt.base.initialized", offsetof(fc_paper_poskf, tilt.base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"tilt.base.n_samples", offsetof(fc_paper_poskf, tilt.base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"tilt.base.n_rejected", offsetof(fc_paper_poskf, tilt.base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"tilt.base.gyro_prev", offsetof(fc_paper_poskf, tilt.base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"tilt.roll", offsetof(fc_paper_poskf, tilt.roll), FC_DOUBLE, 1, FC_CHECK_ANGLE, 0.0},
+    {"tilt.pitch", offsetof(fc_paper_poskf, tilt.pitch), FC_DOUBLE, 1, FC_CHECK_HALF_ANGLE, 0.0},
+    {"tilt.bias_x", offsetof(fc_paper_poskf, tilt.bias_x), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
+    {"tilt.bias_y", offsetof(fc_paper_poskf, tilt.bias_y), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
+    {"tilt.P_roll", offsetof(fc_paper_poskf, tilt.P_roll), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
+    {"tilt.P_pitch", offsetof(fc_paper_poskf, tilt.P_pitch), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
+};
+const fc_layout FC_PAPER_POSKF_LAYOUT = {"fc_paper_poskf", PAPER_POSKF_FIELDS, (int)(sizeof PAPER_POSKF_FIELDS / sizeof PAPER_POSKF_FIELDS[0])};
 
 static const fc_field POSKF_FIELDS[] = {
     {"base.initialized", offsetof(fc_poskf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
@@ -113,15 +185,6 @@ static const fc_field POSKF_FIELDS[] = {
     {"tilt.bias_y", offsetof(fc_poskf, tilt.bias_y), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
     {"tilt.P_roll", offsetof(fc_poskf, tilt.P_roll), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
     {"tilt.P_pitch", offsetof(fc_poskf, tilt.P_pitch), FC_DOUBLE, 4, FC_CHECK_COV, 0.0},
-    {"tilt.bias_z", offsetof(fc_poskf, tilt.bias_z), FC_DOUBLE, 1, FC_CHECK_REAL, 0.0},
-    {"tilt.P_z", offsetof(fc_poskf, tilt.P_z), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"tilt.meas[0:18]", offsetof(fc_poskf, tilt.meas[0]), FC_DOUBLE, 18, FC_CHECK_REAL, 0.0},
-    {"tilt.meas[18:22]", offsetof(fc_poskf, tilt.meas[18]), FC_DOUBLE, 4, FC_CHECK_NONNEG, 0.0},
-    {"tilt.rest[0:6]", offsetof(fc_poskf, tilt.rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
-    {"tilt.rest[6]", offsetof(fc_poskf, tilt.rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
-    {"tilt.rest[7]", offsetof(fc_poskf, tilt.rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"tilt.q_att", offsetof(fc_poskf, tilt.q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
-    {"tilt.face", offsetof(fc_poskf, tilt.face), FC_INT, 1, FC_CHECK_INDEX, 6.0},
     {"att.base.initialized", offsetof(fc_poskf, att.base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"att.base.n_samples", offsetof(fc_poskf, att.base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
     {"att.base.n_rejected", offsetof(fc_poskf, att.base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
@@ -166,7 +229,7 @@ const fc_layout FC_SENSOR_LAYOUT = {"fc_sensor", SENSOR_FIELDS, (int)(sizeof SEN
 
 const fc_layout *fc_state_layout(const char *twin)
 {
-    const fc_layout *all[] = {&FC_CF_LAYOUT, &FC_MGCF_LAYOUT, &FC_KF_LAYOUT, &FC_UKF_LAYOUT, &FC_POSKF_LAYOUT, &FC_SENSOR_LAYOUT};
+    const fc_layout *all[] = {&FC_CF_LAYOUT, &FC_PAPER_CF_LAYOUT, &FC_MGCF_LAYOUT, &FC_PAPER_MGCF_LAYOUT, &FC_KF_LAYOUT, &FC_PAPER_KF_LAYOUT, &FC_UKF_LAYOUT, &FC_PAPER_UKF_LAYOUT, &FC_PAPER_POSKF_LAYOUT, &FC_POSKF_LAYOUT, &FC_SENSOR_LAYOUT};
     size_t i;
     for (i = 0; twin && i < sizeof all / sizeof all[0]; i++) {
         if (strcmp(all[i]->twin, twin) == 0) {

@@ -1,12 +1,15 @@
-/* fc_ukf.h: the unscented Kalman filter on the gravity direction with three gyro-bias states
- * (fusion_core/ukf.py, UnscentedKalmanFilter), the C twin. Duong Quoc et al. eq. 14-17; scaled
- * sigma points after Wan & van der Merwe (2000); the identities that spare the matrices are
- * derived in the Python module's docstring. */
+/* fc_ukf.h: the recommended unscented Kalman filter on the gravity direction with three
+ * gyro-bias states (fusion_core/ukf.py, UnscentedKalmanFilter), the C twin. Duong Quoc et al.
+ * eq. 14-17 (fc_paper_ukf.h) with the mechanisms for real sensors of the Python class's
+ * docstring. */
 #ifndef FC_UKF_H
 #define FC_UKF_H
 
 #include "fc_core.h"
 #include "fc_params.h"
+
+/* ukf.ACC_GATE: no update while ||f|/g - 1| is at or above it */
+#define FC_UKF_ACC_GATE 1.0
 
 typedef struct fc_ukf {
     fc_ukf_params params;
@@ -18,12 +21,12 @@ typedef struct fc_ukf {
     double rest[8];
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
-    double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
+    double gamma, w, w_mu, q_gyro, q_bias, r_acc;
     double q_rotation, dist_tau;  /* UnscentedKalmanFilter._adaptive */
     fc_meas_constants measure;  /* UnscentedKalmanFilter._measure */
     double longest2, rail_var;
     double bias_lo2, bias_hi2, cos_innovation;
-    int trapezoid, options;
+    int trapezoid;
 } fc_ukf;
 
 void fc_ukf_init(fc_ukf *f, const fc_ukf_params *params);

@@ -20,8 +20,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from fusion_core.base import Estimator
 from fusion_core.position import PENDING_MAX
-from fusion_core.registry import ATTITUDE_FILTERS, ESTIMATORS
+from fusion_core.registry import CLASSES
 from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
 from fusion_core.state import (
     BASE_STATE,
@@ -43,10 +44,11 @@ SCENARIOS_OUTPUT = HERE / "fc_scenarios.h"
 STATE_OUTPUT = HERE / "fc_state_tables.c"
 KINDS = ("constant", "sine", "add", "min_jerk", "product", "swelling_sine")
 """The signal kinds of fusion_core.synthetic (and scenarios.swelling_sine), by their C number."""
-PREFIX = {**{key: cls.TWIN for key, cls in ESTIMATORS.items() if cls.TWIN is not None},
-          "sensor": "fc_sensor"}
-"""The C name of each estimator (fusion_core.ESTIMATORS key -> its class's TWIN) and of the
-sensor model."""
+TWINS: dict[str, type[Estimator]] = {cls.TWIN: cls for cls in CLASSES if cls.TWIN is not None}
+"""Every estimator class by its twin's prefix (fusion_core.registry.CLASSES: the references
+first where a recommended filter is built on them)."""
+PREFIX = [*TWINS, "fc_sensor"]
+"""The C name of each estimator class's twin and of the sensor model."""
 
 
 def c_double(x: float) -> str:
@@ -86,13 +88,13 @@ def comment(p: Param) -> str:
     return f"{p.allowed()}{unit}"
 
 
-def estimator_block(key: str) -> list[str]:
-    if key == "sensor":
+def estimator_block(prefix: str) -> list[str]:
+    if prefix == "fc_sensor":
         name, specs = ImuSensorModel.__name__, list(SENSOR_PARAMS)
     else:
-        name, specs = ESTIMATORS[key].__name__, list(ESTIMATORS[key].param_specs().values())
-    prefix = PREFIX[key]
-    out = [f"/* ----- {name} ({key}) " + "-" * (80 - len(name) - len(key) - 14) + " */", ""]
+        cls = TWINS[prefix]
+        name, specs = cls.__name__, list(cls.param_specs().values())
+    out = [f"/* ----- {name} ({prefix}) " + "-" * (80 - len(name) - len(prefix) - 14) + " */", ""]
     for p in specs:
         if p.choices is not None:
             for i, choice in enumerate(p.choices):
@@ -106,7 +108,7 @@ def estimator_block(key: str) -> list[str]:
         out.append(f"{decl:<{width}}  /* {comment(p)} */")
     out.append(f"}} {prefix}_params;")
     out.append("")
-    out.append(f"/* The defaults: {name}.PARAMS (for an estimator, the recommended preset). */")
+    out.append(f"/* The defaults: {name}.PARAMS. */")
     out.append(f"static inline void {prefix}_params_default({prefix}_params *p)")
     out.append("{")
     for p in specs:
@@ -131,8 +133,8 @@ def render() -> str:
         "#include <math.h>",
         "",
     ]
-    for key in PREFIX:
-        lines += estimator_block(key)
+    for prefix in PREFIX:
+        lines += estimator_block(prefix)
     lines += ["#endif /* FC_PARAMS_H */", ""]
     return "\n".join(lines)
 
@@ -209,8 +211,9 @@ Entry = tuple[str, str, Check, int | None]
 """One field of a C layout: its name, its member path in the twin's struct, its check, and its
 number of values (None: the member's whole size)."""
 
-C_CHECKS: dict[tuple[str, str], Check] = {("fc_ukf", "P"): COV_LOWER}
-"""Where the C twin stores a state field in another form than the Python class: the UKF's P is
+C_CHECKS: dict[tuple[str, str], Check] = {("fc_ukf", "P"): COV_LOWER,
+                                          ("fc_paper_ukf", "P"): COV_LOWER}
+"""Where the C twin stores a state field in another form than the Python class: the UKFs' P is
 its packed lower triangle (UnscentedKalmanFilter._P), the Python state its 6x6 matrix."""
 
 
@@ -235,23 +238,35 @@ def _base_entries(prefix: str = "") -> list[Entry]:
 
 
 def state_layouts() -> dict[str, list[Entry]]:
-    """Every twin's state layout: the base state, then the class's STATE (the position filter's
-    and the sensor's, whose C twins hold theirs in other forms, written out here)."""
+    """Every twin's state layout: the base state, then the class's STATE (a position filter's,
+    whose twin holds its nested filters and its queue in C form, and the sensor's, written out
+    here)."""
     layouts: dict[str, list[Entry]] = {}
-    for key in ATTITUDE_FILTERS:
-        prefix = PREFIX[key]
-        entries = _base_entries() + _entries(ESTIMATORS[key].STATE)
+    for prefix, cls in TWINS.items():
+        if cls.HAS_POSITION:
+            continue
+        entries = _base_entries() + _entries(cls.STATE)
         layouts[prefix] = [(n, path, C_CHECKS.get((prefix, path), check), size)
                            for n, path, check, size in entries]
-    kf = layouts["fc_kf"]
+
+    def nested(name: str, twin: str) -> list[Entry]:
+        return [(f"{name}.{n}", f"{name}.{path}", check, size)
+                for n, path, check, size in layouts[twin]]
+
+    axes = {"x": REAL, "P": COV_UPPER}
+    layouts["fc_paper_poskf"] = [
+        *_base_entries(),
+        *_entries({"yaw": TWINS["fc_paper_poskf"].STATE["yaw"], **axes}),
+        *nested("tilt", "fc_paper_kf"),
+    ]
     layouts["fc_poskf"] = [
         *_base_entries(),
-        *_entries({"yaw": ESTIMATORS["poskf"].STATE["yaw"], "x": REAL, "P": COV_UPPER,
+        *_entries({"yaw": TWINS["fc_poskf"].STATE["yaw"], **axes,
                    "quiet_time": NONNEG, "stationary": FLAG, "pending": REAL,
                    "pending_head": index(PENDING_MAX), "pending_count": count(PENDING_MAX),
                    "turned": REAL, "f_mean": REAL}),
-        *[(f"{nested}.{n}", f"{nested}.{path}", check, size)
-          for nested in ("tilt", "att") for n, path, check, size in kf],
+        *nested("tilt", "fc_paper_kf"),
+        *nested("att", "fc_kf"),
     ]
     sensor = dict(ImuSensorModel.STATE)
     del sensor["omega_prev"]  # None in Python before the first sample: has_omega_prev in C
@@ -303,13 +318,8 @@ def render_state_tables() -> str:
         "#include <stddef.h>",
         "#include <string.h>",
         "",
-        '#include "fc_cf.h"',
-        '#include "fc_kf.h"',
-        '#include "fc_mgcf.h"',
-        '#include "fc_poskf.h"',
-        '#include "fc_sensor.h"',
+        *(f'#include "{prefix}.h"' for prefix in sorted(PREFIX)),
         '#include "fc_state.h"',
-        '#include "fc_ukf.h"',
         "",
     ]
     for prefix, entries in state_layouts().items():
@@ -353,8 +363,10 @@ def main(argv: list[str] | None = None) -> int:
                         help="exit 1 (and say so) if a generated header is not what the Python "
                         "sources give")
     args = parser.parse_args(argv)
-    files = {OUTPUT: render(), SCENARIOS_OUTPUT: render_scenarios(),
-             STATE_OUTPUT: render_state_tables()}
+    files = {OUTPUT: render(), SCENARIOS_OUTPUT: render_scenarios()}
+    if not args.check and OUTPUT.read_text() != files[OUTPUT]:
+        OUTPUT.write_text(files[OUTPUT])  # the state tables read the parameter structs from it
+    files[STATE_OUTPUT] = render_state_tables()
     if args.check:
         stale = [p for p, text in files.items()
                  if not p.is_file() or p.read_text() != text]

@@ -14,12 +14,14 @@ from typing import Any
 
 HERE = Path(__file__).resolve().parent
 SOURCES = (
-    "fc_core.c", "fc_noise.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c", "fc_poskf.c",
-    "fc_sensor.c", "fc_plant.c", "fc_state.c", "fc_state_tables.c",
+    "fc_core.c", "fc_noise.c", "fc_paper_cf.c", "fc_paper_mgcf.c", "fc_paper_kf.c",
+    "fc_paper_ukf.c", "fc_paper_poskf.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c",
+    "fc_poskf.c", "fc_sensor.c", "fc_plant.c", "fc_state.c", "fc_state_tables.c",
 )
 """The C sources, in link order."""
 HEADERS = (
-    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_state.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h",
+    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_state.h", "fc_paper_cf.h", "fc_paper_mgcf.h",
+    "fc_paper_kf.h", "fc_paper_ukf.h", "fc_paper_poskf.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h",
     "fc_ukf.h", "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
 )
 """The headers, in the order the binding declares them."""

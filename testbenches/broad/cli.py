@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from fusion_core.registry import keys_help
 
 from ..fmus import DEFAULT_FMU_DIR
-from ..options import choose, positive_float
+from ..options import add_preset, choose, positive_float
 
 if TYPE_CHECKING:
     from .cv import CvResult
@@ -37,10 +37,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="BROAD trial files (.hdf5, .mat) or folders of them")
     p.add_argument("--estimator", default="all",
                    help=f"all or a comma list of {keys_help()} (all)")
-    p.add_argument("--preset", default="recommended",
-                   help="recommended (the defaults, for real MEMS sensors), paper (the seed "
-                   "papers' values), a JSON file of parameters per estimator, all (both named "
-                   "ones), or a comma list (recommended)")
+    add_preset(p, more=", all (both named ones), or a comma list of them")
     p.add_argument("--peers", action="store_true",
                    help="also run VQF (6D), Madgwick and Mahony (ahrs) on the same trials, and VQF "
                    "with its output turned ahead over the sensor's delay as ours (vqf-ahead)")

@@ -32,8 +32,9 @@ import numpy as np
 
 from fusion_core import ESTIMATORS
 from fusion_core.presets import load_preset
+from fusion_core.registry import create
 
-from ..fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, FmuHandle, fmu_path
+from ..fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, FmuHandle, estimator_parameters, fmu_path
 from ..peers import AHEAD_PEERS, PEERS
 from .data import (
     GROUP_ORDER,
@@ -164,7 +165,7 @@ def run_fusion_core(key: str, params: dict[str, Any], trial: BroadTrial) -> dict
     """roll, pitch [N] (and rejected) of fusion_core's estimator on the trial (integrating the
     gyro by the trial's sampling property and turning its outputs ahead over the sensor's delay
     unless params say otherwise)."""
-    return ESTIMATORS[key](**with_sensor(params, trial)).run(trial.acc, trial.gyro, trial.dt)
+    return create(key, with_sensor(params, trial)).run(trial.acc, trial.gyro, trial.dt)
 
 
 def run_fmu(
@@ -179,7 +180,7 @@ def run_fmu(
     out = np.empty((n, 2))
     rejected = np.zeros(n, dtype=bool)
     try:
-        fmu.start(params, n * h)
+        fmu.start(estimator_parameters(fmu, key, params), n * h)
         in_vr = fmu.vrs(SAMPLE_IN)
         out_vr = fmu.vrs(("roll", "pitch"))
         (bad_vr,) = fmu.vrs(("invalid_samples",))

@@ -8,8 +8,9 @@ import sys
 from pathlib import Path
 
 from fusion_core import ESTIMATORS
+from fusion_core.registry import estimator_class
 
-from ..options import non_negative_float, positive_float, positive_int
+from ..options import add_preset, non_negative_float, positive_float, positive_int
 
 
 def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
@@ -38,9 +39,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
                       "(q_w, q_x, q_y, q_z or roll, pitch [rad])")
     tune.add_argument("--validate", type=Path, nargs="*", default=[],
                       help="recordings that check the fit (not fitted)")
-    tune.add_argument("--start", default="recommended",
-                      help="where the fit starts: recommended (default), paper, or a preset "
-                      "JSON file")
+    add_preset(tune, "--start", more=": where the fit starts")
     tune.add_argument("--params", default=None,
                       help="comma list of the parameters to fit, or all (every tunable one); "
                       "default: those the recommended preset took from a scan (cf tau, mgcf "
@@ -114,7 +113,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
               f"{result.validation_rmse_deg:.4f} deg over {len(val_recs)} recording(s)")
     if result.fmu_fit_rmse_deg is not None:
         print(f"  through the FMU: fit {result.fmu_fit_rmse_deg:.4f} deg")
-    specs = ESTIMATORS[args.estimator].param_specs()
+    specs = estimator_class(args.estimator, start).param_specs()
     for d in result.dimensions:
         before = result.start.get(d.name, specs[d.name].default)
         print(f"  {d.name}: {before:.6g} -> {result.fitted.get(d.name, before):.6g}")

@@ -29,6 +29,8 @@ from typing import Any
 import numpy as np
 
 from fusion_core import ESTIMATORS
+from fusion_core.base import Estimator
+from fusion_core.registry import create, estimator_class
 from fusion_core.types import Param
 
 from ..broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
@@ -78,17 +80,20 @@ class Dimension:
         return (self.to_search(self.low), self.to_search(self.high))
 
 
-def tunable(key: str, names: Sequence[str] | None = None) -> list[Param]:
-    """The parameters to fit: the named ones (["all"]: every tunable float parameter of the
-    estimator's PARAMS, not the sample rules or the mounting), by default SCANNED[key];
-    ValueError naming an unknown or untunable one."""
-    specs = ESTIMATORS[key].param_specs()
-    allowed = [p for p in ESTIMATORS[key].PARAMS
+def tunable(key: str, names: Sequence[str] | None = None,
+            cls: type[Estimator] | None = None) -> list[Param]:
+    """The parameters to fit of estimator key's class cls (the recommended one unless given):
+    the named ones (["all"]: every tunable float parameter of the class's PARAMS, not the sample
+    rules or the mounting), by default SCANNED[key] (for a paper's filter: all); ValueError
+    naming an unknown or untunable one."""
+    cls = cls or ESTIMATORS[key]
+    specs = cls.param_specs()
+    allowed = [p for p in cls.PARAMS
                if p.tunable and isinstance(p.default, float) and p.choices is None]
     if names is not None and list(names) == ["all"]:
         return allowed
     if not names:
-        names = SCANNED[key]
+        names = SCANNED[key] if cls is ESTIMATORS[key] else [p.name for p in allowed]
     out = []
     for name in names:
         if name not in specs:
@@ -129,7 +134,7 @@ def score(key: str, params: dict[str, Any], rec: Recording) -> float:
     if rec.up_ref is None:
         raise RecordingError(f"{rec.name}: no reference (q_w, q_x, q_y, q_z or roll, pitch "
                              "columns, or a BROAD trial): tune cannot score it")
-    est = ESTIMATORS[key](**{**rec.sensor, **params})
+    est = create(key, {**rec.sensor, **params})
     out = est.run(rec.acc, rec.gyro, rec.dt)
     g = gravity_from_roll_pitch(out["roll"], out["pitch"])
     return inclination_rmse_deg(g, rec.up_ref, rec.counted)
@@ -181,8 +186,9 @@ def tune(key: str, fit_recs: Sequence[Recording], validate_recs: Sequence[Record
         raise ValueError("tune needs at least one recording with a reference to fit")
     t0 = time.perf_counter()
     start = dict(start or {})
-    defaults = ESTIMATORS[key].param_specs()
-    params = tunable(key, names)
+    cls = estimator_class(key, start)
+    defaults = cls.param_specs()
+    params = tunable(key, names, cls)
     dims = [dimension(p, float(start.get(p.name, defaults[p.name].default))) for p in params]
     x0 = np.array([d.to_search(float(start.get(d.name, defaults[d.name].default)))
                    for d in dims])
@@ -230,14 +236,15 @@ def fmu_score(key: str, params: dict[str, Any], recs: Sequence[Recording],
               fmu_dir: Path | str) -> float:
     """The mean inclination RMSE of the estimator's FMU with params (testbenches' FmuHandle,
     one sample per doStep): the fitted preset confirmed through the FMU."""
-    from ..fmus import ESTIMATOR_FMUS, FmuHandle, fmu_path
+    from ..fmus import ESTIMATOR_FMUS, FmuHandle, estimator_parameters, fmu_path
 
     scores = []
     for rec in recs:
         fmu = FmuHandle(fmu_path(ESTIMATOR_FMUS[key], fmu_dir), f"tune-{key}-{rec.name}")
         out = np.empty((len(rec.dt), 2))
         try:
-            fmu.start({**rec.sensor, **params}, float(np.sum(rec.dt)))
+            fmu.start(estimator_parameters(fmu, key, {**rec.sensor, **params}),
+                      float(np.sum(rec.dt)))
             in_vr = fmu.vrs(("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt"))
             out_vr = fmu.vrs(("roll", "pitch"))
             t = 0.0

@@ -10,7 +10,7 @@ from pathlib import Path
 from fusion_core.scenarios import SCENARIOS
 
 from ..fmus import ESTIMATOR_FMUS
-from ..options import non_negative_int, positive_float, positive_int
+from ..options import add_preset, add_sensor, non_negative_int, positive_float, positive_int
 from .plan import DESIGNS
 
 
@@ -31,10 +31,8 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--design", choices=DESIGNS, default="lhs",
                    help="the space-filling design of the variations (lhs)")
     p.add_argument("--campaign-seed", type=int, default=0, help="seed of the design (0)")
-    p.add_argument("--sensor", default="realistic",
-                   help="ImuSensor parameters: realistic, ideal or a JSON file")
-    p.add_argument("--preset", default="recommended",
-                   help="estimator parameters: recommended, paper or a JSON file")
+    add_sensor(p)
+    add_preset(p)
     p.add_argument("--scheduler", default="local",
                    help="local (a LocalCluster, the default) or the address HOST:PORT of your "
                    "own Dask scheduler")

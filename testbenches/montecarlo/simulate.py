@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from fusion_core import ESTIMATORS
+from fusion_core.registry import create
 from fusion_core.scenarios import get_scenario
 from fusion_core.sensor import ImuSensorModel
 from fusion_core.synthetic import TRUTH_NAMES
@@ -82,7 +82,7 @@ def simulate(run: Run) -> TestbenchResult:
     t, truth, sample = scenario_samples(sc.name, run.seed, run.sensor, run.duration)
     sensor_params = {**run.sensor, "seed": run.seed}
     params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **run.params}
-    est = ESTIMATORS[run.estimator](**params)
+    est = create(run.estimator, params)
     out = est.run(sample["acc"], sample["gyro"], sample["dt"])
     # the master's names, as views of the runs' own arrays (nothing is copied)
     estimate = dict(zip(ESTIMATE, (out["roll"], out["pitch"], *out["bias"].T), strict=True))

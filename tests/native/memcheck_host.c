@@ -1,13 +1,18 @@
 /* A C host of the twins for memory checkers (tests/test_native.py runs it under valgrind):
- * each twin with its defaults and with the papers' Euler propagation, over a recording of
- * motion, rest, a near-zero accelerometer stretch, NaN, inf, huge values and bad dt, step by step
- * and in one batch. Exit status 0 when every output is finite. */
+ * each twin, recommended and the papers', with its defaults and with other options, over a
+ * recording of motion, rest, a near-zero accelerometer stretch, NaN, inf, huge values and bad
+ * dt, step by step and in one batch. Exit status 0 when every output is finite. */
 #include <math.h>
 #include <stdio.h>
 
 #include "fc_cf.h"
 #include "fc_kf.h"
 #include "fc_mgcf.h"
+#include "fc_paper_cf.h"
+#include "fc_paper_kf.h"
+#include "fc_paper_mgcf.h"
+#include "fc_paper_poskf.h"
+#include "fc_paper_ukf.h"
 #include "fc_plant.h"
 #include "fc_poskf.h"
 #include "fc_sensor.h"
@@ -63,81 +68,40 @@ int main(void)
         sample(i, acc_all[i], gyro_all[i], &dt_all[i]);
     }
     for (int variant = 0; variant < 2; variant++) {
-        fc_cf cf;
-        fc_kf kf;
-        fc_mgcf mgcf;
-        fc_mgcf_params mp;
-        fc_mgcf_params_default(&mp);
-        if (variant) {
-            mp.schedule = FC_MGCF_SCHEDULE_SIMULATION;
-            mp.gyro_sampling = FC_MGCF_GYRO_SAMPLING_MEAN;
-        }
-        fc_mgcf_init(&mgcf, &mp);
-        fc_ukf ukf;
-        fc_ukf_params up;
-        fc_ukf_params_default(&up);
-        if (variant) {
-            up.alpha = 0.3;
-            up.beta = 0.0;  /* a negative central weight: the general solve */
-        }
-        fc_ukf_init(&ukf, &up);
-        static fc_poskf poskf;  /* 160 kB with its queue: not on the stack */
-        fc_poskf_params pp;
-        fc_poskf_params_default(&pp);
-        if (variant) {
-            pp.tilt_update = FC_POSKF_TILT_UPDATE_ALWAYS;
-            pp.attitude = FC_POSKF_ATTITUDE_TILT_STAGE;
-        }
-        fc_poskf_init(&poskf, &pp);
-        fc_cf_params cp;
-        fc_kf_params kp;
-        fc_cf_params_default(&cp);
-        fc_kf_params_default(&kp);
-        if (variant) {
-            cp.propagation = FC_CF_PROPAGATION_EULER;
-            kp.propagation = FC_KF_PROPAGATION_EULER;
-            kp.tilt_axes = FC_KF_TILT_AXES_BODY;
-        }
-        fc_cf_init(&cf, &cp);
-        fc_kf_init(&kf, &kp);
-        for (int i = 0; i < N; i++) {
-            fc_estimate e;
-            fc_cf_step(&cf, acc_all[i], gyro_all[i], dt_all[i], &e);
-            bad += !finite_estimate(&e);
-            fc_kf_step(&kf, acc_all[i], gyro_all[i], dt_all[i], &e);
-            bad += !finite_estimate(&e);
-            fc_mgcf_step(&mgcf, acc_all[i], gyro_all[i], dt_all[i], &e);
-            bad += !finite_estimate(&e);
-            fc_ukf_step(&ukf, acc_all[i], gyro_all[i], dt_all[i], &e);
-            bad += !finite_estimate(&e);
-            fc_poskf_step(&poskf, acc_all[i], gyro_all[i], dt_all[i], &e);
-            bad += !finite_estimate(&e);
-        }
-        fc_cf_reset(&cf);
-        fc_kf_reset(&kf);
-        fc_cf_run(&cf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
-        for (int i = 0; i < N; i++) {
-            bad += !finite_estimate(&out[i]);
-        }
-        fc_kf_run(&kf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
-        for (int i = 0; i < N; i++) {
-            bad += !finite_estimate(&out[i]);
-        }
-        fc_mgcf_reset(&mgcf);
-        fc_mgcf_run(&mgcf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
-        for (int i = 0; i < N; i++) {
-            bad += !finite_estimate(&out[i]);
-        }
-        fc_ukf_reset(&ukf);
-        fc_ukf_run(&ukf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
-        for (int i = 0; i < N; i++) {
-            bad += !finite_estimate(&out[i]);
-        }
-        fc_poskf_reset(&poskf);
-        fc_poskf_run(&poskf, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);
-        for (int i = 0; i < N; i++) {
-            bad += !finite_estimate(&out[i]);
-        }
+        /* each twin step by step, then reset and in one batch (T_run); SETUP changes the
+         * parameters of the second variant */
+#define CHECK_TWIN(T, SETUP)                                                              \
+        do {                                                                              \
+            static T f;  /* a position filter's queue is large: not on the stack */      \
+            T##_params p;                                                                 \
+            T##_params_default(&p);                                                       \
+            if (variant) {                                                                \
+                SETUP;                                                                    \
+            }                                                                             \
+            T##_init(&f, &p);                                                             \
+            for (int i = 0; i < N; i++) {                                                 \
+                fc_estimate e;                                                            \
+                T##_step(&f, acc_all[i], gyro_all[i], dt_all[i], &e);                     \
+                bad += !finite_estimate(&e);                                              \
+            }                                                                             \
+            T##_reset(&f);                                                                \
+            T##_run(&f, N, &acc_all[0][0], &gyro_all[0][0], dt_all, out, rejected);       \
+            for (int i = 0; i < N; i++) {                                                 \
+                bad += !finite_estimate(&out[i]);                                         \
+            }                                                                             \
+        } while (0)
+        CHECK_TWIN(fc_cf, p.gyro_sampling = FC_CF_GYRO_SAMPLING_MEAN);
+        CHECK_TWIN(fc_kf, p.acc_lowpass = 0.0);
+        CHECK_TWIN(fc_mgcf, p.gyro_sampling = FC_MGCF_GYRO_SAMPLING_MEAN);
+        /* a negative central weight: the general solve */
+        CHECK_TWIN(fc_ukf, (p.alpha = 0.3, p.beta = 0.0));
+        CHECK_TWIN(fc_poskf, p.zupt_window = 0.0);
+        CHECK_TWIN(fc_paper_cf, p.gyro_sampling = FC_PAPER_CF_GYRO_SAMPLING_POINT);
+        CHECK_TWIN(fc_paper_kf, p.R_loop_time = 0.0);
+        CHECK_TWIN(fc_paper_mgcf, p.schedule = FC_PAPER_MGCF_SCHEDULE_FIXED);
+        CHECK_TWIN(fc_paper_ukf, (p.alpha = 0.3, p.beta = 0.0, p.norm_noise = 0.0));
+        CHECK_TWIN(fc_paper_poskf, p.qr_form = FC_PAPER_POSKF_QR_FORM_PIECEWISE_JERK);
+#undef CHECK_TWIN
     }
     /* the sensor model: every parameter set's samples finite, saturated and quantised */
     static double s_acc[N][3], s_gyro[N][3], s_dt[N], s_bias[N][3];

@@ -1,0 +1,184 @@
+/* fc_paper_kf.c: see fc_paper_kf.h; the twin of fusion_core/papers/kalman.py line by line. */
+#include "fc_paper_kf.h"
+
+#include <string.h>
+
+/* predict_covariance: F P F' + Q (Das & Mary eq. 19-22) */
+void fc_paper_kf_predict_covariance(const double P[4], double dt, double q_angle, double q_bias,
+                                    double out[4])
+{
+    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    out[0] = P00 + dt * (dt * P11 - P01 - P10 + q_angle);
+    out[1] = P01 - dt * P11;
+    out[2] = P10 - dt * P11;
+    out[3] = P11 + q_bias * dt;
+}
+
+/* measurement_gain (Das & Mary eq. 23-27), with the papers' temporaries */
+void fc_paper_kf_measurement_gain(const double P[4], double r, double K[2], double out[4])
+{
+    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    double S = P00 + r;
+    double K0 = P00 / S, K1 = P10 / S;
+    K[0] = K0;
+    K[1] = K1;
+    out[0] = P00 - K0 * P00;
+    out[1] = P01 - K0 * P01;
+    out[2] = P10 - K1 * P00;
+    out[3] = P11 - K1 * P01;
+}
+
+/* bias_update: a direct bias measurement, H = [0, 1] */
+void fc_paper_kf_bias_update(double *angle, double *bias, double P[4], double y, double r)
+{
+    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    double S = P11 + r;
+    double K0 = P01 / S, K1 = P11 / S;
+    *angle = *angle + K0 * y;
+    *bias = *bias + K1 * y;
+    P[0] = P00 - K0 * P10;
+    P[1] = P01 - K0 * P11;
+    P[2] = P10 - K1 * P10;
+    P[3] = P11 - K1 * P11;
+}
+
+static int same4(const double a[4], const double b[4])
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] && a[3] == b[3];
+}
+
+void fc_paper_kf_configure(fc_paper_kf *f)
+{
+    const fc_paper_kf_params *p = &f->params;
+    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
+                      p->mount_yaw, p->sensor_delay, HUGE_VAL);
+    f->q_angle = p->Q_angle;
+    f->q_bias = p->Q_bias;
+    f->r = p->R_measure;
+    f->r_loop = f->r * p->R_loop_time;
+    f->r_step = f->r;
+    fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
+    f->trapezoid = p->gyro_sampling == FC_PAPER_KF_GYRO_SAMPLING_POINT;
+}
+
+fc_estimate fc_paper_kf_estimate(const fc_paper_kf *f)  /* _estimate */
+{
+    fc_estimate e;
+    memset(&e, 0, sizeof e);
+    e.roll = f->roll;
+    e.pitch = f->pitch;
+    e.bias[0] = f->bias_x;
+    e.bias[1] = f->bias_y;
+    return e;
+}
+
+void fc_paper_kf_reset(fc_paper_kf *f)
+{
+    fc_base_reset(&f->base);
+    f->roll = f->pitch = f->bias_x = f->bias_y = 0.0;
+    memset(f->P_roll, 0, sizeof f->P_roll);
+    memset(f->P_pitch, 0, sizeof f->P_pitch);
+    f->r_step = f->r;
+    f->gain_roll[0] = f->gain_roll[1] = f->gain_pitch[0] = f->gain_pitch[1] = 0.0;
+    f->last = fc_paper_kf_estimate(f);
+}
+
+FC_DEFINE_INIT(fc_paper_kf)
+FC_DEFINE_RESTORED(fc_paper_kf)
+
+static void first_sample(fc_paper_kf *f, const double a[3], const double g[3])  /* _init */
+{
+    (void)g;
+    fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
+}
+
+/* propagate: the angles by the Euler rates, P by the papers' F and Q */
+void fc_paper_kf_propagate(fc_paper_kf *f, const double prev[3], const double g[3], double dt)
+{
+    double bx = f->bias_x, by = f->bias_y, roll, pitch;
+    if (f->trapezoid) {
+        fc_heun_euler_step(f->roll, f->pitch, prev[0] - bx, prev[1] - by, prev[2], g[0] - bx,
+                           g[1] - by, g[2], dt, &roll, &pitch);
+    } else {
+        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2], dt, &roll, &pitch);
+    }
+    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+    if (f->r_loop > 0.0) {
+        f->r_step = f->r_loop / dt;
+    }
+    double P[4];
+    memcpy(P, f->P_roll, sizeof P);
+    fc_paper_kf_predict_covariance(P, dt, f->q_angle, f->q_bias, f->P_roll);
+    if (same4(f->P_pitch, P)) {
+        memcpy(f->P_pitch, f->P_roll, sizeof P);
+    } else {
+        double Pp[4];
+        memcpy(Pp, f->P_pitch, sizeof Pp);
+        fc_paper_kf_predict_covariance(Pp, dt, f->q_angle, f->q_bias, f->P_pitch);
+    }
+}
+
+int fc_paper_kf_accel_trusted(const fc_paper_kf *f, double norm2)
+{
+    return f->gate_low2 <= norm2 && norm2 <= f->gate_high2;
+}
+
+/* correct: the accelerometer's roll and pitch (eq. 23-26) */
+void fc_paper_kf_correct(fc_paper_kf *f, double ax, double ay, double az)
+{
+    double acc_roll, acc_pitch;
+    fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
+    double y_roll = acc_roll - f->roll;
+    if (!(-FC_PI <= y_roll && y_roll <= FC_PI)) {
+        y_roll = fc_wrap_angle(y_roll);
+    }
+    fc_paper_kf_correct_innovation(f, y_roll, acc_pitch - f->pitch);
+}
+
+/* correct_innovation: the update with given innovations */
+void fc_paper_kf_correct_innovation(fc_paper_kf *f, double y_roll, double y_pitch)
+{
+    double P[4];
+    memcpy(P, f->P_roll, sizeof P);
+    int shared = same4(f->P_pitch, P);
+    fc_paper_kf_measurement_gain(P, f->r_step, f->gain_roll, f->P_roll);
+    if (shared) {
+        memcpy(f->gain_pitch, f->gain_roll, sizeof f->gain_roll);
+        memcpy(f->P_pitch, f->P_roll, sizeof P);
+    } else {
+        double Pp[4];
+        memcpy(Pp, f->P_pitch, sizeof Pp);
+        fc_paper_kf_measurement_gain(Pp, f->r_step, f->gain_pitch, f->P_pitch);
+    }
+    double roll = f->roll + f->gain_roll[0] * y_roll;
+    f->bias_x += f->gain_roll[1] * y_roll;
+    double pitch = f->pitch + f->gain_pitch[0] * y_pitch;
+    f->bias_y += f->gain_pitch[1] * y_pitch;
+    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+}
+
+/* correct_bias: direct measurements of the x and y gyro bias (variance r each) */
+void fc_paper_kf_correct_bias(fc_paper_kf *f, double z_x, double z_y, double r)
+{
+    fc_paper_kf_bias_update(&f->roll, &f->bias_x, f->P_roll, z_x - f->bias_x, r);
+    fc_paper_kf_bias_update(&f->pitch, &f->bias_y, f->P_pitch, z_y - f->bias_y, r);
+}
+
+/* took_sample: g becomes the previous gyro sample, the sample is counted (as fc_step does) */
+void fc_paper_kf_took_sample(fc_paper_kf *f, const double g[3])
+{
+    memcpy(f->base.gyro_prev, g, sizeof f->base.gyro_prev);
+    f->base.n_samples += 1;
+}
+
+static void advance(fc_paper_kf *f, const double a[3], const double g[3], double dt)
+{
+    fc_paper_kf_propagate(f, f->base.gyro_prev, g, dt);
+    if (fc_paper_kf_accel_trusted(f, a[0] * a[0] + a[1] * a[1] + a[2] * a[2])) {
+        fc_paper_kf_correct(f, a[0], a[1], a[2]);
+    }
+}
+
+FC_DEFINE_STEP_AND_RUN(fc_paper_kf)

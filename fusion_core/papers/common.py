@@ -1,0 +1,26 @@
+"""What the papers' reference filters share: their parameters beside their own, the gate and the
+integration rule at the papers' values."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Final
+
+from ..base import COMMON_PARAMS
+from ..building_blocks import ACC_GATE_PARAMS, GYRO_SAMPLING_PARAM
+from ..types import Param
+
+Vec3 = tuple[float, float, float]
+
+PAPER_COMMON: Final[tuple[Param, ...]] = tuple(p for p in COMMON_PARAMS if p.name != "gyro_range")
+"""The parameters every estimator shares, without gyro_range: the papers' filters know no gyro
+range, and no sample is at a rail for them."""
+PAPER_GATE: Final[tuple[Param, ...]] = tuple(
+    dataclasses.replace(p, default={"gate_low": 0.9, "gate_high": 1.1}[p.name])
+    for p in ACC_GATE_PARAMS
+)
+"""The accelerometer-magnitude gate at 0.9-1.1 g. Gui et al. gate the accelerometer without
+giving bounds in the text: these are our reading."""
+PAPER_SAMPLING: Final = dataclasses.replace(GYRO_SAMPLING_PARAM, default="mean")
+"""The papers integrate each gyro sample with the rectangle rule (rate times dt), exact for the
+interval means that gyro_sampling="mean" describes."""
