@@ -25,6 +25,7 @@ from .building_blocks import (
     REST_PARAMS,
     REST_START,
     ZERO3,
+    RestState,
     Vec3,
     adaptive_noise_constants,
     bias_band2,
@@ -329,7 +330,7 @@ class AngleBiasKalmanFilter(Estimator):
         """Rest detection; at rest the gyro sample measures the bias (variance gyro_psd/dt):
         the x and y biases through the [angle, bias] filters, bias_z through its own state."""
         rest_time, rest_gyro, rest_acc, gyro_var, bound = self._rest_cfg
-        measured = self.rest[7]
+        measured = self.rest.measured
         bias = (self.bias_x, self.bias_y, self.bias_z)
         self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, bias, dt, rest_gyro, rest_acc,
                               rest_time, bound)
@@ -337,11 +338,11 @@ class AngleBiasKalmanFilter(Estimator):
             # the measured vector was turned with a bias not measured yet: it starts again from
             # the rest's mean specific force (measured_vector.measure_restarted), the angles
             # from its tilt
-            f = (self.rest[3], self.rest[4], self.rest[5])
+            f = (self.rest.fx, self.rest.fy, self.rest.fz)
             self.meas = measure_restarted(self.meas, f)
             self.roll, self.pitch = accel_roll_pitch(*f)
         self.P_z += self._q_bias * dt
-        if self.rest[6] >= rest_time:
+        if self.rest.quiet_time >= rest_time:
             r = gyro_var / dt
             self.correct_bias(gx, gy, r)
             k = self.P_z / (self.P_z + r)
@@ -453,7 +454,8 @@ class AngleBiasKalmanFilter(Estimator):
         self.bias_x, self.bias_y, self.bias_z = turn((self.bias_x, self.bias_y, self.bias_z))
         self.meas = measure_turned(self.meas, turn)
         r = self.rest
-        self.rest = (*turn((r[0], r[1], r[2])), *turn((r[3], r[4], r[5])), r[6], r[7])
+        self.rest = RestState(*turn((r.wx, r.wy, r.wz)), *turn((r.fx, r.fy, r.fz)), r.quiet_time,
+                              r.measured)
         P_roll, P_pitch, P_z = self.P_roll, self.P_pitch, self.P_z
         vertical = (max(P_roll[0], P_pitch[0]), 0.0, 0.0, P_z)
         old = (P_roll, P_pitch, vertical)

@@ -218,7 +218,7 @@ class UnscentedKalmanFilter(Estimator):
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
         if p["rest_time"] > 0.0 and not clipped:
             x = self.x
-            measured = self.rest[7]
+            measured = self.rest.measured
             self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, (x[3], x[4], x[5]), dt,
                                   p["rest_gyro"], p["rest_acc"], p["rest_time"],
                                   p["rest_bias_bound"])
@@ -226,11 +226,11 @@ class UnscentedKalmanFilter(Estimator):
                 # the measured vector was turned with a bias not measured yet: it starts again
                 # from the rest's mean specific force (measured_vector.measure_restarted), X
                 # from its direction
-                f = (self.rest[3], self.rest[4], self.rest[5])
+                f = (self.rest.fx, self.rest.fy, self.rest.fz)
                 self.meas = measure_restarted(self.meas, f)
                 n = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
                 self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
-            if self.rest[6] >= p["rest_time"]:
+            if self.rest.quiet_time >= p["rest_time"]:
                 self._zero_rate_update((gx, gy, gz), p["zaru_psd"] / dt)
 
     def _zero_rate_update(self, z: tuple[float, float, float], r: float) -> None:

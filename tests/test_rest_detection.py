@@ -118,12 +118,13 @@ def test_an_uncalibrated_first_rest_aligns_the_filters_without_a_bias_covariance
 
 
 def test_only_a_first_rest_that_the_bias_estimate_misses_by_rest_gyro_aligns() -> None:
-    from fusion_core.building_blocks import uncalibrated_first_rest
+    from fusion_core.building_blocks import RestState, uncalibrated_first_rest
 
     th = next(p.default for p in REST_PARAMS if p.name == "rest_gyro")
     mean = (3.0 * th, 0.0, 0.0)
-    rest = (*mean, 0.0, 0.0, G, REST_TIME, 1.0)  # a rest just measured
+    rest = RestState(*mean, 0.0, 0.0, G, REST_TIME, 1.0)  # a rest just measured
     assert uncalibrated_first_rest(0.0, rest, (0.0, 0.0, 0.0), th)
     assert not uncalibrated_first_rest(1.0, rest, (0.0, 0.0, 0.0), th)  # not the first rest
     assert not uncalibrated_first_rest(0.0, rest, (2.5 * th, 0.0, 0.0), th)  # calibrated enough
-    assert not uncalibrated_first_rest(0.0, (*rest[:7], 0.0), (0.0, 0.0, 0.0), th)  # no rest yet
+    no_rest_yet = rest._replace(measured=0.0)
+    assert not uncalibrated_first_rest(0.0, no_rest_yet, (0.0, 0.0, 0.0), th)

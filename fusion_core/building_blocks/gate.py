@@ -1,0 +1,79 @@
+"""The accelerometer's trust: the magnitude gate of the correction, and the gates of the bias
+learning (the raw sample's norm, the innovation's size)."""
+
+from __future__ import annotations
+
+import math
+from typing import Final
+
+from ..types import DEG, G, Param
+
+ACC_GATE_PARAMS: tuple[Param, ...] = (
+    Param(
+        "gate_low", 0.5,
+        "Accelerometer gate, lower bound of |acc|/g: below it the accelerometer correction is "
+        "skipped (free fall, strong deceleration)",
+        low=0.0, low_open=True, high=1.0,
+    ),
+    Param(
+        "gate_high", 2.0,
+        "Accelerometer gate, upper bound of |acc|/g: above it the accelerometer correction is "
+        "skipped (strong linear acceleration)",
+        low=1.0, high=1000.0,  # a reading beyond 1000 g is no reading (base.MAX_ACC_NORM)
+    ),
+)
+"""Gui et al.'s accelerometer-magnitude gate. The papers give no bounds. Recommended, 0.5 g to
+2 g: with the pre-filter on (ACC_LOWPASS_PARAM) the gate sees the filtered vector, whose norm
+stays near g while the raw one swings, so only gross disturbances need closing it; a narrow gate
+then only adds rejections. The papers' filters' 0.9-1.1 g (fusion_core.papers.common) is our
+reading for the raw accelerometer: it skips samples with 0.1 g or more of linear acceleration
+along gravity, yet stays open at rest for an uncalibrated MEMS accelerometer (scale error up to
+about 3 %)."""
+
+
+def gate_bounds2(params: dict) -> tuple[float, float]:
+    """The accelerometer gate (ACC_GATE_PARAMS) as bounds on the squared norm |acc|^2 [m^2/s^4],
+    so that the per-sample test needs no square root."""
+    return (params["gate_low"] * G) ** 2, (params["gate_high"] * G) ** 2
+
+BIAS_GATE: Final = 0.05
+"""Recommended bias_gate: Duong Quoc et al.'s experimental table for their MPU-6050 (section
+4.2) stops trusting the accelerometer at rho = 0.05; here only the bias stops learning from it.
+The accelerometer sees a gyro bias only as a slow drift of the tilt it measures; a sample whose
+norm is 5 % off g carries linear acceleration (or vibration) whose apparent tilt would be taken
+for that drift, and with a small Q_bias a bias learned wrong stays wrong for minutes. A resting
+MEMS accelerometer (scale error up to 3 % uncalibrated) passes."""
+
+BIAS_GATE_PARAM = Param(
+    "bias_gate", BIAS_GATE,
+    "Bias learning gate on rho = ||a|/g - 1| of the raw accelerometer sample: at or above it "
+    "the accelerometer update leaves the gyro bias alone (the sample measures linear "
+    "acceleration, not the drift of the tilt); 0 = off, every update moves the bias (the papers)",
+    low=0.0, high=1000.0,
+)
+
+BIAS_INNOVATION: Final = 10.0 * DEG
+"""Recommended bias_innovation. A gyro bias shows in the accelerometer update as a slow drift of
+the tilt that each correction takes back: innovations of tenths of a degree (after the
+pre-filter, BROAD's largest are a few degrees in the fast trials). An innovation of tens of
+degrees means the attitude itself is grossly off (after a stretch of absurd samples, a knock,
+a restart in motion); the filters' linear model of the angle-bias coupling does not hold there,
+and learning from it winds the bias up to tens or hundreds of deg/s, which then takes minutes to
+unwind (measured after 1 s of absurd but accepted samples: kf not back under 1 deg within 120 s;
+with the gate, 14 s). The angle is corrected as always; only the bias waits."""
+
+BIAS_INNOVATION_PARAM = Param(
+    "bias_innovation", BIAS_INNOVATION,
+    "Largest tilt innovation the gyro bias learns from: beyond it the attitude is grossly off "
+    "(not a bias drift) and the accelerometer update corrects the angle only; pi = no limit "
+    "(the papers)",
+    unit="rad", low=0.0, low_open=True, high=math.pi, display_unit="deg",
+)
+
+
+def bias_band2(gate: float) -> tuple[float, float]:
+    """BIAS_GATE_PARAM as bounds on the raw sample's squared norm: the bias learns while
+    lo < |a|^2 < hi (any sample when the gate is 0, off)."""
+    if not gate > 0.0:
+        return -1.0, math.inf
+    return (max(1.0 - gate, 0.0) * G) ** 2, ((1.0 + gate) * G) ** 2

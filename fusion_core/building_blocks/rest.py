@@ -1,0 +1,197 @@
+"""Rest detection and the zero-angular-rate bias update: the detector's state (RestState), its
+step, and what the filters without a bias covariance do at rest (bias_at_rest, the alignment at
+an uncalibrated first rest)."""
+
+from __future__ import annotations
+
+from typing import Final, NamedTuple
+
+from ..kinematics import accel_roll_pitch
+from ..types import DEG, Param
+from .sampling import REAL_GYRO_DENSITY, Vec3
+
+
+class RestState(NamedTuple):
+    """The rest detector's state: running means of the rate (wx, wy, wz) and of the specific
+    force (fx, fy, fz), the quiet time [s], and measured: 1.0 once a rest has lasted rest_time
+    (the bias has been measured), else 0.0. The C twin holds the same eight numbers in order
+    (double rest[8])."""
+
+    wx: float
+    wy: float
+    wz: float
+    fx: float
+    fy: float
+    fz: float
+    quiet_time: float
+    measured: float
+
+
+_new = tuple.__new__
+REST_START: Final = RestState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+"""The rest detector's state before the first sample."""
+
+REST_MEAN_TAU: Final = 0.5
+"""Time constant [s] of the running means the rest detector compares each sample with (VQF's
+restFilterTau)."""
+
+REST_PARAMS: tuple[Param, ...] = (
+    Param(
+        "rest_time", 1.5,
+        "Rest detection: after this long with the gyro and accelerometer within rest_gyro and "
+        "rest_acc of their running means (and the mean rate below rest_gyro) the sensor is at "
+        "rest, and the gyro, which then reads its own bias, updates the bias estimate. "
+        "0 = off (the papers)",
+        unit="s", low=0.0,
+    ),
+    Param(
+        "rest_gyro", 2.0 * DEG, "Rest detection: angular-rate threshold",
+        unit="rad/s", low=0.0, low_open=True, display_unit="deg/s",
+    ),
+    Param(
+        "rest_acc", 0.5,
+        "Rest detection: threshold on the specific force's deviation from its running mean",
+        unit="m/s2", low=0.0, low_open=True,
+    ),
+    Param(
+        "rest_bias_bound", 20.0 * DEG,
+        "Rest detection: the largest turn-on gyro bias the sensor may have. Until a first rest "
+        "has measured the bias, a mean rate within rest_gyro plus this of the bias estimate may "
+        "start a rest; after it, the mean rate less the bias estimate must be below rest_gyro "
+        "(0: rest_gyro alone, VQF's rule)",
+        unit="rad/s", low=0.0, display_unit="deg/s",
+    ),
+)
+"""Rest detection for a zero-angular-rate bias update. A still sensor's gyro reads its bias: an
+uncalibrated MEMS gyro's turn-on bias (tenths of a deg/s) times a correction time constant of
+seconds is a tilt error of tenths of a degree, and about z the bias is
+not observable from the accelerometer at all while the sensor is level. The detector is VQF's
+(Laidig & Seel 2023): the rate and the specific force must stay within the thresholds of their
+running means (time constant REST_MEAN_TAU) for rest_time; its defaults (2 deg/s, 0.5 m/s^2,
+1.5 s) are VQF's restThGyr, restThAcc and restMinT. The papers have no rest detection
+(rest_time = 0).
+
+VQF also requires the mean rate itself to be below restThGyr, so that a slow steady rotation,
+which the deviations do not see, is not taken for rest. Against the raw rate that rule also
+refuses the rest of a still gyro whose bias exceeds the threshold: an MPU-6050 as delivered
+(turn-on bias +-20 deg/s in its datasheet) is then never measured at rest, and a complementary
+filter, which learns its bias nowhere else, stays degrees off at rest. So here the mean rate is
+taken less the filter's bias estimate, and before the first rest a mean rate the turn-on bias
+can explain (rest_bias_bound: the datasheet's 20 deg/s) may start one; a filter without a bias
+covariance then aligns at such a first rest (uncalibrated_first_rest). A rest under way lasts
+while the deviations stay small, so that the bias estimate can converge in it. A gyro calibrated
+at start-up never meets either rule: its outputs are those of VQF's rule to the last bit
+(tests/test_rest_detection.py)."""
+
+
+def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
+    """The gyro white-noise PSD of the zero-angular-rate update at rest (REST_PARAMS), whose
+    measurement variance is PSD / dt; default REAL_GYRO_DENSITY squared. The UKF names it
+    zaru_psd, since its gyro_psd is its process noise."""
+    return Param(
+        name, REAL_GYRO_DENSITY**2,
+        "Gyro white-noise power spectral density of the zero-angular-rate update at rest: its "
+        "variance is this / dt (the rate-noise density squared; measured on a real MEMS IMU: "
+        "(0.008 deg/s/sqrt(Hz))^2)",
+        unit="rad2/s", low=0.0, low_open=True, display_unit="deg2/s",
+    )
+
+
+def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
+    """The rest detector's state at the first sample: its means start at that sample, quiet time
+    0, the bias not measured yet."""
+    return _new(RestState, (gx, gy, gz, ax, ay, az, 0.0, 0.0))
+
+
+def rest_step(
+    rest: RestState, gx: float, gy: float, gz: float, ax: float, ay: float, az: float,
+    bias: Vec3, dt: float, th_gyro: float, th_acc: float, rest_time: float, bound: float,
+) -> RestState:
+    """One step of the rest detector (REST_PARAMS); bias: the filter's gyro bias estimate in the
+    frame of g; returns the new RestState. The caller compares its quiet_time with rest_time.
+    Outside a rest the mean rate less the bias must be below th_gyro (plus bound until a first
+    rest has measured the bias); a rest under way lasts while the rate and the specific force stay
+    within their thresholds of their running means."""
+    wx, wy, wz, fx, fy, fz, quiet, measured = rest
+    k = dt / (REST_MEAN_TAU + dt)
+    wx += k * (gx - wx)
+    wy += k * (gy - wy)
+    wz += k * (gz - wz)
+    fx += k * (ax - fx)
+    fy += k * (ay - fy)
+    fz += k * (az - fz)
+    th_g2 = th_gyro * th_gyro
+    dx, dy, dz = gx - wx, gy - wy, gz - wz
+    ex, ey, ez = ax - fx, ay - fy, az - fz
+    still = dx * dx + dy * dy + dz * dz < th_g2 and ex * ex + ey * ey + ez * ez < th_acc * th_acc
+    if still and quiet < rest_time:  # only a mean rate the bias explains may start a rest
+        mx, my, mz = wx - bias[0], wy - bias[1], wz - bias[2]
+        lim = th_gyro + bound if measured == 0.0 else th_gyro
+        still = mx * mx + my * my + mz * mz < lim * lim
+    quiet = quiet + dt if still else 0.0
+    return _new(RestState, (wx, wy, wz, fx, fy, fz, quiet,
+                            (1.0 if quiet >= rest_time else measured)))
+
+
+def first_rest(measured_before: float, rest: RestState) -> bool:
+    """True at the sample the first rest is measured: rest_step's flag `measured` is on and was
+    off (measured_before) before that step."""
+    return measured_before == 0.0 and rest.measured != 0.0
+
+
+def uncalibrated_first_rest(measured_before: float, rest: RestState, bias: Vec3,
+                            th_gyro: float) -> bool:
+    """True at the sample a first rest begins (rest_step's quiet time has just reached
+    rest_time; no rest before it: measured_before, the flag before that step, is 0) with a mean
+    rate that the bias estimate misses by th_gyro or more: a gyro that was not calibrated, whose
+    rest only REST_PARAMS' rest_bias_bound admitted. Such a bias, up to the datasheet's 20 deg/s,
+    has turned the tilt by up to its size times the time before this rest (a few degrees to tens)
+    and would take rest_time more to learn by bias_at_rest, while the tilt error it leaves in the
+    attitude and the turned accelerometer pre-filter decays only with the correction's time
+    constant. So a filter without a bias covariance (cf, mgcf) then aligns, as an inertial
+    system does at standstill: the rest's mean rate is its bias and its mean specific force is
+    gravity (rest_alignment). A calibrated gyro (a residual of tenths of a deg/s, and BROAD's) never
+    meets this, so its outputs are the same to the last bit."""
+    if not first_rest(measured_before, rest):
+        return False
+    mx, my, mz = rest.wx - bias[0], rest.wy - bias[1], rest.wz - bias[2]
+    return mx * mx + my * my + mz * mz >= th_gyro * th_gyro
+
+
+def rest_alignment(rest: RestState) -> tuple[Vec3, float, float, Vec3]:
+    """The alignment at an uncalibrated first rest (uncalibrated_first_rest): the gyro bias (the
+    rest's mean rate), roll and pitch (accel_roll_pitch of its mean specific force, Gui et al.
+    eq. 3-4) and that specific force, which the accelerometer pre-filters start again from."""
+    f = (rest.fx, rest.fy, rest.fz)
+    roll, pitch = accel_roll_pitch(rest.fx, rest.fy, rest.fz)
+    return (rest.wx, rest.wy, rest.wz), roll, pitch, f
+
+
+def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_time: float
+                 ) -> Vec3:
+    """One step of a gyro-bias estimate that follows the gyro while the sensor is at rest
+    (rest_step said so for rest_time): a first-order low-pass with time constant rest_time, the
+    zero-angular-rate update of the filters without a bias covariance (cf, mgcf)."""
+    k = dt / (rest_time + dt)
+    bx, by, bz = bias
+    return bx + k * (gx - bx), by + k * (gy - by), bz + k * (gz - bz)
+
+
+def complementary_rest(
+    rest: RestState, bias: Vec3, gx: float, gy: float, gz: float, ax: float, ay: float,
+    az: float, dt: float, rest_time: float, rest_gyro: float, rest_acc: float, bound: float,
+) -> tuple[RestState, Vec3, tuple[float, float, Vec3] | None]:
+    """The rest detection of the filters without a bias covariance (cf, mgcf), one sample: the
+    detector steps (rest_step); at an uncalibrated first rest they align (rest_alignment),
+    otherwise at rest their bias follows the gyro (bias_at_rest). Returns the detector's state,
+    the bias and, where they aligned, (roll, pitch, the specific force the accelerometer
+    vector starts again from)."""
+    measured = rest.measured
+    rest = rest_step(rest, gx, gy, gz, ax, ay, az, bias, dt, rest_gyro, rest_acc, rest_time,
+                     bound)
+    if uncalibrated_first_rest(measured, rest, bias, rest_gyro):
+        bias, roll, pitch, f = rest_alignment(rest)
+        return rest, bias, (roll, pitch, f)
+    if rest.quiet_time >= rest_time:
+        bias = bias_at_rest(bias, gx, gy, gz, dt, rest_time)
+    return rest, bias, None
