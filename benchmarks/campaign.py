@@ -42,10 +42,10 @@ CAMPAIGN_PASSES = 2
 
 
 def _throughput(workers: int, seeds: int) -> tuple[float, int, float, float]:
-    from testbenches.campaign import load_sensor
     from testbenches.montecarlo.plan import parse_variation, plan
     from testbenches.montecarlo.runner import execute
     from testbenches.montecarlo.store import read_rows
+    from testbenches.options import load_sensor
 
     runs = plan(list(ESTIMATORS), list(SCENARIOS), seeds,
                 [parse_variation("gyro_scale_std=0:0.03")], sensor=load_sensor("realistic"))
@@ -71,8 +71,8 @@ def _per_sample_us() -> tuple[float, float]:
     """The estimators' native batch run and the sensor's share, per sample [us] (seed 0)."""
     from fusion_core import ESTIMATORS as CLASSES
     from fusion_core.sensor import ImuSensorModel
-    from testbenches.campaign import load_sensor
     from testbenches.montecarlo.simulate import scenario_samples
+    from testbenches.options import load_sensor
 
     sensor = load_sensor("realistic")
     est_us, sensor_us = [], []

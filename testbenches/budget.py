@@ -179,6 +179,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     """Register the `budget` subcommand on the subparsers of `python -m testbenches`."""
     p = sub.add_parser("budget", help="which sensor error costs how much accuracy",
                        description=__doc__.split("\n\n")[1])
+    p.set_defaults(func=cmd_budget)
     p.add_argument("--estimator", default="all",
                    help=f"all or a comma list of {keys_help()} (all)")
     p.add_argument("--scenario", default="all",
@@ -198,7 +199,7 @@ def cmd_budget(args: argparse.Namespace) -> int:
     from fusion_core import ESTIMATORS
     from fusion_core.presets import load_preset
 
-    from .campaign import load_sensor
+    from .options import load_sensor
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")

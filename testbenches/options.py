@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import json
 import math
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 PRESET_HELP = ("estimator parameters: recommended (the defaults, for real MEMS sensors), paper "
@@ -73,3 +75,40 @@ def _number(text: str, kind: type, allowed: str, ok: Callable[[Any], bool]) -> A
     if value is None or not ok(value):
         raise argparse.ArgumentTypeError(f"{text!r}: allowed {allowed}")
     return value
+
+
+def load_sensor(spec: str | Path) -> dict[str, Any]:
+    """ImuSensor parameters by name (fusion_core.sensor.SENSOR_PRESETS: realistic, ideal) or
+    from a JSON file of parameters; each is checked by building the sensor model."""
+    from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel, sensor_preset
+
+    text = str(spec)
+    if text in SENSOR_PRESETS or not text.endswith(".json"):
+        return sensor_preset(text)
+    try:
+        params = json.loads(Path(text).read_text())
+        ImuSensorModel(**params)
+    except (OSError, json.JSONDecodeError, TypeError, ValueError) as err:
+        raise ValueError(f"sensor file {text}: {err}") from None
+    return dict(params)
+
+
+def parse_params(items: list[str]) -> dict[str, object]:
+    """NAME=VALUE strings to a dict: numbers as float or int, true/false, else the string."""
+    out: dict[str, object] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        if not sep or not name:
+            raise ValueError(f"--param {item!r}: expected NAME=VALUE")
+        value: object = text
+        if text.lower() in ("true", "false"):
+            value = text.lower() == "true"
+        else:
+            for kind in (int, float):
+                try:
+                    value = kind(text)
+                    break
+                except ValueError:
+                    pass
+        out[name] = value
+    return out

@@ -13,7 +13,7 @@ import numpy as np
 from fusion_core.types import DEG
 
 from . import contract
-from .campaign import CampaignResult
+from .contract_runs import ContractResult
 from .master import TestbenchResult
 from .peer_runs import PeerRun, peer_table
 
@@ -37,7 +37,7 @@ def run_record(r: TestbenchResult, plot: str | None = None) -> dict[str, Any]:
     }
 
 
-def contract_table(result: CampaignResult) -> str:
+def contract_table(result: ContractResult) -> str:
     """One line per run (RMSE roll/pitch against the limit, p99 step time, verdict) and the
     campaign checks."""
     head = (f"{'estimator':<9} {'scenario':<18} {'seed':>4} {'RMSE roll':>10} {'RMSE pitch':>10} "
@@ -96,7 +96,7 @@ def _summary(name: str, peer: bool, scenario: str, rmse: np.ndarray,
                        within)
 
 
-def seed_summaries(result: CampaignResult, peers: list[PeerRun] | None = None
+def seed_summaries(result: ContractResult, peers: list[PeerRun] | None = None
                    ) -> list[SeedSummary]:
     """Each estimator (and peer) on each scenario over its seeds: one seed is one sensor part,
     and the tails over parts are what one seed cannot show. The estimators' bound is their
@@ -168,7 +168,7 @@ def plot_run(r: TestbenchResult, path: Path) -> None:
     plt.close(fig)
 
 
-def write_reports(result: CampaignResult, out_dir: Path, plots: bool = True,
+def write_reports(result: ContractResult, out_dir: Path, plots: bool = True,
                   peers: list[PeerRun] | None = None,
                   summaries: list[SeedSummary] | None = None) -> None:
     """report.json, report.md and, with plots, a PNG per run under out_dir/plots; with peers,

@@ -22,6 +22,7 @@ as the standard says).
 
 from __future__ import annotations
 
+import argparse
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -30,11 +31,12 @@ from xml.sax.saxutils import quoteattr
 from fmpy import read_model_description
 
 from fusion_core import ESTIMATORS
-from fusion_core.scenarios import get_scenario
+from fusion_core.scenarios import SCENARIOS, get_scenario
 from fusion_core.sensor import SENSOR_PARAMS
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, fmu_path
 from .master import SAMPLE, SENSOR_IN
+from .options import parse_params
 
 NS = (
     'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
@@ -147,3 +149,26 @@ def simulate(ssp: Path | str, stop_time: float, step_size: float = 0.01) -> Any:
     parameters = read_ssv(str(ssp), resource="resources/parameters.ssv")
     return simulate_ssp(str(ssp), stop_time=stop_time, step_size=step_size,
                         parameter_set=parameters)
+
+
+def add_ssp_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    ssp = sub.add_parser("export-ssp", help="write a testbench as an SSP file")
+    ssp.add_argument("--estimator", required=True, choices=list(ESTIMATOR_FMUS))
+    ssp.add_argument("--scenario", required=True, choices=list(SCENARIOS))
+    ssp.add_argument("--seed", type=int, default=0, help="sensor noise seed (0)")
+    ssp.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                     help="estimator FMU parameter (repeatable)")
+    ssp.add_argument("--noise-free", action="store_true", help="a sensor without noise")
+    ssp.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
+    ssp.add_argument("out", type=Path, help="the SSP file to write")
+    ssp.set_defaults(func=cmd_export_ssp)
+
+
+def cmd_export_ssp(args: argparse.Namespace) -> int:
+    from .contract import NOISE_FREE
+
+    path = export_ssp(args.estimator, args.scenario, args.out, args.seed,
+                      parse_params(args.param), NOISE_FREE if args.noise_free else None,
+                      args.fmu_dir)
+    print(f"wrote {path}")
+    return 0

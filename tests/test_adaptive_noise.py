@@ -9,10 +9,10 @@ import math
 import pytest
 
 from fusion_core.building_blocks import CONSTANT_NOISE, correction_time
-from testbenches.campaign import load_sensor
 from testbenches.contract import accuracy_limits, compute_metrics
 from testbenches.montecarlo.plan import Run
 from testbenches.montecarlo.simulate import simulate
+from testbenches.options import load_sensor
 
 
 def test_the_correction_time_is_the_kalman_balance_and_never_longer_than_tau() -> None:

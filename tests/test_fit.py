@@ -70,7 +70,7 @@ def test_noise_writes_the_files_and_its_preset_is_the_defaults_derivation(tmp_pa
         noise["gyro_density"]["mean"], noise["acc_density"]["mean"], noise["acc_sample_std"])))
     assert load_preset(tmp_path / "out" / "preset.json")["kf"]["Q_angle"] == pytest.approx(
         GYRO_DENSITY**2, rel=0.3)
-    from testbenches.campaign import load_sensor
+    from testbenches.options import load_sensor
 
     sensor = load_sensor(str(tmp_path / "out" / "sensor.json"))
     assert sensor["gyro_psd"] == pytest.approx(GYRO_DENSITY**2, rel=0.3)

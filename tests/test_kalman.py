@@ -236,10 +236,10 @@ def test_only_the_slow_linear_acceleration_raises_the_measurement_variance() -> 
 def test_sustained_acceleration_is_held_off_on_the_realistic_sensor() -> None:
     """high_dynamics (moves of 0.73 g for seconds, no rest) with the defaults and the realistic
     sensor: within the contract's 5 deg, where the constant R followed the moves (6.9/6.6 deg)."""
-    from testbenches.campaign import load_sensor
     from testbenches.contract import accuracy_limits, compute_metrics
     from testbenches.montecarlo.plan import Run
     from testbenches.montecarlo.simulate import simulate
+    from testbenches.options import load_sensor
 
     m = compute_metrics(simulate(Run("t", "kf", "high_dynamics", 0, None,
                                      load_sensor("realistic"), {}, {})))

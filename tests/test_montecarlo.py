@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from testbenches.campaign import load_sensor
 from testbenches.montecarlo.plan import parse_variation, plan
 from testbenches.montecarlo.runner import MAX_BATCH, MIN_BATCH, batches, connect, execute
 from testbenches.montecarlo.simulate import run_row, simulate
 from testbenches.montecarlo.store import read_rows
 from testbenches.montecarlo.summary import summarise
+from testbenches.options import load_sensor
 
 pytest.importorskip("distributed")
 

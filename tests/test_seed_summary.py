@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from testbenches.campaign import CampaignResult
+from testbenches.contract_runs import ContractResult
 from testbenches.peer_runs import PeerRun
 from testbenches.report import seed_summaries, seed_summary_table
 
@@ -23,7 +23,7 @@ def test_the_statistics_are_numpys_over_each_estimator_and_scenario() -> None:
     rmse = rng.uniform(0.1, 0.6, size=(40, 2))
     runs = [run("ukf", "moderate_dynamics", *v) for v in rmse]
     runs += [run("kf", "roll_sweep", 0.1, 0.1), run("kf", "roll_sweep", 0.3, 0.1)]
-    (ukf, kf) = seed_summaries(CampaignResult(runs=runs))  # type: ignore[arg-type]
+    (ukf, kf) = seed_summaries(ContractResult(runs=runs))  # type: ignore[arg-type]
     assert (ukf.name, ukf.scenario, ukf.seeds, ukf.peer) == ("ukf", "moderate_dynamics", 40,
                                                              False)
     assert ukf.mean == pytest.approx(tuple(rmse.mean(axis=0)), abs=1e-15)
@@ -40,7 +40,7 @@ def test_peers_are_summarised_apart_and_without_a_bound_where_they_have_none() -
              for s in range(3)]
     peers += [PeerRun("vqf", "roll_sweep", s, 0.2 * (s + 1), 0.1, (0.25, 0.25), s == 0)
               for s in range(2)]
-    result = CampaignResult(runs=[run("ukf", "moderate_dynamics", 0.2, 0.2)])  # type: ignore[list-item]
+    result = ContractResult(runs=[run("ukf", "moderate_dynamics", 0.2, 0.2)])  # type: ignore[list-item]
     ours, moderate, sweep = seed_summaries(result, peers)
     assert not ours.peer and moderate.peer and sweep.peer
     assert moderate.within is None and moderate.mean == pytest.approx((0.4, 0.4))

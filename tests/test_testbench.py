@@ -315,11 +315,11 @@ def test_cli_exits_2_with_a_message_for_an_unknown_parameter(fmu_dir: Path, tmp_
 def test_reports_hold_a_plot_per_run_and_the_checks(fmu_dir: Path, tmp_path: Path) -> None:
     import json
 
-    from testbenches.campaign import CampaignResult
+    from testbenches.contract_runs import ContractResult
     from testbenches.report import write_reports
 
     r = run_testbench("kf", "roll_pitch", duration=2.0, fmu_dir=fmu_dir)
-    write_reports(CampaignResult(runs=[r]), tmp_path, plots=True)
+    write_reports(ContractResult(runs=[r]), tmp_path, plots=True)
     report = json.loads((tmp_path / "report.json").read_text())
     png = tmp_path / report["runs"][0]["plot"]
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

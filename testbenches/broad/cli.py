@@ -33,6 +33,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     """Register the `broad` subcommand on the subparsers of `python -m testbenches`."""
     p = sub.add_parser("broad", help="accuracy on BROAD's real recordings (inclination RMSE)",
                        description=HELP)
+    p.set_defaults(func=cmd_broad)
     p.add_argument("paths", nargs="+", type=Path, metavar="PATH",
                    help="BROAD trial files (.hdf5, .mat) or folders of them")
     p.add_argument("--estimator", default="all",

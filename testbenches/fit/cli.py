@@ -17,6 +17,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     noise = sub.add_parser(
         "noise", help="noise densities of a static recording (Allan deviation), a preset for "
         "every estimator and the sensor FMU's parameters for that sensor")
+    noise.set_defaults(func=cmd_noise)
     noise.add_argument("file", type=Path, help="a static recording: CSV (acc_x..z [m/s2], "
                        "gyro_x..z [rad/s], optional time or dt [s]) or a BROAD trial (its rest "
                        "segment is used)")
@@ -33,6 +34,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     tune = sub.add_parser(
         "tune", help="fit an estimator's tunable parameters to recordings with a reference, "
         "validated on others")
+    tune.set_defaults(func=cmd_tune)
     tune.add_argument("--estimator", required=True, choices=list(ESTIMATORS))
     tune.add_argument("files", type=Path, nargs="+",
                       help="recordings to fit: BROAD trials, or CSV with reference columns "

@@ -18,6 +18,7 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "campaign", help="a Monte Carlo campaign of seeded runs on Dask (a local cluster or "
         "your own scheduler), resumable, with percentiles and confidence intervals")
+    p.set_defaults(func=cmd_campaign)
     p.add_argument("--estimator", default="all",
                    help=f"all or a comma list of {', '.join(ESTIMATOR_FMUS)}")
     p.add_argument("--scenario", default="moderate_dynamics",
@@ -55,8 +56,7 @@ def cmd_campaign(args: argparse.Namespace) -> int:
 
     from fusion_core.presets import load_preset
 
-    from ..campaign import load_sensor
-    from ..options import choose
+    from ..options import choose, load_sensor
     from .plan import parse_variation, plan
     from .runner import execute
     from .store import read_rows

@@ -1,10 +1,13 @@
-"""A campaign: estimator x scenario x seed runs plus the contract's T1, T2, T4, position checks."""
+"""The contract run behind `python -m testbenches run`: estimator x scenario x seed runs through
+the FMUs (testbenches.master), plus the contract's T1, T2, T4 and position checks.
+
+Not to be confused with the Monte Carlo campaign of `python -m testbenches campaign`
+(testbenches.montecarlo: thousands of seeded runs in fusion_core, on Dask, for statistics)."""
 
 from __future__ import annotations
 
 import contextlib
 import functools
-import json
 import tempfile
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -20,7 +23,7 @@ from .master import TestbenchResult, run_testbench
 
 
 @dataclass
-class CampaignResult:
+class ContractResult:
     runs: list[TestbenchResult] = field(default_factory=list)
     checks: list[contract.Check] = field(default_factory=list)
     """Campaign-level checks (T1, T2, T4, position); per-run checks live on each run."""
@@ -40,11 +43,12 @@ class Job:
     sensor_params: tuple[tuple[str, Any], ...] = ()
 
 
-def plan(
-    estimators: Sequence[str], scenarios: Sequence[str], seeds: int, jitter: float,
+def contract_jobs(
+    estimators: Sequence[str], scenarios: Sequence[str], *, seeds: int = 1, jitter: float = 0.0,
     contract_checks: bool = True,
 ) -> list[Job]:
-    """The runs of a campaign: every estimator x scenario x seed, then the contract's extras."""
+    """The runs of a contract run: every estimator x scenario x seed, then the contract's
+    extras."""
     jobs = [Job("run", e, s, seed, jitter) for s in scenarios for e in estimators
             for seed in range(seeds)]
     if not contract_checks:
@@ -63,7 +67,8 @@ def plan(
     return jobs
 
 
-def run_campaign(
+def run_contract(
+    *,
     estimators: Sequence[str] = tuple(ESTIMATOR_FMUS),
     scenarios: Sequence[str] = tuple(SCENARIOS),
     seeds: int = 1,
@@ -77,17 +82,18 @@ def run_campaign(
     jobs: int = 1,
     preset: dict[str, dict[str, Any]] | None = None,
     sensor: dict[str, Any] | None = None,
-) -> CampaignResult:
-    """Run a campaign and evaluate the contract; `progress` is called after each run; `params`
+) -> ContractResult:
+    """Run the runs and evaluate the contract; `progress` is called after each run; `params`
     are estimator FMU parameters for every run (each estimator must have them); `duration`
     replaces each scenario's own duration in the runs (not in the contract's extras); timing=False
     leaves the wall-clock check T3 out of the verdict (its figures are still reported); jobs > 1
     runs that many worker processes (one run per process at a time, so T3 stays per core);
     `preset` holds each estimator's parameters (presets.load_preset; `params` go on top) and
     `sensor` the ImuSensor parameters of every run but the contract's noise-free ones."""
-    out = CampaignResult()
+    out = ContractResult()
     extra: dict[tuple[str, str], list[TestbenchResult]] = {}
-    jobs_list = plan(estimators, scenarios, seeds, jitter, contract_checks)
+    jobs_list = contract_jobs(estimators, scenarios, seeds=seeds, jitter=jitter,
+                              contract_checks=contract_checks)
     run_one = functools.partial(_run_job, params=params, fmu_dir=fmu_dir, duration=duration,
                                 timing=timing, preset=preset or {}, sensor=sensor or {})
     with contextlib.ExitStack() as stack:
@@ -116,22 +122,6 @@ def run_campaign(
     return out
 
 
-def load_sensor(spec: str | Path) -> dict[str, Any]:
-    """ImuSensor parameters by name (fusion_core.sensor.SENSOR_PRESETS: realistic, ideal) or
-    from a JSON file of parameters; each is checked by building the sensor model."""
-    from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel, sensor_preset
-
-    text = str(spec)
-    if text in SENSOR_PRESETS or not text.endswith(".json"):
-        return sensor_preset(text)
-    try:
-        params = json.loads(Path(text).read_text())
-        ImuSensorModel(**params)
-    except (OSError, json.JSONDecodeError, TypeError, ValueError) as err:
-        raise ValueError(f"sensor file {text}: {err}") from None
-    return dict(params)
-
-
 def _run_job(job: Job, params: dict[str, Any] | None, fmu_dir: Path | str,
              duration: float | None, timing: bool, preset: dict[str, dict[str, Any]],
              sensor: dict[str, Any]) -> TestbenchResult:
@@ -143,7 +133,7 @@ def _run_job(job: Job, params: dict[str, Any] | None, fmu_dir: Path | str,
     return contract.evaluate(r, timing)
 
 
-def _collect(out: CampaignResult, extra: dict[tuple[str, str], list[TestbenchResult]],
+def _collect(out: ContractResult, extra: dict[tuple[str, str], list[TestbenchResult]],
              job: Job, r: TestbenchResult) -> None:
     """File a finished run: a campaign run, or one of the contract's extras."""
     if job.kind == "run":
