@@ -15,19 +15,20 @@ Python sources.
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
 import shutil
 import tempfile
 import traceback
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from unittest import mock
+from typing import Any
 
-from .estimator import PRESET_ENV
+from .estimator import PRESET_FILE
 from .names import script_path
+
+Preset = dict[str, dict[str, Any]]
+"""A preset's entries by estimator key (fusion_core.presets.load_preset)."""
 
 HERE = Path(__file__).resolve().parent
 RUNTIME_FILES = (
@@ -46,8 +47,9 @@ def fusion_core_dir() -> Path:
     return Path(fusion_core.__file__).resolve().parent
 
 
-def _stage(root: Path) -> list[Path]:
-    """Copy what goes into resources/ besides the slave module; return the paths."""
+def _stage(root: Path, preset: Preset | None) -> list[Path]:
+    """Copy what goes into resources/ besides the slave module, with the preset's entries as
+    PRESET_FILE (none for the recommended values, the defaults); return the paths."""
     shutil.copytree(fusion_core_dir(), root / "fusion_core",
                     ignore=shutil.ignore_patterns("__pycache__", "*.so"))
     _ship_native_library(root / "fusion_core")
@@ -57,10 +59,9 @@ def _stage(root: Path) -> list[Path]:
         shutil.copy2(HERE / name, root / "fmu_src" / name)
     (root / "requirements.txt").write_text(REQUIREMENTS)
     staged += [root / "fmu_src", root / "requirements.txt"]
-    preset = os.environ.get(PRESET_ENV)
-    if preset:  # the start values it was built with, read by the slave when it runs
-        shutil.copy2(preset, root / "preset.json")
-        staged.append(root / "preset.json")
+    if preset and any(preset.values()):  # what it was built with, read by the slave when it runs
+        (root / PRESET_FILE).write_text(json.dumps(preset, indent=1))
+        staged.append(root / PRESET_FILE)
     return staged
 
 
@@ -76,23 +77,29 @@ def _ship_native_library(core: Path) -> None:
     shutil.copy2(native.build(), core / "native" / native.PREBUILT.name)
 
 
-def build(name: str, out_dir: Path) -> Path:
-    """Build the pythonfmu FMU called name into out_dir/<name>.fmu and return its path."""
-    path = build_script(script_path(name), out_dir)
+def build(name: str, out_dir: Path, preset: Preset | None = None) -> Path:
+    """Build the pythonfmu FMU called name into out_dir/<name>.fmu with the preset's estimator
+    class and start values (None: the recommended ones) and return its path."""
+    path = build_script(script_path(name), out_dir, preset)
     if path.name != f"{name}.fmu":
         raise RuntimeError(f"{script_path(name).name} built {path.name}: its class must be {name}")
     return path
 
 
-def build_script(script: Path, out_dir: Path) -> Path:
+def build_script(script: Path, out_dir: Path, preset: Preset | None = None) -> Path:
     """Build the FMU of one slave module (any FmuSlave subclass) into out_dir; the FMU is
-    named after the class. The module name must be unique among the FMUs of a process."""
+    named after the class. The module name must be unique among the FMUs of a process.
+
+    The slave module is built from a copy beside the staged resources: pythonfmu's builder
+    instantiates the slave with the module's folder as its resources, so the slave reads the
+    preset it is built with from there, as it reads it from the FMU's resources when it runs."""
     from pythonfmu import FmuBuilder
 
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fmu_stage_") as tmp:
-        files = _stage(Path(tmp))
-        path = FmuBuilder.build_FMU(script, dest=out_dir, project_files=files)
+        files = _stage(Path(tmp), preset)
+        shutil.copy2(script, Path(tmp) / script.name)
+        path = FmuBuilder.build_FMU(Path(tmp) / script.name, dest=out_dir, project_files=files)
     return Path(path)
 
 
@@ -152,35 +159,32 @@ def build_all(
     if kind not in KINDS:
         raise ValueError(f"kind {kind!r}: allowed {', '.join(KINDS)}")
     names = list(names)
-    starts = load_preset(preset)
-    with contextlib.ExitStack() as stack:
-        if any(starts.values()):  # the recommended values need no file: they are the defaults
-            tmp = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="preset_")))
-            (tmp / "preset.json").write_text(json.dumps(starts, indent=1))
-            stack.enter_context(mock.patch.dict(os.environ, {PRESET_ENV: str(tmp / "preset.json")}))
-        results = []
-        if kind != "native":
-            results += [_build_and_check(name, out_dir) for name in names]
-        if kind != "pythonfmu":
-            results += [_build_native_and_check(name, version, out_dir)
-                        for version in ("fmi2", "fmi3") for name in names]
-        return results
+    entries = load_preset(preset)
+    results = []
+    if kind != "native":
+        results += [_build_and_check(name, out_dir, entries) for name in names]
+    if kind != "pythonfmu":
+        results += [_build_native_and_check(name, version, out_dir, entries)
+                    for version in ("fmi2", "fmi3") for name in names]
+    return results
 
 
-def _build_native_and_check(name: str, version: str, out_dir: Path) -> BuildResult:
+def _build_native_and_check(name: str, version: str, out_dir: Path, preset: Preset
+                            ) -> BuildResult:
     """One row of the build table for a native FMU (out_dir/native/<version>/<name>.fmu)."""
     from .native.build import build_native, native_model
 
     return _checked(BuildResult(name, core="native", kind=version),
-                    lambda: build_native(native_model(name), version, out_dir / "native"))
+                    lambda: build_native(native_model(name, preset), version,
+                                         out_dir / "native"))
 
 
-def _build_and_check(name: str, out_dir: Path) -> BuildResult:
+def _build_and_check(name: str, out_dir: Path, preset: Preset) -> BuildResult:
     """One row of the build table for a pythonfmu FMU."""
     from fusion_core import native
 
     return _checked(BuildResult(name, core="python" if native.reason() else "native"),
-                    lambda: build(name, out_dir))
+                    lambda: build(name, out_dir, preset))
 
 
 def _checked(result: BuildResult, make: Callable[[], Path]) -> BuildResult:

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 from collections.abc import Mapping
 from functools import partial
 from operator import itemgetter
@@ -72,24 +71,18 @@ PAPER_NOTE = (" Built with the preset 'paper': the paper's own filter at its val
 """What a paper's filter adds to its FMU's description."""
 
 
-PRESET_ENV = "FUSION_FMU_PRESET"
-"""Environment variable naming the preset file while build_fmu.py builds (the FMU then carries
-it as resources/preset.json, PRESET_FILE, which the slave reads when it runs)."""
 PRESET_FILE = "preset.json"
 """The preset an FMU was built with, in its resources folder."""
 
 
 def preset_starts(key: str, resources: str | None = None) -> dict[str, Any]:
-    """The preset entry an FMU of estimator key was built with (checked when the file was
-    written; {} for the recommended values, the defaults; "filter": "paper" chooses the paper's
-    filter, fusion_core.registry): from the FMU's resources folder when it runs, from PRESET_ENV
-    while it is built."""
+    """The preset entry an FMU of estimator key was built with, from PRESET_FILE in its
+    resources folder (the build writes it there, fmu_src.build; checked when it was written):
+    {} for the recommended values, the defaults; "filter": "paper" chooses the paper's filter
+    (fusion_core.registry)."""
     path = Path(resources) / PRESET_FILE if resources else None
     if path is None or not path.is_file():
-        env = os.environ.get(PRESET_ENV)
-        if not env:
-            return {}
-        path = Path(env)
+        return {}
     return dict(json.loads(path.read_text()).get(key, {}))
 
 

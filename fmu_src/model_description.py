@@ -156,23 +156,55 @@ def unit_definitions(variables: Sequence[Variable]) -> Element:
     return root
 
 
-def type_definitions(variables: Sequence[Variable]) -> Element | None:
-    """<TypeDefinitions> with one Enumeration type per enumeration variable, or None."""
+def type_definitions(variables: Sequence[Variable], version: str = "2.0") -> Element | None:
+    """<TypeDefinitions> with one enumeration type per enumeration variable (FMI 2.0's
+    SimpleType/Enumeration or FMI 3.0's EnumerationType, by version), or None."""
     enums = [v for v in variables if v.type == "Enumeration"]
     if not enums:
         return None
     root = Element("TypeDefinitions")
     for v in enums:
-        simple = SubElement(root, "SimpleType", {"name": v.type_name or "", "description":
-                                                 f"Choices of {v.name}"})
-        enum = SubElement(simple, "Enumeration")
+        attrs = {"name": v.type_name or "", "description": f"Choices of {v.name}"}
+        if version == "3.0":
+            enum = SubElement(root, "EnumerationType", attrs)
+        else:
+            enum = SubElement(SubElement(root, "SimpleType", attrs), "Enumeration")
         for value, item in enumerate(v.items or (), 1):
             SubElement(enum, "Item", {"name": item, "value": str(value)})
     return root
 
 
-def _number(x: float, kind: str) -> str:
-    return str(int(x)) if kind == "Integer" else repr(float(x))
+def number(x: float | int | bool, kind: str) -> str:
+    """A value of a variable of type kind as modelDescription.xml writes it (a Real by repr,
+    which round-trips every double)."""
+    if kind == "Boolean":
+        return "true" if x else "false"
+    if kind in ("Integer", "Enumeration"):
+        return str(int(x))
+    return repr(float(x))
+
+
+def type_attributes(v: Variable, start: bool = True) -> dict[str, str]:
+    """The attributes a variable's type carries: its enumeration type, unit and display unit,
+    the closed bounds of its range and (start) its start value. FMI 2.0 writes them on the
+    type element inside <ScalarVariable>, FMI 3.0 on the variable's own element; every writer
+    of a model description (decorate for the pythonfmu FMUs, fmu_src.native.build for the
+    native ones) takes them from here."""
+    attrs: dict[str, str] = {}
+    if v.type == "Enumeration":
+        attrs["declaredType"] = v.type_name or ""
+    if v.type == "Real":
+        attrs["unit"] = v.unit or "1"
+        if v.display_unit:
+            attrs["displayUnit"] = v.display_unit
+    if v.type in ("Real", "Integer"):
+        if v.low is not None and not v.low_open:
+            attrs["min"] = number(v.low, v.type)
+        if v.high is not None and not v.high_open:
+            attrs["max"] = number(v.high, v.type)
+    if start:
+        attrs["start"] = number(v.start, v.type)
+    return attrs
 
 
 def decorate(root: Element, variables: Sequence[Variable]) -> None:
@@ -186,23 +218,11 @@ def decorate(root: Element, variables: Sequence[Variable]) -> None:
     for sv in root.iter("ScalarVariable"):
         v = by_name[sv.get("name", "")]
         typed = sv[0]
-        start = typed.get("start")
-        attrs: dict[str, str] = {}
         if v.type == "Enumeration":
             typed.tag = "Enumeration"
-            attrs["declaredType"] = v.type_name or ""
-        if v.type == "Real":
-            attrs["unit"] = v.unit or "1"
-            if v.display_unit:
-                attrs["displayUnit"] = v.display_unit
-        if v.type in ("Real", "Integer"):
-            if v.low is not None and not v.low_open:
-                attrs["min"] = _number(v.low, v.type)
-            if v.high is not None and not v.high_open:
-                attrs["max"] = _number(v.high, v.type)
-        if start is not None:
-            # pythonfmu writes 16 significant digits, which does not round-trip every double.
-            attrs["start"] = repr(float(v.start)) if v.type == "Real" else start
+        # pythonfmu writes a start where FMI wants one, with 16 significant digits, which do
+        # not round-trip every double: ours instead
+        attrs = type_attributes(v, start=typed.get("start") is not None)
         typed.attrib.clear()
         typed.attrib.update(attrs)
 

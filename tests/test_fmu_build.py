@@ -227,7 +227,7 @@ def test_build_command_exits_non_zero_on_a_validation_problem(
     cli = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cli)
 
-    def build_copy(name: str, out_dir: Path) -> Path:  # no rebuild
+    def build_copy(name: str, out_dir: Path, preset: object = None) -> Path:  # no rebuild
         out_dir.mkdir(parents=True, exist_ok=True)
         return Path(shutil.copy(built_fmus.path(name), out_dir))
 

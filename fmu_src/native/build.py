@@ -33,13 +33,19 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 from xml.dom import minidom
 from xml.etree.ElementTree import Element, SubElement, tostring
 
 from fusion_core.native import compiler as twin_compiler
 from fusion_core.native.generate import c_double
 
-from ..model_description import project_version, type_definitions, unit_definitions
+from ..model_description import (
+    project_version,
+    type_attributes,
+    type_definitions,
+    unit_definitions,
+)
 from ..names import script_path
 from ..variables import Variable
 
@@ -139,18 +145,19 @@ def twin_closure(prefix: str) -> tuple[str, ...]:
     return tuple(out)
 
 
-def native_model(name: str) -> NativeModel:
-    """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the class
-    and start values of the preset being built (fmu_src.estimator.PRESET_ENV)."""
+def native_model(name: str, preset: dict[str, dict[str, Any]] | None = None) -> NativeModel:
+    """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the
+    estimator class and start values of the preset's entry for it (None: the recommended
+    ones; fusion_core.presets.load_preset)."""
     from fusion_core.sensor import SENSOR_PARAMS
 
-    from ..estimator import estimator_table, model_description, preset_starts
+    from ..estimator import estimator_table, model_description
 
     module = importlib.import_module(f"fmu_src.models.{script_path(name).stem}")
     cls = getattr(module, name)
     key = getattr(cls, "key", None)
     if key is not None:
-        estimator, variables = estimator_table(key, preset_starts(key))
+        estimator, variables = estimator_table(key, (preset or {}).get(key, {}))
         params = tuple(estimator.param_specs().values())
         return NativeModel(name, model_description(cls.description, estimator), variables,
                            "estimator", estimator.TWIN or "", params)
@@ -264,24 +271,6 @@ def render_config(model: NativeModel) -> str:
 
 # ----- modelDescription.xml ----------------------------------------------------------------------
 
-def _number(x: float | int | bool, kind: str) -> str:
-    if kind == "Boolean":
-        return "true" if x else "false"
-    if kind in ("Integer", "Enumeration"):
-        return str(int(x))
-    return repr(float(x))
-
-
-def _range_attributes(v: Variable) -> dict[str, str]:
-    attrs: dict[str, str] = {}
-    if v.type in ("Real", "Integer"):
-        if v.low is not None and not v.low_open:
-            attrs["min"] = _number(v.low, v.type)
-        if v.high is not None and not v.high_open:
-            attrs["max"] = _number(v.high, v.type)
-    return attrs
-
-
 def _header(root: Element, model: NativeModel) -> None:
     root.set("description", model.description)
     root.set("author", "imu-fusion-fmu contributors")
@@ -342,14 +331,7 @@ def fmi2_model_description(model: NativeModel, sources: Sequence[str]) -> bytes:
             attrs["initial"] = "exact"
             outputs.append(vr + 1)
         sv = SubElement(variables, "ScalarVariable", attrs)
-        typed = {"declaredType": v.type_name or ""} if v.type == "Enumeration" else {}
-        if v.type == "Real":
-            typed["unit"] = v.unit or "1"
-            if v.display_unit:
-                typed["displayUnit"] = v.display_unit
-        typed.update(_range_attributes(v))
-        typed["start"] = _number(v.start, v.type)
-        SubElement(sv, v.type, typed)
+        SubElement(sv, v.type, type_attributes(v))
     structure = SubElement(root, "ModelStructure")
     outs = SubElement(structure, "Outputs")
     for index in outputs:
@@ -380,14 +362,9 @@ def fmi3_model_description(model: NativeModel) -> bytes:
     })
     time_unit = Variable("time", "input", "Real", "the independent variable", 0.0, "s")
     root.append(unit_definitions((*model.variables, time_unit)))
-    enums = [v for v in model.variables if v.type == "Enumeration"]
-    if enums:
-        types = SubElement(root, "TypeDefinitions")
-        for v in enums:
-            et = SubElement(types, "EnumerationType",
-                            {"name": v.type_name or "", "description": f"Choices of {v.name}"})
-            for value, item in enumerate(v.items or (), 1):
-                SubElement(et, "Item", {"name": item, "value": str(value)})
+    types = type_definitions(model.variables, "3.0")
+    if types is not None:
+        root.append(types)
     _log_categories(root)
     SubElement(root, "DefaultExperiment",
                {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.01"})
@@ -401,17 +378,10 @@ def fmi3_model_description(model: NativeModel) -> bytes:
     for vr, v in enumerate(model.variables):
         attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
                  "causality": v.causality, "variability": v.variability or "continuous"}
-        if v.type == "Enumeration":
-            attrs["declaredType"] = v.type_name or ""
-        if v.type == "Real":
-            attrs["unit"] = v.unit or "1"
-            if v.display_unit:
-                attrs["displayUnit"] = v.display_unit
-        attrs.update(_range_attributes(v))
         if v.causality == "output":
             attrs["initial"] = "exact"
             outputs.append(vr)
-        attrs["start"] = _number(v.start, v.type)
+        attrs.update(type_attributes(v))
         SubElement(variables, FMI3_TYPES[v.type], attrs)
     structure = SubElement(root, "ModelStructure")
     for vr in outputs:
