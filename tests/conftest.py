@@ -14,16 +14,12 @@ from pathlib import Path
 
 import pytest
 
+from fusion_core.registry import FMU_NAMES
+
 REPO = Path(__file__).resolve().parents[1]
 
-ESTIMATOR_FMUS: dict[str, str] = {
-    "ComplementaryFilter": "cf",
-    "GainScheduledComplementaryFilter": "mgcf",
-    "AngleBiasKalmanFilter": "kf",
-    "UnscentedKalmanFilter": "ukf",
-    "PositionKalmanFilter": "poskf",
-}
-"""The estimator FMUs (issue 3) and the fusion_core.ESTIMATORS key each one packages."""
+ESTIMATOR_FMUS: dict[str, str] = {name: key for key, name in FMU_NAMES.items()}
+"""The estimator FMUs and the fusion_core.ESTIMATORS key each one packages (the registry's)."""
 
 
 @dataclass(frozen=True)

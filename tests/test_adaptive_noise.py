@@ -9,6 +9,7 @@ import math
 import pytest
 
 from fusion_core.building_blocks import CONSTANT_NOISE, correction_time
+from fusion_core.registry import ATTITUDE_FILTERS
 from testbenches.contract import accuracy_limits, compute_metrics
 from testbenches.montecarlo.plan import Run
 from testbenches.montecarlo.simulate import simulate
@@ -35,7 +36,7 @@ def rmse(key: str, scenario: str, params: dict) -> tuple[float, float]:
     return m["rmse_roll_deg"], m["rmse_pitch_deg"]
 
 
-@pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
+@pytest.mark.parametrize("key", ATTITUDE_FILTERS)
 @pytest.mark.parametrize("scenario", ["roll_sweep", "pitch_sweep", "roll_pitch"])
 def test_the_sweeps_pass_on_the_realistic_sensor(key: str, scenario: str) -> None:
     """Pure rotation with the realistic gyro (1 % scale, 0.67 % cross-axis, 0.16 deg/s of bias
@@ -46,7 +47,7 @@ def test_the_sweeps_pass_on_the_realistic_sensor(key: str, scenario: str) -> Non
     assert roll <= limit[0] and pitch <= limit[1], (roll, pitch)
 
 
-@pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
+@pytest.mark.parametrize("key", ATTITUDE_FILTERS)
 def test_without_the_adaptive_noise_the_roll_sweep_fails(key: str) -> None:
     """The same filter with constant noise, as the papers have it, fails roll_sweep."""
     roll, pitch = rmse(key, "roll_sweep", CONSTANT_NOISE)

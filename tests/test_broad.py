@@ -17,7 +17,7 @@ import pytest
 from fusion_core import DEG, ESTIMATORS
 from fusion_core.kinematics import quat_from_roll_pitch_yaw
 from fusion_core.presets import PRESETS, preset_params
-from fusion_core.registry import create
+from fusion_core.registry import ATTITUDE_FILTERS, create
 from testbenches.__main__ import main
 from testbenches.broad.data import BroadTrial, NotABroadTrial, load_trial, trial_groups
 from testbenches.broad.metric import (
@@ -216,7 +216,7 @@ def test_the_defaults_meet_the_broad_targets_on_the_13_shared_trials() -> None:
     result = evaluate(ALL_TRIALS, plan_columns(list(ESTIMATORS), ["recommended"]))
     means = result.means()
     assert min(means.values()) <= 0.65, means
-    for key in ("cf", "mgcf", "kf", "ukf"):
+    for key in ATTITUDE_FILTERS:
         assert means[key] <= 0.9, means
     assert means["poskf"] <= 1.5, means
     assert abs(means["poskf"] - means["kf"]) <= 0.05, means

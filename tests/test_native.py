@@ -400,3 +400,13 @@ def test_a_scenarios_truth_is_the_same_from_either_backend():
         a, b = sc.truth(t, backend="native"), sc.truth(t, backend="python")
         assert a.shape == b.shape == (2001, 15)
         assert np.max(np.abs(a - b)) <= 1e-12, sc.name
+
+
+@needs_twin
+def test_the_twins_sizes_are_the_python_classes():
+    """The C twin's queue bound and estimate size follow the Python side (generated, derived)."""
+    from fusion_core.position import PENDING_MAX
+
+    _, ffi = native.lib_and_ffi()
+    assert native.poskf_pending_max() == PENDING_MAX
+    assert ffi.sizeof("fc_estimate") == 8 * native.ESTIMATE_FIELDS

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from fusion_core import ESTIMATORS, G
+from fusion_core.registry import ATTITUDE_FILTERS
 from fusion_core.scenarios import SCENARIOS
 from fusion_core.synthetic import TRUTH_NAMES
 from fusion_core.types import DEG
@@ -48,7 +49,7 @@ def _mean_rmse(make, scenario: str) -> np.ndarray:
 
 
 @pytest.mark.parametrize("scenario", ["shaking", "gyro_clipping"])
-@pytest.mark.parametrize("key", ["cf", "mgcf", "kf", "ukf"])
+@pytest.mark.parametrize("key", ATTITUDE_FILTERS)
 def test_every_default_is_within_vqf_plus_ten_percent_over_20_parts(key: str,
                                                                    scenario: str) -> None:
     def run(s):

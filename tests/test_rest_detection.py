@@ -14,11 +14,12 @@ import pytest
 
 from fusion_core import ESTIMATORS, native
 from fusion_core.building_blocks import REST_PARAMS
+from fusion_core.registry import ATTITUDE_FILTERS
 from fusion_core.types import DEG, G
 
 RATE = 100.0
 REST_TIME = next(p.default for p in REST_PARAMS if p.name == "rest_time")
-FILTERS = ("cf", "mgcf", "kf", "ukf")
+FILTERS = ATTITUDE_FILTERS
 BACKENDS = ["python", pytest.param("native", marks=pytest.mark.skipif(
     native.reason() is not None, reason=f"no C twin: {native.reason()}"))]
 

@@ -25,11 +25,11 @@ from .estimators import (
     BASE_STATE,
     ESTIMATE_FIELDS,
     FC_SKIPPED,
-    POSKF_PENDING_MAX,
     STATE_ATTRIBUTES,
     Stepper,
     has_twin,
     new_twin,
+    poskf_pending_max,
     run,
     stepper,
     take_state,
@@ -53,7 +53,7 @@ from .models import normals, plant_truth, sensor_run
 
 __all__ = [
     "BASE_STATE", "CFLAGS", "DATA_HEADERS", "ESTIMATE_FIELDS", "FC_SKIPPED", "HEADERS", "HERE",
-    "POSKF_PENDING_MAX", "PREBUILT", "SOURCES", "STATE_ATTRIBUTES", "Stepper", "available",
+    "PREBUILT", "SOURCES", "STATE_ATTRIBUTES", "Stepper", "available",
     "build", "cache_dir", "cdef", "compiler", "has_twin", "lib_and_ffi", "new_twin", "normals",
-    "plant_truth", "reason", "run", "sensor_run", "stepper", "take_state",
+    "plant_truth", "poskf_pending_max", "reason", "run", "sensor_run", "stepper", "take_state",
 ]

@@ -9,13 +9,13 @@ from typing import Any
 import numpy as np
 
 from ..state import BASE_STATE as STATE_BASE
-from ..types import RUN_CHUNK
+from ..types import RUN_CHUNK, Estimate
 from .library import available, lib_and_ffi
 
 FC_SKIPPED = 1
 """fc_status: FC_OK 0 and FC_SKIPPED 1 took the sample, the larger values rejected it."""
-ESTIMATE_FIELDS = 11
-"""Doubles per fc_estimate: roll, pitch, bias[3], pos[3], vel[3]."""
+ESTIMATE_FIELDS = 2 + 3 * (len(Estimate._fields) - 2)
+"""Doubles per fc_estimate: roll, pitch, then bias[3], pos[3], vel[3] (types.Estimate)."""
 _ESTIMATE_DOUBLES = struct.Struct("=11d")
 """An fc_estimate's memory, read as Python floats."""
 BASE_STATE = tuple(STATE_BASE)
@@ -24,8 +24,11 @@ member."""
 STATE_ATTRIBUTES = {"UnscentedKalmanFilter": {"P": "_P"}, "PaperUnscentedKalmanFilter": {"P": "_P"}}
 """Where a twin's state field is kept under another Python attribute: the UKFs' P is their packed
 lower triangle `_P` (the `P` property shows it as a 6x6 list)."""
-POSKF_PENDING_MAX = 2048
-"""fc_poskf.h's FC_POSKF_PENDING_MAX (position.PENDING_MAX)."""
+def poskf_pending_max() -> int:
+    """The C twin's FC_POSKF_PENDING_MAX, which fusion_core.native.generate writes into
+    fc_params.h from position.PENDING_MAX (tests/test_native.py holds them equal)."""
+    lib, _ = lib_and_ffi()
+    return int(lib.FC_POSKF_PENDING_MAX)
 
 
 def has_twin(estimator: object) -> bool:
@@ -117,9 +120,9 @@ def _fill_position(lib: Any, twin: Any, est: Any) -> None:
     _fill(lib, ffi.addressof(twin[0], "att"), est.att)
     twin.quiet_time = est.quiet_time
     twin.stationary = est.stationary
-    if len(est.pending) > POSKF_PENDING_MAX:
+    if len(est.pending) > poskf_pending_max():
         raise ValueError(f"the stationary queue holds {len(est.pending)} samples, more than "
-                         f"the C twin's {POSKF_PENDING_MAX}")
+                         f"the C twin's {poskf_pending_max()}")
     twin.pending_head = 0
     twin.pending_count = len(est.pending)
     for i, entry in enumerate(est.pending):
@@ -141,7 +144,8 @@ def _take_position(twin: Any, est: Any) -> None:
     est.quiet_time = float(twin.quiet_time)
     est.stationary = bool(twin.stationary)
     head, count = twin.pending_head, twin.pending_count
-    est.pending = [tuple(float(v) for v in twin.pending[(head + i) % POSKF_PENDING_MAX])
+    size = poskf_pending_max()
+    est.pending = [tuple(float(v) for v in twin.pending[(head + i) % size])
                    for i in range(count)]
     est.turned = tuple(float(v) for v in twin.turned)
     est.f_mean = tuple(float(v) for v in twin.f_mean)

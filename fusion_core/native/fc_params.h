@@ -10,6 +10,9 @@
 
 #include <math.h>
 
+/* Sizes the twins' state takes from the Python classes. */
+#define FC_POSKF_PENDING_MAX 2048  /* position.PENDING_MAX */
+
 /* ----- ComplementaryFilter (fc_cf) ------------------------------------------ */
 
 #define FC_CF_GYRO_SAMPLING_POINT 0

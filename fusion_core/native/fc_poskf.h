@@ -10,8 +10,6 @@
 #include "fc_paper_kf.h"
 #include "fc_params.h"
 
-#define FC_POSKF_PENDING_MAX 2048  /* position.PENDING_MAX */
-
 typedef struct fc_poskf {
     fc_poskf_params params;
     fc_base base;

@@ -133,6 +133,11 @@ def render() -> str:
         "#include <math.h>",
         "",
     ]
+    lines += [
+        "/* Sizes the twins' state takes from the Python classes. */",
+        f"#define FC_POSKF_PENDING_MAX {PENDING_MAX}  /* position.PENDING_MAX */",
+        "",
+    ]
     for prefix in PREFIX:
         lines += estimator_block(prefix)
     lines += ["#endif /* FC_PARAMS_H */", ""]

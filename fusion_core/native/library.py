@@ -95,8 +95,8 @@ def build(force: bool = False) -> Path:
 
 def cdef() -> str:
     """The headers as cffi declarations: comments, include guards, #includes, macros and the
-    static inline default functions left out; integer #defines kept, and written into the
-    declarations that use them (array sizes)."""
+    static inline default functions left out; integer #defines kept (lib.NAME), and written
+    into the declarations that use them (array sizes)."""
     out: list[str] = []
     defines: dict[str, str] = {}
     for name in HEADERS:
@@ -105,9 +105,10 @@ def cdef() -> str:
         text = re.sub(r"static inline[^{]*\{.*?\n\}\n", "", text, flags=re.S)
         for line in text.splitlines():
             line = line.rstrip()
-            define = re.match(r"#define (\w+) (-?\d+)$", line)
-            if define:
+            define = re.match(r"#define (\w+) (-?\d+)(?:\s.*)?$", line)
+            if define:  # a constant the binding reads too (lib.NAME)
                 defines[define.group(1)] = define.group(2)
+                out.append(f"#define {define.group(1)} {define.group(2)}")
             elif line.startswith("#"):
                 continue
             elif defines:
