@@ -61,7 +61,7 @@ from .measured_vector import (
     measure_step,
     measure_turned,
 )
-from .papers.kalman import bias_update, measurement_gain, predict_covariance
+from .papers.kalman import RollPitchAxes
 from .state import ANGLE, COV, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec, index
 from .types import DEG, Estimate, G, Param
 
@@ -96,7 +96,7 @@ def angle_only_gain(
     return (K0, 0.0), (P00 - K0 * P00, P01 - K0 * P01, P10 - K0 * P10, P11)
 
 
-class AngleBiasKalmanFilter(Estimator):
+class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     """The recommended 2-state [angle, gyro bias] Kalman filter for roll and for pitch.
 
     The papers' filter (fusion_core.papers.kalman: Gui et al. eq. 5-26, Das & Mary eq. 16-27):
@@ -367,20 +367,7 @@ class AngleBiasKalmanFilter(Estimator):
             wx, wy, wz = gx - bx, gy - by, gz - bz
             q_angle += q_rotation * (wx * wx + wy * wy + wz * wz)
         self.q_step = q_angle
-        # The roll and the pitch filter have the same F, Q and R and every update treats both,
-        # so P_roll == P_pitch: one covariance, computed once (the same numbers as twice). A
-        # state snapshot with two different ones is still followed axis by axis.
-        P, P_pitch = self.P_roll, self.P_pitch
-        self.P_roll = predict_covariance(P, dt, q_angle, self._q_bias)
-        if P_pitch == P:
-            self.P_pitch = self.P_roll
-        else:
-            self.P_pitch = predict_covariance(P_pitch, dt, q_angle, self._q_bias)
-
-    def accel_trusted(self, norm2: float) -> bool:
-        """Whether the accelerometer gate is open for a sample of squared norm norm2."""
-        low2, high2 = self._gate2
-        return low2 <= norm2 <= high2
+        self.predict_covariances(dt, q_angle)
 
     def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch (the biases
@@ -399,34 +386,7 @@ class AngleBiasKalmanFilter(Estimator):
     def correct_innovation(self, y_roll: float, y_pitch: float, learn_bias: bool = True) -> None:
         """Measurement update with given innovations (accelerometer angle - predicted angle);
         with learn_bias False the biases are consider states (angle_only_gain)."""
-        gain = measurement_gain if learn_bias else angle_only_gain
-        P, P_pitch = self.P_roll, self.P_pitch
-        r = self.r_step
-        self.gain_roll, self.P_roll = gain(P, r)
-        if P_pitch == P:  # one covariance (see propagate)
-            self.gain_pitch, self.P_pitch = self.gain_roll, self.P_roll
-        else:
-            self.gain_pitch, self.P_pitch = gain(P_pitch, r)
-        K0, K1 = self.gain_roll
-        roll = self.roll + K0 * y_roll
-        self.bias_x += K1 * y_roll
-        K0, K1 = self.gain_pitch
-        pitch = self.pitch + K0 * y_pitch
-        self.bias_y += K1 * y_pitch
-        self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
-        self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-
-    def correct_bias(self, z_x: float, z_y: float, r: float) -> None:
-        """Update with direct measurements z of the x and y gyro bias (variance r each).
-
-        Used as a zero-angular-rate update: a gyro at rest reads its bias.
-        """
-        self.roll, self.bias_x, self.P_roll = bias_update(
-            self.roll, self.bias_x, self.P_roll, z_x - self.bias_x, r
-        )
-        self.pitch, self.bias_y, self.P_pitch = bias_update(
-            self.pitch, self.bias_y, self.P_pitch, z_y - self.bias_y, r
-        )
+        self.update_angles(y_roll, y_pitch, None if learn_bias else angle_only_gain)
 
     def _switch_face(self) -> None:
         """Move the filters to the face nearest to up, once up is more

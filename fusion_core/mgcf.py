@@ -29,10 +29,7 @@ from .building_blocks import (
 from .kinematics import (
     accel_roll_pitch,
     quat_from_roll_pitch_yaw,
-    quat_gravity_body,
-    quat_mul_rotvec,
     quat_roll_pitch,
-    rotation_increment,
     rotvec_terms,
 )
 from .measured_vector import (
@@ -44,7 +41,7 @@ from .measured_vector import (
     measure_step,
     raw_noise,
 )
-from .papers.mgcf import quat_first_order
+from .papers.mgcf import pi_step
 from .state import NONNEG, REAL, REST, UNIT, StateSpec
 from .types import Estimate, Param
 
@@ -195,34 +192,11 @@ class GainScheduledComplementaryFilter(Estimator):
             tau = 1.0 / kp
             kp *= tau / correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,
                                         r_ref, dt, longest)
-        if self._trapezoid:
-            # Predict with the gyro over the interval, then correct with this sample's
-            # accelerometer against the attitude at this sample's time: the same continuous-time
-            # PI filter without the one-sample lag of comparing a_k with q_{k-1} (which shows as
-            # |omega| dt of error).
-            p0, q0, r0 = self.gyro_prev
-            q = quat_mul_rotvec(self.q, *rotation_increment(
-                p0 - bx, q0 - by, r0 - bz, gx - bx, gy - by, gz - bz, dt
-            ))
-        else:
-            q = self.q  # Mahony's reference order: error from the previous attitude
-        ex = ey = ez = 0.0  # Mahony's error, zero while the correction is off
-        if w0 > 0.0:
-            # e = a/|a| x v, v = R(q)^T e_z the estimated gravity direction in the body frame
-            vx, vy, vz = quat_gravity_body(*q)
-            inv = 1.0 / norm
-            nx, ny, nz = ax * inv, ay * inv, az * inv
-            ex, ey, ez = ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
-            # b <- b - Ki e dt, Ki = w0^2: the integral term, whose negative is the gyro bias;
-            # none from a gyro sample at its rail, nor from a vector still holding its turns
-            if not self.clipped and (self._acc_tau == 0.0 or self.meas.settled(self._measure)):
-                ki_dt = w0 * w0 * dt
-                bx, by, bz = self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
-        if not self._trapezoid:  # then one Euler step with the PI-corrected rate
-            q = quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
-        elif w0 > 0.0:
-            kp_dt = kp * dt
-            q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
+        # the integral term learns nothing from a gyro sample at its rail, nor from a vector
+        # still holding its turns
+        learn = not self.clipped and (self._acc_tau == 0.0 or self.meas.settled(self._measure))
+        q, self.bias = pi_step(self.q, self.bias, self.gyro_prev, (gx, gy, gz), (ax, ay, az),
+                               norm, w0, kp, dt, self._trapezoid, learn)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)
         return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))

@@ -18,17 +18,12 @@ from .kinematics import PI, accel_roll_pitch, wrap_angle
 from .papers.kalman import PAPER_KF_PARAMS, PaperKalmanFilter
 from .papers.position import (
     JERK_PARAMS,
-    AxisStates,
-    Mat3,
-    Sym3,
+    AxisFiltersState,
     axis_filters,
-    axis_lists,
-    axis_tuple,
     first_axis_states,
     level_acceleration,
     process_noise,
-    sym3_matrix,
-    sym3_packed,
+    yaw_and_level_acceleration,
 )
 from .state import ANGLE, COV, FLAG, NESTED, NONNEG, REAL, Queue, Segments, StateSpec
 from .types import DEG, Estimate, Param
@@ -58,7 +53,7 @@ must trust the accelerometer in motion too. The gyro sampling is the sensor's (p
 default, as every recommended estimator)."""
 TILT_PARAM_NAMES: Final = tuple(p.name for p in TILT_PARAMS)
 
-class PositionKalmanFilter(Estimator):
+class PositionKalmanFilter(AxisFiltersState, Estimator):
     """The recommended position filter: Safitri et al.'s [p, v, a] filters with a zero-velocity
     update.
 
@@ -142,8 +137,6 @@ class PositionKalmanFilter(Estimator):
         "pending": Queue(Segments(((NONNEG, 1), (REAL, 4))), 5, PENDING_MAX), "turned": REAL,
         "f_mean": REAL, "tilt_state": NESTED, "attitude_state": NESTED,
     }
-    _x: AxisStates  # [p, v, a] of x, y, z
-    _P: Sym3  # the covariance the three axes share, packed
 
     def _configure(self) -> None:
         p = self._params
@@ -181,32 +174,6 @@ class PositionKalmanFilter(Estimator):
     @attitude_state.setter
     def attitude_state(self, value: dict) -> None:
         self.att.set_state(value)
-
-    @property
-    def tilt_state(self) -> dict:
-        return self.tilt.get_state()
-
-    @tilt_state.setter
-    def tilt_state(self, value: dict) -> None:
-        self.tilt.set_state(value)
-
-    @property
-    def states(self) -> list[list[float]]:
-        """[p, v, a] of the x, y and z axes (a copy)."""
-        return axis_lists(self._x)
-
-    @states.setter
-    def states(self, value: list[list[float]]) -> None:
-        self._x = axis_tuple(value)
-
-    @property
-    def P(self) -> Mat3:
-        """The covariance shared by the three axes, 3x3 (of [p, v, a])."""
-        return sym3_matrix(self._P)
-
-    @P.setter
-    def P(self, value: Mat3) -> None:
-        self._P = sym3_packed(value)
 
     def _reset(self) -> None:
         self.tilt.reset()
@@ -325,13 +292,9 @@ class PositionKalmanFilter(Estimator):
             tilt.correct_bias(gx, gy, self._gyro_var_density / dt)
         tilt.took_sample((gx, gy, gz))
         self.att.step((ax, ay, az), (gx, gy, gz), dt)
-        roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
-        sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
-        if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
-            yaw += dt * (wy * sr + gz * cr) / cp
-            yaw = self.yaw = yaw if -PI <= yaw <= PI else wrap_angle(yaw)
-        # 3. level-frame acceleration with the new attitude
-        acc = level_acceleration(ax, ay, az, sr, cr, sp, cp, sin(yaw), cos(yaw))
+        # 3. yaw from the gyro, the level-frame acceleration with the new attitude
+        self.yaw, acc = yaw_and_level_acceleration(tilt.roll, tilt.pitch, self.yaw, wy, gz,
+                                                   (ax, ay, az), dt)
         # 4. [p, v, a] filter per axis (eq. 20-29)
         if dt != self._Q_dt:
             p = self._params

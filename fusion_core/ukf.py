@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from typing import ClassVar, Final
 
-from .base import ESTIMATE, Estimator, tuple_new
+from .base import Estimator
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
     ADAPTIVE_NOISE_PARAMS,
@@ -28,7 +28,7 @@ from .building_blocks import (
     zero_rate_psd_param,
 )
 from .kalman import KALMAN_MAX_CORRECTION_TIME, RECOMMENDED_INIT_BIAS_STD
-from .kinematics import accel_roll_pitch, rotvec_terms
+from .kinematics import rotvec_terms
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
@@ -41,15 +41,14 @@ from .measured_vector import (
 from .papers.ukf import (
     N_STATE,
     SIGMA_PARAMS,
+    GravityDirectionState,
     cholesky3,
     measurement_update,
-    packed,
     packed_diagonal,
     packed_index,
     predicted_covariance,
     rotation_terms,
     sigma_predict,
-    unpacked,
     unscented_constants,
 )
 from .state import COV, REAL, REST, UNIT, Segments, StateSpec
@@ -61,7 +60,7 @@ ACC_GATE: Final = 1.0
 either."""
 
 
-class UnscentedKalmanFilter(Estimator):
+class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     """The recommended UKF on the gravity direction with three gyro-bias states (Duong Quoc et
     al. eq. 14-17).
 
@@ -175,15 +174,6 @@ class UnscentedKalmanFilter(Estimator):
         self._P = packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
         self.meas = measure_start((ax, ay, az), self._measure)
         self.rest = rest_start(gx, gy, gz, ax, ay, az)
-
-    @property
-    def P(self) -> list[list[float]]:
-        """The 6x6 state covariance as a list of lists (a copy; x = [X (3), b (3)])."""
-        return unpacked(self._P)
-
-    @P.setter
-    def P(self, value: list[list[float]]) -> None:
-        self._P = packed(value)
 
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -303,8 +293,3 @@ class UnscentedKalmanFilter(Estimator):
             n = math.sqrt(X0 * X0 + X1 * X1 + X2 * X2)
         self.x = [X0 / n, X1 / n, X2 / n, b0, b1, b2]
         self._P = P
-
-    def _estimate(self) -> Estimate:
-        X1, X2, X3, bx, by, bz = self.x
-        roll, pitch = accel_roll_pitch(X1, X2, X3)  # X is a resting accelerometer's direction
-        return tuple_new(ESTIMATE, (roll, pitch, (bx, by, bz), None, None))

@@ -6,21 +6,24 @@
 #include <math.h>
 #include <string.h>
 
-/* measurement_gain (Das & Mary eq. 23-27) and angle_only_gain (the bias a consider state) */
-static void gain(const double P[4], double r, int learn_bias, double K[2], double out[4])
+/* angle_only_gain: the update of measurement_gain with the bias a consider state */
+static void angle_only_gain(const double P[4], double r, double K[2], double out[4])
 {
     double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
-    if (learn_bias) {
-        fc_paper_kf_measurement_gain(P, r, K, out);
-    } else {
-        double K0 = P00 / (P00 + r);
-        K[0] = K0;
-        K[1] = 0.0;
-        out[0] = P00 - K0 * P00;
-        out[1] = P01 - K0 * P01;
-        out[2] = P10 - K0 * P10;
-        out[3] = P11;
-    }
+    double K0 = P00 / (P00 + r);
+    K[0] = K0;
+    K[1] = 0.0;
+    out[0] = P00 - K0 * P00;
+    out[1] = P01 - K0 * P01;
+    out[2] = P10 - K0 * P10;
+    out[3] = P11;
+}
+
+static fc_roll_pitch_axes axes(fc_kf *f)
+{
+    fc_roll_pitch_axes a = {&f->roll, &f->pitch, &f->bias_x, &f->bias_y, f->P_roll, f->P_pitch,
+                            f->gain_roll, f->gain_pitch};
+    return a;
 }
 
 static int same4(const double a[4], const double b[4])
@@ -137,39 +140,14 @@ static void propagate(fc_kf *f, const double g[3], double dt, const double phi[3
         q_angle += f->q_rotation * (wx * wx + wy * wy + wz * wz);
     }
     f->q_step = q_angle;
-    double P[4];
-    memcpy(P, f->P_roll, sizeof P);
-    fc_paper_kf_predict_covariance(P, dt, q_angle, f->q_bias, f->P_roll);
-    if (same4(f->P_pitch, P)) {
-        memcpy(f->P_pitch, f->P_roll, sizeof P);
-    } else {
-        double Pp[4];
-        memcpy(Pp, f->P_pitch, sizeof Pp);
-        fc_paper_kf_predict_covariance(Pp, dt, q_angle, f->q_bias, f->P_pitch);
-    }
+    fc_roll_pitch_predict_covariances(axes(f), dt, q_angle, f->q_bias);
 }
 
-/* correct_innovation */
+/* correct_innovation: the biases consider states unless learn_bias */
 static void correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
 {
-    double P[4];
-    memcpy(P, f->P_roll, sizeof P);
-    int shared = same4(f->P_pitch, P);
-    gain(P, f->r_step, learn_bias, f->gain_roll, f->P_roll);
-    if (shared) {
-        memcpy(f->gain_pitch, f->gain_roll, sizeof f->gain_roll);
-        memcpy(f->P_pitch, f->P_roll, sizeof P);
-    } else {
-        double Pp[4];
-        memcpy(Pp, f->P_pitch, sizeof Pp);
-        gain(Pp, f->r_step, learn_bias, f->gain_pitch, f->P_pitch);
-    }
-    double roll = f->roll + f->gain_roll[0] * y_roll;
-    f->bias_x += f->gain_roll[1] * y_roll;
-    double pitch = f->pitch + f->gain_pitch[0] * y_pitch;
-    f->bias_y += f->gain_pitch[1] * y_pitch;
-    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
-    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+    fc_roll_pitch_update_angles(axes(f), f->r_step, y_roll, y_pitch,
+                                learn_bias ? fc_paper_kf_measurement_gain : angle_only_gain);
 }
 
 /* correct: the accelerometer's roll and pitch */
@@ -189,13 +167,6 @@ static void correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
     correct_innovation(f, y_roll, y_pitch, learn_bias);
 }
 
-/* correct_bias: direct measurements of the x and y gyro bias (variance r each) */
-static void correct_bias(fc_kf *f, double z_x, double z_y, double r)
-{
-    fc_paper_kf_bias_update(&f->roll, &f->bias_x, f->P_roll, z_x - f->bias_x, r);
-    fc_paper_kf_bias_update(&f->pitch, &f->bias_y, f->P_pitch, z_y - f->bias_y, r);
-}
-
 /* _zero_rate_update: at rest the gyro measures the bias */
 static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], double dt)
 {
@@ -211,7 +182,7 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
         double r = f->gyro_var / dt;
-        correct_bias(f, g[0], g[1], r);
+        fc_roll_pitch_correct_bias(axes(f), g[0], g[1], r);
         double k = f->P_z / (f->P_z + r);
         f->bias_z += k * (g[2] - f->bias_z);
         f->P_z -= k * f->P_z;

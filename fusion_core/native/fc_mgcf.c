@@ -108,43 +108,12 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         kp *= tau / fc_correction_time(tau, r / f->r_ref, f->q_rotation,
                                        wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
     }
-    double q[4];
-    memcpy(q, f->q, sizeof q);
-    if (f->trapezoid) {
-        const double *w = f->base.gyro_prev;
-        double phi[3];
-        fc_rotation_increment(w[0] - bx, w[1] - by, w[2] - bz, gx - bx, gy - by, gz - bz, dt,
-                              phi);
-        fc_quat_mul_rotvec(q, phi[0], phi[1], phi[2]);
-    }
-    double ex = 0.0, ey = 0.0, ez = 0.0;
-    if (w0 > 0.0) {
-        double v[3];
-        fc_quat_gravity_body(q, v);
-        double inv = 1.0 / norm;
-        double nx = ax * inv, ny = ay * inv, nz = az * inv;
-        ex = ny * v[2] - nz * v[1];
-        ey = nz * v[0] - nx * v[2];
-        ez = nx * v[1] - ny * v[0];
-        /* none from a gyro sample at its rail, nor from a vector still holding its turns */
-        if (!clipped && (f->acc_tau == 0.0 || fc_measure_settled(f->meas, &f->measure))) {
-            double ki_dt = w0 * w0 * dt;
-            bx = bx - ki_dt * ex;
-            by = by - ki_dt * ey;
-            bz = bz - ki_dt * ez;
-            f->bias[0] = bx;
-            f->bias[1] = by;
-            f->bias[2] = bz;
-        }
-    }
-    if (!f->trapezoid) {
-        fc_paper_mgcf_quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by,
-                                       gz + kp * ez - bz, dt);
-    } else if (w0 > 0.0) {
-        double kp_dt = kp * dt;
-        fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
-    }
-    memcpy(f->q, q, sizeof q);
+    /* the integral term learns nothing from a gyro sample at its rail, nor from a vector
+     * still holding its turns */
+    int learn = !clipped && (f->acc_tau == 0.0 || fc_measure_settled(f->meas, &f->measure));
+    const double af[3] = {ax, ay, az};
+    fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, af, norm, w0, kp, dt,
+                          f->trapezoid, learn);
 }
 
 FC_DEFINE_STEP_AND_RUN(fc_mgcf)

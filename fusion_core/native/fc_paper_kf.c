@@ -47,6 +47,60 @@ static int same4(const double a[4], const double b[4])
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] && a[3] == b[3];
 }
 
+/* RollPitchAxes.predict_covariances */
+void fc_roll_pitch_predict_covariances(fc_roll_pitch_axes a, double dt, double q_angle,
+                                       double q_bias)
+{
+    double P[4];
+    memcpy(P, a.P_roll, sizeof P);
+    fc_paper_kf_predict_covariance(P, dt, q_angle, q_bias, a.P_roll);
+    if (same4(a.P_pitch, P)) {
+        memcpy(a.P_pitch, a.P_roll, sizeof P);
+    } else {
+        double Pp[4];
+        memcpy(Pp, a.P_pitch, sizeof Pp);
+        fc_paper_kf_predict_covariance(Pp, dt, q_angle, q_bias, a.P_pitch);
+    }
+}
+
+/* RollPitchAxes.update_angles */
+void fc_roll_pitch_update_angles(fc_roll_pitch_axes a, double r, double y_roll, double y_pitch,
+                                 fc_kf_gain_rule gain)
+{
+    double P[4];
+    memcpy(P, a.P_roll, sizeof P);
+    int shared = same4(a.P_pitch, P);
+    gain(P, r, a.gain_roll, a.P_roll);
+    if (shared) {
+        memcpy(a.gain_pitch, a.gain_roll, 2 * sizeof *a.gain_roll);
+        memcpy(a.P_pitch, a.P_roll, sizeof P);
+    } else {
+        double Pp[4];
+        memcpy(Pp, a.P_pitch, sizeof Pp);
+        gain(Pp, r, a.gain_pitch, a.P_pitch);
+    }
+    double roll = *a.roll + a.gain_roll[0] * y_roll;
+    *a.bias_x += a.gain_roll[1] * y_roll;
+    double pitch = *a.pitch + a.gain_pitch[0] * y_pitch;
+    *a.bias_y += a.gain_pitch[1] * y_pitch;
+    *a.roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    *a.pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+}
+
+/* RollPitchAxes.correct_bias */
+void fc_roll_pitch_correct_bias(fc_roll_pitch_axes a, double z_x, double z_y, double r)
+{
+    fc_paper_kf_bias_update(a.roll, a.bias_x, a.P_roll, z_x - *a.bias_x, r);
+    fc_paper_kf_bias_update(a.pitch, a.bias_y, a.P_pitch, z_y - *a.bias_y, r);
+}
+
+static fc_roll_pitch_axes axes(fc_paper_kf *f)
+{
+    fc_roll_pitch_axes a = {&f->roll, &f->pitch, &f->bias_x, &f->bias_y, f->P_roll, f->P_pitch,
+                            f->gain_roll, f->gain_pitch};
+    return a;
+}
+
 void fc_paper_kf_configure(fc_paper_kf *f)
 {
     const fc_paper_kf_params *p = &f->params;
@@ -107,16 +161,7 @@ void fc_paper_kf_propagate(fc_paper_kf *f, const double prev[3], const double g[
     if (f->r_loop > 0.0) {
         f->r_step = f->r_loop / dt;
     }
-    double P[4];
-    memcpy(P, f->P_roll, sizeof P);
-    fc_paper_kf_predict_covariance(P, dt, f->q_angle, f->q_bias, f->P_roll);
-    if (same4(f->P_pitch, P)) {
-        memcpy(f->P_pitch, f->P_roll, sizeof P);
-    } else {
-        double Pp[4];
-        memcpy(Pp, f->P_pitch, sizeof Pp);
-        fc_paper_kf_predict_covariance(Pp, dt, f->q_angle, f->q_bias, f->P_pitch);
-    }
+    fc_roll_pitch_predict_covariances(axes(f), dt, f->q_angle, f->q_bias);
 }
 
 int fc_paper_kf_accel_trusted(const fc_paper_kf *f, double norm2)
@@ -139,31 +184,14 @@ void fc_paper_kf_correct(fc_paper_kf *f, double ax, double ay, double az)
 /* correct_innovation: the update with given innovations */
 void fc_paper_kf_correct_innovation(fc_paper_kf *f, double y_roll, double y_pitch)
 {
-    double P[4];
-    memcpy(P, f->P_roll, sizeof P);
-    int shared = same4(f->P_pitch, P);
-    fc_paper_kf_measurement_gain(P, f->r_step, f->gain_roll, f->P_roll);
-    if (shared) {
-        memcpy(f->gain_pitch, f->gain_roll, sizeof f->gain_roll);
-        memcpy(f->P_pitch, f->P_roll, sizeof P);
-    } else {
-        double Pp[4];
-        memcpy(Pp, f->P_pitch, sizeof Pp);
-        fc_paper_kf_measurement_gain(Pp, f->r_step, f->gain_pitch, f->P_pitch);
-    }
-    double roll = f->roll + f->gain_roll[0] * y_roll;
-    f->bias_x += f->gain_roll[1] * y_roll;
-    double pitch = f->pitch + f->gain_pitch[0] * y_pitch;
-    f->bias_y += f->gain_pitch[1] * y_pitch;
-    f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
-    f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+    fc_roll_pitch_update_angles(axes(f), f->r_step, y_roll, y_pitch,
+                                fc_paper_kf_measurement_gain);
 }
 
 /* correct_bias: direct measurements of the x and y gyro bias (variance r each) */
 void fc_paper_kf_correct_bias(fc_paper_kf *f, double z_x, double z_y, double r)
 {
-    fc_paper_kf_bias_update(&f->roll, &f->bias_x, f->P_roll, z_x - f->bias_x, r);
-    fc_paper_kf_bias_update(&f->pitch, &f->bias_y, f->P_pitch, z_y - f->bias_y, r);
+    fc_roll_pitch_correct_bias(axes(f), z_x, z_y, r);
 }
 
 /* took_sample: g becomes the previous gyro sample, the sample is counted (as fc_step does) */

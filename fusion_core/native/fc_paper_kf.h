@@ -41,6 +41,24 @@ void fc_paper_kf_correct_innovation(fc_paper_kf *f, double y_roll, double y_pitc
 void fc_paper_kf_correct_bias(fc_paper_kf *f, double z_x, double z_y, double r);
 void fc_paper_kf_took_sample(fc_paper_kf *f, const double g[3]);
 
+/* An update's gain rule: K and the new P from P and R (fc_paper_kf_measurement_gain, or the
+ * recommended filter's angle-only rule). */
+typedef void (*fc_kf_gain_rule)(const double P[4], double r, double K[2], double out[4]);
+
+/* The roll and the pitch filter updated together (papers/kalman.py's RollPitchAxes, shared
+ * with the recommended filter, fc_kf.c): their states by pointer. One covariance while
+ * P_roll == P_pitch (the same numbers as twice), axis by axis otherwise. */
+typedef struct fc_roll_pitch_axes {
+    double *roll, *pitch, *bias_x, *bias_y;
+    double *P_roll, *P_pitch;         /* [4] each */
+    double *gain_roll, *gain_pitch;   /* [2] each */
+} fc_roll_pitch_axes;
+void fc_roll_pitch_predict_covariances(fc_roll_pitch_axes a, double dt, double q_angle,
+                                       double q_bias);
+void fc_roll_pitch_update_angles(fc_roll_pitch_axes a, double r, double y_roll, double y_pitch,
+                                 fc_kf_gain_rule gain);
+void fc_roll_pitch_correct_bias(fc_roll_pitch_axes a, double z_x, double z_y, double r);
+
 /* The equations (papers/kalman.py's functions of the same names): F P F' + Q; the gain and
  * covariance of an angle measurement; a direct bias measurement (P updated in place). */
 void fc_paper_kf_predict_covariance(const double P[4], double dt, double q_angle, double q_bias,

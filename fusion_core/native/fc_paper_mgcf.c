@@ -38,6 +38,46 @@ void fc_paper_mgcf_quat_first_order(double q[4], double w0, double w1, double w2
     q[3] = rz * n;
 }
 
+void fc_paper_mgcf_pi_step(double q[4], double bias[3], const double prev[3], const double g[3],
+                           const double a[3], double norm, double w0, double kp, double dt,
+                           int trapezoid, int learn_bias)
+{
+    double bx = bias[0], by = bias[1], bz = bias[2];
+    double gx = g[0], gy = g[1], gz = g[2];
+    if (trapezoid) {
+        double phi[3];
+        fc_rotation_increment(prev[0] - bx, prev[1] - by, prev[2] - bz, gx - bx, gy - by,
+                              gz - bz, dt, phi);
+        fc_quat_mul_rotvec(q, phi[0], phi[1], phi[2]);
+    }
+    double ex = 0.0, ey = 0.0, ez = 0.0;
+    if (w0 > 0.0) {  /* e = a/|a| x v, v = R(q)^T e_z */
+        double v[3];
+        fc_quat_gravity_body(q, v);
+        double inv = 1.0 / norm;
+        double nx = a[0] * inv, ny = a[1] * inv, nz = a[2] * inv;
+        ex = ny * v[2] - nz * v[1];
+        ey = nz * v[0] - nx * v[2];
+        ez = nx * v[1] - ny * v[0];
+        if (learn_bias) {  /* b <- b - Ki e dt, Ki = w0^2 */
+            double ki_dt = w0 * w0 * dt;
+            bx = bx - ki_dt * ex;
+            by = by - ki_dt * ey;
+            bz = bz - ki_dt * ez;
+            bias[0] = bx;
+            bias[1] = by;
+            bias[2] = bz;
+        }
+    }
+    if (!trapezoid) {
+        fc_paper_mgcf_quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by,
+                                       gz + kp * ez - bz, dt);
+    } else if (w0 > 0.0) {
+        double kp_dt = kp * dt;
+        fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
+    }
+}
+
 void fc_paper_mgcf_configure(fc_paper_mgcf *f)
 {
     const fc_paper_mgcf_params *p = &f->params;
@@ -81,7 +121,6 @@ static void first_sample(fc_paper_mgcf *f, const double a[3], const double g[3])
 static void advance(fc_paper_mgcf *f, const double a[3], const double g[3], double dt)
 {
     double ax = a[0], ay = a[1], az = a[2];
-    double gx = g[0], gy = g[1], gz = g[2];
     double norm = sqrt(ax * ax + ay * ay + az * az);
     int schedule = f->params.schedule;
     int scheduled = schedule == FC_PAPER_MGCF_SCHEDULE_SIMULATION ||
@@ -91,42 +130,8 @@ static void advance(fc_paper_mgcf *f, const double a[3], const double g[3], doub
         w0 = 0.0;
     }
     f->w0_now = w0;
-    double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
-    double kp = f->two_zeta * w0;
-    double q[4];
-    memcpy(q, f->q, sizeof q);
-    if (f->trapezoid) {
-        const double *w = f->base.gyro_prev;
-        double phi[3];
-        fc_rotation_increment(w[0] - bx, w[1] - by, w[2] - bz, gx - bx, gy - by, gz - bz, dt,
-                              phi);
-        fc_quat_mul_rotvec(q, phi[0], phi[1], phi[2]);
-    }
-    double ex = 0.0, ey = 0.0, ez = 0.0;
-    if (w0 > 0.0) {  /* e = a/|a| x v, v = R(q)^T e_z */
-        double v[3];
-        fc_quat_gravity_body(q, v);
-        double inv = 1.0 / norm;
-        double nx = ax * inv, ny = ay * inv, nz = az * inv;
-        ex = ny * v[2] - nz * v[1];
-        ey = nz * v[0] - nx * v[2];
-        ez = nx * v[1] - ny * v[0];
-        double ki_dt = w0 * w0 * dt;  /* b <- b - Ki e dt, Ki = w0^2 */
-        bx = bx - ki_dt * ex;
-        by = by - ki_dt * ey;
-        bz = bz - ki_dt * ez;
-        f->bias[0] = bx;
-        f->bias[1] = by;
-        f->bias[2] = bz;
-    }
-    if (!f->trapezoid) {
-        fc_paper_mgcf_quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by,
-                                       gz + kp * ez - bz, dt);
-    } else if (w0 > 0.0) {
-        double kp_dt = kp * dt;
-        fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
-    }
-    memcpy(f->q, q, sizeof q);
+    fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, a, norm, w0, f->two_zeta * w0, dt,
+                          f->trapezoid, 1);
 }
 
 FC_DEFINE_STEP_AND_RUN(fc_paper_mgcf)

@@ -35,4 +35,11 @@ void fc_paper_mgcf_restored(fc_paper_mgcf *f);
  * recommended filter integrates mean samples with it too). */
 void fc_paper_mgcf_quat_first_order(double q[4], double w0, double w1, double w2, double dt);
 
+/* pi_step: one step of the PI law (papers/mgcf.py's pi_step): q and bias in place, from the
+ * previous and this gyro sample, the specific force a of norm |a|, w0 and Kp; the integral
+ * term learns only while learn_bias. */
+void fc_paper_mgcf_pi_step(double q[4], double bias[3], const double prev[3], const double g[3],
+                           const double a[3], double norm, double w0, double kp, double dt,
+                           int trapezoid, int learn_bias);
+
 #endif /* FC_PAPER_MGCF_H */

@@ -125,6 +125,21 @@ void fc_paper_poskf_level_acceleration(double ax, double ay, double az, double s
     out[2] = u2 - FC_G;
 }
 
+/* yaw_and_level_acceleration: yaw from the gyro (Euler kinematics), the level-frame
+ * acceleration with the new attitude */
+void fc_paper_poskf_yaw_and_level_acceleration(double roll, double pitch, double *yaw, double wy,
+                                               double gz, const double a[3], double dt,
+                                               double acc[3])
+{
+    double y = *yaw;
+    double sr = sin(roll), cr = cos(roll), sp = sin(pitch), cp = cos(pitch);
+    if (cp > 1e-6 || cp < -1e-6) {
+        y += dt * (wy * sr + gz * cr) / cp;
+        y = *yaw = -FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y);
+    }
+    fc_paper_poskf_level_acceleration(a[0], a[1], a[2], sr, cr, sp, cp, sin(y), cos(y), acc);
+}
+
 /* first_axis_states: the tilt stage initialised with the first sample, x and P from it */
 void fc_paper_poskf_first_axis_states(fc_paper_kf *tilt, const double a[3], const double g[3],
                                       double dt, double acc_var_density, double x[9],
@@ -219,14 +234,9 @@ static void advance(fc_paper_poskf *f, const double a[3], const double g[3], dou
         fc_paper_kf_correct(tilt, ax, ay, az);
     }
     fc_paper_kf_took_sample(tilt, g);
-    double roll = tilt->roll, pitch = tilt->pitch, yaw = f->yaw;
-    double sr = sin(roll), cr = cos(roll), sp = sin(pitch), cp = cos(pitch);
-    if (cp > 1e-6 || cp < -1e-6) {
-        yaw += dt * (wy * sr + gz * cr) / cp;
-        yaw = f->yaw = -FC_PI <= yaw && yaw <= FC_PI ? yaw : fc_wrap_angle(yaw);
-    }
     double acc[3];
-    fc_paper_poskf_level_acceleration(ax, ay, az, sr, cr, sp, cp, sin(yaw), cos(yaw), acc);
+    fc_paper_poskf_yaw_and_level_acceleration(tilt->roll, tilt->pitch, &f->yaw, wy, gz, a, dt,
+                                              acc);
     if (dt != f->Q_dt) {
         fc_paper_poskf_process_noise(p->qr_form, p->q, dt, f->Q);
         f->R = f->acc_var_density / dt;

@@ -43,6 +43,10 @@ void fc_paper_poskf_axis_filters(double x[9], double P[6], const double Q[6], do
                                  const double acc[3], double r, int with_zupt, double zupt_r);
 void fc_paper_poskf_level_acceleration(double ax, double ay, double az, double sr, double cr,
                                        double sp, double cp, double sy, double cy, double out[3]);
+/* yaw_and_level_acceleration: yaw turned over dt in place, acc the level-frame acceleration. */
+void fc_paper_poskf_yaw_and_level_acceleration(double roll, double pitch, double *yaw, double wy,
+                                               double gz, const double a[3], double dt,
+                                               double acc[3]);
 void fc_paper_poskf_first_axis_states(fc_paper_kf *tilt, const double a[3], const double g[3],
                                       double dt, double acc_var_density, double x[9],
                                       double P[6]);

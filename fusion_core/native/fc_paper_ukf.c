@@ -509,15 +509,20 @@ void fc_paper_ukf_configure(fc_paper_ukf *f)
     f->trapezoid = p->gyro_sampling == FC_PAPER_UKF_GYRO_SAMPLING_POINT;
 }
 
-fc_estimate fc_paper_ukf_estimate(const fc_paper_ukf *f)
+fc_estimate fc_paper_ukf_gravity_estimate(const double x[6])
 {
     fc_estimate e;
     memset(&e, 0, sizeof e);
-    fc_accel_roll_pitch(f->x[0], f->x[1], f->x[2], &e.roll, &e.pitch);
-    e.bias[0] = f->x[3];
-    e.bias[1] = f->x[4];
-    e.bias[2] = f->x[5];
+    fc_accel_roll_pitch(x[0], x[1], x[2], &e.roll, &e.pitch);
+    e.bias[0] = x[3];
+    e.bias[1] = x[4];
+    e.bias[2] = x[5];
     return e;
+}
+
+fc_estimate fc_paper_ukf_estimate(const fc_paper_ukf *f)
+{
+    return fc_paper_ukf_gravity_estimate(f->x);
 }
 
 void fc_paper_ukf_reset(fc_paper_ukf *f)

@@ -56,6 +56,8 @@ void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const double
                                      double P[21], const double acc[3], double r, double w,
                                      double w_mu, int has_norm, double r_norm, int learn_bias,
                                      double x[6]);
+/* GravityDirectionState._estimate: roll, pitch and the bias from x = [X (3), b (3)]. */
+fc_estimate fc_paper_ukf_gravity_estimate(const double x[6]);
 /* packed_index and cholesky3 (the packed lower factor of a 3x3 S; 0 where not positive
  * definite). */
 int fc_paper_ukf_packed(int i, int j);

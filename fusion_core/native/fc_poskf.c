@@ -158,17 +158,10 @@ static void advance(fc_poskf *f, const double a[3], const double g[3], double dt
     }
     fc_paper_kf_took_sample(tilt, g);
     fc_kf_step(&f->att, a, g, dt, NULL);
-    roll = tilt->roll;
-    pitch = tilt->pitch;
-    double yaw = f->yaw;
-    double sr = sin(roll), cr = cos(roll), sp = sin(pitch), cp = cos(pitch);
-    if (cp > 1e-6 || cp < -1e-6) {
-        yaw += dt * (wy * sr + gz * cr) / cp;
-        yaw = f->yaw = -FC_PI <= yaw && yaw <= FC_PI ? yaw : fc_wrap_angle(yaw);
-    }
-    /* 3. level-frame acceleration with the new attitude */
+    /* 3. yaw from the gyro, the level-frame acceleration with the new attitude */
     double acc[3];
-    fc_paper_poskf_level_acceleration(ax, ay, az, sr, cr, sp, cp, sin(yaw), cos(yaw), acc);
+    fc_paper_poskf_yaw_and_level_acceleration(tilt->roll, tilt->pitch, &f->yaw, wy, gz, a, dt,
+                                              acc);
     /* 4. [p, v, a] filter per axis (eq. 20-29) */
     if (dt != f->Q_dt) {
         fc_paper_poskf_process_noise(FC_PAPER_POSKF_QR_FORM_WHITE_JERK, p->q, dt, f->Q);

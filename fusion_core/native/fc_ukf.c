@@ -27,13 +27,7 @@ void fc_ukf_configure(fc_ukf *f)
 
 fc_estimate fc_ukf_estimate(const fc_ukf *f)
 {
-    fc_estimate e;
-    memset(&e, 0, sizeof e);
-    fc_accel_roll_pitch(f->x[0], f->x[1], f->x[2], &e.roll, &e.pitch);
-    e.bias[0] = f->x[3];
-    e.bias[1] = f->x[4];
-    e.bias[2] = f->x[5];
-    return e;
+    return fc_paper_ukf_gravity_estimate(f->x);
 }
 
 void fc_ukf_reset(fc_ukf *f)

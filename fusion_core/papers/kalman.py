@@ -20,6 +20,7 @@ recommended filter (fusion_core.kalman) is built on them.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import ClassVar, Final
 
 from ..base import ESTIMATE, Estimator, tuple_new
@@ -39,6 +40,8 @@ from .common import PAPER_COMMON, PAPER_GATE, PAPER_SAMPLING, Vec3
 DEG2: Final = DEG * DEG
 Cov = tuple[float, float, float, float]
 """A 2x2 covariance [[P00, P01], [P10, P11]] as (P00, P01, P10, P11)."""
+GainRule = Callable[[Cov, float], tuple[tuple[float, float], Cov]] | None
+"""An update's gain and covariance from P and R (measurement_gain, or another rule)."""
 
 
 def predict_covariance(P: Cov, dt: float, q_angle: float, q_bias: float) -> Cov:
@@ -102,7 +105,72 @@ PAPER_KF_PARAMS: Final[tuple[Param, ...]] = (
 """The parameters of PaperKalmanFilter, at the papers' values."""
 
 
-class PaperKalmanFilter(Estimator):
+class RollPitchAxes:
+    """The two [angle, bias] filters, roll's and pitch's, updated together: the steps the
+    papers' filter and the recommended one (fusion_core.kalman) share.
+
+    The roll and the pitch filter have the same F, Q and R and every update treats both, so
+    P_roll == P_pitch: one covariance, computed once (the same numbers as twice). A state
+    snapshot with two different ones is still followed axis by axis."""
+
+    roll: float
+    pitch: float
+    bias_x: float
+    bias_y: float
+    P_roll: Cov
+    P_pitch: Cov
+    r_step: float
+    gain_roll: tuple[float, float]
+    gain_pitch: tuple[float, float]
+    _gate2: tuple[float, float]
+    _q_bias: float
+
+    def predict_covariances(self, dt: float, q_angle: float) -> None:
+        """Both covariances' time update (predict_covariance)."""
+        P, P_pitch = self.P_roll, self.P_pitch
+        self.P_roll = predict_covariance(P, dt, q_angle, self._q_bias)
+        if P_pitch == P:
+            self.P_pitch = self.P_roll
+        else:
+            self.P_pitch = predict_covariance(P_pitch, dt, q_angle, self._q_bias)
+
+    def accel_trusted(self, norm2: float) -> bool:
+        """Whether the accelerometer gate is open for a sample of squared norm norm2."""
+        low2, high2 = self._gate2
+        return low2 <= norm2 <= high2
+
+    def update_angles(self, y_roll: float, y_pitch: float, gain: GainRule = None) -> None:
+        """Measurement update of both filters with given innovations (accelerometer angle -
+        predicted angle), by gain's rule (None: measurement_gain, eq. 23-27)."""
+        gain = gain or measurement_gain
+        P, P_pitch = self.P_roll, self.P_pitch
+        r = self.r_step
+        self.gain_roll, self.P_roll = gain(P, r)
+        if P_pitch == P:  # one covariance
+            self.gain_pitch, self.P_pitch = self.gain_roll, self.P_roll
+        else:
+            self.gain_pitch, self.P_pitch = gain(P_pitch, r)
+        K0, K1 = self.gain_roll
+        roll = self.roll + K0 * y_roll
+        self.bias_x += K1 * y_roll
+        K0, K1 = self.gain_pitch
+        pitch = self.pitch + K0 * y_pitch
+        self.bias_y += K1 * y_pitch
+        self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
+        self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
+
+    def correct_bias(self, z_x: float, z_y: float, r: float) -> None:
+        """Update with direct measurements z of the x and y gyro bias (variance r each): a
+        gyro at rest reads its bias (a zero-angular-rate update)."""
+        self.roll, self.bias_x, self.P_roll = bias_update(
+            self.roll, self.bias_x, self.P_roll, z_x - self.bias_x, r
+        )
+        self.pitch, self.bias_y, self.P_pitch = bias_update(
+            self.pitch, self.bias_y, self.P_pitch, z_y - self.bias_y, r
+        )
+
+
+class PaperKalmanFilter(RollPitchAxes, Estimator):
     """Gui et al. eq. 5-26 / Das & Mary eq. 16-27: a 2-state [angle, bias] Kalman filter for
     roll and one for pitch, as the papers write it.
 
@@ -179,20 +247,7 @@ class PaperKalmanFilter(Estimator):
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         if self._r_loop > 0.0:
             self.r_step = self._r_loop / dt
-        # The roll and the pitch filter have the same F, Q and R and every update treats both,
-        # so P_roll == P_pitch: one covariance, computed once (the same numbers as twice). A
-        # state snapshot with two different ones is still followed axis by axis.
-        P, P_pitch = self.P_roll, self.P_pitch
-        self.P_roll = predict_covariance(P, dt, self._q_angle, self._q_bias)
-        if P_pitch == P:
-            self.P_pitch = self.P_roll
-        else:
-            self.P_pitch = predict_covariance(P_pitch, dt, self._q_angle, self._q_bias)
-
-    def accel_trusted(self, norm2: float) -> bool:
-        """Whether the accelerometer gate is open for a sample of squared norm norm2."""
-        low2, high2 = self._gate2
-        return low2 <= norm2 <= high2
+        self.predict_covariances(dt, self._q_angle)
 
     def correct(self, ax: float, ay: float, az: float) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch (eq. 23-26)."""
@@ -204,31 +259,7 @@ class PaperKalmanFilter(Estimator):
 
     def correct_innovation(self, y_roll: float, y_pitch: float) -> None:
         """Measurement update with given innovations (accelerometer angle - predicted angle)."""
-        P, P_pitch = self.P_roll, self.P_pitch
-        r = self.r_step
-        self.gain_roll, self.P_roll = measurement_gain(P, r)
-        if P_pitch == P:  # one covariance (see propagate)
-            self.gain_pitch, self.P_pitch = self.gain_roll, self.P_roll
-        else:
-            self.gain_pitch, self.P_pitch = measurement_gain(P_pitch, r)
-        K0, K1 = self.gain_roll
-        roll = self.roll + K0 * y_roll
-        self.bias_x += K1 * y_roll
-        K0, K1 = self.gain_pitch
-        pitch = self.pitch + K0 * y_pitch
-        self.bias_y += K1 * y_pitch
-        self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
-        self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-
-    def correct_bias(self, z_x: float, z_y: float, r: float) -> None:
-        """Update with direct measurements z of the x and y gyro bias (variance r each): a
-        gyro at rest reads its bias (a zero-angular-rate update)."""
-        self.roll, self.bias_x, self.P_roll = bias_update(
-            self.roll, self.bias_x, self.P_roll, z_x - self.bias_x, r
-        )
-        self.pitch, self.bias_y, self.P_pitch = bias_update(
-            self.pitch, self.bias_y, self.P_pitch, z_y - self.bias_y, r
-        )
+        self.update_angles(y_roll, y_pitch)
 
     def took_sample(self, g: Vec3) -> None:
         """Close a sample the driving filter stepped through the stage by hand: g becomes the
@@ -241,4 +272,5 @@ class PaperKalmanFilter(Estimator):
                                     None, None))
 
 
-__all__ = ["PaperKalmanFilter", "bias_update", "measurement_gain", "predict_covariance"]
+__all__ = ["PaperKalmanFilter", "RollPitchAxes", "bias_update", "measurement_gain",
+           "predict_covariance"]

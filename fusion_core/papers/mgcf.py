@@ -31,7 +31,7 @@ from ..kinematics import (
 )
 from ..state import NONNEG, REAL, UNIT, StateSpec
 from ..types import Estimate, G, Param
-from .common import PAPER_COMMON, PAPER_SAMPLING
+from .common import PAPER_COMMON, PAPER_SAMPLING, Vec3
 
 Quat = tuple[float, float, float, float]
 
@@ -63,6 +63,40 @@ def quat_first_order(q: Quat, w: tuple[float, float, float], dt: float) -> Quat:
     rz = qz + qw * wz + qx * wy - qy * wx
     n = 1.0 / math.sqrt(rw * rw + rx * rx + ry * ry + rz * rz)
     return rw * n, rx * n, ry * n, rz * n
+
+
+def pi_step(q: Quat, bias: Vec3, prev: Vec3, g: Vec3, a: Vec3, norm: float, w0: float,
+            kp: float, dt: float, trapezoid: bool, learn_bias: bool) -> tuple[Quat, Vec3]:
+    """One step of the PI law (eq. 7-13, Mahony et al. 2008) from the attitude q and the bias
+    b, the previous and this gyro sample, the specific force a of norm |a| and the gains
+    w0 and Kp: with point samples (trapezoid) the gyro first turns q over the interval (the
+    rate linear between the samples, with the coning term), and the error is taken against
+    the attitude at this sample's time; else it is taken against the previous attitude
+    (Mahony's reference order) and q then follows the PI-corrected rate by the first-order
+    rule. e = a/|a| x v, v = R(q)^T e_z; while learn_bias, b <- b - Ki e dt (Ki = w0^2).
+    Returns the new q and b."""
+    bx, by, bz = bias
+    gx, gy, gz = g
+    if trapezoid:
+        p0, q0, r0 = prev
+        q = quat_mul_rotvec(q, *rotation_increment(
+            p0 - bx, q0 - by, r0 - bz, gx - bx, gy - by, gz - bz, dt
+        ))
+    ex = ey = ez = 0.0  # Mahony's error, zero while the correction is off
+    if w0 > 0.0:
+        vx, vy, vz = quat_gravity_body(*q)  # the estimated gravity direction in the body frame
+        inv = 1.0 / norm
+        nx, ny, nz = a[0] * inv, a[1] * inv, a[2] * inv
+        ex, ey, ez = ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
+        if learn_bias:  # the integral term, whose negative is the gyro bias
+            ki_dt = w0 * w0 * dt
+            bx, by, bz = bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
+    if not trapezoid:  # one Euler step with the PI-corrected rate
+        q = quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
+    elif w0 > 0.0:
+        kp_dt = kp * dt
+        q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
+    return q, bias
 
 
 PAPER_MGCF_PARAMS: Final[tuple[Param, ...]] = (
@@ -129,29 +163,9 @@ class PaperGainScheduledFilter(Estimator):
         if not norm > 0.0:  # no gravity direction in this sample: gyro only
             w0 = 0.0
         self.w0_now = w0
-        bx, by, bz = self.bias
-        kp = self._two_zeta * w0
-        if self._trapezoid:
-            p0, q0, r0 = self.gyro_prev
-            q = quat_mul_rotvec(self.q, *rotation_increment(
-                p0 - bx, q0 - by, r0 - bz, gx - bx, gy - by, gz - bz, dt
-            ))
-        else:
-            q = self.q  # Mahony's reference order: error from the previous attitude
-        ex = ey = ez = 0.0  # Mahony's error, zero while the correction is off
-        if w0 > 0.0:
-            # e = a/|a| x v, v = R(q)^T e_z the estimated gravity direction in the body frame
-            vx, vy, vz = quat_gravity_body(*q)
-            inv = 1.0 / norm
-            nx, ny, nz = ax * inv, ay * inv, az * inv
-            ex, ey, ez = ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
-            ki_dt = w0 * w0 * dt  # b <- b - Ki e dt, Ki = w0^2 (the integral term)
-            bx, by, bz = self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
-        if not self._trapezoid:  # one Euler step with the PI-corrected rate
-            q = quat_first_order(q, (gx + kp * ex - bx, gy + kp * ey - by, gz + kp * ez - bz), dt)
-        elif w0 > 0.0:
-            kp_dt = kp * dt
-            q = quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez)
+        q, self.bias = pi_step(
+            self.q, self.bias, self.gyro_prev, (gx, gy, gz), (ax, ay, az), norm, w0,
+            self._two_zeta * w0, dt, self._trapezoid, True)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)
         return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
@@ -161,4 +175,5 @@ class PaperGainScheduledFilter(Estimator):
         return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
 
 
-__all__ = ["SCHEDULES", "PaperGainScheduledFilter", "quat_first_order", "scheduled_w0"]
+__all__ = ["SCHEDULES", "PaperGainScheduledFilter", "pi_step", "quat_first_order",
+           "scheduled_w0"]

@@ -27,7 +27,7 @@ from ..base import ESTIMATE, Estimator, tuple_new
 from ..kinematics import PI, wrap_angle
 from ..state import ANGLE, COV, NESTED, REAL, StateSpec
 from ..types import MPU6050_ACC_DENSITY, Estimate, G, Param
-from .common import PAPER_COMMON
+from .common import PAPER_COMMON, Vec3
 from .kalman import PAPER_KF_PARAMS, PaperKalmanFilter
 
 Sym3 = tuple[float, float, float, float, float, float]
@@ -145,6 +145,18 @@ def level_acceleration(
     return cy * u0 - sy * u1, sy * u0 + cy * u1, u2 - G
 
 
+def yaw_and_level_acceleration(roll: float, pitch: float, yaw: float, wy: float, gz: float,
+                               a: Vec3, dt: float) -> tuple[float, Vec3]:
+    """Yaw from the gyro over dt (the Z-Y-X Euler-rate kinematics, Duong Quoc et al. eq. 2, with
+    wy the bias-corrected y rate; held where cos(pitch) is 0) and the level-frame acceleration
+    of the specific force a with the new attitude (level_acceleration)."""
+    sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
+    if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
+        yaw += dt * (wy * sr + gz * cr) / cp
+        yaw = yaw if -PI <= yaw <= PI else wrap_angle(yaw)
+    return yaw, level_acceleration(a[0], a[1], a[2], sr, cr, sp, cp, sin(yaw), cos(yaw))
+
+
 QR_FORMS: Final = ("white_jerk", "piecewise_jerk", "diagonal")
 """Safitri et al.'s three Q/R forms (process_noise)."""
 JERK_PARAMS: Final[tuple[Param, ...]] = (
@@ -155,50 +167,14 @@ TILT_PARAM_NAMES: Final = tuple(p.name for p in PAPER_KF_PARAMS)
 """The parameters of the tilt stage (PaperKalmanFilter) a position filter passes through."""
 
 
-class PaperPositionKalmanFilter(Estimator):
-    """Safitri et al. eq. 20-29: a [p, v, a] Kalman filter per axis on the level-frame
-    acceleration, as the paper writes it.
+class AxisFiltersState:
+    """The state both position filters hold: the tilt stage (a PaperKalmanFilter, its state the
+    field tilt_state), the [p, v, a] of the three axes (_x, shown as `states`) and their shared
+    covariance (_P, shown as the 3x3 `P`)."""
 
-    Per sample: the tilt stage (the papers' Kalman filter, PaperKalmanFilter, on the same
-    samples and with every accelerometer sample its gate lets through) gives roll and pitch;
-    yaw is the gyro's integral (Euler kinematics; unobservable: positions are in the
-    start-heading frame); a = R(roll, pitch, yaw) f - g e_z; per axis predict (F eq. 23, Q of
-    the chosen form) and update with a (H = [0 0 1], R = acc_psd / dt). The filter starts at
-    position 0 and velocity 0 (the platform at rest, as in the paper). Roll, pitch and bias are
-    the tilt stage's (bias_z 0).
-    """
-
-    HAS_POSITION = True
-    PARAMS = (
-        Param("qr_form", "white_jerk",
-              "Process-noise form (Safitri et al.'s Q/R forms): 'white_jerk' (eq. 29), "
-              "'piecewise_jerk', 'diagonal'", choices=QR_FORMS),
-        *JERK_PARAMS,
-        Param("acc_psd", MPU6050_ACC_DENSITY**2,
-              "Accelerometer white-noise power spectral density, R = acc_psd/dt (the MPU-6050 "
-              "datasheet's (400 ug/sqrt(Hz))^2)", unit="m2/s3", low=0.0, low_open=True),
-        *PAPER_KF_PARAMS,
-    )
-    COMMON = PAPER_COMMON
-    TWIN: ClassVar[str | None] = "fc_paper_poskf"
-    STATE: ClassVar[StateSpec] = {"yaw": ANGLE, "states": REAL, "P": COV, "tilt_state": NESTED}
-    _x: AxisStates  # [p, v, a] of x, y, z
-    _P: Sym3  # the covariance the three axes share, packed
-
-    def _configure(self) -> None:
-        p = self._params
-        tilt_params = {k: p[k] for k in TILT_PARAM_NAMES}
-        if not hasattr(self, "tilt"):
-            self.tilt = PaperKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
-                                          **tilt_params)
-        else:
-            for k, v in tilt_params.items():
-                if k != "gyro_sampling":
-                    self.tilt.set_param(k, v)
-            self.tilt.set_param("max_dt", p["max_dt"])
-            self.tilt.set_param("max_rate", p["max_rate"])
-        self._acc_var_density = float(p["acc_psd"])
-        self._Q_dt = 0.0  # the dt of Q and R (0: none yet, since every accepted dt is > 0)
+    tilt: PaperKalmanFilter
+    _x: AxisStates
+    _P: Sym3
 
     @property
     def tilt_state(self) -> dict:
@@ -225,6 +201,50 @@ class PaperPositionKalmanFilter(Estimator):
     @P.setter
     def P(self, value: Mat3) -> None:
         self._P = sym3_packed(value)
+
+
+class PaperPositionKalmanFilter(AxisFiltersState, Estimator):
+    """Safitri et al. eq. 20-29: a [p, v, a] Kalman filter per axis on the level-frame
+    acceleration, as the paper writes it.
+
+    Per sample: the tilt stage (the papers' Kalman filter, PaperKalmanFilter, on the same
+    samples and with every accelerometer sample its gate lets through) gives roll and pitch;
+    yaw is the gyro's integral (Euler kinematics; unobservable: positions are in the
+    start-heading frame); a = R(roll, pitch, yaw) f - g e_z; per axis predict (F eq. 23, Q of
+    the chosen form) and update with a (H = [0 0 1], R = acc_psd / dt). The filter starts at
+    position 0 and velocity 0 (the platform at rest, as in the paper). Roll, pitch and bias are
+    the tilt stage's (bias_z 0).
+    """
+
+    HAS_POSITION = True
+    PARAMS = (
+        Param("qr_form", "white_jerk",
+              "Process-noise form (Safitri et al.'s Q/R forms): 'white_jerk' (eq. 29), "
+              "'piecewise_jerk', 'diagonal'", choices=QR_FORMS),
+        *JERK_PARAMS,
+        Param("acc_psd", MPU6050_ACC_DENSITY**2,
+              "Accelerometer white-noise power spectral density, R = acc_psd/dt (the MPU-6050 "
+              "datasheet's (400 ug/sqrt(Hz))^2)", unit="m2/s3", low=0.0, low_open=True),
+        *PAPER_KF_PARAMS,
+    )
+    COMMON = PAPER_COMMON
+    TWIN: ClassVar[str | None] = "fc_paper_poskf"
+    STATE: ClassVar[StateSpec] = {"yaw": ANGLE, "states": REAL, "P": COV, "tilt_state": NESTED}
+
+    def _configure(self) -> None:
+        p = self._params
+        tilt_params = {k: p[k] for k in TILT_PARAM_NAMES}
+        if not hasattr(self, "tilt"):
+            self.tilt = PaperKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
+                                          **tilt_params)
+        else:
+            for k, v in tilt_params.items():
+                if k != "gyro_sampling":
+                    self.tilt.set_param(k, v)
+            self.tilt.set_param("max_dt", p["max_dt"])
+            self.tilt.set_param("max_rate", p["max_rate"])
+        self._acc_var_density = float(p["acc_psd"])
+        self._Q_dt = 0.0  # the dt of Q and R (0: none yet, since every accepted dt is > 0)
 
     def _reset(self) -> None:
         self.tilt.reset()
@@ -256,12 +276,8 @@ class PaperPositionKalmanFilter(Estimator):
         if tilt.accel_trusted(ax * ax + ay * ay + az * az):
             tilt.correct(ax, ay, az)
         tilt.took_sample((gx, gy, gz))
-        roll, pitch, yaw = tilt.roll, tilt.pitch, self.yaw
-        sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
-        if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
-            yaw += dt * (wy * sr + gz * cr) / cp
-            yaw = self.yaw = yaw if -PI <= yaw <= PI else wrap_angle(yaw)
-        acc = level_acceleration(ax, ay, az, sr, cr, sp, cp, sin(yaw), cos(yaw))
+        self.yaw, acc = yaw_and_level_acceleration(tilt.roll, tilt.pitch, self.yaw, wy, gz,
+                                                   (ax, ay, az), dt)
         if dt != self._Q_dt:
             p = self._params
             self._Q = process_noise(p["qr_form"], p["q"], dt)
@@ -315,4 +331,5 @@ def sym3_packed(value: Mat3) -> Sym3:
     return (float(m00), float(m01), float(m02), float(m11), float(m12), float(m22))
 
 
-__all__ = ["PaperPositionKalmanFilter", "axis_filters", "level_acceleration", "process_noise"]
+__all__ = ["PaperPositionKalmanFilter", "axis_filters", "level_acceleration", "process_noise",
+           "yaw_and_level_acceleration"]

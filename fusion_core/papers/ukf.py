@@ -267,7 +267,29 @@ ours for its simulated MPU-6050 at 100 Hz (the datasheet's gyro density, acc_noi
 allowance for linear acceleration, the gate at rho 0.1, norm_noise 0.01)."""
 
 
-class PaperUnscentedKalmanFilter(Estimator):
+class GravityDirectionState:
+    """The state both UKFs hold: x = [X (3), b (3)] and the packed covariance _P, with the 6x6
+    view of P and the estimate that follows from x."""
+
+    x: list[float]
+    _P: tuple[float, ...]
+
+    @property
+    def P(self) -> list[list[float]]:
+        """The 6x6 state covariance as a list of lists (a copy; x = [X (3), b (3)])."""
+        return unpacked(self._P)
+
+    @P.setter
+    def P(self, value: list[list[float]]) -> None:
+        self._P = packed(value)
+
+    def _estimate(self) -> Estimate:
+        X1, X2, X3, bx, by, bz = self.x
+        roll, pitch = accel_roll_pitch(X1, X2, X3)  # X is a resting accelerometer's direction
+        return tuple_new(ESTIMATE, (roll, pitch, (bx, by, bz), None, None))
+
+
+class PaperUnscentedKalmanFilter(GravityDirectionState, Estimator):
     """Duong Quoc et al. eq. 14-17: the UKF on the gravity direction X with three gyro-bias
     states, as the paper writes it.
 
@@ -311,15 +333,6 @@ class PaperUnscentedKalmanFilter(Estimator):
         p_b = self._params["init_bias_std"] ** 2
         self._P = packed_diagonal((p_x, p_x, p_x, p_b, p_b, p_b))
 
-    @property
-    def P(self) -> list[list[float]]:
-        """The 6x6 state covariance as a list of lists (a copy; x = [X (3), b (3)])."""
-        return unpacked(self._P)
-
-    @P.setter
-    def P(self, value: list[list[float]]) -> None:
-        self._P = packed(value)
-
     def _advance(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
     ) -> Estimate:
@@ -344,11 +357,6 @@ class PaperUnscentedKalmanFilter(Estimator):
         self.x = [X0 / n, X1 / n, X2 / n, b0, b1, b2]
         self._P = P
         return self._estimate()
-
-    def _estimate(self) -> Estimate:
-        X1, X2, X3, bx, by, bz = self.x
-        roll, pitch = accel_roll_pitch(X1, X2, X3)  # X is a resting accelerometer's direction
-        return tuple_new(ESTIMATE, (roll, pitch, (bx, by, bz), None, None))
 
 
 def unpacked(t: tuple[float, ...]) -> list[list[float]]:
