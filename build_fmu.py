@@ -1,62 +1,11 @@
 """Build the project's FMUs: `python build_fmu.py [--out DIR] [--only NAME ...] [--kind K]
-[--preset P]`.
-
-Builds every model (or the named ones) as each kind of FMU: pythonfmu (DIR/NAME.fmu) and native
-FMI 2.0 and FMI 3.0 from the C twin (DIR/native/fmi2/NAME.fmu, DIR/native/fmi3/NAME.fmu); --kind
-all (the default where a C compiler exists), pythonfmu or native. The pythonfmu FMUs carry the C
-twin's library beside fusion_core's sources where a compiler built it (fmu_src.build). Start
-values: the estimators' --preset (recommended, the defaults; paper; or a JSON file). Validates
-each FMU with fmpy.validation.validate_fmu plus the project's checks (every variable described,
-every Real with a unit), prints a table (FMU, kind, core, size, variables, validation problems)
-and exits with status 1 if any FMU failed to build or has a problem. A thin layer over
-fmu_src.build.
-"""
+[--preset P]` (the same as `imu-fusion build-fmus`; fmu_src/cli.py)."""
 
 from __future__ import annotations
 
-import argparse
-import importlib.util
 import sys
-from pathlib import Path
 
-if [m for m in ("fmpy", "pythonfmu") if importlib.util.find_spec(m) is None]:
-    sys.exit("build_fmu.py needs fmpy and pythonfmu, the testbench extra: "
-             "pip install 'imu-fusion-fmu[testbench]'")
-
-from fmu_src.build import KINDS, build_all, default_kind, format_table
-from fmu_src.names import model_names
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit status."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("dist"), help="output folder (dist)")
-    parser.add_argument(
-        "--only", nargs="+", metavar="NAME", choices=model_names(),
-        help=f"build only these FMUs (of {', '.join(model_names())})",
-    )
-    parser.add_argument(
-        "--kind", choices=KINDS, default=None,
-        help="which FMUs: all (pythonfmu, native FMI 2.0 and 3.0; the default where a C "
-        "compiler exists, else pythonfmu), pythonfmu, or native",
-    )
-    parser.add_argument(
-        "--preset", default="recommended",
-        help="the estimators' start values: recommended (the defaults), paper, or a JSON file "
-        "of parameters per estimator",
-    )
-    args = parser.parse_args(argv)
-    try:
-        kind = args.kind or default_kind()
-        if kind == "pythonfmu" and args.kind is None:
-            print("no C compiler found: building the pythonfmu FMUs only", file=sys.stderr)
-        results = build_all(args.only or model_names(), args.out, args.preset, kind)
-    except ValueError as err:
-        print(f"error: --preset: {err}", file=sys.stderr)
-        return 2
-    print(format_table(results))
-    return 1 if any(r.problems for r in results) else 0
-
+from fmu_src.cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -299,7 +299,9 @@ class ImuSensorModel:
         if self.gyro_filter is not None and self.acc_filter is not None:
             gyro = self.gyro_filter(gyro, h)
             acc = self.acc_filter(acc, h)
-        dt = h
+        # a host's step h carries the rounding of its time grid (t_k+1 - t_k: 0.01 as
+        # 0.009999999999999787): without jitter the sample's dt is h to the picosecond
+        dt = math.floor(h * 1e12 + 0.5) / 1e12
         if p["jitter"] > 0.0:
             new_error = p["jitter"] * z[18]
             dt = max(h + new_error - self.time_error, 1e-6 * h)

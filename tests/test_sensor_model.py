@@ -140,3 +140,16 @@ def test_the_noise_of_sample_k_depends_on_the_seed_and_k_only() -> None:
     resumed.set_state(snapshot)
     assert [resumed.sample(omega, f, h) for _ in range(800)] == first[700:]
     assert ImuSensorModel(seed=12).sample(omega, f, h) != first[0]
+
+
+def test_without_jitter_the_sample_dt_is_the_step_to_the_picosecond():
+    """A host's step carries its time grid's rounding (0.01 as 0.009999999999999787); the
+    sample's dt is the period itself, in both twins, so that results compare exactly."""
+    from fusion_core.sensor import ImuSensorModel
+
+    for h in (0.009999999999999787, 0.01000000000000156):
+        _, _, dt = ImuSensorModel(seed=1).sample((0.0, 0.0, 0.0), (0.0, 0.0, 9.8), h)
+        assert dt == 0.01
+    out = ImuSensorModel(seed=1).run(np.zeros((3, 3)), np.tile([0.0, 0.0, 9.8], (3, 1)),
+                                     np.array([0.009999999999999787, 0.01, 0.01000000000000156]))
+    assert np.all(out["dt"] == 0.01)

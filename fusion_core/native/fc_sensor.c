@@ -248,7 +248,8 @@ static void sample_in(fc_sensor *s, const interval *c, const double omega[3],
         lowpass(&s->gyro_filter, g, h);
         lowpass(&s->acc_filter, a, h);
     }
-    *dt = h;
+    /* a host's step h carries the rounding of its time grid: without jitter, h to the ps */
+    *dt = floor(h * 1e12 + 0.5) / 1e12;
     if (p->jitter > 0.0) {
         double new_error = p->jitter * z[18];
         double d = h + new_error - s->time_error, floor = 1e-6 * h;

@@ -120,7 +120,9 @@ def execute(runs: Sequence[Run], out_dir: Path, scheduler: str = "local", worker
     client, cluster = connect(scheduler, workers)
     try:
         n_workers = max(1, len(client.scheduler_info().get("workers", {})) or workers)
-        log(f"Dask: {n_workers} worker(s), dashboard {client.dashboard_link}")
+        dashboard = client.scheduler_info().get("services", {}).get("dashboard")
+        log(f"Dask: {n_workers} worker(s)"
+            + (f", dashboard {client.dashboard_link}" if dashboard else ", no dashboard"))
         parts = batches(todo, n_workers, batch_size)
         futures = [client.submit(run_batch, part, retries, fmu_dir, pure=False, retries=1)
                    for part in parts]

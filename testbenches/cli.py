@@ -1,0 +1,73 @@
+"""`imu-fusion COMMAND ...` (and `python -m testbenches COMMAND ...`): the project's command line.
+
+  estimate    the estimators on your own recording (CSV or HDF5): estimates as CSV, a plot, and
+              with a reference the RMSE beside VQF's (testbenches.estimate).
+  build-fmus  build and validate the FMUs (fmu_src.cli; also `python build_fmu.py`).
+  run         estimator x scenario x seed runs through the FMUs with the contract checks
+              (testbenches.contract_runs); prints the contract table, writes DIR/report.json,
+              DIR/report.md and plots; exit status 1 on any FAIL.
+  export-ssp  the plant, sensor and estimator FMUs and their connections as an SSP file.
+  broad       accuracy on BROAD's real recordings beside VQF, Madgwick, Mahony (testbenches.broad).
+  noise       noise densities of a static recording (Allan deviation), a preset for every
+              estimator and the sensor FMU's parameters for that sensor (testbenches.fit).
+  tune        an estimator's tunable parameters fitted to recordings with a reference, validated
+              on others (testbenches.fit).
+  campaign    a Monte Carlo campaign of seeded runs on Dask, resumable, with percentiles and
+              confidence intervals (testbenches.montecarlo).
+  budget      the sensor's error budget: each scenario's RMSE with one group of the IMU's
+              errors switched off at a time (testbenches.budget).
+
+`estimate` needs only the estimators (and h5py for HDF5, matplotlib for its plot, vqf for the
+comparison); the other commands need the testbench extra, and say so where it is missing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from fmu_src.cli import add_build_parser
+
+from .estimate import add_estimate_parser
+
+TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "budget")
+"""The commands that need the testbench extra."""
+
+
+def _parser(prog: str) -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    add_estimate_parser(sub)
+    add_build_parser(sub)
+    from . import missing_modules
+
+    if not missing_modules():
+        from .broad.cli import add_broad_parser
+        from .budget import add_budget_parser
+        from .fit.cli import add_fit_parsers
+        from .montecarlo.cli import add_campaign_parser
+        from .run_cli import add_run_parser
+        from .ssp import add_ssp_parser
+
+        for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
+                    add_campaign_parser, add_budget_parser):
+            add(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None, prog: str = "imu-fusion") -> int:
+    """Run the command line; return the exit status."""
+    from . import INSTALL_HINT, missing_modules
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in TESTBENCH_COMMANDS and missing_modules():
+        print(f"{prog} {argv[0]} needs the testbench extra ({INSTALL_HINT}); not installed: "
+              f"{', '.join(missing_modules())}", file=sys.stderr)
+        return 2
+    args = _parser(prog).parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ValueError, FileNotFoundError, ConnectionError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
