@@ -30,5 +30,5 @@ def test_the_testbench_command_names_the_missing_extra() -> None:
     proc = _run("import sys, runpy; sys.modules['fmpy'] = None; sys.argv = ['x', 'run']\n"
                 "runpy.run_module('testbenches', run_name='__main__')")
     assert proc.returncode == 2
-    assert proc.stderr.strip() == ("python -m testbenches needs the testbench extra (pip install "
-                                   "'imu-fusion-fmu[testbench]'); not installed: fmpy")
+    assert proc.stderr.strip() == ("python -m testbenches run needs the testbench extra (pip "
+                                   "install 'imu-fusion-fmu[testbench]'); not installed: fmpy")

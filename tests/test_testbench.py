@@ -65,8 +65,9 @@ def test_plant_outputs_are_the_truth_at_the_end_of_each_step(fmu_dir: Path) -> N
 def test_every_plant_output_is_the_truth_and_the_sensor_samples_that_step(fmu_dir: Path) -> None:
     """At 1 kHz with jittered steps, on rotation plus linear acceleration (high_dynamics: its
     first move starts at 2 s), all 15 plant outputs are Trajectory.truth at t_k; a noise-free
-    sensor without quantisation passes that step's omega and f on unchanged, with dt = h_k (the
-    master wires each step's plant outputs to the sensor and the sample to the estimator)."""
+    sensor without quantisation passes that step's omega and f on unchanged, with dt = h_k to the
+    picosecond (the master wires each step's plant outputs to the sensor and the sample to the
+    estimator)."""
     r = run_testbench("kf", "high_dynamics", duration=3.0, rate=1000.0, jitter=0.2, seed=5,
                       fmu_dir=fmu_dir, sensor_params=contract.NOISE_FREE, evaluate=False)
     truth = SCENARIOS["high_dynamics"].trajectory().truth(r.t)
@@ -79,7 +80,9 @@ def test_every_plant_output_is_the_truth_and_the_sensor_samples_that_step(fmu_di
     for a in "xyz":
         assert np.array_equal(r.sample[f"gyro_{a}"], r.truth[f"omega_{a}"])
         assert np.array_equal(r.sample[f"acc_{a}"], r.truth[f"f_{a}"])
-    assert np.array_equal(r.sample["dt"], master.communication_steps(3.0, 1000.0, 0.2, 5))
+    steps = master.communication_steps(3.0, 1000.0, 0.2, 5)
+    assert np.array_equal(r.sample["dt"], np.floor(steps * 1e12 + 0.5) / 1e12)
+    assert np.max(np.abs(r.sample["dt"] - steps)) <= 5e-13
     assert np.ptp(r.truth["vel_x"]) > 1.0  # the move really happened
 
 
