@@ -6,6 +6,8 @@ recording (fusion_core.scenarios "moderate_dynamics" with MPU-6050 noise):
   per_sample_us   median us per `step` call of cf, mgcf, kf, ukf, poskf in a Python loop, and per
                   update call of the peers of the `bench` extra (filterpy UKF, ahrs Mahony,
                   Madgwick and EKF, imufusion, VQF), in the same run;
+  per_sample_us_stream  the same through Estimator.stream() (the C twin's step), beside VQF's
+                  update() in the same run;
   fmu_step_us     set inputs + doStep + get outputs through fmpy, per estimator FMU, and the
                   overhead above per_sample_us;
   testbench       steps per second and real-time factor of the plant -> sensor -> estimator

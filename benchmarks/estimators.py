@@ -39,6 +39,34 @@ def fmu_core_pass(key: str, data: list[tuple[list[float], list[float], float]]
     return run
 
 
+def stream_pass(key: str, data: list[tuple[list[float], list[float], float]]
+                ) -> Callable[[], int]:
+    """The same loop through Estimator.stream(): the per-sample step at the C twin's speed."""
+    step = fusion_core.ESTIMATORS[key]().stream().step
+
+    def run() -> int:
+        for acc, gyro, dt in data:
+            step(acc, gyro, dt)
+        return len(data)
+
+    return run
+
+
+STREAM = " (stream)"
+"""The suffix of the stream passes' names in the per-sample timing."""
+
+
+def stream_factories(
+    keys: tuple[str, ...], data: list[tuple[list[float], list[float], float]]
+) -> dict[str, Callable[[], Callable[[], int]]]:
+    """Pass factories of our estimators' streams where the C twin is available, else none."""
+    from fusion_core import native
+
+    if not native.available():
+        return {}
+    return {key + STREAM: (lambda key=key: stream_pass(key, data)) for key in keys}
+
+
 def step_factories(
     keys: tuple[str, ...], data: list[tuple[list[float], list[float], float]]
 ) -> dict[str, Callable[[], Callable[[], int]]]:

@@ -9,6 +9,8 @@ from typing import Any
 
 PER_SAMPLE_TARGETS_US = {"cf": 1.0, "kf": 2.0, "mgcf": 5.0, "ukf": 25.0, "poskf": 10.0}
 UKF_VS_FILTERPY = 10.0
+STREAM_VS_VQF = 3.0
+"""Estimator.stream() per sample at most this many times VQF's update() in the same run."""
 """Our UKF must be at least this many times faster than filterpy's UKF in the same run."""
 FMU_OVERHEAD_TARGET_US = 10.0
 TESTBENCH_RTF_TARGET = 50.0
@@ -59,6 +61,16 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
                 f">= {UKF_VS_FILTERPY:g}x faster", peer / ukf >= UKF_VS_FILTERPY,
                 "13 sigma points through the exact rotation, 6x6 covariance in Python floats",
             ))
+    stream, vqf = r.get("per_sample_us_stream") or {}, (ps or {}).get("vqf")
+    for key, v in stream.items():
+        if v is None or vqf is None:
+            continue
+        out.append(_target(
+            f"per_sample_us_stream.{key} vs vqf", v / vqf, f"<= {STREAM_VS_VQF:g}x VQF update",
+            v / vqf <= STREAM_VS_VQF,
+            "one cffi call in ABI mode (about 0.4 us) plus packing the six numbers and "
+            "building the Estimate in Python",
+        ))
     overhead = r.get("fmu_overhead_us")
     if overhead:
         low = r.get("fmu_overhead_lowlevel_us", {})
@@ -290,6 +302,14 @@ def format_table(r: dict[str, Any]) -> str:
                          f"(target {t['target']}): {_verdict(t)}")
         lines.append(f"  step API floor (an estimator whose update is a Python no-op): "
                      f"{_fmt(r.get('step_floor_us'))} us")
+    stream = {k: v for k, v in r.get("per_sample_us_stream", {}).items() if v is not None}
+    if stream:
+        lines += ["", "Per sample through Estimator.stream(): the C twin's step [us]",
+                  f"  {'estimator':<15}{'median':>10}{'x VQF':>10}   {'target':<22}verdict"]
+        for key, v in stream.items():
+            t = targets.get(f"per_sample_us_stream.{key} vs vqf")
+            lines.append(f"  {key:<15}{_fmt(v):>10}{_fmt(t['measured'] if t else None, 1):>10}   "
+                         f"{(t['target'] if t else ''):<22}{_verdict(t)}")
     if "fmu_step_us" in r:
         lines += ["", "FMU step: set inputs + doStep + get outputs through fmpy [us]; overhead = "
                   "FMU less fusion_core's step, timed in turn",

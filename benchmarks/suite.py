@@ -23,7 +23,7 @@ from .common import (
     time_interleaved,
 )
 from .config import ESTIMATOR_KEYS, BenchConfig
-from .estimators import step_factories
+from .estimators import STREAM, step_factories, stream_factories
 from .fmu import build_fmus, fmu_steps
 from .native import native_section
 from .native_fmu import native_fmu_section
@@ -97,6 +97,7 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         log(f"per-sample timing: {len(ESTIMATOR_KEYS)} estimators and the peers, {n} samples x "
             f"{config.repeats} passes, in turn")
         factories = step_factories(ESTIMATOR_KEYS, data)
+        factories.update(stream_factories(ESTIMATOR_KEYS, data))
         unavailable = {name: "not run (peers switched off)" for name in PEERS}
         if config.peers:
             peer_factories, unavailable = available_peers(rec)
@@ -107,6 +108,10 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         results["per_sample_us"] = {
             key: (detail[key]["median_us"] if key in detail else None)
             for key in (*ESTIMATOR_KEYS, *PEERS)
+        }
+        results["per_sample_us_stream"] = {
+            key: (detail[key + STREAM]["median_us"] if key + STREAM in detail else None)
+            for key in ESTIMATOR_KEYS
         }
         results["per_sample_detail"] = detail
         results["peers_unavailable"] = unavailable

@@ -323,6 +323,15 @@ class Estimator:
         self.n_samples += 1
         return last
 
+    def stream(self) -> Any:
+        """This estimator stepped through its C twin: a fusion_core.native.Stream whose
+        step(acc, gyro, dt) gives step()'s results to the bit at the twin's speed (get_state,
+        set_state and set_param through it stay exact). ValueError saying why where the twin
+        is not available or the class has none."""
+        from .native.stream import Stream
+
+        return Stream(self)
+
     def output(self) -> Estimate:
         """The estimate of the current state as the outputs give it (sensor_delay)."""
         est = self._estimate()

@@ -74,6 +74,28 @@ def test_per_sample_has_every_estimator_and_every_peer_or_its_reason(bench_json:
         assert (ps[name] is not None and ps[name] > 0.0) or name in bench_json["peers_unavailable"]
 
 
+def test_the_stream_is_timed_per_estimator_where_the_twin_is(bench_json: dict) -> None:
+    from fusion_core import native
+
+    stream = bench_json["per_sample_us_stream"]
+    assert set(stream) == set(ESTIMATOR_KEYS)
+    if not native.available():
+        assert all(v is None for v in stream.values())
+        return
+    assert all(stream[k] > 0.0 for k in ESTIMATOR_KEYS)
+    if bench_json["per_sample_us"].get("vqf") is not None:
+        names = {t["name"] for t in bench_json["targets"]}
+        assert {f"per_sample_us_stream.{k} vs vqf" for k in ESTIMATOR_KEYS} <= names
+
+
+def test_the_stream_target_is_three_times_vqfs_update() -> None:
+    results = {"per_sample_us": {"vqf": 0.5}, "per_sample_us_stream": {"cf": 1.4, "ukf": 1.6}}
+    t = {x["name"]: x for x in report.evaluate_targets(results)}
+    assert t["per_sample_us_stream.cf vs vqf"]["measured"] == pytest.approx(2.8)
+    assert t["per_sample_us_stream.cf vs vqf"]["met"] is True
+    assert t["per_sample_us_stream.ukf vs vqf"]["met"] is False
+
+
 def test_fmu_step_and_overhead_per_estimator(bench_json: dict) -> None:
     for key in ESTIMATOR_KEYS:
         step = bench_json["fmu_step_us"][key]

@@ -1,0 +1,66 @@
+"""Estimator.stream(): step() at the C twin's speed, its results and states to the bit, and a
+clear error where the twin cannot serve."""
+
+from __future__ import annotations
+
+import pytest
+from helpers import KEYS, make, noisy_two_axis_recording, paper
+
+from fusion_core import InvalidSample, native
+from fusion_core.kalman import AngleBiasKalmanFilter
+
+needs_twin = pytest.mark.skipif(not native.available(),
+                                reason=f"the C twin is unavailable: {native.reason()}")
+
+
+@needs_twin
+@pytest.mark.parametrize("preset", ["recommended", "paper"])
+@pytest.mark.parametrize("key", KEYS)
+def test_the_stream_gives_steps_results_and_state_to_the_bit(key: str, preset: str) -> None:
+    params = paper(key) if preset == "paper" else {}
+    rec = noisy_two_axis_recording(4.0)
+    samples = list(zip(rec["acc_meas"].tolist(), rec["gyro_meas"].tolist(),
+                       rec["dt"].tolist(), strict=True))
+    python, stream = make(key, **params), make(key, **params).stream()
+    for k, (acc, gyro, dt) in enumerate(samples):
+        assert stream.step(acc, gyro, dt) == python.step(acc, gyro, dt), k
+        if k == 200:  # a state taken from the stream continues in Python, and back
+            snapshot = stream.get_state()
+            assert snapshot == python.get_state()
+            stream.set_state(snapshot)
+    assert stream.get_state() == python.get_state()
+    assert stream.last == python.last
+
+
+@needs_twin
+def test_a_rejected_sample_says_why_and_leaves_the_state() -> None:
+    stream = make("kf").stream()
+    stream.step((0.0, 0.0, 9.8), (0.0, 0.0, 0.0), 0.01)
+    before = stream.get_state()
+    with pytest.raises(InvalidSample, match="is not finite"):
+        stream.step((float("nan"), 0.0, 9.8), (0.0, 0.0, 0.0), 0.01)
+    with pytest.raises(InvalidSample, match="outside the allowed range"):
+        stream.step((0.0, 0.0, 9.8), (0.0, 0.0, 0.0), -0.01)
+    with pytest.raises(InvalidSample, match="three accelerations"):
+        stream.step((0.0, 9.8), (0.0, 0.0, 0.0), 0.01)
+    assert stream.get_state() == before
+
+
+@needs_twin
+def test_a_parameter_change_goes_through_the_stream() -> None:
+    rec = noisy_two_axis_recording(2.0)
+    python, stream = make("cf"), make("cf").stream()
+    for i, (acc, gyro, dt) in enumerate(zip(rec["acc_meas"].tolist(), rec["gyro_meas"].tolist(),
+                                            rec["dt"].tolist(), strict=True)):
+        if i == 50:
+            python.set_param("tau", 0.4)
+            stream.set_param("tau", 0.4)
+        assert stream.step(acc, gyro, dt) == python.step(acc, gyro, dt)
+
+
+def test_a_class_without_a_twin_of_its_own_is_refused_with_the_reason() -> None:
+    class Mine(AngleBiasKalmanFilter):
+        pass
+
+    with pytest.raises(ValueError, match="no C twin of its own"):
+        Mine().stream()
