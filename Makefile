@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup run demo test test-fast test-slow lint fmus native campaign clean
+.PHONY: setup run demo test test-fast test-slow lint fmus native campaign wheel clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -44,6 +44,10 @@ fmus: setup
 native: setup
 	$(BIN)/python -c "from fusion_core import native; print(native.build())"
 
+# The sdist and a platform wheel carrying the C twin's library and the native FMUs (setup.py).
+wheel: setup
+	$(BIN)/python -m build --no-isolation --outdir dist-wheel .
+
 test: setup
 	$(BIN)/python -m pytest -q
 
@@ -65,4 +69,4 @@ bench: setup
 	$(BIN)/python -m benchmarks --out reports
 
 clean:
-	rm -rf dist reports build *.egg-info
+	rm -rf dist dist-wheel reports build *.egg-info

@@ -24,8 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .estimator import PRESET_FILE
-from .names import script_path
+from .names import PRESET_FILE, script_path
 
 Preset = dict[str, dict[str, Any]]
 """A preset's entries by estimator key (fusion_core.presets.load_preset)."""
@@ -33,7 +32,7 @@ Preset = dict[str, dict[str, Any]]
 HERE = Path(__file__).resolve().parent
 RUNTIME_FILES = (
     "__init__.py", "variables.py", "slave.py", "estimator.py", "model_description.py",
-    "testbench_models.py",
+    "names.py", "testbench_models.py",
 )
 """The part of fmu_src an FMU needs at run time (not the build code, not the other models)."""
 REQUIREMENTS = "numpy>=1.24\ncffi>=1.15\n"
@@ -74,7 +73,7 @@ def _ship_native_library(core: Path) -> None:
 
     if native.reason() is not None:
         return
-    shutil.copy2(native.build(), core / "native" / native.PREBUILT.name)
+    shutil.copy2(native.library_path(), core / "native" / native.PREBUILT.name)
 
 
 def build(name: str, out_dir: Path, preset: Preset | None = None) -> Path:
@@ -128,10 +127,16 @@ KINDS = ("all", "pythonfmu", "native")
 
 
 def default_kind() -> str:
-    """"all" where a C compiler exists (the native FMUs need one), else "pythonfmu"."""
+    """"all" where a C compiler exists or the wheel carries the native FMUs, else
+    "pythonfmu"."""
     from fusion_core.native import compiler
 
-    return "all" if compiler() else "pythonfmu"
+    from .names import model_names
+    from .native.prebuilt import prebuilt_fmu
+
+    if compiler() or prebuilt_fmu(model_names()[0], "fmi2", "recommended"):
+        return "all"
+    return "pythonfmu"
 
 
 @dataclass
@@ -164,16 +169,23 @@ def build_all(
     if kind != "native":
         results += [_build_and_check(name, out_dir, entries) for name in names]
     if kind != "pythonfmu":
-        results += [_build_native_and_check(name, version, out_dir, entries)
+        results += [_build_native_and_check(name, version, out_dir, entries, preset)
                     for version in ("fmi2", "fmi3") for name in names]
     return results
 
 
-def _build_native_and_check(name: str, version: str, out_dir: Path, preset: Preset
-                            ) -> BuildResult:
-    """One row of the build table for a native FMU (out_dir/native/<version>/<name>.fmu)."""
-    from .native.build import build_native, native_model
+def _build_native_and_check(name: str, version: str, out_dir: Path, preset: Preset,
+                            preset_name: str = "recommended") -> BuildResult:
+    """One row of the build table for a native FMU (out_dir/native/<version>/<name>.fmu):
+    compiled, or where no compiler exists the wheel's copy for a named preset."""
+    from fusion_core.native import compiler
 
+    from .native.build import build_native, native_model
+    from .native.prebuilt import copy_prebuilt
+
+    if compiler() is None:
+        return _checked(BuildResult(name, core="native", kind=version),
+                        lambda: copy_prebuilt(name, version, preset_name, out_dir / "native"))
     return _checked(BuildResult(name, core="native", kind=version),
                     lambda: build_native(native_model(name, preset), version,
                                          out_dir / "native"))

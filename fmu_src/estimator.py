@@ -27,6 +27,7 @@ from fusion_core import G, InvalidSample
 from fusion_core.base import Estimator
 from fusion_core.types import Estimate
 
+from .names import PRESET_FILE
 from .slave import FmiLog, FmuSlave
 from .variables import (
     Variable,
@@ -69,10 +70,6 @@ their descriptions (by class name; a class not named here estimates all three)."
 PAPER_NOTE = (" Built with the preset 'paper': the paper's own filter at its values "
               "(fusion_core.papers.{name}).")
 """What a paper's filter adds to its FMU's description."""
-
-
-PRESET_FILE = "preset.json"
-"""The preset an FMU was built with, in its resources folder."""
 
 
 def preset_starts(key: str, resources: str | None = None) -> dict[str, Any]:

@@ -28,3 +28,7 @@ def script_path(name: str) -> Path:
     if not path.is_file():
         raise ValueError(f"no FMU called {name!r}: the FMUs are {', '.join(model_names())}")
     return path
+
+
+PRESET_FILE = "preset.json"
+"""The preset an FMU was built with, in its resources folder."""

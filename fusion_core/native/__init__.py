@@ -47,6 +47,7 @@ from .library import (
     cdef,
     compiler,
     lib_and_ffi,
+    library_path,
     reason,
 )
 from .models import normals, plant_truth, sensor_run
@@ -54,7 +55,8 @@ from .stream import Stream
 
 __all__ = [
     "BASE_STATE", "CFLAGS", "DATA_HEADERS", "ESTIMATE_FIELDS", "FC_SKIPPED", "HEADERS", "HERE",
-    "PREBUILT", "SOURCES", "STATE_ATTRIBUTES", "Stepper", "Stream", "available",
-    "build", "cache_dir", "cdef", "compiler", "has_twin", "lib_and_ffi", "new_twin", "normals",
-    "plant_truth", "poskf_pending_max", "reason", "run", "sensor_run", "stepper", "take_state",
+    "PREBUILT", "SOURCES", "STATE_ATTRIBUTES", "Stepper", "Stream", "available", "build",
+    "cache_dir", "cdef", "compiler", "has_twin", "lib_and_ffi", "library_path", "new_twin",
+    "normals", "plant_truth", "poskf_pending_max", "reason", "run", "sensor_run", "stepper",
+    "take_state",
 ]

@@ -37,6 +37,7 @@ first where it loads (same platform); elsewhere the library is built or Python r
 _lib: Any = None
 _ffi: Any = None
 _reason: str | None = "not loaded yet"
+_path: Path | None = None
 _tried = False
 
 
@@ -119,7 +120,7 @@ def cdef() -> str:
 
 
 def _load() -> None:
-    global _lib, _ffi, _reason, _tried
+    global _lib, _ffi, _reason, _tried, _path
     _tried = True
     try:
         import cffi  # type: ignore[import-untyped]
@@ -135,13 +136,14 @@ def _load() -> None:
     if PREBUILT.is_file():  # an FMU's copy: the library built with it, if it loads here
         try:
             _lib, _ffi, _reason = ffi.dlopen(str(PREBUILT)), ffi, None
+            _path = PREBUILT
             return
         except OSError:
             pass
     try:
-        _lib = ffi.dlopen(str(build()))
-        _ffi = ffi
-        _reason = None
+        built = build()
+        _lib = ffi.dlopen(str(built))
+        _ffi, _reason, _path = ffi, None, built
     except (RuntimeError, OSError) as err:
         _reason = str(err)
 
@@ -151,6 +153,14 @@ def available() -> bool:
     if not _tried:
         _load()
     return _lib is not None
+
+
+def library_path() -> Path:
+    """The file of the loaded library (PREBUILT or the built one); RuntimeError with the reason
+    where the twin is unavailable."""
+    if not available() or _path is None:
+        raise RuntimeError(f"the native backend is unavailable: {reason()}")
+    return _path
 
 
 def reason() -> str | None:
