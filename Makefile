@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup run demo test test-fast test-slow lint fmus native campaign wheel clean
+.PHONY: setup run demo test test-fast test-slow lint fmus native campaign wheel crosscheck clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -43,6 +43,12 @@ fmus: setup
 # The C twin of fusion_core as a shared library (built on first use anyway; this says where).
 native: setup
 	$(BIN)/python -c "from fusion_core import native; print(native.build())"
+
+# The native FMUs with fusion_core's reference results and fmpy's in the FMI Cross-Check layout,
+# validated by fmpy's cross-check tools (reports/crosscheck/).
+crosscheck: setup
+	$(BIN)/python build_fmu.py --out dist --kind native
+	$(BIN)/python -m testbenches crosscheck --fmu-dir dist --out reports/crosscheck
 
 # The sdist and a platform wheel carrying the C twin's library and the native FMUs (setup.py).
 wheel: setup

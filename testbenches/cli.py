@@ -16,6 +16,8 @@
               confidence intervals (testbenches.montecarlo).
   budget      the sensor's error budget: each scenario's RMSE with one group of the IMU's
               errors switched off at a time (testbenches.budget).
+  crosscheck  the native FMUs with fusion_core's reference results and fmpy's in the FMI
+              Cross-Check layout, validated by fmpy's cross-check tools (testbenches.crosscheck).
 
 `estimate` needs only the estimators (and h5py for HDF5, matplotlib for its plot, vqf for the
 comparison); the other commands need the testbench extra, and say so where it is missing.
@@ -30,7 +32,8 @@ from fmu_src.cli import add_build_parser
 
 from .estimate import add_estimate_parser
 
-TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "budget")
+TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "budget",
+                      "crosscheck")
 """The commands that need the testbench extra."""
 
 
@@ -45,13 +48,14 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     if not missing_modules():
         from .broad.cli import add_broad_parser
         from .budget import add_budget_parser
+        from .crosscheck import add_crosscheck_parser
         from .fit.cli import add_fit_parsers
         from .montecarlo.cli import add_campaign_parser
         from .run_cli import add_run_parser
         from .ssp import add_ssp_parser
 
         for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
-                    add_campaign_parser, add_budget_parser):
+                    add_campaign_parser, add_budget_parser, add_crosscheck_parser):
             add(sub)
     return parser
 
