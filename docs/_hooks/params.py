@@ -1,0 +1,39 @@
+"""MkDocs hook: `<!-- params: KEY -->` in a page becomes the table of that estimator's
+parameters, read from its class when the site is built (so the table is never stale)."""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+MARK = re.compile(r"<!-- params: (\w+) -->")
+
+
+def _cell(text: Any) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _range(spec: Any) -> str:
+    if spec.choices:
+        return ", ".join(f"`{c}`" for c in spec.choices)
+    if spec.low is None or spec.high is None:
+        return ""
+    left = "(" if spec.low_open else "["
+    right = ")" if spec.high_open else "]"
+    return f"{left}{spec.low:g}, {spec.high:g}{right}"
+
+
+def params_table(key: str) -> str:
+    """The markdown table of estimator key's parameters (the recommended class)."""
+    from fusion_core import registry
+
+    rows = ["| parameter | default | unit | allowed | description |", "|---|---|---|---|---|"]
+    for name, spec in registry.estimator_class(key).param_specs().items():
+        default = f"{spec.default:.6g}" if isinstance(spec.default, float) else repr(spec.default)
+        rows.append(f"| `{name}` | `{_cell(default)}` | {_cell(spec.unit or '')} | "
+                    f"{_cell(_range(spec))} | {_cell(spec.description or '')} |")
+    return "\n".join(rows)
+
+
+def on_page_markdown(markdown: str, **_: Any) -> str:
+    return MARK.sub(lambda m: params_table(m.group(1)), markdown)

@@ -1,0 +1,50 @@
+"""The documentation: the site builds with warnings as errors, the README stays a page, and no
+product file or page depends on the folder our CI keeps beside the project."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+PRODUCT = ("fusion_core", "fmu_src", "testbenches", "benchmarks", "docs", "examples")
+
+
+@pytest.mark.heavy
+@pytest.mark.skipif(importlib.util.find_spec("mkdocs") is None,
+                    reason="mkdocs is not installed (the docs extra, which the test extra has)")
+def test_the_site_builds_strict(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path)],
+        cwd=REPO, capture_output=True, text=True, check=False,
+        env=os.environ | {"NO_MKDOCS_2_WARNING": "1"},
+    )
+    assert proc.returncode == 0, proc.stderr[-4000:]
+    for page in ("index.html", "estimators/ukf/index.html", "interface/index.html"):
+        assert (tmp_path / page).is_file(), page
+    ukf = (tmp_path / "estimators/ukf/index.html").read_text()
+    assert "gyro_range" in ukf and "PaperUnscentedKalmanFilter" in ukf  # the tables were made
+
+
+def test_the_readme_is_a_page() -> None:
+    lines = (REPO / "README.md").read_text().splitlines()
+    assert len(lines) <= 250, len(lines)
+    for heading in ("## Quickstart", "## Install", "## The estimators and FMUs", "## Read on"):
+        assert heading in lines, heading
+
+
+def test_no_product_file_points_at_the_ci_folder_beside_the_project() -> None:
+    hits = []
+    for top in (*PRODUCT, "README.md", "Makefile", "pyproject.toml", "mkdocs.yml", "setup.py"):
+        paths = [REPO / top] if (REPO / top).is_file() else (REPO / top).rglob("*")
+        for path in paths:
+            if path.suffix in (".py", ".md", ".c", ".h", ".toml", ".yml", "") and path.is_file():
+                text = path.read_text(errors="replace")
+                if "../shared" in text or "shared/INTERFACE" in text:
+                    hits.append(str(path.relative_to(REPO)))
+    assert hits == []
