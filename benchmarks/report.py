@@ -44,7 +44,8 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
         vqf = ps.get("vqf")
         limit_text = (
             "CPython float arithmetic: step() is the Python reference, interpreted (the one "
-            "compiled path is the C twin, behind run(), stream() and every FMU; see docs/results/speed.md)"
+            "compiled path is the C twin, behind run(), stream() and every FMU; see "
+            "docs/results/speed.md)"
             + (f"; {floor_text}" if floor_text else "")
             + (f"; VQF (C++) costs {vqf:.2f} us in the same run" if vqf is not None else "")
         )

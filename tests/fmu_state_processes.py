@@ -94,6 +94,6 @@ if __name__ == "__main__":
     # Every result is written: leave without the exit handlers, where pythonfmu 0.7's wrapper
     # reads a static object its own destructor freed (valgrind: finalizePythonInterpreter, an
     # ELF destructor, reads a block freed in exit()), which now and then aborts the process
-    # after its work is done (README, "Known pythonfmu 0.7 defect"). The native FMUs have no
-    # such defect; this helper runs both kinds.
+    # after its work is done (docs/guide/modelica-simulink.md, "Known pythonfmu 0.7 defect").
+    # The native FMUs have no such defect; this helper runs both kinds.
     os._exit(status)

@@ -39,8 +39,9 @@ def test_example_csvs_are_reproducible():
 
 @pytest.mark.parametrize("kind", ["fmi3", "pythonfmu"])
 def test_readme_command_gives_a_sensible_attitude_trace(built_fmus, tmp_path, kind):
-    """The README's fmpy command on the native FMI 3.0 FMU, and on the pythonfmu FMU, whose
-    process may abort at exit after writing its results (pythonfmu's defect, README)."""
+    """The documented fmpy command (docs/guide/fmus.md) on the native FMI 3.0 FMU, and on the
+    pythonfmu FMU, whose process may abort at exit after writing its results (pythonfmu's
+    defect, docs/guide/modelica-simulink.md)."""
     out_csv = tmp_path / "AngleBiasKalmanFilter_out.csv"
     fmu = (built_fmus.path("AngleBiasKalmanFilter") if kind == "pythonfmu"
            else built_fmus.native(kind, "AngleBiasKalmanFilter"))

@@ -34,7 +34,7 @@ HALF_ROW_NOT_MET = {
     "ukf": "not met yet: 0.24/0.20 against 0.175/0.205 (roll); perfect samples of the motion "
            "give 0.13/0.12, and the realistic gyro's scale and cross-axis errors, which the "
            "UKF's bias states chase, most of the rest (0.07/0.21 on the ideal sensor); over 200 "
-           "parts no part meets it, nor does VQF on any (README, Campaigns)",
+           "parts no part meets it, nor does VQF on any (docs/guide/campaigns.md)",
 }
 
 
