@@ -154,10 +154,13 @@ class BuildResult:
 
 def build_all(
     names: Iterable[str], out_dir: Path, preset: str = "recommended", kind: str | None = None,
+    calibration: Path | None = None,
 ) -> list[BuildResult]:
     """Build and check each FMU; a failed build is a problem of its row, not an exception.
     preset: the estimators' start values, a name or a JSON file (fusion_core.presets.load_preset;
-    ValueError for a bad one); kind: one of KINDS (None: default_kind())."""
+    ValueError for a bad one); kind: one of KINDS (None: default_kind()); calibration: a part's
+    calibration.json, whose acc_cal and gyro_cal become every estimator's start values."""
+    from fusion_core.calibration import Calibration
     from fusion_core.presets import load_preset
 
     kind = kind or default_kind()
@@ -165,6 +168,10 @@ def build_all(
         raise ValueError(f"kind {kind!r}: allowed {', '.join(KINDS)}")
     names = list(names)
     entries = load_preset(preset)
+    if calibration is not None:  # start values of one's own: the prebuilt FMUs cannot serve
+        cal = Calibration.read(calibration).params()
+        entries = {key: {**values, **cal} for key, values in entries.items()}
+        preset = f"{preset} with {calibration}"
     results = []
     if kind != "native":
         results += [_build_and_check(name, out_dir, entries) for name in names]

@@ -39,6 +39,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "compiler exists, else pythonfmu), pythonfmu, or native",
     )
     parser.add_argument(
+        "--calibration", type=Path, default=None, metavar="FILE.json",
+        help="a part's calibration (calibration.json): acc_cal and gyro_cal as every estimator "
+        "FMU's start values",
+    )
+    parser.add_argument(
         "--preset", default="recommended",
         help="the estimators' start values: recommended (the defaults), paper (the seed papers' "
         "own filters), or a JSON file of parameters per estimator",
@@ -67,9 +72,10 @@ def run(args: argparse.Namespace) -> int:
     try:
         if kind == "pythonfmu" and args.kind is None:
             print("no C compiler found: building the pythonfmu FMUs only", file=sys.stderr)
-        results = build_all(args.only or model_names(), args.out, args.preset, kind)
-    except ValueError as err:
-        print(f"error: --preset: {err}", file=sys.stderr)
+        results = build_all(args.only or model_names(), args.out, args.preset, kind,
+                            calibration=args.calibration)
+    except (ValueError, FileNotFoundError) as err:
+        print(f"error: {err}", file=sys.stderr)
         return 2
     print(format_table(results))
     return 1 if any(r.problems for r in results) else 0

@@ -16,6 +16,7 @@ from typing import Any, ClassVar, Final
 
 import numpy as np
 
+from .calibration import CALIBRATION_PARAMS, check_calibration, matrices
 from .kinematics import roll_pitch_ahead
 from .state import BASE_STATE, NESTED, StateSpec, check_field
 from .types import (
@@ -61,6 +62,7 @@ COMMON_PARAMS: tuple[Param, ...] = (
         unit="rad/s", low=0.0, low_open=True, display_unit="deg/s",
     ),
     *MOUNTING_PARAMS,
+    *CALIBRATION_PARAMS,
     Param(
         "gyro_range", GYRO_RANGE_DEFAULT,
         "The gyro's full-scale range: a sample with an axis at it (within 0.1 %) is at the rail, "
@@ -99,6 +101,7 @@ without the NamedTuple's Python-level __new__: the hot paths build their estimat
 
 Mat9 = tuple[float, float, float, float, float, float, float, float, float]
 IDENTITY: Final[Mat9] = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+ZERO3: Final = (0.0, 0.0, 0.0)
 
 
 def mounting_matrix(roll: float, pitch: float, yaw: float) -> Mat9:
@@ -175,6 +178,7 @@ class Estimator:
         check_param_names(params, specs, type(self).__name__)
         values = {name: spec.default for name, spec in specs.items()}
         values.update({name: specs[name].validate(v) for name, v in params.items()})
+        check_calibration(values)
         self._check_params(values)
         self._set_params(values)
         self.reset()
@@ -209,6 +213,10 @@ class Estimator:
         self._mounting = mounting_matrix(float(values["mount_roll"]), float(values["mount_pitch"]),
                                          float(values["mount_yaw"]))
         self._mounted: bool = self._mounting != IDENTITY
+        (self._acc_cal, self._acc_off), (self._gyro_cal, self._gyro_off) = (
+            matrices(values).values())
+        self._calibrated: bool = (self._acc_cal != IDENTITY or self._gyro_cal != IDENTITY
+                                  or self._acc_off != ZERO3 or self._gyro_off != ZERO3)
         self._delay = float(values["sensor_delay"])
         # without gyro_range (COMMON) no sample is at a rail
         self._rail = float(values.get("gyro_range", math.inf)) * (1.0 - RAIL_MARGIN)
@@ -299,6 +307,17 @@ class Estimator:
             self._check_values(ax, ay, az, gx, gy, gz, dt)
         rail = self._rail  # on the sensor's own axes, before the mounting (gyro_range)
         self.clipped = not (-rail < gx < rail and -rail < gy < rail and -rail < gz < rail)
+        if self._calibrated:  # the part's calibration (fusion_core.calibration)
+            c0, c1, c2, c3, c4, c5, c6, c7, c8 = self._acc_cal
+            ox, oy, oz = self._acc_off
+            ax, ay, az = ax - ox, ay - oy, az - oz
+            ax, ay, az = (c0 * ax + c1 * ay + c2 * az, c3 * ax + c4 * ay + c5 * az,
+                          c6 * ax + c7 * ay + c8 * az)
+            c0, c1, c2, c3, c4, c5, c6, c7, c8 = self._gyro_cal
+            ox, oy, oz = self._gyro_off
+            gx, gy, gz = gx - ox, gy - oy, gz - oz
+            gx, gy, gz = (c0 * gx + c1 * gy + c2 * gz, c3 * gx + c4 * gy + c5 * gz,
+                          c6 * gx + c7 * gy + c8 * gz)
         if self._mounted:  # into the filter frame (MOUNTING_PARAMS)
             m00, m01, m02, m10, m11, m12, m20, m21, m22 = self._mounting
             ax, ay, az = (m00 * ax + m01 * ay + m02 * az, m10 * ax + m11 * ay + m12 * az,

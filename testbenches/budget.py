@@ -28,7 +28,7 @@ from fusion_core.registry import keys_help
 from fusion_core.scenarios import SCENARIOS
 
 from .contract import accuracy_limits, compute_metrics
-from .options import add_preset, add_sensor, choose, positive_int
+from .options import add_calibration, add_preset, add_sensor, choose, positive_int, with_calibration
 
 SOURCES: dict[str, tuple[str, dict[str, Any]]] = {
     "gyro_scale": ("gyro scale-factor error", {"gyro_scale_std": 0.0}),
@@ -186,6 +186,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
                    help=f"all or a comma list of {', '.join(SCENARIOS)} (all)")
     p.add_argument("--seeds", type=positive_int, default=3, help="seeds per row, averaged (3)")
     add_preset(p)
+    add_calibration(p)
     add_sensor(p)
     p.add_argument("--out", type=Path, default=Path("reports/budget"),
                    help="report folder (reports/budget)")
@@ -203,7 +204,8 @@ def cmd_budget(args: argparse.Namespace) -> int:
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
-    preset, sensor = load_preset(args.preset), load_sensor(args.sensor)
+    preset = with_calibration(load_preset(args.preset), args.calibration)
+    sensor = load_sensor(args.sensor)
     total = len(estimators) * len(scenarios) * len(VARIANTS)
     with tqdm(total=total, unit="set", file=sys.stderr) as bar:
         rows = error_budget(estimators, scenarios, args.seeds, sensor, preset, bar.update)

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .options import add_preset, parse_params
+from .options import add_calibration, add_preset, parse_params, with_calibration
 
 ALIASES: dict[str, tuple[str, ...]] = {
     "acc_x": ("acc_x", "ax", "accx", "acc_x_g", "acc_x_ms2", "accelerometer_x", "a_x"),
@@ -53,6 +53,7 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("recording", type=Path, help="CSV or HDF5 recording")
     p.add_argument("--estimator", default="all", help="all or a comma list of the estimators")
     add_preset(p)
+    add_calibration(p)
     p.add_argument("--rate", type=float, default=None,
                    help="sample rate [Hz] where the file has no time or dt")
     p.add_argument("--time-column", default=None, help="the time column's name [s]")
@@ -312,7 +313,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     if args.reference is not None:
         rec.up_ref = reference_by_time(args.reference, t)
         rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
-    preset = load_preset(args.preset)
+    preset = with_calibration(load_preset(args.preset), args.calibration)
     estimators = {k: create(k, estimator_params(args, preset[k])) for k in keys}
     args.out.mkdir(parents=True, exist_ok=True)
     rows, traces = [], {}

@@ -24,6 +24,26 @@ def add_preset(parser: argparse.ArgumentParser, flag: str = "--preset", more: st
                         help=f"{PRESET_HELP}{more} (recommended)")
 
 
+def add_calibration(parser: argparse.ArgumentParser) -> None:
+    """The --calibration option of every command that runs estimators: a part's calibration
+    (fusion_core.calibration), applied at each estimator's input."""
+    parser.add_argument("--calibration", type=Path, default=None, metavar="FILE.json",
+                        help="the part's calibration (calibration.json, as `calibrate` writes "
+                        "it): acc_cal and gyro_cal applied at every estimator's input")
+
+
+def with_calibration(entries: dict[str, dict[str, Any]], path: Path | None
+                     ) -> dict[str, dict[str, Any]]:
+    """Each estimator's parameters with the calibration file's on top (none: unchanged);
+    ValueError or FileNotFoundError saying what is wrong with the file."""
+    if path is None:
+        return entries
+    from fusion_core.calibration import Calibration
+
+    params = Calibration.read(path).params()
+    return {key: {**values, **params} for key, values in entries.items()}
+
+
 def add_sensor(parser: argparse.ArgumentParser) -> None:
     """The --sensor option every command that simulates the sensor takes (default realistic)."""
     parser.add_argument("--sensor", default="realistic", help=f"{SENSOR_HELP} (realistic)")

@@ -13,6 +13,7 @@ from fusion_core.scenarios import SCENARIOS
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .options import (
+    add_calibration,
     add_preset,
     add_sensor,
     choose,
@@ -21,6 +22,7 @@ from .options import (
     parse_params,
     positive_float,
     positive_int,
+    with_calibration,
 )
 
 
@@ -34,6 +36,7 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
                      help="estimator FMU parameter for every run (repeatable); an enumeration "
                      "by item name, e.g. --param gyro_sampling=mean")
     add_preset(run)
+    add_calibration(run)
     add_sensor(run)
     run.add_argument("--seeds", type=positive_int, default=1,
                      help="seeds per estimator x scenario (1)")
@@ -92,7 +95,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
     from fusion_core.presets import load_preset
 
-    preset = load_preset(args.preset)
+    preset = with_calibration(load_preset(args.preset), args.calibration)
     sensor = load_sensor(args.sensor)
     params = parse_params(args.param)
     check_params(params, estimators, preset)

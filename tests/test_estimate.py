@@ -97,3 +97,24 @@ def test_the_console_script_lists_every_command():
     for command in ("estimate", "build-fmus", "run", "broad", "noise", "tune", "campaign",
                     "budget", "export-ssp"):
         assert command in proc.stdout
+
+
+def test_a_calibration_file_is_applied_at_every_estimators_input(tmp_path, capsys):
+    from fusion_core.calibration import Calibration
+
+    cal = Calibration(acc_matrix=(1.02, 0.01, 0.0, 0.0, 0.98, 0.0, 0.0, 0.0, 1.01),
+                      gyro_offset=(0.01, -0.02, 0.0))
+    path = tmp_path / "calibration.json"
+    cal.write(path)
+    assert main(["estimate", str(EXAMPLE), "--estimator", "ukf", "--calibration", str(path),
+                 "--out", str(tmp_path), "--no-plots"]) == 0
+    ex = _example()
+    dt = np.diff(ex["time"], prepend=ex["time"][0] - 0.01)
+    got = np.loadtxt(tmp_path / "tilt_motion_ukf.csv", delimiter=",", skiprows=1)
+    want = create("ukf", cal.params()).run(ex["acc"], ex["gyro"], dt)
+    assert np.array_equal(got[:, 1], want["roll"])
+    path.write_text('{"gyro_cal": {"matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 2]], '
+                    '"offset": [0, 0, 0]}}')
+    assert main(["estimate", str(EXAMPLE), "--calibration", str(path), "--out",
+                 str(tmp_path), "--no-plots"]) == 2
+    assert "gyro_cal_zz=2.0 is out of range" in capsys.readouterr().err

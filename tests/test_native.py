@@ -16,6 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fusion_core import ESTIMATORS, InvalidSample, native, synthetic
+from fusion_core.calibration import Calibration
 from fusion_core.presets import PRESETS, preset_params
 
 REPO = Path(__file__).resolve().parents[1]
@@ -24,6 +25,14 @@ TOL = 0.0
 """The twins agree bit for bit (the same operations in the same order, no fused multiply-add):
 every comparison of their numbers is an equality."""
 TWIN_KEYS = [k for k, cls in ESTIMATORS.items() if cls.TWIN is not None]
+
+PART_CALIBRATION = Calibration(
+    acc_matrix=(1.023, 0.004, -0.002, 0.003, 0.981, 0.006, -0.005, 0.002, 1.012),
+    acc_offset=(0.12, -0.07, 0.21),
+    gyro_matrix=(1.028, 0.003, 0.001, -0.004, 0.982, 0.002, 0.002, -0.003, 1.004),
+    gyro_offset=(0.011, -0.018, 0.006),
+).params()
+"""A part's calibration of the size imucal's example session has (scales of +2.8 %, -1.8 %)."""
 
 needs_twin = pytest.mark.skipif(not native.available(),
                                 reason=f"no native backend: {native.reason()}")
@@ -132,7 +141,8 @@ def test_the_c_defaults_are_the_python_defaults(key: str) -> None:
 @pytest.mark.parametrize("key", TWIN_KEYS)
 @pytest.mark.parametrize("extra", [{}, {"gyro_sampling": "mean"},
                                    {"mount_pitch": -np.pi / 2, "mount_yaw": 0.3},
-                                   {"sensor_delay": 2.4e-3, "mount_roll": 0.4}])
+                                   {"sensor_delay": 2.4e-3, "mount_roll": 0.4},
+                                   {**PART_CALIBRATION, "mount_yaw": 0.3}])
 def test_python_and_native_runs_are_equal(key: str, preset: str, extra: dict) -> None:
     rec = mixed_recording()
     params = {**preset_params(preset, key), **extra}
@@ -207,7 +217,8 @@ def test_random_short_recordings_give_equal_outputs(samples: list, key: str, pre
     acc = np.array([s[0] for s in samples], dtype=float)
     gyro = np.array([s[1] for s in samples], dtype=float)
     dt = np.array([s[2] for s in samples], dtype=float)
-    params = {**preset_params(preset, key), "sensor_delay": delay}
+    params = {**preset_params(preset, key), "sensor_delay": delay,
+              **(PART_CALIBRATION if delay else {})}
     with np.errstate(all="ignore"):
         out_py = make(key, **params).run(acc, gyro, dt, backend="python")
         out_c = make(key, **params).run(acc, gyro, dt, backend="native")

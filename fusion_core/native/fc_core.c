@@ -562,6 +562,27 @@ void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_
     }
 }
 
+void fc_base_calibrate(fc_base *b, const double acc_cal[9], const double acc_off[3],
+                       const double gyro_cal[9], const double gyro_off[3])
+{
+    static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    b->calibrated = 0;
+    for (int i = 0; i < 9; i++) {
+        b->acc_cal[i] = acc_cal[i];
+        b->gyro_cal[i] = gyro_cal[i];
+        if (acc_cal[i] != identity[i] || gyro_cal[i] != identity[i]) {
+            b->calibrated = 1;
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        b->acc_off[i] = acc_off[i];
+        b->gyro_off[i] = gyro_off[i];
+        if (acc_off[i] != 0.0 || gyro_off[i] != 0.0) {
+            b->calibrated = 1;
+        }
+    }
+}
+
 void fc_base_reset(fc_base *b)
 {
     b->initialized = 0;
@@ -592,6 +613,14 @@ fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt)
     }
     double rail = b->rail;  /* on the sensor's own axes, before the mounting (gyro_range) */
     b->clipped = !(-rail < gx && gx < rail && -rail < gy && gy < rail && -rail < gz && gz < rail);
+    if (b->calibrated) {  /* the part's calibration (fusion_core.calibration) */
+        for (int i = 0; i < 3; i++) {
+            acc[i] = acc[i] - b->acc_off[i];
+            gyro[i] = gyro[i] - b->gyro_off[i];
+        }
+        fc_mat_vec(b->acc_cal, acc, acc);
+        fc_mat_vec(b->gyro_cal, gyro, gyro);
+    }
     if (b->mounted) {
         fc_mat_vec(b->mounting, acc, acc);
         fc_mat_vec(b->mounting, gyro, gyro);

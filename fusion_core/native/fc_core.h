@@ -47,6 +47,8 @@ typedef struct fc_base {
     double max_dt, max_rate, max_rate2;
     double mounting[9];
     int mounted;
+    double acc_cal[9], acc_off[3], gyro_cal[9], gyro_off[3];  /* fusion_core.calibration */
+    int calibrated;
     double delay;  /* sensor_delay [s] */
     double rail;   /* gyro_range (1 - RAIL_MARGIN): a gyro axis at or beyond it is at the rail */
     int clipped;   /* Estimator.clipped: whether this sample's gyro is at its rail */
@@ -162,9 +164,26 @@ void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9]);
 void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
                        double mount_pitch, double mount_yaw, double sensor_delay,
                        double gyro_range);
+/* The part's calibration (fusion_core.calibration): calibrated = cal (raw - off), applied by
+ * fc_base_prepare before the mounting; the identity and zero: none. */
+void fc_base_calibrate(fc_base *b, const double acc_cal[9], const double acc_off[3],
+                       const double gyro_cal[9], const double gyro_off[3]);
+/* fc_base_calibrate with the calibration parameters of any params struct p (every estimator's
+ * has them: COMMON_PARAMS). */
+#define FC_BASE_CALIBRATE(b, p)                                                               \
+    fc_base_calibrate((b),                                                                    \
+        (const double[9]){(p)->acc_cal_xx, (p)->acc_cal_xy, (p)->acc_cal_xz, (p)->acc_cal_yx,  \
+                          (p)->acc_cal_yy, (p)->acc_cal_yz, (p)->acc_cal_zx, (p)->acc_cal_zy,  \
+                          (p)->acc_cal_zz},                                                   \
+        (const double[3]){(p)->acc_off_x, (p)->acc_off_y, (p)->acc_off_z},                    \
+        (const double[9]){(p)->gyro_cal_xx, (p)->gyro_cal_xy, (p)->gyro_cal_xz,               \
+                          (p)->gyro_cal_yx, (p)->gyro_cal_yy, (p)->gyro_cal_yz,               \
+                          (p)->gyro_cal_zx, (p)->gyro_cal_zy, (p)->gyro_cal_zz},              \
+        (const double[3]){(p)->gyro_off_x, (p)->gyro_off_y, (p)->gyro_off_z})
 void fc_base_reset(fc_base *b);
 /* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
- * was), turns it into the filter frame (mounting) and takes an absurd accelerometer reading as
+ * was), applies the calibration, turns it into the filter frame (mounting) and takes an absurd
+ * accelerometer reading as
  * none. Returns FC_OK with acc and gyro rewritten in place, or the rejection. */
 fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt);
 /* Estimator.output: e as the outputs give it, its roll and pitch turned ahead over sensor_delay

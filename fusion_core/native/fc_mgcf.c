@@ -11,6 +11,7 @@ void fc_mgcf_configure(fc_mgcf *f)
     const fc_mgcf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
                       p->mount_yaw, p->sensor_delay, p->gyro_range);
+    FC_BASE_CALIBRATE(&f->base, p);
     f->w0 = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;

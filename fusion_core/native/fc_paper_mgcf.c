@@ -83,6 +83,7 @@ void fc_paper_mgcf_configure(fc_paper_mgcf *f)
     const fc_paper_mgcf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
                       p->mount_yaw, p->sensor_delay, HUGE_VAL);
+    FC_BASE_CALIBRATE(&f->base, p);
     f->w0_fixed = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_PAPER_MGCF_GYRO_SAMPLING_POINT;

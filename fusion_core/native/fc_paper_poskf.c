@@ -176,6 +176,7 @@ void fc_paper_poskf_configure(fc_paper_poskf *f)
     const fc_paper_poskf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
                       p->mount_yaw, p->sensor_delay, HUGE_VAL);
+    FC_BASE_CALIBRATE(&f->base, p);
     tilt_params(p, &f->tilt.params);
     fc_paper_kf_configure(&f->tilt);
     f->acc_var_density = p->acc_psd;

@@ -39,6 +39,30 @@ typedef struct fc_cf_params {
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;           /* [0.8, 1.25] */
+    double acc_cal_xy;           /* [-0.2, 0.2] */
+    double acc_cal_xz;           /* [-0.2, 0.2] */
+    double acc_cal_yx;           /* [-0.2, 0.2] */
+    double acc_cal_yy;           /* [0.8, 1.25] */
+    double acc_cal_yz;           /* [-0.2, 0.2] */
+    double acc_cal_zx;           /* [-0.2, 0.2] */
+    double acc_cal_zy;           /* [-0.2, 0.2] */
+    double acc_cal_zz;           /* [0.8, 1.25] */
+    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;          /* [0.8, 1.25] */
+    double gyro_cal_xy;          /* [-0.2, 0.2] */
+    double gyro_cal_xz;          /* [-0.2, 0.2] */
+    double gyro_cal_yx;          /* [-0.2, 0.2] */
+    double gyro_cal_yy;          /* [0.8, 1.25] */
+    double gyro_cal_yz;          /* [-0.2, 0.2] */
+    double gyro_cal_zx;          /* [-0.2, 0.2] */
+    double gyro_cal_zy;          /* [-0.2, 0.2] */
+    double gyro_cal_zz;          /* [0.8, 1.25] */
+    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
     double gyro_range;           /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_cf_params;
@@ -66,6 +90,30 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
@@ -85,6 +133,30 @@ typedef struct fc_paper_cf_params {
     double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;    /* [0.8, 1.25] */
+    double acc_cal_xy;    /* [-0.2, 0.2] */
+    double acc_cal_xz;    /* [-0.2, 0.2] */
+    double acc_cal_yx;    /* [-0.2, 0.2] */
+    double acc_cal_yy;    /* [0.8, 1.25] */
+    double acc_cal_yz;    /* [-0.2, 0.2] */
+    double acc_cal_zx;    /* [-0.2, 0.2] */
+    double acc_cal_zy;    /* [-0.2, 0.2] */
+    double acc_cal_zz;    /* [0.8, 1.25] */
+    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;   /* [0.8, 1.25] */
+    double gyro_cal_xy;   /* [-0.2, 0.2] */
+    double gyro_cal_xz;   /* [-0.2, 0.2] */
+    double gyro_cal_yx;   /* [-0.2, 0.2] */
+    double gyro_cal_yy;   /* [0.8, 1.25] */
+    double gyro_cal_yz;   /* [-0.2, 0.2] */
+    double gyro_cal_zx;   /* [-0.2, 0.2] */
+    double gyro_cal_zy;   /* [-0.2, 0.2] */
+    double gyro_cal_zz;   /* [0.8, 1.25] */
+    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
     double sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_cf_params;
 
@@ -100,6 +172,30 @@ static inline void fc_paper_cf_params_default(fc_paper_cf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->sensor_delay = 0.0;
 }
 
@@ -127,6 +223,30 @@ typedef struct fc_mgcf_params {
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;           /* [0.8, 1.25] */
+    double acc_cal_xy;           /* [-0.2, 0.2] */
+    double acc_cal_xz;           /* [-0.2, 0.2] */
+    double acc_cal_yx;           /* [-0.2, 0.2] */
+    double acc_cal_yy;           /* [0.8, 1.25] */
+    double acc_cal_yz;           /* [-0.2, 0.2] */
+    double acc_cal_zx;           /* [-0.2, 0.2] */
+    double acc_cal_zy;           /* [-0.2, 0.2] */
+    double acc_cal_zz;           /* [0.8, 1.25] */
+    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;          /* [0.8, 1.25] */
+    double gyro_cal_xy;          /* [-0.2, 0.2] */
+    double gyro_cal_xz;          /* [-0.2, 0.2] */
+    double gyro_cal_yx;          /* [-0.2, 0.2] */
+    double gyro_cal_yy;          /* [0.8, 1.25] */
+    double gyro_cal_yz;          /* [-0.2, 0.2] */
+    double gyro_cal_zx;          /* [-0.2, 0.2] */
+    double gyro_cal_zy;          /* [-0.2, 0.2] */
+    double gyro_cal_zz;          /* [0.8, 1.25] */
+    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
     double gyro_range;           /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_mgcf_params;
@@ -152,6 +272,30 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
@@ -174,6 +318,30 @@ typedef struct fc_paper_mgcf_params {
     double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;    /* [0.8, 1.25] */
+    double acc_cal_xy;    /* [-0.2, 0.2] */
+    double acc_cal_xz;    /* [-0.2, 0.2] */
+    double acc_cal_yx;    /* [-0.2, 0.2] */
+    double acc_cal_yy;    /* [0.8, 1.25] */
+    double acc_cal_yz;    /* [-0.2, 0.2] */
+    double acc_cal_zx;    /* [-0.2, 0.2] */
+    double acc_cal_zy;    /* [-0.2, 0.2] */
+    double acc_cal_zz;    /* [0.8, 1.25] */
+    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;   /* [0.8, 1.25] */
+    double gyro_cal_xy;   /* [-0.2, 0.2] */
+    double gyro_cal_xz;   /* [-0.2, 0.2] */
+    double gyro_cal_yx;   /* [-0.2, 0.2] */
+    double gyro_cal_yy;   /* [0.8, 1.25] */
+    double gyro_cal_yz;   /* [-0.2, 0.2] */
+    double gyro_cal_zx;   /* [-0.2, 0.2] */
+    double gyro_cal_zy;   /* [-0.2, 0.2] */
+    double gyro_cal_zz;   /* [0.8, 1.25] */
+    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
     double sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_mgcf_params;
 
@@ -189,6 +357,30 @@ static inline void fc_paper_mgcf_params_default(fc_paper_mgcf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->sensor_delay = 0.0;
 }
 
@@ -223,6 +415,30 @@ typedef struct fc_kf_params {
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;           /* [0.8, 1.25] */
+    double acc_cal_xy;           /* [-0.2, 0.2] */
+    double acc_cal_xz;           /* [-0.2, 0.2] */
+    double acc_cal_yx;           /* [-0.2, 0.2] */
+    double acc_cal_yy;           /* [0.8, 1.25] */
+    double acc_cal_yz;           /* [-0.2, 0.2] */
+    double acc_cal_zx;           /* [-0.2, 0.2] */
+    double acc_cal_zy;           /* [-0.2, 0.2] */
+    double acc_cal_zz;           /* [0.8, 1.25] */
+    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;          /* [0.8, 1.25] */
+    double gyro_cal_xy;          /* [-0.2, 0.2] */
+    double gyro_cal_xz;          /* [-0.2, 0.2] */
+    double gyro_cal_yx;          /* [-0.2, 0.2] */
+    double gyro_cal_yy;          /* [0.8, 1.25] */
+    double gyro_cal_yz;          /* [-0.2, 0.2] */
+    double gyro_cal_zx;          /* [-0.2, 0.2] */
+    double gyro_cal_zy;          /* [-0.2, 0.2] */
+    double gyro_cal_zz;          /* [0.8, 1.25] */
+    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
     double gyro_range;           /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_kf_params;
@@ -255,6 +471,30 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
@@ -277,6 +517,30 @@ typedef struct fc_paper_kf_params {
     double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;    /* [0.8, 1.25] */
+    double acc_cal_xy;    /* [-0.2, 0.2] */
+    double acc_cal_xz;    /* [-0.2, 0.2] */
+    double acc_cal_yx;    /* [-0.2, 0.2] */
+    double acc_cal_yy;    /* [0.8, 1.25] */
+    double acc_cal_yz;    /* [-0.2, 0.2] */
+    double acc_cal_zx;    /* [-0.2, 0.2] */
+    double acc_cal_zy;    /* [-0.2, 0.2] */
+    double acc_cal_zz;    /* [0.8, 1.25] */
+    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;   /* [0.8, 1.25] */
+    double gyro_cal_xy;   /* [-0.2, 0.2] */
+    double gyro_cal_xz;   /* [-0.2, 0.2] */
+    double gyro_cal_yx;   /* [-0.2, 0.2] */
+    double gyro_cal_yy;   /* [0.8, 1.25] */
+    double gyro_cal_yz;   /* [-0.2, 0.2] */
+    double gyro_cal_zx;   /* [-0.2, 0.2] */
+    double gyro_cal_zy;   /* [-0.2, 0.2] */
+    double gyro_cal_zz;   /* [0.8, 1.25] */
+    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
     double sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_kf_params;
 
@@ -295,6 +559,30 @@ static inline void fc_paper_kf_params_default(fc_paper_kf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->sensor_delay = 0.0;
 }
 
@@ -330,6 +618,30 @@ typedef struct fc_ukf_params {
     double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;           /* [0.8, 1.25] */
+    double acc_cal_xy;           /* [-0.2, 0.2] */
+    double acc_cal_xz;           /* [-0.2, 0.2] */
+    double acc_cal_yx;           /* [-0.2, 0.2] */
+    double acc_cal_yy;           /* [0.8, 1.25] */
+    double acc_cal_yz;           /* [-0.2, 0.2] */
+    double acc_cal_zx;           /* [-0.2, 0.2] */
+    double acc_cal_zy;           /* [-0.2, 0.2] */
+    double acc_cal_zz;           /* [0.8, 1.25] */
+    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;          /* [0.8, 1.25] */
+    double gyro_cal_xy;          /* [-0.2, 0.2] */
+    double gyro_cal_xz;          /* [-0.2, 0.2] */
+    double gyro_cal_yx;          /* [-0.2, 0.2] */
+    double gyro_cal_yy;          /* [0.8, 1.25] */
+    double gyro_cal_yz;          /* [-0.2, 0.2] */
+    double gyro_cal_zx;          /* [-0.2, 0.2] */
+    double gyro_cal_zy;          /* [-0.2, 0.2] */
+    double gyro_cal_zz;          /* [0.8, 1.25] */
+    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
     double gyro_range;           /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_ukf_params;
@@ -363,6 +675,30 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
@@ -388,6 +724,30 @@ typedef struct fc_paper_ukf_params {
     double mount_roll;     /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;    /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;     /* [0.8, 1.25] */
+    double acc_cal_xy;     /* [-0.2, 0.2] */
+    double acc_cal_xz;     /* [-0.2, 0.2] */
+    double acc_cal_yx;     /* [-0.2, 0.2] */
+    double acc_cal_yy;     /* [0.8, 1.25] */
+    double acc_cal_yz;     /* [-0.2, 0.2] */
+    double acc_cal_zx;     /* [-0.2, 0.2] */
+    double acc_cal_zy;     /* [-0.2, 0.2] */
+    double acc_cal_zz;     /* [0.8, 1.25] */
+    double acc_off_x;      /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;      /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;      /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;    /* [0.8, 1.25] */
+    double gyro_cal_xy;    /* [-0.2, 0.2] */
+    double gyro_cal_xz;    /* [-0.2, 0.2] */
+    double gyro_cal_yx;    /* [-0.2, 0.2] */
+    double gyro_cal_yy;    /* [0.8, 1.25] */
+    double gyro_cal_yz;    /* [-0.2, 0.2] */
+    double gyro_cal_zx;    /* [-0.2, 0.2] */
+    double gyro_cal_zy;    /* [-0.2, 0.2] */
+    double gyro_cal_zz;    /* [0.8, 1.25] */
+    double gyro_off_x;     /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;     /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;     /* [-10.0, 10.0] [rad/s] */
     double sensor_delay;   /* [0.0, 0.1] [s] */
 } fc_paper_ukf_params;
 
@@ -409,6 +769,30 @@ static inline void fc_paper_ukf_params_default(fc_paper_ukf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->sensor_delay = 0.0;
 }
 
@@ -440,6 +824,30 @@ typedef struct fc_poskf_params {
     double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;        /* [0.8, 1.25] */
+    double acc_cal_xy;        /* [-0.2, 0.2] */
+    double acc_cal_xz;        /* [-0.2, 0.2] */
+    double acc_cal_yx;        /* [-0.2, 0.2] */
+    double acc_cal_yy;        /* [0.8, 1.25] */
+    double acc_cal_yz;        /* [-0.2, 0.2] */
+    double acc_cal_zx;        /* [-0.2, 0.2] */
+    double acc_cal_zy;        /* [-0.2, 0.2] */
+    double acc_cal_zz;        /* [0.8, 1.25] */
+    double acc_off_x;         /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;         /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;         /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;       /* [0.8, 1.25] */
+    double gyro_cal_xy;       /* [-0.2, 0.2] */
+    double gyro_cal_xz;       /* [-0.2, 0.2] */
+    double gyro_cal_yx;       /* [-0.2, 0.2] */
+    double gyro_cal_yy;       /* [0.8, 1.25] */
+    double gyro_cal_yz;       /* [-0.2, 0.2] */
+    double gyro_cal_zx;       /* [-0.2, 0.2] */
+    double gyro_cal_zy;       /* [-0.2, 0.2] */
+    double gyro_cal_zz;       /* [0.8, 1.25] */
+    double gyro_off_x;        /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;        /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;        /* [-10.0, 10.0] [rad/s] */
     double gyro_range;        /* [0.001, 10000.0] [rad/s] */
     double sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_poskf_params;
@@ -469,6 +877,30 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->gyro_range = 34.90658503988659;
     p->sensor_delay = 0.0;
 }
@@ -497,6 +929,30 @@ typedef struct fc_paper_poskf_params {
     double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
     double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    double acc_cal_xx;    /* [0.8, 1.25] */
+    double acc_cal_xy;    /* [-0.2, 0.2] */
+    double acc_cal_xz;    /* [-0.2, 0.2] */
+    double acc_cal_yx;    /* [-0.2, 0.2] */
+    double acc_cal_yy;    /* [0.8, 1.25] */
+    double acc_cal_yz;    /* [-0.2, 0.2] */
+    double acc_cal_zx;    /* [-0.2, 0.2] */
+    double acc_cal_zy;    /* [-0.2, 0.2] */
+    double acc_cal_zz;    /* [0.8, 1.25] */
+    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    double gyro_cal_xx;   /* [0.8, 1.25] */
+    double gyro_cal_xy;   /* [-0.2, 0.2] */
+    double gyro_cal_xz;   /* [-0.2, 0.2] */
+    double gyro_cal_yx;   /* [-0.2, 0.2] */
+    double gyro_cal_yy;   /* [0.8, 1.25] */
+    double gyro_cal_yz;   /* [-0.2, 0.2] */
+    double gyro_cal_zx;   /* [-0.2, 0.2] */
+    double gyro_cal_zy;   /* [-0.2, 0.2] */
+    double gyro_cal_zz;   /* [0.8, 1.25] */
+    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
     double sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_poskf_params;
 
@@ -518,6 +974,30 @@ static inline void fc_paper_poskf_params_default(fc_paper_poskf_params *p)
     p->mount_roll = 0.0;
     p->mount_pitch = 0.0;
     p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
     p->sensor_delay = 0.0;
 }
 

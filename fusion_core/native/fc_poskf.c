@@ -11,6 +11,7 @@ void fc_poskf_configure(fc_poskf *f)
     const fc_poskf_params *p = &f->params;
     fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
                       p->mount_yaw, p->sensor_delay, p->gyro_range);
+    FC_BASE_CALIBRATE(&f->base, p);
     /* the tilt stage: the papers' kf with the TILT_PARAMS given */
     fc_paper_kf_params tp;
     fc_paper_kf_params_default(&tp);

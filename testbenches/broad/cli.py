@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from fusion_core.registry import keys_help
 
 from ..fmus import DEFAULT_FMU_DIR
-from ..options import add_preset, choose, positive_float
+from ..options import add_calibration, add_preset, choose, positive_float
 
 if TYPE_CHECKING:
     from .cv import CvResult
@@ -39,6 +39,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--estimator", default="all",
                    help=f"all or a comma list of {keys_help()} (all)")
     add_preset(p, more=", all (both named ones), or a comma list of them")
+    add_calibration(p)
     p.add_argument("--peers", action="store_true",
                    help="also run VQF (6D), Madgwick and Mahony (ahrs) on the same trials, and VQF "
                    "with its output turned ahead over the sensor's delay as ours (vqf-ahead)")
@@ -89,7 +90,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
     except PeerUnavailable as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    columns = plan_columns(estimators, presets, peers, fmu=args.fmu)
+    columns = plan_columns(estimators, presets, peers, fmu=args.fmu,
+                           calibration=args.calibration)
     files = collect_paths(args.paths)
     if not files:
         raise ValueError(f"no trial files in {', '.join(map(str, args.paths))}")

@@ -125,13 +125,17 @@ def column_name(key: str, preset: str) -> str:
 
 def plan_columns(
     estimators: Sequence[str], presets: Sequence[str], peers: Sequence[str] = (),
-    fmu: bool = False,
+    fmu: bool = False, calibration: Path | None = None,
 ) -> list[Column]:
-    """Columns for estimators x presets (in that order), then the peers."""
+    """Columns for estimators x presets (in that order), then the peers; a calibration file's
+    parameters on top of every estimator's (testbenches.options.with_calibration)."""
     bad = [k for k in estimators if k not in ESTIMATORS]
     if bad:
         raise ValueError(f"unknown estimator(s) {', '.join(bad)}: allowed {', '.join(ESTIMATORS)}")
-    loaded = {p: load_preset(p) for p in presets}  # ValueError for an unknown one
+    from ..options import with_calibration
+
+    # ValueError for an unknown preset or a bad calibration file
+    loaded = {p: with_calibration(load_preset(p), calibration) for p in presets}
     allowed = [*PEERS, *AHEAD_PEERS]
     bad = [p for p in peers if p not in allowed]
     if bad:

@@ -10,7 +10,14 @@ from pathlib import Path
 from fusion_core import ESTIMATORS
 from fusion_core.registry import estimator_class
 
-from ..options import add_preset, non_negative_float, positive_float, positive_int
+from ..options import (
+    add_calibration,
+    add_preset,
+    non_negative_float,
+    positive_float,
+    positive_int,
+    with_calibration,
+)
 
 
 def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
@@ -42,6 +49,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     tune.add_argument("--validate", type=Path, nargs="*", default=[],
                       help="recordings that check the fit (not fitted)")
     add_preset(tune, "--start", more=": where the fit starts")
+    add_calibration(tune)
     tune.add_argument("--params", default=None,
                       help="comma list of the parameters to fit, or all (every tunable one); "
                       "default: those the recommended preset took from a scan (cf tau, mgcf "
@@ -92,7 +100,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
     fit_recs = [load(p, args.rate) for p in args.files]
     val_recs = [load(p, args.rate) for p in args.validate]
-    start = load_preset(args.start)[args.estimator]
+    start = with_calibration(load_preset(args.start), args.calibration)[args.estimator]
     names = [n.strip() for n in args.params.split(",")] if args.params else None
     with tqdm(total=args.max_evaluations, unit="run", file=sys.stderr) as bar:
         def progress(best: float) -> None:

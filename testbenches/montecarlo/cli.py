@@ -10,7 +10,15 @@ from pathlib import Path
 from fusion_core.scenarios import SCENARIOS
 
 from ..fmus import ESTIMATOR_FMUS
-from ..options import add_preset, add_sensor, non_negative_int, positive_float, positive_int
+from ..options import (
+    add_calibration,
+    add_preset,
+    add_sensor,
+    non_negative_int,
+    positive_float,
+    positive_int,
+    with_calibration,
+)
 from .plan import DESIGNS
 
 
@@ -34,6 +42,7 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--campaign-seed", type=int, default=0, help="seed of the design (0)")
     add_sensor(p)
     add_preset(p)
+    add_calibration(p)
     p.add_argument("--scheduler", default="local",
                    help="local (a LocalCluster, the default) or the address HOST:PORT of your "
                    "own Dask scheduler")
@@ -66,7 +75,8 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
     variations = [parse_variation(v) for v in args.vary]
     runs = plan(estimators, scenarios, args.seeds, variations, args.duration,
-                load_sensor(args.sensor), load_preset(args.preset), args.design,
+                load_sensor(args.sensor),
+                with_calibration(load_preset(args.preset), args.calibration), args.design,
                 args.campaign_seed, args.fmu)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "campaign.json").write_text(json.dumps(
