@@ -24,6 +24,7 @@ new ids.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -134,6 +135,40 @@ def _gyro_clipping() -> Trajectory:
     )
 
 
+CALIBRATION_POSES_DEG: tuple[tuple[float, float, float], ...] = (
+    (0.0, 0.0, 0.0), (90.0, 0.0, 30.0), (180.0, 0.0, -20.0), (270.0, 0.0, 40.0),
+    (360.0, -85.0, 0.0), (360.0, 85.0, -30.0), (405.0, 35.0, 20.0), (495.0, -35.0, -40.0),
+    (585.0, 35.0, 10.0), (675.0, -35.0, -30.0), (765.0, -35.0, 30.0), (855.0, 35.0, -10.0),
+    (945.0, -35.0, 40.0), (1035.0, 35.0, 0.0),
+)
+"""The calibration session's poses (roll, pitch, yaw in deg, roll unwrapped so that each move
+is the short way): each axis up and down (pitch +-85 deg for x), and the eight octants' diagonals
+twice; yaw changes with every move, so that the turns are about mixed axes."""
+CALIBRATION_HOLD_S = 3.0
+CALIBRATION_MOVE_S = 1.6
+"""Each pose is held 3 s; each move (90-180 deg) takes 1.6 s, at most 200 deg/s: a hand's pace,
+far inside a MEMS gyro's range."""
+
+
+def _calibration_session() -> Trajectory:
+    # A calibration session as Tedaldi et al. (2014) ask for it and a hand makes it: static poses
+    # spread over the sphere, minimum-jerk turns between them, no translation.
+    signals: list[list[Signal]] = [[constant(a * DEG)] for a in CALIBRATION_POSES_DEG[0]]
+    t = CALIBRATION_HOLD_S
+    for before, after in itertools.pairwise(CALIBRATION_POSES_DEG):
+        for axis in range(3):
+            if after[axis] != before[axis]:
+                signals[axis].append(min_jerk(0.0, (after[axis] - before[axis]) * DEG, t,
+                                              CALIBRATION_MOVE_S))
+        t += CALIBRATION_MOVE_S + CALIBRATION_HOLD_S
+    roll, pitch, yaw = (add(*s) for s in signals)
+    return Trajectory(roll=roll, pitch=pitch, yaw=yaw)
+
+
+CALIBRATION_DURATION_S = (CALIBRATION_HOLD_S + (len(CALIBRATION_POSES_DEG) - 1)
+                          * (CALIBRATION_MOVE_S + CALIBRATION_HOLD_S))
+
+
 @dataclass(frozen=True)
 class Scenario:
     id: int
@@ -141,6 +176,9 @@ class Scenario:
     duration: float
     build: Callable[[], Trajectory]
     description: str
+    estimation: bool = True
+    """Whether the contract and the campaigns estimate on it (not a calibration session, which
+    is what `calibrate` reads)."""
 
     def trajectory(self) -> Trajectory:
         return self.build()
@@ -209,9 +247,16 @@ SCENARIOS: dict[str, Scenario] = {
             10, "gyro_clipping", 60.0, _gyro_clipping,
             "swings beyond the gyro's +-2000 deg/s range for about 8 % of the samples",
         ),
+        Scenario(
+            11, "calibration_session", CALIBRATION_DURATION_S, _calibration_session,
+            "14 static poses of 3 s over the sphere, turns of 90-180 deg about mixed axes "
+            "between them (testbenches calibrate)", estimation=False,
+        ),
     )
 }
 SCENARIO_BY_ID: dict[int, Scenario] = {s.id: s for s in SCENARIOS.values()}
+ESTIMATION_SCENARIOS: tuple[str, ...] = tuple(n for n, s in SCENARIOS.items() if s.estimation)
+"""The scenarios the contract, `run`, `budget` and `campaign` estimate on."""
 
 
 def get_scenario(key: str | int) -> Scenario:

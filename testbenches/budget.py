@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from fusion_core.registry import keys_help
-from fusion_core.scenarios import SCENARIOS
+from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
 from .contract import accuracy_limits, compute_metrics
 from .options import add_calibration, add_preset, add_sensor, choose, positive_int, with_calibration
@@ -183,7 +183,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     p.add_argument("--estimator", default="all",
                    help=f"all or a comma list of {keys_help()} (all)")
     p.add_argument("--scenario", default="all",
-                   help=f"all or a comma list of {', '.join(SCENARIOS)} (all)")
+                   help=f"all or a comma list of {', '.join(ESTIMATION_SCENARIOS)} (all)")
     p.add_argument("--seeds", type=positive_int, default=3, help="seeds per row, averaged (3)")
     add_preset(p)
     add_calibration(p)
@@ -203,7 +203,7 @@ def cmd_budget(args: argparse.Namespace) -> int:
     from .options import load_sensor
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
-    scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
+    scenarios = choose(args.scenario, list(ESTIMATION_SCENARIOS), "scenario")
     preset = with_calibration(load_preset(args.preset), args.calibration)
     sensor = load_sensor(args.sensor)
     total = len(estimators) * len(scenarios) * len(VARIANTS)

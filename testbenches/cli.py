@@ -16,6 +16,8 @@
               confidence intervals (testbenches.montecarlo).
   budget      the sensor's error budget: each scenario's RMSE with one group of the IMU's
               errors switched off at a time (testbenches.budget).
+  calibrate   a part's calibration from a session of static poses and turns: calibration.json
+              for --calibration (testbenches.calibrate).
   crosscheck  the native FMUs with fusion_core's reference results and fmpy's in the FMI
               Cross-Check layout, validated by fmpy's cross-check tools (testbenches.crosscheck).
 
@@ -33,7 +35,7 @@ from fmu_src.cli import add_build_parser
 from .estimate import add_estimate_parser
 
 TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "budget",
-                      "crosscheck")
+                      "crosscheck", "calibrate")
 """The commands that need the testbench extra."""
 
 
@@ -48,6 +50,7 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     if not missing_modules():
         from .broad.cli import add_broad_parser
         from .budget import add_budget_parser
+        from .calibrate.cli import add_calibrate_parser
         from .crosscheck import add_crosscheck_parser
         from .fit.cli import add_fit_parsers
         from .montecarlo.cli import add_campaign_parser
@@ -55,7 +58,8 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         from .ssp import add_ssp_parser
 
         for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
-                    add_campaign_parser, add_budget_parser, add_crosscheck_parser):
+                    add_campaign_parser, add_budget_parser, add_crosscheck_parser,
+                    add_calibrate_parser):
             add(sub)
     return parser
 

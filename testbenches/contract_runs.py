@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fusion_core.scenarios import SCENARIOS
+from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
 from . import contract
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, extract_under
@@ -70,7 +70,7 @@ def contract_jobs(
 def run_contract(
     *,
     estimators: Sequence[str] = tuple(ESTIMATOR_FMUS),
-    scenarios: Sequence[str] = tuple(SCENARIOS),
+    scenarios: Sequence[str] = ESTIMATION_SCENARIOS,
     seeds: int = 1,
     jitter: float = 0.0,
     fmu_dir: Path | str = DEFAULT_FMU_DIR,
@@ -82,6 +82,7 @@ def run_contract(
     jobs: int = 1,
     preset: dict[str, dict[str, Any]] | None = None,
     sensor: dict[str, Any] | None = None,
+    calibrate_first: bool = False,
 ) -> ContractResult:
     """Run the runs and evaluate the contract; `progress` is called after each run; `params`
     are estimator FMU parameters for every run (each estimator must have them); `duration`
@@ -89,13 +90,23 @@ def run_contract(
     leaves the wall-clock check T3 out of the verdict (its figures are still reported); jobs > 1
     runs that many worker processes (one run per process at a time, so T3 stays per core);
     `preset` holds each estimator's parameters (presets.load_preset; `params` go on top) and
-    `sensor` the ImuSensor parameters of every run but the contract's noise-free ones."""
+    `sensor` the ImuSensor parameters of every run but the contract's noise-free ones;
+    calibrate_first: each seed's part is calibrated on its own calibration session first, and
+    its runs apply the result (testbenches.calibrate.part; not the noise-free extras, whose
+    sensor has no part errors)."""
     out = ContractResult()
     extra: dict[tuple[str, str], list[TestbenchResult]] = {}
     jobs_list = contract_jobs(estimators, scenarios, seeds=seeds, jitter=jitter,
                               contract_checks=contract_checks)
+    part: dict[int, dict[str, float]] = {}
+    if calibrate_first:
+        from .calibrate.part import part_calibration
+
+        part = {seed: part_calibration(sensor or {}, seed)
+                for seed in sorted({j.seed for j in jobs_list if j.kind == "run"})}
     run_one = functools.partial(_run_job, params=params, fmu_dir=fmu_dir, duration=duration,
-                                timing=timing, preset=preset or {}, sensor=sensor or {})
+                                timing=timing, preset=preset or {}, sensor=sensor or {},
+                                part=part)
     with contextlib.ExitStack() as stack:
         if jobs > 1:
             root = stack.enter_context(tempfile.TemporaryDirectory(prefix="campaign_"))
@@ -124,9 +135,10 @@ def run_contract(
 
 def _run_job(job: Job, params: dict[str, Any] | None, fmu_dir: Path | str,
              duration: float | None, timing: bool, preset: dict[str, dict[str, Any]],
-             sensor: dict[str, Any]) -> TestbenchResult:
+             sensor: dict[str, Any], part: dict[int, dict[str, float]]) -> TestbenchResult:
     sensor_params = dict(job.sensor_params) if job.sensor_params else dict(sensor)
-    run_params = {**preset.get(job.estimator, {}), **(params or {})}
+    calibration = part.get(job.seed, {}) if job.kind == "run" else {}
+    run_params = {**preset.get(job.estimator, {}), **calibration, **(params or {})}
     r = run_testbench(job.estimator, job.scenario, seed=job.seed, jitter=job.jitter,
                       params=run_params, sensor_params=sensor_params, fmu_dir=fmu_dir,
                       duration=duration if job.kind == "run" else None, evaluate=False)

@@ -61,9 +61,11 @@ def peer_limits(scenario: str) -> tuple[float, float] | None:
 
 def run_peers(
     peers: dict[str, Peer], scenarios: Iterable[str], seeds: int, sensor: dict[str, Any],
-    duration: float | None = None,
+    duration: float | None = None, calibrate_first: bool = False,
 ) -> list[PeerRun]:
-    """Every peer on every scenario and seed (0 .. seeds-1) of the contract run."""
+    """Every peer on every scenario and seed (0 .. seeds-1) of the contract run; with
+    calibrate_first on the samples calibrated as the estimators calibrate them (each part's
+    matrices from its own calibration session: testbenches.calibrate.part)."""
     from fusion_core.synthetic import TRUTH_NAMES
 
     rows = []
@@ -71,8 +73,11 @@ def run_peers(
         for seed in range(seeds):
             t, truth_array, sample = scenario_samples(scenario, seed, sensor, duration)
             truth = {n: truth_array[:, i] for i, n in enumerate(TRUTH_NAMES)}
+            acc, gyro = sample["acc"], sample["gyro"]
+            if calibrate_first:
+                acc, gyro = _calibrated(acc, gyro, sensor, seed)
             for name, peer in peers.items():
-                roll, pitch = roll_pitch_from_up(peer(sample["acc"], sample["gyro"], RATE))
+                roll, pitch = roll_pitch_from_up(peer(acc, gyro, RATE))
                 err_roll, err_pitch, keep = contract.attitude_errors(scenario, t, truth, roll,
                                                                      pitch)
                 rmse = (contract.scored_rmse(err_roll, keep), contract.scored_rmse(err_pitch, keep))
@@ -82,6 +87,18 @@ def run_peers(
                 )
                 rows.append(PeerRun(name, scenario, seed, *rmse, allowed, passed))
     return rows
+
+
+def _calibrated(acc: np.ndarray, gyro: np.ndarray, sensor: dict[str, Any], seed: int
+                ) -> tuple[np.ndarray, np.ndarray]:
+    from fusion_core.calibration import Calibration, matrix_names
+
+    from .calibrate.part import part_calibration
+
+    values = part_calibration(sensor, seed)
+    cal = Calibration(acc_matrix=tuple(values[n] for n in matrix_names("acc")),  # type: ignore[arg-type]
+                      gyro_matrix=tuple(values[n] for n in matrix_names("gyro")))  # type: ignore[arg-type]
+    return cal.apply(acc, gyro)
 
 
 def peer_table(rows: list[PeerRun]) -> str:

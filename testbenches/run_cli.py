@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from fusion_core.scenarios import SCENARIOS
+from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .options import (
@@ -31,12 +31,15 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     run.add_argument("--estimator", default="all",
                      help=f"all or a comma list of {', '.join(ESTIMATOR_FMUS)}")
     run.add_argument("--scenario", default="all",
-                     help=f"all or a comma list of {', '.join(SCENARIOS)}")
+                     help=f"all or a comma list of {', '.join(ESTIMATION_SCENARIOS)}")
     run.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                      help="estimator FMU parameter for every run (repeatable); an enumeration "
                      "by item name, e.g. --param gyro_sampling=mean")
     add_preset(run)
     add_calibration(run)
+    run.add_argument("--calibrate-first", action="store_true",
+                     help="calibrate each seed's sensor part on its own calibration session "
+                     "first (the calibrate command's code) and apply its matrices in the runs")
     add_sensor(run)
     run.add_argument("--seeds", type=positive_int, default=1,
                      help="seeds per estimator x scenario (1)")
@@ -92,7 +95,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
 
     estimators = choose(args.estimator, list(ESTIMATOR_FMUS), "estimator")
-    scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
+    scenarios = choose(args.scenario, list(ESTIMATION_SCENARIOS), "scenario")
     from fusion_core.presets import load_preset
 
     preset = with_calibration(load_preset(args.preset), args.calibration)
@@ -113,13 +116,15 @@ def cmd_run(args: argparse.Namespace) -> int:
                               jitter=args.jitter, fmu_dir=fmu_dir, progress=progress,
                               contract_checks=not args.no_contract, params=params,
                               duration=args.duration, timing=not args.no_timing_check,
-                              jobs=args.jobs, preset=preset, sensor=sensor)
+                              jobs=args.jobs, preset=preset, sensor=sensor,
+                              calibrate_first=args.calibrate_first)
     print(contract_table(result))
     peer_rows = None
     if peers:
         from .peer_runs import peer_table, run_peers
 
-        peer_rows = run_peers(peers, scenarios, args.seeds, sensor, args.duration)
+        peer_rows = run_peers(peers, scenarios, args.seeds, sensor, args.duration,
+                              calibrate_first=args.calibrate_first)
         print("\n" + peer_table(peer_rows))
     summaries = seed_summaries(result, peer_rows)
     if over_several_seeds(summaries):

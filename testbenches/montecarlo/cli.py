@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from fusion_core.scenarios import SCENARIOS
+from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
 from ..fmus import ESTIMATOR_FMUS
 from ..options import (
@@ -30,7 +30,8 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--estimator", default="all",
                    help=f"all or a comma list of {', '.join(ESTIMATOR_FMUS)}")
     p.add_argument("--scenario", default="moderate_dynamics",
-                   help=f"all or a comma list of {', '.join(SCENARIOS)} (moderate_dynamics)")
+                   help=f"all or a comma list of {', '.join(ESTIMATION_SCENARIOS)} "
+                   "(moderate_dynamics)")
     p.add_argument("--seeds", type=positive_int, default=100,
                    help="runs per estimator and scenario: seed i, design point i (100)")
     p.add_argument("--duration", type=positive_float, default=None,
@@ -43,6 +44,9 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     add_sensor(p)
     add_preset(p)
     add_calibration(p)
+    p.add_argument("--calibrate-first", action="store_true",
+                   help="calibrate each run's sensor part on its own calibration session first "
+                   "(the calibrate command's code) and apply its matrices")
     p.add_argument("--scheduler", default="local",
                    help="local (a LocalCluster, the default) or the address HOST:PORT of your "
                    "own Dask scheduler")
@@ -72,12 +76,12 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     from .summary import write
 
     estimators = choose(args.estimator, list(ESTIMATOR_FMUS), "estimator")
-    scenarios = choose(args.scenario, list(SCENARIOS), "scenario")
+    scenarios = choose(args.scenario, list(ESTIMATION_SCENARIOS), "scenario")
     variations = [parse_variation(v) for v in args.vary]
     runs = plan(estimators, scenarios, args.seeds, variations, args.duration,
                 load_sensor(args.sensor),
                 with_calibration(load_preset(args.preset), args.calibration), args.design,
-                args.campaign_seed, args.fmu)
+                args.campaign_seed, args.fmu, args.calibrate_first)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "campaign.json").write_text(json.dumps(
         {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(args).items()

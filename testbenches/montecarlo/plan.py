@@ -89,6 +89,9 @@ class Run:
     params: dict[str, Any] = field(hash=False)
     varied: dict[str, float] = field(hash=False)
     fmu: bool = False
+    calibrate_first: bool = False
+    """The part is calibrated on its own calibration session first (testbenches.calibrate.part)
+    and the run applies the result."""
 
 
 def design(n: int, d: int, kind: str, seed: int) -> np.ndarray:
@@ -115,7 +118,8 @@ def run_key(spec: dict[str, Any]) -> str:
 def plan(estimators: list[str], scenarios: list[str], seeds: int,
          variations: list[Variation] | None = None, duration: float | None = None,
          sensor: dict[str, Any] | None = None, preset: dict[str, dict[str, Any]] | None = None,
-         kind: str = "lhs", campaign_seed: int = 0, fmu: bool = False) -> list[Run]:
+         kind: str = "lhs", campaign_seed: int = 0, fmu: bool = False,
+         calibrate_first: bool = False) -> list[Run]:
     """Every run: estimator x scenario x seed, seed i with design point i."""
     variations = variations or []
     points = design(seeds, len(variations), kind, campaign_seed)
@@ -137,6 +141,8 @@ def plan(estimators: list[str], scenarios: list[str], seeds: int,
                         if v.target == "estimator" and v.name in specs}}
                 spec = {"estimator": estimator, "scenario": scenario, "seed": seed,
                         "duration": duration, "sensor": s, "params": p, "fmu": fmu}
+                if calibrate_first:  # (absent otherwise: the keys of earlier campaigns hold)
+                    spec["calibrate_first"] = True
                 runs.append(Run(run_key(spec), estimator, scenario, seed, duration, s, p,
-                                varied, fmu))
+                                varied, fmu, calibrate_first))
     return runs

@@ -76,12 +76,22 @@ def scenario_samples(
     return t, truth, sample
 
 
+def _calibration(run: Run) -> dict[str, float]:
+    """The part's calibration where the run calibrates first, else none."""
+    if not run.calibrate_first:
+        return {}
+    from ..calibrate.part import part_calibration
+
+    return part_calibration(run.sensor, run.seed)
+
+
 def simulate(run: Run) -> TestbenchResult:
     """The run's traces, as the FMU testbench's result (metrics not yet computed)."""
     sc = get_scenario(run.scenario)
     t, truth, sample = scenario_samples(sc.name, run.seed, run.sensor, run.duration)
     sensor_params = {**run.sensor, "seed": run.seed}
-    params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **run.params}
+    params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"),
+              **_calibration(run), **run.params}
     est = create(run.estimator, params)
     out = est.run(sample["acc"], sample["gyro"], sample["dt"])
     # the master's names, as views of the runs' own arrays (nothing is copied)
@@ -107,7 +117,8 @@ def run_row(run: Run, fmu_dir: Path | str | None = None) -> dict[str, Any]:
         from ..master import run_testbench
 
         result = run_testbench(run.estimator, run.scenario, seed=run.seed,
-                               duration=run.duration, rate=RATE, params=run.params,
+                               duration=run.duration, rate=RATE,
+                               params={**_calibration(run), **run.params},
                                sensor_params=run.sensor, fmu_dir=kind_dir(fmu_dir or "dist"),
                                evaluate=False)
     else:

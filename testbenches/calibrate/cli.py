@@ -1,0 +1,282 @@
+"""`imu-fusion calibrate RECORDING`: a part's calibration from a session of static poses and the
+turns between them, written as calibration.json for every estimator's input.
+
+    imu-fusion calibrate session.csv [--rate HZ] [--gyro-unit rad/s|deg/s] [--acc-unit m/s2|g]
+                         [--sections FILE.json] [--gyro-range DEG_PER_S] [--out DIR]
+
+Finds the static intervals itself (Tedaldi's detector, its threshold chosen by Tedaldi's
+criterion), fits the accelerometer (|a| = g at every pose) and the gyro (the turns between poses
+take one pose's gravity direction to the next one's), and writes DIR/calibration.json
+(`acc_cal` and `gyro_cal`, each {"matrix": 3x3, "offset": 3} in SI units, calibrated = matrix
+(raw - offset), with the units, the poses, the residual per pose and each term's standard
+uncertainty) and DIR/calibration.png (the static intervals over the signals; the residual per
+pose before and after). With --sections (imucal's section list) it also computes Ferraris's
+calibration from those sections and from the session's own intervals, and imucal's where imucal
+is installed, beside it; a session of Ferraris's six poses alone is calibrated by Ferraris's
+method. A session that cannot determine the model is refused with what to record instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.calibration import Calibration
+from fusion_core.types import G
+
+from ..options import positive_float
+from . import ferraris as fer
+from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
+from .tedaldi import CalibrationRefused, Fit, Session, calibrate_session
+
+
+def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """The calibrate subcommand."""
+    p = sub.add_parser("calibrate", help="a part's calibration from a session of static poses "
+                       "and turns (calibration.json for --calibration)",
+                       description=__doc__.split("\n\n")[0])
+    p.add_argument("recording", type=Path, help="the session: CSV (or HDF5) with acc_x..z, "
+                   "gyro_x..z and a time column (or --rate)")
+    p.add_argument("--rate", type=positive_float, default=None,
+                   help="sample rate [Hz] where the file has no time column")
+    p.add_argument("--time-column", default=None, help="the time column's name [s]")
+    p.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s"), default="auto",
+                   help="the gyro columns' unit (auto: from their size)")
+    p.add_argument("--acc-unit", choices=("auto", "m/s2", "g"), default="auto",
+                   help="the accelerometer columns' unit (auto: from the norm at rest)")
+    p.add_argument("--sections", type=Path, default=None, metavar="FILE.json",
+                   help="imucal's section list (x_p ... z_a, x_rot ... z_rot): Ferraris's "
+                   "calibration beside")
+    p.add_argument("--gyro-range", type=positive_float, default=2000.0, metavar="DEG_PER_S",
+                   help="the gyro's full-scale range [deg/s] (2000)")
+    p.add_argument("--gravity", type=positive_float, default=G,
+                   help=f"local gravity [m/s^2] ({G})")
+    p.add_argument("--out", type=Path, default=Path("calibration"),
+                   help="output folder (calibration)")
+    p.set_defaults(func=run)
+
+
+def _fit_json(fit: Fit, unit: str) -> dict[str, Any]:
+    return {"matrix_std": fit.matrix_std.tolist(), "offset_std": fit.offset_std.tolist(),
+            "residual_before": fit.before.tolist(), "residual_after": fit.after.tolist(),
+            "residual_unit": unit, **fit.extra}
+
+
+def _calibration(acc: Fit, gyro: Fit, extra: dict[str, Any]) -> Calibration:
+    return Calibration(tuple(acc.matrix.ravel()), tuple(acc.offset),  # type: ignore[arg-type]
+                       tuple(gyro.matrix.ravel()), tuple(gyro.offset),  # type: ignore[arg-type]
+                       extra=extra)
+
+
+def _own_sections(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, g: float
+                  ) -> tuple[dict[str, tuple[int, int]], Fit, Fit] | None:
+    """Ferraris on the session's own intervals: of the detector's thresholds that find all
+    nine sections, the one whose poses Ferraris's accelerometer fits best."""
+    rate = 1.0 / float(np.median(dt))
+    varsigma = variance_magnitude(acc, rate)
+    floor = noise_floor(varsigma)
+    best = None
+    for k in MULTIPLES:
+        statics = static_intervals(acc, gyro, rate, k * floor, varsigma)
+        if len(statics) < len(fer.POSES):
+            continue
+        bias = np.mean([s.gyro for s in statics], axis=0)
+        try:
+            sections = fer.sections_from_session(statics, gyro, dt, bias)
+            acc_fit, gyro_fit = fer.ferraris(acc, gyro, dt, sections, g)
+        except (CalibrationRefused, np.linalg.LinAlgError):
+            continue
+        score = float(np.mean(acc_fit.after ** 2))
+        if best is None or score < best[0]:
+            best = (score, sections, acc_fit, gyro_fit)
+    return None if best is None else best[1:]
+
+
+def _imucal(acc: np.ndarray, gyro: np.ndarray, rate: float,
+            sections: dict[str, tuple[int, int]]) -> tuple[np.ndarray, np.ndarray] | None:
+    """imucal's Ferraris matrices (accelerometer, gyro) on the same sections, where installed."""
+    try:
+        import pandas as pd
+        from imucal import FerrarisCalibration, ferraris_regions_from_section_list
+    except ImportError:
+        return None
+    data = pd.DataFrame(np.column_stack([acc, np.degrees(gyro)]),
+                        columns=["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"])
+    section_list = pd.DataFrame({name: {"start": s, "end": e} for name, (s, e)
+                                 in sections.items()}).T
+    regions = ferraris_regions_from_section_list(data, section_list)
+    info = FerrarisCalibration().compute(regions, sampling_rate_hz=rate, from_acc_unit="m/s^2",
+                                         from_gyr_unit="deg/s")
+    return (np.linalg.inv(info.R_a) @ np.linalg.inv(info.K_a),
+            np.linalg.inv(info.R_g) @ np.linalg.inv(info.K_g))
+
+
+def _matrix_rows(label: str, m: np.ndarray) -> str:
+    return f"  {label:<28}" + "  ".join(" ".join(f"{v:+.4f}" for v in row) for row in m)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Calibrate, write calibration.json and calibration.png, print the result."""
+    from ..estimate import load_recording
+
+    rec, t = load_recording(args.recording, rate=args.rate, time_column=args.time_column,
+                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit)
+    acc, gyro, dt, g = rec.acc, rec.gyro, rec.dt, args.gravity
+    rate = 1.0 / float(np.median(dt))
+    gyro_range = math.radians(args.gyro_range)
+    session: Session | None = None
+    refused: str | None = None
+    try:
+        session = calibrate_session(acc, gyro, dt, gyro_range, g)
+    except CalibrationRefused as err:
+        refused = str(err)
+    comparisons: dict[str, Any] = {}
+    given = fer.read_sections(args.sections) if args.sections else None
+    lines = [f"{args.recording}: {len(acc)} samples at {rate:.4g} Hz"]
+    if given is not None:
+        f_acc, f_gyro = fer.ferraris(acc, gyro, dt, given, g)
+        comparisons["ferraris"] = {"acc_matrix": f_acc.matrix.tolist(),
+                                   "gyro_matrix": f_gyro.matrix.tolist(),
+                                   **fer.summary(f_acc, f_gyro)}
+        own = _own_sections(acc, gyro, dt, g)
+        if own is not None:
+            comparisons["ferraris_own_sections"] = {
+                "sections": {k: list(v) for k, v in own[0].items()},
+                "acc_matrix": own[1].matrix.tolist(), "gyro_matrix": own[2].matrix.tolist(),
+                **fer.summary(own[1], own[2])}
+        peer = _imucal(acc, gyro, rate, given)
+        if peer is not None:
+            comparisons["imucal"] = {"acc_matrix": peer[0].tolist(),
+                                     "gyro_matrix": peer[1].tolist()}
+    if session is not None:
+        acc_fit, gyro_fit, method = session.acc, session.gyro, "tedaldi"
+    elif given is not None:
+        acc_fit, gyro_fit, method = f_acc, f_gyro, "ferraris"
+        lines.append(f"Tedaldi's method refused ({refused}); Ferraris's from the sections")
+    else:
+        print(f"error: {args.recording}: {refused}", file=sys.stderr)
+        return 2
+    extra: dict[str, Any] = {
+        "method": method,
+        "units": {"acc": "m/s2", "gyro": "rad/s", "matrix": "1"},
+        "input_units": {"acc": args.acc_unit, "gyro": args.gyro_unit},
+        "gravity": g,
+        "recording": str(args.recording),
+        "acc": _fit_json(acc_fit, "m/s2 (| |a| - g | per pose)"),
+        "gyro": _fit_json(gyro_fit, "rad (gravity direction per turn)" if method == "tedaldi"
+                          else "rad (| turn - 2 pi | per turn)"),
+    }
+    if session is not None:
+        extra["poses"] = len(session.statics)
+        extra["static_intervals"] = [[s.start, s.stop] for s in session.statics]
+        extra["detector"] = {"window_s": WINDOW_S, "floor": session.floor,
+                             "multiple": session.multiple, "threshold": session.threshold}
+        extra["turn_degrees"] = session.turn_degrees.tolist()
+    if comparisons:
+        extra["comparisons"] = comparisons
+    cal = _calibration(acc_fit, gyro_fit, extra)
+    args.out.mkdir(parents=True, exist_ok=True)
+    cal.write(args.out / "calibration.json")
+    if session is not None:
+        spans = [(s.start, s.stop, "static") for s in session.statics]
+        labels = [str(k) for k in range(len(session.statics))]
+    else:
+        assert given is not None
+        spans = [(lo, hi, "static" if name in fer.POSES else "turn")
+                 for name, (lo, hi) in given.items()]
+        labels = list(fer.POSES)
+    _plot(args.out / "calibration.png", t, acc, gyro, spans, labels, acc_fit, gyro_fit,
+          method, g)
+    lines += _report(method, session, acc_fit, gyro_fit, comparisons)
+    lines.append(f"wrote {args.out / 'calibration.json'} and {args.out / 'calibration.png'}")
+    print("\n".join(lines))
+    return 0
+
+
+def _report(method: str, session: Session | None, acc_fit: Fit, gyro_fit: Fit,
+            comparisons: dict[str, Any]) -> list[str]:
+    lines = []
+    if session is not None:
+        lines.append(f"{len(session.statics)} static poses (threshold {session.multiple:g} x "
+                     f"the noise floor), {int(np.sum(session.turn_degrees >= 20))} turns")
+    lines.append(f"method: {method}; calibrated = matrix (raw - offset)")
+    for sensor, fit, unit in (("acc", acc_fit, "m/s2"), ("gyro", gyro_fit, "rad/s")):
+        lines.append(_matrix_rows(f"{sensor} matrix", fit.matrix))
+        lines.append(f"  {sensor + ' offset [' + unit + ']':<28}"
+                     + " ".join(f"{v:+.5f}" for v in fit.offset))
+        if np.all(np.isfinite(fit.matrix_std)):
+            lines.append(f"  {'  standard uncertainty':<28}"
+                         + f"matrix up to {np.max(fit.matrix_std):.2g}, offset up to "
+                         f"{np.max(fit.offset_std):.2g}")
+    lines.append(f"  acc residual per pose: before {_rms(acc_fit.before):.4f}, after "
+                 f"{_rms(acc_fit.after):.4f} m/s2 (RMS)")
+    lines.append(f"  gyro residual per turn: before {math.degrees(_rms(gyro_fit.before)):.3f}, "
+                 f"after {math.degrees(_rms(gyro_fit.after)):.3f} deg (RMS)")
+    for name, comp in comparisons.items():
+        lines.append(f"{name}:")
+        lines.append(_matrix_rows("acc matrix", np.array(comp["acc_matrix"])))
+        lines.append(_matrix_rows("gyro matrix", np.array(comp["gyro_matrix"])))
+    return lines
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if len(x) else math.nan
+
+
+def _plot(path: Path, t: np.ndarray, acc: np.ndarray, gyro: np.ndarray,
+          spans: list[tuple[int, int, str]], labels: list[str], acc_fit: Fit, gyro_fit: Fit,
+          method: str, g: float) -> None:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    fig, axes = plt.subplots(3, 1, figsize=(10, 9))
+    ax = axes[0]
+    ax.plot(t, np.linalg.norm(acc, axis=1) / g, lw=0.7, label="|acc| [g]")
+    ax.plot(t, np.degrees(np.linalg.norm(gyro, axis=1)) / 100.0, lw=0.7,
+            label="|gyro| [100 deg/s]")
+    for lo, hi, kind in spans:
+        ax.axvspan(t[lo], t[hi - 1], color="tab:green" if kind == "static" else "tab:orange",
+                   alpha=0.2, lw=0)
+    ax.set_xlabel("time [s]")
+    ax.set_title("the session; the static intervals found shaded" if method == "tedaldi" else
+                 "the session; the sections given shaded (poses green, turns orange)")
+    ax.legend(loc="upper right")
+    ax = axes[1]
+    k = np.arange(len(acc_fit.before))
+    ax.bar(k - 0.2, acc_fit.before, 0.4, label="raw")
+    ax.bar(k + 0.2, acc_fit.after, 0.4, label="calibrated")
+    ax.set_yscale("log")
+    ax.set_xticks(k, labels)
+    ax.set_xlabel("pose")
+    ax.set_ylabel("| |a| - g | [m/s2]")
+    ax.set_title(f"accelerometer residual per pose ({method})")
+    ax.legend()
+    ax = axes[2]
+    k = np.arange(len(gyro_fit.before))
+    ax.bar(k - 0.2, np.degrees(gyro_fit.before), 0.4, label="raw less the bias")
+    ax.bar(k + 0.2, np.degrees(gyro_fit.after), 0.4, label="calibrated")
+    if method != "tedaldi":
+        ax.set_xticks(k, list(fer.TURNS))
+    ax.set_xlabel("turn")
+    ax.set_ylabel("deg")
+    ax.set_title("gyro residual per turn (predicted against measured gravity direction)"
+                 if method == "tedaldi" else "gyro residual per full turn")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def calibration_json(path: Path) -> dict[str, Any]:
+    """calibration.json as written (for reports and tests)."""
+    return json.loads(path.read_text())

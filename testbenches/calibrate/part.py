@@ -1,0 +1,54 @@
+"""Calibrating a simulated part before it is used (`run --calibrate-first`,
+`campaign --calibrate-first`): the calibration_session scenario recorded through the same sensor
+part (its parameters and seed), calibrated by the calibrate command's own code, the result
+applied at the estimators' input.
+
+What carries over from the session to the runs is the part's matrices (scale factors,
+misalignment, cross-coupling), not its offsets: a MEMS part's biases change from one power-up
+and one temperature to the next (the realistic sensor draws what a start-up calibration leaves),
+and the estimators learn the gyro's themselves. The session is a recording of its own: the same
+part, not the run's samples.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from typing import Any
+
+import numpy as np
+
+from fusion_core.calibration import matrix_names
+from fusion_core.scenarios import get_scenario
+from fusion_core.sensor import ImuSensorModel
+
+from .tedaldi import CalibrationRefused, calibrate_session
+
+SESSION = "calibration_session"
+RATE = 100.0
+
+
+@functools.lru_cache(maxsize=64)
+def _part_calibration(sensor_json: str) -> tuple[tuple[str, float], ...]:
+    sensor = json.loads(sensor_json)
+    sc = get_scenario(SESSION)
+    n = round(sc.duration * RATE)
+    steps = np.full(n, 1.0 / RATE)
+    truth = sc.truth(np.cumsum(steps))
+    out = ImuSensorModel(**sensor).run(truth[:, 3:6], truth[:, 6:9], steps)
+    try:
+        session = calibrate_session(out["acc"], out["gyro"], out["dt"],
+                                    float(sensor.get("gyro_range", np.radians(2000.0))))
+    except CalibrationRefused as err:
+        raise CalibrationRefused(f"the calibration session of part seed {sensor.get('seed')} "
+                                 f"could not be calibrated: {err}") from None
+    values = dict(zip(matrix_names("acc"), session.acc.matrix.ravel().tolist(), strict=True))
+    values.update(zip(matrix_names("gyro"), session.gyro.matrix.ravel().tolist(), strict=True))
+    return tuple(values.items())
+
+
+def part_calibration(sensor: dict[str, Any], seed: int) -> dict[str, float]:
+    """The estimator parameters that calibrate the part of these sensor parameters and seed
+    (its matrices; cached per part, as a worker runs several estimators on one)."""
+    key = json.dumps({**sensor, "seed": seed}, sort_keys=True)
+    return dict(_part_calibration(key))
