@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup run demo test test-fast test-slow lint fmus native campaign wheel crosscheck clean
+.PHONY: setup run demo test test-fast test-slow lint fmus native campaign wheel crosscheck embedded clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -49,6 +49,12 @@ native: setup
 crosscheck: setup
 	$(BIN)/python build_fmu.py --out dist --kind native
 	$(BIN)/python -m testbenches crosscheck --fmu-dir dist --out reports/crosscheck
+
+# The C twin on an Arm Cortex-M under QEMU (double on a Cortex-M7, float on a Cortex-M4F): its
+# outputs against the desktop's, instructions per sample, RAM and flash (build/embedded/).
+# Needs gcc-arm-none-eabi, libnewlib-arm-none-eabi and qemu-system-arm; says so where missing.
+embedded: setup
+	$(BIN)/python -m testbenches.embedded
 
 # The sdist and a platform wheel carrying the C twin's library and the native FMUs (setup.py).
 wheel: setup

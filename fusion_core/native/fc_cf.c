@@ -13,7 +13,7 @@ void fc_cf_configure(fc_cf *f)
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_CF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
-    f->r_ref = pow(p->acc_noise, 2.0);
+    f->r_ref = fc_pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
@@ -34,7 +34,7 @@ void fc_cf_reset(fc_cf *f)
 {
     fc_base_reset(&f->base);
     f->roll = f->pitch = 0.0;
-    static const double zero[3] = {0.0, 0.0, 0.0};
+    static const fc_real zero[3] = {0.0, 0.0, 0.0};
     fc_measure_start(f->meas, zero, &f->measure);
     f->q_att[0] = 1.0;
     f->q_att[1] = f->q_att[2] = f->q_att[3] = 0.0;
@@ -46,7 +46,7 @@ void fc_cf_reset(fc_cf *f)
 FC_DEFINE_INIT(fc_cf)
 FC_DEFINE_RESTORED(fc_cf)
 
-static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_cf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
     fc_measure_start(f->meas, a, &f->measure);
@@ -54,22 +54,22 @@ static void first_sample(fc_cf *f, const double a[3], const double g[3])  /* _in
     fc_rest_start(f->rest, g, a);
 }
 
-static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt)  /* _advance */
+static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real dt)  /* _advance */
 {
     const fc_cf_params *p = &f->params;
-    double a[3] = {a_in[0], a_in[1], a_in[2]};
-    double rest_time = p->rest_time;
-    double roll, pitch, phi[3], terms[4];
+    fc_real a[3] = {a_in[0], a_in[1], a_in[2]};
+    fc_real rest_time = p->rest_time;
+    fc_real roll, pitch, phi[3], terms[4];
     int clipped = f->base.clipped;  /* at the gyro's rail: no rate measured (gyro_range) */
-    double fa[3];
+    fc_real fa[3];
     if (rest_time > 0.0 && !clipped &&  /* at rest the gyro reads its bias: follow it */
         fc_complementary_rest(f->rest, f->bias, g, a, dt, rest_time, p->rest_gyro, p->rest_acc,
                               p->rest_bias_bound, &f->roll, &f->pitch, fa)) {
         fc_measure_align(f->meas, fa);  /* an uncalibrated first rest: its tilt */
         fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
     }
-    double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
-    double r = f->r_ref;
+    fc_real bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
+    fc_real r = f->r_ref;
     int aligning = 0;
     fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
     fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
@@ -82,18 +82,18 @@ static void advance(fc_cf *f, const double a_in[3], const double g[3], double dt
     }
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
     fc_quat_roll_pitch(f->q_att, &roll, &pitch);
-    double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        double acc_roll, acc_pitch;
+        fc_real acc_roll, acc_pitch;
         fc_accel_roll_pitch(a[0], a[1], a[2], &acc_roll, &acc_pitch);
-        double tau = f->tau;
+        fc_real tau = f->tau;
         if (f->q_rotation > 0.0 || r != f->r_ref) {  /* the adaptive noise */
-            double wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
+            fc_real wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
             tau = fc_correction_time(tau, r / f->r_ref, f->q_rotation,
                                      wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
         }
-        double k = aligning ? 1.0 : dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
-        double y = acc_roll - roll;
+        fc_real k = aligning ? 1.0 : dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
+        fc_real y = acc_roll - roll;
         roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
         pitch += k * (acc_pitch - pitch);
         fc_quat_from_roll_pitch(roll, pitch, f->q_att);

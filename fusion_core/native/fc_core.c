@@ -11,91 +11,91 @@
 
 /* ----- kinematics.py ----------------------------------------------------------------------- */
 
-double fc_wrap_angle(double x)  /* wrap_angle */
+fc_real fc_wrap_angle(fc_real x)  /* wrap_angle */
 {
-    return remainder(x, FC_TWO_PI);
+    return fc_remainder(x, FC_TWO_PI);
 }
 
-double fc_clamp_pitch(double theta)  /* clamp_pitch */
+fc_real fc_clamp_pitch(fc_real theta)  /* clamp_pitch */
 {
     theta = theta < FC_HALF_PI ? theta : FC_HALF_PI;
     return theta > -FC_HALF_PI ? theta : -FC_HALF_PI;
 }
 
-void fc_accel_roll_pitch(double ax, double ay, double az, double *roll, double *pitch)
+void fc_accel_roll_pitch(fc_real ax, fc_real ay, fc_real az, fc_real *roll, fc_real *pitch)
 {
-    *roll = atan2(ay, az);
-    *pitch = atan2(-ax, sqrt(ay * ay + az * az));
+    *roll = fc_atan2(ay, az);
+    *pitch = fc_atan2(-ax, fc_sqrt(ay * ay + az * az));
 }
 
-/* euler_rates (with the cos(pitch) guard of heun_euler_step) */
-static void euler_rates(double phi, double theta, double p, double q, double r, double *dphi,
-                        double *dtheta)
+/* euler_rates (with the fc_cos(pitch) guard of heun_euler_step) */
+static void euler_rates(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real *dphi,
+                        fc_real *dtheta)
 {
-    double sp = sin(phi), cp = cos(phi), ct = cos(theta);
+    fc_real sp = fc_sin(phi), cp = fc_cos(phi), ct = fc_cos(theta);
     if (-MIN_COS_PITCH < ct && ct < MIN_COS_PITCH) {
-        ct = copysign(MIN_COS_PITCH, ct);
+        ct = fc_copysign(MIN_COS_PITCH, ct);
     }
-    *dphi = p + (q * sp + r * cp) * sin(theta) / ct;
+    *dphi = p + (q * sp + r * cp) * fc_sin(theta) / ct;
     *dtheta = q * cp - r * sp;
 }
 
-void fc_euler_step(double phi, double theta, double p, double q, double r, double dt,
-                   double *phi_out, double *theta_out)
+void fc_euler_step(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real dt,
+                   fc_real *phi_out, fc_real *theta_out)
 {
-    double dp, dtheta;
+    fc_real dp, dtheta;
     euler_rates(phi, theta, p, q, r, &dp, &dtheta);
     *phi_out = phi + dt * dp;
     *theta_out = theta + dt * dtheta;
 }
 
-void fc_heun_euler_step(double phi, double theta, double p0, double q0, double r0, double p1,
-                        double q1, double r1, double dt, double *phi_out, double *theta_out)
+void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_real r0, fc_real p1,
+                        fc_real q1, fc_real r1, fc_real dt, fc_real *phi_out, fc_real *theta_out)
 {
-    double d1p, d1t, d2p, d2t;
+    fc_real d1p, d1t, d2p, d2t;
     euler_rates(phi, theta, p0, q0, r0, &d1p, &d1t);
-    double phi1 = phi + dt * d1p, theta1 = theta + dt * d1t;
+    fc_real phi1 = phi + dt * d1p, theta1 = theta + dt * d1t;
     euler_rates(phi1, theta1, p1, q1, r1, &d2p, &d2t);
     *phi_out = phi + 0.5 * dt * (d1p + d2p);
     *theta_out = theta + 0.5 * dt * (d1t + d2t);
 }
 
-void fc_quat_from_roll_pitch_yaw(double phi, double theta, double psi, double q[4])
+void fc_quat_from_roll_pitch_yaw(fc_real phi, fc_real theta, fc_real psi, fc_real q[4])
 {
-    double cr = cos(0.5 * phi), sr = sin(0.5 * phi);
-    double cp = cos(0.5 * theta), sp = sin(0.5 * theta);
-    double cy = cos(0.5 * psi), sy = sin(0.5 * psi);
+    fc_real cr = fc_cos(0.5 * phi), sr = fc_sin(0.5 * phi);
+    fc_real cp = fc_cos(0.5 * theta), sp = fc_sin(0.5 * theta);
+    fc_real cy = fc_cos(0.5 * psi), sy = fc_sin(0.5 * psi);
     q[0] = cr * cp * cy + sr * sp * sy;
     q[1] = sr * cp * cy - cr * sp * sy;
     q[2] = cr * sp * cy + sr * cp * sy;
     q[3] = cr * cp * sy - sr * sp * cy;
 }
 
-void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch)
+void fc_quat_roll_pitch(const fc_real q[4], fc_real *roll, fc_real *pitch)
 {
-    double w = q[0], x = q[1], y = q[2], z = q[3];
-    *roll = atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
-    double s = 2.0 * (w * y - x * z);
+    fc_real w = q[0], x = q[1], y = q[2], z = q[3];
+    *roll = fc_atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+    fc_real s = 2.0 * (w * y - x * z);
     if (!(-1.0 <= s && s <= 1.0)) {
         s = s < 1.0 ? s : 1.0;     /* max(-1, min(1, s)) */
         s = -1.0 > s ? -1.0 : s;
     }
-    *pitch = asin(s);
+    *pitch = fc_asin(s);
 }
 
-void fc_quat_gravity_body(const double q[4], double g[3])
+void fc_quat_gravity_body(const fc_real q[4], fc_real g[3])
 {
-    double w = q[0], x = q[1], y = q[2], z = q[3];
+    fc_real w = q[0], x = q[1], y = q[2], z = q[3];
     g[0] = 2.0 * (x * z - w * y);
     g[1] = 2.0 * (y * z + w * x);
     g[2] = w * w - x * x - y * y + z * z;
 }
 
-/* rotvec_terms: cos(a/2), sin(a/2)/a, sin(a)/a, (1 - cos a)/a^2; below a^2 = SERIES_A2 their
- * Taylor series through a^8 (exact to double precision there), else from one sine-cosine pair */
-void fc_rotvec_terms(double vx, double vy, double vz, double t[4])
+/* rotvec_terms: fc_cos(a/2), fc_sin(a/2)/a, fc_sin(a)/a, (1 - cos a)/a^2; below a^2 = SERIES_A2 their
+ * Taylor series through a^8 (exact to fc_real precision there), else from one sine-cosine pair */
+void fc_rotvec_terms(fc_real vx, fc_real vy, fc_real vz, fc_real t[4])
 {
-    double a2 = vx * vx + vy * vy + vz * vz;
+    fc_real a2 = vx * vx + vy * vy + vz * vz;
     if (a2 < SERIES_A2) {
         t[0] = 1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
                                                               - a2 * (1.0 / 10321920.0))));
@@ -107,79 +107,79 @@ void fc_rotvec_terms(double vx, double vy, double vz, double t[4])
                                                                - a2 * (1.0 / 3628800.0))));
         return;
     }
-    double angle = sqrt(a2);
-    double ch = cos(0.5 * angle), sh = sin(0.5 * angle);
+    fc_real angle = fc_sqrt(a2);
+    fc_real ch = fc_cos(0.5 * angle), sh = fc_sin(0.5 * angle);
     t[0] = ch;
     t[1] = sh / angle;
     t[2] = 2.0 * sh * ch / angle;
     t[3] = 2.0 * sh * sh / a2;
 }
 
-void fc_quat_mul_rotvec_terms(double q[4], double vx, double vy, double vz, const double t[4])
+void fc_quat_mul_rotvec_terms(fc_real q[4], fc_real vx, fc_real vy, fc_real vz, const fc_real t[4])
 {
-    double w = q[0], x = q[1], y = q[2], z = q[3];
-    double c = t[0], s = t[1];
-    double bx = s * vx, by = s * vy, bz = s * vz;
-    double rw = w * c - x * bx - y * by - z * bz;
-    double rx = w * bx + x * c + y * bz - z * by;
-    double ry = w * by - x * bz + y * c + z * bx;
-    double rz = w * bz + x * by - y * bx + z * c;
-    double n = 1.0 / sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
+    fc_real w = q[0], x = q[1], y = q[2], z = q[3];
+    fc_real c = t[0], s = t[1];
+    fc_real bx = s * vx, by = s * vy, bz = s * vz;
+    fc_real rw = w * c - x * bx - y * by - z * bz;
+    fc_real rx = w * bx + x * c + y * bz - z * by;
+    fc_real ry = w * by - x * bz + y * c + z * bx;
+    fc_real rz = w * bz + x * by - y * bx + z * c;
+    fc_real n = 1.0 / fc_sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
     q[0] = rw * n;
     q[1] = rx * n;
     q[2] = ry * n;
     q[3] = rz * n;
 }
 
-void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz)
+void fc_quat_mul_rotvec(fc_real q[4], fc_real vx, fc_real vy, fc_real vz)
 {
-    double t[4];
+    fc_real t[4];
     fc_rotvec_terms(vx, vy, vz, t);
     fc_quat_mul_rotvec_terms(q, vx, vy, vz, t);
 }
 
-void fc_roll_pitch_ahead(double roll, double pitch, double wx, double wy, double wz,
-                         double delay, double *roll_out, double *pitch_out)
+void fc_roll_pitch_ahead(fc_real roll, fc_real pitch, fc_real wx, fc_real wy, fc_real wz,
+                         fc_real delay, fc_real *roll_out, fc_real *pitch_out)
 {
-    double q[4];
+    fc_real q[4];
     fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, q);
     fc_quat_mul_rotvec(q, wx * delay, wy * delay, wz * delay);
     fc_quat_roll_pitch(q, roll_out, pitch_out);
 }
 
-void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
-                           double dt, double phi[3])
+void fc_rotation_increment(fc_real p0, fc_real q0, fc_real r0, fc_real p1, fc_real q1, fc_real r1,
+                           fc_real dt, fc_real phi[3])
 {
-    double a0 = p0 * dt, a1 = q0 * dt, a2 = r0 * dt;
-    double b0 = p1 * dt, b1 = q1 * dt, b2 = r1 * dt;
-    double k = 1.0 / 12.0;
+    fc_real a0 = p0 * dt, a1 = q0 * dt, a2 = r0 * dt;
+    fc_real b0 = p1 * dt, b1 = q1 * dt, b2 = r1 * dt;
+    fc_real k = 1.0 / 12.0;
     phi[0] = 0.5 * (a0 + b0) + k * (a1 * b2 - a2 * b1);
     phi[1] = 0.5 * (a1 + b1) + k * (a2 * b0 - a0 * b2);
     phi[2] = 0.5 * (a2 + b2) + k * (a0 * b1 - a1 * b0);
 }
 
-void fc_rotate_back_terms(const double v[3], const double phi[3], const double t[4],
-                          double out[3])
+void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_real t[4],
+                          fc_real out[3])
 {
-    double p0 = phi[0], p1 = phi[1], p2 = phi[2];
-    double s = t[2], c = t[3];
-    double v0 = v[0], v1 = v[1], v2 = v[2];
-    double u0 = p1 * v2 - p2 * v1, u1 = p2 * v0 - p0 * v2, u2 = p0 * v1 - p1 * v0;
+    fc_real p0 = phi[0], p1 = phi[1], p2 = phi[2];
+    fc_real s = t[2], c = t[3];
+    fc_real v0 = v[0], v1 = v[1], v2 = v[2];
+    fc_real u0 = p1 * v2 - p2 * v1, u1 = p2 * v0 - p0 * v2, u2 = p0 * v1 - p1 * v0;
     out[0] = v0 - s * u0 + c * (p1 * u2 - p2 * u1);
     out[1] = v1 - s * u1 + c * (p2 * u0 - p0 * u2);
     out[2] = v2 - s * u2 + c * (p0 * u1 - p1 * u0);
 }
 
-void fc_rotate_back(const double v[3], const double phi[3], double out[3])
+void fc_rotate_back(const fc_real v[3], const fc_real phi[3], fc_real out[3])
 {
-    double t[4];
+    fc_real t[4];
     fc_rotvec_terms(phi[0], phi[1], phi[2], t);
     fc_rotate_back_terms(v, phi, t, out);
 }
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 
-const double FC_FACES[6][9] = {
+const fc_real FC_FACES[6][9] = {
     {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0},
     {1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0},
     {0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0},
@@ -189,26 +189,26 @@ const double FC_FACES[6][9] = {
 };
 
 /* quat_from_roll_pitch: roll and pitch with yaw 0 (the filters' free yaw) */
-void fc_quat_from_roll_pitch(double roll, double pitch, double q[4])
+void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4])
 {
-    double cr = cos(0.5 * roll), sr = sin(0.5 * roll);
-    double cp = cos(0.5 * pitch), sp = sin(0.5 * pitch);
+    fc_real cr = fc_cos(0.5 * roll), sr = fc_sin(0.5 * roll);
+    fc_real cp = fc_cos(0.5 * pitch), sp = fc_sin(0.5 * pitch);
     q[0] = cr * cp;
     q[1] = sr * cp;
     q[2] = cr * sp;
     q[3] = -(sr * sp);
 }
 
-void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2)
+void fc_gate_bounds2(fc_real gate_low, fc_real gate_high, fc_real *low2, fc_real *high2)
 {
-    *low2 = pow(gate_low * FC_G, 2.0);
-    *high2 = pow(gate_high * FC_G, 2.0);
+    *low2 = fc_pow(gate_low * FC_G, 2.0);
+    *high2 = fc_pow(gate_high * FC_G, 2.0);
 }
 
-void fc_body_rotation(const double g0[3], const double g1[3], const double bias[3], double dt,
-                      int trapezoid, double phi[3])
+void fc_body_rotation(const fc_real g0[3], const fc_real g1[3], const fc_real bias[3], fc_real dt,
+                      int trapezoid, fc_real phi[3])
 {
-    double b0 = bias[0], b1 = bias[1], b2 = bias[2];
+    fc_real b0 = bias[0], b1 = bias[1], b2 = bias[2];
     if (trapezoid) {
         fc_rotation_increment(g0[0] - b0, g0[1] - b1, g0[2] - b2, g1[0] - b0, g1[1] - b1,
                               g1[2] - b2, dt, phi);
@@ -219,41 +219,41 @@ void fc_body_rotation(const double g0[3], const double g1[3], const double bias[
     phi[2] = (g1[2] - b2) * dt;
 }
 
-void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
-                                     const double a[3], double dt, double tau)
+void fc_lowpass_specific_force_terms(fc_real f[3], const fc_real phi[3], const fc_real terms[4],
+                                     const fc_real a[3], fc_real dt, fc_real tau)
 {
-    double t[3];
+    fc_real t[3];
     fc_rotate_back_terms(f, phi, terms, t);
-    double k = dt / (tau + dt);
+    fc_real k = dt / (tau + dt);
     f[0] = t[0] + k * (a[0] - t[0]);
     f[1] = t[1] + k * (a[1] - t[1]);
     f[2] = t[2] + k * (a[2] - t[2]);
 }
 
-void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
-                                 double disturbance_time, double acc_tau, double *q_rotation,
-                                 double *dist_tau)
+void fc_adaptive_noise_constants(fc_real gyro_scale_std, fc_real scale_time,
+                                 fc_real disturbance_time, fc_real acc_tau, fc_real *q_rotation,
+                                 fc_real *dist_tau)
 {
-    *q_rotation = pow(gyro_scale_std, 2.0) * scale_time;
+    *q_rotation = fc_pow(gyro_scale_std, 2.0) * scale_time;
     *dist_tau = acc_tau > 0.0 ? disturbance_time : 0.0;
 }
 
-double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
-                          double dt, double longest)
+fc_real fc_correction_time(fc_real tau, fc_real r_ratio, fc_real q_rotation, fc_real w2, fc_real r,
+                          fc_real dt, fc_real longest)
 {
-    double q_ratio = 1.0 + q_rotation * w2 * tau * tau / (r * dt);
-    double t = tau * sqrt(r_ratio / q_ratio);
-    double cap = longest > tau ? longest : tau;
+    fc_real q_ratio = 1.0 + q_rotation * w2 * tau * tau / (r * dt);
+    fc_real t = tau * fc_sqrt(r_ratio / q_ratio);
+    fc_real cap = longest > tau ? longest : tau;
     return t < cap ? t : cap;
 }
 
-double fc_adaptive_prefilter_time(double tau, double dist, double noise)
+fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise)
 {
-    double excess = dist - noise;
+    fc_real excess = dist - noise;
     if (excess <= 0.0) {
         return 0.0;
     }
-    double full = PREFILTER_FULL * noise;
+    fc_real full = PREFILTER_FULL * noise;
     if (excess >= full) {
         return tau;
     }
@@ -263,7 +263,7 @@ double fc_adaptive_prefilter_time(double tau, double dist, double noise)
 /* ----- measured_vector.py ------------------------------------------------------------------ */
 #define DISTURBANCE_ATTACK 0.05 /* measured_vector.DISTURBANCE_ATTACK [s] */
 
-void fc_measure_constants(double acc_lowpass, double disturbance_time, double band, double r,
+void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
                           fc_meas_constants *c)
 {
     c->stage = 0.5 * acc_lowpass;
@@ -273,14 +273,14 @@ void fc_measure_constants(double acc_lowpass, double disturbance_time, double ba
     c->r = r;
 }
 
-void fc_measure_start(double m[FC_MEAS_SIZE], const double a[3], const fc_meas_constants *c)
+void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c)
 {
     fc_measure_align(m, a);
     m[FC_MEAS_DIST] = m[FC_MEAS_SLOW] = m[FC_MEAS_FILL] = 0.0;
     m[FC_MEAS_SETTLE] = 2.0 * c->stage;
 }
 
-void fc_measure_align(double m[FC_MEAS_SIZE], const double f[3])
+void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
 {
     for (int v = 0; v < FC_MEAS_DIST; v += 3) {
         m[v] = f[0];
@@ -289,26 +289,26 @@ void fc_measure_align(double m[FC_MEAS_SIZE], const double f[3])
     }
 }
 
-static double two_stage_noise(double k)
+static fc_real two_stage_noise(fc_real k)
 {
-    double a2 = (1.0 - k) * (1.0 - k);
-    double d = 1.0 - a2;
+    fc_real a2 = (1.0 - k) * (1.0 - k);
+    fc_real d = 1.0 - a2;
     return k * k * k * k * (1.0 + a2) / (d * d * d);
 }
 
-static void lowpass2(double *s1, double *s, const double phi[3], const double a[3], double dt,
-                     double tau, const double terms[4])
+static void lowpass2(fc_real *s1, fc_real *s, const fc_real phi[3], const fc_real a[3], fc_real dt,
+                     fc_real tau, const fc_real terms[4])
 {
     fc_lowpass_specific_force_terms(s1, phi, terms, a, dt, tau);
     fc_lowpass_specific_force_terms(s, phi, terms, s1, dt, tau);
 }
 
-double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double phi[3],
-                       const double terms[4], double dt, const fc_meas_constants *c,
+fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
+                       const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
                        int *filling)
 {
-    double stage = c->stage;
-    double full = 2.0 * stage;
+    fc_real stage = c->stage;
+    fc_real full = 2.0 * stage;
     if (m[FC_MEAS_SETTLE] < full) {
         m[FC_MEAS_SETTLE] += dt;
     }
@@ -317,12 +317,12 @@ double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double p
         m[FC_MEAS_FILL] += dt;
         stage = m[FC_MEAS_FILL] < full ? 0.5 * m[FC_MEAS_FILL] : stage;
     }
-    double r = c->r;
-    double tau = stage;
+    fc_real r = c->r;
+    fc_real tau = stage;
     if (c->dist_tau > 0.0) {
-        double *ref = m + FC_MEAS_REF, *s = m + FC_MEAS_S;
+        fc_real *ref = m + FC_MEAS_REF, *s = m + FC_MEAS_S;
         lowpass2(m + FC_MEAS_REF1, ref, phi, a, dt, stage, terms);
-        double e0 = a[0] - ref[0], e1 = a[1] - ref[1], e2 = a[2] - ref[2];
+        fc_real e0 = a[0] - ref[0], e1 = a[1] - ref[1], e2 = a[2] - ref[2];
         m[FC_MEAS_DIST] += dt / (c->dist_tau + dt)
                            * (e0 * e0 + e1 * e1 + e2 * e2 - m[FC_MEAS_DIST]);
         if (!*filling) {
@@ -333,10 +333,10 @@ double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double p
             e0 = s[0] - ref[0];
             e1 = s[1] - ref[1];
             e2 = s[2] - ref[2];
-            double inst = e0 * e0 + e1 * e1 + e2 * e2;
-            double rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
+            fc_real inst = e0 * e0 + e1 * e1 + e2 * e2;
+            fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
-            double excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
+            fc_real excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
             if (excess > 0.0) {
                 r += excess / (FC_G * FC_G);
             }
@@ -346,29 +346,29 @@ double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double p
     return r;
 }
 
-int fc_measure_settled(const double m[FC_MEAS_SIZE], const fc_meas_constants *c)
+int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)
 {
     return m[FC_MEAS_SETTLE] >= 2.0 * c->stage;
 }
 
-double fc_measure_raw_noise(const double m[FC_MEAS_SIZE], const fc_meas_constants *c)
+fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)
 {
-    double excess = m[FC_MEAS_DIST] - c->noise;
+    fc_real excess = m[FC_MEAS_DIST] - c->noise;
     return excess > 0.0 ? c->r + excess / (FC_G * FC_G) : c->r;
 }
 
-void fc_measure_restart(double m[FC_MEAS_SIZE], const double f[3])
+void fc_measure_restart(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
 {
     fc_measure_align(m, f);
     m[FC_MEAS_SLOW] = 0.0;
 }
 
-void fc_measure_clipped(double m[FC_MEAS_SIZE])
+void fc_measure_clipped(fc_real m[FC_MEAS_SIZE])
 {
     m[FC_MEAS_SETTLE] = 0.0;
 }
 
-void fc_rest_start(double rest[8], const double gyro[3], const double acc[3])
+void fc_rest_start(fc_real rest[8], const fc_real gyro[3], const fc_real acc[3])
 {
     rest[0] = gyro[0];
     rest[1] = gyro[1];
@@ -380,27 +380,27 @@ void fc_rest_start(double rest[8], const double gyro[3], const double acc[3])
     rest[7] = 0.0;
 }
 
-void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, double ay,
-                  double az, const double bias[3], double dt, double th_gyro, double th_acc,
-                  double rest_time, double bound)
+void fc_rest_step(fc_real rest[8], fc_real gx, fc_real gy, fc_real gz, fc_real ax, fc_real ay,
+                  fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro, fc_real th_acc,
+                  fc_real rest_time, fc_real bound)
 {
-    double wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
-    double quiet = rest[6], measured = rest[7];
-    double k = dt / (FC_REST_MEAN_TAU + dt);
+    fc_real wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
+    fc_real quiet = rest[6], measured = rest[7];
+    fc_real k = dt / (FC_REST_MEAN_TAU + dt);
     wx += k * (gx - wx);
     wy += k * (gy - wy);
     wz += k * (gz - wz);
     fx += k * (ax - fx);
     fy += k * (ay - fy);
     fz += k * (az - fz);
-    double th_g2 = th_gyro * th_gyro;
-    double dx = gx - wx, dy = gy - wy, dz = gz - wz;
-    double ex = ax - fx, ey = ay - fy, ez = az - fz;
+    fc_real th_g2 = th_gyro * th_gyro;
+    fc_real dx = gx - wx, dy = gy - wy, dz = gz - wz;
+    fc_real ex = ax - fx, ey = ay - fy, ez = az - fz;
     int still = dx * dx + dy * dy + dz * dz < th_g2
         && ex * ex + ey * ey + ez * ez < th_acc * th_acc;
     if (still && quiet < rest_time) {  /* only a mean rate the bias explains may start a rest */
-        double mx = wx - bias[0], my = wy - bias[1], mz = wz - bias[2];
-        double lim = measured == 0.0 ? th_gyro + bound : th_gyro;
+        fc_real mx = wx - bias[0], my = wy - bias[1], mz = wz - bias[2];
+        fc_real lim = measured == 0.0 ? th_gyro + bound : th_gyro;
         still = mx * mx + my * my + mz * mz < lim * lim;
     }
     quiet = still ? quiet + dt : 0.0;
@@ -414,23 +414,23 @@ void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, do
     rest[7] = quiet >= rest_time ? 1.0 : measured;
 }
 
-int fc_first_rest(double measured_before, const double rest[8])
+int fc_first_rest(fc_real measured_before, const fc_real rest[8])
 {
     return measured_before == 0.0 && rest[7] != 0.0;
 }
 
-int fc_uncalibrated_first_rest(double measured_before, const double rest[8], const double bias[3],
-                               double th_gyro)
+int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[8], const fc_real bias[3],
+                               fc_real th_gyro)
 {
     if (!fc_first_rest(measured_before, rest)) {
         return 0;
     }
-    double mx = rest[0] - bias[0], my = rest[1] - bias[1], mz = rest[2] - bias[2];
+    fc_real mx = rest[0] - bias[0], my = rest[1] - bias[1], mz = rest[2] - bias[2];
     return mx * mx + my * my + mz * mz >= th_gyro * th_gyro;
 }
 
-void fc_rest_alignment(const double rest[8], double bias[3], double *roll, double *pitch,
-                       double f[3])
+void fc_rest_alignment(const fc_real rest[8], fc_real bias[3], fc_real *roll, fc_real *pitch,
+                       fc_real f[3])
 {
     f[0] = rest[3];
     f[1] = rest[4];
@@ -441,20 +441,20 @@ void fc_rest_alignment(const double rest[8], double bias[3], double *roll, doubl
     bias[2] = rest[2];
 }
 
-void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
-                     double rest_time)
+void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
+                     fc_real rest_time)
 {
-    double k = dt / (rest_time + dt);
+    fc_real k = dt / (rest_time + dt);
     bias[0] = bias[0] + k * (gx - bias[0]);
     bias[1] = bias[1] + k * (gy - bias[1]);
     bias[2] = bias[2] + k * (gz - bias[2]);
 }
 
-int fc_complementary_rest(double rest[8], double bias[3], const double g[3], const double a[3],
-                          double dt, double rest_time, double rest_gyro, double rest_acc,
-                          double bound, double *roll, double *pitch, double f[3])
+int fc_complementary_rest(fc_real rest[8], fc_real bias[3], const fc_real g[3], const fc_real a[3],
+                          fc_real dt, fc_real rest_time, fc_real rest_gyro, fc_real rest_acc,
+                          fc_real bound, fc_real *roll, fc_real *pitch, fc_real f[3])
 {
-    double measured = rest[7];
+    fc_real measured = rest[7];
     fc_rest_step(rest, g[0], g[1], g[2], a[0], a[1], a[2], bias, dt, rest_gyro, rest_acc,
                  rest_time, bound);
     if (fc_uncalibrated_first_rest(measured, rest, bias, rest_gyro)) {
@@ -467,21 +467,21 @@ int fc_complementary_rest(double rest[8], double bias[3], const double g[3], con
     return 0;
 }
 
-void fc_bias_band2(double gate, double *lo, double *hi)
+void fc_bias_band2(fc_real gate, fc_real *lo, fc_real *hi)
 {
     if (!(gate > 0.0)) {
         *lo = -1.0;
         *hi = HUGE_VAL;
         return;
     }
-    double low = 1.0 - gate;
-    *lo = pow((low >= 0.0 ? low : 0.0) * FC_G, 2.0);
-    *hi = pow((1.0 + gate) * FC_G, 2.0);
+    fc_real low = 1.0 - gate;
+    *lo = fc_pow((low >= 0.0 ? low : 0.0) * FC_G, 2.0);
+    *hi = fc_pow((1.0 + gate) * FC_G, 2.0);
 }
 
-int fc_nearest_face(double ux, double uy, double uz)
+int fc_nearest_face(fc_real ux, fc_real uy, fc_real uz)
 {
-    double ax = fabs(ux), ay = fabs(uy), az = fabs(uz);
+    fc_real ax = fc_fabs(ux), ay = fc_fabs(uy), az = fc_fabs(uz);
     if (az >= ax && az >= ay) {
         return uz >= 0.0 ? 0 : 1;
     }
@@ -491,17 +491,17 @@ int fc_nearest_face(double ux, double uy, double uz)
     return uy > 0.0 ? 4 : 5;
 }
 
-void fc_mat_vec(const double m[9], const double v[3], double out[3])
+void fc_mat_vec(const fc_real m[9], const fc_real v[3], fc_real out[3])
 {
-    double x = v[0], y = v[1], z = v[2];
+    fc_real x = v[0], y = v[1], z = v[2];
     out[0] = m[0] * x + m[1] * y + m[2] * z;
     out[1] = m[3] * x + m[4] * y + m[5] * z;
     out[2] = m[6] * x + m[7] * y + m[8] * z;
 }
 
-void fc_mat_t_vec(const double m[9], const double v[3], double out[3])
+void fc_mat_t_vec(const fc_real m[9], const fc_real v[3], fc_real out[3])
 {
-    double x = v[0], y = v[1], z = v[2];
+    fc_real x = v[0], y = v[1], z = v[2];
     out[0] = m[0] * x + m[3] * y + m[6] * z;
     out[1] = m[1] * x + m[4] * y + m[7] * z;
     out[2] = m[2] * x + m[5] * y + m[8] * z;
@@ -514,20 +514,20 @@ void fc_mat_t_vec(const double m[9], const double v[3], double out[3])
 #define RAIL_MARGIN 1e-3               /* base.RAIL_MARGIN */
 
 /* cos and sin of a, exact 0 and +-1 at multiples of pi/2 (mounting_matrix's cs) */
-static void right_angle_cs(double a, double *c, double *s)
+static void right_angle_cs(fc_real a, fc_real *c, fc_real *s)
 {
-    *c = cos(a);
-    *s = sin(a);
-    double quarter = a / (0.5 * FC_PI);
-    if (fabs(quarter - nearbyint(quarter)) < 1e-12) {
-        *c = nearbyint(*c);
-        *s = nearbyint(*s);
+    *c = fc_cos(a);
+    *s = fc_sin(a);
+    fc_real quarter = a / (0.5 * FC_PI);
+    if (fc_fabs(quarter - fc_nearbyint(quarter)) < 1e-12) {
+        *c = fc_nearbyint(*c);
+        *s = fc_nearbyint(*s);
     }
 }
 
-void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9])
+void fc_mounting_matrix(fc_real roll, fc_real pitch, fc_real yaw, fc_real m[9])
 {
-    double cr, sr, cp, sp, cy, sy;
+    fc_real cr, sr, cp, sp, cy, sy;
     right_angle_cs(roll, &cr, &sr);
     right_angle_cs(pitch, &cp, &sp);
     right_angle_cs(yaw, &cy, &sy);
@@ -542,15 +542,15 @@ void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9])
     m[8] = cp * cr;
 }
 
-void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
-                       double mount_pitch, double mount_yaw, double sensor_delay,
-                       double gyro_range)
+void fc_base_configure(fc_base *b, fc_real max_dt, fc_real max_rate, fc_real mount_roll,
+                       fc_real mount_pitch, fc_real mount_yaw, fc_real sensor_delay,
+                       fc_real gyro_range)
 {
-    static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    static const fc_real identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
     b->max_dt = max_dt;
     b->max_rate = max_rate;
     b->delay = sensor_delay;
-    b->max_rate2 = pow(max_rate, 2.0);
+    b->max_rate2 = fc_pow(max_rate, 2.0);
     b->rail = gyro_range * (1.0 - RAIL_MARGIN);
     b->clipped = 0;
     fc_mounting_matrix(mount_roll, mount_pitch, mount_yaw, b->mounting);
@@ -562,10 +562,10 @@ void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_
     }
 }
 
-void fc_base_calibrate(fc_base *b, const double acc_cal[9], const double acc_off[3],
-                       const double gyro_cal[9], const double gyro_off[3])
+void fc_base_calibrate(fc_base *b, const fc_real acc_cal[9], const fc_real acc_off[3],
+                       const fc_real gyro_cal[9], const fc_real gyro_off[3])
 {
-    static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    static const fc_real identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
     b->calibrated = 0;
     for (int i = 0; i < 9; i++) {
         b->acc_cal[i] = acc_cal[i];
@@ -591,11 +591,11 @@ void fc_base_reset(fc_base *b)
     b->gyro_prev[0] = b->gyro_prev[1] = b->gyro_prev[2] = 0.0;
 }
 
-fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt)
+fc_status fc_base_prepare(fc_base *b, fc_real acc[3], fc_real gyro[3], fc_real dt)
 {
-    double ax = acc[0], ay = acc[1], az = acc[2], gx = gyro[0], gy = gyro[1], gz = gyro[2];
-    double w2 = gx * gx + gy * gy + gz * gz;
-    double total = ax + ay + az + w2 + dt;
+    fc_real ax = acc[0], ay = acc[1], az = acc[2], gx = gyro[0], gy = gyro[1], gz = gyro[2];
+    fc_real w2 = gx * gx + gy * gy + gz * gz;
+    fc_real total = ax + ay + az + w2 + dt;
     if (!(total - total == 0.0 && w2 <= b->max_rate2 && 0.0 < dt && dt <= b->max_dt)) {
         /* Estimator.check_sample: what is wrong (a finite sample whose sum overflowed passes) */
         if (!isfinite(ax) || !isfinite(ay) || !isfinite(az)) {
@@ -607,11 +607,11 @@ fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt)
         if (!isfinite(dt) || !(0.0 < dt && dt <= b->max_dt)) {
             return FC_BAD_DT;
         }
-        if (!(hypot(hypot(gx, gy), gz) <= b->max_rate)) {
+        if (!(fc_hypot(fc_hypot(gx, gy), gz) <= b->max_rate)) {
             return FC_BAD_RATE;
         }
     }
-    double rail = b->rail;  /* on the sensor's own axes, before the mounting (gyro_range) */
+    fc_real rail = b->rail;  /* on the sensor's own axes, before the mounting (gyro_range) */
     b->clipped = !(-rail < gx && gx < rail && -rail < gy && gy < rail && -rail < gz && gz < rail);
     if (b->calibrated) {  /* the part's calibration (fusion_core.calibration) */
         for (int i = 0; i < 3; i++) {
@@ -625,23 +625,23 @@ fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt)
         fc_mat_vec(b->mounting, acc, acc);
         fc_mat_vec(b->mounting, gyro, gyro);
     }
-    double norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+    fc_real norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
     if (!(norm2 <= MAX_ACC_NORM * MAX_ACC_NORM)) {
         acc[0] = acc[1] = acc[2] = 0.0;
     }
     return FC_OK;
 }
 
-int fc_base_can_init(const double acc[3])
+int fc_base_can_init(const fc_real acc[3])
 {
-    double norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+    fc_real norm2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
     return norm2 >= MIN_INIT_NORM * MIN_INIT_NORM;
 }
 
 fc_estimate fc_base_output(const fc_base *b, fc_estimate e)
 {
     if (b->delay > 0.0 && b->initialized) {
-        const double *g = b->gyro_prev;
+        const fc_real *g = b->gyro_prev;
         fc_roll_pitch_ahead(e.roll, e.pitch, g[0] - e.bias[0], g[1] - e.bias[1], g[2] - e.bias[2],
                             b->delay, &e.roll, &e.pitch);
     }
@@ -649,9 +649,9 @@ fc_estimate fc_base_output(const fc_base *b, fc_estimate e)
 }
 
 fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
-                  const double acc[3], const double gyro[3], double dt, fc_estimate *out)
+                  const fc_real acc[3], const fc_real gyro[3], fc_real dt, fc_estimate *out)
 {
-    double a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
+    fc_real a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
     fc_status status = fc_base_prepare(base, a, g, dt);
     if (status != FC_OK) {
         return status;
@@ -677,7 +677,7 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
 }
 
 long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
-            const double *acc, const double *gyro, const double *dt, fc_estimate *out,
+            const fc_real *acc, const fc_real *gyro, const fc_real *dt, fc_estimate *out,
             unsigned char *rejected)
 {
     long bad = 0;

@@ -13,6 +13,8 @@
 
 #include <stddef.h>
 
+#include "fc_real.h"
+
 #define FC_G 9.80665            /* standard gravity [m/s^2] (fusion_core.types.G) */
 #define FC_PI 3.141592653589793
 #define FC_TWO_PI (2.0 * FC_PI)
@@ -31,10 +33,10 @@ typedef enum fc_status {
 /* An estimate: roll and pitch [rad], gyro bias [rad/s]; position [m] and velocity [m/s] for the
  * position filter (0 elsewhere). */
 typedef struct fc_estimate {
-    double roll, pitch;
-    double bias[3];
-    double pos[3];
-    double vel[3];
+    fc_real roll, pitch;
+    fc_real bias[3];
+    fc_real pos[3];
+    fc_real vel[3];
 } fc_estimate;
 
 /* The state every estimator has (Estimator._BASE_STATE) and the sample rules' constants. */
@@ -42,63 +44,63 @@ typedef struct fc_base {
     int initialized;
     long n_samples;
     long n_rejected;
-    double gyro_prev[3];
+    fc_real gyro_prev[3];
     /* derived from the parameters (Estimator._set_params) */
-    double max_dt, max_rate, max_rate2;
-    double mounting[9];
+    fc_real max_dt, max_rate, max_rate2;
+    fc_real mounting[9];
     int mounted;
-    double acc_cal[9], acc_off[3], gyro_cal[9], gyro_off[3];  /* fusion_core.calibration */
+    fc_real acc_cal[9], acc_off[3], gyro_cal[9], gyro_off[3];  /* fusion_core.calibration */
     int calibrated;
-    double delay;  /* sensor_delay [s] */
-    double rail;   /* gyro_range (1 - RAIL_MARGIN): a gyro axis at or beyond it is at the rail */
+    fc_real delay;  /* sensor_delay [s] */
+    fc_real rail;   /* gyro_range (1 - RAIL_MARGIN): a gyro axis at or beyond it is at the rail */
     int clipped;   /* Estimator.clipped: whether this sample's gyro is at its rail */
 } fc_base;
 
 /* ----- kinematics.py ----------------------------------------------------------------------- */
-double fc_wrap_angle(double x);
-double fc_clamp_pitch(double theta);
-void fc_accel_roll_pitch(double ax, double ay, double az, double *roll, double *pitch);
-void fc_euler_step(double phi, double theta, double p, double q, double r, double dt,
-                   double *phi_out, double *theta_out);
-void fc_heun_euler_step(double phi, double theta, double p0, double q0, double r0, double p1,
-                        double q1, double r1, double dt, double *phi_out, double *theta_out);
-void fc_quat_from_roll_pitch_yaw(double phi, double theta, double psi, double q[4]);
-void fc_quat_roll_pitch(const double q[4], double *roll, double *pitch);
-void fc_quat_gravity_body(const double q[4], double g[3]);
-void fc_rotvec_terms(double vx, double vy, double vz, double t[4]);
-void fc_quat_mul_rotvec(double q[4], double vx, double vy, double vz);
-void fc_quat_mul_rotvec_terms(double q[4], double vx, double vy, double vz, const double t[4]);
-void fc_roll_pitch_ahead(double roll, double pitch, double wx, double wy, double wz,
-                         double delay, double *roll_out, double *pitch_out);
-void fc_rotation_increment(double p0, double q0, double r0, double p1, double q1, double r1,
-                           double dt, double phi[3]);
-void fc_rotate_back(const double v[3], const double phi[3], double out[3]);
-void fc_rotate_back_terms(const double v[3], const double phi[3], const double t[4],
-                          double out[3]);
+fc_real fc_wrap_angle(fc_real x);
+fc_real fc_clamp_pitch(fc_real theta);
+void fc_accel_roll_pitch(fc_real ax, fc_real ay, fc_real az, fc_real *roll, fc_real *pitch);
+void fc_euler_step(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real dt,
+                   fc_real *phi_out, fc_real *theta_out);
+void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_real r0, fc_real p1,
+                        fc_real q1, fc_real r1, fc_real dt, fc_real *phi_out, fc_real *theta_out);
+void fc_quat_from_roll_pitch_yaw(fc_real phi, fc_real theta, fc_real psi, fc_real q[4]);
+void fc_quat_roll_pitch(const fc_real q[4], fc_real *roll, fc_real *pitch);
+void fc_quat_gravity_body(const fc_real q[4], fc_real g[3]);
+void fc_rotvec_terms(fc_real vx, fc_real vy, fc_real vz, fc_real t[4]);
+void fc_quat_mul_rotvec(fc_real q[4], fc_real vx, fc_real vy, fc_real vz);
+void fc_quat_mul_rotvec_terms(fc_real q[4], fc_real vx, fc_real vy, fc_real vz, const fc_real t[4]);
+void fc_roll_pitch_ahead(fc_real roll, fc_real pitch, fc_real wx, fc_real wy, fc_real wz,
+                         fc_real delay, fc_real *roll_out, fc_real *pitch_out);
+void fc_rotation_increment(fc_real p0, fc_real q0, fc_real r0, fc_real p1, fc_real q1, fc_real r1,
+                           fc_real dt, fc_real phi[3]);
+void fc_rotate_back(const fc_real v[3], const fc_real phi[3], fc_real out[3]);
+void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_real t[4],
+                          fc_real out[3]);
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 #define FC_REST_MEAN_TAU 0.5
 #define FC_SLOWEST_CORRECTION 1e9
 #define FC_FACE_SWITCH_COS 0.5
-extern const double FC_FACES[6][9];
-void fc_quat_from_roll_pitch(double roll, double pitch, double q[4]);
-void fc_gate_bounds2(double gate_low, double gate_high, double *low2, double *high2);
-void fc_body_rotation(const double g0[3], const double g1[3], const double bias[3], double dt,
-                      int trapezoid, double phi[3]);
-void fc_lowpass_specific_force_terms(double f[3], const double phi[3], const double terms[4],
-                                     const double a[3], double dt, double tau);
+extern const fc_real FC_FACES[6][9];
+void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4]);
+void fc_gate_bounds2(fc_real gate_low, fc_real gate_high, fc_real *low2, fc_real *high2);
+void fc_body_rotation(const fc_real g0[3], const fc_real g1[3], const fc_real bias[3], fc_real dt,
+                      int trapezoid, fc_real phi[3]);
+void fc_lowpass_specific_force_terms(fc_real f[3], const fc_real phi[3], const fc_real terms[4],
+                                     const fc_real a[3], fc_real dt, fc_real tau);
 /* adaptive_noise_constants: the rotation term of the process noise per (rad/s)^2 and the
  * disturbance's averaging time (0: off, also without the pre-filter acc_tau) */
-void fc_adaptive_noise_constants(double gyro_scale_std, double scale_time,
-                                 double disturbance_time, double acc_tau, double *q_rotation,
-                                 double *dist_tau);
+void fc_adaptive_noise_constants(fc_real gyro_scale_std, fc_real scale_time,
+                                 fc_real disturbance_time, fc_real acc_tau, fc_real *q_rotation,
+                                 fc_real *dist_tau);
 /* correction_time: a complementary filter's time constant under the adaptive noise, at most the
  * larger of tau and longest */
-double fc_correction_time(double tau, double r_ratio, double q_rotation, double w2, double r,
-                          double dt, double longest);
+fc_real fc_correction_time(fc_real tau, fc_real r_ratio, fc_real q_rotation, fc_real w2, fc_real r,
+                          fc_real dt, fc_real longest);
 /* adaptive_prefilter_time: tau times the disturbance's excess over the noise, in units of
  * PREFILTER_FULL times the noise, between 0 and tau */
-double fc_adaptive_prefilter_time(double tau, double dist, double noise);
+fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise);
 /* ----- measured_vector.py ------------------------------------------------------------------ */
 /* Measure: the measured vector's state as one array of doubles, in the Python NamedTuple's
  * order: each second-order low-pass as its two stages (the first stage, then the output), the
@@ -110,93 +112,93 @@ enum {
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {
-    double stage, dist_tau, noise, band, r;
+    fc_real stage, dist_tau, noise, band, r;
 } fc_meas_constants;
-void fc_measure_constants(double acc_lowpass, double disturbance_time, double band, double r,
+void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
                           fc_meas_constants *c);
 /* measure_start: every low-pass at a, no disturbance measured, settled */
-void fc_measure_start(double m[FC_MEAS_SIZE], const double a[3], const fc_meas_constants *c);
+void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
 /* measure_step: one sample a; returns the measurement noise r [rad^2], *filling whether the
  * vector is still filling */
-double fc_measure_step(double m[FC_MEAS_SIZE], const double a[3], const double phi[3],
-                       const double terms[4], double dt, const fc_meas_constants *c,
+fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
+                       const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
                        int *filling);
 /* Measure.settled */
-int fc_measure_settled(const double m[FC_MEAS_SIZE], const fc_meas_constants *c);
+int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* raw_noise */
-double fc_measure_raw_noise(const double m[FC_MEAS_SIZE], const fc_meas_constants *c);
+fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* measure_restarted: aligned at f, the slow band from nothing */
-void fc_measure_restart(double m[FC_MEAS_SIZE], const double f[3]);
+void fc_measure_restart(fc_real m[FC_MEAS_SIZE], const fc_real f[3]);
 /* measure_clipped */
-void fc_measure_clipped(double m[FC_MEAS_SIZE]);
+void fc_measure_clipped(fc_real m[FC_MEAS_SIZE]);
 /* every vector of the low-passes set to f (a rest alignment) */
-void fc_measure_align(double m[FC_MEAS_SIZE], const double f[3]);
+void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3]);
 
 /* The rest detector's state at the first sample: its means start at that sample, quiet 0, the
  * bias not measured yet. */
-void fc_rest_start(double rest[8], const double gyro[3], const double acc[3]);
+void fc_rest_start(fc_real rest[8], const fc_real gyro[3], const fc_real acc[3]);
 /* rest_step: bias is the filter's gyro bias estimate in the frame of g */
-void fc_rest_step(double rest[8], double gx, double gy, double gz, double ax, double ay,
-                  double az, const double bias[3], double dt, double th_gyro, double th_acc,
-                  double rest_time, double bound);
+void fc_rest_step(fc_real rest[8], fc_real gx, fc_real gy, fc_real gz, fc_real ax, fc_real ay,
+                  fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro, fc_real th_acc,
+                  fc_real rest_time, fc_real bound);
 /* first_rest: measured_before is rest[7] before this sample's fc_rest_step */
-int fc_first_rest(double measured_before, const double rest[8]);
+int fc_first_rest(fc_real measured_before, const fc_real rest[8]);
 /* uncalibrated_first_rest: measured_before is rest[7] before this sample's fc_rest_step */
-int fc_uncalibrated_first_rest(double measured_before, const double rest[8], const double bias[3],
-                               double th_gyro);
+int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[8], const fc_real bias[3],
+                               fc_real th_gyro);
 /* rest_alignment: bias, roll, pitch and the specific force f from the rest's means */
-void fc_rest_alignment(const double rest[8], double bias[3], double *roll, double *pitch,
-                       double f[3]);
-void fc_bias_at_rest(double bias[3], double gx, double gy, double gz, double dt,
-                     double rest_time);
+void fc_rest_alignment(const fc_real rest[8], fc_real bias[3], fc_real *roll, fc_real *pitch,
+                       fc_real f[3]);
+void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
+                     fc_real rest_time);
 /* complementary_rest: the rest detection of cf and mgcf, one sample; returns 1 where they
  * aligned (*roll, *pitch and f, the specific force the vector starts again from, set), else 0 */
-int fc_complementary_rest(double rest[8], double bias[3], const double g[3], const double a[3],
-                          double dt, double rest_time, double rest_gyro, double rest_acc,
-                          double bound, double *roll, double *pitch, double f[3]);
-void fc_bias_band2(double gate, double *lo, double *hi);
-int fc_nearest_face(double ux, double uy, double uz);
-void fc_mat_vec(const double m[9], const double v[3], double out[3]);
-void fc_mat_t_vec(const double m[9], const double v[3], double out[3]);
+int fc_complementary_rest(fc_real rest[8], fc_real bias[3], const fc_real g[3], const fc_real a[3],
+                          fc_real dt, fc_real rest_time, fc_real rest_gyro, fc_real rest_acc,
+                          fc_real bound, fc_real *roll, fc_real *pitch, fc_real f[3]);
+void fc_bias_band2(fc_real gate, fc_real *lo, fc_real *hi);
+int fc_nearest_face(fc_real ux, fc_real uy, fc_real uz);
+void fc_mat_vec(const fc_real m[9], const fc_real v[3], fc_real out[3]);
+void fc_mat_t_vec(const fc_real m[9], const fc_real v[3], fc_real out[3]);
 
 /* ----- base.py ----------------------------------------------------------------------------- */
-void fc_mounting_matrix(double roll, double pitch, double yaw, double m[9]);
-void fc_base_configure(fc_base *b, double max_dt, double max_rate, double mount_roll,
-                       double mount_pitch, double mount_yaw, double sensor_delay,
-                       double gyro_range);
+void fc_mounting_matrix(fc_real roll, fc_real pitch, fc_real yaw, fc_real m[9]);
+void fc_base_configure(fc_base *b, fc_real max_dt, fc_real max_rate, fc_real mount_roll,
+                       fc_real mount_pitch, fc_real mount_yaw, fc_real sensor_delay,
+                       fc_real gyro_range);
 /* The part's calibration (fusion_core.calibration): calibrated = cal (raw - off), applied by
  * fc_base_prepare before the mounting; the identity and zero: none. */
-void fc_base_calibrate(fc_base *b, const double acc_cal[9], const double acc_off[3],
-                       const double gyro_cal[9], const double gyro_off[3]);
+void fc_base_calibrate(fc_base *b, const fc_real acc_cal[9], const fc_real acc_off[3],
+                       const fc_real gyro_cal[9], const fc_real gyro_off[3]);
 /* fc_base_calibrate with the calibration parameters of any params struct p (every estimator's
  * has them: COMMON_PARAMS). */
 #define FC_BASE_CALIBRATE(b, p)                                                               \
     fc_base_calibrate((b),                                                                    \
-        (const double[9]){(p)->acc_cal_xx, (p)->acc_cal_xy, (p)->acc_cal_xz, (p)->acc_cal_yx,  \
+        (const fc_real[9]){(p)->acc_cal_xx, (p)->acc_cal_xy, (p)->acc_cal_xz, (p)->acc_cal_yx,  \
                           (p)->acc_cal_yy, (p)->acc_cal_yz, (p)->acc_cal_zx, (p)->acc_cal_zy,  \
                           (p)->acc_cal_zz},                                                   \
-        (const double[3]){(p)->acc_off_x, (p)->acc_off_y, (p)->acc_off_z},                    \
-        (const double[9]){(p)->gyro_cal_xx, (p)->gyro_cal_xy, (p)->gyro_cal_xz,               \
+        (const fc_real[3]){(p)->acc_off_x, (p)->acc_off_y, (p)->acc_off_z},                    \
+        (const fc_real[9]){(p)->gyro_cal_xx, (p)->gyro_cal_xy, (p)->gyro_cal_xz,               \
                           (p)->gyro_cal_yx, (p)->gyro_cal_yy, (p)->gyro_cal_yz,               \
                           (p)->gyro_cal_zx, (p)->gyro_cal_zy, (p)->gyro_cal_zz},              \
-        (const double[3]){(p)->gyro_off_x, (p)->gyro_off_y, (p)->gyro_off_z})
+        (const fc_real[3]){(p)->gyro_off_x, (p)->gyro_off_y, (p)->gyro_off_z})
 void fc_base_reset(fc_base *b);
 /* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
  * was), applies the calibration, turns it into the filter frame (mounting) and takes an absurd
  * accelerometer reading as
  * none. Returns FC_OK with acc and gyro rewritten in place, or the rejection. */
-fc_status fc_base_prepare(fc_base *b, double acc[3], double gyro[3], double dt);
+fc_status fc_base_prepare(fc_base *b, fc_real acc[3], fc_real gyro[3], fc_real dt);
 /* Estimator.output: e as the outputs give it, its roll and pitch turned ahead over sensor_delay
  * with the last sample's rate minus e's bias (fc_roll_pitch_ahead) once initialised. */
 fc_estimate fc_base_output(const fc_base *b, fc_estimate e);
 /* Whether a prepared sample may initialise the filter (its accelerometer norm >= 0.1 g). */
-int fc_base_can_init(const double acc[3]);
+int fc_base_can_init(const fc_real acc[3]);
 
 /* What an estimator adds to the shared step (Estimator._init, _advance, _estimate), on a
  * prepared sample (in the filter frame); self is the estimator's struct. */
 typedef struct fc_ops {
-    void (*first_sample)(void *self, const double acc[3], const double gyro[3]);
-    void (*advance)(void *self, const double acc[3], const double gyro[3], double dt);
+    void (*first_sample)(void *self, const fc_real acc[3], const fc_real gyro[3]);
+    void (*advance)(void *self, const fc_real acc[3], const fc_real gyro[3], fc_real dt);
     fc_estimate (*estimate)(const void *self);
 } fc_ops;
 
@@ -204,12 +206,12 @@ typedef struct fc_ops {
  * estimator's last estimate. FC_OK or FC_SKIPPED with *out the estimate (out may be NULL); a
  * rejection leaves everything as it was. */
 fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
-                  const double acc[3], const double gyro[3], double dt, fc_estimate *out);
+                  const fc_real acc[3], const fc_real gyro[3], fc_real dt, fc_estimate *out);
 /* Estimator.run for any estimator: n samples (acc, gyro [n][3] row-major, dt [n]), out[i] the
  * estimate after sample i, the last one for a rejected sample (rejected[i] = 1, counted in
  * n_rejected). Returns the number of rejected samples. */
 long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
-            const double *acc, const double *gyro, const double *dt, fc_estimate *out,
+            const fc_real *acc, const fc_real *gyro, const fc_real *dt, fc_estimate *out,
             unsigned char *rejected);
 
 /* T_init(f, params) for an estimator T: params (NULL: the defaults) in, T_configure, T_reset. */
@@ -237,11 +239,11 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
  * file's static first_sample(T *, acc, gyro) and advance(T *, acc, gyro, dt) and its public
  * T_estimate. */
 #define FC_DEFINE_STEP_AND_RUN(T)                                                             \
-    static void first_sample_op(void *self, const double acc[3], const double gyro[3])       \
+    static void first_sample_op(void *self, const fc_real acc[3], const fc_real gyro[3])       \
     {                                                                                         \
         first_sample((T *)self, acc, gyro);                                                   \
     }                                                                                         \
-    static void advance_op(void *self, const double acc[3], const double gyro[3], double dt) \
+    static void advance_op(void *self, const fc_real acc[3], const fc_real gyro[3], fc_real dt) \
     {                                                                                         \
         advance((T *)self, acc, gyro, dt);                                                    \
     }                                                                                         \
@@ -250,12 +252,12 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
         return T##_estimate((const T *)self);                                                 \
     }                                                                                         \
     static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};                     \
-    fc_status T##_step(T *f, const double acc[3], const double gyro[3], double dt,            \
+    fc_status T##_step(T *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,            \
                        fc_estimate *out)                                                      \
     {                                                                                         \
         return fc_step(&OPS, f, &f->base, &f->last, acc, gyro, dt, out);                      \
     }                                                                                         \
-    long T##_run(T *f, long n, const double *acc, const double *gyro, const double *dt,       \
+    long T##_run(T *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,       \
                  fc_estimate *out, unsigned char *rejected)                                   \
     {                                                                                         \
         return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);          \

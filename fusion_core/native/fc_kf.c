@@ -7,10 +7,10 @@
 #include <string.h>
 
 /* angle_only_gain: the update of measurement_gain with the bias a consider state */
-static void angle_only_gain(const double P[4], double r, double K[2], double out[4])
+static void angle_only_gain(const fc_real P[4], fc_real r, fc_real K[2], fc_real out[4])
 {
-    double P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
-    double K0 = P00 / (P00 + r);
+    fc_real P00 = P[0], P01 = P[1], P10 = P[2], P11 = P[3];
+    fc_real K0 = P00 / (P00 + r);
     K[0] = K0;
     K[1] = 0.0;
     out[0] = P00 - K0 * P00;
@@ -26,7 +26,7 @@ static fc_roll_pitch_axes axes(fc_kf *f)
     return a;
 }
 
-static int same4(const double a[4], const double b[4])
+static int same4(const fc_real a[4], const fc_real b[4])
 {
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] && a[3] == b[3];
 }
@@ -47,8 +47,8 @@ void fc_kf_configure(fc_kf *f)
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, &f->measure);
-    f->longest2 = pow(p->max_correction_time, 2.0);
-    f->rail_var = pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
+    f->longest2 = fc_pow(p->max_correction_time, 2.0);
+    f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
@@ -61,11 +61,11 @@ fc_estimate fc_kf_estimate(const fc_kf *f)  /* _estimate */
 {
     fc_estimate e;
     memset(&e, 0, sizeof e);
-    double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
     if (f->face) {  /* from the face frame back to the sensor's */
-        const double *C = FC_FACES[f->face];
-        double cp = cos(f->pitch);
-        double v[3] = {-sin(f->pitch), sin(f->roll) * cp, cos(f->roll) * cp}, up[3];
+        const fc_real *C = FC_FACES[f->face];
+        fc_real cp = fc_cos(f->pitch);
+        fc_real v[3] = {-fc_sin(f->pitch), fc_sin(f->roll) * cp, fc_cos(f->roll) * cp}, up[3];
         fc_mat_t_vec(C, v, up);
         fc_accel_roll_pitch(up[0], up[1], up[2], &e.roll, &e.pitch);
         fc_mat_t_vec(C, b, e.bias);
@@ -84,7 +84,7 @@ void fc_kf_reset(fc_kf *f)
     memset(f->P_roll, 0, sizeof f->P_roll);
     memset(f->P_pitch, 0, sizeof f->P_pitch);
     f->bias_z = f->P_z = 0.0;
-    static const double zero[3] = {0.0, 0.0, 0.0};
+    static const fc_real zero[3] = {0.0, 0.0, 0.0};
     fc_measure_start(f->meas, zero, &f->measure);
     memset(f->rest, 0, sizeof f->rest);
     f->q_att[0] = 1.0;
@@ -99,9 +99,9 @@ void fc_kf_reset(fc_kf *f)
 FC_DEFINE_INIT(fc_kf)
 FC_DEFINE_RESTORED(fc_kf)
 
-static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  /* _init */
+static void first_sample(fc_kf *f, const fc_real a_in[3], const fc_real g_in[3])  /* _init */
 {
-    double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
+    fc_real a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
     f->face = fc_nearest_face(a[0], a[1], a[2]);
     if (f->face) {
         fc_mat_vec(FC_FACES[f->face], a, a);
@@ -111,11 +111,11 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
     fc_measure_start(f->meas, a, &f->measure);
     fc_rest_start(f->rest, g, a);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
-    double p_b = pow(f->params.init_bias_std, 2.0);
+    fc_real p_b = fc_pow(f->params.init_bias_std, 2.0);
     /* a sample whose norm is off g by d carries at least d of linear acceleration */
-    double p_a = f->r;
+    fc_real p_a = f->r;
     if (f->acc_tau > 0.0) {
-        double d = (sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) - FC_G) / FC_G;
+        fc_real d = (fc_sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) - FC_G) / FC_G;
         p_a += d * d;
     }
     f->P_roll[0] = p_a;
@@ -127,17 +127,17 @@ static void first_sample(fc_kf *f, const double a_in[3], const double g_in[3])  
 
 /* propagate: the attitude quaternion turned by phi (with its fc_rotvec_terms), P by the papers'
  * F and Q with the adaptive Q_angle */
-static void propagate(fc_kf *f, const double g[3], double dt, const double phi[3],
-                      const double terms[4])
+static void propagate(fc_kf *f, const fc_real g[3], fc_real dt, const fc_real phi[3],
+                      const fc_real terms[4])
 {
-    double bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
+    fc_real bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
     fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
-    double q_angle = f->q_angle;
+    fc_real q_angle = f->q_angle;
     if (f->q_rotation > 0.0) {  /* gyro_scale_std: a scale error adds up while the sensor turns */
-        double wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
+        fc_real wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
         q_angle += f->q_rotation * (wx * wx + wy * wy + wz * wz);
     }
     f->q_step = q_angle;
@@ -145,23 +145,23 @@ static void propagate(fc_kf *f, const double g[3], double dt, const double phi[3
 }
 
 /* correct_innovation: the biases consider states unless learn_bias */
-static void correct_innovation(fc_kf *f, double y_roll, double y_pitch, int learn_bias)
+static void correct_innovation(fc_kf *f, fc_real y_roll, fc_real y_pitch, int learn_bias)
 {
     fc_roll_pitch_update_angles(axes(f), f->r_step, y_roll, y_pitch,
                                 learn_bias ? fc_paper_kf_measurement_gain : angle_only_gain);
 }
 
 /* correct: the accelerometer's roll and pitch */
-static void correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
+static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias)
 {
-    double acc_roll, acc_pitch;
+    fc_real acc_roll, acc_pitch;
     fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
-    double y_roll = acc_roll - f->roll;
+    fc_real y_roll = acc_roll - f->roll;
     if (!(-FC_PI <= y_roll && y_roll <= FC_PI)) {
         y_roll = fc_wrap_angle(y_roll);
     }
-    double y_pitch = acc_pitch - f->pitch;
-    double gate = f->params.bias_innovation;
+    fc_real y_pitch = acc_pitch - f->pitch;
+    fc_real gate = f->params.bias_innovation;
     if (!(-gate <= y_roll && y_roll <= gate && -gate <= y_pitch && y_pitch <= gate)) {
         learn_bias = 0;  /* grossly off: the angle only (bias_innovation) */
     }
@@ -169,10 +169,10 @@ static void correct(fc_kf *f, double ax, double ay, double az, int learn_bias)
 }
 
 /* _zero_rate_update: at rest the gyro measures the bias */
-static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], double dt)
+static void zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
-    double b[3] = {f->bias_x, f->bias_y, f->bias_z};
-    double measured = f->rest[7];
+    fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    fc_real measured = f->rest[7];
     fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], b, dt, f->rest_gyro, f->rest_acc,
                  f->rest_time, f->rest_bias_bound);
     if (f->acc_tau > 0.0 && fc_first_rest(measured, f->rest)) {
@@ -182,26 +182,26 @@ static void zero_rate_update(fc_kf *f, const double a[3], const double g[3], dou
     }
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
-        double r = f->gyro_var / dt;
+        fc_real r = f->gyro_var / dt;
         fc_roll_pitch_correct_bias(axes(f), g[0], g[1], r);
-        double k = f->P_z / (f->P_z + r);
+        fc_real k = f->P_z / (f->P_z + r);
         f->bias_z += k * (g[2] - f->bias_z);
         f->P_z -= k * f->P_z;
     }
 }
 
 /* _update, in the filters' frame; prev: the previous gyro sample there */
-static void update(fc_kf *f, const double a_in[3], const double g[3], double dt,
-                   const double prev[3])
+static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real dt,
+                   const fc_real prev[3])
 {
-    double a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4];
-    double b[3] = {f->bias_x, f->bias_y, f->bias_z};
+    fc_real a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4];
+    fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
     fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
     fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
     propagate(f, g, dt, phi, terms);
     int clipped = f->base.clipped;  /* at the gyro's rail: the rate beyond it is unknown */
     if (clipped) {
-        double grow = f->rail_var * dt * dt;
+        fc_real grow = f->rail_var * dt * dt;
         int shared = same4(f->P_pitch, f->P_roll);
         f->P_roll[0] = f->P_roll[0] + grow;
         if (shared) {
@@ -210,8 +210,8 @@ static void update(fc_kf *f, const double a_in[3], const double g[3], double dt,
             f->P_pitch[0] = f->P_pitch[0] + grow;
         }
     }
-    double pred_roll = f->roll, pred_pitch = f->pitch;
-    double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    fc_real pred_roll = f->roll, pred_pitch = f->pitch;
+    fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     /* the raw sample, before the pre-filter (bias_gate); never a sample at the rail */
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     if (f->rest_time > 0.0 && !clipped) {
@@ -222,18 +222,18 @@ static void update(fc_kf *f, const double a_in[3], const double g[3], double dt,
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        double r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
+        fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
         /* one sample's variance plus the disturbance that reaches the measured vector, up to
          * the longest correction time */
-        double base = f->r;
+        fc_real base = f->r;
         r = base + (r - f->measure.r);
-        double cap = f->q_step * f->longest2 / dt;
+        fc_real cap = f->q_step * f->longest2 / dt;
         f->r_step = r < cap ? r : (cap > base ? cap : base);
         /* no bias from a vector that is filling or holds turns the gyro did not measure */
         learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
-    double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
         correct(f, a[0], a[1], a[2], learn_bias);
     }
@@ -245,32 +245,32 @@ static void update(fc_kf *f, const double a_in[3], const double g[3], double dt,
 /* _switch_face: to the face nearest to up, every state turned by C_new C_old^T */
 static void switch_face(fc_kf *f)
 {
-    double roll = f->roll, pitch = f->pitch, cp = cos(pitch);
-    const double *C = FC_FACES[f->face];
-    double up[3] = {-sin(pitch), sin(roll) * cp, cos(roll) * cp}, t[3];
+    fc_real roll = f->roll, pitch = f->pitch, cp = fc_cos(pitch);
+    const fc_real *C = FC_FACES[f->face];
+    fc_real up[3] = {-fc_sin(pitch), fc_sin(roll) * cp, fc_cos(roll) * cp}, t[3];
     fc_mat_t_vec(C, up, t);
     int next = fc_nearest_face(t[0], t[1], t[2]);
     if (next == f->face) {
         return;
     }
-    const double *C2 = FC_FACES[next];
-#define TURN(v, out) do { double tmp_[3]; fc_mat_t_vec(C, (v), tmp_); fc_mat_vec(C2, tmp_, (out)); } while (0)
-    double u2[3];
+    const fc_real *C2 = FC_FACES[next];
+#define TURN(v, out) do { fc_real tmp_[3]; fc_mat_t_vec(C, (v), tmp_); fc_mat_vec(C2, tmp_, (out)); } while (0)
+    fc_real u2[3];
     TURN(up, u2);
     fc_accel_roll_pitch(u2[0], u2[1], u2[2], &f->roll, &f->pitch);
     fc_quat_from_roll_pitch_yaw(f->roll, f->pitch, 0.0, f->q_att);
-    double b[3] = {f->bias_x, f->bias_y, f->bias_z}, b2[3];
+    fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z}, b2[3];
     TURN(b, b2);
     f->bias_x = b2[0];
     f->bias_y = b2[1];
     f->bias_z = b2[2];
     for (int v = 0; v < FC_MEAS_DIST; v += 3) {
-        double turned[3];
+        fc_real turned[3];
         TURN(f->meas + v, turned);
         memcpy(f->meas + v, turned, sizeof turned);
     }
-    double w[3] = {f->rest[0], f->rest[1], f->rest[2]}, sf[3] = {f->rest[3], f->rest[4], f->rest[5]};
-    double w2[3], sf2[3];
+    fc_real w[3] = {f->rest[0], f->rest[1], f->rest[2]}, sf[3] = {f->rest[3], f->rest[4], f->rest[5]};
+    fc_real w2[3], sf2[3];
     TURN(w, w2);
     TURN(sf, sf2);
     f->rest[0] = w2[0];
@@ -280,7 +280,7 @@ static void switch_face(fc_kf *f)
     f->rest[4] = sf2[1];
     f->rest[5] = sf2[2];
 #undef TURN
-    double old[3][4];
+    fc_real old[3][4];
     memcpy(old[0], f->P_roll, sizeof old[0]);
     memcpy(old[1], f->P_pitch, sizeof old[1]);
     old[2][0] = f->P_pitch[0] > f->P_roll[0] ? f->P_pitch[0] : f->P_roll[0];  /* max(...) */
@@ -289,7 +289,7 @@ static void switch_face(fc_kf *f)
     int source[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) {  /* the old axis that new axis k is: row k of C2 C^T */
         for (int j = 0; j < 3; j++) {
-            double d = C2[3 * k] * C[3 * j] + C2[3 * k + 1] * C[3 * j + 1]
+            fc_real d = C2[3 * k] * C[3 * j] + C2[3 * k + 1] * C[3 * j + 1]
                 + C2[3 * k + 2] * C[3 * j + 2];
             if (d != 0.0) {
                 source[k] = j;
@@ -302,19 +302,19 @@ static void switch_face(fc_kf *f)
     f->face = next;
 }
 
-static void advance(fc_kf *f, const double a_in[3], const double g_in[3], double dt)
+static void advance(fc_kf *f, const fc_real a_in[3], const fc_real g_in[3], fc_real dt)
 {
-    double a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
-    double prev[3] = {f->base.gyro_prev[0], f->base.gyro_prev[1], f->base.gyro_prev[2]};
+    fc_real a[3] = {a_in[0], a_in[1], a_in[2]}, g[3] = {g_in[0], g_in[1], g_in[2]};
+    fc_real prev[3] = {f->base.gyro_prev[0], f->base.gyro_prev[1], f->base.gyro_prev[2]};
     if (f->face) {  /* into the face frame */
-        const double *C = FC_FACES[f->face];
+        const fc_real *C = FC_FACES[f->face];
         fc_mat_vec(C, a, a);
         fc_mat_vec(C, g, g);
         fc_mat_vec(C, prev, prev);
     }
     update(f, a, g, dt, prev);
-    /* up's z in the face frame, cos(roll) cos(pitch), read off the attitude quaternion */
-    const double *q = f->q_att;
+    /* up's z in the face frame, fc_cos(roll) fc_cos(pitch), read off the attitude quaternion */
+    const fc_real *q = f->q_att;
     if (q[0] * q[0] - q[1] * q[1] - q[2] * q[2] + q[3] * q[3] < FC_FACE_SWITCH_COS) {
         switch_face(f);
     }

@@ -12,33 +12,33 @@ typedef struct fc_kf {
     fc_kf_params params;
     fc_base base;
     /* AngleBiasKalmanFilter.STATE */
-    double roll, pitch, bias_x, bias_y;
-    double P_roll[4], P_pitch[4];   /* [P00, P01, P10, P11] of each axis */
-    double bias_z, P_z;
-    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
-    double rest[8];
-    double q_att[4];
+    fc_real roll, pitch, bias_x, bias_y;
+    fc_real P_roll[4], P_pitch[4];   /* [P00, P01, P10, P11] of each axis */
+    fc_real bias_z, P_z;
+    fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
+    fc_real rest[8];
+    fc_real q_att[4];
     int face;
-    double gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
+    fc_real gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
     fc_estimate last;
-    double r_step;  /* this step's measurement variance (the measured vector's noise) */
-    double q_step;  /* this step's angle process noise (propagate) */
+    fc_real r_step;  /* this step's measurement variance (the measured vector's noise) */
+    fc_real q_step;  /* this step's angle process noise (propagate) */
     /* derived from params (AngleBiasKalmanFilter._configure) */
-    double q_angle, q_bias, r, gate_low2, gate_high2, acc_tau;
-    double q_rotation, dist_tau;  /* AngleBiasKalmanFilter._adaptive */
+    fc_real q_angle, q_bias, r, gate_low2, gate_high2, acc_tau;
+    fc_real q_rotation, dist_tau;  /* AngleBiasKalmanFilter._adaptive */
     fc_meas_constants measure;  /* AngleBiasKalmanFilter._measure */
-    double longest2, rail_var;
-    double rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;
-    double bias_lo2, bias_hi2;
+    fc_real longest2, rail_var;
+    fc_real rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;
+    fc_real bias_lo2, bias_hi2;
     int trapezoid;
 } fc_kf;
 
 void fc_kf_init(fc_kf *f, const fc_kf_params *params);
 void fc_kf_configure(fc_kf *f);
 void fc_kf_reset(fc_kf *f);
-fc_status fc_kf_step(fc_kf *f, const double acc[3], const double gyro[3], double dt,
+fc_status fc_kf_step(fc_kf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
                      fc_estimate *out);
-long fc_kf_run(fc_kf *f, long n, const double *acc, const double *gyro, const double *dt,
+long fc_kf_run(fc_kf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_kf_estimate(const fc_kf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */

@@ -20,7 +20,7 @@ void fc_mgcf_configure(fc_mgcf *f)
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
     f->rest_bias_bound = p->rest_bias_bound;
-    f->r_ref = pow(p->acc_noise, 2.0);
+    f->r_ref = fc_pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
@@ -44,7 +44,7 @@ void fc_mgcf_reset(fc_mgcf *f)
     f->q[1] = f->q[2] = f->q[3] = 0.0;
     memset(f->bias, 0, sizeof f->bias);
     f->w0_now = 0.0;
-    static const double zero[3] = {0.0, 0.0, 0.0};
+    static const fc_real zero[3] = {0.0, 0.0, 0.0};
     fc_measure_start(f->meas, zero, &f->measure);
     memset(f->rest, 0, sizeof f->rest);
     f->last = fc_mgcf_estimate(f);
@@ -53,23 +53,23 @@ void fc_mgcf_reset(fc_mgcf *f)
 FC_DEFINE_INIT(fc_mgcf)
 FC_DEFINE_RESTORED(fc_mgcf)
 
-static void first_sample(fc_mgcf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_mgcf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
-    double roll, pitch;
+    fc_real roll, pitch;
     fc_accel_roll_pitch(a[0], a[1], a[2], &roll, &pitch);
     fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, f->q);
     fc_measure_start(f->meas, a, &f->measure);
     fc_rest_start(f->rest, g, a);
 }
 
-static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double dt)
+static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_real dt)
 {
-    double ax = a_in[0], ay = a_in[1], az = a_in[2];
-    double gx = g[0], gy = g[1], gz = g[2];
-    double r = f->r_ref;
+    fc_real ax = a_in[0], ay = a_in[1], az = a_in[2];
+    fc_real gx = g[0], gy = g[1], gz = g[2];
+    fc_real r = f->r_ref;
     int aligning = 0;
     int clipped = f->base.clipped;
-    double roll, pitch, fa[3];  /* _real_sensor_options */
+    fc_real roll, pitch, fa[3];  /* _real_sensor_options */
     if (f->rest_time > 0.0 && !clipped &&
         fc_complementary_rest(f->rest, f->bias, g, a_in, dt, f->rest_time, f->rest_gyro,
                               f->rest_acc, f->rest_bias_bound, &roll, &pitch, fa)) {
@@ -77,7 +77,7 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         fc_quat_from_roll_pitch(roll, pitch, f->q);
     }
     if (f->acc_tau > 0.0) {
-        double phi[3], terms[4];
+        fc_real phi[3], terms[4];
         fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);
         if (clipped) {
@@ -89,8 +89,8 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         az = f->meas[FC_MEAS_F + 2];
         r = fc_measure_raw_noise(f->meas, &f->measure);
     }
-    double norm = sqrt(ax * ax + ay * ay + az * az);
-    double w0 = f->w0;
+    fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
+    fc_real w0 = f->w0;
     if (!(norm > 0.0)) {  /* no gravity direction in this sample: gyro only */
         w0 = 0.0;
     }
@@ -100,19 +100,19 @@ static void advance(fc_mgcf *f, const double a_in[3], const double g[3], double 
         fc_quat_from_roll_pitch(roll, pitch, f->q);
         return;
     }
-    double bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
-    double kp = f->two_zeta * w0;
+    fc_real bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
+    fc_real kp = f->two_zeta * w0;
     /* the adaptive noise: 1/Kp follows correction_time */
     if (kp * FC_SLOWEST_CORRECTION > 1.0 && (f->q_rotation > 0.0 || r != f->r_ref)) {
-        double wx = gx - bx, wy = gy - by, wz = gz - bz;
-        double tau = 1.0 / kp;
+        fc_real wx = gx - bx, wy = gy - by, wz = gz - bz;
+        fc_real tau = 1.0 / kp;
         kp *= tau / fc_correction_time(tau, r / f->r_ref, f->q_rotation,
                                        wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
     }
     /* the integral term learns nothing from a gyro sample at its rail, nor from a vector
      * still holding its turns */
     int learn = !clipped && (f->acc_tau == 0.0 || fc_measure_settled(f->meas, &f->measure));
-    const double af[3] = {ax, ay, az};
+    const fc_real af[3] = {ax, ay, az};
     fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, af, norm, w0, kp, dt,
                           f->trapezoid, learn);
 }

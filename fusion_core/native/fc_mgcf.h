@@ -11,15 +11,15 @@ typedef struct fc_mgcf {
     fc_mgcf_params params;
     fc_base base;
     /* GainScheduledComplementaryFilter.STATE */
-    double q[4];
-    double bias[3];
-    double w0_now;
-    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
-    double rest[8];
+    fc_real q[4];
+    fc_real bias[3];
+    fc_real w0_now;
+    fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
+    fc_real rest[8];
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
-    double w0, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
-    double r_ref, q_rotation, dist_tau, longest;  /* _adaptive */
+    fc_real w0, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
+    fc_real r_ref, q_rotation, dist_tau, longest;  /* _adaptive */
     fc_meas_constants measure;  /* _measure */
     int trapezoid;
 } fc_mgcf;
@@ -27,9 +27,9 @@ typedef struct fc_mgcf {
 void fc_mgcf_init(fc_mgcf *f, const fc_mgcf_params *params);
 void fc_mgcf_configure(fc_mgcf *f);
 void fc_mgcf_reset(fc_mgcf *f);
-fc_status fc_mgcf_step(fc_mgcf *f, const double acc[3], const double gyro[3], double dt,
+fc_status fc_mgcf_step(fc_mgcf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
                        fc_estimate *out);
-long fc_mgcf_run(fc_mgcf *f, long n, const double *acc, const double *gyro, const double *dt,
+long fc_mgcf_run(fc_mgcf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                  fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */

@@ -34,28 +34,28 @@ void fc_paper_cf_reset(fc_paper_cf *f)
 FC_DEFINE_INIT(fc_paper_cf)
 FC_DEFINE_RESTORED(fc_paper_cf)
 
-static void first_sample(fc_paper_cf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_paper_cf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
     (void)g;
     fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
 }
 
-static void advance(fc_paper_cf *f, const double a[3], const double g[3], double dt)
+static void advance(fc_paper_cf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
-    double roll, pitch;
+    fc_real roll, pitch;
     if (f->trapezoid) {
-        const double *w0 = f->base.gyro_prev;
+        const fc_real *w0 = f->base.gyro_prev;
         fc_heun_euler_step(f->roll, f->pitch, w0[0], w0[1], w0[2], g[0], g[1], g[2], dt, &roll,
                            &pitch);
     } else {
         fc_euler_step(f->roll, f->pitch, g[0], g[1], g[2], dt, &roll, &pitch);
     }
-    double n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        double acc_roll, acc_pitch;
+        fc_real acc_roll, acc_pitch;
         fc_accel_roll_pitch(a[0], a[1], a[2], &acc_roll, &acc_pitch);
-        double k = dt / (f->tau + dt);  /* 1 - a, Gui et al. eq. 2 */
-        double y = acc_roll - roll;
+        fc_real k = dt / (f->tau + dt);  /* 1 - a, Gui et al. eq. 2 */
+        fc_real y = acc_roll - roll;
         roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
         pitch += k * (acc_pitch - pitch);
     }

@@ -10,20 +10,20 @@ typedef struct fc_paper_cf {
     fc_paper_cf_params params;
     fc_base base;
     /* PaperComplementaryFilter.STATE */
-    double roll, pitch;
+    fc_real roll, pitch;
     fc_estimate last;
     /* derived from params (PaperComplementaryFilter._configure) */
-    double tau, gate_low2, gate_high2;
+    fc_real tau, gate_low2, gate_high2;
     int trapezoid;
 } fc_paper_cf;
 
 void fc_paper_cf_init(fc_paper_cf *f, const fc_paper_cf_params *params);
 void fc_paper_cf_configure(fc_paper_cf *f);
 void fc_paper_cf_reset(fc_paper_cf *f);
-fc_status fc_paper_cf_step(fc_paper_cf *f, const double acc[3], const double gyro[3], double dt,
+fc_status fc_paper_cf_step(fc_paper_cf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
                            fc_estimate *out);
-long fc_paper_cf_run(fc_paper_cf *f, long n, const double *acc, const double *gyro,
-                     const double *dt, fc_estimate *out, unsigned char *rejected);
+long fc_paper_cf_run(fc_paper_cf *f, long n, const fc_real *acc, const fc_real *gyro,
+                     const fc_real *dt, fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_paper_cf_estimate(const fc_paper_cf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_cf_restored(fc_paper_cf *f);

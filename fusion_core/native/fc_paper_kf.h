@@ -11,59 +11,59 @@ typedef struct fc_paper_kf {
     fc_paper_kf_params params;
     fc_base base;
     /* PaperKalmanFilter.STATE */
-    double roll, pitch, bias_x, bias_y;
-    double P_roll[4], P_pitch[4];  /* [P00, P01, P10, P11] of each axis */
-    double gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
+    fc_real roll, pitch, bias_x, bias_y;
+    fc_real P_roll[4], P_pitch[4];  /* [P00, P01, P10, P11] of each axis */
+    fc_real gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */
     fc_estimate last;
-    double r_step;  /* this step's measurement variance (R_loop_time) */
+    fc_real r_step;  /* this step's measurement variance (R_loop_time) */
     /* derived from params (PaperKalmanFilter._configure) */
-    double q_angle, q_bias, r, r_loop, gate_low2, gate_high2;
+    fc_real q_angle, q_bias, r, r_loop, gate_low2, gate_high2;
     int trapezoid;
 } fc_paper_kf;
 
 void fc_paper_kf_init(fc_paper_kf *f, const fc_paper_kf_params *params);
 void fc_paper_kf_configure(fc_paper_kf *f);
 void fc_paper_kf_reset(fc_paper_kf *f);
-fc_status fc_paper_kf_step(fc_paper_kf *f, const double acc[3], const double gyro[3], double dt,
+fc_status fc_paper_kf_step(fc_paper_kf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
                            fc_estimate *out);
-long fc_paper_kf_run(fc_paper_kf *f, long n, const double *acc, const double *gyro,
-                     const double *dt, fc_estimate *out, unsigned char *rejected);
+long fc_paper_kf_run(fc_paper_kf *f, long n, const fc_real *acc, const fc_real *gyro,
+                     const fc_real *dt, fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_paper_kf_estimate(const fc_paper_kf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_kf_restored(fc_paper_kf *f);
 
 /* The tilt stage: the steps of one sample, for a filter that drives them (the position filters;
  * PaperKalmanFilter's methods of the same names). */
-void fc_paper_kf_propagate(fc_paper_kf *f, const double prev[3], const double g[3], double dt);
-int fc_paper_kf_accel_trusted(const fc_paper_kf *f, double norm2);
-void fc_paper_kf_correct(fc_paper_kf *f, double ax, double ay, double az);
-void fc_paper_kf_correct_innovation(fc_paper_kf *f, double y_roll, double y_pitch);
-void fc_paper_kf_correct_bias(fc_paper_kf *f, double z_x, double z_y, double r);
-void fc_paper_kf_took_sample(fc_paper_kf *f, const double g[3]);
+void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real g[3], fc_real dt);
+int fc_paper_kf_accel_trusted(const fc_paper_kf *f, fc_real norm2);
+void fc_paper_kf_correct(fc_paper_kf *f, fc_real ax, fc_real ay, fc_real az);
+void fc_paper_kf_correct_innovation(fc_paper_kf *f, fc_real y_roll, fc_real y_pitch);
+void fc_paper_kf_correct_bias(fc_paper_kf *f, fc_real z_x, fc_real z_y, fc_real r);
+void fc_paper_kf_took_sample(fc_paper_kf *f, const fc_real g[3]);
 
 /* An update's gain rule: K and the new P from P and R (fc_paper_kf_measurement_gain, or the
  * recommended filter's angle-only rule). */
-typedef void (*fc_kf_gain_rule)(const double P[4], double r, double K[2], double out[4]);
+typedef void (*fc_kf_gain_rule)(const fc_real P[4], fc_real r, fc_real K[2], fc_real out[4]);
 
 /* The roll and the pitch filter updated together (papers/kalman.py's RollPitchAxes, shared
  * with the recommended filter, fc_kf.c): their states by pointer. One covariance while
  * P_roll == P_pitch (the same numbers as twice), axis by axis otherwise. */
 typedef struct fc_roll_pitch_axes {
-    double *roll, *pitch, *bias_x, *bias_y;
-    double *P_roll, *P_pitch;         /* [4] each */
-    double *gain_roll, *gain_pitch;   /* [2] each */
+    fc_real *roll, *pitch, *bias_x, *bias_y;
+    fc_real *P_roll, *P_pitch;         /* [4] each */
+    fc_real *gain_roll, *gain_pitch;   /* [2] each */
 } fc_roll_pitch_axes;
-void fc_roll_pitch_predict_covariances(fc_roll_pitch_axes a, double dt, double q_angle,
-                                       double q_bias);
-void fc_roll_pitch_update_angles(fc_roll_pitch_axes a, double r, double y_roll, double y_pitch,
+void fc_roll_pitch_predict_covariances(fc_roll_pitch_axes a, fc_real dt, fc_real q_angle,
+                                       fc_real q_bias);
+void fc_roll_pitch_update_angles(fc_roll_pitch_axes a, fc_real r, fc_real y_roll, fc_real y_pitch,
                                  fc_kf_gain_rule gain);
-void fc_roll_pitch_correct_bias(fc_roll_pitch_axes a, double z_x, double z_y, double r);
+void fc_roll_pitch_correct_bias(fc_roll_pitch_axes a, fc_real z_x, fc_real z_y, fc_real r);
 
 /* The equations (papers/kalman.py's functions of the same names): F P F' + Q; the gain and
  * covariance of an angle measurement; a direct bias measurement (P updated in place). */
-void fc_paper_kf_predict_covariance(const double P[4], double dt, double q_angle, double q_bias,
-                                    double out[4]);
-void fc_paper_kf_measurement_gain(const double P[4], double r, double K[2], double out[4]);
-void fc_paper_kf_bias_update(double *angle, double *bias, double P[4], double y, double r);
+void fc_paper_kf_predict_covariance(const fc_real P[4], fc_real dt, fc_real q_angle, fc_real q_bias,
+                                    fc_real out[4]);
+void fc_paper_kf_measurement_gain(const fc_real P[4], fc_real r, fc_real K[2], fc_real out[4]);
+void fc_paper_kf_bias_update(fc_real *angle, fc_real *bias, fc_real P[4], fc_real y, fc_real r);
 
 #endif /* FC_PAPER_KF_H */

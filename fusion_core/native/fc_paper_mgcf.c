@@ -6,14 +6,14 @@
 
 /* SCHEDULES by schedule (FC_PAPER_MGCF_SCHEDULE_SIMULATION, _EXPERIMENTAL): (rho upper bound,
  * w0 [rad/s]) rows; rho at or above the last bound: w0 = 0 */
-static const double SCHEDULES[2][3][2] = {
+static const fc_real SCHEDULES[2][3][2] = {
     {{0.01, 0.1}, {0.25, 0.07}, {0.35, 0.035}},
     {{0.025, 0.1}, {0.035, 0.07}, {0.05, 0.05}},
 };
 
 /* scheduled_w0: the table is chosen here, by its index, so the filter's struct holds no
  * pointer (fc_state.h) */
-static double scheduled_w0(double rho, int schedule)
+static fc_real scheduled_w0(fc_real rho, int schedule)
 {
     for (int i = 0; i < 3; i++) {
         if (rho < SCHEDULES[schedule][i][0]) {
@@ -23,44 +23,44 @@ static double scheduled_w0(double rho, int schedule)
     return 0.0;
 }
 
-void fc_paper_mgcf_quat_first_order(double q[4], double w0, double w1, double w2, double dt)
+void fc_paper_mgcf_quat_first_order(fc_real q[4], fc_real w0, fc_real w1, fc_real w2, fc_real dt)
 {
-    double qw = q[0], qx = q[1], qy = q[2], qz = q[3];
-    double wx = 0.5 * dt * w0, wy = 0.5 * dt * w1, wz = 0.5 * dt * w2;
-    double rw = qw - qx * wx - qy * wy - qz * wz;
-    double rx = qx + qw * wx + qy * wz - qz * wy;
-    double ry = qy + qw * wy - qx * wz + qz * wx;
-    double rz = qz + qw * wz + qx * wy - qy * wx;
-    double n = 1.0 / sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
+    fc_real qw = q[0], qx = q[1], qy = q[2], qz = q[3];
+    fc_real wx = 0.5 * dt * w0, wy = 0.5 * dt * w1, wz = 0.5 * dt * w2;
+    fc_real rw = qw - qx * wx - qy * wy - qz * wz;
+    fc_real rx = qx + qw * wx + qy * wz - qz * wy;
+    fc_real ry = qy + qw * wy - qx * wz + qz * wx;
+    fc_real rz = qz + qw * wz + qx * wy - qy * wx;
+    fc_real n = 1.0 / fc_sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
     q[0] = rw * n;
     q[1] = rx * n;
     q[2] = ry * n;
     q[3] = rz * n;
 }
 
-void fc_paper_mgcf_pi_step(double q[4], double bias[3], const double prev[3], const double g[3],
-                           const double a[3], double norm, double w0, double kp, double dt,
+void fc_paper_mgcf_pi_step(fc_real q[4], fc_real bias[3], const fc_real prev[3], const fc_real g[3],
+                           const fc_real a[3], fc_real norm, fc_real w0, fc_real kp, fc_real dt,
                            int trapezoid, int learn_bias)
 {
-    double bx = bias[0], by = bias[1], bz = bias[2];
-    double gx = g[0], gy = g[1], gz = g[2];
+    fc_real bx = bias[0], by = bias[1], bz = bias[2];
+    fc_real gx = g[0], gy = g[1], gz = g[2];
     if (trapezoid) {
-        double phi[3];
+        fc_real phi[3];
         fc_rotation_increment(prev[0] - bx, prev[1] - by, prev[2] - bz, gx - bx, gy - by,
                               gz - bz, dt, phi);
         fc_quat_mul_rotvec(q, phi[0], phi[1], phi[2]);
     }
-    double ex = 0.0, ey = 0.0, ez = 0.0;
+    fc_real ex = 0.0, ey = 0.0, ez = 0.0;
     if (w0 > 0.0) {  /* e = a/|a| x v, v = R(q)^T e_z */
-        double v[3];
+        fc_real v[3];
         fc_quat_gravity_body(q, v);
-        double inv = 1.0 / norm;
-        double nx = a[0] * inv, ny = a[1] * inv, nz = a[2] * inv;
+        fc_real inv = 1.0 / norm;
+        fc_real nx = a[0] * inv, ny = a[1] * inv, nz = a[2] * inv;
         ex = ny * v[2] - nz * v[1];
         ey = nz * v[0] - nx * v[2];
         ez = nx * v[1] - ny * v[0];
         if (learn_bias) {  /* b <- b - Ki e dt, Ki = w0^2 */
-            double ki_dt = w0 * w0 * dt;
+            fc_real ki_dt = w0 * w0 * dt;
             bx = bx - ki_dt * ex;
             by = by - ki_dt * ey;
             bz = bz - ki_dt * ez;
@@ -73,7 +73,7 @@ void fc_paper_mgcf_pi_step(double q[4], double bias[3], const double prev[3], co
         fc_paper_mgcf_quat_first_order(q, gx + kp * ex - bx, gy + kp * ey - by,
                                        gz + kp * ez - bz, dt);
     } else if (w0 > 0.0) {
-        double kp_dt = kp * dt;
+        fc_real kp_dt = kp * dt;
         fc_quat_mul_rotvec(q, kp_dt * ex, kp_dt * ey, kp_dt * ez);
     }
 }
@@ -111,22 +111,22 @@ void fc_paper_mgcf_reset(fc_paper_mgcf *f)
 FC_DEFINE_INIT(fc_paper_mgcf)
 FC_DEFINE_RESTORED(fc_paper_mgcf)
 
-static void first_sample(fc_paper_mgcf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_paper_mgcf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
     (void)g;
-    double roll, pitch;
+    fc_real roll, pitch;
     fc_accel_roll_pitch(a[0], a[1], a[2], &roll, &pitch);
     fc_quat_from_roll_pitch_yaw(roll, pitch, 0.0, f->q);
 }
 
-static void advance(fc_paper_mgcf *f, const double a[3], const double g[3], double dt)
+static void advance(fc_paper_mgcf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
-    double ax = a[0], ay = a[1], az = a[2];
-    double norm = sqrt(ax * ax + ay * ay + az * az);
+    fc_real ax = a[0], ay = a[1], az = a[2];
+    fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
     int schedule = f->params.schedule;
     int scheduled = schedule == FC_PAPER_MGCF_SCHEDULE_SIMULATION ||
                     schedule == FC_PAPER_MGCF_SCHEDULE_EXPERIMENTAL;
-    double w0 = scheduled ? scheduled_w0(fabs(norm / FC_G - 1.0), schedule) : f->w0_fixed;
+    fc_real w0 = scheduled ? scheduled_w0(fc_fabs(norm / FC_G - 1.0), schedule) : f->w0_fixed;
     if (!(norm > 0.0)) {  /* no gravity direction in this sample: gyro only */
         w0 = 0.0;
     }

@@ -17,11 +17,11 @@ int fc_paper_ukf_packed(int i, int j)  /* packed_index */
     return i * (i + 1) / 2 + j;
 }
 
-/* psd_sqrt_columns: gamma V sqrt(max(w, 0)) by cyclic Jacobi rotations; off[j] is column j */
-static void psd_sqrt_columns(const double P[21], double gamma, double off[6][6])
+/* psd_sqrt_columns: gamma V fc_sqrt(max(w, 0)) by cyclic Jacobi rotations; off[j] is column j */
+static void psd_sqrt_columns(const fc_real P[21], fc_real gamma, fc_real off[6][6])
 {
     const int n = N_STATE;
-    double A[6][6], V[6][6];
+    fc_real A[6][6], V[6][6];
     for (int i = 0; i < n; i++) {
         for (int j = 0; j < n; j++) {
             A[i][j] = P[fc_paper_ukf_packed(i, j)];
@@ -29,7 +29,7 @@ static void psd_sqrt_columns(const double P[21], double gamma, double off[6][6])
         }
     }
     for (int sweep = 0; sweep < JACOBI_SWEEPS; sweep++) {
-        double o = 0.0;
+        fc_real o = 0.0;
         for (int i = 0; i < n; i++) {
             for (int j = i + 1; j < n; j++) {
                 o += A[i][j] * A[i][j];
@@ -40,26 +40,26 @@ static void psd_sqrt_columns(const double P[21], double gamma, double off[6][6])
         }
         for (int p = 0; p < n; p++) {
             for (int q = p + 1; q < n; q++) {
-                double apq = A[p][q];
+                fc_real apq = A[p][q];
                 if (apq == 0.0) {
                     continue;
                 }
-                double theta = (A[q][q] - A[p][p]) / (2.0 * apq);
-                double t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
-                double c = 1.0 / sqrt(t * t + 1.0);
-                double s = t * c;
+                fc_real theta = (A[q][q] - A[p][p]) / (2.0 * apq);
+                fc_real t = (theta >= 0.0 ? 1.0 : -1.0) / (fc_fabs(theta) + fc_sqrt(theta * theta + 1.0));
+                fc_real c = 1.0 / fc_sqrt(t * t + 1.0);
+                fc_real s = t * c;
                 for (int k = 0; k < n; k++) {
-                    double akp = A[k][p], akq = A[k][q];
+                    fc_real akp = A[k][p], akq = A[k][q];
                     A[k][p] = c * akp - s * akq;
                     A[k][q] = s * akp + c * akq;
                 }
                 for (int k = 0; k < n; k++) {
-                    double apk = A[p][k], aqk = A[q][k];
+                    fc_real apk = A[p][k], aqk = A[q][k];
                     A[p][k] = c * apk - s * aqk;
                     A[q][k] = s * apk + c * aqk;
                 }
                 for (int k = 0; k < n; k++) {
-                    double vkp = V[k][p], vkq = V[k][q];
+                    fc_real vkp = V[k][p], vkq = V[k][q];
                     V[k][p] = c * vkp - s * vkq;
                     V[k][q] = s * vkp + c * vkq;
                 }
@@ -67,7 +67,7 @@ static void psd_sqrt_columns(const double P[21], double gamma, double off[6][6])
         }
     }
     for (int j = 0; j < n; j++) {
-        double root = A[j][j] > 0.0 ? gamma * sqrt(A[j][j]) : 0.0;
+        fc_real root = A[j][j] > 0.0 ? gamma * fc_sqrt(A[j][j]) : 0.0;
         for (int k = 0; k < n; k++) {
             off[j][k] = V[k][j] * root;
         }
@@ -75,86 +75,86 @@ static void psd_sqrt_columns(const double P[21], double gamma, double off[6][6])
 }
 
 /* _sigma_offsets: the columns of gamma L, P = L L^T (Cholesky-Banachiewicz, written out) */
-static void sigma_offsets(const double P[21], double gamma, double off[6][6])
+static void sigma_offsets(const fc_real P[21], fc_real gamma, fc_real off[6][6])
 {
-    double p00 = P[0], p10 = P[1], p11 = P[2], p20 = P[3], p21 = P[4], p22 = P[5];
-    double p30 = P[6], p31 = P[7], p32 = P[8], p33 = P[9];
-    double p40 = P[10], p41 = P[11], p42 = P[12], p43 = P[13], p44 = P[14];
-    double p50 = P[15], p51 = P[16], p52 = P[17], p53 = P[18], p54 = P[19], p55 = P[20];
-    double d;
+    fc_real p00 = P[0], p10 = P[1], p11 = P[2], p20 = P[3], p21 = P[4], p22 = P[5];
+    fc_real p30 = P[6], p31 = P[7], p32 = P[8], p33 = P[9];
+    fc_real p40 = P[10], p41 = P[11], p42 = P[12], p43 = P[13], p44 = P[14];
+    fc_real p50 = P[15], p51 = P[16], p52 = P[17], p53 = P[18], p54 = P[19], p55 = P[20];
+    fc_real d;
     if (!(p00 > 0.0)) {
         psd_sqrt_columns(P, gamma, off);
         return;
     }
-    double l00 = sqrt(p00), i0 = 1.0 / l00;
-    double l10 = p10 * i0;
+    fc_real l00 = fc_sqrt(p00), i0 = 1.0 / l00;
+    fc_real l10 = p10 * i0;
     d = p11 - l10 * l10;
     if (!(d > 0.0)) {
         psd_sqrt_columns(P, gamma, off);
         return;
     }
-    double l11 = sqrt(d), i1 = 1.0 / l11;
-    double l20 = p20 * i0;
-    double l21 = (p21 - l20 * l10) * i1;
+    fc_real l11 = fc_sqrt(d), i1 = 1.0 / l11;
+    fc_real l20 = p20 * i0;
+    fc_real l21 = (p21 - l20 * l10) * i1;
     d = p22 - l20 * l20 - l21 * l21;
     if (!(d > 0.0)) {
         psd_sqrt_columns(P, gamma, off);
         return;
     }
-    double l22 = sqrt(d), i2 = 1.0 / l22;
-    double l30 = p30 * i0;
-    double l31 = (p31 - l30 * l10) * i1;
-    double l32 = (p32 - l30 * l20 - l31 * l21) * i2;
+    fc_real l22 = fc_sqrt(d), i2 = 1.0 / l22;
+    fc_real l30 = p30 * i0;
+    fc_real l31 = (p31 - l30 * l10) * i1;
+    fc_real l32 = (p32 - l30 * l20 - l31 * l21) * i2;
     d = p33 - l30 * l30 - l31 * l31 - l32 * l32;
     if (!(d > 0.0)) {
         psd_sqrt_columns(P, gamma, off);
         return;
     }
-    double l33 = sqrt(d), i3 = 1.0 / l33;
-    double l40 = p40 * i0;
-    double l41 = (p41 - l40 * l10) * i1;
-    double l42 = (p42 - l40 * l20 - l41 * l21) * i2;
-    double l43 = (p43 - l40 * l30 - l41 * l31 - l42 * l32) * i3;
+    fc_real l33 = fc_sqrt(d), i3 = 1.0 / l33;
+    fc_real l40 = p40 * i0;
+    fc_real l41 = (p41 - l40 * l10) * i1;
+    fc_real l42 = (p42 - l40 * l20 - l41 * l21) * i2;
+    fc_real l43 = (p43 - l40 * l30 - l41 * l31 - l42 * l32) * i3;
     d = p44 - l40 * l40 - l41 * l41 - l42 * l42 - l43 * l43;
     if (!(d > 0.0)) {
         psd_sqrt_columns(P, gamma, off);
         return;
     }
-    double l44 = sqrt(d);
-    double l50 = p50 * i0;
-    double l51 = (p51 - l50 * l10) * i1;
-    double l52 = (p52 - l50 * l20 - l51 * l21) * i2;
-    double l53 = (p53 - l50 * l30 - l51 * l31 - l52 * l32) * i3;
-    double l54 = (p54 - l50 * l40 - l51 * l41 - l52 * l42 - l53 * l43) / l44;
+    fc_real l44 = fc_sqrt(d);
+    fc_real l50 = p50 * i0;
+    fc_real l51 = (p51 - l50 * l10) * i1;
+    fc_real l52 = (p52 - l50 * l20 - l51 * l21) * i2;
+    fc_real l53 = (p53 - l50 * l30 - l51 * l31 - l52 * l32) * i3;
+    fc_real l54 = (p54 - l50 * l40 - l51 * l41 - l52 * l42 - l53 * l43) / l44;
     d = p55 - l50 * l50 - l51 * l51 - l52 * l52 - l53 * l53 - l54 * l54;
     if (!(d > 0.0)) {
         psd_sqrt_columns(P, gamma, off);
         return;
     }
-    double g = gamma;
-    const double cols[6][6] = {
+    fc_real g = gamma;
+    const fc_real cols[6][6] = {
         {g * l00, g * l10, g * l20, g * l30, g * l40, g * l50},
         {0.0, g * l11, g * l21, g * l31, g * l41, g * l51},
         {0.0, 0.0, g * l22, g * l32, g * l42, g * l52},
         {0.0, 0.0, 0.0, g * l33, g * l43, g * l53},
         {0.0, 0.0, 0.0, 0.0, g * l44, g * l54},
-        {0.0, 0.0, 0.0, 0.0, 0.0, g * sqrt(d)},
+        {0.0, 0.0, 0.0, 0.0, 0.0, g * fc_sqrt(d)},
     };
     memcpy(off, cols, sizeof cols);
 }
 
 /* cholesky3 / cholesky4: the packed lower factor, 0 when not positive definite */
-int fc_paper_ukf_cholesky3(double s00, double s10, double s11, double s20, double s21, double s22,
-                     double L[6])
+int fc_paper_ukf_cholesky3(fc_real s00, fc_real s10, fc_real s11, fc_real s20, fc_real s21, fc_real s22,
+                     fc_real L[6])
 {
     if (!(s00 > 0.0)) {
         return 0;
     }
-    double l00 = sqrt(s00), l10 = s10 / l00, d = s11 - l10 * l10;
+    fc_real l00 = fc_sqrt(s00), l10 = s10 / l00, d = s11 - l10 * l10;
     if (!(d > 0.0)) {
         return 0;
     }
-    double l11 = sqrt(d), l20 = s20 / l00, l21 = (s21 - l20 * l10) / l11;
+    fc_real l11 = fc_sqrt(d), l20 = s20 / l00, l21 = (s21 - l20 * l10) / l11;
     d = s22 - l20 * l20 - l21 * l21;
     if (!(d > 0.0)) {
         return 0;
@@ -164,35 +164,35 @@ int fc_paper_ukf_cholesky3(double s00, double s10, double s11, double s20, doubl
     L[2] = l11;
     L[3] = l20;
     L[4] = l21;
-    L[5] = sqrt(d);
+    L[5] = fc_sqrt(d);
     return 1;
 }
 
-static int cholesky4(const double S[10], double L[10])  /* cholesky3, then the last row */
+static int cholesky4(const fc_real S[10], fc_real L[10])  /* cholesky3, then the last row */
 {
     if (!fc_paper_ukf_cholesky3(S[0], S[1], S[2], S[3], S[4], S[5], L)) {
         return 0;
     }
-    double l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
-    double l30 = S[6] / l00, l31 = (S[7] - l30 * l10) / l11;
-    double l32 = (S[8] - l30 * l20 - l31 * l21) / l22;
-    double d = S[9] - l30 * l30 - l31 * l31 - l32 * l32;
+    fc_real l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
+    fc_real l30 = S[6] / l00, l31 = (S[7] - l30 * l10) / l11;
+    fc_real l32 = (S[8] - l30 * l20 - l31 * l21) / l22;
+    fc_real d = S[9] - l30 * l30 - l31 * l31 - l32 * l32;
     if (!(d > 0.0)) {
         return 0;
     }
     L[6] = l30;
     L[7] = l31;
     L[8] = l32;
-    L[9] = sqrt(d);
+    L[9] = fc_sqrt(d);
     return 1;
 }
 
 /* general_update: K^T = S^-1 P_xz^T by Gauss-Jordan with partial pivoting; x and P in place */
-static void general_update(double x[6], double P[21], const double S[10],
-                           const double rows[6][4], const double y[4])
+static void general_update(fc_real x[6], fc_real P[21], const fc_real S[10],
+                           const fc_real rows[6][4], const fc_real y[4])
 {
     enum { M = 4, WIDTH = 4 + N_STATE + 1 };
-    double aug[M][WIDTH];
+    fc_real aug[M][WIDTH];
     for (int i = 0; i < M; i++) {
         for (int j = 0; j < M; j++) {
             aug[i][j] = S[fc_paper_ukf_packed(i, j)];
@@ -205,31 +205,31 @@ static void general_update(double x[6], double P[21], const double S[10],
     for (int col = 0; col < M; col++) {
         int pivot = col;
         for (int i = col + 1; i < M; i++) {
-            if (fabs(aug[i][col]) > fabs(aug[pivot][col])) {
+            if (fc_fabs(aug[i][col]) > fc_fabs(aug[pivot][col])) {
                 pivot = i;
             }
         }
         if (aug[pivot][col] == 0.0) {
             return;  /* singular S: x and P as they were */
         }
-        double tmp[WIDTH];
+        fc_real tmp[WIDTH];
         memcpy(tmp, aug[col], sizeof tmp);
         memcpy(aug[col], aug[pivot], sizeof tmp);
         memcpy(aug[pivot], tmp, sizeof tmp);
-        double inv = 1.0 / aug[col][col];
+        fc_real inv = 1.0 / aug[col][col];
         for (int k = 0; k < WIDTH; k++) {
             aug[col][k] = aug[col][k] * inv;
         }
         for (int i = 0; i < M; i++) {
             if (i != col && aug[i][col] != 0.0) {
-                double f = aug[i][col];
+                fc_real f = aug[i][col];
                 for (int k = 0; k < WIDTH; k++) {
                     aug[i][k] = aug[i][k] - f * aug[col][k];
                 }
             }
         }
     }
-    double K[N_STATE][M], Siy[M], KSK[N_STATE][N_STATE];
+    fc_real K[N_STATE][M], Siy[M], KSK[N_STATE][N_STATE];
     for (int i = 0; i < N_STATE; i++) {
         for (int k = 0; k < M; k++) {
             K[i][k] = aug[k][M + i];
@@ -240,7 +240,7 @@ static void general_update(double x[6], double P[21], const double S[10],
     }
     for (int i = 0; i < N_STATE; i++) {
         for (int j = 0; j < N_STATE; j++) {
-            double sum = 0.0;
+            fc_real sum = 0.0;
             for (int k = 0; k < M; k++) {
                 sum += K[i][k] * rows[j][k];
             }
@@ -248,7 +248,7 @@ static void general_update(double x[6], double P[21], const double S[10],
         }
     }
     for (int i = 0; i < N_STATE; i++) {
-        double sum = 0.0;
+        fc_real sum = 0.0;
         for (int k = 0; k < M; k++) {
             sum += rows[i][k] * Siy[k];
         }
@@ -262,31 +262,31 @@ static void general_update(double x[6], double P[21], const double S[10],
 }
 
 /* kalman_update and consider_bias: x + K y, P - K S K^T (eq. 17); x and P in place */
-static void kalman_update(double x[6], double P[21], const double S[10], const double rows[6][4],
-                          const double y[4], int learn_bias)
+static void kalman_update(fc_real x[6], fc_real P[21], const fc_real S[10], const fc_real rows[6][4],
+                          const fc_real y[4], int learn_bias)
 {
-    double x_old[6], P_old[21];
+    fc_real x_old[6], P_old[21];
     memcpy(x_old, x, sizeof x_old);
     memcpy(P_old, P, sizeof P_old);
-    double L[10];
+    fc_real L[10];
     if (!cholesky4(S, L)) {
         general_update(x, P, S, rows, y);
     } else {
-        double l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
-        double l30 = L[6], l31 = L[7], l32 = L[8], l33 = L[9];
-        double i0 = 1.0 / l00, i1 = 1.0 / l11, i2 = 1.0 / l22, i3 = 1.0 / l33;
-        double Y[7][4];
+        fc_real l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
+        fc_real l30 = L[6], l31 = L[7], l32 = L[8], l33 = L[9];
+        fc_real i0 = 1.0 / l00, i1 = 1.0 / l11, i2 = 1.0 / l22, i3 = 1.0 / l33;
+        fc_real Y[7][4];
         for (int k = 0; k < 7; k++) {  /* forward substitution, L^-1 r, for each row and y */
-            const double *r = k < 6 ? rows[k] : y;
-            double y0 = r[0] * i0;
-            double y1 = (r[1] - l10 * y0) * i1;
-            double y2 = (r[2] - l20 * y0 - l21 * y1) * i2;
+            const fc_real *r = k < 6 ? rows[k] : y;
+            fc_real y0 = r[0] * i0;
+            fc_real y1 = (r[1] - l10 * y0) * i1;
+            fc_real y2 = (r[2] - l20 * y0 - l21 * y1) * i2;
             Y[k][0] = y0;
             Y[k][1] = y1;
             Y[k][2] = y2;
             Y[k][3] = (r[3] - l30 * y0 - l31 * y1 - l32 * y2) * i3;
         }
-        const double *z = Y[6];
+        const fc_real *z = Y[6];
         for (int i = 0; i < 6; i++) {
             x[i] = x_old[i] + (Y[i][0] * z[0] + Y[i][1] * z[1] + Y[i][2] * z[2] + Y[i][3] * z[3]);
         }
@@ -308,24 +308,24 @@ static void kalman_update(double x[6], double P[21], const double S[10], const d
     }
 }
 
-void fc_paper_ukf_unscented_constants(double alpha, double beta, double kappa, double *gamma,
-                                      double *w, double *w_mu)
+void fc_paper_ukf_unscented_constants(fc_real alpha, fc_real beta, fc_real kappa, fc_real *gamma,
+                                      fc_real *w, fc_real *w_mu)
 {
-    double alpha2 = pow(alpha, 2.0);
-    double lam = alpha2 * (N_STATE + kappa) - N_STATE;
-    *gamma = sqrt(N_STATE + lam);
+    fc_real alpha2 = fc_pow(alpha, 2.0);
+    fc_real lam = alpha2 * (N_STATE + kappa) - N_STATE;
+    *gamma = fc_sqrt(N_STATE + lam);
     *w = 0.5 / (N_STATE + lam);
     *w_mu = beta - alpha2;
 }
 
 /* rotation_terms: c and d of phi(b) = c - M b (eq. 14) */
-void fc_paper_ukf_rotation_terms(const double prev[3], const double g[3], double dt,
-                                 int trapezoid, double terms[6])
+void fc_paper_ukf_rotation_terms(const fc_real prev[3], const fc_real g[3], fc_real dt,
+                                 int trapezoid, fc_real terms[6])
 {
-    double gx = g[0], gy = g[1], gz = g[2];
+    fc_real gx = g[0], gy = g[1], gz = g[2];
     if (trapezoid) {
-        double h0 = prev[0], h1 = prev[1], h2 = prev[2];
-        double k = dt * dt / 12.0, hdt = 0.5 * dt;
+        fc_real h0 = prev[0], h1 = prev[1], h2 = prev[2];
+        fc_real k = dt * dt / 12.0, hdt = 0.5 * dt;
         terms[0] = hdt * (h0 + gx) + k * (h1 * gz - h2 * gy);
         terms[1] = hdt * (h1 + gy) + k * (h2 * gx - h0 * gz);
         terms[2] = hdt * (h2 + gz) + k * (h0 * gy - h1 * gx);
@@ -340,41 +340,41 @@ void fc_paper_ukf_rotation_terms(const double prev[3], const double g[3], double
     }
 }
 
-/* sigma_predict: every sigma point through X_{k+1} = exp(-[phi]x) X_k (eq. 14-15) */
-void fc_paper_ukf_sigma_predict(const double x[6], const double P[21], const double terms[6],
-                                double dt, double gamma, double w, double w_mu, int norm_row,
+/* sigma_predict: every sigma point through X_{k+1} = fc_exp(-[phi]x) X_k (eq. 14-15) */
+void fc_paper_ukf_sigma_predict(const fc_real x[6], const fc_real P[21], const fc_real terms[6],
+                                fc_real dt, fc_real gamma, fc_real w, fc_real w_mu, int norm_row,
                                 fc_ukf_prediction *pred)
 {
-    double X0 = x[0], X1 = x[1], X2 = x[2], b0 = x[3], b1 = x[4], b2 = x[5];
-    double off[6][6];
+    fc_real X0 = x[0], X1 = x[1], X2 = x[2], b0 = x[3], b1 = x[4], b2 = x[5];
+    fc_real off[6][6];
     sigma_offsets(P, gamma, off);
-    double c0 = terms[0], c1 = terms[1], c2 = terms[2];
-    double d0 = terms[3], d1 = terms[4], d2 = terms[5];
-    double f0 = c0 - (dt * b0 - (d1 * b2 - d2 * b1));
-    double f1 = c1 - (dt * b1 - (d2 * b0 - d0 * b2));
-    double f2 = c2 - (dt * b2 - (d0 * b1 - d1 * b0));
-    double Xv[3] = {X0, X1, X2}, fv[3] = {f0, f1, f2}, Yc[3];
+    fc_real c0 = terms[0], c1 = terms[1], c2 = terms[2];
+    fc_real d0 = terms[3], d1 = terms[4], d2 = terms[5];
+    fc_real f0 = c0 - (dt * b0 - (d1 * b2 - d2 * b1));
+    fc_real f1 = c1 - (dt * b1 - (d2 * b0 - d0 * b2));
+    fc_real f2 = c2 - (dt * b2 - (d0 * b1 - d1 * b0));
+    fc_real Xv[3] = {X0, X1, X2}, fv[3] = {f0, f1, f2}, Yc[3];
     fc_rotate_back(Xv, fv, Yc);
-    double Y0 = Yc[0], Y1 = Yc[1], Y2 = Yc[2];
-    double m0 = 0.0, m1 = 0.0, m2 = 0.0;
-    double e00 = 0.0, e10 = 0.0, e11 = 0.0, e20 = 0.0, e21 = 0.0, e22 = 0.0;
-    double x00 = 0.0, x01 = 0.0, x02 = 0.0, x10 = 0.0, x11 = 0.0, x12 = 0.0;
-    double x20 = 0.0, x21 = 0.0, x22 = 0.0;
-    double v_sum = 0.0, vv = 0.0, ev0 = 0.0, ev1 = 0.0, ev2 = 0.0, bv0 = 0.0, bv1 = 0.0,
+    fc_real Y0 = Yc[0], Y1 = Yc[1], Y2 = Yc[2];
+    fc_real m0 = 0.0, m1 = 0.0, m2 = 0.0;
+    fc_real e00 = 0.0, e10 = 0.0, e11 = 0.0, e20 = 0.0, e21 = 0.0, e22 = 0.0;
+    fc_real x00 = 0.0, x01 = 0.0, x02 = 0.0, x10 = 0.0, x11 = 0.0, x12 = 0.0;
+    fc_real x20 = 0.0, x21 = 0.0, x22 = 0.0;
+    fc_real v_sum = 0.0, vv = 0.0, ev0 = 0.0, ev1 = 0.0, ev2 = 0.0, bv0 = 0.0, bv1 = 0.0,
         bv2 = 0.0;
     for (int j = 0; j < 6; j++) {
-        double s0 = off[j][0], s1 = off[j][1], s2 = off[j][2];
-        double s3 = off[j][3], s4 = off[j][4], s5 = off[j][5];
-        double t0 = dt * s3 - (d1 * s5 - d2 * s4);
-        double t1 = dt * s4 - (d2 * s3 - d0 * s5);
-        double t2 = dt * s5 - (d0 * s4 - d1 * s3);
-        double xp[3] = {X0 + s0, X1 + s1, X2 + s2}, fp[3] = {f0 - t0, f1 - t1, f2 - t2};
-        double xm[3] = {X0 - s0, X1 - s1, X2 - s2}, fm[3] = {f0 + t0, f1 + t1, f2 + t2};
-        double r[3];
+        fc_real s0 = off[j][0], s1 = off[j][1], s2 = off[j][2];
+        fc_real s3 = off[j][3], s4 = off[j][4], s5 = off[j][5];
+        fc_real t0 = dt * s3 - (d1 * s5 - d2 * s4);
+        fc_real t1 = dt * s4 - (d2 * s3 - d0 * s5);
+        fc_real t2 = dt * s5 - (d0 * s4 - d1 * s3);
+        fc_real xp[3] = {X0 + s0, X1 + s1, X2 + s2}, fp[3] = {f0 - t0, f1 - t1, f2 - t2};
+        fc_real xm[3] = {X0 - s0, X1 - s1, X2 - s2}, fm[3] = {f0 + t0, f1 + t1, f2 + t2};
+        fc_real r[3];
         fc_rotate_back(xp, fp, r);
-        double ep0 = r[0] - Y0, ep1 = r[1] - Y1, ep2 = r[2] - Y2;
+        fc_real ep0 = r[0] - Y0, ep1 = r[1] - Y1, ep2 = r[2] - Y2;
         fc_rotate_back(xm, fm, r);
-        double em0 = r[0] - Y0, em1 = r[1] - Y1, em2 = r[2] - Y2;
+        fc_real em0 = r[0] - Y0, em1 = r[1] - Y1, em2 = r[2] - Y2;
         m0 += ep0 + em0;
         m1 += ep1 + em1;
         m2 += ep2 + em2;
@@ -384,7 +384,7 @@ void fc_paper_ukf_sigma_predict(const double x[6], const double P[21], const dou
         e20 += ep2 * ep0 + em2 * em0;
         e21 += ep2 * ep1 + em2 * em1;
         e22 += ep2 * ep2 + em2 * em2;
-        double u0 = ep0 - em0, u1 = ep1 - em1, u2 = ep2 - em2;
+        fc_real u0 = ep0 - em0, u1 = ep1 - em1, u2 = ep2 - em2;
         x00 += u0 * s3;
         x01 += u0 * s4;
         x02 += u0 * s5;
@@ -395,9 +395,9 @@ void fc_paper_ukf_sigma_predict(const double x[6], const double P[21], const dou
         x21 += u2 * s4;
         x22 += u2 * s5;
         if (norm_row && (s0 != 0.0 || s1 != 0.0 || s2 != 0.0)) {
-            double a = 2.0 * (X0 * s0 + X1 * s1 + X2 * s2);
-            double q = s0 * s0 + s1 * s1 + s2 * s2;
-            double vp = q + a, vm = q - a;
+            fc_real a = 2.0 * (X0 * s0 + X1 * s1 + X2 * s2);
+            fc_real q = s0 * s0 + s1 * s1 + s2 * s2;
+            fc_real vp = q + a, vm = q - a;
             v_sum += vp + vm;
             vv += vp * vp + vm * vm;
             ev0 += ep0 * vp + em0 * vm;
@@ -409,7 +409,7 @@ void fc_paper_ukf_sigma_predict(const double x[6], const double P[21], const dou
             bv2 += a * s5;
         }
     }
-    double mu0 = w * m0, mu1 = w * m1, mu2 = w * m2;
+    fc_real mu0 = w * m0, mu1 = w * m1, mu2 = w * m2;
     pred->X[0] = Y0 + mu0;
     pred->X[1] = Y1 + mu1;
     pred->X[2] = Y2 + mu2;
@@ -443,12 +443,12 @@ void fc_paper_ukf_sigma_predict(const double x[6], const double P[21], const dou
 }
 
 /* predicted_covariance: with Q = qg (I - h h^T) for X and qb I for b (eq. 15) */
-void fc_paper_ukf_predicted_covariance(const fc_ukf_prediction *pred, const double P[21],
-                                       const double h[3], double qg, double qb, double out[21])
+void fc_paper_ukf_predicted_covariance(const fc_ukf_prediction *pred, const fc_real P[21],
+                                       const fc_real h[3], fc_real qg, fc_real qb, fc_real out[21])
 {
-    const double *A = pred->A, *C = pred->C;
-    double h0 = h[0], h1 = h[1], h2 = h[2];
-    double Pn[21] = {
+    const fc_real *A = pred->A, *C = pred->C;
+    fc_real h0 = h[0], h1 = h[1], h2 = h[2];
+    fc_real Pn[21] = {
         A[0] + qg * (1.0 - h0 * h0),
         A[1] - qg * (h1 * h0), A[2] + qg * (1.0 - h1 * h1),
         A[3] - qg * (h2 * h0), A[4] - qg * (h2 * h1), A[5] + qg * (1.0 - h2 * h2),
@@ -460,30 +460,30 @@ void fc_paper_ukf_predicted_covariance(const fc_ukf_prediction *pred, const doub
 }
 
 /* measurement_update: z = [acc/g; 1], h = [X; |X|^2] (eq. 16-17) */
-void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const double b[3],
-                                     double P[21], const double acc[3], double r, double w,
-                                     double w_mu, int has_norm, double r_norm, int learn_bias,
-                                     double x[6])
+void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const fc_real b[3],
+                                     fc_real P[21], const fc_real acc[3], fc_real r, fc_real w,
+                                     fc_real w_mu, int has_norm, fc_real r_norm, int learn_bias,
+                                     fc_real x[6])
 {
-    const double *A = pred->A, *C = pred->C, *mu = pred->mu;
-    double mu_v = w * pred->v_sum;
-    double sv0 = w * pred->ev[0] + w_mu * mu[0] * mu_v;
-    double sv1 = w * pred->ev[1] + w_mu * mu[1] * mu_v;
-    double sv2 = w * pred->ev[2] + w_mu * mu[2] * mu_v;
+    const fc_real *A = pred->A, *C = pred->C, *mu = pred->mu;
+    fc_real mu_v = w * pred->v_sum;
+    fc_real sv0 = w * pred->ev[0] + w_mu * mu[0] * mu_v;
+    fc_real sv1 = w * pred->ev[1] + w_mu * mu[1] * mu_v;
+    fc_real sv2 = w * pred->ev[2] + w_mu * mu[2] * mu_v;
     /* no pseudo-measurement: with its sums 0, s33 = 1 and a zero innovation the last row is
      * independent of the others and changes nothing (exactly) */
-    double s33 = 1.0, y3 = 0.0;
+    fc_real s33 = 1.0, y3 = 0.0;
     if (has_norm) {
         s33 = w * pred->vv + w_mu * mu_v * mu_v + r_norm;
         y3 = 1.0 - (pred->v_prior + mu_v);
     }
-    const double S[10] = {A[0] + r, A[1], A[2] + r, A[3], A[4], A[5] + r, sv0, sv1, sv2, s33};
-    const double rows[6][4] = {
+    const fc_real S[10] = {A[0] + r, A[1], A[2] + r, A[3], A[4], A[5] + r, sv0, sv1, sv2, s33};
+    const fc_real rows[6][4] = {
         {A[0], A[1], A[3], sv0}, {A[1], A[2], A[4], sv1}, {A[3], A[4], A[5], sv2},
         {C[0], C[3], C[6], w * pred->bv[0]}, {C[1], C[4], C[7], w * pred->bv[1]},
         {C[2], C[5], C[8], w * pred->bv[2]},
     };
-    const double innovation[4] = {
+    const fc_real innovation[4] = {
         acc[0] / FC_G - pred->X[0], acc[1] / FC_G - pred->X[1], acc[2] / FC_G - pred->X[2], y3,
     };
     x[0] = pred->X[0];
@@ -504,13 +504,13 @@ void fc_paper_ukf_configure(fc_paper_ukf *f)
     fc_paper_ukf_unscented_constants(p->alpha, p->beta, p->kappa, &f->gamma, &f->w, &f->w_mu);
     f->q_gyro = p->gyro_psd;
     f->q_bias = p->bias_psd;
-    f->r_acc = pow(p->acc_noise, 2.0);
-    f->r_norm = pow(p->norm_noise, 2.0);
+    f->r_acc = fc_pow(p->acc_noise, 2.0);
+    f->r_norm = fc_pow(p->norm_noise, 2.0);
     f->gate = p->acc_gate;
     f->trapezoid = p->gyro_sampling == FC_PAPER_UKF_GYRO_SAMPLING_POINT;
 }
 
-fc_estimate fc_paper_ukf_gravity_estimate(const double x[6])
+fc_estimate fc_paper_ukf_gravity_estimate(const fc_real x[6])
 {
     fc_estimate e;
     memset(&e, 0, sizeof e);
@@ -529,7 +529,7 @@ fc_estimate fc_paper_ukf_estimate(const fc_paper_ukf *f)
 void fc_paper_ukf_reset(fc_paper_ukf *f)
 {
     fc_base_reset(&f->base);
-    const double x0[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
+    const fc_real x0[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
     memcpy(f->x, x0, sizeof x0);
     memset(f->P, 0, sizeof f->P);
     f->last = fc_paper_ukf_estimate(f);
@@ -538,41 +538,41 @@ void fc_paper_ukf_reset(fc_paper_ukf *f)
 FC_DEFINE_INIT(fc_paper_ukf)
 FC_DEFINE_RESTORED(fc_paper_ukf)
 
-static void first_sample(fc_paper_ukf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_paper_ukf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
     (void)g;
-    double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    fc_real n = fc_sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     f->x[0] = a[0] / n;
     f->x[1] = a[1] / n;
     f->x[2] = a[2] / n;
     f->x[3] = f->x[4] = f->x[5] = 0.0;
-    double p_x = pow(f->params.acc_noise, 2.0);
-    double p_b = pow(f->params.init_bias_std, 2.0);
+    fc_real p_x = fc_pow(f->params.acc_noise, 2.0);
+    fc_real p_b = fc_pow(f->params.init_bias_std, 2.0);
     memset(f->P, 0, sizeof f->P);
     f->P[0] = f->P[2] = f->P[5] = p_x;
     f->P[9] = f->P[14] = f->P[20] = p_b;
 }
 
-static void advance(fc_paper_ukf *f, const double a[3], const double g[3], double dt)
+static void advance(fc_paper_ukf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
-    double b[3] = {f->x[3], f->x[4], f->x[5]};
-    double norm = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    int update = fabs(norm / FC_G - 1.0) < f->gate && norm > 0.0;  /* rho < acc_gate */
+    fc_real b[3] = {f->x[3], f->x[4], f->x[5]};
+    fc_real norm = fc_sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    int update = fc_fabs(norm / FC_G - 1.0) < f->gate && norm > 0.0;  /* rho < acc_gate */
     int norm_row = update && f->r_norm > 0.0;  /* the pseudo-measurement |X|^2 = 1 */
-    double terms[6];
+    fc_real terms[6];
     fc_paper_ukf_rotation_terms(f->base.gyro_prev, g, dt, f->trapezoid, terms);
     fc_ukf_prediction pred;
     fc_paper_ukf_sigma_predict(f->x, f->P, terms, dt, f->gamma, f->w, f->w_mu, norm_row, &pred);
-    double X0 = pred.X[0], X1 = pred.X[1], X2 = pred.X[2];
-    double n = sqrt(X0 * X0 + X1 * X1 + X2 * X2);
-    double inv = 1.0 / n;
-    double h[3] = {X0 * inv, X1 * inv, X2 * inv}, P[21];
+    fc_real X0 = pred.X[0], X1 = pred.X[1], X2 = pred.X[2];
+    fc_real n = fc_sqrt(X0 * X0 + X1 * X1 + X2 * X2);
+    fc_real inv = 1.0 / n;
+    fc_real h[3] = {X0 * inv, X1 * inv, X2 * inv}, P[21];
     fc_paper_ukf_predicted_covariance(&pred, f->P, h, f->q_gyro * dt, f->q_bias * dt, P);
-    double x[6] = {X0, X1, X2, b[0], b[1], b[2]};
+    fc_real x[6] = {X0, X1, X2, b[0], b[1], b[2]};
     if (update) {
         fc_paper_ukf_measurement_update(&pred, b, P, a, f->r_acc, f->w, f->w_mu, norm_row,
                                         f->r_norm, 1, x);
-        n = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        n = fc_sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     }
     f->x[0] = x[0] / n;
     f->x[1] = x[1] / n;

@@ -13,55 +13,55 @@ typedef struct fc_paper_ukf {
     fc_paper_ukf_params params;
     fc_base base;
     /* PaperUnscentedKalmanFilter.STATE */
-    double x[6];   /* X (the gravity direction, 3), b (the gyro bias, 3) */
-    double P[21];  /* the covariance's lower triangle, row by row */
+    fc_real x[6];   /* X (the gravity direction, 3), b (the gyro bias, 3) */
+    fc_real P[21];  /* the covariance's lower triangle, row by row */
     fc_estimate last;
     /* derived from params (PaperUnscentedKalmanFilter._configure) */
-    double gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
+    fc_real gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
     int trapezoid;
 } fc_paper_ukf;
 
 void fc_paper_ukf_init(fc_paper_ukf *f, const fc_paper_ukf_params *params);
 void fc_paper_ukf_configure(fc_paper_ukf *f);
 void fc_paper_ukf_reset(fc_paper_ukf *f);
-fc_status fc_paper_ukf_step(fc_paper_ukf *f, const double acc[3], const double gyro[3],
-                            double dt, fc_estimate *out);
-long fc_paper_ukf_run(fc_paper_ukf *f, long n, const double *acc, const double *gyro,
-                      const double *dt, fc_estimate *out, unsigned char *rejected);
+fc_status fc_paper_ukf_step(fc_paper_ukf *f, const fc_real acc[3], const fc_real gyro[3],
+                            fc_real dt, fc_estimate *out);
+long fc_paper_ukf_run(fc_paper_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
+                      const fc_real *dt, fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_paper_ukf_estimate(const fc_paper_ukf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_ukf_restored(fc_paper_ukf *f);
 
 /* papers/ukf.py's Prediction: the unscented transform of one sample's process model. */
 typedef struct fc_ukf_prediction {
-    double X[3];   /* the predicted mean of X */
-    double A[6];   /* its covariance before Q, packed */
-    double C[9];   /* the weighted X-b cross terms x00, x01, x02, x10, ..., x22 */
-    double mu[3];  /* the mean deviation */
-    double v_prior, v_sum, vv, ev[3], bv[3];  /* the unit-norm pseudo-measurement's sums */
+    fc_real X[3];   /* the predicted mean of X */
+    fc_real A[6];   /* its covariance before Q, packed */
+    fc_real C[9];   /* the weighted X-b cross terms x00, x01, x02, x10, ..., x22 */
+    fc_real mu[3];  /* the mean deviation */
+    fc_real v_prior, v_sum, vv, ev[3], bv[3];  /* the unit-norm pseudo-measurement's sums */
 } fc_ukf_prediction;
 
 /* The equations (papers/ukf.py's functions of the same names). */
-void fc_paper_ukf_unscented_constants(double alpha, double beta, double kappa, double *gamma,
-                                      double *w, double *w_mu);
-void fc_paper_ukf_rotation_terms(const double prev[3], const double g[3], double dt,
-                                 int trapezoid, double terms[6]);
-void fc_paper_ukf_sigma_predict(const double x[6], const double P[21], const double terms[6],
-                                double dt, double gamma, double w, double w_mu, int norm_row,
+void fc_paper_ukf_unscented_constants(fc_real alpha, fc_real beta, fc_real kappa, fc_real *gamma,
+                                      fc_real *w, fc_real *w_mu);
+void fc_paper_ukf_rotation_terms(const fc_real prev[3], const fc_real g[3], fc_real dt,
+                                 int trapezoid, fc_real terms[6]);
+void fc_paper_ukf_sigma_predict(const fc_real x[6], const fc_real P[21], const fc_real terms[6],
+                                fc_real dt, fc_real gamma, fc_real w, fc_real w_mu, int norm_row,
                                 fc_ukf_prediction *pred);
-void fc_paper_ukf_predicted_covariance(const fc_ukf_prediction *pred, const double P[21],
-                                       const double h[3], double qg, double qb, double out[21]);
+void fc_paper_ukf_predicted_covariance(const fc_ukf_prediction *pred, const fc_real P[21],
+                                       const fc_real h[3], fc_real qg, fc_real qb, fc_real out[21]);
 /* x (6) out: X and b after the update; P (21) in and out. has_norm 0: no pseudo-measurement. */
-void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const double b[3],
-                                     double P[21], const double acc[3], double r, double w,
-                                     double w_mu, int has_norm, double r_norm, int learn_bias,
-                                     double x[6]);
+void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const fc_real b[3],
+                                     fc_real P[21], const fc_real acc[3], fc_real r, fc_real w,
+                                     fc_real w_mu, int has_norm, fc_real r_norm, int learn_bias,
+                                     fc_real x[6]);
 /* GravityDirectionState._estimate: roll, pitch and the bias from x = [X (3), b (3)]. */
-fc_estimate fc_paper_ukf_gravity_estimate(const double x[6]);
+fc_estimate fc_paper_ukf_gravity_estimate(const fc_real x[6]);
 /* packed_index and cholesky3 (the packed lower factor of a 3x3 S; 0 where not positive
  * definite). */
 int fc_paper_ukf_packed(int i, int j);
-int fc_paper_ukf_cholesky3(double s00, double s10, double s11, double s20, double s21,
-                           double s22, double L[6]);
+int fc_paper_ukf_cholesky3(fc_real s00, fc_real s10, fc_real s11, fc_real s20, fc_real s21,
+                           fc_real s22, fc_real L[6]);
 
 #endif /* FC_PAPER_UKF_H */

@@ -8,7 +8,7 @@
 #ifndef FC_PARAMS_H
 #define FC_PARAMS_H
 
-#include <math.h>
+#include "fc_real.h"
 
 /* Sizes the twins' state takes from the Python classes. */
 #define FC_POSKF_PENDING_MAX 2048  /* position.PENDING_MAX */
@@ -19,52 +19,52 @@
 #define FC_CF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_cf_params {
-    double tau;                  /* (0.0, 1000000.0] [s] */
-    double gate_low;             /* (0.0, 1.0] */
-    double gate_high;            /* [1.0, 1000.0] */
-    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
-    double rest_time;            /* [0.0, 1000000.0] [s] */
-    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
-    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
-    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
-    int gyro_sampling;           /* one of 'point', 'mean' */
-    double acc_noise;            /* [1e-06, 10.0] */
-    double gyro_scale_std;       /* [0.0, 0.5] */
-    double scale_time;           /* [0.0, 1000000.0] [s] */
-    double disturbance_time;     /* [0.0, 1000000.0] [s] */
-    double max_correction_time;  /* [0.0, 1000000.0] [s] */
-    double slow_band_time;       /* [0.01, 10.0] [s] */
-    double max_dt;               /* (0.0, 1000000.0] [s] */
-    double max_rate;             /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;           /* [0.8, 1.25] */
-    double acc_cal_xy;           /* [-0.2, 0.2] */
-    double acc_cal_xz;           /* [-0.2, 0.2] */
-    double acc_cal_yx;           /* [-0.2, 0.2] */
-    double acc_cal_yy;           /* [0.8, 1.25] */
-    double acc_cal_yz;           /* [-0.2, 0.2] */
-    double acc_cal_zx;           /* [-0.2, 0.2] */
-    double acc_cal_zy;           /* [-0.2, 0.2] */
-    double acc_cal_zz;           /* [0.8, 1.25] */
-    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;          /* [0.8, 1.25] */
-    double gyro_cal_xy;          /* [-0.2, 0.2] */
-    double gyro_cal_xz;          /* [-0.2, 0.2] */
-    double gyro_cal_yx;          /* [-0.2, 0.2] */
-    double gyro_cal_yy;          /* [0.8, 1.25] */
-    double gyro_cal_yz;          /* [-0.2, 0.2] */
-    double gyro_cal_zx;          /* [-0.2, 0.2] */
-    double gyro_cal_zy;          /* [-0.2, 0.2] */
-    double gyro_cal_zz;          /* [0.8, 1.25] */
-    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
-    double sensor_delay;         /* [0.0, 0.1] [s] */
+    fc_real tau;                  /* (0.0, 1000000.0] [s] */
+    fc_real gate_low;             /* (0.0, 1.0] */
+    fc_real gate_high;            /* [1.0, 1000.0] */
+    fc_real acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    fc_real rest_time;            /* [0.0, 1000000.0] [s] */
+    fc_real rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    fc_real rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    fc_real rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
+    int gyro_sampling;            /* one of 'point', 'mean' */
+    fc_real acc_noise;            /* [1e-06, 10.0] */
+    fc_real gyro_scale_std;       /* [0.0, 0.5] */
+    fc_real scale_time;           /* [0.0, 1000000.0] [s] */
+    fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
+    fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
+    fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real max_dt;               /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;           /* [0.8, 1.25] */
+    fc_real acc_cal_xy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;           /* [0.8, 1.25] */
+    fc_real acc_cal_yz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;           /* [0.8, 1.25] */
+    fc_real acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;          /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;          /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;          /* [0.8, 1.25] */
+    fc_real gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_range;           /* [0.001, 10000.0] [rad/s] */
+    fc_real sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_cf_params;
 
 /* The defaults: ComplementaryFilter.PARAMS. */
@@ -124,40 +124,40 @@ static inline void fc_cf_params_default(fc_cf_params *p)
 #define FC_PAPER_CF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_paper_cf_params {
-    double tau;           /* (0.0, 1000000.0] [s] */
-    double gate_low;      /* (0.0, 1.0] */
-    double gate_high;     /* [1.0, 1000.0] */
-    int gyro_sampling;    /* one of 'point', 'mean' */
-    double max_dt;        /* (0.0, 1000000.0] [s] */
-    double max_rate;      /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;    /* [0.8, 1.25] */
-    double acc_cal_xy;    /* [-0.2, 0.2] */
-    double acc_cal_xz;    /* [-0.2, 0.2] */
-    double acc_cal_yx;    /* [-0.2, 0.2] */
-    double acc_cal_yy;    /* [0.8, 1.25] */
-    double acc_cal_yz;    /* [-0.2, 0.2] */
-    double acc_cal_zx;    /* [-0.2, 0.2] */
-    double acc_cal_zy;    /* [-0.2, 0.2] */
-    double acc_cal_zz;    /* [0.8, 1.25] */
-    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;   /* [0.8, 1.25] */
-    double gyro_cal_xy;   /* [-0.2, 0.2] */
-    double gyro_cal_xz;   /* [-0.2, 0.2] */
-    double gyro_cal_yx;   /* [-0.2, 0.2] */
-    double gyro_cal_yy;   /* [0.8, 1.25] */
-    double gyro_cal_yz;   /* [-0.2, 0.2] */
-    double gyro_cal_zx;   /* [-0.2, 0.2] */
-    double gyro_cal_zy;   /* [-0.2, 0.2] */
-    double gyro_cal_zz;   /* [0.8, 1.25] */
-    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
-    double sensor_delay;  /* [0.0, 0.1] [s] */
+    fc_real tau;           /* (0.0, 1000000.0] [s] */
+    fc_real gate_low;      /* (0.0, 1.0] */
+    fc_real gate_high;     /* [1.0, 1000.0] */
+    int gyro_sampling;     /* one of 'point', 'mean' */
+    fc_real max_dt;        /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;      /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;    /* [0.8, 1.25] */
+    fc_real acc_cal_xy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;    /* [0.8, 1.25] */
+    fc_real acc_cal_yz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;    /* [0.8, 1.25] */
+    fc_real acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;   /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;   /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;   /* [0.8, 1.25] */
+    fc_real gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
+    fc_real sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_cf_params;
 
 /* The defaults: PaperComplementaryFilter.PARAMS. */
@@ -205,50 +205,50 @@ static inline void fc_paper_cf_params_default(fc_paper_cf_params *p)
 #define FC_MGCF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_mgcf_params {
-    double w0;                   /* [0.0, 10000.0] [rad/s] */
-    double zeta;                 /* [0.0, 1000.0] */
-    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
-    double rest_time;            /* [0.0, 1000000.0] [s] */
-    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
-    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
-    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
-    int gyro_sampling;           /* one of 'point', 'mean' */
-    double acc_noise;            /* [1e-06, 10.0] */
-    double gyro_scale_std;       /* [0.0, 0.5] */
-    double scale_time;           /* [0.0, 1000000.0] [s] */
-    double disturbance_time;     /* [0.0, 1000000.0] [s] */
-    double max_correction_time;  /* [0.0, 1000000.0] [s] */
-    double max_dt;               /* (0.0, 1000000.0] [s] */
-    double max_rate;             /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;           /* [0.8, 1.25] */
-    double acc_cal_xy;           /* [-0.2, 0.2] */
-    double acc_cal_xz;           /* [-0.2, 0.2] */
-    double acc_cal_yx;           /* [-0.2, 0.2] */
-    double acc_cal_yy;           /* [0.8, 1.25] */
-    double acc_cal_yz;           /* [-0.2, 0.2] */
-    double acc_cal_zx;           /* [-0.2, 0.2] */
-    double acc_cal_zy;           /* [-0.2, 0.2] */
-    double acc_cal_zz;           /* [0.8, 1.25] */
-    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;          /* [0.8, 1.25] */
-    double gyro_cal_xy;          /* [-0.2, 0.2] */
-    double gyro_cal_xz;          /* [-0.2, 0.2] */
-    double gyro_cal_yx;          /* [-0.2, 0.2] */
-    double gyro_cal_yy;          /* [0.8, 1.25] */
-    double gyro_cal_yz;          /* [-0.2, 0.2] */
-    double gyro_cal_zx;          /* [-0.2, 0.2] */
-    double gyro_cal_zy;          /* [-0.2, 0.2] */
-    double gyro_cal_zz;          /* [0.8, 1.25] */
-    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
-    double sensor_delay;         /* [0.0, 0.1] [s] */
+    fc_real w0;                   /* [0.0, 10000.0] [rad/s] */
+    fc_real zeta;                 /* [0.0, 1000.0] */
+    fc_real acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    fc_real rest_time;            /* [0.0, 1000000.0] [s] */
+    fc_real rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    fc_real rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    fc_real rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
+    int gyro_sampling;            /* one of 'point', 'mean' */
+    fc_real acc_noise;            /* [1e-06, 10.0] */
+    fc_real gyro_scale_std;       /* [0.0, 0.5] */
+    fc_real scale_time;           /* [0.0, 1000000.0] [s] */
+    fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
+    fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
+    fc_real max_dt;               /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;           /* [0.8, 1.25] */
+    fc_real acc_cal_xy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;           /* [0.8, 1.25] */
+    fc_real acc_cal_yz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;           /* [0.8, 1.25] */
+    fc_real acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;          /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;          /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;          /* [0.8, 1.25] */
+    fc_real gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_range;           /* [0.001, 10000.0] [rad/s] */
+    fc_real sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_mgcf_params;
 
 /* The defaults: GainScheduledComplementaryFilter.PARAMS. */
@@ -309,40 +309,40 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
 #define FC_PAPER_MGCF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_paper_mgcf_params {
-    int schedule;         /* one of 'simulation', 'experimental', 'fixed' */
-    double w0;            /* [0.0, 10000.0] [rad/s] */
-    double zeta;          /* [0.0, 1000.0] */
-    int gyro_sampling;    /* one of 'point', 'mean' */
-    double max_dt;        /* (0.0, 1000000.0] [s] */
-    double max_rate;      /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;    /* [0.8, 1.25] */
-    double acc_cal_xy;    /* [-0.2, 0.2] */
-    double acc_cal_xz;    /* [-0.2, 0.2] */
-    double acc_cal_yx;    /* [-0.2, 0.2] */
-    double acc_cal_yy;    /* [0.8, 1.25] */
-    double acc_cal_yz;    /* [-0.2, 0.2] */
-    double acc_cal_zx;    /* [-0.2, 0.2] */
-    double acc_cal_zy;    /* [-0.2, 0.2] */
-    double acc_cal_zz;    /* [0.8, 1.25] */
-    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;   /* [0.8, 1.25] */
-    double gyro_cal_xy;   /* [-0.2, 0.2] */
-    double gyro_cal_xz;   /* [-0.2, 0.2] */
-    double gyro_cal_yx;   /* [-0.2, 0.2] */
-    double gyro_cal_yy;   /* [0.8, 1.25] */
-    double gyro_cal_yz;   /* [-0.2, 0.2] */
-    double gyro_cal_zx;   /* [-0.2, 0.2] */
-    double gyro_cal_zy;   /* [-0.2, 0.2] */
-    double gyro_cal_zz;   /* [0.8, 1.25] */
-    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
-    double sensor_delay;  /* [0.0, 0.1] [s] */
+    int schedule;          /* one of 'simulation', 'experimental', 'fixed' */
+    fc_real w0;            /* [0.0, 10000.0] [rad/s] */
+    fc_real zeta;          /* [0.0, 1000.0] */
+    int gyro_sampling;     /* one of 'point', 'mean' */
+    fc_real max_dt;        /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;      /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;    /* [0.8, 1.25] */
+    fc_real acc_cal_xy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;    /* [0.8, 1.25] */
+    fc_real acc_cal_yz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;    /* [0.8, 1.25] */
+    fc_real acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;   /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;   /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;   /* [0.8, 1.25] */
+    fc_real gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
+    fc_real sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_mgcf_params;
 
 /* The defaults: PaperGainScheduledFilter.PARAMS. */
@@ -390,57 +390,57 @@ static inline void fc_paper_mgcf_params_default(fc_paper_mgcf_params *p)
 #define FC_KF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_kf_params {
-    double Q_angle;              /* [0.0, 1.0] [rad2/s] */
-    double Q_bias;               /* [0.0, 1.0] [rad2/s3] */
-    double R_measure;            /* (0.0, 100.0] [rad2] */
-    double gyro_scale_std;       /* [0.0, 0.5] */
-    double scale_time;           /* [0.0, 1000000.0] [s] */
-    double disturbance_time;     /* [0.0, 1000000.0] [s] */
-    double gate_low;             /* (0.0, 1.0] */
-    double gate_high;            /* [1.0, 1000.0] */
-    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
-    double rest_time;            /* [0.0, 1000000.0] [s] */
-    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
-    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
-    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
-    double gyro_psd;             /* (0.0, 1.0] [rad2/s] */
-    double init_bias_std;        /* (0.0, 10000.0] [rad/s] */
-    double bias_gate;            /* [0.0, 1000.0] */
-    double bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
-    int gyro_sampling;           /* one of 'point', 'mean' */
-    double slow_band_time;       /* [0.01, 10.0] [s] */
-    double max_correction_time;  /* [0.0, 1000000.0] [s] */
-    double max_dt;               /* (0.0, 1000000.0] [s] */
-    double max_rate;             /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;           /* [0.8, 1.25] */
-    double acc_cal_xy;           /* [-0.2, 0.2] */
-    double acc_cal_xz;           /* [-0.2, 0.2] */
-    double acc_cal_yx;           /* [-0.2, 0.2] */
-    double acc_cal_yy;           /* [0.8, 1.25] */
-    double acc_cal_yz;           /* [-0.2, 0.2] */
-    double acc_cal_zx;           /* [-0.2, 0.2] */
-    double acc_cal_zy;           /* [-0.2, 0.2] */
-    double acc_cal_zz;           /* [0.8, 1.25] */
-    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;          /* [0.8, 1.25] */
-    double gyro_cal_xy;          /* [-0.2, 0.2] */
-    double gyro_cal_xz;          /* [-0.2, 0.2] */
-    double gyro_cal_yx;          /* [-0.2, 0.2] */
-    double gyro_cal_yy;          /* [0.8, 1.25] */
-    double gyro_cal_yz;          /* [-0.2, 0.2] */
-    double gyro_cal_zx;          /* [-0.2, 0.2] */
-    double gyro_cal_zy;          /* [-0.2, 0.2] */
-    double gyro_cal_zz;          /* [0.8, 1.25] */
-    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
-    double sensor_delay;         /* [0.0, 0.1] [s] */
+    fc_real Q_angle;              /* [0.0, 1.0] [rad2/s] */
+    fc_real Q_bias;               /* [0.0, 1.0] [rad2/s3] */
+    fc_real R_measure;            /* (0.0, 100.0] [rad2] */
+    fc_real gyro_scale_std;       /* [0.0, 0.5] */
+    fc_real scale_time;           /* [0.0, 1000000.0] [s] */
+    fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
+    fc_real gate_low;             /* (0.0, 1.0] */
+    fc_real gate_high;            /* [1.0, 1000.0] */
+    fc_real acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    fc_real rest_time;            /* [0.0, 1000000.0] [s] */
+    fc_real rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    fc_real rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    fc_real rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
+    fc_real gyro_psd;             /* (0.0, 1.0] [rad2/s] */
+    fc_real init_bias_std;        /* (0.0, 10000.0] [rad/s] */
+    fc_real bias_gate;            /* [0.0, 1000.0] */
+    fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
+    int gyro_sampling;            /* one of 'point', 'mean' */
+    fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
+    fc_real max_dt;               /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;           /* [0.8, 1.25] */
+    fc_real acc_cal_xy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;           /* [0.8, 1.25] */
+    fc_real acc_cal_yz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;           /* [0.8, 1.25] */
+    fc_real acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;          /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;          /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;          /* [0.8, 1.25] */
+    fc_real gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_range;           /* [0.001, 10000.0] [rad/s] */
+    fc_real sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_kf_params;
 
 /* The defaults: AngleBiasKalmanFilter.PARAMS. */
@@ -505,43 +505,43 @@ static inline void fc_kf_params_default(fc_kf_params *p)
 #define FC_PAPER_KF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_paper_kf_params {
-    double Q_angle;       /* [0.0, 1.0] [rad2/s] */
-    double Q_bias;        /* [0.0, 1.0] [rad2/s3] */
-    double R_measure;     /* (0.0, 100.0] [rad2] */
-    double R_loop_time;   /* [0.0, 1000000.0] [s] */
-    double gate_low;      /* (0.0, 1.0] */
-    double gate_high;     /* [1.0, 1000.0] */
-    int gyro_sampling;    /* one of 'point', 'mean' */
-    double max_dt;        /* (0.0, 1000000.0] [s] */
-    double max_rate;      /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;    /* [0.8, 1.25] */
-    double acc_cal_xy;    /* [-0.2, 0.2] */
-    double acc_cal_xz;    /* [-0.2, 0.2] */
-    double acc_cal_yx;    /* [-0.2, 0.2] */
-    double acc_cal_yy;    /* [0.8, 1.25] */
-    double acc_cal_yz;    /* [-0.2, 0.2] */
-    double acc_cal_zx;    /* [-0.2, 0.2] */
-    double acc_cal_zy;    /* [-0.2, 0.2] */
-    double acc_cal_zz;    /* [0.8, 1.25] */
-    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;   /* [0.8, 1.25] */
-    double gyro_cal_xy;   /* [-0.2, 0.2] */
-    double gyro_cal_xz;   /* [-0.2, 0.2] */
-    double gyro_cal_yx;   /* [-0.2, 0.2] */
-    double gyro_cal_yy;   /* [0.8, 1.25] */
-    double gyro_cal_yz;   /* [-0.2, 0.2] */
-    double gyro_cal_zx;   /* [-0.2, 0.2] */
-    double gyro_cal_zy;   /* [-0.2, 0.2] */
-    double gyro_cal_zz;   /* [0.8, 1.25] */
-    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
-    double sensor_delay;  /* [0.0, 0.1] [s] */
+    fc_real Q_angle;       /* [0.0, 1.0] [rad2/s] */
+    fc_real Q_bias;        /* [0.0, 1.0] [rad2/s3] */
+    fc_real R_measure;     /* (0.0, 100.0] [rad2] */
+    fc_real R_loop_time;   /* [0.0, 1000000.0] [s] */
+    fc_real gate_low;      /* (0.0, 1.0] */
+    fc_real gate_high;     /* [1.0, 1000.0] */
+    int gyro_sampling;     /* one of 'point', 'mean' */
+    fc_real max_dt;        /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;      /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;    /* [0.8, 1.25] */
+    fc_real acc_cal_xy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;    /* [0.8, 1.25] */
+    fc_real acc_cal_yz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;    /* [0.8, 1.25] */
+    fc_real acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;   /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;   /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;   /* [0.8, 1.25] */
+    fc_real gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
+    fc_real sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_kf_params;
 
 /* The defaults: PaperKalmanFilter.PARAMS. */
@@ -592,58 +592,58 @@ static inline void fc_paper_kf_params_default(fc_paper_kf_params *p)
 #define FC_UKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_ukf_params {
-    double gyro_psd;             /* (0.0, 1.0] [rad2/s] */
-    double bias_psd;             /* [0.0, 1.0] [rad2/s3] */
-    double acc_noise;            /* [1e-06, 10.0] */
-    double init_bias_std;        /* (0.0, 10000.0] [rad/s] */
-    double alpha;                /* [0.0001, 1.0] */
-    double beta;                 /* [0.0, 1000.0] */
-    double kappa;                /* (-5.0, 1000.0] */
-    double gyro_scale_std;       /* [0.0, 0.5] */
-    double scale_time;           /* [0.0, 1000000.0] [s] */
-    double disturbance_time;     /* [0.0, 1000000.0] [s] */
-    int gyro_sampling;           /* one of 'point', 'mean' */
-    double acc_lowpass;          /* [0.0, 1000000.0] [s] */
-    double rest_time;            /* [0.0, 1000000.0] [s] */
-    double rest_gyro;            /* (0.0, 10000.0] [rad/s] */
-    double rest_acc;             /* (0.0, 10000.0] [m/s2] */
-    double rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
-    double zaru_psd;             /* (0.0, 1.0] [rad2/s] */
-    double bias_gate;            /* [0.0, 1000.0] */
-    double bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
-    double slow_band_time;       /* [0.01, 10.0] [s] */
-    double max_correction_time;  /* [0.0, 1000000.0] [s] */
-    double max_dt;               /* (0.0, 1000000.0] [s] */
-    double max_rate;             /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;           /* [0.8, 1.25] */
-    double acc_cal_xy;           /* [-0.2, 0.2] */
-    double acc_cal_xz;           /* [-0.2, 0.2] */
-    double acc_cal_yx;           /* [-0.2, 0.2] */
-    double acc_cal_yy;           /* [0.8, 1.25] */
-    double acc_cal_yz;           /* [-0.2, 0.2] */
-    double acc_cal_zx;           /* [-0.2, 0.2] */
-    double acc_cal_zy;           /* [-0.2, 0.2] */
-    double acc_cal_zz;           /* [0.8, 1.25] */
-    double acc_off_x;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;            /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;            /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;          /* [0.8, 1.25] */
-    double gyro_cal_xy;          /* [-0.2, 0.2] */
-    double gyro_cal_xz;          /* [-0.2, 0.2] */
-    double gyro_cal_yx;          /* [-0.2, 0.2] */
-    double gyro_cal_yy;          /* [0.8, 1.25] */
-    double gyro_cal_yz;          /* [-0.2, 0.2] */
-    double gyro_cal_zx;          /* [-0.2, 0.2] */
-    double gyro_cal_zy;          /* [-0.2, 0.2] */
-    double gyro_cal_zz;          /* [0.8, 1.25] */
-    double gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
-    double gyro_range;           /* [0.001, 10000.0] [rad/s] */
-    double sensor_delay;         /* [0.0, 0.1] [s] */
+    fc_real gyro_psd;             /* (0.0, 1.0] [rad2/s] */
+    fc_real bias_psd;             /* [0.0, 1.0] [rad2/s3] */
+    fc_real acc_noise;            /* [1e-06, 10.0] */
+    fc_real init_bias_std;        /* (0.0, 10000.0] [rad/s] */
+    fc_real alpha;                /* [0.0001, 1.0] */
+    fc_real beta;                 /* [0.0, 1000.0] */
+    fc_real kappa;                /* (-5.0, 1000.0] */
+    fc_real gyro_scale_std;       /* [0.0, 0.5] */
+    fc_real scale_time;           /* [0.0, 1000000.0] [s] */
+    fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
+    int gyro_sampling;            /* one of 'point', 'mean' */
+    fc_real acc_lowpass;          /* [0.0, 1000000.0] [s] */
+    fc_real rest_time;            /* [0.0, 1000000.0] [s] */
+    fc_real rest_gyro;            /* (0.0, 10000.0] [rad/s] */
+    fc_real rest_acc;             /* (0.0, 10000.0] [m/s2] */
+    fc_real rest_bias_bound;      /* [0.0, 10000.0] [rad/s] */
+    fc_real zaru_psd;             /* (0.0, 1.0] [rad2/s] */
+    fc_real bias_gate;            /* [0.0, 1000.0] */
+    fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
+    fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
+    fc_real max_dt;               /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;          /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;            /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;           /* [0.8, 1.25] */
+    fc_real acc_cal_xy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;           /* [0.8, 1.25] */
+    fc_real acc_cal_yz;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;           /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;           /* [0.8, 1.25] */
+    fc_real acc_off_x;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;            /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;            /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;          /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;          /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;          /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;          /* [0.8, 1.25] */
+    fc_real gyro_off_x;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;           /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_range;           /* [0.001, 10000.0] [rad/s] */
+    fc_real sensor_delay;         /* [0.0, 0.1] [s] */
 } fc_ukf_params;
 
 /* The defaults: UnscentedKalmanFilter.PARAMS. */
@@ -709,46 +709,46 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
 #define FC_PAPER_UKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_paper_ukf_params {
-    double gyro_psd;       /* (0.0, 1.0] [rad2/s] */
-    double bias_psd;       /* [0.0, 1.0] [rad2/s3] */
-    double acc_noise;      /* [1e-06, 10.0] */
-    double norm_noise;     /* [0.0, 10.0] */
-    double acc_gate;       /* (0.0, 1000.0] */
-    double init_bias_std;  /* (0.0, 10000.0] [rad/s] */
-    double alpha;          /* [0.0001, 1.0] */
-    double beta;           /* [0.0, 1000.0] */
-    double kappa;          /* (-5.0, 1000.0] */
-    int gyro_sampling;     /* one of 'point', 'mean' */
-    double max_dt;         /* (0.0, 1000000.0] [s] */
-    double max_rate;       /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;      /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;     /* [0.8, 1.25] */
-    double acc_cal_xy;     /* [-0.2, 0.2] */
-    double acc_cal_xz;     /* [-0.2, 0.2] */
-    double acc_cal_yx;     /* [-0.2, 0.2] */
-    double acc_cal_yy;     /* [0.8, 1.25] */
-    double acc_cal_yz;     /* [-0.2, 0.2] */
-    double acc_cal_zx;     /* [-0.2, 0.2] */
-    double acc_cal_zy;     /* [-0.2, 0.2] */
-    double acc_cal_zz;     /* [0.8, 1.25] */
-    double acc_off_x;      /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;      /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;      /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;    /* [0.8, 1.25] */
-    double gyro_cal_xy;    /* [-0.2, 0.2] */
-    double gyro_cal_xz;    /* [-0.2, 0.2] */
-    double gyro_cal_yx;    /* [-0.2, 0.2] */
-    double gyro_cal_yy;    /* [0.8, 1.25] */
-    double gyro_cal_yz;    /* [-0.2, 0.2] */
-    double gyro_cal_zx;    /* [-0.2, 0.2] */
-    double gyro_cal_zy;    /* [-0.2, 0.2] */
-    double gyro_cal_zz;    /* [0.8, 1.25] */
-    double gyro_off_x;     /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;     /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;     /* [-10.0, 10.0] [rad/s] */
-    double sensor_delay;   /* [0.0, 0.1] [s] */
+    fc_real gyro_psd;       /* (0.0, 1.0] [rad2/s] */
+    fc_real bias_psd;       /* [0.0, 1.0] [rad2/s3] */
+    fc_real acc_noise;      /* [1e-06, 10.0] */
+    fc_real norm_noise;     /* [0.0, 10.0] */
+    fc_real acc_gate;       /* (0.0, 1000.0] */
+    fc_real init_bias_std;  /* (0.0, 10000.0] [rad/s] */
+    fc_real alpha;          /* [0.0001, 1.0] */
+    fc_real beta;           /* [0.0, 1000.0] */
+    fc_real kappa;          /* (-5.0, 1000.0] */
+    int gyro_sampling;      /* one of 'point', 'mean' */
+    fc_real max_dt;         /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;       /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;      /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;     /* [0.8, 1.25] */
+    fc_real acc_cal_xy;     /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;     /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;     /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;     /* [0.8, 1.25] */
+    fc_real acc_cal_yz;     /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;     /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;     /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;     /* [0.8, 1.25] */
+    fc_real acc_off_x;      /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;      /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;      /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;    /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;    /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;    /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;    /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;    /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;    /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;    /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;    /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;    /* [0.8, 1.25] */
+    fc_real gyro_off_x;     /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;     /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;     /* [-10.0, 10.0] [rad/s] */
+    fc_real sensor_delay;   /* [0.0, 0.1] [s] */
 } fc_paper_ukf_params;
 
 /* The defaults: PaperUnscentedKalmanFilter.PARAMS. */
@@ -802,54 +802,54 @@ static inline void fc_paper_ukf_params_default(fc_paper_ukf_params *p)
 #define FC_POSKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_poskf_params {
-    double q;                 /* (0.0, 10000.0] [m2/s5] */
-    double acc_psd;           /* (0.0, 10000.0] [m2/s3] */
-    double zupt_acc;          /* (0.0, 10000.0] [m/s2] */
-    double zupt_level_acc;    /* (0.0, 10000.0] [m/s2] */
-    double zupt_gyro;         /* (0.0, 10000.0] [rad/s] */
-    double zupt_window;       /* [0.0, 1000000.0] [s] */
-    double zupt_speed;        /* [0.0, 1000.0] [m/s] */
-    double zupt_force_after;  /* [0.0, 1000000.0] [s] */
-    double zupt_noise;        /* (0.0, 1000.0] [m/s] */
-    double gyro_psd;          /* (0.0, 1.0] [rad2/s] */
-    double Q_angle;           /* [0.0, 1.0] [rad2/s] */
-    double Q_bias;            /* [0.0, 1.0] [rad2/s3] */
-    double R_measure;         /* (0.0, 100.0] [rad2] */
-    double R_loop_time;       /* [0.0, 1000000.0] [s] */
-    double gate_low;          /* (0.0, 1.0] */
-    double gate_high;         /* [1.0, 1000.0] */
-    int gyro_sampling;        /* one of 'point', 'mean' */
-    double max_dt;            /* (0.0, 1000000.0] [s] */
-    double max_rate;          /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;        /* [0.8, 1.25] */
-    double acc_cal_xy;        /* [-0.2, 0.2] */
-    double acc_cal_xz;        /* [-0.2, 0.2] */
-    double acc_cal_yx;        /* [-0.2, 0.2] */
-    double acc_cal_yy;        /* [0.8, 1.25] */
-    double acc_cal_yz;        /* [-0.2, 0.2] */
-    double acc_cal_zx;        /* [-0.2, 0.2] */
-    double acc_cal_zy;        /* [-0.2, 0.2] */
-    double acc_cal_zz;        /* [0.8, 1.25] */
-    double acc_off_x;         /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;         /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;         /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;       /* [0.8, 1.25] */
-    double gyro_cal_xy;       /* [-0.2, 0.2] */
-    double gyro_cal_xz;       /* [-0.2, 0.2] */
-    double gyro_cal_yx;       /* [-0.2, 0.2] */
-    double gyro_cal_yy;       /* [0.8, 1.25] */
-    double gyro_cal_yz;       /* [-0.2, 0.2] */
-    double gyro_cal_zx;       /* [-0.2, 0.2] */
-    double gyro_cal_zy;       /* [-0.2, 0.2] */
-    double gyro_cal_zz;       /* [0.8, 1.25] */
-    double gyro_off_x;        /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;        /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;        /* [-10.0, 10.0] [rad/s] */
-    double gyro_range;        /* [0.001, 10000.0] [rad/s] */
-    double sensor_delay;      /* [0.0, 0.1] [s] */
+    fc_real q;                 /* (0.0, 10000.0] [m2/s5] */
+    fc_real acc_psd;           /* (0.0, 10000.0] [m2/s3] */
+    fc_real zupt_acc;          /* (0.0, 10000.0] [m/s2] */
+    fc_real zupt_level_acc;    /* (0.0, 10000.0] [m/s2] */
+    fc_real zupt_gyro;         /* (0.0, 10000.0] [rad/s] */
+    fc_real zupt_window;       /* [0.0, 1000000.0] [s] */
+    fc_real zupt_speed;        /* [0.0, 1000.0] [m/s] */
+    fc_real zupt_force_after;  /* [0.0, 1000000.0] [s] */
+    fc_real zupt_noise;        /* (0.0, 1000.0] [m/s] */
+    fc_real gyro_psd;          /* (0.0, 1.0] [rad2/s] */
+    fc_real Q_angle;           /* [0.0, 1.0] [rad2/s] */
+    fc_real Q_bias;            /* [0.0, 1.0] [rad2/s3] */
+    fc_real R_measure;         /* (0.0, 100.0] [rad2] */
+    fc_real R_loop_time;       /* [0.0, 1000000.0] [s] */
+    fc_real gate_low;          /* (0.0, 1.0] */
+    fc_real gate_high;         /* [1.0, 1000.0] */
+    int gyro_sampling;         /* one of 'point', 'mean' */
+    fc_real max_dt;            /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;          /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;        /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;       /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;         /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;        /* [0.8, 1.25] */
+    fc_real acc_cal_xy;        /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;        /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;        /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;        /* [0.8, 1.25] */
+    fc_real acc_cal_yz;        /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;        /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;        /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;        /* [0.8, 1.25] */
+    fc_real acc_off_x;         /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;         /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;         /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;       /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;       /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;       /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;       /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;       /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;       /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;       /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;       /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;       /* [0.8, 1.25] */
+    fc_real gyro_off_x;        /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;        /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;        /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_range;        /* [0.001, 10000.0] [rad/s] */
+    fc_real sensor_delay;      /* [0.0, 0.1] [s] */
 } fc_poskf_params;
 
 /* The defaults: PositionKalmanFilter.PARAMS. */
@@ -914,46 +914,46 @@ static inline void fc_poskf_params_default(fc_poskf_params *p)
 #define FC_PAPER_POSKF_GYRO_SAMPLING_MEAN 1
 
 typedef struct fc_paper_poskf_params {
-    int qr_form;          /* one of 'white_jerk', 'piecewise_jerk', 'diagonal' */
-    double q;             /* (0.0, 10000.0] [m2/s5] */
-    double acc_psd;       /* (0.0, 10000.0] [m2/s3] */
-    double Q_angle;       /* [0.0, 1.0] [rad2/s] */
-    double Q_bias;        /* [0.0, 1.0] [rad2/s3] */
-    double R_measure;     /* (0.0, 100.0] [rad2] */
-    double R_loop_time;   /* [0.0, 1000000.0] [s] */
-    double gate_low;      /* (0.0, 1.0] */
-    double gate_high;     /* [1.0, 1000.0] */
-    int gyro_sampling;    /* one of 'point', 'mean' */
-    double max_dt;        /* (0.0, 1000000.0] [s] */
-    double max_rate;      /* (0.0, 10000.0] [rad/s] */
-    double mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
-    double acc_cal_xx;    /* [0.8, 1.25] */
-    double acc_cal_xy;    /* [-0.2, 0.2] */
-    double acc_cal_xz;    /* [-0.2, 0.2] */
-    double acc_cal_yx;    /* [-0.2, 0.2] */
-    double acc_cal_yy;    /* [0.8, 1.25] */
-    double acc_cal_yz;    /* [-0.2, 0.2] */
-    double acc_cal_zx;    /* [-0.2, 0.2] */
-    double acc_cal_zy;    /* [-0.2, 0.2] */
-    double acc_cal_zz;    /* [0.8, 1.25] */
-    double acc_off_x;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_y;     /* [-100.0, 100.0] [m/s2] */
-    double acc_off_z;     /* [-100.0, 100.0] [m/s2] */
-    double gyro_cal_xx;   /* [0.8, 1.25] */
-    double gyro_cal_xy;   /* [-0.2, 0.2] */
-    double gyro_cal_xz;   /* [-0.2, 0.2] */
-    double gyro_cal_yx;   /* [-0.2, 0.2] */
-    double gyro_cal_yy;   /* [0.8, 1.25] */
-    double gyro_cal_yz;   /* [-0.2, 0.2] */
-    double gyro_cal_zx;   /* [-0.2, 0.2] */
-    double gyro_cal_zy;   /* [-0.2, 0.2] */
-    double gyro_cal_zz;   /* [0.8, 1.25] */
-    double gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
-    double gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
-    double sensor_delay;  /* [0.0, 0.1] [s] */
+    int qr_form;           /* one of 'white_jerk', 'piecewise_jerk', 'diagonal' */
+    fc_real q;             /* (0.0, 10000.0] [m2/s5] */
+    fc_real acc_psd;       /* (0.0, 10000.0] [m2/s3] */
+    fc_real Q_angle;       /* [0.0, 1.0] [rad2/s] */
+    fc_real Q_bias;        /* [0.0, 1.0] [rad2/s3] */
+    fc_real R_measure;     /* (0.0, 100.0] [rad2] */
+    fc_real R_loop_time;   /* [0.0, 1000000.0] [s] */
+    fc_real gate_low;      /* (0.0, 1.0] */
+    fc_real gate_high;     /* [1.0, 1000.0] */
+    int gyro_sampling;     /* one of 'point', 'mean' */
+    fc_real max_dt;        /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;      /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;    /* [0.8, 1.25] */
+    fc_real acc_cal_xy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;    /* [0.8, 1.25] */
+    fc_real acc_cal_yz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;    /* [0.8, 1.25] */
+    fc_real acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;   /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;   /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;   /* [0.8, 1.25] */
+    fc_real gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
+    fc_real sensor_delay;  /* [0.0, 0.1] [s] */
 } fc_paper_poskf_params;
 
 /* The defaults: PaperPositionKalmanFilter.PARAMS. */
@@ -1010,29 +1010,29 @@ static inline void fc_paper_poskf_params_default(fc_paper_poskf_params *p)
 #define FC_SENSOR_CALIBRATION_PERFECT 2
 
 typedef struct fc_sensor_params {
-    long seed;                     /* [0, 2147483647] */
-    int gyro_sampling;             /* one of 'point', 'mean' */
-    double gyro_psd;               /* [0.0, 1.0] [rad2/s] */
-    double acc_psd;                /* [0.0, 10000.0] [m2/s3] */
-    int calibration;               /* one of 'startup', 'none', 'perfect' */
-    double gyro_bias_x;            /* [-10000.0, 10000.0] [rad/s] */
-    double gyro_bias_y;            /* [-10000.0, 10000.0] [rad/s] */
-    double gyro_bias_z;            /* [-10000.0, 10000.0] [rad/s] */
-    double acc_bias_x;             /* [-10000.0, 10000.0] [m/s2] */
-    double acc_bias_y;             /* [-10000.0, 10000.0] [m/s2] */
-    double acc_bias_z;             /* [-10000.0, 10000.0] [m/s2] */
-    double gyro_bias_instability;  /* [0.0, 10000.0] [rad/s] */
-    double acc_bias_instability;   /* [0.0, 10000.0] [m/s2] */
-    double bias_time_constant;     /* (0.0, 1000000.0] [s] */
-    double gyro_bias_psd;          /* [0.0, 1.0] [rad2/s3] */
-    double acc_bias_psd;           /* [0.0, 10000.0] [m2/s5] */
-    double gyro_scale_std;         /* [0.0, 0.5] */
-    double gyro_cross_axis_std;    /* [0.0, 0.5] */
-    long dlpf_cfg;                 /* [-1, 6] */
-    double gyro_range;             /* [0.001, 10000.0] [rad/s] */
-    double acc_range;              /* [0.01, 10000.0] [m/s2] */
-    long bits;                     /* [0, 32] */
-    double jitter;                 /* [0.0, 1000000.0] [s] */
+    long seed;                      /* [0, 2147483647] */
+    int gyro_sampling;              /* one of 'point', 'mean' */
+    fc_real gyro_psd;               /* [0.0, 1.0] [rad2/s] */
+    fc_real acc_psd;                /* [0.0, 10000.0] [m2/s3] */
+    int calibration;                /* one of 'startup', 'none', 'perfect' */
+    fc_real gyro_bias_x;            /* [-10000.0, 10000.0] [rad/s] */
+    fc_real gyro_bias_y;            /* [-10000.0, 10000.0] [rad/s] */
+    fc_real gyro_bias_z;            /* [-10000.0, 10000.0] [rad/s] */
+    fc_real acc_bias_x;             /* [-10000.0, 10000.0] [m/s2] */
+    fc_real acc_bias_y;             /* [-10000.0, 10000.0] [m/s2] */
+    fc_real acc_bias_z;             /* [-10000.0, 10000.0] [m/s2] */
+    fc_real gyro_bias_instability;  /* [0.0, 10000.0] [rad/s] */
+    fc_real acc_bias_instability;   /* [0.0, 10000.0] [m/s2] */
+    fc_real bias_time_constant;     /* (0.0, 1000000.0] [s] */
+    fc_real gyro_bias_psd;          /* [0.0, 1.0] [rad2/s3] */
+    fc_real acc_bias_psd;           /* [0.0, 10000.0] [m2/s5] */
+    fc_real gyro_scale_std;         /* [0.0, 0.5] */
+    fc_real gyro_cross_axis_std;    /* [0.0, 0.5] */
+    long dlpf_cfg;                  /* [-1, 6] */
+    fc_real gyro_range;             /* [0.001, 10000.0] [rad/s] */
+    fc_real acc_range;              /* [0.01, 10000.0] [m/s2] */
+    long bits;                      /* [0, 32] */
+    fc_real jitter;                 /* [0.0, 1000000.0] [s] */
 } fc_sensor_params;
 
 /* The defaults: ImuSensorModel.PARAMS. */

@@ -35,7 +35,7 @@ void fc_poskf_configure(fc_poskf *f)
     f->att.params = ap;
     fc_kf_configure(&f->att);
     f->acc_var_density = p->acc_psd;
-    f->zupt_var = pow(p->zupt_noise, 2.0);
+    f->zupt_var = fc_pow(p->zupt_noise, 2.0);
     f->gyro_var_density = p->gyro_psd;
     f->Q_dt = 0.0;
 }
@@ -77,7 +77,7 @@ void fc_poskf_restored(fc_poskf *f)  /* the nested filters' last estimates too (
     f->last = fc_base_output(&f->base, fc_poskf_estimate(f));
 }
 
-static void first_sample(fc_poskf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_poskf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
     fc_paper_poskf_first_axis_states(&f->tilt, a, g, f->params.max_dt, f->acc_var_density, f->x,
                                      f->P);
@@ -87,48 +87,48 @@ static void first_sample(fc_poskf *f, const double a[3], const double g[3])  /* 
 
 static int slow_enough(const fc_poskf *f)  /* _slow_enough */
 {
-    const double *x = f->x;
-    double speed = sqrt(x[1] * x[1] + x[4] * x[4] + x[7] * x[7]);
-    double sigma = sqrt(f->P[3] + f->zupt_var);
-    double bound = 5.0 * sigma > f->params.zupt_speed ? 5.0 * sigma : f->params.zupt_speed;
+    const fc_real *x = f->x;
+    fc_real speed = fc_sqrt(x[1] * x[1] + x[4] * x[4] + x[7] * x[7]);
+    fc_real sigma = fc_sqrt(f->P[3] + f->zupt_var);
+    fc_real bound = 5.0 * sigma > f->params.zupt_speed ? 5.0 * sigma : f->params.zupt_speed;
     return speed <= bound;
 }
 
-static void advance(fc_poskf *f, const double a[3], const double g[3], double dt)
+static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
     const fc_poskf_params *p = &f->params;
     fc_paper_kf *tilt = &f->tilt;
-    double ax = a[0], ay = a[1], az = a[2], gx = g[0], gy = g[1], gz = g[2];
+    fc_real ax = a[0], ay = a[1], az = a[2], gx = g[0], gy = g[1], gz = g[2];
     /* 1. stationary detector */
-    double mx = f->f_mean[0], my = f->f_mean[1], mz = f->f_mean[2];
-    double dx = ax - mx, dy = ay - my, dz = az - mz;
-    double wx = gx - tilt->bias_x, wy = gy - tilt->bias_y;
-    double roll = tilt->roll, pitch = tilt->pitch, l[3];
-    fc_paper_poskf_level_acceleration(ax, ay, az, sin(roll), cos(roll), sin(pitch), cos(pitch),
+    fc_real mx = f->f_mean[0], my = f->f_mean[1], mz = f->f_mean[2];
+    fc_real dx = ax - mx, dy = ay - my, dz = az - mz;
+    fc_real wx = gx - tilt->bias_x, wy = gy - tilt->bias_y;
+    fc_real roll = tilt->roll, pitch = tilt->pitch, l[3];
+    fc_paper_poskf_level_acceleration(ax, ay, az, fc_sin(roll), fc_cos(roll), fc_sin(pitch), fc_cos(pitch),
                                       0.0, 1.0, l);
-    int quiet = sqrt(dx * dx + dy * dy + dz * dz) < p->zupt_acc
-        && sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) < p->zupt_level_acc
-        && sqrt(wx * wx + wy * wy + gz * gz) < p->zupt_gyro;
-    double window = p->zupt_window;
-    double k = window > 0.0 ? dt / window : 1.0;
+    int quiet = fc_sqrt(dx * dx + dy * dy + dz * dz) < p->zupt_acc
+        && fc_sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) < p->zupt_level_acc
+        && fc_sqrt(wx * wx + wy * wy + gz * gz) < p->zupt_gyro;
+    fc_real window = p->zupt_window;
+    fc_real k = window > 0.0 ? dt / window : 1.0;
     if (k > 1.0) {
         k = 1.0;
     }
     f->f_mean[0] = mx + k * dx;
     f->f_mean[1] = my + k * dy;
     f->f_mean[2] = mz + k * dz;
-    double quiet_time = f->quiet_time = quiet ? f->quiet_time + dt : 0.0;
+    fc_real quiet_time = f->quiet_time = quiet ? f->quiet_time + dt : 0.0;
     int stationary = f->stationary = quiet && quiet_time >= window
         && (quiet_time >= p->zupt_force_after || slow_enough(f));
     /* 2. tilt stage */
     fc_paper_kf_propagate(tilt, f->base.gyro_prev, g, dt);
-    double d_roll = tilt->roll - roll;
-    double turned_roll = f->turned[0], turned_pitch = f->turned[1];
+    fc_real d_roll = tilt->roll - roll;
+    fc_real turned_roll = f->turned[0], turned_pitch = f->turned[1];
     turned_roll += -FC_PI <= d_roll && d_roll <= FC_PI ? d_roll : fc_wrap_angle(d_roll);
     turned_pitch = turned_pitch + tilt->pitch - pitch;
     f->turned[0] = turned_roll;
     f->turned[1] = turned_pitch;
-    double n2 = ax * ax + ay * ay + az * az;
+    fc_real n2 = ax * ax + ay * ay + az * az;
     if (!quiet) {
         f->pending_head = f->pending_count = 0;
     } else {
@@ -137,7 +137,7 @@ static void advance(fc_poskf *f, const double a[3], const double g[3], double dt
                 f->pending_head = (f->pending_head + 1) % FC_POSKF_PENDING_MAX;
                 f->pending_count--;
             }
-            double *e = f->pending[(f->pending_head + f->pending_count) % FC_POSKF_PENDING_MAX];
+            fc_real *e = f->pending[(f->pending_head + f->pending_count) % FC_POSKF_PENDING_MAX];
             e[0] = quiet_time;
             fc_accel_roll_pitch(ax, ay, az, &e[1], &e[2]);
             e[3] = turned_roll;
@@ -145,8 +145,8 @@ static void advance(fc_poskf *f, const double a[3], const double g[3], double dt
             f->pending_count++;
         }
         while (f->pending_count && quiet_time - f->pending[f->pending_head][0] >= window) {
-            const double *e = f->pending[f->pending_head];
-            double acc_roll = e[1], acc_pitch = e[2], then_roll = e[3], then_pitch = e[4];
+            const fc_real *e = f->pending[f->pending_head];
+            fc_real acc_roll = e[1], acc_pitch = e[2], then_roll = e[3], then_pitch = e[4];
             f->pending_head = (f->pending_head + 1) % FC_POSKF_PENDING_MAX;
             f->pending_count--;
             fc_paper_kf_correct_innovation(
@@ -160,7 +160,7 @@ static void advance(fc_poskf *f, const double a[3], const double g[3], double dt
     fc_paper_kf_took_sample(tilt, g);
     fc_kf_step(&f->att, a, g, dt, NULL);
     /* 3. yaw from the gyro, the level-frame acceleration with the new attitude */
-    double acc[3];
+    fc_real acc[3];
     fc_paper_poskf_yaw_and_level_acceleration(tilt->roll, tilt->pitch, &f->yaw, wy, gz, a, dt,
                                               acc);
     /* 4. [p, v, a] filter per axis (eq. 20-29) */

@@ -14,30 +14,30 @@ typedef struct fc_poskf {
     fc_poskf_params params;
     fc_base base;
     /* PositionKalmanFilter.STATE */
-    double yaw;
-    double x[9];      /* [p, v, a] of x, y, z */
-    double P[6];      /* the covariance the axes share: m00, m01, m02, m11, m12, m22 */
-    double quiet_time;
+    fc_real yaw;
+    fc_real x[9];      /* [p, v, a] of x, y, z */
+    fc_real P[6];      /* the covariance the axes share: m00, m01, m02, m11, m12, m22 */
+    fc_real quiet_time;
     int stationary;
     /* the stationary queue: (quiet time, acc roll, acc pitch, turned roll, turned pitch) */
-    double pending[FC_POSKF_PENDING_MAX][5];
+    fc_real pending[FC_POSKF_PENDING_MAX][5];
     int pending_head, pending_count;
-    double turned[2];
-    double f_mean[3];
+    fc_real turned[2];
+    fc_real f_mean[3];
     fc_paper_kf tilt;  /* the tilt stage */
     fc_kf att;         /* the attitude outputs */
     fc_estimate last;
     /* derived from params (PositionKalmanFilter._configure) */
-    double acc_var_density, zupt_var, gyro_var_density;
-    double Q[6], R, Q_dt;
+    fc_real acc_var_density, zupt_var, gyro_var_density;
+    fc_real Q[6], R, Q_dt;
 } fc_poskf;
 
 void fc_poskf_init(fc_poskf *f, const fc_poskf_params *params);
 void fc_poskf_configure(fc_poskf *f);
 void fc_poskf_reset(fc_poskf *f);
-fc_status fc_poskf_step(fc_poskf *f, const double acc[3], const double gyro[3], double dt,
+fc_status fc_poskf_step(fc_poskf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
                         fc_estimate *out);
-long fc_poskf_run(fc_poskf *f, long n, const double *acc, const double *gyro, const double *dt,
+long fc_poskf_run(fc_poskf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                   fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_poskf_estimate(const fc_poskf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */

@@ -15,15 +15,15 @@ void fc_ukf_configure(fc_ukf *f)
     fc_paper_ukf_unscented_constants(p->alpha, p->beta, p->kappa, &f->gamma, &f->w, &f->w_mu);
     f->q_gyro = p->gyro_psd;
     f->q_bias = p->bias_psd;
-    f->r_acc = pow(p->acc_noise, 2.0);
+    f->r_acc = fc_pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 p->acc_lowpass, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc, &f->measure);
-    f->longest2 = pow(p->max_correction_time, 2.0);
-    f->rail_var = pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
+    f->longest2 = fc_pow(p->max_correction_time, 2.0);
+    f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
-    f->cos_innovation = p->bias_innovation < FC_PI ? cos(p->bias_innovation) : -2.0;
+    f->cos_innovation = p->bias_innovation < FC_PI ? fc_cos(p->bias_innovation) : -2.0;
 }
 
 fc_estimate fc_ukf_estimate(const fc_ukf *f)
@@ -34,10 +34,10 @@ fc_estimate fc_ukf_estimate(const fc_ukf *f)
 void fc_ukf_reset(fc_ukf *f)
 {
     fc_base_reset(&f->base);
-    const double x0[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
+    const fc_real x0[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
     memcpy(f->x, x0, sizeof x0);
     memset(f->P, 0, sizeof f->P);
-    static const double zero[3] = {0.0, 0.0, 0.0};
+    static const fc_real zero[3] = {0.0, 0.0, 0.0};
     fc_measure_start(f->meas, zero, &f->measure);
     memset(f->rest, 0, sizeof f->rest);
     f->last = fc_ukf_estimate(f);
@@ -46,20 +46,20 @@ void fc_ukf_reset(fc_ukf *f)
 FC_DEFINE_INIT(fc_ukf)
 FC_DEFINE_RESTORED(fc_ukf)
 
-static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _init */
+static void first_sample(fc_ukf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
-    double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    fc_real n = fc_sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     f->x[0] = a[0] / n;
     f->x[1] = a[1] / n;
     f->x[2] = a[2] / n;
     f->x[3] = f->x[4] = f->x[5] = 0.0;
     /* a sample whose norm is off g by d carries at least d of linear acceleration */
-    double p_x = pow(f->params.acc_noise, 2.0);
+    fc_real p_x = fc_pow(f->params.acc_noise, 2.0);
     if (f->params.acc_lowpass > 0.0) {
-        double d = (n - FC_G) / FC_G;
+        fc_real d = (n - FC_G) / FC_G;
         p_x += d * d;
     }
-    double p_b = pow(f->params.init_bias_std, 2.0);
+    fc_real p_b = fc_pow(f->params.init_bias_std, 2.0);
     memset(f->P, 0, sizeof f->P);
     f->P[0] = f->P[2] = f->P[5] = p_x;
     f->P[9] = f->P[14] = f->P[20] = p_b;
@@ -68,17 +68,17 @@ static void first_sample(fc_ukf *f, const double a[3], const double g[3])  /* _i
 }
 
 /* _zero_rate_update: at rest the gyro reads its bias (z = gyro, h(x) = b, variance r) */
-static void zero_rate_update(fc_ukf *f, const double z[3], double r)
+static void zero_rate_update(fc_ukf *f, const fc_real z[3], fc_real r)
 {
-    const double *P = f->P;
-    double L[6];
+    const fc_real *P = f->P;
+    fc_real L[6];
     if (!fc_paper_ukf_cholesky3(P[9] + r, P[13], P[14] + r, P[18], P[19], P[20] + r, L)) {
         return;
     }
-    double l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
-    double cols[7][3];
+    fc_real l00 = L[0], l10 = L[1], l11 = L[2], l20 = L[3], l21 = L[4], l22 = L[5];
+    fc_real cols[7][3];
     for (int j = 0; j < 7; j++) {
-        double c0, c1, c2;
+        fc_real c0, c1, c2;
         if (j < 6) {
             c0 = P[fc_paper_ukf_packed(3, j)];
             c1 = P[fc_paper_ukf_packed(4, j)];
@@ -88,14 +88,14 @@ static void zero_rate_update(fc_ukf *f, const double z[3], double r)
             c1 = z[1] - f->x[4];
             c2 = z[2] - f->x[5];
         }
-        double y0 = c0 / l00;
-        double y1 = (c1 - l10 * y0) / l11;
+        fc_real y0 = c0 / l00;
+        fc_real y1 = (c1 - l10 * y0) / l11;
         cols[j][0] = y0;
         cols[j][1] = y1;
         cols[j][2] = (c2 - l20 * y0 - l21 * y1) / l22;
     }
-    const double *v = cols[6];
-    double x[6], Pn[21];
+    const fc_real *v = cols[6];
+    fc_real x[6], Pn[21];
     for (int i = 0; i < 6; i++) {
         x[i] = f->x[i] + (cols[i][0] * v[0] + cols[i][1] * v[1] + cols[i][2] * v[2]);
     }
@@ -106,7 +106,7 @@ static void zero_rate_update(fc_ukf *f, const double z[3], double r)
         }
     }
     memcpy(f->P, Pn, sizeof Pn);
-    double n = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    fc_real n = fc_sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     f->x[0] = x[0] / n;
     f->x[1] = x[1] / n;
     f->x[2] = x[2] / n;
@@ -117,41 +117,41 @@ static void zero_rate_update(fc_ukf *f, const double z[3], double r)
 
 /* _filter_update: one sample of the paper's UKF (eq. 14-17) with the recommended noise; capped:
  * r is the measured vector's, at most max_correction_time's */
-static void filter_update(fc_ukf *f, double ax, double ay, double az, const double g[3],
-                          double dt, int learn_bias, double r, int capped)
+static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const fc_real g[3],
+                          fc_real dt, int learn_bias, fc_real r, int capped)
 {
-    double b[3] = {f->x[3], f->x[4], f->x[5]};
-    double terms[6];
+    fc_real b[3] = {f->x[3], f->x[4], f->x[5]};
+    fc_real terms[6];
     fc_paper_ukf_rotation_terms(f->base.gyro_prev, g, dt, f->trapezoid, terms);
     fc_ukf_prediction pred;
     fc_paper_ukf_sigma_predict(f->x, f->P, terms, dt, f->gamma, f->w, f->w_mu, 0, &pred);
-    double X0 = pred.X[0], X1 = pred.X[1], X2 = pred.X[2];
-    double n = sqrt(X0 * X0 + X1 * X1 + X2 * X2);
-    double inv = 1.0 / n;
-    double q_gyro = f->q_gyro;
+    fc_real X0 = pred.X[0], X1 = pred.X[1], X2 = pred.X[2];
+    fc_real n = fc_sqrt(X0 * X0 + X1 * X1 + X2 * X2);
+    fc_real inv = 1.0 / n;
+    fc_real q_gyro = f->q_gyro;
     if (f->q_rotation > 0.0) {  /* gyro_scale_std: a scale error adds up while the sensor turns */
-        double wx = g[0] - b[0], wy = g[1] - b[1], wz = g[2] - b[2];
+        fc_real wx = g[0] - b[0], wy = g[1] - b[1], wz = g[2] - b[2];
         q_gyro += f->q_rotation * (wx * wx + wy * wy + wz * wz);
     }
     if (f->base.clipped) {  /* at the rail the rate beyond it is unknown (gyro_range) */
         q_gyro += f->rail_var * dt;
     }
-    double h[3] = {X0 * inv, X1 * inv, X2 * inv}, P[21];
+    fc_real h[3] = {X0 * inv, X1 * inv, X2 * inv}, P[21];
     fc_paper_ukf_predicted_covariance(&pred, f->P, h, q_gyro * dt, f->q_bias * dt, P);
-    double x[6] = {X0, X1, X2, b[0], b[1], b[2]};
-    double norm = sqrt(ax * ax + ay * ay + az * az);
-    if (fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0) {
+    fc_real x[6] = {X0, X1, X2, b[0], b[1], b[2]};
+    fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
+    if (fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0) {
         if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
             learn_bias = 0;  /* grossly off: X only (bias_innovation) */
         }
         if (capped) {  /* the longest correction time: r at most q T^2 / dt */
-            double cap = q_gyro * f->longest2 / dt;
+            fc_real cap = q_gyro * f->longest2 / dt;
             r = r < cap ? r : (cap > f->r_acc ? cap : f->r_acc);
         }
-        const double acc[3] = {ax, ay, az};
+        const fc_real acc[3] = {ax, ay, az};
         fc_paper_ukf_measurement_update(&pred, b, P, acc, r, f->w, f->w_mu, 0, 0.0, learn_bias,
                                         x);
-        n = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        n = fc_sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     }
     f->x[0] = x[0] / n;
     f->x[1] = x[1] / n;
@@ -162,38 +162,38 @@ static void filter_update(fc_ukf *f, double ax, double ay, double az, const doub
     memcpy(f->P, P, sizeof P);
 }
 
-static void advance(fc_ukf *f, const double a[3], const double g[3], double dt)
+static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
     const fc_ukf_params *p = &f->params;
-    double raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int clipped = f->base.clipped;
     /* the raw sample (bias_gate); never a sample at the rail */
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
-        double phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
+        fc_real phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
         fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for the low-passes */
         int filling;
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        double r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
+        fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
         /* no bias from a vector that is filling or holds turns the gyro did not measure */
         learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
-        const double *m = f->meas + FC_MEAS_F;
+        const fc_real *m = f->meas + FC_MEAS_F;
         filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1);
     } else {
         filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0);
     }
     if (p->rest_time > 0.0 && !clipped) {
-        double measured = f->rest[7];
+        fc_real measured = f->rest[7];
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], &f->x[3], dt, p->rest_gyro,
                      p->rest_acc, p->rest_time, p->rest_bias_bound);
         if (p->acc_lowpass > 0.0 && fc_first_rest(measured, f->rest)) {
             /* the measured vector starts again from the rest's mean, X from its direction */
-            const double *m = f->rest + 3;
+            const fc_real *m = f->rest + 3;
             fc_measure_restart(f->meas, m);
-            double n = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            fc_real n = fc_sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
             f->x[0] = m[0] / n;
             f->x[1] = m[1] / n;
             f->x[2] = m[2] / n;

@@ -15,26 +15,26 @@ typedef struct fc_ukf {
     fc_ukf_params params;
     fc_base base;
     /* UnscentedKalmanFilter.STATE */
-    double x[6];      /* X (the gravity direction, 3), b (the gyro bias, 3) */
-    double P[21];     /* the covariance's lower triangle, row by row */
-    double meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
-    double rest[8];
+    fc_real x[6];      /* X (the gravity direction, 3), b (the gyro bias, 3) */
+    fc_real P[21];     /* the covariance's lower triangle, row by row */
+    fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
+    fc_real rest[8];
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
-    double gamma, w, w_mu, q_gyro, q_bias, r_acc;
-    double q_rotation, dist_tau;  /* UnscentedKalmanFilter._adaptive */
+    fc_real gamma, w, w_mu, q_gyro, q_bias, r_acc;
+    fc_real q_rotation, dist_tau;  /* UnscentedKalmanFilter._adaptive */
     fc_meas_constants measure;  /* UnscentedKalmanFilter._measure */
-    double longest2, rail_var;
-    double bias_lo2, bias_hi2, cos_innovation;
+    fc_real longest2, rail_var;
+    fc_real bias_lo2, bias_hi2, cos_innovation;
     int trapezoid;
 } fc_ukf;
 
 void fc_ukf_init(fc_ukf *f, const fc_ukf_params *params);
 void fc_ukf_configure(fc_ukf *f);
 void fc_ukf_reset(fc_ukf *f);
-fc_status fc_ukf_step(fc_ukf *f, const double acc[3], const double gyro[3], double dt,
+fc_status fc_ukf_step(fc_ukf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
                       fc_estimate *out);
-long fc_ukf_run(fc_ukf *f, long n, const double *acc, const double *gyro, const double *dt,
+long fc_ukf_run(fc_ukf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                 fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_ukf_estimate(const fc_ukf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */

@@ -64,7 +64,7 @@ def c_double(x: float) -> str:
 def c_type(p: Param) -> str:
     if p.choices is not None or isinstance(p.default, bool):
         return "int"
-    return "long" if isinstance(p.default, int) else "double"
+    return "long" if isinstance(p.default, int) else "fc_real"
 
 
 def choice_name(prefix: str, p: Param, choice: str) -> str:
@@ -130,7 +130,7 @@ def render() -> str:
         "#ifndef FC_PARAMS_H",
         "#define FC_PARAMS_H",
         "",
-        "#include <math.h>",
+        '#include "fc_real.h"',
         "",
     ]
     lines += [

@@ -25,8 +25,8 @@ HEADERS = (
     "fc_ukf.h", "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
 )
 """The headers, in the order the binding declares them."""
-DATA_HEADERS = ("fc_scenarios.h",)
-"""Headers of tables the binding does not declare (the scenarios' signal nodes), compiled in."""
+DATA_HEADERS = ("fc_scenarios.h", "fc_real.h")
+"""Headers the binding does not declare, compiled in: the scenarios' signal nodes, the real type."""
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
 Python's does, which is what makes the twins equal."""
@@ -94,11 +94,12 @@ def build(force: bool = False) -> Path:
     return target
 
 
-def cdef() -> str:
+def cdef(real: str = "double") -> str:
     """The headers as cffi declarations: comments, include guards, #includes, macros and the
     static inline default functions left out; integer #defines kept (lib.NAME), and written
-    into the declarations that use them (array sizes)."""
-    out: list[str] = []
+    into the declarations that use them (array sizes). real: the twins' real type (fc_real.h;
+    the binding is the double build, testbenches.embedded also loads a float one)."""
+    out: list[str] = [f"typedef {real} fc_real;"]
     defines: dict[str, str] = {}
     for name in HEADERS:
         text = re.sub(r"/\*.*?\*/", "", (HERE / name).read_text(), flags=re.S)

@@ -1,0 +1,1 @@
+"""The C twin on a microcontroller: `make embedded` (testbenches.embedded.build)."""
