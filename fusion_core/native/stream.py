@@ -12,6 +12,8 @@ from .library import available, lib_and_ffi, reason
 
 _new = tuple.__new__
 _PACK6 = struct.Struct("=6d").pack_into
+_UNPACK5 = struct.Struct("=5d").unpack_from
+_UNPACK11 = struct.Struct("=11d").unpack_from
 
 
 class Stream:
@@ -36,13 +38,20 @@ class Stream:
         self._sample = ffi.new("double[6]")
         self._sample_bytes = ffi.buffer(self._sample)
         self._acc, self._gyro = self._sample, self._sample + 3
+        self._call, self._null = self._stepper._step, self._stepper._null
+        self._bind()
+
+    def _bind(self) -> None:
+        """The twin's last estimate, bound for the per-sample path (again after the stepper
+        makes a new twin: set_state, set_param)."""
+        self._last = self._stepper._last
 
     def step(self, acc: Any, gyro: Any, dt: float) -> Estimate:
         """One IMU sample, as Estimator.step."""
         st = self._stepper
         try:
             _PACK6(self._sample_bytes, 0, *acc, *gyro)
-            status = st._step(st.twin, self._acc, self._gyro, dt, st._null)
+            status = self._call(st.twin, self._acc, self._gyro, dt, self._null)
         except (struct.error, TypeError, ValueError, OverflowError) as err:
             raise InvalidSample(
                 f"sample is not three accelerations, three rates and dt: {err}") from None
@@ -50,11 +59,12 @@ class Stream:
             st.sync()
             self.estimator.check_sample(acc, gyro, dt)
             raise InvalidSample("rejected by the sample rules")
-        v = st.last()
         if self._position:
+            v = _UNPACK11(self._last)
             return _new(Estimate, (v[0], v[1], (v[2], v[3], v[4]), (v[5], v[6], v[7]),
                                    (v[8], v[9], v[10])))
-        return _new(Estimate, (v[0], v[1], (v[2], v[3], v[4]), None, None))
+        roll, pitch, bx, by, bz = _UNPACK5(self._last)
+        return _new(Estimate, (roll, pitch, (bx, by, bz), None, None))
 
     @property
     def last(self) -> Estimate:
@@ -71,9 +81,11 @@ class Stream:
         """Estimator.set_state, then the twin continues from it."""
         self.estimator.set_state(snapshot)
         self._stepper.load()
+        self._bind()
 
     def set_param(self, name: str, value: Any) -> None:
         """Estimator.set_param, the state kept."""
         self._stepper.sync()
         self.estimator.set_param(name, value)
         self._stepper.load()
+        self._bind()
