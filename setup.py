@@ -8,8 +8,11 @@ where a C compiler exists holds
 - fmu_src/native/prebuilt/<preset>/<fmi2|fmi3>/<Model>.fmu for the recommended and paper
   presets (fmu_src.native.prebuilt), which `imu-fusion build-fmus --kind native` copies where
   no compiler exists (a JSON preset's start values are compiled into the binary: it needs one).
-The wheel is then tagged for this platform (py3-none-PLATFORM: the library is plain C, called
-through cffi's ABI mode, so it serves every CPython). Where no compiler exists, or an editable
+- fusion_core/native/_fc_stream.abi3.so, stream()'s compiled entry point, where the Python
+  headers exist too.
+The wheel is then tagged for this platform: cp310-abi3-PLATFORM with the entry point (CPython's
+stable ABI, any CPython from 3.10), else py3-none-PLATFORM (the library is plain C, called
+through cffi's ABI mode). Where no compiler exists, or an editable
 install is made, nothing is compiled and the package runs in Python or builds the twin on first
 use, as a source checkout does.
 """
@@ -68,6 +71,8 @@ class PlatformWheel(bdist_wheel):
         if self.root_is_pure:
             return "py3", "none", "any"
         _, _, plat = super().get_tag()
+        if (Path(self.bdist_dir or "") / "fusion_core" / "native" / "_fc_stream.abi3.so").exists():
+            return "cp310", "abi3", plat  # stream()'s entry point: CPython's stable ABI
         return "py3", "none", plat
 
 

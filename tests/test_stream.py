@@ -13,10 +13,24 @@ needs_twin = pytest.mark.skipif(not native.available(),
                                 reason=f"the C twin is unavailable: {native.reason()}")
 
 
+@pytest.fixture(params=["compiled", "cffi"])
+def entry(request, monkeypatch) -> str:
+    """Both ways a stream steps: the compiled entry point, and the cffi call it falls back to
+    where that is not built."""
+    from fusion_core.native import stream
+
+    if request.param == "cffi":
+        monkeypatch.setattr(stream, "stream_extension", lambda: None)
+    elif native.library.stream_extension() is None:
+        pytest.skip(f"no compiled entry point: {native.library.stream_reason()}")
+    return request.param
+
+
 @needs_twin
 @pytest.mark.parametrize("preset", ["recommended", "paper"])
 @pytest.mark.parametrize("key", KEYS)
-def test_the_stream_gives_steps_results_and_state_to_the_bit(key: str, preset: str) -> None:
+def test_the_stream_gives_steps_results_and_state_to_the_bit(key: str, preset: str,
+                                                              entry: str) -> None:
     params = paper(key) if preset == "paper" else {}
     rec = noisy_two_axis_recording(4.0)
     samples = list(zip(rec["acc_meas"].tolist(), rec["gyro_meas"].tolist(),
@@ -33,7 +47,19 @@ def test_the_stream_gives_steps_results_and_state_to_the_bit(key: str, preset: s
 
 
 @needs_twin
-def test_a_rejected_sample_says_why_and_leaves_the_state() -> None:
+def test_arrays_and_numpy_numbers_step_as_lists_do(entry: str) -> None:
+    import numpy as np
+
+    rec = noisy_two_axis_recording(1.0)
+    a, b = make("ukf").stream(), make("ukf").stream()
+    for acc, gyro, dt in zip(rec["acc_meas"], rec["gyro_meas"], rec["dt"], strict=True):
+        assert a.step(acc, gyro, dt) == b.step(acc.tolist(), gyro.tolist(), float(dt))
+    assert a.step(np.float32([0.0, 0.0, 9.8]), (0, 0, 0), np.float64(0.01)) == \
+        b.step([0.0, 0.0, float(np.float32(9.8))], [0.0, 0.0, 0.0], 0.01)
+
+
+@needs_twin
+def test_a_rejected_sample_says_why_and_leaves_the_state(entry: str) -> None:
     stream = make("kf").stream()
     stream.step((0.0, 0.0, 9.8), (0.0, 0.0, 0.0), 0.01)
     before = stream.get_state()

@@ -33,6 +33,7 @@ from fusion_core import native
 assert shutil.which("cc") is None and shutil.which("gcc") is None, "a compiler is visible"
 assert native.available(), native.reason()
 assert native.library_path().parent.name == "native", native.library_path()
+assert native.library.stream_reason() is None, native.library.stream_reason()
 rng = np.random.default_rng(0)
 acc = np.array([0.0, 0.0, 9.81]) + 0.05 * rng.standard_normal((400, 3))
 gyro = 0.01 * rng.standard_normal((400, 3))
@@ -78,10 +79,11 @@ def _missing(module: str) -> bool:
 
 def test_the_wheel_carries_the_library_and_both_presets_native_fmus(dists: Path) -> None:
     (wheel,) = dists.glob("*.whl")
-    assert wheel.name.endswith(".whl") and "-py3-none-" in wheel.name
+    assert wheel.name.endswith(".whl") and "-cp310-abi3-" in wheel.name
     assert not wheel.name.endswith("-any.whl"), wheel.name
     names = zipfile.ZipFile(wheel).namelist()
     assert "fusion_core/native/libfusion_core.so" in names
+    assert "fusion_core/native/_fc_stream.abi3.so" in names  # stream()'s entry point
     assert "fusion_core/native/fc_kf.h" in names  # the binding's declarations
     for preset in ("recommended", "paper"):
         for version in ("fmi2", "fmi3"):

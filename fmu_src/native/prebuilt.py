@@ -56,6 +56,14 @@ def build_into(build_lib: Path) -> Iterator[str]:
     library.parent.mkdir(parents=True, exist_ok=True)
     shutil.copy2(native.build(), library)
     yield f"compiled {library.relative_to(build_lib)}"
+    from fusion_core.native.library import STREAM_PREBUILT, build_stream
+
+    try:  # stream()'s compiled entry point needs the Python headers too
+        stream = library.parent / STREAM_PREBUILT.name
+        shutil.copy2(build_stream(), stream)
+        yield f"compiled {stream.relative_to(build_lib)}"
+    except RuntimeError as err:
+        yield f"no compiled entry point for stream(): {err}"
     for preset in PRESETS:
         entries = load_preset(preset)
         out = build_lib / "fmu_src" / "native" / FOLDER / preset

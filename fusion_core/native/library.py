@@ -94,6 +94,71 @@ def build(force: bool = False) -> Path:
     return target
 
 
+STREAM_SOURCE = HERE / "fc_stream_ext.c"
+"""Estimator.stream()'s compiled entry point: a CPython extension of the stable ABI that calls a
+twin's step through its address (no arithmetic of its own)."""
+STREAM_PREBUILT = HERE / "_fc_stream.abi3.so"
+"""The entry point built with a wheel, loaded before any build."""
+_stream: Any = None
+_stream_reason: str | None = "not loaded yet"
+
+
+def build_stream(force: bool = False) -> Path:
+    """Compile the stream's entry point (unless cached) and return its path; RuntimeError
+    saying why not (no compiler, no Python headers)."""
+    import sysconfig
+
+    cc = compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler found")
+    include = sysconfig.get_paths().get("include")
+    if not include or not (Path(include) / "Python.h").is_file():
+        raise RuntimeError(f"no Python.h in {include} (the Python development headers)")
+    h = hashlib.sha256(STREAM_SOURCE.read_bytes() + f"{cc} {include}".encode()).hexdigest()[:16]
+    target = cache_dir() / f"stream-{h}" / STREAM_PREBUILT.name
+    if target.is_file() and not force:
+        return target
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
+    os.close(fd)
+    cmd = [cc, "-std=c99", "-O2", "-fPIC", "-shared", "-I", include, "-o", tmp,
+           str(STREAM_SOURCE)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        os.unlink(tmp)
+        tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-10:])
+        raise RuntimeError(f"building the stream's entry point failed ({' '.join(cmd)}):\n{tail}")
+    os.replace(tmp, target)
+    return target
+
+
+def stream_extension() -> Any:
+    """The stream's compiled entry point (built on first use), or None where it cannot be had
+    (stream_reason() says why: stream() then steps through the cffi call)."""
+    global _stream, _stream_reason
+    if _stream is None and _stream_reason == "not loaded yet":
+        import importlib.machinery
+        import importlib.util
+
+        try:
+            path = STREAM_PREBUILT if STREAM_PREBUILT.is_file() else build_stream()
+            loader = importlib.machinery.ExtensionFileLoader("_fc_stream", str(path))
+            spec = importlib.util.spec_from_file_location("_fc_stream", path, loader=loader)
+            assert spec is not None
+            module = importlib.util.module_from_spec(spec)
+            loader.exec_module(module)
+            _stream, _stream_reason = module, None
+        except (RuntimeError, OSError, ImportError) as err:
+            _stream_reason = str(err)
+    return _stream
+
+
+def stream_reason() -> str | None:
+    """Why the stream's entry point is not available; None when it is."""
+    stream_extension()
+    return _stream_reason
+
+
 def cdef(real: str = "double") -> str:
     """The headers as cffi declarations: comments, include guards, #includes, macros and the
     static inline default functions left out; integer #defines kept (lib.NAME), and written

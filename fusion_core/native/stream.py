@@ -8,7 +8,7 @@ from typing import Any
 
 from ..types import Estimate, InvalidSample
 from .estimators import FC_SKIPPED, Stepper, has_twin
-from .library import available, lib_and_ffi, reason
+from .library import available, lib_and_ffi, reason, stream_extension
 
 _new = tuple.__new__
 _PACK6 = struct.Struct("=6d").pack_into
@@ -42,9 +42,24 @@ class Stream:
         self._bind()
 
     def _bind(self) -> None:
-        """The twin's last estimate, bound for the per-sample path (again after the stepper
-        makes a new twin: set_state, set_param)."""
+        """The twin's last estimate, bound for the per-sample path, and the compiled entry
+        point where it is built (library.stream_extension), as this object's `step` (again
+        after the stepper makes a new twin: set_state, set_param)."""
         self._last = self._stepper._last
+        ext = stream_extension()
+        if ext is None:
+            return
+        _, ffi = lib_and_ffi()
+        st = self._stepper
+        address = lambda cdata: int(ffi.cast("uintptr_t", cdata))  # noqa: E731
+        self.step = ext.stepper(  # type: ignore[method-assign]
+            address(st._step), address(st.twin), address(ffi.addressof(st.twin[0], "last")),
+            self._position, Estimate, tuple.__new__, self._step_cffi).step
+
+    def _step_cffi(self, acc: Any, gyro: Any, dt: float) -> Estimate:
+        """The step through the cffi call: where the compiled entry point is missing, and for
+        the samples it hands back (not six plain numbers, or rejected: said why here)."""
+        return Stream.step(self, acc, gyro, dt)
 
     def step(self, acc: Any, gyro: Any, dt: float) -> Estimate:
         """One IMU sample, as Estimator.step."""
