@@ -69,8 +69,9 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
         out.append(_target(
             f"per_sample_us_stream.{key} vs vqf", v / vqf, f"<= {STREAM_VS_VQF:g}x VQF update",
             v / vqf <= STREAM_VS_VQF,
-            "one cffi call in ABI mode (about 0.4 us) plus packing the six numbers and "
-            "building the Estimate in Python",
+            "the twin's own work plus Python's calling convention and the Estimate; without "
+            "the compiled entry point (fusion_core.native.library.stream_reason()), one cffi "
+            "call in ABI mode, packing the six numbers and building the Estimate in Python",
         ))
     overhead = r.get("fmu_overhead_us")
     if overhead:
