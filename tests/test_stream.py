@@ -90,3 +90,25 @@ def test_a_class_without_a_twin_of_its_own_is_refused_with_the_reason() -> None:
 
     with pytest.raises(ValueError, match="no C twin of its own"):
         Mine().stream()
+
+
+@needs_twin
+def test_a_step_taken_before_set_state_stays_safe_to_call(entry: str) -> None:
+    """A step bound before set_state, called after it and a garbage collection, steps a twin
+    that is still alive (the compiled entry point keeps the one it was bound to): finite
+    estimates, no crash; the stream itself continues from the state it was given."""
+    import gc
+    import math
+
+    stream = make("kf").stream()
+    old = stream.step
+    old((0.0, 0.0, 9.8), (0.0, 0.0, 0.0), 0.01)
+    stream.set_state(make("kf").get_state())
+    gc.collect()
+    for _ in range(200):
+        e = old((0.0, 0.1, 9.8), (0.01, 0.0, 0.0), 0.01)
+        assert math.isfinite(e.roll) and math.isfinite(e.pitch)
+    fresh = make("kf")
+    stream.set_state(fresh.get_state())
+    assert stream.step((0.0, 0.0, 9.8), (0.0, 0.0, 0.0), 0.01) == fresh.step(
+        (0.0, 0.0, 9.8), (0.0, 0.0, 0.0), 0.01)

@@ -25,6 +25,7 @@ typedef struct {
     PyObject *estimate_type; /* fusion_core.types.Estimate */
     PyObject *tuple_new;     /* tuple.__new__ */
     PyObject *reject;        /* reject(acc, gyro, dt): raises InvalidSample */
+    PyObject *owner;         /* what keeps the twin's memory alive (its cffi object) */
 } Stepper;
 
 static int three(PyObject *seq, double out[3])
@@ -121,12 +122,33 @@ static PyMethodDef stepper_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
-static void stepper_dealloc(PyObject *self_obj)
+/* The stepper takes part in the garbage collector: its `reject` callback holds the stream,
+ * which holds the stepper, and the collector breaks that cycle. */
+static int stepper_traverse(PyObject *self_obj, visitproc visit, void *arg)
 {
     Stepper *self = (Stepper *)self_obj;
-    Py_XDECREF(self->estimate_type);
-    Py_XDECREF(self->tuple_new);
-    Py_XDECREF(self->reject);
+    Py_VISIT(self->estimate_type);
+    Py_VISIT(self->tuple_new);
+    Py_VISIT(self->reject);
+    Py_VISIT(self->owner);
+    Py_VISIT(Py_TYPE(self_obj));
+    return 0;
+}
+
+static int stepper_clear(PyObject *self_obj)
+{
+    Stepper *self = (Stepper *)self_obj;
+    Py_CLEAR(self->estimate_type);
+    Py_CLEAR(self->tuple_new);
+    Py_CLEAR(self->reject);
+    Py_CLEAR(self->owner);
+    return 0;
+}
+
+static void stepper_dealloc(PyObject *self_obj)
+{
+    PyObject_GC_UnTrack(self_obj);
+    stepper_clear(self_obj);
     PyTypeObject *type = Py_TYPE(self_obj);
     freefunc free_fn = (freefunc)PyType_GetSlot(type, Py_tp_free);
     free_fn(self_obj);
@@ -136,25 +158,29 @@ static void stepper_dealloc(PyObject *self_obj)
 static PyType_Slot stepper_slots[] = {
     {Py_tp_methods, stepper_methods},
     {Py_tp_dealloc, stepper_dealloc},
+    {Py_tp_traverse, stepper_traverse},
+    {Py_tp_clear, stepper_clear},
     {Py_tp_doc, "A twin's compiled per-sample step (fusion_core.native.stream)."},
     {0, NULL},
 };
 
 static PyType_Spec stepper_spec = {
-    "_fc_stream.Stepper", sizeof(Stepper), 0, Py_TPFLAGS_DEFAULT, stepper_slots,
+    "_fc_stream.Stepper", sizeof(Stepper), 0, Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    stepper_slots,
 };
 
 static PyObject *stepper_type;
 
-/* stepper(step_address, twin_address, last_address, position, Estimate, tuple_new, reject) */
+/* stepper(step_address, twin_address, last_address, position, Estimate, tuple_new, reject,
+ *         owner): owner keeps the twin's memory alive as long as this stepper lives */
 static PyObject *make_stepper(PyObject *module, PyObject *args)
 {
     unsigned long long step, twin, last;
     int position;
-    PyObject *estimate_type, *tuple_new, *reject;
+    PyObject *estimate_type, *tuple_new, *reject, *owner;
     (void)module;
-    if (!PyArg_ParseTuple(args, "KKKpOOO", &step, &twin, &last, &position, &estimate_type,
-                          &tuple_new, &reject)) {
+    if (!PyArg_ParseTuple(args, "KKKpOOOO", &step, &twin, &last, &position, &estimate_type,
+                          &tuple_new, &reject, &owner)) {
         return NULL;
     }
     if (step == 0 || twin == 0 || last == 0) {
@@ -174,16 +200,18 @@ static PyObject *make_stepper(PyObject *module, PyObject *args)
     Py_INCREF(estimate_type);
     Py_INCREF(tuple_new);
     Py_INCREF(reject);
+    Py_INCREF(owner);
     self->estimate_type = estimate_type;
     self->tuple_new = tuple_new;
     self->reject = reject;
+    self->owner = owner; /* (tp_alloc has put it in the collector's care) */
     return (PyObject *)self;
 }
 
 static PyMethodDef module_methods[] = {
     {"stepper", make_stepper, METH_VARARGS,
      "stepper(step_address, twin_address, last_address, position, Estimate, tuple_new, "
-     "reject)"},
+     "reject, owner)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -54,11 +54,11 @@ class Stream:
         address = lambda cdata: int(ffi.cast("uintptr_t", cdata))  # noqa: E731
         self.step = ext.stepper(  # type: ignore[method-assign]
             address(st._step), address(st.twin), address(ffi.addressof(st.twin[0], "last")),
-            self._position, Estimate, tuple.__new__, self._step_cffi).step
+            self._position, Estimate, tuple.__new__, self._step_cffi, st.twin).step
 
     def _step_cffi(self, acc: Any, gyro: Any, dt: float) -> Estimate:
-        """The step through the cffi call: where the compiled entry point is missing, and for
-        the samples it hands back (not six plain numbers, or rejected: said why here)."""
+        """The compiled step's way back for the samples it does not take (not six plain
+        numbers, or rejected: the cffi call says why)."""
         return Stream.step(self, acc, gyro, dt)
 
     def step(self, acc: Any, gyro: Any, dt: float) -> Estimate:
