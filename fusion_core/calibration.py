@@ -154,6 +154,14 @@ class Calibration:
             out.update(zip(offset_names(sensor), getattr(self, f"{sensor}_offset"), strict=True))
         return out
 
+    @classmethod
+    def from_params(cls, values: Mapping[str, Any]) -> Calibration:
+        """The calibration of estimator parameters (params' inverse; a name left out keeps
+        its default)."""
+        full = {p.name: values.get(p.name, p.default) for p in CALIBRATION_PARAMS}
+        (am, ao), (gm, go) = matrices(full).values()
+        return cls(am, ao, gm, go)
+
     def apply(self, acc: Any, gyro: Any) -> tuple[Any, Any]:
         """Calibrated arrays [N, 3] of raw ones, as the estimators compute them."""
         import numpy as np

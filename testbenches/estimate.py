@@ -19,7 +19,6 @@ A file that cannot serve gets one line saying what was wrong.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 from pathlib import Path
 from typing import Any
@@ -96,15 +95,10 @@ def _find(header: list[str], quantity: str, given: str | None = None) -> int | N
 
 def read_csv(path: Path, time_column: str | None) -> tuple[dict[str, np.ndarray], list[str]]:
     """The columns of a CSV file by the header's names (numbers; RecordingError otherwise)."""
-    from .fit.recording import RecordingError
+    from .fit.recording import RecordingError, csv_header_rows
 
-    with path.open(newline="") as fh:
-        reader = csv.reader(fh)
-        try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise RecordingError(f"{path}: empty file") from None
-        rows = [r for r in reader if r and any(c.strip() for c in r)]
+    header, rows = csv_header_rows(path)
+    rows = [r for r in rows if any(c.strip() for c in r)]
     if not rows:
         raise RecordingError(f"{path}: a header and no samples")
     if any(len(r) != len(header) for r in rows):

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from . import contract
-from .montecarlo.simulate import RATE, scenario_samples
+from .samples import RATE, scenario_samples
 
 Peer = Callable[[np.ndarray, np.ndarray, float], np.ndarray]
 
@@ -91,14 +91,11 @@ def run_peers(
 
 def _calibrated(acc: np.ndarray, gyro: np.ndarray, sensor: dict[str, Any], seed: int
                 ) -> tuple[np.ndarray, np.ndarray]:
-    from fusion_core.calibration import Calibration, matrix_names
+    from fusion_core.calibration import Calibration
 
     from .calibrate.part import part_calibration
 
-    values = part_calibration(sensor, seed)
-    cal = Calibration(acc_matrix=tuple(values[n] for n in matrix_names("acc")),  # type: ignore[arg-type]
-                      gyro_matrix=tuple(values[n] for n in matrix_names("gyro")))  # type: ignore[arg-type]
-    return cal.apply(acc, gyro)
+    return Calibration.from_params(part_calibration(sensor, seed)).apply(acc, gyro)
 
 
 def peer_table(rows: list[PeerRun]) -> str:

@@ -66,6 +66,7 @@ def test_the_default_is_no_calibration_and_every_estimator_has_it() -> None:
             for p in CALIBRATION_PARAMS:
                 assert specs[p.name] == p
     assert Calibration().params() == {p.name: p.default for p in CALIBRATION_PARAMS}
+    assert Calibration.from_params(PART.params()) == PART
 
 
 def test_a_bad_matrix_is_refused_naming_the_entry_or_the_matrix_and_the_bound() -> None:

@@ -6,9 +6,7 @@
 void fc_cf_configure(fc_cf *f)
 {
     const fc_cf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, p->gyro_range);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
     f->tau = p->tau;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
     f->trapezoid = p->gyro_sampling == FC_CF_GYRO_SAMPLING_POINT;

@@ -170,18 +170,24 @@ void fc_base_configure(fc_base *b, fc_real max_dt, fc_real max_rate, fc_real mou
  * fc_base_prepare before the mounting; the identity and zero: none. */
 void fc_base_calibrate(fc_base *b, const fc_real acc_cal[9], const fc_real acc_off[3],
                        const fc_real gyro_cal[9], const fc_real gyro_off[3]);
-/* fc_base_calibrate with the calibration parameters of any params struct p (every estimator's
- * has them: COMMON_PARAMS). */
-#define FC_BASE_CALIBRATE(b, p)                                                               \
-    fc_base_calibrate((b),                                                                    \
-        (const fc_real[9]){(p)->acc_cal_xx, (p)->acc_cal_xy, (p)->acc_cal_xz, (p)->acc_cal_yx,  \
-                          (p)->acc_cal_yy, (p)->acc_cal_yz, (p)->acc_cal_zx, (p)->acc_cal_zy,  \
-                          (p)->acc_cal_zz},                                                   \
-        (const fc_real[3]){(p)->acc_off_x, (p)->acc_off_y, (p)->acc_off_z},                    \
-        (const fc_real[9]){(p)->gyro_cal_xx, (p)->gyro_cal_xy, (p)->gyro_cal_xz,               \
-                          (p)->gyro_cal_yx, (p)->gyro_cal_yy, (p)->gyro_cal_yz,               \
-                          (p)->gyro_cal_zx, (p)->gyro_cal_zy, (p)->gyro_cal_zz},              \
-        (const fc_real[3]){(p)->gyro_off_x, (p)->gyro_off_y, (p)->gyro_off_z})
+/* Estimator._set_params' shared part for any params struct p (every estimator's has COMMON's
+ * fields): the sample rules, mounting, delay, the gyro's range (HUGE_VAL for a filter without
+ * one: the papers') and the part's calibration. */
+#define FC_BASE_CONFIGURE(b, p, gyro_range)                                                   \
+    do {                                                                                      \
+        fc_base_configure((b), (p)->max_dt, (p)->max_rate, (p)->mount_roll, (p)->mount_pitch,  \
+                          (p)->mount_yaw, (p)->sensor_delay, (gyro_range));                   \
+        fc_base_calibrate(                                                                    \
+            (b),                                                                              \
+            (const fc_real[9]){(p)->acc_cal_xx, (p)->acc_cal_xy, (p)->acc_cal_xz,             \
+                               (p)->acc_cal_yx, (p)->acc_cal_yy, (p)->acc_cal_yz,             \
+                               (p)->acc_cal_zx, (p)->acc_cal_zy, (p)->acc_cal_zz},            \
+            (const fc_real[3]){(p)->acc_off_x, (p)->acc_off_y, (p)->acc_off_z},               \
+            (const fc_real[9]){(p)->gyro_cal_xx, (p)->gyro_cal_xy, (p)->gyro_cal_xz,          \
+                               (p)->gyro_cal_yx, (p)->gyro_cal_yy, (p)->gyro_cal_yz,          \
+                               (p)->gyro_cal_zx, (p)->gyro_cal_zy, (p)->gyro_cal_zz},         \
+            (const fc_real[3]){(p)->gyro_off_x, (p)->gyro_off_y, (p)->gyro_off_z});           \
+    } while (0)
 void fc_base_reset(fc_base *b);
 /* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
  * was), applies the calibration, turns it into the filter frame (mounting) and takes an absurd

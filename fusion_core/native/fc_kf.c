@@ -34,9 +34,7 @@ static int same4(const fc_real a[4], const fc_real b[4])
 void fc_kf_configure(fc_kf *f)
 {
     const fc_kf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, p->gyro_range);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;

@@ -9,9 +9,7 @@
 void fc_mgcf_configure(fc_mgcf *f)
 {
     const fc_mgcf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, p->gyro_range);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
     f->w0 = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;
@@ -30,11 +28,7 @@ void fc_mgcf_configure(fc_mgcf *f)
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
 {
-    fc_estimate e;
-    memset(&e, 0, sizeof e);
-    fc_quat_roll_pitch(f->q, &e.roll, &e.pitch);
-    memcpy(e.bias, f->bias, sizeof e.bias);
-    return e;
+    return fc_paper_mgcf_quat_estimate(f->q, f->bias);
 }
 
 void fc_mgcf_reset(fc_mgcf *f)

@@ -104,9 +104,7 @@ static fc_roll_pitch_axes axes(fc_paper_kf *f)
 void fc_paper_kf_configure(fc_paper_kf *f)
 {
     const fc_paper_kf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, HUGE_VAL);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;

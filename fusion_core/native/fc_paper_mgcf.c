@@ -81,21 +81,24 @@ void fc_paper_mgcf_pi_step(fc_real q[4], fc_real bias[3], const fc_real prev[3],
 void fc_paper_mgcf_configure(fc_paper_mgcf *f)
 {
     const fc_paper_mgcf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, HUGE_VAL);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
     f->w0_fixed = p->w0;
     f->two_zeta = 2.0 * p->zeta;
     f->trapezoid = p->gyro_sampling == FC_PAPER_MGCF_GYRO_SAMPLING_POINT;
 }
 
-fc_estimate fc_paper_mgcf_estimate(const fc_paper_mgcf *f)
+fc_estimate fc_paper_mgcf_quat_estimate(const fc_real q[4], const fc_real bias[3])
 {
     fc_estimate e;
     memset(&e, 0, sizeof e);
-    fc_quat_roll_pitch(f->q, &e.roll, &e.pitch);
-    memcpy(e.bias, f->bias, sizeof e.bias);
+    fc_quat_roll_pitch(q, &e.roll, &e.pitch);
+    memcpy(e.bias, bias, sizeof e.bias);
     return e;
+}
+
+fc_estimate fc_paper_mgcf_estimate(const fc_paper_mgcf *f)
+{
+    return fc_paper_mgcf_quat_estimate(f->q, f->bias);
 }
 
 void fc_paper_mgcf_reset(fc_paper_mgcf *f)

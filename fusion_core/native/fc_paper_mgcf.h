@@ -28,6 +28,8 @@ fc_status fc_paper_mgcf_step(fc_paper_mgcf *f, const fc_real acc[3], const fc_re
 long fc_paper_mgcf_run(fc_paper_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
                        const fc_real *dt, fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_paper_mgcf_estimate(const fc_paper_mgcf *f);
+/* The estimate of a quaternion's roll and pitch and a gyro bias (both mgcfs' _estimate). */
+fc_estimate fc_paper_mgcf_quat_estimate(const fc_real q[4], const fc_real bias[3]);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_mgcf_restored(fc_paper_mgcf *f);
 

@@ -174,9 +174,7 @@ static void tilt_params(const fc_paper_poskf_params *p, fc_paper_kf_params *tp)
 void fc_paper_poskf_configure(fc_paper_poskf *f)
 {
     const fc_paper_poskf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, HUGE_VAL);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
     tilt_params(p, &f->tilt.params);
     fc_paper_kf_configure(&f->tilt);
     f->acc_var_density = p->acc_psd;
@@ -191,13 +189,18 @@ fc_estimate fc_paper_poskf_estimate(const fc_paper_poskf *f)
     e.pitch = f->tilt.pitch;
     e.bias[0] = f->tilt.bias_x;
     e.bias[1] = f->tilt.bias_y;
-    e.pos[0] = f->x[0];
-    e.pos[1] = f->x[3];
-    e.pos[2] = f->x[6];
-    e.vel[0] = f->x[1];
-    e.vel[1] = f->x[4];
-    e.vel[2] = f->x[7];
+    fc_paper_poskf_put_axes(f->x, &e);
     return e;
+}
+
+void fc_paper_poskf_put_axes(const fc_real x[9], fc_estimate *e)
+{
+    e->pos[0] = x[0];
+    e->pos[1] = x[3];
+    e->pos[2] = x[6];
+    e->vel[0] = x[1];
+    e->vel[1] = x[4];
+    e->vel[2] = x[7];
 }
 
 void fc_paper_poskf_reset(fc_paper_poskf *f)

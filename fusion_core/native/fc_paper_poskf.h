@@ -31,6 +31,8 @@ fc_status fc_paper_poskf_step(fc_paper_poskf *f, const fc_real acc[3], const fc_
 long fc_paper_poskf_run(fc_paper_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
                         const fc_real *dt, fc_estimate *out, unsigned char *rejected);
 fc_estimate fc_paper_poskf_estimate(const fc_paper_poskf *f);
+/* The position and velocity of the [p, v, a] axis states x (x, y, z axes in turn) into e. */
+void fc_paper_poskf_put_axes(const fc_real x[9], fc_estimate *e);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_poskf_restored(fc_paper_poskf *f);
 

@@ -498,9 +498,7 @@ void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const fc_rea
 void fc_paper_ukf_configure(fc_paper_ukf *f)
 {
     const fc_paper_ukf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, HUGE_VAL);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
     fc_paper_ukf_unscented_constants(p->alpha, p->beta, p->kappa, &f->gamma, &f->w, &f->w_mu);
     f->q_gyro = p->gyro_psd;
     f->q_bias = p->bias_psd;

@@ -9,9 +9,7 @@
 void fc_poskf_configure(fc_poskf *f)
 {
     const fc_poskf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, p->gyro_range);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
     /* the tilt stage: the papers' kf with the TILT_PARAMS given */
     fc_paper_kf_params tp;
     fc_paper_kf_params_default(&tp);
@@ -43,12 +41,7 @@ void fc_poskf_configure(fc_poskf *f)
 fc_estimate fc_poskf_estimate(const fc_poskf *f)
 {
     fc_estimate e = f->att.last;  /* the attitude kf's own output (in the sensor frame) */
-    e.pos[0] = f->x[0];
-    e.pos[1] = f->x[3];
-    e.pos[2] = f->x[6];
-    e.vel[0] = f->x[1];
-    e.vel[1] = f->x[4];
-    e.vel[2] = f->x[7];
+    fc_paper_poskf_put_axes(f->x, &e);
     return e;
 }
 

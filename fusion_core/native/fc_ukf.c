@@ -9,9 +9,7 @@
 void fc_ukf_configure(fc_ukf *f)
 {
     const fc_ukf_params *p = &f->params;
-    fc_base_configure(&f->base, p->max_dt, p->max_rate, p->mount_roll, p->mount_pitch,
-                      p->mount_yaw, p->sensor_delay, p->gyro_range);
-    FC_BASE_CALIBRATE(&f->base, p);
+    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
     fc_paper_ukf_unscented_constants(p->alpha, p->beta, p->kappa, &f->gamma, &f->w, &f->w_mu);
     f->q_gyro = p->gyro_psd;
     f->q_bias = p->bias_psd;

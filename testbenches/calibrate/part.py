@@ -19,23 +19,17 @@ from typing import Any
 import numpy as np
 
 from fusion_core.calibration import matrix_names
-from fusion_core.scenarios import get_scenario
-from fusion_core.sensor import ImuSensorModel
 
+from ..samples import scenario_samples
 from .tedaldi import CalibrationRefused, calibrate_session
 
 SESSION = "calibration_session"
-RATE = 100.0
 
 
 @functools.lru_cache(maxsize=64)
 def _part_calibration(sensor_json: str) -> tuple[tuple[str, float], ...]:
     sensor = json.loads(sensor_json)
-    sc = get_scenario(SESSION)
-    n = round(sc.duration * RATE)
-    steps = np.full(n, 1.0 / RATE)
-    truth = sc.truth(np.cumsum(steps))
-    out = ImuSensorModel(**sensor).run(truth[:, 3:6], truth[:, 6:9], steps)
+    _, _, out = scenario_samples(SESSION, sensor["seed"], sensor)
     try:
         session = calibrate_session(out["acc"], out["gyro"], out["dt"],
                                     float(sensor.get("gyro_range", np.radians(2000.0))))

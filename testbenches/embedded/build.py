@@ -35,6 +35,8 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 TWIN = REPO / "fusion_core" / "native"
 OUT = REPO / "build" / "embedded"
+RATE = 100.0
+"""The contract scenarios' sample rate [Hz]."""
 N = 1500
 """Samples per recording (flash holds the recordings and the desktop's estimates)."""
 LIBM_N = 1000
@@ -82,14 +84,7 @@ def twin_sources() -> list[Path]:
 def recordings() -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
     """(name, acc, gyro, dt) of N samples: moderate_dynamics through the realistic sensor (seed
     0), and the first trial in BROAD_DIR where there is one."""
-    from fusion_core.scenarios import get_scenario
-    from fusion_core.sensor import ImuSensorModel, sensor_preset
-
-    sc = get_scenario("moderate_dynamics")
-    steps = np.full(N, 0.01)
-    truth = sc.truth(np.cumsum(steps))
-    out = ImuSensorModel(**{**sensor_preset("realistic"), "seed": 0}).run(
-        truth[:, 3:6], truth[:, 6:9], steps)
+    _, _, out = realistic_samples("moderate_dynamics", duration=N / RATE)
     recs = [("moderate_dynamics", out["acc"], out["gyro"], out["dt"])]
     broad = os.environ.get("BROAD_DIR")
     if broad and Path(broad).is_dir():
@@ -106,18 +101,33 @@ def recordings() -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
     return recs
 
 
-def desktop_estimates(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> np.ndarray:
-    """[5, N, 11]: each estimator's estimates (roll, pitch, bias, pos, vel) from the desktop's
-    C twin with the recommended parameters."""
+def realistic_samples(scenario: str, seed: int = 0, duration: float | None = None) -> Any:
+    """A scenario through the realistic sensor part of a seed: times, truth and samples
+    (testbenches.samples, the campaigns' data flow)."""
+    from fusion_core.sensor import sensor_preset
+
+    from ..samples import scenario_samples
+
+    return scenario_samples(scenario, seed, sensor_preset("realistic"), duration)
+
+
+def desktop_table(key: str, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
+                  params: dict[str, Any] | None = None) -> np.ndarray:
+    """[N, 11]: an estimator's estimates (roll, pitch, bias, pos, vel; fc_estimate's order)
+    from the desktop's double C twin."""
     from fusion_core.registry import create
 
-    table = np.zeros((len(ESTIMATORS), len(acc), 11))
-    for i, key in enumerate(ESTIMATORS):
-        out = create(key).run(acc, gyro, dt, backend="native")
-        table[i, :, 0], table[i, :, 1], table[i, :, 2:5] = out["roll"], out["pitch"], out["bias"]
-        if "pos" in out:
-            table[i, :, 5:8], table[i, :, 8:11] = out["pos"], out["vel"]
+    out = create(key, params or {}).run(acc, gyro, dt, backend="native")
+    table = np.zeros((len(acc), 11))
+    table[:, 0], table[:, 1], table[:, 2:5] = out["roll"], out["pitch"], out["bias"]
+    if "pos" in out:
+        table[:, 5:8], table[:, 8:11] = out["pos"], out["vel"]
     return table
+
+
+def desktop_estimates(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> np.ndarray:
+    """[5, N, 11]: every estimator's desktop_table with the recommended parameters."""
+    return np.array([desktop_table(key, acc, gyro, dt) for key in ESTIMATORS])
 
 
 def libm_table() -> np.ndarray:

@@ -24,7 +24,7 @@ import numpy as np
 
 from fusion_core.native.library import CFLAGS, cdef, compiler
 
-from .build import ESTIMATORS, OUT, twin_sources
+from .build import ESTIMATORS, OUT, desktop_table, realistic_samples, twin_sources
 
 REAL_FLAGS = ("-DFC_REAL_FLOAT=1", "-fsingle-precision-constant")
 LONG_SAMPLES = 1_000_000
@@ -75,32 +75,6 @@ class FloatTwin:
         return np.frombuffer(ffi.buffer(out), dtype=np.float32).reshape(n, 11).astype(float)
 
 
-def _double(key: str, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
-            params: dict[str, Any] | None = None) -> np.ndarray:
-    from fusion_core.registry import create
-
-    out = create(key, params or {}).run(acc, gyro, dt, backend="native")
-    table = np.zeros((len(acc), 11))
-    table[:, 0], table[:, 1], table[:, 2:5] = out["roll"], out["pitch"], out["bias"]
-    if "pos" in out:
-        table[:, 5:8], table[:, 8:11] = out["pos"], out["vel"]
-    return table
-
-
-def _scenario(name: str, seed: int = 0, duration: float | None = None):
-    from fusion_core.scenarios import get_scenario
-    from fusion_core.sensor import ImuSensorModel, sensor_preset
-
-    sc = get_scenario(name)
-    n = round((duration or sc.duration) * 100.0)
-    steps = np.full(n, 0.01)
-    t = np.cumsum(steps)
-    truth = sc.truth(t)
-    out = ImuSensorModel(**{**sensor_preset("realistic"), "seed": seed}).run(
-        truth[:, 3:6], truth[:, 6:9], steps)
-    return t, truth, out
-
-
 def contract_scenarios(twin: FloatTwin) -> dict[str, Any]:
     """Per scenario and estimator: roll and pitch RMSE [deg] of both builds and the largest
     difference of the two RMSEs."""
@@ -111,11 +85,11 @@ def contract_scenarios(twin: FloatTwin) -> dict[str, Any]:
 
     rows: dict[str, Any] = {}
     for name in ESTIMATION_SCENARIOS:
-        t, truth_array, out = _scenario(name)
+        t, truth_array, out = realistic_samples(name)
         truth = {n: truth_array[:, i] for i, n in enumerate(TRUTH_NAMES)}
         for key in ESTIMATORS:
             both = {}
-            for build, est in (("double", _double(key, out["acc"], out["gyro"], out["dt"])),
+            for build, est in (("double", desktop_table(key, out["acc"], out["gyro"], out["dt"])),
                                ("float", twin.run(key, out["acc"], out["gyro"], out["dt"]))):
                 er, ep, keep = contract.attitude_errors(name, t, truth, est[:, 0], est[:, 1])
                 both[build] = (contract.scored_rmse(er, keep), contract.scored_rmse(ep, keep))
@@ -139,7 +113,7 @@ def broad_trials(twin: FloatTwin, folder: Path) -> dict[str, Any]:
         ref = gravity_from_quat(trial.opt_quat)
         for key in ESTIMATORS:
             res = {}
-            for build, est in (("double", _double(key, trial.acc, trial.gyro, dt, params)),
+            for build, est in (("double", desktop_table(key, trial.acc, trial.gyro, dt, params)),
                                ("float", twin.run(key, trial.acc, trial.gyro, dt, params))):
                 res[build] = inclination_rmse_deg(gravity_from_roll_pitch(est[:, 0], est[:, 1]),
                                                   ref, trial.movement)
@@ -151,15 +125,18 @@ def broad_trials(twin: FloatTwin, folder: Path) -> dict[str, Any]:
 def long_run(twin: FloatTwin) -> dict[str, Any]:
     """10^6 samples of roll_pitch: the largest roll/pitch difference [deg] between the builds
     over the whole run and over its last tenth, and whether every float output stayed finite."""
-    _, _, out = _scenario("roll_pitch", duration=LONG_SAMPLES / 100.0)
+    from ..samples import forget
+
+    _, _, out = realistic_samples("roll_pitch", duration=LONG_SAMPLES / 100.0)
     rows: dict[str, Any] = {}
     for key in ESTIMATORS:
-        d = _double(key, out["acc"], out["gyro"], out["dt"])
+        d = desktop_table(key, out["acc"], out["gyro"], out["dt"])
         f = twin.run(key, out["acc"], out["gyro"], out["dt"])
         diff = np.degrees(np.max(np.abs(f[:, :2] - d[:, :2]), axis=1))
         tail = diff[int(0.9 * len(diff)):]
         rows[key] = {"max_diff_deg": float(np.max(diff)), "last_tenth_max_diff_deg":
                      float(np.max(tail)), "finite": bool(np.all(np.isfinite(f)))}
+    forget()  # a million samples need not stay in the process
     return rows
 
 

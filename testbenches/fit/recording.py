@@ -82,14 +82,20 @@ def load(path: str | Path, rate: float | None = None) -> Recording:
                      trial.sensor_delay)
 
 
-def _load_csv(path: Path, rate: float | None) -> Recording:
+def csv_header_rows(path: Path) -> tuple[list[str], list[list[str]]]:
+    """A CSV file's header (names stripped) and its non-empty rows; RecordingError for an empty
+    file."""
     with path.open(newline="") as fh:
         reader = csv.reader(fh)
         try:
             header = [h.strip() for h in next(reader)]
         except StopIteration:
             raise RecordingError(f"{path}: empty file") from None
-        rows = [r for r in reader if r]
+        return header, [r for r in reader if r]
+
+
+def _load_csv(path: Path, rate: float | None) -> Recording:
+    header, rows = csv_header_rows(path)
     missing = [c for c in IMU_COLUMNS if c not in header]
     if missing:
         raise RecordingError(

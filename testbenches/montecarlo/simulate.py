@@ -3,8 +3,8 @@
 By default through fusion_core: the scenario's truth (fusion_core.native.plant_truth, the C
 twin of the plant FMU, or the Python trajectory where there is no twin), the sensor model's
 batch run and the estimator's batch run (the C twins where built). A worker keeps the last
-scenarios' truth and the last seeds' samples: they do not depend on the estimator, and the
-plan puts the estimators of one seed next to each other. The data flow is the
+scenarios' truth and the last seeds' samples (testbenches.samples): they do not depend on the
+estimator, and the plan puts the estimators of one seed next to each other. The data flow is the
 testbench master's (docs/interface.md, Timing): the truth at t_k, the sensor's sample at t_k
 with dt = h, the estimate for that sample; so a run gives what the three FMUs give for the same
 seed, at the C twins' speed (tests/test_montecarlo.py compares them). With fmu=True the run is
@@ -13,8 +13,6 @@ the FMU testbench itself (testbenches.master.run_testbench through fmpy).
 
 from __future__ import annotations
 
-import functools
-import json
 import time
 from pathlib import Path
 from typing import Any
@@ -23,57 +21,16 @@ import numpy as np
 
 from fusion_core.registry import create
 from fusion_core.scenarios import get_scenario
-from fusion_core.sensor import ImuSensorModel
 from fusion_core.synthetic import TRUTH_NAMES
 
 from ..contract import compute_metrics
-from ..master import ESTIMATE, POSITION, SAMPLE, TestbenchResult, communication_steps
+from ..master import ESTIMATE, POSITION, SAMPLE, TestbenchResult
+from ..samples import RATE, scenario_samples
 from .plan import Run
 
-RATE = 100.0
-"""The campaign's sample rate [Hz], the contract's."""
 METRICS = ("rmse_roll_deg", "rmse_pitch_deg", "max_err_deg", "bias_err_dps", "invalid_samples",
            "samples")
 """The contract metrics each row keeps."""
-
-
-@functools.lru_cache(maxsize=16)
-def _truth(scenario_id: int, duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Steps, times and [N, 15] truth (TRUTH_NAMES' order) of a scenario: the plant's C twin,
-    or the Python trajectory. The truth depends on the scenario and the duration only, so a
-    worker computes it once for all its runs of that scenario (read-only arrays)."""
-    steps = communication_steps(duration, RATE, 0.0, 0)
-    t = np.cumsum(steps)
-    truth = get_scenario(scenario_id).truth(t)
-    for a in (steps, t, truth):
-        a.setflags(write=False)
-    return steps, t, truth
-
-
-@functools.lru_cache(maxsize=4)
-def _samples(scenario_id: int, duration: float, sensor_json: str) -> dict[str, np.ndarray]:
-    """The sensor's samples of a scenario for one parameter set (with its seed): the same for
-    every estimator of a seed, which the plan puts next to each other, so that a worker runs the
-    sensor once for them."""
-    steps, _, truth = _truth(scenario_id, duration)
-    out = ImuSensorModel(**json.loads(sensor_json)).run(truth[:, 3:6], truth[:, 6:9], steps)
-    for a in out.values():
-        a.setflags(write=False)
-    return out
-
-
-def scenario_samples(
-    scenario: str, seed: int, sensor: dict[str, Any], duration: float | None = None
-) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
-    """Times [N], truth [N, 15] (TRUTH_NAMES' order) and the sensor's samples (acc, gyro [N, 3],
-    dt [N], gyro_bias [N, 3]) of a scenario for one sensor parameter set and seed: what the
-    estimator FMUs get in the testbench for that seed (read-only arrays, shared by a worker's
-    runs)."""
-    sc = get_scenario(scenario)
-    duration = sc.duration if duration is None else float(duration)
-    _, t, truth = _truth(sc.id, duration)
-    sample = _samples(sc.id, duration, json.dumps({**sensor, "seed": seed}, sort_keys=True))
-    return t, truth, sample
 
 
 def _calibration(run: Run) -> dict[str, float]:
