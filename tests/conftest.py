@@ -108,9 +108,10 @@ def fmu_key(fmu_name: str) -> str:
 
 @pytest.fixture(scope="session")
 def fmu_recording() -> dict:
-    """10 s at 100 Hz: at rest, a two-axis tilt with a yaw turn and a 1 m move, at rest again;
-    MPU-6050 noise and a constant gyro bias, so that every state of every filter is busy
-    (bias estimates, the position filter's stationary queue)."""
+    """12 s at 100 Hz: at rest, a two-axis tilt with a yaw turn and a 1 m move, at rest again
+    for 5.5 s (the rest detector recognises a rest once its running means have settled after the
+    move, some 3 s after it); MPU-6050 noise and a constant gyro bias, so that every state of
+    every filter is busy (bias estimates, the position filter's stationary queue)."""
     from fusion_core import synthetic
 
     s = synthetic
@@ -121,7 +122,7 @@ def fmu_recording() -> dict:
         pos=(s.min_jerk(0.0, 1.0, 1.0, 3.0), s.min_jerk(0.0, -0.5, 2.0, 3.0), s.constant()),
     )
     noise = s.ImuNoise(gyro_bias=(0.01, -0.006, 0.004))
-    return s.record(trajectory, 9.99, 100.0, noise=noise, seed=7)
+    return s.record(trajectory, 11.99, 100.0, noise=noise, seed=7)
 
 
 @pytest.fixture(scope="session")

@@ -29,7 +29,7 @@ def test_outputs_equal_fusion_core_run(fmu_path, fmu_key, fmu_recording, fusion_
     ref = fusion_core_run(fmu_key, acc, gyro, dt)
     with FmuInstance(fmu_path) as fmu:
         out = fmu.run_samples(acc, gyro, dt)
-    assert len(out["roll"]) == len(acc) == 1000
+    assert len(out["roll"]) == len(acc) == 1200
     assert max_difference(out, ref, output_keys(fmu_key)) <= TOLERANCE
     assert np.all(out["invalid_samples"] == 0)
 

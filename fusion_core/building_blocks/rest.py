@@ -13,9 +13,10 @@ from .sampling import REAL_GYRO_DENSITY, Vec3
 
 class RestState(NamedTuple):
     """The rest detector's state: running means of the rate (wx, wy, wz) and of the specific
-    force (fx, fy, fz), the quiet time [s], and measured: 1.0 once a rest has lasted rest_time
-    (the bias has been measured), else 0.0. The C twin holds the same eight numbers in order
-    (double rest[8])."""
+    force (fx, fy, fz), the quiet time [s], measured: 1.0 once a rest has lasted rest_time (the
+    bias has been measured), else 0.0, and the mean specific force (ox, oy, oz) where the quiet
+    time had lasted REST_MEAN_TAU (REST_TURN). The C twin holds the same eleven numbers in order
+    (fc_real rest[FC_REST_SIZE])."""
 
     wx: float
     wy: float
@@ -25,23 +26,42 @@ class RestState(NamedTuple):
     fz: float
     quiet_time: float
     measured: float
+    ox: float
+    oy: float
+    oz: float
 
 
 _new = tuple.__new__
-REST_START: Final = RestState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+REST_START: Final = RestState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 """The rest detector's state before the first sample."""
 
 REST_MEAN_TAU: Final = 0.5
 """Time constant [s] of the running means the rest detector compares each sample with (VQF's
 restFilterTau)."""
 
+REST_TURN: Final = 0.1
+"""The share of rest_gyro by which the mean specific force may turn while a rest lasts: it must
+stay within REST_TURN * rest_gyro * rest_time [rad] (0.3 deg with VQF's thresholds) of its
+direction once the quiet time has lasted REST_MEAN_TAU. Until then the reference follows the
+mean, which is still settling from the motion before (a 0.5 s mean moves by a tenth of its lag
+over the next 1.2 s), so a rest right after a motion is recognised a second or so later than by
+the rate thresholds alone. A rest is where the gyro reads its own bias, and the bias it
+learns there is off by whatever the sensor still turns. The rate thresholds cannot tell a bias
+from a slow turn: near the ends of a slow swing (a ship's roll, an arm tilting at a few deg/s)
+the rate stays below rest_gyro for seconds, and the gyro's deviations from their running mean
+stay small throughout a smooth rotation. Gravity's direction can: a turn about any horizontal
+axis moves it. A tenth of the rate threshold bounds the bias error a rest may teach to a tenth of
+what VQF's rule alone admits, and is still some twenty times the noise of a 0.5 s mean of a
+consumer MEMS accelerometer (0.003 m/s^2 against 0.05). A turn about gravity itself stays
+invisible, and leaves roll and pitch alone."""
+
 REST_PARAMS: tuple[Param, ...] = (
     Param(
         "rest_time", 1.5,
         "Rest detection: after this long with the gyro and accelerometer within rest_gyro and "
-        "rest_acc of their running means (and the mean rate below rest_gyro) the sensor is at "
-        "rest, and the gyro, which then reads its own bias, updates the bias estimate. "
-        "0 = off (the papers)",
+        "rest_acc of their running means (the mean rate below rest_gyro, the mean specific "
+        "force not turning) the sensor is at rest, and the gyro, which then reads its own "
+        "bias, updates the bias estimate. 0 = off (the papers)",
         unit="s", low=0.0,
     ),
     Param(
@@ -80,8 +100,10 @@ taken less the filter's bias estimate, and before the first rest a mean rate the
 can explain (rest_bias_bound: the datasheet's 20 deg/s) may start one; a filter without a bias
 covariance then aligns at such a first rest (uncalibrated_first_rest). A rest under way lasts
 while the deviations stay small, so that the bias estimate can converge in it. A gyro calibrated
-at start-up never meets either rule: its outputs are those of VQF's rule to the last bit
-(tests/test_rest_detection.py)."""
+at start-up never meets the turn-on rule: its outputs are those of VQF's rule to the last bit
+wherever the sensor is still when the rates say so (tests/test_rest_detection.py). Where it is
+not (a slow swing), gravity's direction turns, and a rest, starting or under way, ends
+(REST_TURN)."""
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
@@ -100,7 +122,7 @@ def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
 def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
     """The rest detector's state at the first sample: its means start at that sample, quiet time
     0, the bias not measured yet."""
-    return _new(RestState, (gx, gy, gz, ax, ay, az, 0.0, 0.0))
+    return _new(RestState, (gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az))
 
 
 def rest_step(
@@ -110,9 +132,10 @@ def rest_step(
     """One step of the rest detector (REST_PARAMS); bias: the filter's gyro bias estimate in the
     frame of g; returns the new RestState. The caller compares its quiet_time with rest_time.
     Outside a rest the mean rate less the bias must be below th_gyro (plus bound until a first
-    rest has measured the bias); a rest under way lasts while the rate and the specific force stay
-    within their thresholds of their running means."""
-    wx, wy, wz, fx, fy, fz, quiet, measured = rest
+    rest has measured the bias); a rest, starting or under way, lasts while the rate and the
+    specific force stay within their thresholds of their running means and the mean specific
+    force within REST_TURN of its direction early in the quiet time."""
+    wx, wy, wz, fx, fy, fz, quiet, measured, ox, oy, oz = rest
     k = dt / (REST_MEAN_TAU + dt)
     wx += k * (gx - wx)
     wy += k * (gy - wy)
@@ -124,13 +147,19 @@ def rest_step(
     dx, dy, dz = gx - wx, gy - wy, gz - wz
     ex, ey, ez = ax - fx, ay - fy, az - fz
     still = dx * dx + dy * dy + dz * dz < th_g2 and ex * ex + ey * ey + ez * ez < th_acc * th_acc
+    if still and quiet >= REST_MEAN_TAU:  # gravity's direction has not turned (REST_TURN)
+        ex, ey, ez = fx - ox, fy - oy, fz - oz
+        turn = REST_TURN * th_gyro * rest_time
+        still = ex * ex + ey * ey + ez * ez < turn * turn * (fx * fx + fy * fy + fz * fz)
     if still and quiet < rest_time:  # only a mean rate the bias explains may start a rest
         mx, my, mz = wx - bias[0], wy - bias[1], wz - bias[2]
         lim = th_gyro + bound if measured == 0.0 else th_gyro
         still = mx * mx + my * my + mz * mz < lim * lim
+    if still and quiet < REST_MEAN_TAU:  # the mean settles: the reference follows it
+        ox, oy, oz = fx, fy, fz
     quiet = quiet + dt if still else 0.0
     return _new(RestState, (wx, wy, wz, fx, fy, fz, quiet,
-                            (1.0 if quiet >= rest_time else measured)))
+                            (1.0 if quiet >= rest_time else measured), ox, oy, oz))
 
 
 def first_rest(measured_before: float, rest: RestState) -> bool:

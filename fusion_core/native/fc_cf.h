@@ -15,7 +15,7 @@ typedef struct fc_cf {
     fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
     fc_real q_att[4];
     fc_real bias[3];
-    fc_real rest[8];
+    fc_real rest[FC_REST_SIZE];
     fc_estimate last;
     /* derived from params (ComplementaryFilter._configure) */
     fc_real tau, gate_low2, gate_high2, acc_tau;

@@ -368,7 +368,7 @@ void fc_measure_clipped(fc_real m[FC_MEAS_SIZE])
     m[FC_MEAS_SETTLE] = 0.0;
 }
 
-void fc_rest_start(fc_real rest[8], const fc_real gyro[3], const fc_real acc[3])
+void fc_rest_start(fc_real rest[FC_REST_SIZE], const fc_real gyro[3], const fc_real acc[3])
 {
     rest[0] = gyro[0];
     rest[1] = gyro[1];
@@ -378,14 +378,17 @@ void fc_rest_start(fc_real rest[8], const fc_real gyro[3], const fc_real acc[3])
     rest[5] = acc[2];
     rest[6] = 0.0;
     rest[7] = 0.0;
+    rest[8] = acc[0];
+    rest[9] = acc[1];
+    rest[10] = acc[2];
 }
 
-void fc_rest_step(fc_real rest[8], fc_real gx, fc_real gy, fc_real gz, fc_real ax, fc_real ay,
-                  fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro, fc_real th_acc,
-                  fc_real rest_time, fc_real bound)
+void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz, fc_real ax,
+                  fc_real ay, fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro,
+                  fc_real th_acc, fc_real rest_time, fc_real bound)
 {
     fc_real wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
-    fc_real quiet = rest[6], measured = rest[7];
+    fc_real quiet = rest[6], measured = rest[7], ox = rest[8], oy = rest[9], oz = rest[10];
     fc_real k = dt / (FC_REST_MEAN_TAU + dt);
     wx += k * (gx - wx);
     wy += k * (gy - wy);
@@ -398,10 +401,22 @@ void fc_rest_step(fc_real rest[8], fc_real gx, fc_real gy, fc_real gz, fc_real a
     fc_real ex = ax - fx, ey = ay - fy, ez = az - fz;
     int still = dx * dx + dy * dy + dz * dz < th_g2
         && ex * ex + ey * ey + ez * ez < th_acc * th_acc;
+    if (still && quiet >= FC_REST_MEAN_TAU) {  /* gravity's direction has not turned */
+        ex = fx - ox;
+        ey = fy - oy;
+        ez = fz - oz;
+        fc_real turn = FC_REST_TURN * th_gyro * rest_time;
+        still = ex * ex + ey * ey + ez * ez < turn * turn * (fx * fx + fy * fy + fz * fz);
+    }
     if (still && quiet < rest_time) {  /* only a mean rate the bias explains may start a rest */
         fc_real mx = wx - bias[0], my = wy - bias[1], mz = wz - bias[2];
         fc_real lim = measured == 0.0 ? th_gyro + bound : th_gyro;
         still = mx * mx + my * my + mz * mz < lim * lim;
+    }
+    if (still && quiet < FC_REST_MEAN_TAU) {  /* the mean settles: the reference follows it */
+        ox = fx;
+        oy = fy;
+        oz = fz;
     }
     quiet = still ? quiet + dt : 0.0;
     rest[0] = wx;
@@ -412,15 +427,18 @@ void fc_rest_step(fc_real rest[8], fc_real gx, fc_real gy, fc_real gz, fc_real a
     rest[5] = fz;
     rest[6] = quiet;
     rest[7] = quiet >= rest_time ? 1.0 : measured;
+    rest[8] = ox;
+    rest[9] = oy;
+    rest[10] = oz;
 }
 
-int fc_first_rest(fc_real measured_before, const fc_real rest[8])
+int fc_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE])
 {
     return measured_before == 0.0 && rest[7] != 0.0;
 }
 
-int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[8], const fc_real bias[3],
-                               fc_real th_gyro)
+int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE],
+                               const fc_real bias[3], fc_real th_gyro)
 {
     if (!fc_first_rest(measured_before, rest)) {
         return 0;
@@ -429,8 +447,8 @@ int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[8], c
     return mx * mx + my * my + mz * mz >= th_gyro * th_gyro;
 }
 
-void fc_rest_alignment(const fc_real rest[8], fc_real bias[3], fc_real *roll, fc_real *pitch,
-                       fc_real f[3])
+void fc_rest_alignment(const fc_real rest[FC_REST_SIZE], fc_real bias[3], fc_real *roll,
+                       fc_real *pitch, fc_real f[3])
 {
     f[0] = rest[3];
     f[1] = rest[4];
@@ -450,9 +468,10 @@ void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_rea
     bias[2] = bias[2] + k * (gz - bias[2]);
 }
 
-int fc_complementary_rest(fc_real rest[8], fc_real bias[3], const fc_real g[3], const fc_real a[3],
-                          fc_real dt, fc_real rest_time, fc_real rest_gyro, fc_real rest_acc,
-                          fc_real bound, fc_real *roll, fc_real *pitch, fc_real f[3])
+int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],
+                          const fc_real a[3], fc_real dt, fc_real rest_time, fc_real rest_gyro,
+                          fc_real rest_acc, fc_real bound, fc_real *roll, fc_real *pitch,
+                          fc_real f[3])
 {
     fc_real measured = rest[7];
     fc_rest_step(rest, g[0], g[1], g[2], a[0], a[1], a[2], bias, dt, rest_gyro, rest_acc,

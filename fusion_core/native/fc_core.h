@@ -80,6 +80,8 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 #define FC_REST_MEAN_TAU 0.5
+#define FC_REST_TURN 0.1
+#define FC_REST_SIZE 11  /* building_blocks.RestState */
 #define FC_SLOWEST_CORRECTION 1e9
 #define FC_FACE_SWITCH_COS 0.5
 extern const fc_real FC_FACES[6][9];
@@ -136,26 +138,27 @@ void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3]);
 
 /* The rest detector's state at the first sample: its means start at that sample, quiet 0, the
  * bias not measured yet. */
-void fc_rest_start(fc_real rest[8], const fc_real gyro[3], const fc_real acc[3]);
+void fc_rest_start(fc_real rest[FC_REST_SIZE], const fc_real gyro[3], const fc_real acc[3]);
 /* rest_step: bias is the filter's gyro bias estimate in the frame of g */
-void fc_rest_step(fc_real rest[8], fc_real gx, fc_real gy, fc_real gz, fc_real ax, fc_real ay,
-                  fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro, fc_real th_acc,
-                  fc_real rest_time, fc_real bound);
+void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz, fc_real ax,
+                  fc_real ay, fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro,
+                  fc_real th_acc, fc_real rest_time, fc_real bound);
 /* first_rest: measured_before is rest[7] before this sample's fc_rest_step */
-int fc_first_rest(fc_real measured_before, const fc_real rest[8]);
+int fc_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE]);
 /* uncalibrated_first_rest: measured_before is rest[7] before this sample's fc_rest_step */
-int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[8], const fc_real bias[3],
-                               fc_real th_gyro);
+int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE],
+                               const fc_real bias[3], fc_real th_gyro);
 /* rest_alignment: bias, roll, pitch and the specific force f from the rest's means */
-void fc_rest_alignment(const fc_real rest[8], fc_real bias[3], fc_real *roll, fc_real *pitch,
-                       fc_real f[3]);
+void fc_rest_alignment(const fc_real rest[FC_REST_SIZE], fc_real bias[3], fc_real *roll,
+                       fc_real *pitch, fc_real f[3]);
 void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
                      fc_real rest_time);
 /* complementary_rest: the rest detection of cf and mgcf, one sample; returns 1 where they
  * aligned (*roll, *pitch and f, the specific force the vector starts again from, set), else 0 */
-int fc_complementary_rest(fc_real rest[8], fc_real bias[3], const fc_real g[3], const fc_real a[3],
-                          fc_real dt, fc_real rest_time, fc_real rest_gyro, fc_real rest_acc,
-                          fc_real bound, fc_real *roll, fc_real *pitch, fc_real f[3]);
+int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],
+                          const fc_real a[3], fc_real dt, fc_real rest_time, fc_real rest_gyro,
+                          fc_real rest_acc, fc_real bound, fc_real *roll, fc_real *pitch,
+                          fc_real f[3]);
 void fc_bias_band2(fc_real gate, fc_real *lo, fc_real *hi);
 int fc_nearest_face(fc_real ux, fc_real uy, fc_real uz);
 void fc_mat_vec(const fc_real m[9], const fc_real v[3], fc_real out[3]);

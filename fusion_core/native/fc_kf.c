@@ -267,16 +267,11 @@ static void switch_face(fc_kf *f)
         TURN(f->meas + v, turned);
         memcpy(f->meas + v, turned, sizeof turned);
     }
-    fc_real w[3] = {f->rest[0], f->rest[1], f->rest[2]}, sf[3] = {f->rest[3], f->rest[4], f->rest[5]};
-    fc_real w2[3], sf2[3];
-    TURN(w, w2);
-    TURN(sf, sf2);
-    f->rest[0] = w2[0];
-    f->rest[1] = w2[1];
-    f->rest[2] = w2[2];
-    f->rest[3] = sf2[0];
-    f->rest[4] = sf2[1];
-    f->rest[5] = sf2[2];
+    for (int v = 0; v < FC_REST_SIZE; v += v == 3 ? 5 : 3) {  /* rates, means, start's mean */
+        fc_real turned[3];
+        TURN(f->rest + v, turned);
+        memcpy(f->rest + v, turned, sizeof turned);
+    }
 #undef TURN
     fc_real old[3][4];
     memcpy(old[0], f->P_roll, sizeof old[0]);

@@ -16,7 +16,7 @@ typedef struct fc_kf {
     fc_real P_roll[4], P_pitch[4];   /* [P00, P01, P10, P11] of each axis */
     fc_real bias_z, P_z;
     fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
-    fc_real rest[8];
+    fc_real rest[FC_REST_SIZE];
     fc_real q_att[4];
     int face;
     fc_real gain_roll[2], gain_pitch[2];  /* the last update's gains (diagnostics) */

@@ -15,7 +15,7 @@ typedef struct fc_mgcf {
     fc_real bias[3];
     fc_real w0_now;
     fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
-    fc_real rest[8];
+    fc_real rest[FC_REST_SIZE];
     fc_estimate last;
     /* derived from params (GainScheduledComplementaryFilter._configure) */
     fc_real w0, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;

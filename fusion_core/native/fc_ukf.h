@@ -18,7 +18,7 @@ typedef struct fc_ukf {
     fc_real x[6];      /* X (the gravity direction, 3), b (the gyro bias, 3) */
     fc_real P[21];     /* the covariance's lower triangle, row by row */
     fc_real meas[FC_MEAS_SIZE];  /* the measured vector (acc_lowpass > 0; measured_vector) */
-    fc_real rest[8];
+    fc_real rest[FC_REST_SIZE];
     fc_estimate last;
     /* derived from params (UnscentedKalmanFilter._configure) */
     fc_real gamma, w, w_mu, q_gyro, q_bias, r_acc;
