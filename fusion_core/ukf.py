@@ -23,6 +23,7 @@ from .building_blocks import (
     bias_band2,
     body_rotation,
     first_rest,
+    rest_mean_share,
     rest_start,
     rest_step,
     zero_rate_psd_param,
@@ -60,6 +61,16 @@ ACC_GATE: Final = 1.0
 either."""
 
 
+def rest_covariance(P: tuple[float, ...], p_x: float) -> tuple[float, ...]:
+    """The packed lower triangle P of [X, b] with X's block p_x I and no covariance between X
+    and the bias: X just taken from a rest's mean (variance p_x per axis), the bias block kept."""
+    out = list(P)
+    for i in (1, 3, 4, 6, 7, 8, 10, 11, 12, 15, 16, 17):  # X's off-diagonals, X with b
+        out[i] = 0.0
+    out[0] = out[2] = out[5] = p_x
+    return tuple(out)
+
+
 class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     """The recommended UKF on the gravity direction with three gyro-bias states (Duong Quoc et
     al. eq. 14-17).
@@ -78,7 +89,9 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     it grows Q, no bias is learned), rest detection with a zero-rate update of the bias states
     (rest_time > 0), and the bias learned only while the raw sample is within bias_gate of g,
     the measured and the predicted gravity direction within bias_innovation and the measured
-    vector settled (else the biases are consider states).
+    vector settled (else the biases are consider states). While the measured vector fills, X
+    is its direction, and at the first rest the rest's mean direction with that mean's
+    variance and no covariance with the bias, as in the kf (kalman.AngleBiasKalmanFilter).
     No unit-norm pseudo-measurement (the paper's |X|^2 = 1 row): X is renormalised after every
     update, so |X|^2 = 1 tells the filter nothing about X, but the unscented transform of |X|^2
     reacts to the sigma points' spread (points X +- gamma s with s across X lie gamma^2 |s|^2 off
@@ -203,7 +216,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
             # no bias from a vector that is filling (a mean of the first samples, of a motion's
             # start as likely as of rest) or holds turns the gyro did not measure (gyro_range)
             learn_bias = learn_bias and not filling and self.meas.settled(self._measure)
-            self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r)
+            self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r, filling)
         else:
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
         if p["rest_time"] > 0.0 and not clipped:
@@ -215,11 +228,12 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
             if p["acc_lowpass"] > 0.0 and first_rest(measured, self.rest):
                 # the measured vector was turned with a bias not measured yet: it starts again
                 # from the rest's mean specific force (measured_vector.measure_restarted), X
-                # from its direction
+                # from its direction, as sure of it as that mean is (and independent of the bias)
                 f = (self.rest.fx, self.rest.fy, self.rest.fz)
                 self.meas = measure_restarted(self.meas, f)
                 n = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
                 self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
+                self._P = rest_covariance(self._P, p["acc_noise"] ** 2 * rest_mean_share(dt))
             if self.rest.quiet_time >= p["rest_time"]:
                 self._zero_rate_update((gx, gy, gz), p["zaru_psd"] / dt)
 
@@ -256,13 +270,15 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
 
     def _filter_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float,
-        learn_bias: bool, r: float | None = None,
+        learn_bias: bool, r: float | None = None, aligning: bool = False,
     ) -> None:
         """One sample of the paper's UKF (eq. 14-17) with the recommended noise: predict
         (rotation_terms, sigma_predict), the process noise with the gyro's scale uncertainty
         and the rate beyond a rail (predicted_covariance), then the update with f/g
         (measurement_update; the bias states as consider states unless learn_bias) of variance
-        r per axis, at most max_correction_time's (acc_noise^2 unless given)."""
+        r per axis, at most max_correction_time's (acc_noise^2 unless given); aligning: the
+        measured vector still fills, and X is its direction instead (as the other filters'
+        attitude is its tilt then)."""
         x = self.x
         b0, b1, b2 = x[3], x[4], x[5]
         terms = rotation_terms(self.gyro_prev, (gx, gy, gz), dt, self._trapezoid)
@@ -280,7 +296,9 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         P = predicted_covariance(pred, self._P, (X0 * inv, X1 * inv, X2 * inv), q_gyro * dt,
                                  self._q_bias * dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
-        if abs(norm / G - 1.0) < ACC_GATE and norm > 0.0:
+        if abs(norm / G - 1.0) < ACC_GATE and norm > 0.0 and aligning:
+            X0, X1, X2, n = ax, ay, az, norm
+        elif abs(norm / G - 1.0) < ACC_GATE and norm > 0.0:
             if ax * X0 + ay * X1 + az * X2 < self._cos_innovation * norm * n:
                 learn_bias = False  # grossly off: X only (bias_innovation)
             if r is None:

@@ -194,14 +194,15 @@ def test_the_gain_grows_with_the_rate_by_the_scale_uncertainty(scale_std: float)
     covariance prediction with the rotation term, and the gain P00 / (P00 + R) (the reference;
     the C twin is held to it by tests/test_native.py)."""
     dt, w, T = 0.01, 2.0, 0.5
-    kf = AngleBiasKalmanFilter(gyro_scale_std=scale_std, scale_time=T, rest_time=0.0)
+    # the raw sample (acc_lowpass 0): a measured vector still fills at the second sample, and
+    # the filter then takes its tilt instead of an update
+    kf = AngleBiasKalmanFilter(gyro_scale_std=scale_std, scale_time=T, rest_time=0.0,
+                               acc_lowpass=0.0)
     acc, gyro = np.array([[0.0, 0.0, G]] * 2), np.array([[0.0, 0.0, 0.0], [w, 0.0, 0.0]])
     kf.run(acc, gyro, dt, backend="python")
     p = kf.params
     P00 = p["R_measure"] + dt * (dt * p["init_bias_std"] ** 2 + p["Q_angle"]
                                  + scale_std**2 * w**2 * T)
-    # R: the step's measurement noise (the measured vector's, R_measure plus what little of the
-    # turn the slow band shows)
     assert kf.gain_roll[0] == pytest.approx(P00 / (P00 + kf.r_step), rel=1e-12)
 
 

@@ -119,6 +119,14 @@ def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
     )
 
 
+def rest_mean_share(dt: float) -> float:
+    """The share of one sample's white-noise variance left in the rest detector's running mean
+    (time constant REST_MEAN_TAU, gain k = dt / (REST_MEAN_TAU + dt)): k / (2 - k). A filter
+    that takes its tilt from a rest's mean specific force is that sure of it."""
+    k = dt / (REST_MEAN_TAU + dt)
+    return k / (2.0 - k)
+
+
 def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
     """The rest detector's state at the first sample: its means start at that sample, quiet time
     0, the bias not measured yet."""

@@ -432,6 +432,12 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
     rest[10] = oz;
 }
 
+fc_real fc_rest_mean_share(fc_real dt)
+{
+    fc_real k = dt / (FC_REST_MEAN_TAU + dt);
+    return k / (2.0 - k);
+}
+
 int fc_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE])
 {
     return measured_before == 0.0 && rest[7] != 0.0;

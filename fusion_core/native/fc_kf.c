@@ -174,9 +174,17 @@ static void zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], f
     fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], b, dt, f->rest_gyro, f->rest_acc,
                  f->rest_time, f->rest_bias_bound);
     if (f->acc_tau > 0.0 && fc_first_rest(measured, f->rest)) {
-        /* the measured vector starts again from the rest's mean, the angles from its tilt */
+        /* the measured vector starts again from the rest's mean, the angles from its tilt, as
+         * sure of them as that mean is (and independent of the bias) */
         fc_measure_restart(f->meas, f->rest + 3);
         fc_accel_roll_pitch(f->rest[3], f->rest[4], f->rest[5], &f->roll, &f->pitch);
+        fc_real p = f->r * fc_rest_mean_share(dt);
+        f->P_roll[0] = p;
+        f->P_roll[1] = 0.0;
+        f->P_roll[2] = 0.0;
+        f->P_pitch[0] = p;
+        f->P_pitch[1] = 0.0;
+        f->P_pitch[2] = 0.0;
     }
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
@@ -215,8 +223,8 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     if (f->rest_time > 0.0 && !clipped) {
         zero_rate_update(f, a, g, dt);
     }
+    int filling = 0;
     if (f->acc_tau > 0.0) {
-        int filling;
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
@@ -233,7 +241,11 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     }
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        correct(f, a[0], a[1], a[2], learn_bias);
+        if (filling) {  /* the vector still fills: the attitude is its tilt */
+            fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
+        } else {
+            correct(f, a[0], a[1], a[2], learn_bias);
+        }
     }
     if (f->roll != pred_roll || f->pitch != pred_pitch) {
         fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);

@@ -114,9 +114,10 @@ static void zero_rate_update(fc_ukf *f, const fc_real z[3], fc_real r)
 }
 
 /* _filter_update: one sample of the paper's UKF (eq. 14-17) with the recommended noise; capped:
- * r is the measured vector's, at most max_correction_time's */
+ * r is the measured vector's, at most max_correction_time's; aligning: the vector still fills,
+ * X is its direction */
 static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const fc_real g[3],
-                          fc_real dt, int learn_bias, fc_real r, int capped)
+                          fc_real dt, int learn_bias, fc_real r, int capped, int aligning)
 {
     fc_real b[3] = {f->x[3], f->x[4], f->x[5]};
     fc_real terms[6];
@@ -138,7 +139,12 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
     fc_paper_ukf_predicted_covariance(&pred, f->P, h, q_gyro * dt, f->q_bias * dt, P);
     fc_real x[6] = {X0, X1, X2, b[0], b[1], b[2]};
     fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
-    if (fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0) {
+    if (fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0 && aligning) {
+        x[0] = ax;
+        x[1] = ay;
+        x[2] = az;
+        n = norm;
+    } else if (fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0) {
         if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
             learn_bias = 0;  /* grossly off: X only (bias_innovation) */
         }
@@ -160,6 +166,19 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
     memcpy(f->P, P, sizeof P);
 }
 
+/* rest_covariance: X's block p_x I, no covariance between X and the bias (packed lower
+ * triangle of [X, b]) */
+static void rest_covariance(fc_real P[21], fc_real p_x)
+{
+    static const int zero[12] = {1, 3, 4, 6, 7, 8, 10, 11, 12, 15, 16, 17};
+    for (int i = 0; i < 12; i++) {
+        P[zero[i]] = 0.0;
+    }
+    P[0] = p_x;
+    P[2] = p_x;
+    P[5] = p_x;
+}
+
 static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
     const fc_ukf_params *p = &f->params;
@@ -179,22 +198,24 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
         /* no bias from a vector that is filling or holds turns the gyro did not measure */
         learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
         const fc_real *m = f->meas + FC_MEAS_F;
-        filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1);
+        filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1, filling);
     } else {
-        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0);
+        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0, 0);
     }
     if (p->rest_time > 0.0 && !clipped) {
         fc_real measured = f->rest[7];
         fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], &f->x[3], dt, p->rest_gyro,
                      p->rest_acc, p->rest_time, p->rest_bias_bound);
         if (p->acc_lowpass > 0.0 && fc_first_rest(measured, f->rest)) {
-            /* the measured vector starts again from the rest's mean, X from its direction */
+            /* the measured vector starts again from the rest's mean, X from its direction, as
+             * sure of it as that mean is (and independent of the bias) */
             const fc_real *m = f->rest + 3;
             fc_measure_restart(f->meas, m);
             fc_real n = fc_sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
             f->x[0] = m[0] / n;
             f->x[1] = m[1] / n;
             f->x[2] = m[2] / n;
+            rest_covariance(f->P, fc_pow(p->acc_noise, 2.0) * fc_rest_mean_share(dt));
         }
         if (f->rest[6] >= p->rest_time) {
             zero_rate_update(f, g, p->zaru_psd / dt);
