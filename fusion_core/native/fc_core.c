@@ -289,7 +289,7 @@ void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
     }
 }
 
-static fc_real two_stage_noise(fc_real k)
+fc_real fc_two_stage_noise(fc_real k)
 {
     fc_real a2 = (1.0 - k) * (1.0 - k);
     fc_real d = 1.0 - a2;
@@ -336,7 +336,7 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             fc_real inst = e0 * e0 + e1 * e1 + e2 * e2;
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
-            fc_real excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
+            fc_real excess = m[FC_MEAS_SLOW] - c->noise * fc_two_stage_noise(dt / (c->band + dt));
             if (excess > 0.0) {
                 r += excess / (FC_G * FC_G);
             }

@@ -122,6 +122,8 @@ void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
 /* measure_step: one sample a; returns the measurement noise r [rad^2], *filling whether the
  * vector is still filling */
+/* two_stage_noise: the share of white variance two first-order stages of gain k pass */
+fc_real fc_two_stage_noise(fc_real k);
 fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
                        const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
                        int *filling);

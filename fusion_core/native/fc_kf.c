@@ -220,10 +220,13 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     /* the raw sample, before the pre-filter (bias_gate); never a sample at the rail */
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
+    fc_real measured = f->rest[7];
     if (f->rest_time > 0.0 && !clipped) {
         zero_rate_update(f, a, g, dt);
     }
+    int rested = fc_first_rest(measured, f->rest);  /* the angles are the first rest's tilt */
     int filling = 0;
+    fc_real r_meas = f->r;
     if (f->acc_tau > 0.0) {
         if (clipped) {
             fc_measure_clipped(f->meas);
@@ -233,6 +236,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
          * the longest correction time */
         fc_real base = f->r;
         r = base + (r - f->measure.r);
+        r_meas = r;
         fc_real cap = f->q_step * f->longest2 / dt;
         f->r_step = r < cap ? r : (cap > base ? cap : base);
         /* no bias from a vector that is filling or holds turns the gyro did not measure */
@@ -241,8 +245,22 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     }
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        if (filling) {  /* the vector still fills: the attitude is its tilt */
+        if (filling && rested) {
+            /* the rest's mean, not turned by any gyro error, is the better tilt */
+        } else if (filling) {  /* the vector still fills: the attitude is its tilt, as uncertain */
             fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
+            fc_real fill = f->meas[FC_MEAS_FILL];
+            fc_real k = dt / (0.5 * fill + dt);
+            fc_real age = 0.5 * fill;
+            fc_real white = f->r * fc_two_stage_noise(k) + (r_meas - f->r);
+            fc_real c = -f->P_roll[3] * age;
+            f->P_roll[0] = white + f->P_roll[3] * age * age;
+            f->P_roll[1] = c;
+            f->P_roll[2] = c;
+            c = -f->P_pitch[3] * age;
+            f->P_pitch[0] = white + f->P_pitch[3] * age * age;
+            f->P_pitch[1] = c;
+            f->P_pitch[2] = c;
         } else {
             correct(f, a[0], a[1], a[2], learn_bias);
         }
