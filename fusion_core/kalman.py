@@ -98,6 +98,17 @@ def angle_only_gain(
     return (K0, 0.0), (P00 - K0 * P00, P01 - K0 * P01, P10 - K0 * P10, P11)
 
 
+def measured_axis(P: tuple[float, float, float, float], var: float, age: float
+                  ) -> tuple[float, float, float, float]:
+    """An axis's covariance once its angle is set from a measurement of variance var whose
+    samples were turned by the gyro over age [s] on average (0: a rest's mean, not turned): a
+    bias error b turned them by -b age, so the angle's variance is var + P11 age^2 and its
+    covariance with the bias -age P11, as the propagation's is -t P11; P11 stays."""
+    P11 = P[3]
+    c = 0.0 - P11 * age
+    return (var + P11 * age * age, c, c, P11)
+
+
 class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     """The recommended 2-state [angle, gyro bias] Kalman filter for roll and for pitch.
 
@@ -317,10 +328,9 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         lo, hi = self._bias_band2
         # the raw sample, before the pre-filter (bias_gate); never a sample at the rail
         learn_bias = lo < raw2 < hi and not clipped
-        measured = self.rest.measured
-        if self._rest_cfg[0] > 0.0 and not clipped:  # rest_time
-            self._zero_rate_update(ax, ay, az, gx, gy, gz, dt)
-        rested = first_rest(measured, self.rest)  # the angles are the first rest's tilt
+        # at a first rest the angles are its tilt (_zero_rate_update)
+        rested = (self._rest_cfg[0] > 0.0 and not clipped
+                  and self._zero_rate_update(ax, ay, az, gx, gy, gz, dt))
         filling = False
         if self._acc_tau > 0.0:
             m = measure_clipped(self.meas) if clipped else self.meas
@@ -337,39 +347,36 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             learn_bias = learn_bias and not filling and self.meas.settled(self._measure)
             ax, ay, az = self.meas.f
         if self.accel_trusted(ax * ax + ay * ay + az * az):
-            if filling and rested:
-                pass  # the rest's mean, not turned by any gyro error, is the better tilt
-            elif filling:  # the vector still fills: the attitude is its tilt (as cf's and mgcf's)
+            if not filling:
+                self.correct(ax, ay, az, learn_bias)
+            elif not rested:  # (a first rest's mean, which no gyro error turned, stands)
+                # the vector still fills: the attitude is its tilt (as cf's and mgcf's), as
+                # uncertain as that vector: one sample's variance over the samples so far (each
+                # stage half the time since the start) plus the disturbance that reaches it,
+                # the samples turned over half the fill on average (measured_axis)
                 self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
-                # and as uncertain as that vector: one sample's variance over the samples so far
-                # (each stage half the time since the start), the disturbance that reaches it,
-                # and the turn a bias error gives it over its samples' mean age, which ties
-                # its error to the bias's (cov -age P11, as the propagation's -t P11)
                 k = dt / (0.5 * self.meas.fill + dt)
                 age = 0.5 * self.meas.fill
-                white = self._r * two_stage_noise(k) + (r - self._r)
-                P = self.P_roll
-                c = -P[3] * age
-                self.P_roll = (white + P[3] * age * age, c, c, P[3])
-                P = self.P_pitch
-                c = -P[3] * age
-                self.P_pitch = (white + P[3] * age * age, c, c, P[3])
-            else:
-                self.correct(ax, ay, az, learn_bias)
+                var = self._r * two_stage_noise(k) + (r - self._r)
+                self.P_roll = measured_axis(self.P_roll, var, age)
+                self.P_pitch = measured_axis(self.P_pitch, var, age)
         if (self.roll, self.pitch) != predicted:
             self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
 
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> None:
+    ) -> bool:
         """Rest detection; at rest the gyro sample measures the bias (variance gyro_psd/dt):
-        the x and y biases through the [angle, bias] filters, bias_z through its own state."""
+        the x and y biases through the [angle, bias] filters, bias_z through its own state.
+        Returns whether this sample is the first rest's, which set the angles (with the
+        measured vector)."""
         rest_time, rest_gyro, rest_acc, gyro_var, bound = self._rest_cfg
         measured = self.rest.measured
         bias = (self.bias_x, self.bias_y, self.bias_z)
         self.rest = rest_step(self.rest, gx, gy, gz, ax, ay, az, bias, dt, rest_gyro, rest_acc,
                               rest_time, bound)
-        if self._acc_tau > 0.0 and first_rest(measured, self.rest):
+        rested = self._acc_tau > 0.0 and first_rest(measured, self.rest)
+        if rested:
             # the measured vector was turned with a bias not measured yet: it starts again from
             # the rest's mean specific force (measured_vector.measure_restarted), the angles
             # from its tilt, as sure of them as that mean is (and independent of the bias)
@@ -377,8 +384,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             self.meas = measure_restarted(self.meas, f)
             self.roll, self.pitch = accel_roll_pitch(*f)
             p = self._r * rest_mean_share(dt)
-            self.P_roll = (p, 0.0, 0.0, self.P_roll[3])
-            self.P_pitch = (p, 0.0, 0.0, self.P_pitch[3])
+            self.P_roll = measured_axis(self.P_roll, p, 0.0)
+            self.P_pitch = measured_axis(self.P_pitch, p, 0.0)
         self.P_z += self._q_bias * dt
         if self.rest.quiet_time >= rest_time:
             r = gyro_var / dt
@@ -386,6 +393,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             k = self.P_z / (self.P_z + r)
             self.bias_z += k * (gz - self.bias_z)
             self.P_z -= k * self.P_z
+        return rested
 
     def propagate(
         self, gx: float, gy: float, gz: float, dt: float, phi: Vec3,

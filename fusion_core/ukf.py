@@ -296,9 +296,10 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         P = predicted_covariance(pred, self._P, (X0 * inv, X1 * inv, X2 * inv), q_gyro * dt,
                                  self._q_bias * dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
-        if abs(norm / G - 1.0) < ACC_GATE and norm > 0.0 and aligning:
+        gate = abs(norm / G - 1.0) < ACC_GATE and norm > 0.0
+        if gate and aligning:  # the vector still fills: X is its direction
             X0, X1, X2, n = ax, ay, az, norm
-        elif abs(norm / G - 1.0) < ACC_GATE and norm > 0.0:
+        elif gate:
             if ax * X0 + ay * X1 + az * X2 < self._cos_innovation * norm * n:
                 learn_bias = False  # grossly off: X only (bias_innovation)
             if r is None:

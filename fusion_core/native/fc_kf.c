@@ -167,24 +167,32 @@ static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias
 }
 
 /* _zero_rate_update: at rest the gyro measures the bias */
-static void zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
+/* measured_axis: the covariance once the angle is set from a measurement of variance var whose
+ * samples the gyro turned over age [s] on average */
+static void measured_axis(fc_real P[4], fc_real var, fc_real age)
+{
+    fc_real c = 0.0 - P[3] * age;
+    P[0] = var + P[3] * age * age;
+    P[1] = c;
+    P[2] = c;
+}
+
+/* _zero_rate_update: returns whether this sample is the first rest's, which set the angles */
+static int zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
     fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
     fc_real measured = f->rest[7];
     fc_rest_step(f->rest, g[0], g[1], g[2], a[0], a[1], a[2], b, dt, f->rest_gyro, f->rest_acc,
                  f->rest_time, f->rest_bias_bound);
-    if (f->acc_tau > 0.0 && fc_first_rest(measured, f->rest)) {
+    int rested = f->acc_tau > 0.0 && fc_first_rest(measured, f->rest);
+    if (rested) {
         /* the measured vector starts again from the rest's mean, the angles from its tilt, as
          * sure of them as that mean is (and independent of the bias) */
         fc_measure_restart(f->meas, f->rest + 3);
         fc_accel_roll_pitch(f->rest[3], f->rest[4], f->rest[5], &f->roll, &f->pitch);
         fc_real p = f->r * fc_rest_mean_share(dt);
-        f->P_roll[0] = p;
-        f->P_roll[1] = 0.0;
-        f->P_roll[2] = 0.0;
-        f->P_pitch[0] = p;
-        f->P_pitch[1] = 0.0;
-        f->P_pitch[2] = 0.0;
+        measured_axis(f->P_roll, p, 0.0);
+        measured_axis(f->P_pitch, p, 0.0);
     }
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
@@ -194,6 +202,7 @@ static void zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], f
         f->bias_z += k * (g[2] - f->bias_z);
         f->P_z -= k * f->P_z;
     }
+    return rested;
 }
 
 /* _update, in the filters' frame; prev: the previous gyro sample there */
@@ -220,11 +229,8 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     /* the raw sample, before the pre-filter (bias_gate); never a sample at the rail */
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
-    fc_real measured = f->rest[7];
-    if (f->rest_time > 0.0 && !clipped) {
-        zero_rate_update(f, a, g, dt);
-    }
-    int rested = fc_first_rest(measured, f->rest);  /* the angles are the first rest's tilt */
+    /* at a first rest the angles are its tilt (zero_rate_update) */
+    int rested = f->rest_time > 0.0 && !clipped && zero_rate_update(f, a, g, dt);
     int filling = 0;
     fc_real r_meas = f->r;
     if (f->acc_tau > 0.0) {
@@ -245,24 +251,17 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     }
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        if (filling && rested) {
-            /* the rest's mean, not turned by any gyro error, is the better tilt */
-        } else if (filling) {  /* the vector still fills: the attitude is its tilt, as uncertain */
+        if (!filling) {
+            correct(f, a[0], a[1], a[2], learn_bias);
+        } else if (!rested) {  /* (a first rest's mean, which no gyro error turned, stands) */
+            /* the vector still fills: the attitude is its tilt, as uncertain as that vector */
             fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
             fc_real fill = f->meas[FC_MEAS_FILL];
             fc_real k = dt / (0.5 * fill + dt);
             fc_real age = 0.5 * fill;
-            fc_real white = f->r * fc_two_stage_noise(k) + (r_meas - f->r);
-            fc_real c = -f->P_roll[3] * age;
-            f->P_roll[0] = white + f->P_roll[3] * age * age;
-            f->P_roll[1] = c;
-            f->P_roll[2] = c;
-            c = -f->P_pitch[3] * age;
-            f->P_pitch[0] = white + f->P_pitch[3] * age * age;
-            f->P_pitch[1] = c;
-            f->P_pitch[2] = c;
-        } else {
-            correct(f, a[0], a[1], a[2], learn_bias);
+            fc_real var = f->r * fc_two_stage_noise(k) + (r_meas - f->r);
+            measured_axis(f->P_roll, var, age);
+            measured_axis(f->P_pitch, var, age);
         }
     }
     if (f->roll != pred_roll || f->pitch != pred_pitch) {

@@ -139,12 +139,13 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
     fc_paper_ukf_predicted_covariance(&pred, f->P, h, q_gyro * dt, f->q_bias * dt, P);
     fc_real x[6] = {X0, X1, X2, b[0], b[1], b[2]};
     fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
-    if (fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0 && aligning) {
+    int gate = fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0;
+    if (gate && aligning) {  /* the vector still fills: X is its direction */
         x[0] = ax;
         x[1] = ay;
         x[2] = az;
         n = norm;
-    } else if (fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0) {
+    } else if (gate) {
         if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
             learn_bias = 0;  /* grossly off: X only (bias_innovation) */
         }
