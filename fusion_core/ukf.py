@@ -38,6 +38,7 @@ from .measured_vector import (
     measure_restarted,
     measure_start,
     measure_step,
+    two_stage_noise,
 )
 from .papers.ukf import (
     N_STATE,
@@ -61,13 +62,26 @@ ACC_GATE: Final = 1.0
 either."""
 
 
-def rest_covariance(P: tuple[float, ...], p_x: float) -> tuple[float, ...]:
-    """The packed lower triangle P of [X, b] with X's block p_x I and no covariance between X
-    and the bias: X just taken from a rest's mean (variance p_x per axis), the bias block kept."""
+def measured_covariance(P: tuple[float, ...], X: tuple[float, float, float], var: float,
+                        age: float) -> tuple[float, ...]:
+    """The packed lower triangle P of [X, b] once X is taken from a measured vector of variance
+    var per axis whose samples the gyro turned over age [s] on average (0: a rest's mean, which
+    no gyro error turned): a bias error db turned them by dX = -age [X]x db, so
+    P_XX = var I + age^2 [X]x P_bb [X]x^T and P_Xb = -age [X]x P_bb, as the propagation's
+    covariance of X with b is after a time age (kalman.measured_axis, per axis); P_bb stays."""
+    x0, x1, x2 = X
+    S = ((0.0, -x2, x1), (x2, 0.0, -x0), (-x1, x0, 0.0))  # [X]x
+    B = [[P[packed_index(3 + i, 3 + j)] for j in range(3)] for i in range(3)]
+    M = [[S[i][0] * B[0][j] + S[i][1] * B[1][j] + S[i][2] * B[2][j] for j in range(3)]
+         for i in range(3)]  # [X]x P_bb
+    a2 = age * age
     out = list(P)
-    for i in (1, 3, 4, 6, 7, 8, 10, 11, 12, 15, 16, 17):  # X's off-diagonals, X with b
-        out[i] = 0.0
-    out[0] = out[2] = out[5] = p_x
+    for i in range(3):
+        for j in range(3):
+            out[packed_index(3 + j, i)] = 0.0 - age * M[i][j]
+        for k in range(i + 1):
+            s = a2 * (M[i][0] * S[k][0] + M[i][1] * S[k][1] + M[i][2] * S[k][2])
+            out[packed_index(i, k)] = var + s if k == i else s
     return tuple(out)
 
 
@@ -90,8 +104,10 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     (rest_time > 0), and the bias learned only while the raw sample is within bias_gate of g,
     the measured and the predicted gravity direction within bias_innovation and the measured
     vector settled (else the biases are consider states). While the measured vector fills, X
-    is its direction, and at the first rest the rest's mean direction with that mean's
-    variance and no covariance with the bias, as in the kf (kalman.AngleBiasKalmanFilter).
+    is its direction, with that vector's variance and the covariance with the bias of the turn
+    a bias error gave its samples, and at the first rest the rest's mean direction with that
+    mean's variance and no covariance with the bias, as in the kf (kalman.AngleBiasKalmanFilter;
+    measured_covariance).
     No unit-norm pseudo-measurement (the paper's |X|^2 = 1 row): X is renormalised after every
     update, so |X|^2 = 1 tells the filter nothing about X, but the unscented transform of |X|^2
     reacts to the sigma points' spread (points X +- gamma s with s across X lie gamma^2 |s|^2 off
@@ -233,7 +249,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                 self.meas = measure_restarted(self.meas, f)
                 n = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
                 self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
-                self._P = rest_covariance(self._P, p["acc_noise"] ** 2 * rest_mean_share(dt))
+                self._P = measured_covariance(self._P, (self.x[0], self.x[1], self.x[2]),
+                                              p["acc_noise"] ** 2 * rest_mean_share(dt), 0.0)
             if self.rest.quiet_time >= p["rest_time"]:
                 self._zero_rate_update((gx, gy, gz), p["zaru_psd"] / dt)
 
@@ -297,8 +314,16 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                  self._q_bias * dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         gate = abs(norm / G - 1.0) < ACC_GATE and norm > 0.0
-        if gate and aligning:  # the vector still fills: X is its direction
+        if gate and aligning:  # the vector still fills: X is its direction, as uncertain as
+            # that vector (one sample's variance over the samples so far, each stage half the
+            # time since the start, plus the disturbance that reaches it; r unless given), its
+            # samples turned over half the fill on average (measured_covariance)
             X0, X1, X2, n = ax, ay, az, norm
+            r_acc = self._r_acc
+            excess = 0.0 if r is None else r - r_acc
+            age = 0.5 * self.meas.fill
+            var = r_acc * two_stage_noise(dt / (age + dt)) + excess
+            P = measured_covariance(P, (X0 / n, X1 / n, X2 / n), var, age)
         elif gate:
             if ax * X0 + ay * X1 + az * X2 < self._cos_innovation * norm * n:
                 learn_bias = False  # grossly off: X only (bias_innovation)

@@ -113,6 +113,35 @@ static void zero_rate_update(fc_ukf *f, const fc_real z[3], fc_real r)
     f->x[5] = x[5];
 }
 
+/* measured_covariance: P once X is taken from a measured vector of variance var per axis whose
+ * samples the gyro turned over age [s] on average: P_XX = var I + age^2 [X]x P_bb [X]x^T,
+ * P_Xb = -age [X]x P_bb, P_bb kept (packed lower triangle of [X, b]) */
+static void measured_covariance(fc_real P[21], const fc_real X[3], fc_real var, fc_real age)
+{
+    const fc_real S[3][3] = {{0.0, -X[2], X[1]}, {X[2], 0.0, -X[0]}, {-X[1], X[0], 0.0}};
+    fc_real B[3][3], M[3][3];
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            B[i][j] = P[fc_paper_ukf_packed(3 + i, 3 + j)];
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            M[i][j] = S[i][0] * B[0][j] + S[i][1] * B[1][j] + S[i][2] * B[2][j];
+        }
+    }
+    fc_real a2 = age * age;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            P[fc_paper_ukf_packed(3 + j, i)] = 0.0 - age * M[i][j];
+        }
+        for (int k = 0; k <= i; k++) {
+            fc_real s = a2 * (M[i][0] * S[k][0] + M[i][1] * S[k][1] + M[i][2] * S[k][2]);
+            P[fc_paper_ukf_packed(i, k)] = k == i ? var + s : s;
+        }
+    }
+}
+
 /* _filter_update: one sample of the paper's UKF (eq. 14-17) with the recommended noise; capped:
  * r is the measured vector's, at most max_correction_time's; aligning: the vector still fills,
  * X is its direction */
@@ -140,11 +169,17 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
     fc_real x[6] = {X0, X1, X2, b[0], b[1], b[2]};
     fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
     int gate = fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0;
-    if (gate && aligning) {  /* the vector still fills: X is its direction */
+    if (gate && aligning) {  /* the vector still fills: X is its direction, as uncertain */
         x[0] = ax;
         x[1] = ay;
         x[2] = az;
         n = norm;
+        fc_real r_acc = f->r_acc;
+        fc_real excess = capped ? r - r_acc : 0.0;
+        fc_real age = 0.5 * f->meas[FC_MEAS_FILL];
+        fc_real var = r_acc * fc_two_stage_noise(dt / (age + dt)) + excess;
+        const fc_real h_new[3] = {x[0] / n, x[1] / n, x[2] / n};
+        measured_covariance(P, h_new, var, age);
     } else if (gate) {
         if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
             learn_bias = 0;  /* grossly off: X only (bias_innovation) */
@@ -165,19 +200,6 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
     f->x[4] = x[4];
     f->x[5] = x[5];
     memcpy(f->P, P, sizeof P);
-}
-
-/* rest_covariance: X's block p_x I, no covariance between X and the bias (packed lower
- * triangle of [X, b]) */
-static void rest_covariance(fc_real P[21], fc_real p_x)
-{
-    static const int zero[12] = {1, 3, 4, 6, 7, 8, 10, 11, 12, 15, 16, 17};
-    for (int i = 0; i < 12; i++) {
-        P[zero[i]] = 0.0;
-    }
-    P[0] = p_x;
-    P[2] = p_x;
-    P[5] = p_x;
 }
 
 static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
@@ -216,7 +238,8 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
             f->x[0] = m[0] / n;
             f->x[1] = m[1] / n;
             f->x[2] = m[2] / n;
-            rest_covariance(f->P, fc_pow(p->acc_noise, 2.0) * fc_rest_mean_share(dt));
+            measured_covariance(f->P, f->x, fc_pow(p->acc_noise, 2.0) * fc_rest_mean_share(dt),
+                                0.0);
         }
         if (f->rest[6] >= p->rest_time) {
             zero_rate_update(f, g, p->zaru_psd / dt);
