@@ -44,7 +44,12 @@ from __future__ import annotations
 
 from typing import Final, NamedTuple
 
-from .building_blocks import Vec3, adaptive_prefilter_time, lowpass_specific_force
+from .building_blocks import (
+    Vec3,
+    adaptive_prefilter_time,
+    lowpass_specific_force,
+    on_the_mark,
+)
 from .state import NONNEG, REAL, Segments
 from .types import G, Param
 
@@ -153,11 +158,11 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     f1, f, ref1, ref, s1, s, dist, slow, fill, settle = m
     stage = c.stage
     full = 2.0 * stage
-    if settle < full:
-        settle += dt
+    if settle < full:  # both times counted up to the full length (building_blocks.on_the_mark)
+        settle = on_the_mark(settle + dt, dt, full)
     filling = fill < full
     if filling:  # a mean of the samples so far (each stage half the time since the start)
-        fill += dt
+        fill = on_the_mark(fill + dt, dt, full)
         stage = 0.5 * fill if fill < full else stage
     r = c.r
     tau = stage

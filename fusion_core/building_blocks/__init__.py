@@ -89,6 +89,7 @@ from .sampling import (
     ZERO3,
     Vec3,
     body_rotation,
+    on_the_mark,
 )
 
 __all__ = [
@@ -131,6 +132,7 @@ __all__ = [
     "mat_t_vec",
     "mat_vec",
     "nearest_face",
+    "on_the_mark",
     "quat_from_roll_pitch",
     "rest_alignment",
     "rest_mean_share",

@@ -8,7 +8,7 @@ from typing import Final, NamedTuple
 
 from ..kinematics import accel_roll_pitch
 from ..types import DEG, Param
-from .sampling import REAL_GYRO_DENSITY, Vec3
+from .sampling import REAL_GYRO_DENSITY, Vec3, on_the_mark
 
 
 class RestState(NamedTuple):
@@ -165,7 +165,7 @@ def rest_step(
         still = mx * mx + my * my + mz * mz < lim * lim
     if still and quiet < REST_MEAN_TAU:  # the mean settles: the reference follows it
         ox, oy, oz = fx, fy, fz
-    quiet = quiet + dt if still else 0.0
+    quiet = on_the_mark(on_the_mark(quiet + dt, dt, REST_MEAN_TAU), dt, rest_time) if still else 0.0
     return _new(RestState, (wx, wy, wz, fx, fy, fz, quiet,
                             (1.0 if quiet >= rest_time else measured), ox, oy, oz))
 

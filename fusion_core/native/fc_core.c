@@ -205,6 +205,12 @@ void fc_gate_bounds2(fc_real gate_low, fc_real gate_high, fc_real *low2, fc_real
     *high2 = fc_pow(gate_high * FC_G, 2.0);
 }
 
+fc_real fc_on_the_mark(fc_real t, fc_real dt, fc_real mark)
+{
+    fc_real d = t - mark;
+    return -0.5 * dt < d && d < 0.5 * dt ? mark : t;
+}
+
 void fc_body_rotation(const fc_real g0[3], const fc_real g1[3], const fc_real bias[3], fc_real dt,
                       int trapezoid, fc_real phi[3])
 {
@@ -309,12 +315,12 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
 {
     fc_real stage = c->stage;
     fc_real full = 2.0 * stage;
-    if (m[FC_MEAS_SETTLE] < full) {
-        m[FC_MEAS_SETTLE] += dt;
+    if (m[FC_MEAS_SETTLE] < full) {  /* both counted up to the full length (fc_on_the_mark) */
+        m[FC_MEAS_SETTLE] = fc_on_the_mark(m[FC_MEAS_SETTLE] + dt, dt, full);
     }
     *filling = m[FC_MEAS_FILL] < full;
     if (*filling) {  /* a mean of the samples so far (each stage half the time since the start) */
-        m[FC_MEAS_FILL] += dt;
+        m[FC_MEAS_FILL] = fc_on_the_mark(m[FC_MEAS_FILL] + dt, dt, full);
         stage = m[FC_MEAS_FILL] < full ? 0.5 * m[FC_MEAS_FILL] : stage;
     }
     fc_real r = c->r;
@@ -418,7 +424,8 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
         oy = fy;
         oz = fz;
     }
-    quiet = still ? quiet + dt : 0.0;
+    quiet = still ? fc_on_the_mark(fc_on_the_mark(quiet + dt, dt, FC_REST_MEAN_TAU), dt, rest_time)
+                  : 0.0;
     rest[0] = wx;
     rest[1] = wy;
     rest[2] = wz;

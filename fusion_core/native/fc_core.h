@@ -87,6 +87,9 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
 extern const fc_real FC_FACES[6][9];
 void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4]);
 void fc_gate_bounds2(fc_real gate_low, fc_real gate_high, fc_real *low2, fc_real *high2);
+/* building_blocks.on_the_mark: t, or mark where t is within half a sample of it (a count
+ * reaches its mark at the nearest sample in float as in double) */
+fc_real fc_on_the_mark(fc_real t, fc_real dt, fc_real mark);
 void fc_body_rotation(const fc_real g0[3], const fc_real g1[3], const fc_real bias[3], fc_real dt,
                       int trapezoid, fc_real phi[3]);
 void fc_lowpass_specific_force_terms(fc_real f[3], const fc_real phi[3], const fc_real terms[4],
