@@ -115,7 +115,8 @@ class ComplementaryFilter(Estimator):
         # noise's share of the disturbance statistic and the longest correction time
         self._adaptive = complementary_adaptive(p, self._acc_tau)
         self._measure = measure_constants(self._acc_tau, self._adaptive[2],
-                                          float(p["slow_band_time"]), self._adaptive[0])
+                                          float(p["slow_band_time"]), self._adaptive[0],
+                                          float(p["gyro_scale_std"]))
 
     def _reset(self) -> None:
         self.roll = 0.0

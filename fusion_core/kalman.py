@@ -238,7 +238,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         # (rad/s)^2, the disturbance's averaging time (0: off), the white noise's share
         self._adaptive = adaptive_noise_constants(p, self._acc_tau)
         self._measure = measure_constants(self._acc_tau, self._adaptive[1],
-                                          float(p["slow_band_time"]), self._r)
+                                          float(p["slow_band_time"]), self._r,
+                                          float(p["gyro_scale_std"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))

@@ -127,7 +127,7 @@ class GainScheduledComplementaryFilter(Estimator):
         self._adaptive = complementary_adaptive(p, self._acc_tau)
         # no slow band: the mgcf's noise is the raw disturbance (measured_vector.raw_noise)
         self._measure = measure_constants(self._acc_tau, self._adaptive[2], 0.0,
-                                          self._adaptive[0])
+                                          self._adaptive[0], 0.0)
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)

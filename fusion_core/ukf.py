@@ -173,7 +173,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         # disturbance statistic (3 axes of one sample's variance, (acc_noise g)^2)
         self._adaptive = adaptive_noise_constants(p, float(p["acc_lowpass"]))
         self._measure = measure_constants(float(p["acc_lowpass"]), self._adaptive[1],
-                                          float(p["slow_band_time"]), self._r_acc)
+                                          float(p["slow_band_time"]), self._r_acc,
+                                          float(p["gyro_scale_std"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._trapezoid: bool = p["gyro_sampling"] == "point"

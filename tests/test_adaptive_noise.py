@@ -92,3 +92,34 @@ def test_the_unit_norm_row_shrinks_the_covariance_of_x() -> None:
         traces[r_norm] = Pn[0] + Pn[2]
     # one update takes 0.7 % of it (rounding would be 1e-16); over 3.5 s of updates 7 %
     assert traces[0.01**2] < (1.0 - 1e-3) * traces[None], traces
+
+
+def test_the_slow_band_leaves_out_what_a_gyro_s_rate_error_turns_the_vectors_apart_by() -> None:
+    """A sensor turning at 1 rad/s about x with no linear acceleration, its gyro reading
+    sqrt(3) x 0.5 % too much (a scale and two cross-axis errors of gyro_scale_std 0.005 each):
+    the short and the full-length low-pass, turned by that gyro, part by g sigma |w| times
+    their delays' difference. Counted as disturbance, that raises the measurement noise
+    fivefold; left out, it stays at one sample's. A translation (no rotation) counts in full
+    either way."""
+    from fusion_core.kinematics import rotvec_terms
+    from fusion_core.measured_vector import measure_constants, measure_start, measure_step
+    from fusion_core.types import G
+
+    dt, r, gyro_scale_std = 0.01, 0.005**2, 0.005
+    error = 1.0 + math.sqrt(3.0) * gyro_scale_std
+
+    def noise(discount: float, rate: float, sway: float) -> float:
+        c = measure_constants(1.5, 3.0, 0.15, r, discount)
+        m = measure_start((0.0, 0.0, G), c)
+        r_k = r
+        for k in range(1, 1000):  # 10 s: the vectors fill and the statistic settles
+            t = k * dt
+            a = (sway * math.sin(2.0 * math.pi * 0.3 * t),  # a 0.3 Hz sway along x
+                 G * math.sin(rate * t), G * math.cos(rate * t))  # gravity, turning about x
+            phi = (rate * error * dt, 0.0, 0.0)
+            m, r_k, _ = measure_step(m, a, phi, rotvec_terms(*phi), dt, c)
+        return r_k
+
+    assert noise(0.0, 1.0, 0.0) > 5.0 * r  # the turn taken for disturbance
+    assert noise(gyro_scale_std, 1.0, 0.0) < 1.1 * r  # left out
+    assert noise(gyro_scale_std, 0.0, 2.0) == noise(0.0, 0.0, 2.0) > 100.0 * r  # in full

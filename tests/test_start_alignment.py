@@ -56,7 +56,7 @@ def test_the_measured_vector_is_a_mean_of_the_samples_while_it_fills() -> None:
     (weights summing to 1) in which no sample weighs more than 1.5 / n: never one sample's tilt.
     (Two stages each of half the time since the start weigh the middle samples most.)"""
     dt = 0.01
-    c = measure_constants(1.0, 0.0, 0.15, 1e-5)
+    c = measure_constants(1.0, 0.0, 0.15, 1e-5, 0.0)
     zero, terms = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
     for n in (2, 5, 20, 60, 99):
         weights = []

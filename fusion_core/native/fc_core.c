@@ -270,13 +270,14 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise)
 #define DISTURBANCE_ATTACK 0.05 /* measured_vector.DISTURBANCE_ATTACK [s] */
 
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_meas_constants *c)
+                          fc_real gyro_scale_std, fc_meas_constants *c)
 {
     c->stage = 0.5 * acc_lowpass;
     c->dist_tau = disturbance_time;
     c->noise = 3.0 * r * FC_G * FC_G;
     c->band = band;
     c->r = r;
+    c->turn = 3.0 * gyro_scale_std * gyro_scale_std * FC_G * FC_G;
 }
 
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c)
@@ -340,6 +341,11 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             e1 = s[1] - ref[1];
             e2 = s[2] - ref[2];
             fc_real inst = e0 * e0 + e1 * e1 + e2 * e2;
+            /* less what the gyro's rate error turns the two apart by */
+            fc_real lag = 2.0 * (stage - c->band);
+            fc_real w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt);
+            fc_real turn = c->turn * w2 * (lag * lag);
+            inst = inst > turn ? inst - turn : 0.0;
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
             fc_real excess = m[FC_MEAS_SLOW] - c->noise * fc_two_stage_noise(dt / (c->band + dt));

@@ -117,10 +117,10 @@ enum {
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {
-    fc_real stage, dist_tau, noise, band, r;
+    fc_real stage, dist_tau, noise, band, r, turn;
 } fc_meas_constants;
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_meas_constants *c);
+                          fc_real gyro_scale_std, fc_meas_constants *c);
 /* measure_start: every low-pass at a, no disturbance measured, settled */
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
 /* measure_step: one sample a; returns the measurement noise r [rad^2], *filling whether the

@@ -23,7 +23,7 @@ void fc_mgcf_configure(fc_mgcf *f)
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
     /* no slow band: the mgcf's noise is the raw disturbance (fc_measure_raw_noise) */
-    fc_measure_constants(f->acc_tau, f->dist_tau, 0.0, f->r_ref, &f->measure);
+    fc_measure_constants(f->acc_tau, f->dist_tau, 0.0, f->r_ref, 0.0, &f->measure);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)

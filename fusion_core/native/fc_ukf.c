@@ -16,7 +16,8 @@ void fc_ukf_configure(fc_ukf *f)
     f->r_acc = fc_pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 p->acc_lowpass, &f->q_rotation, &f->dist_tau);
-    fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc, &f->measure);
+    fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc,
+                         p->gyro_scale_std, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
     f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
