@@ -53,7 +53,7 @@ def test_the_float_build_keeps_every_contract_rmse_within_a_hundredth_of_a_degre
     """The twins in single precision (FC_REAL_FLOAT) against double on every contract scenario
     (realistic sensor, seed 0): each roll and pitch RMSE within 0.01 deg of double's. A time
     counted by summing dt in float ends a sample off (150 x 0.01 s sums to just under 1.5 s),
-    which moved kf's and ukf's high_dynamics RMSE by 0.03 deg until the counts met their marks
+    which alone moves kf's and ukf's high_dynamics RMSE by 0.03 deg: the counts meet their marks
     at the nearest sample (building_blocks.on_the_mark)."""
     from testbenches.embedded.float_accuracy import FloatTwin, contract_scenarios
 

@@ -184,7 +184,7 @@ def test_while_the_vector_fills_the_ukf_s_covariance_is_that_vector_s() -> None:
 def test_an_uncalibrated_gyro_that_never_rests_costs_the_ukf_what_it_costs_the_kf() -> None:
     """Gyro biases of up to 18 deg/s (calibration none) on a sensor that never rests, with the
     prior init_bias_std 3 deg/s: a filling vector turned by such a bias is degrees off, and a
-    UKF that held X as sure as one sample while it filled learned that turn as bias (one part
+    UKF that holds X as sure as one sample while it fills learns that turn as bias (one part
     44 deg RMS, the mean of six twice the kf's). With the turn in X's covariance, as the kf
     has it in its angles', the UKF is within 10 % of the kf on the mean of the six parts."""
     from testbenches.samples import scenario_samples

@@ -51,8 +51,8 @@ def on_the_mark(t: float, dt: float, mark: float) -> float:
     """t, a time counted sample by sample, or mark where t is within half a sample (dt) of it.
     A count reaches its mark at the sample nearest to it, whatever the rounding of the sum: in
     single precision 150 steps of 0.01 s sum to just under 1.5 s, and a measured vector or a
-    rest timed by the raw sum ends a sample later than in double, which moved the float build's
-    estimate by 0.07 deg on a contract scenario. Counts compared with a mark pass through this
+    rest timed by the raw sum ends a sample later than in double, which alone moves the float
+    build's estimate by 0.07 deg on high_dynamics. Counts compared with a mark pass through this
     one at each step (measured_vector.measure_step, rest.rest_step)."""
     d = t - mark
     return mark if -0.5 * dt < d < 0.5 * dt else t
