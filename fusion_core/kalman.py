@@ -55,13 +55,13 @@ from .kinematics import (
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    fill_noise,
     measure_clipped,
     measure_constants,
     measure_restarted,
     measure_start,
     measure_step,
     measure_turned,
-    two_stage_noise,
 )
 from .papers.kalman import RollPitchAxes
 from .state import ANGLE, COV, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec, index
@@ -352,13 +352,9 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
                 self.correct(ax, ay, az, learn_bias)
             elif not rested:  # (a first rest's mean, which no gyro error turned, stands)
                 # the vector still fills: the attitude is its tilt (as cf's and mgcf's), as
-                # uncertain as that vector: one sample's variance over the samples so far (each
-                # stage half the time since the start) plus the disturbance that reaches it,
-                # the samples turned over half the fill on average (measured_axis)
+                # uncertain as that vector, its samples turned over their mean age (fill_noise)
                 self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
-                k = dt / (0.5 * self.meas.fill + dt)
-                age = 0.5 * self.meas.fill
-                var = self._r * two_stage_noise(k) + (r - self._r)
+                var, age = fill_noise(self.meas, r, dt, self._measure)
                 self.P_roll = measured_axis(self.P_roll, var, age)
                 self.P_pitch = measured_axis(self.P_pitch, var, age)
         if (self.roll, self.pitch) != predicted:

@@ -204,6 +204,16 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle), r, filling
 
 
+def fill_noise(m: Measure, r: float, dt: float, c: MeasureConstants) -> tuple[float, float]:
+    """While the vector fills, its tilt variance and its samples' mean age [s] (half the fill):
+    one sample's white variance as much as passes two stages each of half the time since the
+    start (two_stage_noise), plus the disturbance in r (measure_step's noise, less c.r). A
+    filter that takes the vector's tilt then is that sure of it, and a bias error has turned it
+    over that age (kalman.measured_axis, ukf.measured_covariance)."""
+    age = 0.5 * m.fill
+    return c.r * two_stage_noise(dt / (age + dt)) + (r - c.r), age
+
+
 def raw_noise(m: Measure, c: MeasureConstants) -> float:
     """The measurement noise [rad^2] sized by the raw sample's disturbance (`dist`, all of the
     linear acceleration against the full-length reference, fast or slow) instead of the slow band

@@ -33,12 +33,12 @@ from .kinematics import rotvec_terms
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    fill_noise,
     measure_clipped,
     measure_constants,
     measure_restarted,
     measure_start,
     measure_step,
-    two_stage_noise,
 )
 from .papers.ukf import (
     N_STATE,
@@ -233,7 +233,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
             # no bias from a vector that is filling (a mean of the first samples, of a motion's
             # start as likely as of rest) or holds turns the gyro did not measure (gyro_range)
             learn_bias = learn_bias and not filling and self.meas.settled(self._measure)
-            self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r, filling)
+            fill = fill_noise(self.meas, r, dt, self._measure) if filling else None
+            self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r, fill)
         else:
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
         if p["rest_time"] > 0.0 and not clipped:
@@ -288,15 +289,15 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
 
     def _filter_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float,
-        learn_bias: bool, r: float | None = None, aligning: bool = False,
+        learn_bias: bool, r: float | None = None, fill: tuple[float, float] | None = None,
     ) -> None:
         """One sample of the paper's UKF (eq. 14-17) with the recommended noise: predict
         (rotation_terms, sigma_predict), the process noise with the gyro's scale uncertainty
         and the rate beyond a rail (predicted_covariance), then the update with f/g
         (measurement_update; the bias states as consider states unless learn_bias) of variance
-        r per axis, at most max_correction_time's (acc_noise^2 unless given); aligning: the
-        measured vector still fills, and X is its direction instead (as the other filters'
-        attitude is its tilt then)."""
+        r per axis, at most max_correction_time's (acc_noise^2 unless given); fill: while the
+        measured vector fills, its variance and its samples' mean age (fill_noise), and X is its
+        direction instead (as the other filters' attitude is its tilt then)."""
         x = self.x
         b0, b1, b2 = x[3], x[4], x[5]
         terms = rotation_terms(self.gyro_prev, (gx, gy, gz), dt, self._trapezoid)
@@ -315,16 +316,10 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                  self._q_bias * dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         gate = abs(norm / G - 1.0) < ACC_GATE and norm > 0.0
-        if gate and aligning:  # the vector still fills: X is its direction, as uncertain as
-            # that vector (one sample's variance over the samples so far, each stage half the
-            # time since the start, plus the disturbance that reaches it; r unless given), its
-            # samples turned over half the fill on average (measured_covariance)
+        if gate and fill is not None:  # the vector still fills: X is its direction, as
+            # uncertain as that vector, its samples turned over their mean age
             X0, X1, X2, n = ax, ay, az, norm
-            r_acc = self._r_acc
-            excess = 0.0 if r is None else r - r_acc
-            age = 0.5 * self.meas.fill
-            var = r_acc * two_stage_noise(dt / (age + dt)) + excess
-            P = measured_covariance(P, (X0 / n, X1 / n, X2 / n), var, age)
+            P = measured_covariance(P, (X0 / n, X1 / n, X2 / n), *fill)
         elif gate:
             if ax * X0 + ay * X1 + az * X2 < self._cos_innovation * norm * n:
                 learn_bias = False  # grossly off: X only (bias_innovation)

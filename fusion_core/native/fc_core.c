@@ -296,7 +296,7 @@ void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
     }
 }
 
-fc_real fc_two_stage_noise(fc_real k)
+static fc_real two_stage_noise(fc_real k)
 {
     fc_real a2 = (1.0 - k) * (1.0 - k);
     fc_real d = 1.0 - a2;
@@ -348,7 +348,7 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             inst = inst > turn ? inst - turn : 0.0;
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
-            fc_real excess = m[FC_MEAS_SLOW] - c->noise * fc_two_stage_noise(dt / (c->band + dt));
+            fc_real excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
             if (excess > 0.0) {
                 r += excess / (FC_G * FC_G);
             }
@@ -356,6 +356,14 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
     }
     lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, phi, a, dt, tau, terms);
     return r;
+}
+
+void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,
+                           const fc_meas_constants *c, fc_real *var, fc_real *age)
+{
+    fc_real a = 0.5 * m[FC_MEAS_FILL];
+    *var = c->r * two_stage_noise(dt / (a + dt)) + (r - c->r);
+    *age = a;
 }
 
 int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)

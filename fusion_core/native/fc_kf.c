@@ -257,10 +257,8 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         } else if (!rested) {  /* (a first rest's mean, which no gyro error turned, stands) */
             /* the vector still fills: the attitude is its tilt, as uncertain as that vector */
             fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
-            fc_real fill = f->meas[FC_MEAS_FILL];
-            fc_real k = dt / (0.5 * fill + dt);
-            fc_real age = 0.5 * fill;
-            fc_real var = f->r * fc_two_stage_noise(k) + (r_meas - f->r);
+            fc_real var, age;
+            fc_measure_fill_noise(f->meas, r_meas, dt, &f->measure, &var, &age);
             measured_axis(f->P_roll, var, age);
             measured_axis(f->P_pitch, var, age);
         }

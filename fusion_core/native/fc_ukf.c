@@ -144,10 +144,10 @@ static void measured_covariance(fc_real P[21], const fc_real X[3], fc_real var, 
 }
 
 /* _filter_update: one sample of the paper's UKF (eq. 14-17) with the recommended noise; capped:
- * r is the measured vector's, at most max_correction_time's; aligning: the vector still fills,
- * X is its direction */
+ * r is the measured vector's, at most max_correction_time's; fill (NULL unless the vector still
+ * fills): its variance and its samples' mean age, and X is its direction */
 static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const fc_real g[3],
-                          fc_real dt, int learn_bias, fc_real r, int capped, int aligning)
+                          fc_real dt, int learn_bias, fc_real r, int capped, const fc_real *fill)
 {
     fc_real b[3] = {f->x[3], f->x[4], f->x[5]};
     fc_real terms[6];
@@ -170,17 +170,13 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
     fc_real x[6] = {X0, X1, X2, b[0], b[1], b[2]};
     fc_real norm = fc_sqrt(ax * ax + ay * ay + az * az);
     int gate = fc_fabs(norm / FC_G - 1.0) < FC_UKF_ACC_GATE && norm > 0.0;
-    if (gate && aligning) {  /* the vector still fills: X is its direction, as uncertain */
+    if (gate && fill) {  /* the vector still fills: X is its direction, as uncertain */
         x[0] = ax;
         x[1] = ay;
         x[2] = az;
         n = norm;
-        fc_real r_acc = f->r_acc;
-        fc_real excess = capped ? r - r_acc : 0.0;
-        fc_real age = 0.5 * f->meas[FC_MEAS_FILL];
-        fc_real var = r_acc * fc_two_stage_noise(dt / (age + dt)) + excess;
         const fc_real h_new[3] = {x[0] / n, x[1] / n, x[2] / n};
-        measured_covariance(P, h_new, var, age);
+        measured_covariance(P, h_new, fill[0], fill[1]);
     } else if (gate) {
         if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
             learn_bias = 0;  /* grossly off: X only (bias_innovation) */
@@ -222,9 +218,13 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
         /* no bias from a vector that is filling or holds turns the gyro did not measure */
         learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
         const fc_real *m = f->meas + FC_MEAS_F;
-        filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1, filling);
+        fc_real fill[2];
+        if (filling) {
+            fc_measure_fill_noise(f->meas, r, dt, &f->measure, &fill[0], &fill[1]);
+        }
+        filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1, filling ? fill : NULL);
     } else {
-        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0, 0);
+        filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0, NULL);
     }
     if (p->rest_time > 0.0 && !clipped) {
         fc_real measured = f->rest[7];
