@@ -29,6 +29,20 @@ def test_the_site_builds_strict(tmp_path: Path) -> None:
         assert (tmp_path / page).is_file(), page
     ukf = (tmp_path / "estimators/ukf/index.html").read_text()
     assert "gyro_range" in ukf and "PaperUnscentedKalmanFilter" in ukf  # the tables were made
+    home = (tmp_path / "index.html").read_text()
+    assert 'id="quickstart"' in home and 'href="results/broad/"' in home  # the README, relinked
+
+
+def test_the_home_page_is_the_readme_with_its_links_into_docs_relative() -> None:
+    spec = importlib.util.spec_from_file_location("readme_hook", REPO / "docs/_hooks/readme.py")
+    assert spec is not None and spec.loader is not None
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+    assert (REPO / "docs/index.md").read_text().strip() == hook.MARK
+    page = hook.on_page_markdown(hook.MARK)
+    readme = (REPO / "README.md").read_text()
+    assert page == hook.readme_for_site(readme) and "## Quickstart" in page
+    assert "](docs/" not in page and "](CHANGELOG.md)" not in page
 
 
 def test_the_readme_is_a_page() -> None:
