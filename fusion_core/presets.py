@@ -5,8 +5,10 @@ Two sets, as the interface contract names them:
 - "recommended": values for real MEMS IMUs. They are the classes' own defaults (so the dicts
   here are empty) and the start values of every FMU; each value's derivation is in the
   docstring of its estimator class, in this order of sources: sensor physics (noise densities,
-  sampling, the accelerometer's trust), then, only where physics fixes nothing, a coarse scan
-  whose plateau's middle was taken, never its minimum.
+  sampling, scale-factor class, range, the accelerometer's trust), then, only where physics
+  fixes nothing, a coarse scan checked by cross-validation across groups of recordings
+  (`python -m testbenches broad DIR --cv`: each scanned value chosen again without each group
+  and scored on it), never an in-sample minimum.
 - "paper": the seed papers' own filters (fusion_core.papers, chosen by "filter": "paper"), at
   their values and rules, to reproduce their results. The papers tune for one calibrated sensor
   at one loop rate and integrate the gyro with the rectangle rule; on a real IMU at another rate

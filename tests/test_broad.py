@@ -336,3 +336,49 @@ def test_cv_on_two_folds_chooses_without_the_held_out_one(
     assert set(cv["chosen_per_fold"]) == {"slow_rotation", "translation"}
     assert cv["in_sample_mean_deg"] == pytest.approx(report["mean_inclination_rmse_deg"]["kf"],
                                                      abs=1e-6)  # report.json's 6 decimals
+
+
+def test_cv_grid_cross_validates_the_parameters_given(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`broad --cv-grid NAME=V1,V2` (implying --cv) chooses those parameters again per fold and
+    nothing else: cv.json holds that grid, each fold's choice is one of its values, and the
+    held-out error is the chosen point's."""
+    from testbenches.broad.cv import _rmse
+    from testbenches.broad.data import load_trial
+    from testbenches.broad.run import run_fusion_core
+
+    a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
+    b = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL)
+    out = tmp_path / "report"
+    assert main(["broad", str(a), str(b), "--estimator", "kf", "--no-plots", "--out", str(out),
+                 "--cv-grid", "scale_time=0.25,0.5"]) == 0
+    assert "(scale_time where the estimator has it)" in capsys.readouterr().out
+    doc = json.loads((out / "cv.json").read_text())
+    assert doc["grid"] == {"scale_time": [0.25, 0.5]}
+    cv = doc["estimators"]["kf"]
+    assert cv["defaults"] == {"scale_time": 0.5}
+    for fold, point in cv["chosen_per_fold"].items():
+        assert set(point) == {"scale_time"} and point["scale_time"] in (0.25, 0.5)
+        (trial,) = [t for t, f in doc["folds"].items() if f == fold]
+        t = load_trial(a if trial.startswith("10") else b)
+        r = run_fusion_core("kf", point, t)
+        assert cv["cv_held_out_deg"][trial] == pytest.approx(_rmse(t, r["roll"], r["pitch"]))
+
+
+@pytest.mark.parametrize(("entry", "says"), [
+    ("scale_time", "expected NAME=V1,V2,... with numbers"),
+    ("scale_time=fast", "expected NAME=V1,V2,... with numbers"),
+    ("no_such=1", "no_such is no parameter of kf; allowed: "),
+    ("scale_time=-1", "kf: parameter 'scale_time'=-1.0 is out of range"),
+    ("scale_time=", "scale_time needs at least one value"),
+])
+def test_cv_grid_refuses_a_bad_entry_before_any_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], entry: str, says: str
+) -> None:
+    a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
+    out = tmp_path / "report"
+    assert main(["broad", str(a), "--estimator", "kf", "--no-plots", "--out", str(out),
+                 "--cv-grid", entry]) == 2
+    assert says in capsys.readouterr().err
+    assert not out.exists()

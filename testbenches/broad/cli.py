@@ -18,7 +18,7 @@ from ..fmus import DEFAULT_FMU_DIR
 from ..options import add_calibration, add_preset, choose, positive_float
 
 if TYPE_CHECKING:
-    from .cv import CvResult
+    from .cv import CvResult, Grid
     from .data import BroadTrial
     from .run import BroadResult
 
@@ -58,10 +58,16 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="skip the bar chart")
     p.add_argument("--cv", action="store_true",
                    help="cross-validate the defaults: each parameter a scan chooses (acc_lowpass, "
-                   "slow_band_time) chosen again without each motion fold (slow rotation, fast "
-                   "rotation, translation, disturbed/combined) and scored on it; prints the "
+                   "slow_band_time, scale_time) chosen again without each motion fold (slow "
+                   "rotation, fast rotation, translation, disturbed/combined) and scored on it; "
+                   "prints the "
                    "cross-validated mean beside the in-sample one (and VQF's with --peers) and "
                    "adds cv_mean_inclination_rmse_deg to report.json (testbenches.broad.cv)")
+    p.add_argument("--cv-grid", action="append", default=[], metavar="NAME=V1,V2,...",
+                   help="cross-validate these parameters and values instead (repeat for several; "
+                   "implies --cv): e.g. --cv-grid scale_time=0.25,0.5,1 for a parameter of your "
+                   "own, on your own recordings (default: acc_lowpass=1,1.5,2, "
+                   "slow_band_time=0.05,0.1,0.15,0.3 and scale_time=0.25,0.5,1)")
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
                    "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
@@ -83,6 +89,13 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from .run import collect_paths, evaluate, plan_columns
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
+    grid = None
+    if args.cv_grid:  # refused before any run
+        from .cv import CV_ESTIMATORS, check_grid, parse_grid
+
+        grid = parse_grid(args.cv_grid)
+        check_grid(grid, [k for k in estimators if k in CV_ESTIMATORS] or list(CV_ESTIMATORS))
+        args.cv = True
     presets = list(PRESETS) if args.preset == "all" else [p for p in args.preset.split(",") if p]
     peers = [*PEERS, *AHEAD_PEERS] if args.peers else []
     try:
@@ -106,7 +119,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
                           progress=progress)
     print(table(result))
-    cv = cross_validation(trials, result, estimators, args.out, args.peers) if args.cv else None
+    cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid)
+          if args.cv else None)
     extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
     paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
@@ -123,9 +137,10 @@ def cmd_broad(args: argparse.Namespace) -> int:
 
 
 def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
-                     out: Path, peers: bool) -> CvResult | None:
-    """The cross-validation (testbenches.broad.cv) of the estimators that have one, written to
-    DIR/cv.json; None where none has. The peer the evaluation ran already is taken from it."""
+                     out: Path, peers: bool, grid: Grid | None = None) -> CvResult | None:
+    """The cross-validation (testbenches.broad.cv) of the estimators that have one over grid
+    (None: CV_GRID), written to DIR/cv.json; None where none has. The peer the evaluation ran
+    already is taken from it."""
     import json
 
     from tqdm import tqdm
@@ -143,7 +158,7 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
               total=len(trials) * len(keys) + (len(trials) if peers else 0)) as bar:
         cv = cross_validate(trials, groups, keys,
                             {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]} if peers else None,
-                            lambda label: bar.update(), measured)
+                            lambda label: bar.update(), measured, grid)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
     return cv

@@ -18,7 +18,7 @@ trials.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,16 +33,21 @@ from .run import run_fusion_core
 CV_GRID: dict[str, tuple[float, ...]] = {
     "acc_lowpass": (1.0, 1.5, 2.0),
     "slow_band_time": (0.05, 0.1, 0.15, 0.3),
+    "scale_time": (0.25, 0.5, 1.0),
 }
 """The parameters physics leaves open, with the values a scan tries. acc_lowpass: the measured
 vector's length (VQF's 3 s time constant sits at the long end once its gain is counted);
 slow_band_time: the corner between the disturbance the pre-filter removes and the one that
-reaches the vector (measured_vector.BAND_PARAM). Every other default comes from the sensor's
-physics (its noise densities, its range) or is a bound (max_correction_time)."""
+reaches the vector (measured_vector.BAND_PARAM); scale_time: how long a gyro's scale error adds
+up in one direction, a property of the motion rather than of the sensor (ADAPTIVE_NOISE_PARAMS).
+Every other default comes from the sensor's physics (its noise densities, its scale-factor
+class, its range) or is a bound (max_correction_time). `broad --cv-grid` takes another grid."""
 CV_ESTIMATORS: tuple[str, ...] = ATTITUDE_FILTERS
 """The estimators with a measured vector (the position filter's attitude is the kf's)."""
 FOLDS: tuple[str, ...] = ("slow_rotation", "fast_rotation", "translation", "disturbed_combined")
 """The motion folds, from BROAD's groups (fold_of)."""
+Grid = Mapping[str, Sequence[float]]
+"""Parameter name -> the values a scan tries."""
 
 
 def fold_of(groups: Sequence[str]) -> str:
@@ -100,6 +105,10 @@ class CvResult:
     estimators: dict[str, EstimatorCv]
     peers: dict[str, dict[str, float]] = field(default_factory=dict)
     """peer -> trial -> RMSE [deg] (nothing to fit: its in-sample and CV figures are one)."""
+    grid: dict[str, list[float]] = field(default_factory=lambda: {k: list(v)
+                                                                   for k, v in CV_GRID.items()})
+    """The parameters chosen again per fold and their values (CV_GRID unless another was
+    given)."""
 
     def fold_mean(self, values: dict[str, float], fold: str) -> float:
         picked = [v for t, v in values.items() if self.folds[t] == fold]
@@ -110,9 +119,9 @@ class CvResult:
 
     def as_dict(self) -> dict[str, Any]:
         return {
-            "method": "leave one motion fold out: each CV_GRID parameter chosen on the other "
+            "method": "leave one motion fold out: each grid parameter chosen on the other "
                       "folds' trials, scored on the held-out fold's",
-            "grid": {k: list(v) for k, v in CV_GRID.items()},  # each estimator: those it has
+            "grid": self.grid,  # each estimator: those it has
             "folds": self.folds,
             "estimators": {k: e.as_dict() for k, e in self.estimators.items()},
             "peers": self.peers,
@@ -130,13 +139,18 @@ def cross_validate(
     peers: dict[str, Callable[..., np.ndarray]] | None = None,
     progress: Callable[[str], None] | None = None,
     measured: dict[str, dict[str, float]] | None = None,
+    grid: Grid | None = None,
 ) -> CvResult:
-    """The cross-validation of every estimator's CV_GRID parameters over the trials (groups:
-    each trial's BROAD groups). peers: name -> f(acc, gyro, rate, delay) giving the up
-    direction, scored on the same trials. progress(label) is called after each trial.
-    measured: peer name -> trial -> RMSE already measured on these trials (the evaluation's
-    own columns), which are not run again."""
+    """The cross-validation of every estimator's grid parameters over the trials (groups: each
+    trial's BROAD groups). peers: name -> f(acc, gyro, rate, delay) giving the up direction,
+    scored on the same trials. progress(label) is called after each trial. measured: peer
+    name -> trial -> RMSE already measured on these trials (the evaluation's own columns),
+    which are not run again. grid: the parameters to choose again per fold and their values
+    (CV_GRID; check_grid says whether one is valid); an estimator without a parameter of it
+    leaves that one out."""
     measured = measured or {}
+    grid = CV_GRID if grid is None else grid
+    check_grid(grid, estimators)
     names = [t.name for t in trials]
     folds = {t.name: fold_of(g) for t, g in zip(trials, groups, strict=True)}
     present = [f for f in FOLDS if f in folds.values()]
@@ -148,14 +162,14 @@ def cross_validate(
         if key not in CV_ESTIMATORS:
             raise ValueError(f"--cv covers {', '.join(CV_ESTIMATORS)}, not {key}")
         specs = ESTIMATORS[key].param_specs()
-        keys = [k for k in CV_GRID if k in specs]  # the mgcf has no slow band
-        grid = [dict(zip(keys, values, strict=True))
-                for values in itertools.product(*(CV_GRID[k] for k in keys))]
+        keys = [k for k in grid if k in specs]  # the mgcf has no slow band
+        points = [dict(zip(keys, values, strict=True))
+                  for values in itertools.product(*(grid[k] for k in keys))]
         defaults = {k: float(specs[k].default) for k in keys}
-        cv = EstimatorCv(key, defaults, grid=grid, errors=np.zeros((len(grid), len(trials))))
-        at_default = grid.index(defaults) if defaults in grid else None
+        cv = EstimatorCv(key, defaults, grid=points, errors=np.zeros((len(points), len(trials))))
+        at_default = points.index(defaults) if defaults in points else None
         for j, trial in enumerate(trials):
-            for i, point in enumerate(grid):
+            for i, point in enumerate(points):
                 r = run_fusion_core(key, point, trial)
                 cv.errors[i, j] = _rmse(trial, r["roll"], r["pitch"])
             if at_default is None:  # defaults off the grid: run them too
@@ -165,11 +179,11 @@ def cross_validate(
                 cv.in_sample[trial.name] = float(cv.errors[at_default, j])
             if progress is not None:
                 progress(f"{key} {trial.name[:28]}")
-        cv.scan_choice = grid[int(np.argmin(cv.errors.mean(axis=1)))]
+        cv.scan_choice = points[int(np.argmin(cv.errors.mean(axis=1)))]
         for fold in present:
             train = [j for j, n in enumerate(names) if folds[n] != fold]
             best = int(np.argmin(cv.errors[:, train].mean(axis=1)))
-            cv.chosen[fold] = grid[best]
+            cv.chosen[fold] = points[best]
             for j, n in enumerate(names):
                 if folds[n] == fold:
                     cv.held_out[n] = float(cv.errors[best, j])
@@ -186,7 +200,43 @@ def cross_validate(
                 up, gravity_from_quat(trial.opt_quat), trial.movement)
             if progress is not None:
                 progress(f"{name} {trial.name[:28]}")
-    return CvResult(names, folds, out, peer_rows)
+    return CvResult(names, folds, out, peer_rows, {k: [float(v) for v in grid[k]] for k in grid})
+
+
+def check_grid(grid: Grid, estimators: Sequence[str]) -> None:
+    """ValueError saying what is wrong unless every parameter of grid belongs to at least one
+    of the estimators and each of its values (at least one) is inside its range there."""
+    for name, values in grid.items():
+        owners = [k for k in estimators if name in ESTIMATORS[k].param_specs()]
+        if not owners:
+            allowed = sorted({n for k in estimators for n in ESTIMATORS[k].param_specs()})
+            raise ValueError(f"--cv-grid: {name} is no parameter of {', '.join(estimators)}; "
+                             f"allowed: {', '.join(allowed)}")
+        if not values:
+            raise ValueError(f"--cv-grid: {name} needs at least one value")
+        for key in owners:
+            spec = ESTIMATORS[key].param_specs()[name]
+            for v in values:
+                try:
+                    spec.validate(v)
+                except ValueError as err:
+                    raise ValueError(f"--cv-grid: {key}: {err}") from None
+
+
+def parse_grid(entries: Sequence[str]) -> dict[str, list[float]]:
+    """--cv-grid's NAME=V1,V2,... entries as a grid; ValueError naming the entry that is not of
+    that form."""
+    grid: dict[str, list[float]] = {}
+    for entry in entries:
+        name, sep, values = entry.partition("=")
+        try:
+            if not sep or not name.strip():
+                raise ValueError
+            grid[name.strip()] = [float(v) for v in values.split(",") if v.strip()]
+        except ValueError:
+            raise ValueError(f"--cv-grid {entry!r}: expected NAME=V1,V2,... with numbers, e.g. "
+                             f"acc_lowpass=1,1.5,2") from None
+    return grid
 
 
 def cv_table(result: CvResult) -> str:
@@ -205,8 +255,8 @@ def cv_table(result: CvResult) -> str:
         cells = " ".join(f"{result.fold_mean(values, f):18.3f}" for f in present)
         lines.append(f"{name:10s} {'(no fit)':10s} {cells} {np.mean(list(values.values())):7.3f}")
     lines.append("")
-    lines.append("chosen without each fold (" + ", ".join(CV_GRID) + " where the estimator "
-                 "has it):")
+    lines.append("chosen without each fold (" + ", ".join(result.grid) + " where the "
+                 "estimator has it):")
     for key, e in result.estimators.items():
         chosen = "; ".join(f"{f}: " + "/".join(f"{v:g}" for v in e.chosen[f].values())
                            for f in present)
@@ -217,5 +267,5 @@ def cv_table(result: CvResult) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["CV_ESTIMATORS", "CV_GRID", "FOLDS", "CvResult", "EstimatorCv", "cross_validate",
-           "cv_table", "fold_of"]
+__all__ = ["CV_ESTIMATORS", "CV_GRID", "FOLDS", "CvResult", "EstimatorCv", "Grid", "check_grid",
+           "cross_validate", "cv_table", "fold_of", "parse_grid"]
