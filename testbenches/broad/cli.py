@@ -65,9 +65,11 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "adds cv_mean_inclination_rmse_deg to report.json (testbenches.broad.cv)")
     p.add_argument("--cv-grid", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="cross-validate these parameters and values instead (repeat for several; "
-                   "implies --cv): e.g. --cv-grid scale_time=0.25,0.5,1 for a parameter of your "
-                   "own, on your own recordings (default: acc_lowpass=1,1.5,2, "
-                   "slow_band_time=0.05,0.1,0.15,0.3 and scale_time=0.25,0.5,1)")
+                   "implies --cv): e.g. --cv-grid scale_time=0.25,0.5,1 --cv-grid "
+                   "max_correction_time=1,3,10 (default: acc_lowpass=1,1.5,2, "
+                   "slow_band_time=0.05,0.1,0.15,0.3 and scale_time=0.25,0.5,1). The trials may be "
+                   "recordings of one's own in BROAD's format, their motion groups in their names "
+                   "or a trials.json")
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
                    "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
