@@ -221,3 +221,18 @@ def test_bench_json_says_which_core_ran(bench_json: dict) -> None:
 
     assert bench_json["core"]["kind"] == "python"
     assert bench_json["core"]["native"] == native.available()
+
+
+def test_batch_loop_runs_one_estimators_batch_for_a_profiler(
+    capsys: pytest.CaptureFixture[str]
+) -> None:
+    from benchmarks import batch_loop
+    from fusion_core import native
+
+    if not native.available():
+        pytest.skip(f"the C twin is not available: {native.reason()}")
+    assert batch_loop.main(["kf", "--samples", "500", "--repeat", "2"]) == 0
+    assert capsys.readouterr().out.startswith("kf: ")
+    with pytest.raises(SystemExit):
+        batch_loop.main(["no_such_filter"])
+    assert "allowed cf, mgcf, kf, ukf, poskf" in capsys.readouterr().err
