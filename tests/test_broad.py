@@ -366,19 +366,21 @@ def test_cv_grid_cross_validates_the_parameters_given(
         assert cv["cv_held_out_deg"][trial] == pytest.approx(_rmse(t, r["roll"], r["pitch"]))
 
 
-@pytest.mark.parametrize(("entry", "says"), [
-    ("scale_time", "expected NAME=V1,V2,... with numbers"),
-    ("scale_time=fast", "expected NAME=V1,V2,... with numbers"),
-    ("no_such=1", "no_such is no parameter of kf; allowed: "),
-    ("scale_time=-1", "kf: parameter 'scale_time'=-1.0 is out of range"),
-    ("scale_time=", "scale_time needs at least one value"),
+@pytest.mark.parametrize(("entries", "says"), [
+    (["scale_time"], "expected NAME=V1,V2,... with numbers"),
+    (["scale_time=fast"], "expected NAME=V1,V2,... with numbers"),
+    (["no_such=1"], "no_such is no parameter of kf; allowed: "),
+    (["scale_time=-1"], "kf: parameter 'scale_time'=-1.0 is out of range"),
+    (["scale_time="], "scale_time needs at least one value"),
+    (["scale_time=0.5", "scale_time=1"], "scale_time is given twice"),
 ])
 def test_cv_grid_refuses_a_bad_entry_before_any_run(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], entry: str, says: str
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], entries: list[str], says: str
 ) -> None:
     a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
     out = tmp_path / "report"
+    grid = [arg for entry in entries for arg in ("--cv-grid", entry)]
     assert main(["broad", str(a), "--estimator", "kf", "--no-plots", "--out", str(out),
-                 "--cv-grid", entry]) == 2
+                 *grid]) == 2
     assert says in capsys.readouterr().err
     assert not out.exists()

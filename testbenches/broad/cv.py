@@ -236,10 +236,14 @@ def parse_grid(entries: Sequence[str]) -> dict[str, list[float]]:
         try:
             if not sep or not name.strip():
                 raise ValueError
-            grid[name.strip()] = [float(v) for v in values.split(",") if v.strip()]
+            parsed = [float(v) for v in values.split(",") if v.strip()]
         except ValueError:
             raise ValueError(f"--cv-grid {entry!r}: expected NAME=V1,V2,... with numbers, e.g. "
                              f"acc_lowpass=1,1.5,2") from None
+        if name.strip() in grid:
+            raise ValueError(f"--cv-grid: {name.strip()} is given twice; give its values once, "
+                             f"comma-separated")
+        grid[name.strip()] = parsed
     return grid
 
 
