@@ -353,7 +353,8 @@ def test_cv_grid_cross_validates_the_parameters_given(
     out = tmp_path / "report"
     assert main(["broad", str(a), str(b), "--estimator", "kf", "--no-plots", "--out", str(out),
                  "--cv-grid", "scale_time=0.25,0.5"]) == 0
-    assert "(scale_time where the estimator has it)" in capsys.readouterr().out
+    assert "(scale_time where the estimator has it; among the points that keep" in \
+        capsys.readouterr().out
     doc = json.loads((out / "cv.json").read_text())
     assert doc["grid"] == {"scale_time": [0.25, 0.5]}
     cv = doc["estimators"]["kf"]
@@ -384,3 +385,54 @@ def test_cv_grid_refuses_a_bad_entry_before_any_run(
                  *grid]) == 2
     assert says in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_contract_constraint_names_the_first_check_a_point_fails() -> None:
+    """The defaults keep the contract's per-run accuracy bounds (make run); the kf with a 2 s
+    measured vector turns too slowly for the roll sweep's bound, and the reason says so."""
+    from testbenches.broad.feasible import contract_failure
+
+    assert contract_failure("kf", {}) is None
+    why = contract_failure("kf", {"acc_lowpass": 2.0})
+    assert why is not None and why.startswith("roll_sweep: FAIL accuracy roll RMSE")
+
+
+def test_a_fold_chooses_the_best_point_the_constraint_allows(tmp_path: Path) -> None:
+    """With the best point of every fold refused, each fold takes the next best by its own
+    training mean, the refusal is recorded with its reason, and without a constraint the
+    refused point is chosen again."""
+    from testbenches.broad.cv import cross_validate
+    from testbenches.broad.data import load_trial
+
+    trials = [load_trial(write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")),
+              load_trial(write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0,
+                                     MAT_TRIAL))]
+    groups = [["undisturbed", "translation", "slow"], ["undisturbed", "rotation", "slow"]]
+    grid = {"scale_time": [0.1, 0.5, 2.0]}
+    free = cross_validate(trials, groups, ["kf"], grid=grid, constraint=None)
+    e = free.estimators["kf"]
+    refused = {fold: point["scale_time"] for fold, point in e.chosen.items()}
+
+    def refuse(key: str, point: dict[str, float]) -> str | None:
+        return "refused here" if point["scale_time"] in refused.values() else None
+
+    held = cross_validate(trials, groups, ["kf"], grid=grid, constraint=refuse).estimators["kf"]
+    assert not free.estimators["kf"].refused and held.refused
+    assert set(held.refused.values()) == {"refused here"}
+    for fold, point in held.chosen.items():
+        assert point["scale_time"] not in refused.values()
+        train = [j for j, t in enumerate(trials) if free.folds[t.name] != fold]
+        allowed = [i for i, p in enumerate(e.grid) if p["scale_time"] not in refused.values()]
+        best = min(allowed, key=lambda i: e.errors[i, train].mean())
+        assert point == e.grid[best]
+
+
+def test_cv_unconstrained_is_said_in_cv_json(tmp_path: Path) -> None:
+    a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
+    b = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL)
+    out = tmp_path / "report"
+    assert main(["broad", str(a), str(b), "--estimator", "kf", "--no-plots", "--out", str(out),
+                 "--cv-unconstrained", "--cv-grid", "scale_time=0.25,0.5"]) == 0
+    doc = json.loads((out / "cv.json").read_text())
+    assert doc["constrained_by_contract"] is False
+    assert doc["estimators"]["kf"]["refused_by_contract"] == {}

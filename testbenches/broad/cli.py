@@ -70,6 +70,10 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "slow_band_time=0.05,0.1,0.15,0.3 and scale_time=0.25,0.5,1). The trials may be "
                    "recordings of one's own in BROAD's format, their motion groups in their names "
                    "or a trials.json")
+    p.add_argument("--cv-unconstrained", action="store_true",
+                   help="let each fold choose any grid point, also one that fails the contract's "
+                   "accuracy bounds on the realistic sensor (by default a fold chooses the best "
+                   "point that keeps them: testbenches.broad.feasible); implies --cv")
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
                    "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
@@ -98,6 +102,7 @@ def cmd_broad(args: argparse.Namespace) -> int:
         grid = parse_grid(args.cv_grid)
         check_grid(grid, [k for k in estimators if k in CV_ESTIMATORS] or list(CV_ESTIMATORS))
         args.cv = True
+    args.cv = args.cv or args.cv_unconstrained
     presets = list(PRESETS) if args.preset == "all" else [p for p in args.preset.split(",") if p]
     peers = [*PEERS, *AHEAD_PEERS] if args.peers else []
     try:
@@ -121,8 +126,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
                           progress=progress)
     print(table(result))
-    cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid)
-          if args.cv else None)
+    cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid,
+                           constrained=not args.cv_unconstrained) if args.cv else None)
     extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
     paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
@@ -139,16 +144,19 @@ def cmd_broad(args: argparse.Namespace) -> int:
 
 
 def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
-                     out: Path, peers: bool, grid: Grid | None = None) -> CvResult | None:
+                     out: Path, peers: bool, grid: Grid | None = None,
+                     constrained: bool = True) -> CvResult | None:
     """The cross-validation (testbenches.broad.cv) of the estimators that have one over grid
-    (None: CV_GRID), written to DIR/cv.json; None where none has. The peer the evaluation ran
-    already is taken from it."""
+    (None: CV_GRID), each choice among the points that keep the contract where constrained,
+    written to DIR/cv.json; None where none has. The peer the evaluation ran already is taken
+    from it."""
     import json
 
     from tqdm import tqdm
 
     from ..peers import AHEAD_PEERS
     from .cv import CV_ESTIMATORS, cross_validate
+    from .feasible import contract_failure
 
     keys = [k for k in estimators if k in CV_ESTIMATORS]
     if not keys:
@@ -160,7 +168,8 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
               total=len(trials) * len(keys) + (len(trials) if peers else 0)) as bar:
         cv = cross_validate(trials, groups, keys,
                             {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]} if peers else None,
-                            lambda label: bar.update(), measured, grid)
+                            lambda label: bar.update(), measured, grid,
+                            contract_failure if constrained else None)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
     return cv
