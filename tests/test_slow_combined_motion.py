@@ -1,0 +1,89 @@
+"""A combined motion whose translation is slower than the measured vector: the weakness BROAD's
+combined trial (32: rotation at about 2 rad/s with about 1 m/s2 of slow linear acceleration)
+shows against VQF, reproduced on the realistic sensor, and held as a target.
+
+A linear acceleration slower than acc_lowpass passes the measured vector whole, and the slow
+band (a short low-pass against the full-length one) cannot see what both pass, so the filters
+trust a vector that is off. The test fails the day the Kalman filters reach VQF's RMSE plus
+10 % there (the rule of the shaking and gyro_clipping scenarios); then it becomes a contract
+scenario.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from fusion_core import ESTIMATORS, synthetic
+from fusion_core.sensor import ImuSensorModel
+from fusion_core.synthetic import Signal, Trajectory, add, sine
+from fusion_core.types import DEG
+from testbenches.broad.metric import gravity_from_roll_pitch, inclination_error
+
+RATE = 100.0
+DURATION = 120.0
+PARTS = range(6)
+SETTLE = 5.0
+"""Seconds left out at the start: the fill of the measured vector and VQF's start."""
+
+
+Up = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+"""A filter run: acc, gyro [N, 3], dt [N] -> the up direction [N, 3]."""
+
+
+def _accel_sine(acc: float, freq: float, phase: float = 0.0) -> Signal:
+    return sine(acc / (2.0 * math.pi * freq) ** 2, freq, phase)
+
+
+def slow_combined() -> Trajectory:
+    """Turns of +-60 deg at 0.5 Hz (and slower tones) while the sensor is carried back and forth
+    by 0.6-1 m/s2 at 0.12-0.2 Hz: periods of 5-8 s, longer than the measured vector's 1.5 s."""
+    return Trajectory(
+        roll=add(sine(60 * DEG, 0.5), sine(20 * DEG, 0.13, 0.7)),
+        pitch=add(sine(42 * DEG, 0.4, 1.0), sine(10 * DEG, 0.11)),
+        yaw=sine(60 * DEG, 0.07),
+        pos=(_accel_sine(1.0, 0.15), _accel_sine(0.8, 0.195, 1.1), _accel_sine(0.6, 0.135, 0.4)),
+    )
+
+
+def mean_rmse_deg(run: Up) -> float:
+    """The inclination RMSE [deg] after SETTLE, averaged over the parts; run(acc, gyro, dt)
+    gives the up direction [N, 3]."""
+    out = []
+    for seed in PARTS:
+        rec = synthetic.record(slow_combined(), DURATION, RATE, seed=seed)
+        s = ImuSensorModel(seed=seed).run(rec["omega"], rec["f"], rec["dt"])
+        up = run(s["acc"], s["gyro"], s["dt"])
+        err = inclination_error(up, gravity_from_roll_pitch(rec["roll"], rec["pitch"]))
+        keep = np.arange(len(err)) / RATE >= SETTLE
+        out.append(math.degrees(math.sqrt(float(np.mean(err[keep] ** 2)))))
+    return float(np.mean(out))
+
+
+def ours(key: str) -> Up:
+    def run(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> np.ndarray:
+        o = ESTIMATORS[key]().run(acc, gyro, dt)
+        return gravity_from_roll_pitch(o["roll"], o["pitch"])
+    return run
+
+
+NOT_MET = ("not met yet: kf 2.82 and ukf 2.78 deg against VQF 1.76 (+10 %: 1.94); the cf 2.62; "
+           "with the translation at 0.3 Hz all are level with VQF (docs/results/broad.md, "
+           "trial 32)")
+
+
+@pytest.mark.parametrize("key", ["kf", "ukf"])
+@pytest.mark.xfail(strict=True, reason=NOT_MET)
+def test_the_kalman_filters_are_within_vqf_plus_ten_percent_on_slow_combined_motion(
+    key: str
+) -> None:
+    pytest.importorskip("vqf")
+    from testbenches.peers import PEERS
+
+    vqf = mean_rmse_deg(lambda acc, gyro, dt: PEERS["vqf"](acc, gyro, RATE))
+    mine = mean_rmse_deg(ours(key))
+    print(f"\n{key} {mine:.3f} deg against VQF {vqf:.3f}")
+    assert mine <= 1.1 * vqf
