@@ -380,6 +380,12 @@ def test_cv_grid_cross_validates_the_parameters_given(
     doc = json.loads((out / "cv.json").read_text())
     assert doc["grid"] == {"scale_time": [0.25, 0.5]}
     cv = doc["estimators"]["kf"]
+    assert cv["grid_points"] == [{"scale_time": 0.25}, {"scale_time": 0.5}]
+    assert len(cv["grid_errors_deg"]) == 2 and len(doc["trials"]) == 2
+    for point, row in zip(cv["grid_points"], cv["grid_errors_deg"], strict=True):
+        for trial, err in zip(doc["trials"], row, strict=True):
+            if cv["chosen_per_fold"][doc["folds"][trial]] == point:
+                assert err == pytest.approx(cv["cv_held_out_deg"][trial])
     assert cv["defaults"] == {"scale_time": 0.5}
     for fold, point in cv["chosen_per_fold"].items():
         assert set(point) == {"scale_time"} and point["scale_time"] in (0.25, 0.5)
@@ -458,3 +464,15 @@ def test_cv_unconstrained_is_said_in_cv_json(tmp_path: Path) -> None:
     doc = json.loads((out / "cv.json").read_text())
     assert doc["constrained_by_contract"] is False
     assert doc["estimators"]["kf"]["refused_by_contract"] == {}
+
+
+def test_cv_draws_in_sample_against_cross_validated_per_fold(tmp_path: Path) -> None:
+    a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
+    b = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL)
+    out = tmp_path / "report"
+    assert main(["broad", str(a), str(b), "--estimator", "kf", "--out", str(out),
+                 "--cv-grid", "scale_time=0.25,0.5"]) == 0
+    assert (out / "cv.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["broad", str(a), str(b), "--estimator", "kf", "--out", str(tmp_path / "np"),
+                 "--no-plots", "--cv-grid", "scale_time=0.25,0.5"]) == 0
+    assert not (tmp_path / "np" / "cv.png").exists()

@@ -127,7 +127,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
                           progress=progress)
     print(table(result))
     cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid,
-                           constrained=not args.cv_unconstrained) if args.cv else None)
+                           constrained=not args.cv_unconstrained, plot=not args.no_plots)
+          if args.cv else None)
     extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
     paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
@@ -145,11 +146,11 @@ def cmd_broad(args: argparse.Namespace) -> int:
 
 def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
                      out: Path, peers: bool, grid: Grid | None = None,
-                     constrained: bool = True) -> CvResult | None:
+                     constrained: bool = True, plot: bool = True) -> CvResult | None:
     """The cross-validation (testbenches.broad.cv) of the estimators that have one over grid
     (None: CV_GRID), each choice among the points that keep the contract where constrained,
-    written to DIR/cv.json; None where none has. The peer the evaluation ran already is taken
-    from it."""
+    written to DIR/cv.json (and with plot DIR/cv.png); None where none has. The peer the
+    evaluation ran already is taken from it."""
     import json
 
     from tqdm import tqdm
@@ -172,6 +173,10 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
                             contract_failure if constrained else None)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
+    if plot:
+        from .cv import plot_cv
+
+        plot_cv(cv, out / "cv.png")
     return cv
 
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -80,7 +81,8 @@ class EstimatorCv:
     """trial -> RMSE [deg] of the defaults."""
     grid: list[dict[str, float]] = field(default_factory=list)
     errors: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    """[grid point, trial] RMSE [deg]."""
+    """[grid point, trial] RMSE [deg] (cv.json: grid_errors_deg, its columns cv.json's
+    trials)."""
     chosen: dict[str, dict[str, float]] = field(default_factory=dict)
     """fold -> the grid point chosen without it."""
     held_out: dict[str, float] = field(default_factory=dict)
@@ -106,7 +108,9 @@ class EstimatorCv:
                 "cv_held_out_deg": self.held_out, "chosen_per_fold": self.chosen,
                 "in_sample_mean_deg": self.in_sample_mean(), "cv_mean_deg": self.cv_mean(),
                 "scan_choice": self.scan_choice, "scan_minimum_mean_deg": self.scan_mean(),
-                "refused_by_contract": self.refused}
+                "refused_by_contract": self.refused,
+                "grid_points": self.grid,
+                "grid_errors_deg": [[float(v) for v in row] for row in self.errors]}
 
 
 @dataclass
@@ -140,6 +144,7 @@ class CvResult:
                          "bounds" if self.constrained else ""),
             "constrained_by_contract": self.constrained,
             "grid": self.grid,  # each estimator: those it has
+            "trials": self.trials,  # the columns of each grid_errors_deg
             "folds": self.folds,
             "estimators": {k: e.as_dict() for k, e in self.estimators.items()},
             "peers": self.peers,
@@ -321,5 +326,46 @@ def cv_table(result: CvResult) -> str:
     return "\n".join(lines)
 
 
+def plot_cv(result: CvResult, path: Path) -> None:
+    """Bars per motion fold and over all trials: each estimator's in-sample figure (light) and
+    cross-validated one (dark) side by side, each peer's as a dashed line across its group."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    present = [f for f in FOLDS if f in result.folds.values()]
+    groups = [*present, "all"]
+
+    def figure(values: dict[str, float], group: str) -> float:
+        return (float(np.mean(list(values.values()))) if group == "all"
+                else result.fold_mean(values, group))
+
+    keys = list(result.estimators)
+    x = np.arange(len(groups))
+    width = 0.8 / max(1, 2 * len(keys))
+    fig, ax = plt.subplots(figsize=(3.0 + 1.6 * len(groups), 4.5))
+    for i, key in enumerate(keys):
+        e = result.estimators[key]
+        color = plt.cm.tab10(i % 10)
+        base = x + (2 * i - (2 * len(keys) - 1) / 2) * width
+        ax.bar(base, [figure(e.in_sample, g) for g in groups], width, color=color, alpha=0.35,
+               label=f"{key} in sample")
+        ax.bar(base + width, [figure(e.held_out, g) for g in groups], width, color=color,
+               label=f"{key} cross-validated")
+    for j, (name, values) in enumerate(result.peers.items()):
+        for k, g in enumerate(groups):
+            ax.hlines(figure(values, g), x[k] - 0.42, x[k] + 0.42, colors="k",
+                      linestyles="--" if j == 0 else ":", label=name if k == 0 else None)
+    ax.set_xticks(x, [g.replace("_", " ") for g in groups], fontsize=8)
+    ax.set_ylabel("mean inclination RMSE [deg]")
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize=7, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.12))
+    ax.set_title("BROAD, leave one motion fold out: in sample against cross-validated")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 __all__ = ["CV_ESTIMATORS", "CV_GRID", "FOLDS", "CvResult", "EstimatorCv", "Grid", "check_grid",
-           "cross_validate", "cv_table", "fold_of", "parse_grid"]
+           "cross_validate", "cv_table", "fold_of", "parse_grid", "plot_cv"]
