@@ -205,31 +205,12 @@ def cross_validate(
                 cv.in_sample[trial.name] = float(cv.errors[at_default, j])
             if progress is not None:
                 progress(f"{key} {trial.name[:28]}")
-        verdicts: dict[int, str | None] = {}
+        allowed = _Allowed(key, points, constraint)
 
-        def best(columns: list[int], cv: EstimatorCv = cv, key: str = key,
-                 points: list[dict[str, float]] = points,
-                 verdicts: dict[int, str | None] = verdicts) -> int:
-            """The grid point with the lowest mean over these trials that the constraint
-            allows."""
-            for i in np.argsort(cv.errors[:, columns].mean(axis=1), kind="stable"):
-                i = int(i)
-                if constraint is None:
-                    return i
-                if i not in verdicts:
-                    verdicts[i] = constraint(key, points[i])
-                why = verdicts[i]
-                if why is None:
-                    return i
-                cv.refused[_point_label(points[i])] = why
-            raise ValueError(f"no grid point of {key} keeps the contract (e.g. "
-                             f"{next(iter(cv.refused.values()))}): give values nearer its "
-                             f"defaults")
-
-        cv.scan_choice = points[best(list(range(len(trials))))]
+        cv.scan_choice = points[_best_allowed(cv, list(range(len(trials))), allowed)]
         for fold in present:
             train = [j for j, n in enumerate(names) if folds[n] != fold]
-            chosen = best(train)
+            chosen = _best_allowed(cv, train, allowed)
             cv.chosen[fold] = points[chosen]
             for j, n in enumerate(names):
                 if folds[n] == fold:
@@ -253,6 +234,36 @@ def cross_validate(
 
 def _point_label(point: dict[str, float]) -> str:
     return ", ".join(f"{k}={v:g}" for k, v in point.items())
+
+
+@dataclass
+class _Allowed:
+    """Why grid point i of an estimator may not be chosen (None: it may), each point judged
+    once."""
+
+    key: str
+    points: list[dict[str, float]]
+    constraint: Callable[[str, dict[str, float]], str | None] | None
+    verdicts: dict[int, str | None] = field(default_factory=dict)
+
+    def __call__(self, i: int) -> str | None:
+        if self.constraint is None:
+            return None
+        if i not in self.verdicts:
+            self.verdicts[i] = self.constraint(self.key, self.points[i])
+        return self.verdicts[i]
+
+
+def _best_allowed(cv: EstimatorCv, columns: list[int], allowed: _Allowed) -> int:
+    """The grid point with the lowest mean over these trials' columns that allowed lets be
+    chosen; the refused ones better than it go to cv.refused with the reason."""
+    for i in np.argsort(cv.errors[:, columns].mean(axis=1), kind="stable"):
+        why = allowed(int(i))
+        if why is None:
+            return int(i)
+        cv.refused[_point_label(allowed.points[int(i)])] = why
+    raise ValueError(f"no grid point of {allowed.key} keeps the contract (e.g. "
+                     f"{next(iter(cv.refused.values()))}): give values nearer its defaults")
 
 
 def check_grid(grid: Grid, estimators: Sequence[str]) -> None:
