@@ -125,13 +125,13 @@ void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
 /* measure_step: one sample a; returns the measurement noise r [rad^2], *filling whether the
  * vector is still filling */
+fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
+                       const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
+                       int *filling);
 /* fill_noise: while the vector fills, its tilt variance and its samples' mean age [s], from
  * measure_step's noise r */
 void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,
                            const fc_meas_constants *c, fc_real *var, fc_real *age);
-fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
-                       const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
-                       int *filling);
 /* Measure.settled */
 int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* raw_noise */

@@ -60,9 +60,9 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="cross-validate the defaults: each parameter a scan chooses (acc_lowpass, "
                    "slow_band_time, scale_time) chosen again without each motion fold (slow "
                    "rotation, fast rotation, translation, disturbed/combined) and scored on it; "
-                   "prints the "
-                   "cross-validated mean beside the in-sample one (and VQF's with --peers) and "
-                   "adds cv_mean_inclination_rmse_deg to report.json (testbenches.broad.cv)")
+                   "prints the cross-validated mean beside the in-sample one (and VQF's with "
+                   "--peers) and adds cv_mean_inclination_rmse_deg to report.json "
+                   "(testbenches.broad.cv)")
     p.add_argument("--cv-grid", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="cross-validate these parameters and values instead (repeat for several; "
                    "implies --cv): e.g. --cv-grid scale_time=0.25,0.5,1 --cv-grid "
@@ -95,14 +95,13 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from .run import collect_paths, evaluate, plan_columns
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
+    run_cv = args.cv or bool(args.cv_grid) or args.cv_unconstrained
     grid = None
     if args.cv_grid:  # refused before any run
         from .cv import CV_ESTIMATORS, check_grid, parse_grid
 
         grid = parse_grid(args.cv_grid)
         check_grid(grid, [k for k in estimators if k in CV_ESTIMATORS] or list(CV_ESTIMATORS))
-        args.cv = True
-    args.cv = args.cv or args.cv_unconstrained
     presets = list(PRESETS) if args.preset == "all" else [p for p in args.preset.split(",") if p]
     peers = [*PEERS, *AHEAD_PEERS] if args.peers else []
     try:
@@ -128,13 +127,13 @@ def cmd_broad(args: argparse.Namespace) -> int:
     print(table(result))
     cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid,
                            constrained=not args.cv_unconstrained, plot=not args.no_plots)
-          if args.cv else None)
+          if run_cv else None)
     extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
     paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))
     print("reports: " + ", ".join(str(p) for p in paths.values()))
-    if args.cv:
+    if run_cv:
         from .cv import cv_table
 
         print("\n" + (cv_table(cv) if cv is not None else
