@@ -68,6 +68,27 @@ its white noise and quantisation off too."""
 PAPER_MODERATE = {"cf": (1.84, 2.03), "mgcf": (1.07, 1.32), "ukf": (0.35, 0.41),
                   "kf": (1.84, 2.03), "poskf": (1.84, 2.03)}
 """Duong Quoc et al., moderate dynamics, roll/pitch RMSE [deg]; Kalman filters held to CCF's."""
+DEFAULTS_MODERATE_SHARE = 0.5
+"""The defaults on the realistic sensor, moderate_dynamics: at most this share of the paper's row
+(tests/test_paper_rows.py), which a filter with the sensor's noise, bias prior and measured
+vector owes the papers' unmodelled one; a cross-validation keeps it where the defaults do
+(testbenches.broad.feasible)."""
+DEFAULTS_MODERATE_NOT_MET = {
+    "ukf": "not met yet: 0.24/0.20 against 0.175/0.205 (roll); perfect samples of the motion "
+           "give 0.13/0.12, and the realistic gyro's scale and cross-axis errors, which the "
+           "UKF's bias states chase, most of the rest (0.07/0.21 on the ideal sensor); over 200 "
+           "parts no part meets it, nor does VQF on any (docs/guide/campaigns.md)",
+}
+"""Estimators whose defaults do not meet DEFAULTS_MODERATE_SHARE yet, with what they give."""
+
+
+def defaults_moderate_limits(estimator: str) -> tuple[float, float] | None:
+    """Roll/pitch RMSE [deg] the defaults owe moderate_dynamics on the realistic sensor, None
+    where they do not meet it yet (DEFAULTS_MODERATE_NOT_MET)."""
+    if estimator in DEFAULTS_MODERATE_NOT_MET:
+        return None
+    roll, pitch = PAPER_MODERATE[estimator]
+    return DEFAULTS_MODERATE_SHARE * roll, DEFAULTS_MODERATE_SHARE * pitch
 
 # Bounds for the other scenarios [deg, RMSE roll/pitch], with their reasons:
 STATIC = (0.1, 0.1)

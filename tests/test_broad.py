@@ -10,6 +10,7 @@ import math
 import os
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -222,26 +223,44 @@ def test_the_defaults_meet_the_broad_targets_on_the_13_shared_trials() -> None:
     assert abs(means["poskf"] - means["kf"]) <= 0.05, means
 
 
-@pytest.mark.skipif(len(ALL_TRIALS) != 13, reason=f"the 13 shared BROAD trials are not all in "
-                    f"{DATA} (found {len(ALL_TRIALS)})")
-@pytest.mark.slow
-def test_cross_validated_the_best_default_is_level_with_vqf_on_the_13_shared_trials() -> None:
-    """Issue 32's targets that hold: with every scanned parameter chosen again without each
-    motion fold (among the points the contract allows), each attitude filter's mean stays at
-    most 0.60 deg and the best at most VQF's with the same output prediction (0.545, nothing to
-    fit)."""
+@pytest.fixture(scope="module")
+def shared_cv() -> Any:
+    """The cross-validation of the attitude filters' defaults over the 13 shared trials, VQF
+    with the output prediction beside them (about 50 s)."""
     from testbenches.broad.cv import CV_ESTIMATORS, cross_validate
     from testbenches.peers import AHEAD_PEERS
 
+    if len(ALL_TRIALS) != 13:
+        pytest.skip(f"the 13 shared BROAD trials are not all in {DATA} (found {len(ALL_TRIALS)})")
     pytest.importorskip("vqf")
     trials = [load_trial(p) for p in ALL_TRIALS]
     groups = [t.groups for t in evaluate(trials, plan_columns(["kf"], ["recommended"])).trials]
-    result = cross_validate(trials, groups, CV_ESTIMATORS,
-                            {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]})
-    cv = result.cv_means()
-    vqf = float(np.mean(list(result.peers["vqf-ahead"].values())))
+    return cross_validate(trials, groups, CV_ESTIMATORS, {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]})
+
+
+@pytest.mark.slow
+def test_cross_validated_the_defaults_meet_issue_32s_targets(shared_cv: Any) -> None:
+    """Issue 32's targets on the 13 shared trials, every scanned parameter chosen again without
+    each motion fold (by regret, among the points the contract allows): the best at most
+    0.53 deg and at most VQF's with the same output prediction (0.545, nothing to fit), each
+    attitude filter at most 0.60, and cross-validated minus in-sample at most 0.02 deg for the
+    mgcf, kf and ukf (the cf's: test_the_cfs_cross_validated_gap)."""
+    cv = shared_cv.cv_means()
+    vqf = float(np.mean(list(shared_cv.peers["vqf-ahead"].values())))
     assert all(v <= 0.60 for v in cv.values()), cv
-    assert min(cv.values()) <= vqf, (cv, vqf)
+    assert min(cv.values()) <= min(0.53, vqf), (cv, vqf)
+    for key in ("mgcf", "kf", "ukf"):
+        e = shared_cv.estimators[key]
+        assert e.cv_mean() - e.in_sample_mean() <= 0.02, (key, e.cv_mean(), e.in_sample_mean())
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="not met yet: 0.539 cross-validated against 0.518 in "
+                   "sample (0.021); without the disturbed fold the others choose the longer slow "
+                   "band and less rotation noise (1.5/0.3/0.25), which costs that fold 0.06 deg")
+def test_the_cfs_cross_validated_gap(shared_cv: Any) -> None:
+    e = shared_cv.estimators["cf"]
+    assert e.cv_mean() - e.in_sample_mean() <= 0.02, (e.cv_mean(), e.in_sample_mean())
 
 
 def test_cli_on_one_trial_slice_prints_the_table_and_writes_the_reports(
@@ -425,6 +444,18 @@ def test_the_contract_constraint_names_the_first_check_a_point_fails() -> None:
     assert why is not None and why.startswith("roll_sweep: FAIL accuracy roll RMSE")
 
 
+def test_the_constraint_keeps_the_share_of_the_papers_row_the_defaults_owe() -> None:
+    """The mgcf's defaults meet half the paper's moderate_dynamics row on the realistic sensor
+    (tests/test_paper_rows.py); its 1.5 s measured vector leaves it in pitch, which the
+    contract's own bound (the whole row) allows, and the constraint says so."""
+    from testbenches.broad.feasible import contract_failure
+
+    assert contract_failure("mgcf", {}) is None
+    why = contract_failure("mgcf", {"acc_lowpass": 1.5})
+    assert why is not None and why.startswith("moderate_dynamics: FAIL defaults' pitch RMSE")
+    assert "0.5 of the paper's row" in why
+
+
 def test_a_fold_chooses_the_best_point_the_constraint_allows(tmp_path: Path) -> None:
     """With the best point of every fold refused, each fold takes the next best by its own
     training mean, the refusal is recorded with its reason, and without a constraint the
@@ -455,14 +486,45 @@ def test_a_fold_chooses_the_best_point_the_constraint_allows(tmp_path: Path) -> 
         assert point == e.grid[best]
 
 
-def test_cv_unconstrained_is_said_in_cv_json(tmp_path: Path) -> None:
+def test_the_regret_choice_takes_the_point_that_holds_on_every_training_fold() -> None:
+    """Point 3 has the lowest mean over the training trials, carried by the fold with most
+    trials, and is twice the best on another fold; point 1 is at most 22 % above the best on
+    every fold: regret takes point 1, mean point 3. With 1 and 3 refused, the regret counts
+    against the allowed points' best: point 2 is at most 25 % above it on each fold, point 0 33 %
+    on one, so regret takes 2 where mean takes 0."""
+    from testbenches.broad.cv import EstimatorCv, _Allowed, _choose
+
+    folds = [[0, 1, 2, 3], [4], [5]]  # the columns of three training folds
+    errors = np.array([[1.0, 1.0, 1.0, 1.0, 1.4, 0.5],
+                       [1.1, 1.1, 1.1, 1.1, 1.0, 0.5],
+                       [1.25, 1.25, 1.25, 1.25, 1.05, 0.55],
+                       [0.9, 0.9, 0.9, 0.9, 1.0, 1.0]])
+    points = [{"p": float(i)} for i in range(len(errors))]
+    cv = EstimatorCv("kf", {"p": 0.0}, grid=points, errors=errors)
+
+    def free(key: str, point: dict[str, float]) -> str | None:
+        return None
+
+    def no_1_or_3(key: str, point: dict[str, float]) -> str | None:
+        return "refused here" if point["p"] in (1.0, 3.0) else None
+
+    assert _choose(cv, folds, _Allowed("kf", points, free), "mean") == 3
+    assert _choose(cv, folds, _Allowed("kf", points, free), "regret") == 1
+    assert _choose(cv, folds, _Allowed("kf", points, no_1_or_3), "mean") == 0
+    assert _choose(cv, folds, _Allowed("kf", points, no_1_or_3), "regret") == 2
+    assert set(cv.refused) == {"p=1", "p=3"}
+
+
+def test_cv_unconstrained_and_the_choice_are_said_in_cv_json(tmp_path: Path) -> None:
     a = write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5")
     b = write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL)
     out = tmp_path / "report"
     assert main(["broad", str(a), str(b), "--estimator", "kf", "--no-plots", "--out", str(out),
-                 "--cv-unconstrained", "--cv-grid", "scale_time=0.25,0.5"]) == 0
+                 "--cv-unconstrained", "--cv-choice", "mean", "--cv-grid",
+                 "scale_time=0.25,0.5"]) == 0
     doc = json.loads((out / "cv.json").read_text())
-    assert doc["constrained_by_contract"] is False
+    assert doc["constrained_by_contract"] is False and doc["choice"] == "mean"
+    assert "by the lowest training mean" in doc["method"]
     assert doc["estimators"]["kf"]["refused_by_contract"] == {}
 
 

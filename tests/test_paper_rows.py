@@ -9,7 +9,12 @@ import pytest
 
 from fusion_core.presets import KEYS, preset_params
 from fusion_core.sensor import sensor_preset
-from testbenches.contract import PAPER_MODERATE, compute_metrics
+from testbenches.contract import (
+    DEFAULTS_MODERATE_NOT_MET,
+    DEFAULTS_MODERATE_SHARE,
+    PAPER_MODERATE,
+    compute_metrics,
+)
 from testbenches.montecarlo.plan import Run
 from testbenches.montecarlo.simulate import simulate
 
@@ -30,19 +35,11 @@ def test_the_papers_values_on_the_ideal_sensor_are_within_the_papers_row(key: st
     assert roll <= row[0] and pitch <= row[1]
 
 
-HALF_ROW_NOT_MET = {
-    "ukf": "not met yet: 0.24/0.20 against 0.175/0.205 (roll); perfect samples of the motion "
-           "give 0.13/0.12, and the realistic gyro's scale and cross-axis errors, which the "
-           "UKF's bias states chase, most of the rest (0.07/0.21 on the ideal sensor); over 200 "
-           "parts no part meets it, nor does VQF on any (docs/guide/campaigns.md)",
-}
-
-
 @pytest.mark.parametrize("key", [
-    pytest.param(k, marks=pytest.mark.xfail(strict=True, reason=HALF_ROW_NOT_MET[k]))
-    if k in HALF_ROW_NOT_MET else k for k in KEYS])
+    pytest.param(k, marks=pytest.mark.xfail(strict=True, reason=DEFAULTS_MODERATE_NOT_MET[k]))
+    if k in DEFAULTS_MODERATE_NOT_MET else k for k in KEYS])
 def test_the_defaults_on_the_realistic_sensor_are_at_most_half_the_papers_row(key: str) -> None:
     roll, pitch = moderate_rmse(key, "recommended", "realistic")
     row = PAPER_MODERATE[key]
     print(f"\n{key} recommended/realistic {roll:.3f}/{pitch:.3f} against half of {row}")
-    assert roll <= row[0] / 2 and pitch <= row[1] / 2
+    assert roll <= row[0] * DEFAULTS_MODERATE_SHARE and pitch <= row[1] * DEFAULTS_MODERATE_SHARE

@@ -74,6 +74,11 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="let each fold choose any grid point, also one that fails the contract's "
                    "accuracy bounds on the realistic sensor (by default a fold chooses the best "
                    "point that keeps them: testbenches.broad.feasible); implies --cv")
+    p.add_argument("--cv-choice", choices=("regret", "mean"), default=None,
+                   help="how each fold chooses among the grid points: regret (default) takes the "
+                   "point whose worst training fold is least above that fold's best, so that it "
+                   "holds on every kind of motion; mean takes the lowest mean over the training "
+                   "trials (testbenches.broad.cv.CHOICES); implies --cv")
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
                    "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
@@ -95,7 +100,7 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from .run import collect_paths, evaluate, plan_columns
 
     estimators = choose(args.estimator, list(ESTIMATORS), "estimator")
-    run_cv = args.cv or bool(args.cv_grid) or args.cv_unconstrained
+    run_cv = args.cv or bool(args.cv_grid) or args.cv_unconstrained or bool(args.cv_choice)
     grid = None
     if args.cv_grid:  # refused before any run
         from .cv import CV_ESTIMATORS, check_grid, parse_grid
@@ -126,7 +131,8 @@ def cmd_broad(args: argparse.Namespace) -> int:
                           progress=progress)
     print(table(result))
     cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid,
-                           constrained=not args.cv_unconstrained, plot=not args.no_plots)
+                           constrained=not args.cv_unconstrained, plot=not args.no_plots,
+                           choice=args.cv_choice or "regret")
           if run_cv else None)
     extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
     paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
@@ -145,11 +151,12 @@ def cmd_broad(args: argparse.Namespace) -> int:
 
 def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
                      out: Path, peers: bool, grid: Grid | None = None,
-                     constrained: bool = True, plot: bool = True) -> CvResult | None:
+                     constrained: bool = True, plot: bool = True,
+                     choice: str = "regret") -> CvResult | None:
     """The cross-validation (testbenches.broad.cv) of the estimators that have one over grid
-    (None: CV_GRID), each choice among the points that keep the contract where constrained,
-    written to DIR/cv.json (and with plot DIR/cv.png); None where none has. The peer the
-    evaluation ran already is taken from it."""
+    (None: CV_GRID), each fold choosing by choice (cv.CHOICES) among the points that keep the
+    contract where constrained, written to DIR/cv.json (and with plot DIR/cv.png); None where
+    none has. The peer the evaluation ran already is taken from it."""
     import json
 
     from tqdm import tqdm
@@ -169,7 +176,7 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
         cv = cross_validate(trials, groups, keys,
                             {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]} if peers else None,
                             lambda label: bar.update(), measured, grid,
-                            contract_failure if constrained else None)
+                            contract_failure if constrained else None, choice)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
     if plot:
