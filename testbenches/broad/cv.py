@@ -15,11 +15,11 @@ per estimator). A fold chooses among the grid points that keep the contract's pe
 bounds (testbenches.broad.feasible: the realistic sensor's scenarios see a sensor class and
 motions BROAD lacks, and a value they refuse is none a default could take; `--cv-unconstrained`
 lets every point be chosen), and by the smallest regret (CHOICES): the point whose worst
-training fold is least above that fold's best point. A user's mix of motions is not BROAD's (the
-unseen recordings hold twice the share of combined motion), so a default has to be near the best
-on every kind of motion rather than best on the mean of the mix these trials happen to have;
-the lowest mean over the training trials (`--cv-choice mean`) lets the folds with most trials
-decide.
+training fold is least above that fold's best point. A user's mix of motions is not these
+trials' (4 of the 13 shared trials are disturbed or combined, 8 of BROAD's 17 further trials are
+combined), so a default has to be near the best on every kind of motion rather than best on the
+mean of the mix these trials happen to have; the lowest mean over the training trials
+(`--cv-choice mean`) lets the folds with most trials decide.
 """
 
 from __future__ import annotations
