@@ -513,6 +513,9 @@ def test_the_regret_choice_takes_the_point_that_holds_on_every_training_fold() -
     assert _choose(cv, folds, _Allowed("kf", points, no_1_or_3), "mean") == 0
     assert _choose(cv, folds, _Allowed("kf", points, no_1_or_3), "regret") == 2
     assert set(cv.refused) == {"p=1", "p=3"}
+    exact = EstimatorCv("kf", {"p": 0.0}, grid=points[:2], errors=np.array(
+        [[0.0, 1.0], [0.1, 0.5]]))  # a fold where point 0 is exact: no 0/0, point 0 wins
+    assert _choose(exact, [[0], [1]], _Allowed("kf", points[:2], free), "regret") == 0
 
 
 def test_cv_unconstrained_and_the_choice_are_said_in_cv_json(tmp_path: Path) -> None:

@@ -296,7 +296,8 @@ def _choose(cv: EstimatorCv, folds: list[list[int]], allowed: _Allowed, choice: 
     per_fold = np.stack([cv.errors[:, cols].mean(axis=1) for cols in folds], axis=1)
     best = [per_fold[_first_allowed(np.argsort(per_fold[:, f], kind="stable"), cv, allowed,
                                     record=False), f] for f in range(len(folds))]
-    regret = (per_fold / np.asarray(best)).max(axis=1)
+    # (a fold whose best is exact: the other points' regret is as large as a float's)
+    regret = (per_fold / np.maximum(best, np.finfo(float).tiny)).max(axis=1)
     return _first_allowed(np.lexsort((mean, regret)), cv, allowed)
 
 
