@@ -56,6 +56,7 @@ from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
     fill_noise,
+    gate_norm2,
     measure_clipped,
     measure_constants,
     measure_restarted,
@@ -145,10 +146,11 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
       uncertainty);
     - a gyro at its rail (gyro_range): the rate beyond it is unknown, so the angles' variance
       grows by it, no bias is learned from the sample and the measured vector starts again;
-    - the bias learns from the accelerometer only while the raw sample's norm is within bias_gate
-      of g (Duong Quoc et al.'s real-sensor cutoff), both innovations are within bias_innovation
-      (a larger one is a gross attitude error, not a bias drift) and the measured vector is
-      settled; otherwise the biases are consider states (angle_only_gain).
+    - the bias learns from the accelerometer only while the norm of what reaches the measured
+      vector (its slow band: measured_vector.gate_norm2; without the vector the raw sample's) is
+      within bias_gate of g (Duong Quoc et al.'s real-sensor cutoff), both innovations are within
+      bias_innovation (a larger one is a gross attitude error, not a bias drift) and the
+      measured vector is settled; otherwise the biases are consider states (angle_only_gain).
 
     Start: the first valid sample sets the angles from the accelerometer and the biases to 0;
     P = diag(R_measure + ((|a| - g) / g)^2, init_bias_std^2): the angles as sure as one
@@ -327,7 +329,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         predicted = (self.roll, self.pitch)
         raw2 = ax * ax + ay * ay + az * az
         lo, hi = self._bias_band2
-        # the raw sample, before the pre-filter (bias_gate); never a sample at the rail
+        # without the measured vector the raw sample (bias_gate); never a sample at the rail
         learn_bias = lo < raw2 < hi and not clipped
         # at a first rest the angles are its tilt (_zero_rate_update)
         rested = (self._rest_cfg[0] > 0.0 and not clipped
@@ -343,9 +345,12 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             r = base + (r - self._measure.r)
             cap = self.q_step * self._longest2 / dt
             self.r_step = r if r < cap else (cap if cap > base else base)
-            # no bias from a vector that is filling (a mean of the first samples, of a motion's
-            # start as likely as of rest) or holds turns the gyro did not measure (gyro_range)
-            learn_bias = learn_bias and not filling and self.meas.settled(self._measure)
+            # the bias gate on what reaches the vector (gate_norm2); no bias from a vector that
+            # is filling (a mean of the first samples, of a motion's start as likely as of rest)
+            # or holds turns the gyro did not measure (gyro_range)
+            n2 = gate_norm2(self.meas, self._measure, raw2)
+            learn_bias = (lo < n2 < hi and not clipped and not filling
+                          and self.meas.settled(self._measure))
             ax, ay, az = self.meas.f
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             if not filling:

@@ -34,6 +34,7 @@ from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
     fill_noise,
+    gate_norm2,
     measure_clipped,
     measure_constants,
     measure_restarted,
@@ -101,7 +102,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     acceleration that reaches it, capped at max_correction_time), the gyro's scale uncertainty
     while it turns (building_blocks.ADAPTIVE_NOISE_PARAMS), a gyro at its rail (the rate beyond
     it grows Q, no bias is learned), rest detection with a zero-rate update of the bias states
-    (rest_time > 0), and the bias learned only while the raw sample is within bias_gate of g,
+    (rest_time > 0), and the bias learned only while the slow band of the measured vector
+    (measured_vector.gate_norm2; without the vector the raw sample) is within bias_gate of g,
     the measured and the predicted gravity direction within bias_innovation and the measured
     vector settled (else the biases are consider states). While the measured vector fills, X
     is its direction, with that vector's variance and the covariance with the bias of the turn
@@ -222,17 +224,21 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         p = self._params
         lo, hi = self._bias_band2
         clipped = self.clipped
-        # the raw sample (bias_gate); never a sample at the rail
-        learn_bias = lo < ax * ax + ay * ay + az * az < hi and not clipped
+        # without the measured vector the raw sample (bias_gate); never a sample at the rail
+        raw2 = ax * ax + ay * ay + az * az
+        learn_bias = lo < raw2 < hi and not clipped
         if p["acc_lowpass"] > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), (self.x[3], self.x[4], self.x[5]),
                                 dt, self._trapezoid)
             terms = rotvec_terms(*phi)  # once, for the measured vector's low-passes
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt, self._measure)
-            # no bias from a vector that is filling (a mean of the first samples, of a motion's
-            # start as likely as of rest) or holds turns the gyro did not measure (gyro_range)
-            learn_bias = learn_bias and not filling and self.meas.settled(self._measure)
+            # the bias gate on what reaches the vector (gate_norm2); no bias from a vector that
+            # is filling (a mean of the first samples, of a motion's start as likely as of rest)
+            # or holds turns the gyro did not measure (gyro_range)
+            n2 = gate_norm2(self.meas, self._measure, raw2)
+            learn_bias = (lo < n2 < hi and not clipped and not filling
+                          and self.meas.settled(self._measure))
             fill = fill_noise(self.meas, r, dt, self._measure) if filling else None
             self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r, fill)
         else:

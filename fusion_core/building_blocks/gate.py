@@ -46,7 +46,8 @@ MEMS accelerometer (scale error up to 3 % uncalibrated) passes."""
 
 BIAS_GATE_PARAM = Param(
     "bias_gate", BIAS_GATE,
-    "Bias learning gate on rho = ||a|/g - 1| of the raw accelerometer sample: at or above it "
+    "Bias learning gate on rho = ||a|/g - 1| of the specific force that reaches the measured "
+    "vector (its slow band; without the vector the raw accelerometer sample): at or above it "
     "the accelerometer update leaves the gyro bias alone (the sample measures linear "
     "acceleration, not the drift of the tilt); 0 = off, every update moves the bias (the papers)",
     low=0.0, high=1000.0,

@@ -371,6 +371,16 @@ int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c
     return m[FC_MEAS_SETTLE] >= 2.0 * c->stage;
 }
 
+fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
+                              fc_real raw2)
+{
+    if (c->dist_tau > 0.0 && c->band > 0.0) {
+        const fc_real *s = m + FC_MEAS_S;
+        return s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
+    }
+    return raw2;
+}
+
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)
 {
     fc_real excess = m[FC_MEAS_DIST] - c->noise;

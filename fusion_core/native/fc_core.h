@@ -134,6 +134,9 @@ void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,
                            const fc_meas_constants *c, fc_real *var, fc_real *age);
 /* Measure.settled */
 int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
+/* gate_norm2: the squared norm a bias gate judges (the slow band's, else raw2) */
+fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
+                              fc_real raw2);
 /* raw_noise */
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* measure_restarted: aligned at f, the slow band from nothing */

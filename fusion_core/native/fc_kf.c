@@ -228,7 +228,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     }
     fc_real pred_roll = f->roll, pred_pitch = f->pitch;
     fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    /* the raw sample, before the pre-filter (bias_gate); never a sample at the rail */
+    /* without the measured vector the raw sample (bias_gate); never a sample at the rail */
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     /* at a first rest the angles are its tilt (zero_rate_update) */
     int rested = f->rest_time > 0.0 && !clipped && zero_rate_update(f, a, g, dt);
@@ -246,8 +246,11 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         r_meas = r;
         fc_real cap = f->q_step * f->longest2 / dt;
         f->r_step = r < cap ? r : (cap > base ? cap : base);
-        /* no bias from a vector that is filling or holds turns the gyro did not measure */
-        learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
+        /* the bias gate on what reaches the vector (gate_norm2); no bias from a vector that is
+         * filling or holds turns the gyro did not measure */
+        fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
+        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && !clipped && !filling
+                     && fc_measure_settled(f->meas, &f->measure);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];

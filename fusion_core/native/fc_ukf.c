@@ -204,7 +204,7 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
     const fc_ukf_params *p = &f->params;
     fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int clipped = f->base.clipped;
-    /* the raw sample (bias_gate); never a sample at the rail */
+    /* without the measured vector the raw sample (bias_gate); never a sample at the rail */
     int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
         fc_real phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
@@ -215,8 +215,11 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
             fc_measure_clipped(f->meas);
         }
         fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
-        /* no bias from a vector that is filling or holds turns the gyro did not measure */
-        learn_bias = learn_bias && !filling && fc_measure_settled(f->meas, &f->measure);
+        /* the bias gate on what reaches the vector (gate_norm2); no bias from a vector that is
+         * filling or holds turns the gyro did not measure */
+        fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
+        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && !clipped && !filling
+                     && fc_measure_settled(f->meas, &f->measure);
         const fc_real *m = f->meas + FC_MEAS_F;
         fc_real fill[2];
         if (filling) {
