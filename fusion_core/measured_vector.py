@@ -32,7 +32,7 @@ Three things follow, and this module is each of them:
    process noise already holds it (ADAPTIVE_NOISE_PARAMS' rotation term), so the statistic
    leaves it out: counted as disturbance, it slows the correction in exactly the rotations
    where a gyro's scale error asks for a faster one (the realistic sensor's high_dynamics, seed
-   0: kf 2.50/3.43 deg with it counted, 2.27/3.21 without; on BROAD's 13 trials, whose gyro's
+   0: kf 2.17/3.41 deg with it counted, 2.02/3.21 without; on BROAD's 13 trials, whose gyro's
    scale errors are smaller, the cross-validated means move by at most 0.003 deg either way:
    `python -m testbenches broad DIR --cv`). The
    statistic rises within DISTURBANCE_ATTACK (a disturbance that starts counts before a filter

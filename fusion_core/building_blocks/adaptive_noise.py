@@ -21,7 +21,7 @@ of a hand-held or robot motion. Physics leaves its exact value open, and two kin
 pull it apart: on BROAD (scale errors of at most 0.74 %) every motion fold, chosen without,
 asks for 0.25 s (testbenches.broad.cv.CV_GRID cross-validates it with the other open
 parameters), while the realistic sensor's scenarios (scale errors of 1 %) ask for more (kf
-high_dynamics over 8 parts: 3.18/4.01 deg at 0.25 s, 2.87/3.60 at 0.5, 2.82/3.22 at 1). The
+high_dynamics over 8 parts: 2.59/4.01 deg at 0.25 s, 2.50/3.59 at 0.5, 2.59/3.23 at 1). The
 process noise a scale error adds belongs to the sensor class, which one IMU's recordings cannot
 show; 0.5 s holds on both (docs/results/broad.md)."""
 

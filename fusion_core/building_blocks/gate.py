@@ -1,5 +1,5 @@
 """The accelerometer's trust: the magnitude gate of the correction, and the gates of the bias
-learning (the raw sample's norm, the innovation's size)."""
+learning (the norm of what reaches the measured vector, the innovation's size)."""
 
 from __future__ import annotations
 
@@ -39,10 +39,12 @@ def gate_bounds2(params: dict) -> tuple[float, float]:
 BIAS_GATE: Final = 0.05
 """Recommended bias_gate: Duong Quoc et al.'s experimental table for their MPU-6050 (section
 4.2) stops trusting the accelerometer at rho = 0.05; here only the bias stops learning from it.
-The accelerometer sees a gyro bias only as a slow drift of the tilt it measures; a sample whose
-norm is 5 % off g carries linear acceleration (or vibration) whose apparent tilt would be taken
-for that drift, and with a small Q_bias a bias learned wrong stays wrong for minutes. A resting
-MEMS accelerometer (scale error up to 3 % uncalibrated) passes."""
+The accelerometer sees a gyro bias only as a slow drift of the tilt it measures; a vector whose
+norm is 5 % off g carries linear acceleration whose apparent tilt would be taken for that drift,
+and with a small Q_bias a bias learned wrong stays wrong for minutes. With the measured vector
+the gate judges what reaches it (measured_vector.gate_norm2), so shaking and vibration, which
+the vector does not hold, leave the bias free to learn. A resting MEMS accelerometer (scale
+error up to 3 % uncalibrated) passes."""
 
 BIAS_GATE_PARAM = Param(
     "bias_gate", BIAS_GATE,
