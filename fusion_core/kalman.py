@@ -329,8 +329,6 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         predicted = (self.roll, self.pitch)
         raw2 = ax * ax + ay * ay + az * az
         lo, hi = self._bias_band2
-        # without the measured vector the raw sample (bias_gate); never a sample at the rail
-        learn_bias = lo < raw2 < hi and not clipped
         # at a first rest the angles are its tilt (_zero_rate_update)
         rested = (self._rest_cfg[0] > 0.0 and not clipped
                   and self._zero_rate_update(ax, ay, az, gx, gy, gz, dt))
@@ -352,6 +350,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             learn_bias = (lo < n2 < hi and not clipped and not filling
                           and self.meas.settled(self._measure))
             ax, ay, az = self.meas.f
+        else:  # the raw sample (bias_gate); never a sample at the rail
+            learn_bias = lo < raw2 < hi and not clipped
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             if not filling:
                 self.correct(ax, ay, az, learn_bias)

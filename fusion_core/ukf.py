@@ -224,9 +224,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         p = self._params
         lo, hi = self._bias_band2
         clipped = self.clipped
-        # without the measured vector the raw sample (bias_gate); never a sample at the rail
         raw2 = ax * ax + ay * ay + az * az
-        learn_bias = lo < raw2 < hi and not clipped
         if p["acc_lowpass"] > 0.0:
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), (self.x[3], self.x[4], self.x[5]),
                                 dt, self._trapezoid)
@@ -241,7 +239,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                           and self.meas.settled(self._measure))
             fill = fill_noise(self.meas, r, dt, self._measure) if filling else None
             self._filter_update(*self.meas.f, gx, gy, gz, dt, learn_bias, r, fill)
-        else:
+        else:  # the raw sample (bias_gate); never a sample at the rail
+            learn_bias = lo < raw2 < hi and not clipped
             self._filter_update(ax, ay, az, gx, gy, gz, dt, learn_bias)
         if p["rest_time"] > 0.0 and not clipped:
             x = self.x

@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import os
@@ -516,6 +517,16 @@ def test_the_regret_choice_takes_the_point_that_holds_on_every_training_fold() -
     exact = EstimatorCv("kf", {"p": 0.0}, grid=points[:2], errors=np.array(
         [[0.0, 1.0], [0.1, 0.5]]))  # a fold where point 0 is exact: no 0/0, point 0 wins
     assert _choose(exact, [[0], [1]], _Allowed("kf", points[:2], free), "regret") == 0
+
+
+def test_broad_offers_the_choices_cross_validate_makes() -> None:
+    """--cv-choice's values are cv.CHOICES (the CLI names them without importing cv)."""
+    from testbenches.broad.cli import add_broad_parser
+    from testbenches.broad.cv import CHOICES
+
+    parser = add_broad_parser(argparse.ArgumentParser().add_subparsers())
+    (action,) = [a for a in parser._actions if a.dest == "cv_choice"]
+    assert tuple(action.choices) == CHOICES
 
 
 def test_cv_unconstrained_and_the_choice_are_said_in_cv_json(tmp_path: Path) -> None:

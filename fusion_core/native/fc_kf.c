@@ -228,8 +228,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     }
     fc_real pred_roll = f->roll, pred_pitch = f->pitch;
     fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    /* without the measured vector the raw sample (bias_gate); never a sample at the rail */
-    int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
+    int learn_bias;
     /* at a first rest the angles are its tilt (zero_rate_update) */
     int rested = f->rest_time > 0.0 && !clipped && zero_rate_update(f, a, g, dt);
     int filling = 0;
@@ -252,6 +251,8 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && !clipped && !filling
                      && fc_measure_settled(f->meas, &f->measure);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
+    } else {  /* the raw sample (bias_gate); never a sample at the rail */
+        learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     }
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {

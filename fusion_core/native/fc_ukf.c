@@ -204,8 +204,6 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
     const fc_ukf_params *p = &f->params;
     fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     int clipped = f->base.clipped;
-    /* without the measured vector the raw sample (bias_gate); never a sample at the rail */
-    int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
         fc_real phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
         fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
@@ -218,15 +216,16 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
         /* the bias gate on what reaches the vector (gate_norm2); no bias from a vector that is
          * filling or holds turns the gyro did not measure */
         fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
-        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && !clipped && !filling
-                     && fc_measure_settled(f->meas, &f->measure);
+        int learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && !clipped && !filling
+                         && fc_measure_settled(f->meas, &f->measure);
         const fc_real *m = f->meas + FC_MEAS_F;
         fc_real fill[2];
         if (filling) {
             fc_measure_fill_noise(f->meas, r, dt, &f->measure, &fill[0], &fill[1]);
         }
         filter_update(f, m[0], m[1], m[2], g, dt, learn_bias, r, 1, filling ? fill : NULL);
-    } else {
+    } else {  /* the raw sample (bias_gate); never a sample at the rail */
+        int learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
         filter_update(f, a[0], a[1], a[2], g, dt, learn_bias, f->r_acc, 0, NULL);
     }
     if (p->rest_time > 0.0 && !clipped) {

@@ -117,7 +117,7 @@ class EstimatorCv:
         return {"defaults": self.defaults, "in_sample_deg": self.in_sample,
                 "cv_held_out_deg": self.held_out, "chosen_per_fold": self.chosen,
                 "in_sample_mean_deg": self.in_sample_mean(), "cv_mean_deg": self.cv_mean(),
-                "scan_choice": self.scan_choice, "scan_minimum_mean_deg": self.scan_mean(),
+                "scan_choice": self.scan_choice, "scan_choice_mean_deg": self.scan_mean(),
                 "refused_by_contract": self.refused,
                 "grid_points": self.grid,
                 "grid_errors_deg": [[float(v) for v in row] for row in self.errors]}
