@@ -14,7 +14,7 @@ from fusion_core import ESTIMATORS, native
 from fusion_core.registry import keys_help
 
 from .common import recording
-from .native import _tiled
+from .native import tiled
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -32,7 +32,7 @@ def main(argv: list[str] | None = None) -> int:
     if not native.available():
         print(f"error: the C twin is not available ({native.reason()})", file=sys.stderr)
         return 2
-    acc, gyro, dt = _tiled(recording(60.0), args.samples)
+    acc, gyro, dt = tiled(recording(60.0), args.samples)
     cls = ESTIMATORS[args.key]
     t0 = time.perf_counter()
     for _ in range(args.repeat):

@@ -37,7 +37,7 @@ def _median_seconds(fn: Any, repeats: int) -> float:
     return statistics.median(times)
 
 
-def _tiled(rec: dict[str, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def tiled(rec: dict[str, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     idx = np.arange(n) % len(rec["dt"])
     return (np.ascontiguousarray(rec["acc_meas"][idx]),
             np.ascontiguousarray(rec["gyro_meas"][idx]), np.ascontiguousarray(rec["dt"][idx]))
@@ -49,7 +49,7 @@ def vqf_batch_us(rec: dict[str, np.ndarray], repeats: int) -> float | str:
         from vqf import VQF
     except ImportError as err:
         return f"ImportError: {err}"
-    acc, gyro, dt = _tiled(rec, MIN_SAMPLES)
+    acc, gyro, dt = tiled(rec, MIN_SAMPLES)
     seconds = _median_seconds(lambda: VQF(float(dt[0])).updateBatch(gyro, acc), repeats)
     return seconds / len(dt) * 1e6
 
@@ -58,7 +58,7 @@ def native_section(rec: dict[str, np.ndarray], repeats: int) -> dict[str, Any]:
     """The native section of bench.json (see the module docstring)."""
     if not native.available():
         return {"available": False, "reason": native.reason()}
-    acc, gyro, dt = _tiled(rec, max(MIN_SAMPLES, len(rec["dt"])))
+    acc, gyro, dt = tiled(rec, max(MIN_SAMPLES, len(rec["dt"])))
     n = len(dt)
     out: dict[str, Any] = {"available": True, "samples": n, "run_us_per_sample": {},
                            "python_run_us_per_sample": {}, "speedup_vs_python": {},
