@@ -38,6 +38,7 @@ from .kinematics import (
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    STRETCH_PARAM,
     measure_aligned,
     measure_clipped,
     measure_constants,
@@ -95,6 +96,7 @@ class ComplementaryFilter(Estimator):
         GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
+        STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_cf"
     STATE: ClassVar[StateSpec] = {
@@ -116,7 +118,8 @@ class ComplementaryFilter(Estimator):
         self._adaptive = complementary_adaptive(p, self._acc_tau)
         self._measure = measure_constants(self._acc_tau, self._adaptive[2],
                                           float(p["slow_band_time"]), self._adaptive[0],
-                                          float(p["gyro_scale_std"]))
+                                          float(p["gyro_scale_std"]),
+                                          float(p["acc_lowpass_stretch"]))
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -155,7 +158,7 @@ class ComplementaryFilter(Estimator):
         if self._acc_tau > 0.0:  # the filter and its gate use the measured vector
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
-                                                  self._measure)
+                                                  self._measure, self.rest.measured > 0.0)
             ax, ay, az = self.meas.f
         self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
         roll, pitch = quat_roll_pitch(*self.q_att)

@@ -55,6 +55,7 @@ from .kinematics import (
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    STRETCH_PARAM,
     fill_noise,
     gate_norm2,
     measure_clipped,
@@ -213,6 +214,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         BIAS_INNOVATION_PARAM,
         GYRO_SAMPLING_PARAM,
         BAND_PARAM,
+        STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
     TWIN: ClassVar[str | None] = "fc_kf"
@@ -241,7 +243,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self._adaptive = adaptive_noise_constants(p, self._acc_tau)
         self._measure = measure_constants(self._acc_tau, self._adaptive[1],
                                           float(p["slow_band_time"]), self._r,
-                                          float(p["gyro_scale_std"]))
+                                          float(p["gyro_scale_std"]),
+                                          float(p["acc_lowpass_stretch"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
@@ -336,7 +339,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         if self._acc_tau > 0.0:
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt,
-                                                 self._measure)
+                                                 self._measure, self.rest.measured > 0.0)
             # one sample's variance plus the disturbance that reaches the measured vector, up
             # to the longest correction time
             base = self._r

@@ -5,7 +5,7 @@ An accelerometer sample is gravity plus the body's linear acceleration plus whit
 filters do not measure the raw sample; they measure a low-passed specific force that turns with
 the gyro (Laidig & Seel 2023, VQF: in an almost inertial frame gravity is constant and the linear
 acceleration of a body that ends where it started averages to its velocity change over time).
-Three things follow, and this module is each of them:
+Four things follow, and this module is each of them:
 
 1. The measured vector `f` is a second-order low-pass: two first-order stages of time constant
    acc_lowpass / 2 each, every stage turned by the gyro's rotation increment. A second-order
@@ -45,6 +45,24 @@ Three things follow, and this module is each of them:
    from the sample at the rail it would be that one sample's tilt, and on the synthetic
    gyro_clipping scenario the complementary filter's error was three times larger so.
 
+4. The vector grows longer (up to acc_lowpass_stretch times, STRETCH_PARAM) where linear
+   acceleration slower than it reaches it: a hand carrying a turning sensor back and forth with
+   periods of 5-8 s passes a 1.5 s vector at about two thirds of its amplitude, and the filters
+   then trust a vector degrees off (BROAD's combined trial 32: VQF, whose vector is 3 s long,
+   0.56 deg, the kf 0.78). A longer vector costs in two ways. It turns with the gyro's scale
+   error for longer, so it grows only by the share of the slow band that the turn of the longer
+   vector would not explain (`stretched`, with the mean square rate over a stage, `rate2`): in
+   BROAD's rotation trials and in the contract's sweeps it keeps its length. And it turns with
+   the estimated gyro bias for longer: the attitude and the vector then drift together, and the
+   innovation a bias error leaves shrinks from the correction time to the correction time less
+   the vector's lag, so a bias learned wrongly is unlearned more slowly. A filter started in a
+   moving hand learns 0.2-0.3 deg/s of bias from its first seconds, and with a 3 s vector it
+   kept 0.9 deg of error after 10 s instead of 0.4 (tests/test_start_alignment.py). So the
+   vector grows only once a rest has measured the bias (the filters' rest detector,
+   `bias_measured`), as at the start of most recordings and of every BROAD trial.
+   Measured with the defaults (`python -m testbenches broad DIR --cv`, the 13 shared trials):
+   docs/results/broad.md.
+
 The statistic of the adaptive length (`dist`: the raw sample against the full-length reference)
 is the first-order pre-filter's, kept: it decides whether there is anything to average.
 """
@@ -54,6 +72,7 @@ from __future__ import annotations
 from typing import Final, NamedTuple
 
 from .building_blocks import (
+    PREFILTER_FULL,
     Vec3,
     adaptive_prefilter_time,
     lowpass_specific_force,
@@ -80,9 +99,21 @@ BAND_PARAM: Final = Param(
 the swing of a translation or a combined motion. Chosen by cross-validation over BROAD's groups of
 trials (`python -m testbenches broad --cv`), with the synthetic shaking scenario as the check of
 the fast side."""
-MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 4)))
+STRETCH_PARAM: Final = Param(
+    "acc_lowpass_stretch", 2.0,
+    "The longest the measured vector may grow, as a multiple of acc_lowpass, once a rest has "
+    "measured the gyro bias and while the slow band finds more linear acceleration reaching the "
+    "vector than the gyro's scale error would turn a vector of that length by (1: never longer "
+    "than acc_lowpass)",
+    low=1.0, high=10.0,
+)
+"""Recommended 2: 3 s at acc_lowpass 1.5 s, the time constant of VQF's vector, where the slow
+combined motion from rest (tests/test_slow_combined_motion.py) comes within VQF + 10 %. The
+cross-validation over BROAD's motion folds (testbenches.broad.cv.CV_GRID holds 1, 1.5 and 2)
+chooses 1.5 or 2 without every fold, never 1. Module docstring, item 4."""
+MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 5)))
 """The state check of a Measure (fusion_core.state): six vectors, two mean squares, two
-times."""
+times and a mean square rate."""
 
 
 class Measure(NamedTuple):
@@ -107,6 +138,9 @@ class Measure(NamedTuple):
     settle: float
     """Time [s] since the last gyro sample at its rail, counted up to the full length (the full
     length from the start)."""
+    rate2: float
+    """Mean square rate [rad^2/s^2] over one stage (acc_lowpass / 2): what a longer vector would
+    turn with (the stretch, module docstring item 4)."""
 
     def settled(self, c: MeasureConstants) -> bool:
         """Whether the vector holds no sample turned by a rotation the gyro did not measure (no
@@ -118,7 +152,7 @@ class Measure(NamedTuple):
 def measure_start(a: Vec3, c: MeasureConstants) -> Measure:
     """The state at a first sample a: every low-pass starts at it, no disturbance measured, and
     settled (no gyro sample at its rail yet: the vector holds no rotation the gyro missed)."""
-    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage)
+    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage, 0.0)
 
 
 class MeasureConstants(NamedTuple):
@@ -139,14 +173,17 @@ class MeasureConstants(NamedTuple):
     """(g sigma)^2 [m^2/s^4] with sigma = sqrt(3) gyro_scale_std, the gyro's rate error as a
     fraction of the rate: the slow band's share per (rad/s)^2 and s^2 of lag that a turn
     explains (module docstring, item 2)."""
+    stretch: float
+    """acc_lowpass_stretch: the longest vector as a multiple of the full length (1: none)."""
 
 
 def measure_constants(acc_lowpass: float, disturbance_time: float, band: float, r: float,
-                      gyro_scale_std: float) -> MeasureConstants:
-    """The constants of measure_step from the parameters, one sample's tilt variance r and the
-    gyro's scale uncertainty (0: no turn discounted from the slow band)."""
+                      gyro_scale_std: float, stretch: float = 1.0) -> MeasureConstants:
+    """The constants of measure_step from the parameters, one sample's tilt variance r, the
+    gyro's scale uncertainty (0: no turn discounted from the slow band) and the longest
+    vector's multiple of acc_lowpass (STRETCH_PARAM; 1: none)."""
     return MeasureConstants(0.5 * acc_lowpass, disturbance_time, 3.0 * r * G * G, band, r,
-                            3.0 * gyro_scale_std * gyro_scale_std * G * G)
+                            3.0 * gyro_scale_std * gyro_scale_std * G * G, stretch)
 
 
 def two_stage_noise(k: float) -> float:
@@ -166,11 +203,13 @@ def _lowpass2(s1: Vec3, s: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
 
 
 def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, float, float],
-                 dt: float, c: MeasureConstants) -> tuple[Measure, float, bool]:
+                 dt: float, c: MeasureConstants, bias_measured: bool = False
+                 ) -> tuple[Measure, float, bool]:
     """One sample a of the measured vector (the module docstring), phi the interval's rotation
-    vector with its rotvec_terms. Returns the new state (its f is the measured vector), the
-    measurement noise r [rad^2] and whether the vector is still filling."""
-    f1, f, ref1, ref, s1, s, dist, slow, fill, settle = m
+    vector with its rotvec_terms; bias_measured: whether a rest has measured the gyro bias (the
+    vector may then grow longer, item 4). Returns the new state (its f is the measured vector),
+    the measurement noise r [rad^2] and whether the vector is still filling."""
+    f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2 = m
     stage = c.stage
     full = 2.0 * stage
     if settle < full:  # both times counted up to the full length (building_blocks.on_the_mark)
@@ -199,11 +238,37 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
             inst = inst - turn if inst > turn else 0.0
             rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
             slow += dt / (rise + dt) * (inst - slow)
+            rate2 += dt / (stage + dt) * (w2 - rate2)
             excess = slow - c.noise * two_stage_noise(dt / (c.band + dt))
             if excess > 0.0:
                 r += excess / (G * G)
+                if c.stretch > 1.0 and bias_measured and not filling:
+                    tau = tau * stretched(c, excess, rate2, lag, full)
     f1, f = _lowpass2(f1, f, phi, a, dt, tau, terms)
-    return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle), r, filling
+    return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2), r, filling
+
+
+def stretched(c: MeasureConstants, excess: float, rate2: float, lag: float, full: float
+              ) -> float:
+    """The measured vector's length as a multiple of the full length (1 to c.stretch), from the
+    slow band's excess over the white noise [m^2/s^4], the mean square rate rate2, the slow
+    band's lag against the reference [s] and the full length [s] (module docstring, item 4).
+
+    A vector k = stretch^2 times as long in lag passes what of the slow band lies below its
+    corner at about (1/stretch)^2 of its power, and turns with a gyro's scale error by k times
+    the turn: c.turn rate2 full^2 at the full length. The slow band is measured against the full
+    length, with one turn discounted (measure_step); counted at the longer vector's scale, k - 1
+    more of it is turn, not linear acceleration. What is left, over the turn the longest vector
+    would carry (and PREFILTER_FULL times the white noise, below which nothing is worth
+    averaging), is the share of the stretch taken: the vector grows where linear acceleration
+    slower than it reaches it and the gyro's turn would cost less."""
+    k = c.stretch * c.stretch
+    ts = c.turn * rate2
+    left = excess - (k - 1.0) * ts * (lag * lag)
+    x = left / (PREFILTER_FULL * c.noise + k * ts * (full * full))
+    if x <= 0.0:
+        return 1.0
+    return 1.0 + (c.stretch - 1.0) * (x if x < 1.0 else 1.0)
 
 
 def fill_noise(m: Measure, r: float, dt: float, c: MeasureConstants) -> tuple[float, float]:
@@ -270,4 +335,4 @@ def measure_turned(m: Measure, turn) -> Measure:  # type: ignore[no-untyped-def]
     """The state with every vector turned by turn (a function of a vector: the kf's face
     switch)."""
     return Measure(turn(m.f1), turn(m.f), turn(m.ref1), turn(m.ref), turn(m.s1), turn(m.s),
-                   m.dist, m.slow, m.fill, m.settle)
+                   m.dist, m.slow, m.fill, m.settle, m.rate2)

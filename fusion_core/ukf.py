@@ -33,6 +33,7 @@ from .kinematics import rotvec_terms
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
+    STRETCH_PARAM,
     fill_noise,
     gate_norm2,
     measure_clipped,
@@ -156,6 +157,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
         BAND_PARAM,
+        STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
     TWIN: ClassVar[str | None] = "fc_ukf"
@@ -176,7 +178,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         self._adaptive = adaptive_noise_constants(p, float(p["acc_lowpass"]))
         self._measure = measure_constants(float(p["acc_lowpass"]), self._adaptive[1],
                                           float(p["slow_band_time"]), self._r_acc,
-                                          float(p["gyro_scale_std"]))
+                                          float(p["gyro_scale_std"]),
+                                          float(p["acc_lowpass_stretch"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._trapezoid: bool = p["gyro_sampling"] == "point"
@@ -230,7 +233,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                 dt, self._trapezoid)
             terms = rotvec_terms(*phi)  # once, for the measured vector's low-passes
             m = measure_clipped(self.meas) if clipped else self.meas
-            self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt, self._measure)
+            self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt, self._measure,
+                                                 self.rest.measured > 0.0)
             # the bias gate on what reaches the vector (gate_norm2); no bias from a vector that
             # is filling (a mean of the first samples, of a motion's start as likely as of rest)
             # or holds turns the gyro did not measure (gyro_range)

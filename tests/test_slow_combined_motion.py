@@ -4,9 +4,12 @@ shows against VQF, reproduced on the realistic sensor, and held as a target.
 
 A linear acceleration slower than acc_lowpass passes the measured vector whole, and the slow
 band (a short low-pass against the full-length one) cannot see what both pass, so the filters
-trust a vector that is off. The test fails the day the Kalman filters reach VQF's RMSE plus
-10 % there (the rule of the shaking and gyro_clipping scenarios); then it becomes a contract
-scenario.
+trust a vector that is off. The vector grows longer where the slow band finds more linear
+acceleration than the gyro's turn explains, once a rest has measured the gyro bias
+(measured_vector, item 4): from a rest, as recordings usually start, every filter with a slow
+band is within VQF's RMSE plus 10 % (the rule of the shaking and gyro_clipping scenarios).
+Started in motion the vector keeps its length, and the Kalman filters stay behind; that test
+fails the day they reach VQF + 10 % there.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import pytest
 
 from fusion_core import ESTIMATORS, synthetic
 from fusion_core.sensor import ImuSensorModel
-from fusion_core.synthetic import Signal, Trajectory, add, sine
+from fusion_core.synthetic import Signal, Trajectory, add, min_jerk, product, sine
 from fusion_core.types import DEG
 from testbenches.broad.metric import gravity_from_roll_pitch, inclination_error
 
@@ -38,29 +41,42 @@ def _accel_sine(acc: float, freq: float, phase: float = 0.0) -> Signal:
     return sine(acc / (2.0 * math.pi * freq) ** 2, freq, phase)
 
 
-def slow_combined() -> Trajectory:
+def slow_combined(rest: float = 0.0) -> Trajectory:
     """Turns of +-60 deg at 0.5 Hz (and slower tones) while the sensor is carried back and forth
-    by 0.6-1 m/s2 at 0.12-0.2 Hz: periods of 5-8 s, longer than the measured vector's 1.5 s."""
-    return Trajectory(
+    by 0.6-1 m/s2 at 0.12-0.2 Hz: periods of 5-8 s, longer than the measured vector's 1.5 s.
+    rest > 0: level and still for that long [s], then the motion fades in over 2 s."""
+    motion = Trajectory(
         roll=add(sine(60 * DEG, 0.5), sine(20 * DEG, 0.13, 0.7)),
         pitch=add(sine(42 * DEG, 0.4, 1.0), sine(10 * DEG, 0.11)),
         yaw=sine(60 * DEG, 0.07),
         pos=(_accel_sine(1.0, 0.15), _accel_sine(0.8, 0.195, 1.1), _accel_sine(0.6, 0.135, 0.4)),
     )
+    if rest <= 0.0:
+        return motion
+    fade = min_jerk(0.0, 1.0, rest, 2.0)
+    return Trajectory(roll=product(motion.roll, fade), pitch=product(motion.pitch, fade),
+                      yaw=product(motion.yaw, fade),
+                      pos=tuple(product(p, fade) for p in motion.pos))
 
 
-def mean_rmse_deg(run: Up) -> float:
-    """The inclination RMSE [deg] after SETTLE, averaged over the parts; run(acc, gyro, dt)
-    gives the up direction [N, 3]."""
+def mean_rmse_deg(run: Up, rest: float = 0.0) -> float:
+    """The inclination RMSE [deg] after SETTLE (after the rest and SETTLE where the motion
+    starts from a rest), averaged over the parts; run(acc, gyro, dt) gives the up direction
+    [N, 3]."""
     out = []
     for seed in PARTS:
-        rec = synthetic.record(slow_combined(), DURATION, RATE, seed=seed)
+        rec = synthetic.record(slow_combined(rest), DURATION + rest, RATE, seed=seed)
         s = ImuSensorModel(seed=seed).run(rec["omega"], rec["f"], rec["dt"])
         up = run(s["acc"], s["gyro"], s["dt"])
         err = inclination_error(up, gravity_from_roll_pitch(rec["roll"], rec["pitch"]))
-        keep = np.arange(len(err)) / RATE >= SETTLE
+        keep = np.arange(len(err)) / RATE >= rest + SETTLE
         out.append(math.degrees(math.sqrt(float(np.mean(err[keep] ** 2)))))
     return float(np.mean(out))
+
+
+REST = 3.0
+"""The rest a recording from rest starts with [s]: longer than rest_time, so that the filters'
+rest detectors measure the gyro bias."""
 
 
 def ours(key: str) -> Up:
@@ -70,9 +86,9 @@ def ours(key: str) -> Up:
     return run
 
 
-NOT_MET = ("not met yet: kf 2.85 and ukf 2.75 deg against VQF 1.76 (+10 %: 1.94); the cf 2.62; "
-           "with the translation at 0.3 Hz all are level with VQF (docs/results/broad.md, "
-           "trial 32)")
+NOT_MET = ("not met yet started in motion, where the vector keeps its length until a rest has "
+           "measured the bias: kf 2.85 and ukf 2.75 deg against VQF 1.76 (+10 %: 1.94); the cf "
+           "2.62; from a rest all are within (the test below)")
 
 
 @pytest.mark.parametrize("key", ["kf", "ukf"])
@@ -85,5 +101,19 @@ def test_the_kalman_filters_are_within_vqf_plus_ten_percent_on_slow_combined_mot
 
     vqf = mean_rmse_deg(lambda acc, gyro, dt: PEERS["vqf"](acc, gyro, RATE))
     mine = mean_rmse_deg(ours(key))
+    print(f"\n{key} {mine:.3f} deg against VQF {vqf:.3f}")
+    assert mine <= 1.1 * vqf
+
+
+@pytest.mark.parametrize("key", ["cf", "kf", "ukf"])
+def test_from_a_rest_every_filter_with_a_slow_band_is_within_vqf_plus_ten_percent(key: str
+                                                                                 ) -> None:
+    """The same motion after 3 s at rest (VQF 1.69 deg): cf 1.78, kf and ukf 1.81 with the
+    longer vector, 2.59 and 2.70 with the vector kept at acc_lowpass."""
+    pytest.importorskip("vqf")
+    from testbenches.peers import PEERS
+
+    vqf = mean_rmse_deg(lambda acc, gyro, dt: PEERS["vqf"](acc, gyro, RATE), REST)
+    mine = mean_rmse_deg(ours(key), REST)
     print(f"\n{key} {mine:.3f} deg against VQF {vqf:.3f}")
     assert mine <= 1.1 * vqf

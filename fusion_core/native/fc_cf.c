@@ -16,7 +16,7 @@ void fc_cf_configure(fc_cf *f)
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
-                         &f->measure);
+                         p->acc_lowpass_stretch, &f->measure);
 }
 
 fc_estimate fc_cf_estimate(const fc_cf *f)
@@ -76,7 +76,7 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &aligning);
+        r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, f->rest[7] > 0.0, &aligning);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);

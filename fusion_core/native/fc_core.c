@@ -270,7 +270,7 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise)
 #define DISTURBANCE_ATTACK 0.05 /* measured_vector.DISTURBANCE_ATTACK [s] */
 
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_real gyro_scale_std, fc_meas_constants *c)
+                          fc_real gyro_scale_std, fc_real stretch, fc_meas_constants *c)
 {
     c->stage = 0.5 * acc_lowpass;
     c->dist_tau = disturbance_time;
@@ -278,6 +278,7 @@ void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real
     c->band = band;
     c->r = r;
     c->turn = 3.0 * gyro_scale_std * gyro_scale_std * FC_G * FC_G;
+    c->stretch = stretch;
 }
 
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c)
@@ -285,6 +286,7 @@ void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas
     fc_measure_align(m, a);
     m[FC_MEAS_DIST] = m[FC_MEAS_SLOW] = m[FC_MEAS_FILL] = 0.0;
     m[FC_MEAS_SETTLE] = 2.0 * c->stage;
+    m[FC_MEAS_RATE2] = 0.0;
 }
 
 void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
@@ -310,9 +312,23 @@ static void lowpass2(fc_real *s1, fc_real *s, const fc_real phi[3], const fc_rea
     fc_lowpass_specific_force_terms(s, phi, terms, s1, dt, tau);
 }
 
+/* stretched: the vector's length as a multiple of the full length, 1 to c->stretch */
+static fc_real stretched(const fc_meas_constants *c, fc_real excess, fc_real rate2, fc_real lag,
+                         fc_real full)
+{
+    fc_real k = c->stretch * c->stretch;
+    fc_real ts = c->turn * rate2;
+    fc_real left = excess - (k - 1.0) * ts * (lag * lag);
+    fc_real x = left / (PREFILTER_FULL * c->noise + k * ts * (full * full));
+    if (x <= 0.0) {
+        return 1.0;
+    }
+    return 1.0 + (c->stretch - 1.0) * (x < 1.0 ? x : 1.0);
+}
+
 fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
                        const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
-                       int *filling)
+                       int bias_measured, int *filling)
 {
     fc_real stage = c->stage;
     fc_real full = 2.0 * stage;
@@ -348,9 +364,13 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             inst = inst > turn ? inst - turn : 0.0;
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
+            m[FC_MEAS_RATE2] += dt / (stage + dt) * (w2 - m[FC_MEAS_RATE2]);
             fc_real excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
             if (excess > 0.0) {
                 r += excess / (FC_G * FC_G);
+                if (c->stretch > 1.0 && bias_measured && !*filling) {  /* the longer vector (stretched) */
+                    tau = tau * stretched(c, excess, m[FC_MEAS_RATE2], lag, full);
+                }
             }
         }
     }

@@ -109,25 +109,26 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise);
 /* ----- measured_vector.py ------------------------------------------------------------------ */
 /* Measure: the measured vector's state as one array of doubles, in the Python NamedTuple's
  * order: each second-order low-pass as its two stages (the first stage, then the output), the
- * disturbance statistics and the two times. */
+ * disturbance statistics, the two times and the mean square rate. */
 enum {
     FC_MEAS_F1 = 0, FC_MEAS_F = 3, FC_MEAS_REF1 = 6, FC_MEAS_REF = 9, FC_MEAS_S1 = 12,
     FC_MEAS_S = 15, FC_MEAS_DIST = 18, FC_MEAS_SLOW = 19, FC_MEAS_FILL = 20, FC_MEAS_SETTLE = 21,
-    FC_MEAS_SIZE = 22
+    FC_MEAS_RATE2 = 22, FC_MEAS_SIZE = 23
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {
-    fc_real stage, dist_tau, noise, band, r, turn;
+    fc_real stage, dist_tau, noise, band, r, turn, stretch;
 } fc_meas_constants;
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_real gyro_scale_std, fc_meas_constants *c);
+                          fc_real gyro_scale_std, fc_real stretch, fc_meas_constants *c);
 /* measure_start: every low-pass at a, no disturbance measured, settled */
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
-/* measure_step: one sample a; returns the measurement noise r [rad^2], *filling whether the
- * vector is still filling */
+/* measure_step: one sample a (bias_measured: a rest has measured the gyro bias, the vector may
+ * grow longer); returns the measurement noise r [rad^2], *filling whether the vector is still
+ * filling */
 fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_real phi[3],
                        const fc_real terms[4], fc_real dt, const fc_meas_constants *c,
-                       int *filling);
+                       int bias_measured, int *filling);
 /* fill_noise: while the vector fills, its tilt variance and its samples' mean age [s], from
  * measure_step's noise r */
 void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,

@@ -45,7 +45,7 @@ void fc_kf_configure(fc_kf *f)
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, p->gyro_scale_std,
-                         &f->measure);
+                         p->acc_lowpass_stretch, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
     f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->rest_time = p->rest_time;
@@ -237,7 +237,8 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
+        fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, f->rest[7] > 0.0,
+                                   &filling);
         /* one sample's variance plus the disturbance that reaches the measured vector, up to
          * the longest correction time */
         fc_real base = f->r;

@@ -23,7 +23,7 @@ void fc_mgcf_configure(fc_mgcf *f)
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
     /* no slow band: the mgcf's noise is the raw disturbance (fc_measure_raw_noise) */
-    fc_measure_constants(f->acc_tau, f->dist_tau, 0.0, f->r_ref, 0.0, &f->measure);
+    fc_measure_constants(f->acc_tau, f->dist_tau, 0.0, f->r_ref, 0.0, 1.0, &f->measure);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
@@ -77,7 +77,7 @@ static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_re
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, &aligning);
+        fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, 0, &aligning);
         ax = f->meas[FC_MEAS_F];
         ay = f->meas[FC_MEAS_F + 1];
         az = f->meas[FC_MEAS_F + 2];

@@ -34,6 +34,7 @@ typedef struct fc_cf_params {
     fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_dt;               /* (0.0, 1000000.0] [s] */
     fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
     fc_real mount_roll;           /* [-3.141592653589793, 3.141592653589793] [rad] */
@@ -85,6 +86,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
+    p->acc_lowpass_stretch = 2.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
     p->mount_roll = 0.0;
@@ -409,6 +411,7 @@ typedef struct fc_kf_params {
     fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
     int gyro_sampling;            /* one of 'point', 'mean' */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real max_dt;               /* (0.0, 1000000.0] [s] */
     fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
@@ -465,6 +468,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->bias_innovation = 0.17453292519943295;
     p->gyro_sampling = FC_KF_GYRO_SAMPLING_POINT;
     p->slow_band_time = 0.15;
+    p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;
@@ -612,6 +616,7 @@ typedef struct fc_ukf_params {
     fc_real bias_gate;            /* [0.0, 1000.0] */
     fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real max_dt;               /* (0.0, 1000000.0] [s] */
     fc_real max_rate;             /* (0.0, 10000.0] [rad/s] */
@@ -669,6 +674,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;
     p->slow_band_time = 0.15;
+    p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     p->max_dt = 1.0;
     p->max_rate = 1000.0;

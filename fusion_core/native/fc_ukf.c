@@ -17,7 +17,7 @@ void fc_ukf_configure(fc_ukf *f)
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 p->acc_lowpass, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc,
-                         p->gyro_scale_std, &f->measure);
+                         p->gyro_scale_std, p->acc_lowpass_stretch, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
     f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
@@ -212,7 +212,8 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, &filling);
+        fc_real r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, f->rest[7] > 0.0,
+                                   &filling);
         /* the bias gate on what reaches the vector (gate_norm2); no bias from a vector that is
          * filling or holds turns the gyro did not measure */
         fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);

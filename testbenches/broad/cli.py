@@ -31,6 +31,8 @@ folders holding them. Peers (--peers) need the bench extra: pip install -e '.[be
 
 def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     """Register the `broad` subcommand on the subparsers of `python -m testbenches`."""
+    from .cv import CV_GRID  # the help names the grid it cross-validates
+
     p = sub.add_parser("broad", help="accuracy on BROAD's real recordings (inclination RMSE)",
                        description=HELP)
     p.set_defaults(func=cmd_broad)
@@ -57,8 +59,8 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
                    help="skip the bar chart")
     p.add_argument("--cv", action="store_true",
-                   help="cross-validate the defaults: each parameter a scan chooses (acc_lowpass, "
-                   "slow_band_time, scale_time) chosen again without each motion fold (slow "
+                   help="cross-validate the defaults: each parameter a scan chooses ("
+                   + ", ".join(CV_GRID) + ") chosen again without each motion fold (slow "
                    "rotation, fast rotation, translation, disturbed/combined) and scored on it; "
                    "prints the cross-validated mean beside the in-sample one (and VQF's with "
                    "--peers) and adds cv_mean_inclination_rmse_deg to report.json "
@@ -66,8 +68,9 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
     p.add_argument("--cv-grid", action="append", default=[], metavar="NAME=V1,V2,...",
                    help="cross-validate these parameters and values instead (repeat for several; "
                    "implies --cv): e.g. --cv-grid scale_time=0.25,0.5,1 --cv-grid "
-                   "max_correction_time=1,3,10 (default: acc_lowpass=1,1.5,2, "
-                   "slow_band_time=0.05,0.1,0.15,0.3 and scale_time=0.25,0.5,1). The trials may be "
+                   "max_correction_time=1,3,10 (default: "
+                   + ", ".join(f"{k}={','.join(f'{v:g}' for v in vs)}" for k, vs in CV_GRID.items())
+                   + "). The trials may be "
                    "recordings of one's own in BROAD's format, their motion groups in their names "
                    "or a trials.json")
     p.add_argument("--cv-unconstrained", action="store_true",

@@ -43,6 +43,7 @@ CV_GRID: dict[str, tuple[float, ...]] = {
     "acc_lowpass": (1.0, 1.5, 2.0),
     "slow_band_time": (0.05, 0.1, 0.15, 0.3),
     "scale_time": (0.25, 0.5, 1.0),
+    "acc_lowpass_stretch": (1.0, 1.5, 2.0),
 }
 """The parameters physics leaves open, with the values a scan tries. acc_lowpass: the measured
 vector's length (VQF's 3 s time constant sits at the long end once its gain is counted);
@@ -52,7 +53,9 @@ up in one direction, a property of the motion rather than of the sensor (ADAPTIV
 from 0.25 s: below it, where BROAD alone would go, the realistic sensor's high_dynamics
 scenario leaves its 5-deg bound at most points (kf 4.34/5.53 deg over 8 parts at 1.5/0.3/0.03),
 and the folds' choices are made among the points that keep the contract anyway
-(cross_validate's constraint).
+(cross_validate's constraint); acc_lowpass_stretch: how much longer the vector may grow where
+slow linear acceleration reaches it (measured_vector.STRETCH_PARAM), from off (1) to VQF's
+3 s at the default length (2).
 Every other default comes from the sensor's physics (its noise densities, its scale-factor
 class, its range) or is a bound (max_correction_time). `broad --cv-grid` takes another grid."""
 CV_ESTIMATORS: tuple[str, ...] = ATTITUDE_FILTERS
