@@ -10,7 +10,7 @@ the mean over all trials of the error each trial got from a choice made without 
 in-sample mean is the defaults' own. A default holds when the two are close; where the scan's
 choice on a fold differs from the default, the fold says what the default costs there.
 
-Every grid point runs once per trial (through the compiled twin where it loads: a few seconds
+Every grid point runs once per trial (through the compiled twin where it loads: under a minute
 per estimator). A fold chooses among the grid points that keep the contract's per-run accuracy
 bounds (testbenches.broad.feasible: the realistic sensor's scenarios see a sensor class and
 motions BROAD lacks, and a value they refuse is none a default could take; `--cv-unconstrained`
