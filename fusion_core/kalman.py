@@ -40,6 +40,7 @@ from .building_blocks import (
     rest_start,
     rest_step,
     zero_rate_psd_param,
+    zero_rate_sample,
 )
 from .kinematics import (
     HALF_PI,
@@ -392,8 +393,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             self.P_roll = measured_axis(self.P_roll, p, 0.0)
             self.P_pitch = measured_axis(self.P_pitch, p, 0.0)
         self.P_z += self._q_bias * dt
-        if self.rest.quiet_time >= rest_time:
-            r = gyro_var / dt
+        r = gyro_var / dt
+        if self.rest.quiet_time >= rest_time and zero_rate_sample(self.rest, gx, gy, gz, r):
             self.correct_bias(gx, gy, r)
             k = self.P_z / (self.P_z + r)
             self.bias_z += k * (gz - self.bias_z)

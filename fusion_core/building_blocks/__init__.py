@@ -82,6 +82,7 @@ from .rest import (
     rest_step,
     uncalibrated_first_rest,
     zero_rate_psd_param,
+    zero_rate_sample,
 )
 from .sampling import (
     GYRO_SAMPLING_PARAM,
@@ -140,4 +141,5 @@ __all__ = [
     "rest_step",
     "uncalibrated_first_rest",
     "zero_rate_psd_param",
+    "zero_rate_sample",
 ]

@@ -525,6 +525,17 @@ void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_rea
     bias[2] = bias[2] + k * (gz - bias[2]);
 }
 
+#define ZERO_RATE_SPREAD 75.0  /* building_blocks.ZERO_RATE_SPREAD */
+/* building_blocks.REAL_GYRO_DENSITY [rad/s/sqrt(Hz)] */
+#define REAL_GYRO_DENSITY (0.008 * (FC_PI / 180.0))
+
+int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz,
+                        fc_real r)
+{
+    fc_real dx = gx - rest[0], dy = gy - rest[1], dz = gz - rest[2];
+    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r;
+}
+
 int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],
                           const fc_real a[3], fc_real dt, fc_real rest_time, fc_real rest_gyro,
                           fc_real rest_acc, fc_real bound, fc_real *roll, fc_real *pitch,
@@ -537,7 +548,9 @@ int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_
         fc_rest_alignment(rest, bias, roll, pitch, f);
         return 1;
     }
-    if (rest[6] >= rest_time) {
+    /* building_blocks.CONSTANT_REST_GYRO_VAR / dt */
+    fc_real r = REAL_GYRO_DENSITY * REAL_GYRO_DENSITY / dt;
+    if (rest[6] >= rest_time && fc_zero_rate_sample(rest, g[0], g[1], g[2], r)) {
         fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time);
     }
     return 0;

@@ -166,6 +166,10 @@ void fc_rest_alignment(const fc_real rest[FC_REST_SIZE], fc_real bias[3], fc_rea
                        fc_real *pitch, fc_real f[3]);
 void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
                      fc_real rest_time);
+/* zero_rate_sample: whether a gyro sample may update the bias at rest (within ZERO_RATE_SPREAD
+ * times r, its white-noise variance per axis, of the rest detector's running mean rate) */
+int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz,
+                        fc_real r);
 /* complementary_rest: the rest detection of cf and mgcf, one sample; returns 1 where they
  * aligned (*roll, *pitch and f, the specific force the vector starts again from, set), else 0 */
 int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],
