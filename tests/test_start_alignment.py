@@ -220,8 +220,8 @@ def test_held_in_a_hand_after_a_rest_a_kalman_filter_is_within_vqf_plus_ten_perc
     after the motion starts (VQF 0.21 deg): kf 0.19, ukf 0.19. The motion fades in, and a
     zero-rate update that took the rest's last samples learned the first turn as bias (0.07
     deg/s on a perfect gyro), which linear acceleration then kept from being unlearned: 0.42
-    deg (building_blocks.ZERO_RATE_SPREAD). The complementary filters are at 0.41 (cf) and 0.32
-    (mgcf) here."""
+    deg (building_blocks.ZERO_RATE_SPREAD). The complementary filters are at 0.29 (cf) and 0.26
+    (mgcf) here (building_blocks.bias_at_rest)."""
     from fusion_core.sensor import ImuSensorModel
     from testbenches.peers import run_vqf
 

@@ -517,9 +517,13 @@ void fc_rest_alignment(const fc_real rest[FC_REST_SIZE], fc_real bias[3], fc_rea
 }
 
 void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
-                     fc_real rest_time)
+                     fc_real rest_time, fc_real since)
 {
-    fc_real k = dt / (rest_time + dt);
+    fc_real memory = since + FC_REST_MEAN_TAU;
+    if (memory > rest_time) {
+        memory = rest_time;
+    }
+    fc_real k = dt / (memory + dt);
     bias[0] = bias[0] + k * (gx - bias[0]);
     bias[1] = bias[1] + k * (gy - bias[1]);
     bias[2] = bias[2] + k * (gz - bias[2]);
@@ -551,7 +555,7 @@ int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_
     /* building_blocks.CONSTANT_REST_GYRO_VAR / dt */
     fc_real r = REAL_GYRO_DENSITY * REAL_GYRO_DENSITY / dt;
     if (rest[6] >= rest_time && fc_zero_rate_sample(rest, g[0], g[1], g[2], r)) {
-        fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time);
+        fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time, rest[6] - rest_time);
     }
     return 0;
 }

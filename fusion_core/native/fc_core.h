@@ -164,8 +164,9 @@ int fc_uncalibrated_first_rest(fc_real measured_before, const fc_real rest[FC_RE
 /* rest_alignment: bias, roll, pitch and the specific force f from the rest's means */
 void fc_rest_alignment(const fc_real rest[FC_REST_SIZE], fc_real bias[3], fc_real *roll,
                        fc_real *pitch, fc_real f[3]);
+/* bias_at_rest: since, the time since the rest was measured (its memory grows with it) */
 void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
-                     fc_real rest_time);
+                     fc_real rest_time, fc_real since);
 /* zero_rate_sample: whether a gyro sample may update the bias at rest (within ZERO_RATE_SPREAD
  * times r, its white-noise variance per axis, of the rest detector's running mean rate) */
 int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz,
