@@ -393,12 +393,13 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             self.P_roll = measured_axis(self.P_roll, p, 0.0)
             self.P_pitch = measured_axis(self.P_pitch, p, 0.0)
         self.P_z += self._q_bias * dt
-        r = gyro_var / dt
-        if self.rest.quiet_time >= rest_time and zero_rate_sample(self.rest, gx, gy, gz, r):
-            self.correct_bias(gx, gy, r)
-            k = self.P_z / (self.P_z + r)
-            self.bias_z += k * (gz - self.bias_z)
-            self.P_z -= k * self.P_z
+        if self.rest.quiet_time >= rest_time:
+            r = gyro_var / dt
+            if zero_rate_sample(self.rest, gx, gy, gz, r):  # a still gyro's sample
+                self.correct_bias(gx, gy, r)
+                k = self.P_z / (self.P_z + r)
+                self.bias_z += k * (gz - self.bias_z)
+                self.P_z -= k * self.P_z
         return rested
 
     def propagate(

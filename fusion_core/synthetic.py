@@ -245,6 +245,17 @@ def product(u: Signal, v: Signal) -> Signal:
     return with_spec(f, "product", spec_of(u), spec_of(v))
 
 
+def after_rest(trajectory: Trajectory, rest: float, fade: float = 2.0) -> Trajectory:
+    """The trajectory still and level for rest seconds, then faded in over fade seconds (every
+    signal times a minimum-jerk ramp from 0 to 1): a recording that starts at rest, as most do,
+    with a motion that sets in gradually."""
+    ramp = min_jerk(0.0, 1.0, rest, fade)
+    return Trajectory(roll=product(trajectory.roll, ramp), pitch=product(trajectory.pitch, ramp),
+                      yaw=product(trajectory.yaw, ramp),
+                      pos=(product(trajectory.pos[0], ramp), product(trajectory.pos[1], ramp),
+                           product(trajectory.pos[2], ramp)))
+
+
 def two_axis_motion() -> Trajectory:
     """Simultaneous roll and pitch (roll 0.5 rad at 0.5 Hz, pitch 0.35 rad at 0.35 Hz)."""
     return Trajectory(roll=sine(0.5, 0.5), pitch=sine(0.35, 0.35))

@@ -263,10 +263,10 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                 self.x = [f[0] / n, f[1] / n, f[2] / n, x[3], x[4], x[5]]
                 self._P = measured_covariance(self._P, (self.x[0], self.x[1], self.x[2]),
                                               p["acc_noise"] ** 2 * rest_mean_share(dt), 0.0)
-            r = p["zaru_psd"] / dt
-            if self.rest.quiet_time >= p["rest_time"] and zero_rate_sample(self.rest, gx, gy, gz,
-                                                                           r):
-                self._zero_rate_update((gx, gy, gz), r)
+            if self.rest.quiet_time >= p["rest_time"]:
+                r = p["zaru_psd"] / dt
+                if zero_rate_sample(self.rest, gx, gy, gz, r):  # a still gyro's sample
+                    self._zero_rate_update((gx, gy, gz), r)
 
     def _zero_rate_update(self, z: tuple[float, float, float], r: float) -> None:
         """At rest the gyro reads its bias: a linear Kalman update with z = gyro, h(x) = b

@@ -511,7 +511,7 @@ def test_the_regret_choice_takes_the_point_that_holds_on_every_training_fold() -
 
 
 def test_broad_offers_the_choices_cross_validate_makes() -> None:
-    """--cv-choice's values are cv.CHOICES (the CLI names them without importing cv)."""
+    """--cv-choice's values are cv.CHOICES."""
     from testbenches.broad.cli import add_broad_parser
     from testbenches.broad.cv import CHOICES
 

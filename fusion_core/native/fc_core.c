@@ -368,7 +368,7 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             fc_real excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
             if (excess > 0.0) {
                 r += excess / (FC_G * FC_G);
-                if (c->stretch > 1.0 && bias_measured && !*filling) {  /* the longer vector (stretched) */
+                if (c->stretch > 1.0 && bias_measured && !*filling) {  /* stretched */
                     tau = tau * stretched(c, excess, m[FC_MEAS_RATE2], lag, full);
                 }
             }
@@ -530,8 +530,9 @@ void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_rea
 }
 
 #define ZERO_RATE_SPREAD 75.0  /* building_blocks.ZERO_RATE_SPREAD */
-/* building_blocks.REAL_GYRO_DENSITY [rad/s/sqrt(Hz)] */
+/* building_blocks.CONSTANT_REST_GYRO_VAR: REAL_GYRO_DENSITY (0.008 deg/s/sqrt(Hz)) squared */
 #define REAL_GYRO_DENSITY (0.008 * (FC_PI / 180.0))
+#define CONSTANT_REST_GYRO_VAR (REAL_GYRO_DENSITY * REAL_GYRO_DENSITY)
 
 int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz,
                         fc_real r)
@@ -552,9 +553,8 @@ int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_
         fc_rest_alignment(rest, bias, roll, pitch, f);
         return 1;
     }
-    /* building_blocks.CONSTANT_REST_GYRO_VAR / dt */
-    fc_real r = REAL_GYRO_DENSITY * REAL_GYRO_DENSITY / dt;
-    if (rest[6] >= rest_time && fc_zero_rate_sample(rest, g[0], g[1], g[2], r)) {
+    if (rest[6] >= rest_time && fc_zero_rate_sample(rest, g[0], g[1], g[2],
+                                                    CONSTANT_REST_GYRO_VAR / dt)) {
         fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time, rest[6] - rest_time);
     }
     return 0;

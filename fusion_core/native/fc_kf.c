@@ -196,12 +196,14 @@ static int zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc
         measured_axis(f->P_pitch, p, 0.0);
     }
     f->P_z += f->q_bias * dt;
-    fc_real r = f->gyro_var / dt;
-    if (f->rest[6] >= f->rest_time && fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {
-        fc_roll_pitch_correct_bias(axes(f), g[0], g[1], r);
-        fc_real k = f->P_z / (f->P_z + r);
-        f->bias_z += k * (g[2] - f->bias_z);
-        f->P_z -= k * f->P_z;
+    if (f->rest[6] >= f->rest_time) {
+        fc_real r = f->gyro_var / dt;
+        if (fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {  /* a still gyro's sample */
+            fc_roll_pitch_correct_bias(axes(f), g[0], g[1], r);
+            fc_real k = f->P_z / (f->P_z + r);
+            f->bias_z += k * (g[2] - f->bias_z);
+            f->P_z -= k * f->P_z;
+        }
     }
     return rested;
 }

@@ -245,9 +245,11 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
             measured_covariance(f->P, f->x, fc_pow(p->acc_noise, 2.0) * fc_rest_mean_share(dt),
                                 0.0);
         }
-        fc_real r = p->zaru_psd / dt;
-        if (f->rest[6] >= p->rest_time && fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {
-            zero_rate_update(f, g, r);
+        if (f->rest[6] >= p->rest_time) {
+            fc_real r = p->zaru_psd / dt;
+            if (fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {  /* a still gyro's sample */
+                zero_rate_update(f, g, r);
+            }
         }
     }
 }

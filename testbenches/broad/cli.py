@@ -31,7 +31,7 @@ folders holding them. Peers (--peers) need the bench extra: pip install -e '.[be
 
 def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     """Register the `broad` subcommand on the subparsers of `python -m testbenches`."""
-    from .cv import CV_GRID  # the help names the grid it cross-validates
+    from .cv import CHOICES, CV_GRID  # the help names the grid and the choices
 
     p = sub.add_parser("broad", help="accuracy on BROAD's real recordings (inclination RMSE)",
                        description=HELP)
@@ -77,7 +77,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="let each fold choose any grid point, also one that fails the contract's "
                    "accuracy bounds on the realistic sensor (by default a fold chooses the best "
                    "point that keeps them: testbenches.broad.feasible); implies --cv")
-    p.add_argument("--cv-choice", choices=("regret", "mean"), default=None,
+    p.add_argument("--cv-choice", choices=CHOICES, default=None,
                    help="how each fold chooses among the grid points: regret (default) takes the "
                    "point whose worst training fold is least above that fold's best, so that it "
                    "holds on every kind of motion; mean takes the lowest mean over the training "

@@ -69,6 +69,9 @@ CHOICES: tuple[str, ...] = ("regret", "mean")
 the smallest max over the training folds of m_f(p) / min_q m_f(q), m_f(p) the mean RMSE of
 point p over fold f's trials and q the allowed points (ties: the lower training mean); mean: the
 lowest mean over the training trials."""
+CHOICE_PHRASES: dict[str, str] = {"regret": "by the smallest regret over the training folds",
+                                  "mean": "by the lowest training mean"}
+"""How cv.json's method and the printed table name each of CHOICES."""
 
 
 def fold_of(groups: Sequence[str]) -> str:
@@ -157,8 +160,7 @@ class CvResult:
                       "folds' trials, scored on the held-out fold's"
                       + (", among the grid points that keep the contract's per-run accuracy "
                          "bounds" if self.constrained else "")
-                      + (", by the smallest regret over the training folds" if
-                         self.choice == "regret" else ", by the lowest training mean"),
+                      + ", " + CHOICE_PHRASES[self.choice],
             "constrained_by_contract": self.constrained,
             "choice": self.choice,
             "grid": self.grid,  # each estimator: those it has
@@ -363,8 +365,7 @@ def cv_table(result: CvResult) -> str:
     lines.append("chosen without each fold (" + ", ".join(result.grid) + " where the "
                  "estimator has it" + ("; among the points that keep the contract's accuracy "
                                        "bounds" if result.constrained else "")
-                 + ("; by the smallest regret over the training folds" if result.choice ==
-                    "regret" else "; by the lowest training mean") + "):")
+                 + "; " + CHOICE_PHRASES[result.choice] + "):")
     for key, e in result.estimators.items():
         chosen = "; ".join(f"{f}: " + "/".join(f"{v:g}" for v in e.chosen[f].values())
                            for f in present)
