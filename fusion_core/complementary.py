@@ -19,10 +19,13 @@ from .building_blocks import (
     body_rotation,
     complementary_adaptive,
     complementary_rest,
+    corrected_quat,
     correction_time,
     gate_bounds2,
     quat_from_roll_pitch,
     rest_start,
+    tilt_innovation,
+    turned_roll_pitch,
 )
 from .kinematics import (
     HALF_PI,
@@ -31,8 +34,8 @@ from .kinematics import (
     clamp_pitch,
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
-    quat_roll_pitch,
     rotvec_terms,
+    up_terms,
     wrap_angle,
 )
 from .measured_vector import (
@@ -160,20 +163,24 @@ class ComplementaryFilter(Estimator):
             self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
                                                   self._measure, self.rest.measured > 0.0)
             ax, ay, az = self.meas.f
-        self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
-        roll, pitch = quat_roll_pitch(*self.q_att)
+        # the attitude turned, roll and pitch with it, the correction from the angles between
+        # the two tilts (building_blocks.attitude)
+        before = up_terms(*self.q_att)
+        self.q_att = q = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
+        up = up_terms(*q)
+        roll, pitch = turned_roll_pitch(self.roll, self.pitch, before, up, q)
         if self._gate_low2 <= ax * ax + ay * ay + az * az <= self._gate_high2:
-            acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
+            y_roll, y_pitch = tilt_innovation(ax, ay, az, up)
             tau = self._tau
             if q_rotation > 0.0 or r != r_ref:  # the adaptive noise shortens the correction
                 wx, wy, wz = gx - bx, gy - by, gz - bz
                 tau = correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,
                                       r_ref, dt, longest)
             k = 1.0 if aligning else dt / (tau + dt)  # 1 - a, Gui et al. eq. 2
-            y = acc_roll - roll
-            roll += k * (y if -PI <= y <= PI else wrap_angle(y))
-            pitch += k * (acc_pitch - pitch)
-            self.q_att = quat_from_roll_pitch(roll, pitch)
+            dr, dp = k * y_roll, k * y_pitch
+            roll += dr
+            pitch += dp
+            self.q_att = corrected_quat(q, up, roll, pitch, dr, dp)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         return tuple_new(ESTIMATE, (roll, pitch, bias, None, None))

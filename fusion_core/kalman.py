@@ -30,6 +30,7 @@ from .building_blocks import (
     adaptive_noise_constants,
     bias_band2,
     body_rotation,
+    corrected_quat,
     first_rest,
     gate_bounds2,
     mat_t_vec,
@@ -39,6 +40,8 @@ from .building_blocks import (
     rest_mean_share,
     rest_start,
     rest_step,
+    tilt_innovation,
+    turned_roll_pitch,
     zero_rate_psd_param,
     zero_rate_sample,
 )
@@ -49,8 +52,8 @@ from .kinematics import (
     clamp_pitch,
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
-    quat_roll_pitch,
     rotvec_terms,
+    up_terms,
     wrap_angle,
 )
 from .measured_vector import (
@@ -264,6 +267,10 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self.meas = measure_start(ZERO3, self._measure)  # the measured vector (acc_lowpass > 0)
         self.rest = REST_START  # rest detector (building_blocks.RestState)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # the attitude, with a free yaw
+        # within a sample only (propagate sets them, correct reads them): the turned q's
+        # up_terms and the angles it predicted
+        self._up = up_terms(*self.q_att)
+        self._predicted = (0.0, 0.0)
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
         self.face = 0  # index into FACES of the filters' frame; 0: the sensor's own
@@ -331,12 +338,14 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             self.P_pitch = (self.P_roll if P_pitch == P
                             else (P_pitch[0] + grow, P_pitch[1], P_pitch[2], P_pitch[3]))
         predicted = (self.roll, self.pitch)
+        up = self._up
         raw2 = ax * ax + ay * ay + az * az
         lo, hi = self._bias_band2
         # at a first rest the angles are its tilt (_zero_rate_update)
         rested = (self._rest_cfg[0] > 0.0 and not clipped
                   and self._zero_rate_update(ax, ay, az, gx, gy, gz, dt))
         filling = False
+        reset = rested  # the angles set from a tilt: q rebuilt from them
         if self._acc_tau > 0.0:
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt,
@@ -363,11 +372,15 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
                 # the vector still fills: the attitude is its tilt (as cf's and mgcf's), as
                 # uncertain as that vector, its samples turned over their mean age (fill_noise)
                 self.roll, self.pitch = accel_roll_pitch(ax, ay, az)
+                reset = True
                 var, age = fill_noise(self.meas, r, dt, self._measure)
                 self.P_roll = measured_axis(self.P_roll, var, age)
                 self.P_pitch = measured_axis(self.P_pitch, var, age)
-        if (self.roll, self.pitch) != predicted:
+        if reset:
             self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
+        elif (self.roll, self.pitch) != predicted:  # q turned by the correction
+            self.q_att = corrected_quat(self.q_att, up, self.roll, self.pitch,
+                                        self.roll - predicted[0], self.pitch - predicted[1])
 
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -407,13 +420,17 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         terms: tuple[float, float, float, float],
     ) -> None:
         """Time update: the attitude quaternion turned by the interval's rotation vector phi
-        (with its rotvec_terms), P by the papers' F and Q (predict_covariance) with the
-        adaptive Q_angle."""
+        (with its rotvec_terms), roll and pitch by the angles it turned them by
+        (building_blocks.turned_roll_pitch), P by the papers' F and Q (predict_covariance) with
+        the adaptive Q_angle. Keeps the turned q's up_terms for the correction (_up)."""
         bx, by, bz = self.bias_x, self.bias_y, self.bias_z
-        self.q_att = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
-        roll, pitch = quat_roll_pitch(*self.q_att)
+        before = up_terms(*self.q_att)
+        self.q_att = q = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
+        self._up = up = up_terms(*q)
+        roll, pitch = turned_roll_pitch(self.roll, self.pitch, before, up, q)
         self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
+        self._predicted = (self.roll, self.pitch)
         q_angle = self._q_angle
         q_rotation = self._adaptive[0]
         if q_rotation > 0.0:  # gyro_scale_std: a scale error adds up while the sensor turns
@@ -425,12 +442,13 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True) -> None:
         """Measurement update of both axes with the accelerometer's roll and pitch (the biases
         left alone unless learn_bias, bias_gate, and while an innovation exceeds
-        bias_innovation)."""
-        acc_roll, acc_pitch = accel_roll_pitch(ax, ay, az)
-        y_roll = acc_roll - self.roll
-        if not -PI <= y_roll <= PI:
-            y_roll = wrap_angle(y_roll)
-        y_pitch = acc_pitch - self.pitch
+        bias_innovation). The innovations are the angles from the predicted attitude's tilt to
+        the accelerometer's (building_blocks.tilt_innovation), less what a zero-rate update
+        moved the angles by since."""
+        y_roll, y_pitch = tilt_innovation(ax, ay, az, self._up)
+        pred_roll, pred_pitch = self._predicted
+        y_roll -= self.roll - pred_roll
+        y_pitch -= self.pitch - pred_pitch
         gate = self._bias_innovation
         if not (-gate <= y_roll <= gate and -gate <= y_pitch <= gate):
             learn_bias = False  # grossly off: the angle only (bias_innovation)

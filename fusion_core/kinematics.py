@@ -29,6 +29,12 @@ _SERIES_A2: Final = 1e-2
 100 Hz): below it, Taylor series through a^8, whose first omitted term is below 3e-18 (under a
 thirtieth of an ulp of 1), so they are exact to double precision there and need no sine, cosine,
 square root or division: most of a sigma-point filter's time otherwise."""
+_SERIES_T2: Final = 1e-2
+"""angle_of's series bound on the squared tangent (an angle of 0.0997 rad, 5.7 deg): below it,
+arctan's Taylor series through t^15, whose first omitted term is below 6e-18 of the angle (under a
+twentieth of an ulp), so it is exact to double precision there and needs no arctangent: the
+angles a filter turns by in one interval, and the innovations of a converged filter, are such
+angles."""
 
 
 def wrap_angle(x: float) -> float:
@@ -202,6 +208,79 @@ def rotation_increment(
         0.5 * (a1 + b1) + k * (a2 * b0 - a0 * b2),
         0.5 * (a2 + b2) + k * (a0 * b1 - a1 * b0),
     )
+
+
+def rotation_back_matrix(phi: tuple[float, float, float],
+                         terms: tuple[float, float, float, float]
+                         ) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """rotate_back's rotation exp(-[phi]x) = I - sin(a)/a [phi]x + (1 - cos a)/a^2 [phi]x^2 as a
+    matrix, row by row, from terms = rotvec_terms(*phi): a filter that turns several vectors by
+    one interval (the measured vector's six stages) builds it once and turns each with nine
+    products instead of Rodrigues' two cross products."""
+    p0, p1, p2 = phi
+    _, _, s, c = terms
+    x0, x1, x2 = s * p0, s * p1, s * p2
+    c01, c02, c12 = c * (p0 * p1), c * (p0 * p2), c * (p1 * p2)
+    q0, q1, q2 = p0 * p0, p1 * p1, p2 * p2
+    return (1.0 - c * (q1 + q2), x2 + c01, c02 - x1,
+            c01 - x2, 1.0 - c * (q0 + q2), x0 + c12,
+            x1 + c02, c12 - x0, 1.0 - c * (q0 + q1))
+
+
+def up_terms(w: float, x: float, y: float, z: float) -> tuple[float, float, float, float]:
+    """sin(roll) cos(pitch), cos(roll) cos(pitch), sin(pitch) and cos(pitch) of a unit
+    quaternion: quat_roll_pitch's arguments (roll is the angle of the first two, pitch the
+    arcsine of the third) and the length of the first two."""
+    sr = 2.0 * (w * x + y * z)
+    cr = 1.0 - 2.0 * (x * x + y * y)
+    return sr, cr, 2.0 * (w * y - x * z), sqrt(sr * sr + cr * cr)
+
+
+def angle_of(num: float, den: float) -> float:
+    """atan2(num, den), the angle from one direction to another given the sine and cosine of
+    their difference (each times the same positive length): below (num/den)^2 = _SERIES_T2 with
+    den > 0, arctan's Taylor series in t = num/den (Estrin's scheme: four pairs of terms, then
+    t^4 and t^8, so that few operations wait on each other), else atan2."""
+    if den > 0.0 and num * num < _SERIES_T2 * (den * den):
+        t = num / den
+        t2 = t * t
+        t4 = t2 * t2
+        lo = (1.0 - t2 * (1.0 / 3.0)) + t4 * (1.0 / 5.0 - t2 * (1.0 / 7.0))
+        hi = (1.0 / 9.0 - t2 * (1.0 / 11.0)) + t4 * (1.0 / 13.0 - t2 * (1.0 / 15.0))
+        return t * (lo + (t4 * t4) * hi)
+    return atan2(num, den)
+
+
+def half_angle(a: float) -> tuple[float, float]:
+    """cos(a/2) and sin(a/2): below a^2 = _SERIES_A2 rotvec_terms' series of cos(a/2) and of
+    sin(a/2)/a (times a), else a sine-cosine pair."""
+    a2 = a * a
+    if a2 < _SERIES_A2:
+        return (1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
+                                                                - a2 * (1.0 / 10321920.0)))),
+                a * (0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
+                                                                   - a2 * (1.0 / 185794560.0))))))
+    return cos(0.5 * a), sin(0.5 * a)
+
+
+def quat_turn_roll_pitch(q: tuple[float, float, float, float],
+                         up: tuple[float, float, float, float], dr: float, dp: float
+                         ) -> tuple[float, float, float, float]:
+    """q with its roll grown by dr and its pitch by dp, its yaw kept; up = up_terms(*q), whose
+    cos(pitch) must not be 0. With q = q_z(yaw) q_y(pitch) q_x(roll) (Z-Y-X Euler), the new
+    attitude is q q_x(-roll) q_y(dp) q_x(roll) q_x(dr): q times a turn by dp about the body axis
+    (0, cos roll, -sin roll), then one by dr about body x; no sine or cosine of roll or pitch,
+    and those of dr/2 and dp/2 from half_angle."""
+    cr, sr = half_angle(dr)
+    cp, sp = half_angle(dp)
+    sphi, cphi = up[0] / up[3], up[1] / up[3]
+    a2, a3 = sp * cphi, -(sp * sphi)
+    dw, dx, dy, dz = cp * cr, cp * sr, a2 * cr + a3 * sr, a3 * cr - a2 * sr
+    w, x, y, z = q
+    return (w * dw - x * dx - y * dy - z * dz,
+            w * dx + x * dw + y * dz - z * dy,
+            w * dy - x * dz + y * dw + z * dx,
+            w * dz + x * dy - y * dx + z * dw)
 
 
 def rotate_back(v: tuple[float, float, float], phi: tuple[float, float, float],

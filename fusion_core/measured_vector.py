@@ -73,11 +73,13 @@ from typing import Final, NamedTuple
 
 from .building_blocks import (
     PREFILTER_FULL,
+    Mat9,
     Vec3,
     adaptive_prefilter_time,
     lowpass_specific_force,
     on_the_mark,
 )
+from .kinematics import rotation_back_matrix
 from .state import NONNEG, REAL, Segments
 from .types import G, Param
 
@@ -194,12 +196,13 @@ def two_stage_noise(k: float) -> float:
     return k * k * k * k * (1.0 + a2) / (d * d * d)
 
 
-def _lowpass2(s1: Vec3, s: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
-              terms: tuple[float, float, float, float]) -> tuple[Vec3, Vec3]:
+def _lowpass2(s1: Vec3, s: Vec3, back: Mat9, a: Vec3, dt: float, tau: float
+              ) -> tuple[Vec3, Vec3]:
     """One step of a second-order low-pass: two first-order stages of time constant tau, each
-    turned by phi (building_blocks.lowpass_specific_force)."""
-    s1 = lowpass_specific_force(s1, phi, a, dt, tau, terms)
-    return s1, lowpass_specific_force(s, phi, s1, dt, tau, terms)
+    turned by back (building_blocks.lowpass_specific_force)."""
+    k = dt / (tau + dt)
+    s1 = lowpass_specific_force(s1, back, a, k)
+    return s1, lowpass_specific_force(s, back, s1, k)
 
 
 def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, float, float],
@@ -220,14 +223,15 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
         stage = 0.5 * fill if fill < full else stage
     r = c.r
     tau = stage
+    back = rotation_back_matrix(phi, terms)  # once, for the six stages
     if c.dist_tau > 0.0:
-        ref1, ref = _lowpass2(ref1, ref, phi, a, dt, stage, terms)
+        ref1, ref = _lowpass2(ref1, ref, back, a, dt, stage)
         e0, e1, e2 = a[0] - ref[0], a[1] - ref[1], a[2] - ref[2]
         dist += dt / (c.dist_tau + dt) * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
         if not filling:
             tau = stage * adaptive_prefilter_time(1.0, dist, c.noise)
         if c.band > 0.0:  # the slow band (band 0: not measured, r stays white: raw_noise's users)
-            s1, s = _lowpass2(s1, s, phi, a, dt, c.band, terms)
+            s1, s = _lowpass2(s1, s, back, a, dt, c.band)
             e0, e1, e2 = s[0] - ref[0], s[1] - ref[1], s[2] - ref[2]
             inst = e0 * e0 + e1 * e1 + e2 * e2
             # less what the gyro's rate error turns the two apart by: sigma |w| times the
@@ -244,7 +248,7 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
                 r += excess / (G * G)
                 if c.stretch > 1.0 and bias_measured and not filling:
                     tau = tau * stretched(c, excess, rate2, lag, full)
-    f1, f = _lowpass2(f1, f, phi, a, dt, tau, terms)
+    f1, f = _lowpass2(f1, f, back, a, dt, tau)
     return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2), r, filling
 
 

@@ -45,7 +45,10 @@ from .adaptive_noise import (
     correction_time,
 )
 from .attitude import (
+    corrected_quat,
     quat_from_roll_pitch,
+    tilt_innovation,
+    turned_roll_pitch,
 )
 from .faces import (
     FACE_SWITCH_COS,
@@ -126,6 +129,7 @@ __all__ = [
     "body_rotation",
     "complementary_adaptive",
     "complementary_rest",
+    "corrected_quat",
     "correction_time",
     "first_rest",
     "gate_bounds2",
@@ -139,6 +143,8 @@ __all__ = [
     "rest_mean_share",
     "rest_start",
     "rest_step",
+    "tilt_innovation",
+    "turned_roll_pitch",
     "uncalibrated_first_rest",
     "zero_rate_psd_param",
     "zero_rate_sample",

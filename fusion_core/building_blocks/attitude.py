@@ -7,11 +7,28 @@ by the bias-corrected rotation vector of each interval (the quaternion filters' 
 kinematics.rotation_increment), take roll and pitch from it, apply their paper's correction to
 roll and pitch, and rebuild q from the corrected roll and pitch with yaw 0 (quat_from_roll_pitch:
 the free yaw does not change roll or pitch). The correction law, its gains and its covariance are
-the paper's."""
+the paper's.
+
+The kf takes these steps without an arctangent, sine or cosine of roll or pitch (each is a libm
+call, and they were a quarter of its time): roll and pitch grow by the angles q turned them by
+in the interval (turned_roll_pitch), the innovation is the angle from q's tilt to the
+accelerometer's (tilt_innovation) and the corrected q is q turned by the correction
+(corrected_quat). Each is the same angle as the round trip's, computed as the angle between two
+directions, which for the small angles of one interval and of a converged filter's innovation is
+a short series (kinematics.angle_of, half_angle) exact to double precision; large angles and a
+tilt near the vertical (cos(pitch) below STEP_MIN_COS) take the round trip's functions."""
 
 from __future__ import annotations
 
-from math import cos, sin
+from math import cos, sin, sqrt
+from typing import Final
+
+from ..kinematics import angle_of, quat_roll_pitch, quat_turn_roll_pitch
+
+STEP_MIN_COS: Final = 0.1
+"""The smallest cos(pitch) at which roll is advanced by its increment: nearer the vertical roll
+turns by large angles in one interval and is read off q instead (at cos(pitch) = 0 roll is not
+defined; the kf's face switch keeps cos(pitch) above 0.5 in its frame)."""
 
 
 def quat_from_roll_pitch(roll: float, pitch: float) -> tuple[float, float, float, float]:
@@ -24,3 +41,39 @@ def quat_from_roll_pitch(roll: float, pitch: float) -> tuple[float, float, float
     cr, sr = cos(0.5 * roll), sin(0.5 * roll)
     cp, sp = cos(0.5 * pitch), sin(0.5 * pitch)
     return cr * cp, sr * cp, cr * sp, -(sr * sp)
+
+
+def turned_roll_pitch(roll: float, pitch: float, before: tuple[float, float, float, float],
+                      after: tuple[float, float, float, float],
+                      q: tuple[float, float, float, float]) -> tuple[float, float]:
+    """Roll and pitch after the attitude q turned in an interval: each grown by the angle q
+    turned it by, from kinematics.up_terms before and after (roll the angle between the two
+    (sin roll, cos roll) directions, pitch between the two (sin pitch, cos pitch)); near the
+    vertical (STEP_MIN_COS) read off q (quat_roll_pitch)."""
+    if before[3] > STEP_MIN_COS and after[3] > STEP_MIN_COS:
+        return (roll + angle_of(after[0] * before[1] - after[1] * before[0],
+                                after[1] * before[1] + after[0] * before[0]),
+                pitch + angle_of(after[2] * before[3] - before[2] * after[3],
+                                 after[3] * before[3] + after[2] * before[2]))
+    return quat_roll_pitch(*q)
+
+
+def tilt_innovation(ax: float, ay: float, az: float, up: tuple[float, float, float, float]
+                    ) -> tuple[float, float]:
+    """The accelerometer's roll and pitch (kinematics.accel_roll_pitch: atan2(ay, az) and
+    atan2(-ax, sqrt(ay^2 + az^2))) less those of the attitude whose up_terms are up: each the
+    angle from the attitude's direction to the accelerometer's, in [-pi, pi]."""
+    h = sqrt(ay * ay + az * az)
+    return (angle_of(ay * up[1] - az * up[0], az * up[1] + ay * up[0]),
+            angle_of(-ax * up[3] - h * up[2], h * up[3] - ax * up[2]))
+
+
+def corrected_quat(q: tuple[float, float, float, float], up: tuple[float, float, float, float],
+                   roll: float, pitch: float, dr: float, dp: float
+                   ) -> tuple[float, float, float, float]:
+    """The attitude q (up: its up_terms) after a correction by dr in roll and dp in pitch to
+    roll and pitch: q turned by the correction (kinematics.quat_turn_roll_pitch), near the
+    vertical rebuilt from roll and pitch (quat_from_roll_pitch)."""
+    if up[3] > STEP_MIN_COS:
+        return quat_turn_roll_pitch(q, up, dr, dp)
+    return quat_from_roll_pitch(roll, pitch)

@@ -4,8 +4,8 @@ from it."""
 
 from __future__ import annotations
 
-from ..kinematics import rotate_back
 from ..types import Param
+from .faces import Mat9, mat_vec
 from .sampling import Vec3
 
 ACC_LOWPASS_PARAM = Param(
@@ -35,12 +35,10 @@ real recordings (testbenches/broad): the fast-translation trials, whose raw acce
 swings between 0.02 g and 5 g, drop from tens of degrees to below 1 deg of inclination error."""
 
 
-def lowpass_specific_force(f: Vec3, phi: Vec3, a: Vec3, dt: float, tau: float,
-                           terms: tuple[float, float, float, float]) -> Vec3:
+def lowpass_specific_force(f: Vec3, turn: Mat9, a: Vec3, k: float) -> Vec3:
     """One step of the accelerometer pre-filter (ACC_LOWPASS_PARAM): the filtered specific force
-    f turned with the body by phi, then blended with the new sample a, k = dt / (tau + dt);
-    terms: kinematics.rotvec_terms(*phi), which the caller also turns its attitude or a second
-    pre-filter with."""
-    f0, f1, f2 = rotate_back(f, phi, terms)
-    k = dt / (tau + dt)
+    f turned with the body by turn (kinematics.rotation_back_matrix of the interval's rotation,
+    built once for every vector it turns), then blended with the new sample a by
+    k = dt / (tau + dt)."""
+    f0, f1, f2 = mat_vec(turn, f)
     return f0 + k * (a[0] - f0), f1 + k * (a[1] - f1), f2 + k * (a[2] - f2)

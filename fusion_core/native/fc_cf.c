@@ -79,12 +79,17 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
         r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, f->rest[7] > 0.0, &aligning);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
+    fc_real before[4], up[4];  /* the attitude turned, roll and pitch with it */
+    fc_up_terms(f->q_att, before);
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
-    fc_quat_roll_pitch(f->q_att, &roll, &pitch);
+    fc_up_terms(f->q_att, up);
+    roll = f->roll;
+    pitch = f->pitch;
+    fc_turned_roll_pitch(&roll, &pitch, before, up, f->q_att);
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
-        fc_real acc_roll, acc_pitch;
-        fc_accel_roll_pitch(a[0], a[1], a[2], &acc_roll, &acc_pitch);
+        fc_real y_roll, y_pitch;
+        fc_tilt_innovation(a[0], a[1], a[2], up, &y_roll, &y_pitch);
         fc_real tau = f->tau;
         if (f->q_rotation > 0.0 || r != f->r_ref) {  /* the adaptive noise */
             fc_real wx = g[0] - bx, wy = g[1] - by, wz = g[2] - bz;
@@ -92,10 +97,10 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
                                      wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
         }
         fc_real k = aligning ? 1.0 : dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
-        fc_real y = acc_roll - roll;
-        roll += k * (-FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y));
-        pitch += k * (acc_pitch - pitch);
-        fc_quat_from_roll_pitch(roll, pitch, f->q_att);
+        fc_real dr = k * y_roll, dp = k * y_pitch;
+        roll += dr;
+        pitch += dp;
+        fc_corrected_quat(f->q_att, up, roll, pitch, dr, dp);
     }
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);

@@ -170,11 +170,81 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
     out[2] = v2 - s * u2 + c * (p0 * u1 - p1 * u0);
 }
 
+void fc_rotation_back_matrix(const fc_real phi[3], const fc_real t[4], fc_real m[9])
+{
+    fc_real p0 = phi[0], p1 = phi[1], p2 = phi[2], s = t[2], c = t[3];
+    fc_real x0 = s * p0, x1 = s * p1, x2 = s * p2;
+    fc_real c01 = c * (p0 * p1), c02 = c * (p0 * p2), c12 = c * (p1 * p2);
+    fc_real q0 = p0 * p0, q1 = p1 * p1, q2 = p2 * p2;
+    m[0] = 1.0 - c * (q1 + q2);
+    m[1] = x2 + c01;
+    m[2] = c02 - x1;
+    m[3] = c01 - x2;
+    m[4] = 1.0 - c * (q0 + q2);
+    m[5] = x0 + c12;
+    m[6] = x1 + c02;
+    m[7] = c12 - x0;
+    m[8] = 1.0 - c * (q0 + q1);
+}
+
 void fc_rotate_back(const fc_real v[3], const fc_real phi[3], fc_real out[3])
 {
     fc_real t[4];
     fc_rotvec_terms(phi[0], phi[1], phi[2], t);
     fc_rotate_back_terms(v, phi, t, out);
+}
+
+/* up_terms: sin(roll) cos(pitch), cos(roll) cos(pitch), sin(pitch) and cos(pitch) of q */
+void fc_up_terms(const fc_real q[4], fc_real t[4])
+{
+    fc_real w = q[0], x = q[1], y = q[2], z = q[3];
+    t[0] = 2.0 * (w * x + y * z);
+    t[1] = 1.0 - 2.0 * (x * x + y * y);
+    t[2] = 2.0 * (w * y - x * z);
+    t[3] = fc_sqrt(t[0] * t[0] + t[1] * t[1]);
+}
+
+#define SERIES_T2 1e-2       /* kinematics._SERIES_T2 */
+
+fc_real fc_angle_of(fc_real num, fc_real den)
+{
+    if (den > 0.0 && num * num < SERIES_T2 * (den * den)) {
+        fc_real t = num / den, t2 = t * t, t4 = t2 * t2;
+        fc_real lo = (1.0 - t2 * (1.0 / 3.0)) + t4 * (1.0 / 5.0 - t2 * (1.0 / 7.0));
+        fc_real hi = (1.0 / 9.0 - t2 * (1.0 / 11.0)) + t4 * (1.0 / 13.0 - t2 * (1.0 / 15.0));
+        return t * (lo + (t4 * t4) * hi);
+    }
+    return fc_atan2(num, den);
+}
+
+void fc_half_angle(fc_real a, fc_real *c, fc_real *s)
+{
+    fc_real a2 = a * a;
+    if (a2 < SERIES_A2) {
+        *c = 1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
+                                                            - a2 * (1.0 / 10321920.0))));
+        *s = a * (0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
+                                                                 - a2 * (1.0 / 185794560.0)))));
+        return;
+    }
+    *c = fc_cos(0.5 * a);
+    *s = fc_sin(0.5 * a);
+}
+
+/* quat_turn_roll_pitch: q with roll + dr and pitch + dp; t: q's up_terms */
+void fc_quat_turn_roll_pitch(fc_real q[4], const fc_real t[4], fc_real dr, fc_real dp)
+{
+    fc_real cr, sr, cp, sp;
+    fc_half_angle(dr, &cr, &sr);
+    fc_half_angle(dp, &cp, &sp);
+    fc_real sphi = t[0] / t[3], cphi = t[1] / t[3];
+    fc_real a2 = sp * cphi, a3 = -(sp * sphi);
+    fc_real dw = cp * cr, dx = cp * sr, dy = a2 * cr + a3 * sr, dz = a3 * cr - a2 * sr;
+    fc_real w = q[0], x = q[1], y = q[2], z = q[3];
+    q[0] = w * dw - x * dx - y * dy - z * dz;
+    q[1] = w * dx + x * dw + y * dz - z * dy;
+    q[2] = w * dy - x * dz + y * dw + z * dx;
+    q[3] = w * dz + x * dy - y * dx + z * dw;
 }
 
 /* ----- building_blocks.py ------------------------------------------------------------------ */
@@ -197,6 +267,39 @@ void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4])
     q[1] = sr * cp;
     q[2] = cr * sp;
     q[3] = -(sr * sp);
+}
+
+#define STEP_MIN_COS 0.1     /* building_blocks.STEP_MIN_COS */
+
+void fc_turned_roll_pitch(fc_real *roll, fc_real *pitch, const fc_real before[4],
+                          const fc_real after[4], const fc_real q[4])
+{
+    if (before[3] > STEP_MIN_COS && after[3] > STEP_MIN_COS) {
+        *roll = *roll + fc_angle_of(after[0] * before[1] - after[1] * before[0],
+                                    after[1] * before[1] + after[0] * before[0]);
+        *pitch = *pitch + fc_angle_of(after[2] * before[3] - before[2] * after[3],
+                                      after[3] * before[3] + after[2] * before[2]);
+        return;
+    }
+    fc_quat_roll_pitch(q, roll, pitch);
+}
+
+void fc_tilt_innovation(fc_real ax, fc_real ay, fc_real az, const fc_real up[4], fc_real *y_roll,
+                        fc_real *y_pitch)
+{
+    fc_real h = fc_sqrt(ay * ay + az * az);
+    *y_roll = fc_angle_of(ay * up[1] - az * up[0], az * up[1] + ay * up[0]);
+    *y_pitch = fc_angle_of(-ax * up[3] - h * up[2], h * up[3] - ax * up[2]);
+}
+
+void fc_corrected_quat(fc_real q[4], const fc_real up[4], fc_real roll, fc_real pitch, fc_real dr,
+                       fc_real dp)
+{
+    if (up[3] > STEP_MIN_COS) {
+        fc_quat_turn_roll_pitch(q, up, dr, dp);
+        return;
+    }
+    fc_quat_from_roll_pitch(roll, pitch, q);
 }
 
 void fc_gate_bounds2(fc_real gate_low, fc_real gate_high, fc_real *low2, fc_real *high2)
@@ -225,12 +328,10 @@ void fc_body_rotation(const fc_real g0[3], const fc_real g1[3], const fc_real bi
     phi[2] = (g1[2] - b2) * dt;
 }
 
-void fc_lowpass_specific_force_terms(fc_real f[3], const fc_real phi[3], const fc_real terms[4],
-                                     const fc_real a[3], fc_real dt, fc_real tau)
+void fc_lowpass_specific_force(fc_real f[3], const fc_real back[9], const fc_real a[3], fc_real k)
 {
     fc_real t[3];
-    fc_rotate_back_terms(f, phi, terms, t);
-    fc_real k = dt / (tau + dt);
+    fc_mat_vec(back, f, t);
     f[0] = t[0] + k * (a[0] - t[0]);
     f[1] = t[1] + k * (a[1] - t[1]);
     f[2] = t[2] + k * (a[2] - t[2]);
@@ -305,11 +406,12 @@ static fc_real two_stage_noise(fc_real k)
     return k * k * k * k * (1.0 + a2) / (d * d * d);
 }
 
-static void lowpass2(fc_real *s1, fc_real *s, const fc_real phi[3], const fc_real a[3], fc_real dt,
-                     fc_real tau, const fc_real terms[4])
+static void lowpass2(fc_real *s1, fc_real *s, const fc_real back[9], const fc_real a[3],
+                     fc_real dt, fc_real tau)
 {
-    fc_lowpass_specific_force_terms(s1, phi, terms, a, dt, tau);
-    fc_lowpass_specific_force_terms(s, phi, terms, s1, dt, tau);
+    fc_real k = dt / (tau + dt);
+    fc_lowpass_specific_force(s1, back, a, k);
+    fc_lowpass_specific_force(s, back, s1, k);
 }
 
 /* stretched: the vector's length as a multiple of the full length, 1 to c->stretch */
@@ -341,10 +443,11 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
         stage = m[FC_MEAS_FILL] < full ? 0.5 * m[FC_MEAS_FILL] : stage;
     }
     fc_real r = c->r;
-    fc_real tau = stage;
+    fc_real tau = stage, back[9];
+    fc_rotation_back_matrix(phi, terms, back);  /* once, for the six stages */
     if (c->dist_tau > 0.0) {
         fc_real *ref = m + FC_MEAS_REF, *s = m + FC_MEAS_S;
-        lowpass2(m + FC_MEAS_REF1, ref, phi, a, dt, stage, terms);
+        lowpass2(m + FC_MEAS_REF1, ref, back, a, dt, stage);
         fc_real e0 = a[0] - ref[0], e1 = a[1] - ref[1], e2 = a[2] - ref[2];
         m[FC_MEAS_DIST] += dt / (c->dist_tau + dt)
                            * (e0 * e0 + e1 * e1 + e2 * e2 - m[FC_MEAS_DIST]);
@@ -352,7 +455,7 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             tau = stage * fc_adaptive_prefilter_time(1.0, m[FC_MEAS_DIST], c->noise);
         }
         if (c->band > 0.0) {  /* the slow band (band 0: not measured) */
-            lowpass2(m + FC_MEAS_S1, s, phi, a, dt, c->band, terms);
+            lowpass2(m + FC_MEAS_S1, s, back, a, dt, c->band);
             e0 = s[0] - ref[0];
             e1 = s[1] - ref[1];
             e2 = s[2] - ref[2];
@@ -374,7 +477,7 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             }
         }
     }
-    lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, phi, a, dt, tau, terms);
+    lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, back, a, dt, tau);
     return r;
 }
 

@@ -75,6 +75,16 @@ void fc_roll_pitch_ahead(fc_real roll, fc_real pitch, fc_real wx, fc_real wy, fc
 void fc_rotation_increment(fc_real p0, fc_real q0, fc_real r0, fc_real p1, fc_real q1, fc_real r1,
                            fc_real dt, fc_real phi[3]);
 void fc_rotate_back(const fc_real v[3], const fc_real phi[3], fc_real out[3]);
+/* kinematics.rotation_back_matrix: rotate_back's rotation exp(-[phi]x), row by row */
+void fc_rotation_back_matrix(const fc_real phi[3], const fc_real t[4], fc_real m[9]);
+/* kinematics.up_terms: sin(roll) cos(pitch), cos(roll) cos(pitch), sin(pitch), cos(pitch) of q */
+void fc_up_terms(const fc_real q[4], fc_real t[4]);
+/* kinematics.angle_of: atan2(num, den), a small angle by arctan's series */
+fc_real fc_angle_of(fc_real num, fc_real den);
+/* kinematics.half_angle: cos(a/2) and sin(a/2) */
+void fc_half_angle(fc_real a, fc_real *c, fc_real *s);
+/* kinematics.quat_turn_roll_pitch: q with roll + dr and pitch + dp, its yaw kept (t: up_terms) */
+void fc_quat_turn_roll_pitch(fc_real q[4], const fc_real t[4], fc_real dr, fc_real dp);
 void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_real t[4],
                           fc_real out[3]);
 
@@ -86,14 +96,26 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
 #define FC_FACE_SWITCH_COS 0.5
 extern const fc_real FC_FACES[6][9];
 void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4]);
+/* building_blocks.turned_roll_pitch: roll and pitch grown by the angles q turned them by (before,
+ * after: kinematics.up_terms), near the vertical read off q */
+void fc_turned_roll_pitch(fc_real *roll, fc_real *pitch, const fc_real before[4],
+                          const fc_real after[4], const fc_real q[4]);
+/* building_blocks.tilt_innovation: the accelerometer's roll and pitch less those of up */
+void fc_tilt_innovation(fc_real ax, fc_real ay, fc_real az, const fc_real up[4], fc_real *y_roll,
+                        fc_real *y_pitch);
+/* building_blocks.corrected_quat: q (up: its up_terms) turned by the correction dr, dp to roll
+ * and pitch */
+void fc_corrected_quat(fc_real q[4], const fc_real up[4], fc_real roll, fc_real pitch, fc_real dr,
+                       fc_real dp);
 void fc_gate_bounds2(fc_real gate_low, fc_real gate_high, fc_real *low2, fc_real *high2);
 /* building_blocks.on_the_mark: t, or mark where t is within half a sample of it (a count
  * reaches its mark at the nearest sample in float as in double) */
 fc_real fc_on_the_mark(fc_real t, fc_real dt, fc_real mark);
 void fc_body_rotation(const fc_real g0[3], const fc_real g1[3], const fc_real bias[3], fc_real dt,
                       int trapezoid, fc_real phi[3]);
-void fc_lowpass_specific_force_terms(fc_real f[3], const fc_real phi[3], const fc_real terms[4],
-                                     const fc_real a[3], fc_real dt, fc_real tau);
+/* building_blocks.lowpass_specific_force: f turned by back (rotation_back_matrix), blended
+ * with a by k = dt / (tau + dt) */
+void fc_lowpass_specific_force(fc_real f[3], const fc_real back[9], const fc_real a[3], fc_real k);
 /* adaptive_noise_constants: the rotation term of the process noise per (rad/s)^2 and the
  * disturbance's averaging time (0: off, also without the pre-filter acc_tau) */
 void fc_adaptive_noise_constants(fc_real gyro_scale_std, fc_real scale_time,

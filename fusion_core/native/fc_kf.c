@@ -127,11 +127,14 @@ static void first_sample(fc_kf *f, const fc_real a_in[3], const fc_real g_in[3])
 /* propagate: the attitude quaternion turned by phi (with its fc_rotvec_terms), P by the papers'
  * F and Q with the adaptive Q_angle */
 static void propagate(fc_kf *f, const fc_real g[3], fc_real dt, const fc_real phi[3],
-                      const fc_real terms[4])
+                      const fc_real terms[4], fc_real up[4])
 {
-    fc_real bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
+    fc_real bx = f->bias_x, by = f->bias_y, bz = f->bias_z, before[4];
+    fc_up_terms(f->q_att, before);
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
-    fc_quat_roll_pitch(f->q_att, &roll, &pitch);
+    fc_up_terms(f->q_att, up);
+    fc_real roll = f->roll, pitch = f->pitch;
+    fc_turned_roll_pitch(&roll, &pitch, before, up, f->q_att);
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
     fc_real q_angle = f->q_angle;
@@ -151,15 +154,13 @@ static void correct_innovation(fc_kf *f, fc_real y_roll, fc_real y_pitch, int le
 }
 
 /* correct: the accelerometer's roll and pitch */
-static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias)
+static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias,
+                    const fc_real up[4], fc_real moved_roll, fc_real moved_pitch)
 {
-    fc_real acc_roll, acc_pitch;
-    fc_accel_roll_pitch(ax, ay, az, &acc_roll, &acc_pitch);
-    fc_real y_roll = acc_roll - f->roll;
-    if (!(-FC_PI <= y_roll && y_roll <= FC_PI)) {
-        y_roll = fc_wrap_angle(y_roll);
-    }
-    fc_real y_pitch = acc_pitch - f->pitch;
+    fc_real y_roll, y_pitch;
+    fc_tilt_innovation(ax, ay, az, up, &y_roll, &y_pitch);
+    y_roll -= moved_roll;
+    y_pitch -= moved_pitch;
     fc_real gate = f->params.bias_innovation;
     if (!(-gate <= y_roll && y_roll <= gate && -gate <= y_pitch && y_pitch <= gate)) {
         learn_bias = 0;  /* grossly off: the angle only (bias_innovation) */
@@ -212,11 +213,11 @@ static int zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc
 static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real dt,
                    const fc_real prev[3])
 {
-    fc_real a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4];
+    fc_real a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4], up[4];
     fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
     fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
     fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
-    propagate(f, g, dt, phi, terms);
+    propagate(f, g, dt, phi, terms, up);
     int clipped = f->base.clipped;  /* at the gyro's rail: the rate beyond it is unknown */
     if (clipped) {
         fc_real grow = f->rail_var * dt * dt;
@@ -233,7 +234,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     int learn_bias;
     /* at a first rest the angles are its tilt (zero_rate_update) */
     int rested = f->rest_time > 0.0 && !clipped && zero_rate_update(f, a, g, dt);
-    int filling = 0;
+    int filling = 0, reset = rested;  /* the angles set from a tilt: q rebuilt from them */
     fc_real r_meas = f->r;
     if (f->acc_tau > 0.0) {
         if (clipped) {
@@ -260,18 +261,22 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
         if (!filling) {
-            correct(f, a[0], a[1], a[2], learn_bias);
+            correct(f, a[0], a[1], a[2], learn_bias, up, f->roll - pred_roll, f->pitch - pred_pitch);
         } else if (!rested) {  /* (a first rest's mean, which no gyro error turned, stands) */
             /* the vector still fills: the attitude is its tilt, as uncertain as that vector */
             fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
+            reset = 1;
             fc_real var, age;
             fc_measure_fill_noise(f->meas, r_meas, dt, &f->measure, &var, &age);
             measured_axis(f->P_roll, var, age);
             measured_axis(f->P_pitch, var, age);
         }
     }
-    if (f->roll != pred_roll || f->pitch != pred_pitch) {
+    if (reset) {
         fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
+    } else if (f->roll != pred_roll || f->pitch != pred_pitch) {  /* q turned by the correction */
+        fc_corrected_quat(f->q_att, up, f->roll, f->pitch, f->roll - pred_roll,
+                          f->pitch - pred_pitch);
     }
 }
 

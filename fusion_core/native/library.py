@@ -27,9 +27,12 @@ HEADERS = (
 """The headers, in the order the binding declares them."""
 DATA_HEADERS = ("fc_scenarios.h", "fc_real.h")
 """Headers the binding does not declare, compiled in: the scenarios' signal nodes, the real type."""
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math")
+CFLAGS = ("-std=c99", "-O2", "-fno-semantic-interposition", "-fPIC", "-shared",
+          "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
-Python's does, which is what makes the twins equal."""
+Python's does, which is what makes the twins equal. -fno-semantic-interposition lets the compiler
+inline the small shared functions of fc_core.c (the angles, the low-pass stages) into their
+callers, as it does outside a shared library: nothing outside interposes them."""
 PREBUILT = HERE / "libfusion_core.so"
 """A library built beside the sources, as the pythonfmu FMUs ship it (fmu_src.build): loaded
 first where it loads (same platform); elsewhere the library is built or Python runs."""
