@@ -25,7 +25,6 @@ from .building_blocks import (
     quat_from_roll_pitch,
     rest_start,
     tilt_innovation,
-    turned_roll_pitch,
 )
 from .kinematics import (
     HALF_PI,
@@ -34,6 +33,7 @@ from .kinematics import (
     clamp_pitch,
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
+    quat_roll_pitch,
     rotvec_terms,
     up_terms,
     wrap_angle,
@@ -163,12 +163,11 @@ class ComplementaryFilter(Estimator):
             self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
                                                   self._measure, self.rest.measured > 0.0)
             ax, ay, az = self.meas.f
-        # the attitude turned, roll and pitch with it, the correction from the angles between
-        # the two tilts (building_blocks.attitude)
-        before = up_terms(*self.q_att)
+        # the attitude turned, the correction from the angle between the two tilts and q turned
+        # by it (building_blocks.attitude)
         self.q_att = q = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
         up = up_terms(*q)
-        roll, pitch = turned_roll_pitch(self.roll, self.pitch, before, up, q)
+        roll, pitch = quat_roll_pitch(*q)
         if self._gate_low2 <= ax * ax + ay * ay + az * az <= self._gate_high2:
             y_roll, y_pitch = tilt_innovation(ax, ay, az, up)
             tau = self._tau

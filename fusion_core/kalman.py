@@ -41,7 +41,6 @@ from .building_blocks import (
     rest_start,
     rest_step,
     tilt_innovation,
-    turned_roll_pitch,
     zero_rate_psd_param,
     zero_rate_sample,
 )
@@ -52,6 +51,7 @@ from .kinematics import (
     clamp_pitch,
     quat_from_roll_pitch_yaw,
     quat_mul_rotvec,
+    quat_roll_pitch,
     rotvec_terms,
     up_terms,
     wrap_angle,
@@ -420,14 +420,13 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         terms: tuple[float, float, float, float],
     ) -> None:
         """Time update: the attitude quaternion turned by the interval's rotation vector phi
-        (with its rotvec_terms), roll and pitch by the angles it turned them by
-        (building_blocks.turned_roll_pitch), P by the papers' F and Q (predict_covariance) with
-        the adaptive Q_angle. Keeps the turned q's up_terms for the correction (_up)."""
+        (with its rotvec_terms), roll and pitch read off it, P by the papers' F and Q
+        (predict_covariance) with the adaptive Q_angle. Keeps the turned q's up_terms for the
+        correction (_up)."""
         bx, by, bz = self.bias_x, self.bias_y, self.bias_z
-        before = up_terms(*self.q_att)
         self.q_att = q = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
-        self._up = up = up_terms(*q)
-        roll, pitch = turned_roll_pitch(self.roll, self.pitch, before, up, q)
+        self._up = up_terms(*q)
+        roll, pitch = quat_roll_pitch(*q)
         self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         self._predicted = (self.roll, self.pitch)

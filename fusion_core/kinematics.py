@@ -33,8 +33,7 @@ _SERIES_T2: Final = 1e-2
 """angle_of's series bound on the squared tangent (an angle of 0.0997 rad, 5.7 deg): below it,
 arctan's Taylor series through t^15, whose first omitted term is below 6e-18 of the angle (under a
 twentieth of an ulp), so it is exact to double precision there and needs no arctangent: the
-angles a filter turns by in one interval, and the innovations of a converged filter, are such
-angles."""
+innovations of a converged filter are such angles."""
 
 
 def wrap_angle(x: float) -> float:

@@ -48,7 +48,6 @@ from .attitude import (
     corrected_quat,
     quat_from_roll_pitch,
     tilt_innovation,
-    turned_roll_pitch,
 )
 from .faces import (
     FACE_SWITCH_COS,
@@ -144,7 +143,6 @@ __all__ = [
     "rest_start",
     "rest_step",
     "tilt_innovation",
-    "turned_roll_pitch",
     "uncalibrated_first_rest",
     "zero_rate_psd_param",
     "zero_rate_sample",

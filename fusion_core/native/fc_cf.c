@@ -79,13 +79,10 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
         r = fc_measure_step(f->meas, a, phi, terms, dt, &f->measure, f->rest[7] > 0.0, &aligning);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     }
-    fc_real before[4], up[4];  /* the attitude turned, roll and pitch with it */
-    fc_up_terms(f->q_att, before);
+    fc_real up[4];  /* the attitude turned (building_blocks.attitude) */
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
     fc_up_terms(f->q_att, up);
-    roll = f->roll;
-    pitch = f->pitch;
-    fc_turned_roll_pitch(&roll, &pitch, before, up, f->q_att);
+    fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
         fc_real y_roll, y_pitch;

@@ -271,19 +271,6 @@ void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4])
 
 #define STEP_MIN_COS 0.1     /* building_blocks.STEP_MIN_COS */
 
-void fc_turned_roll_pitch(fc_real *roll, fc_real *pitch, const fc_real before[4],
-                          const fc_real after[4], const fc_real q[4])
-{
-    if (before[3] > STEP_MIN_COS && after[3] > STEP_MIN_COS) {
-        *roll = *roll + fc_angle_of(after[0] * before[1] - after[1] * before[0],
-                                    after[1] * before[1] + after[0] * before[0]);
-        *pitch = *pitch + fc_angle_of(after[2] * before[3] - before[2] * after[3],
-                                      after[3] * before[3] + after[2] * before[2]);
-        return;
-    }
-    fc_quat_roll_pitch(q, roll, pitch);
-}
-
 void fc_tilt_innovation(fc_real ax, fc_real ay, fc_real az, const fc_real up[4], fc_real *y_roll,
                         fc_real *y_pitch)
 {

@@ -96,10 +96,6 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
 #define FC_FACE_SWITCH_COS 0.5
 extern const fc_real FC_FACES[6][9];
 void fc_quat_from_roll_pitch(fc_real roll, fc_real pitch, fc_real q[4]);
-/* building_blocks.turned_roll_pitch: roll and pitch grown by the angles q turned them by (before,
- * after: kinematics.up_terms), near the vertical read off q */
-void fc_turned_roll_pitch(fc_real *roll, fc_real *pitch, const fc_real before[4],
-                          const fc_real after[4], const fc_real q[4]);
 /* building_blocks.tilt_innovation: the accelerometer's roll and pitch less those of up */
 void fc_tilt_innovation(fc_real ax, fc_real ay, fc_real az, const fc_real up[4], fc_real *y_roll,
                         fc_real *y_pitch);

@@ -129,12 +129,10 @@ static void first_sample(fc_kf *f, const fc_real a_in[3], const fc_real g_in[3])
 static void propagate(fc_kf *f, const fc_real g[3], fc_real dt, const fc_real phi[3],
                       const fc_real terms[4], fc_real up[4])
 {
-    fc_real bx = f->bias_x, by = f->bias_y, bz = f->bias_z, before[4];
-    fc_up_terms(f->q_att, before);
+    fc_real bx = f->bias_x, by = f->bias_y, bz = f->bias_z, roll, pitch;
     fc_quat_mul_rotvec_terms(f->q_att, phi[0], phi[1], phi[2], terms);
     fc_up_terms(f->q_att, up);
-    fc_real roll = f->roll, pitch = f->pitch;
-    fc_turned_roll_pitch(&roll, &pitch, before, up, f->q_att);
+    fc_quat_roll_pitch(f->q_att, &roll, &pitch);
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
     fc_real q_angle = f->q_angle;
