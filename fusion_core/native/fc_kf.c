@@ -19,13 +19,6 @@ static void angle_only_gain(const fc_real P[4], fc_real r, fc_real K[2], fc_real
     out[3] = P11;
 }
 
-static fc_roll_pitch_axes axes(fc_kf *f)
-{
-    fc_roll_pitch_axes a = {&f->roll, &f->pitch, &f->bias_x, &f->bias_y, f->P_roll, f->P_pitch,
-                            f->gain_roll, f->gain_pitch};
-    return a;
-}
-
 static int same4(const fc_real a[4], const fc_real b[4])
 {
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] && a[3] == b[3];
@@ -141,13 +134,13 @@ static void propagate(fc_kf *f, const fc_real g[3], fc_real dt, const fc_real ph
         q_angle += f->q_rotation * (wx * wx + wy * wy + wz * wz);
     }
     f->q_step = q_angle;
-    fc_roll_pitch_predict_covariances(axes(f), dt, q_angle, f->q_bias);
+    fc_roll_pitch_predict_covariances(FC_ROLL_PITCH_AXES(f), dt, q_angle, f->q_bias);
 }
 
 /* correct_innovation: the biases consider states unless learn_bias */
 static void correct_innovation(fc_kf *f, fc_real y_roll, fc_real y_pitch, int learn_bias)
 {
-    fc_roll_pitch_update_angles(axes(f), f->r_step, y_roll, y_pitch,
+    fc_roll_pitch_update_angles(FC_ROLL_PITCH_AXES(f), f->r_step, y_roll, y_pitch,
                                 learn_bias ? fc_paper_kf_measurement_gain : angle_only_gain);
 }
 
@@ -198,7 +191,7 @@ static int zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc
     if (f->rest[6] >= f->rest_time) {
         fc_real r = f->gyro_var / dt;
         if (fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {  /* a still gyro's sample */
-            fc_roll_pitch_correct_bias(axes(f), g[0], g[1], r);
+            fc_roll_pitch_correct_bias(FC_ROLL_PITCH_AXES(f), g[0], g[1], r);
             fc_real k = f->P_z / (f->P_z + r);
             f->bias_z += k * (g[2] - f->bias_z);
             f->P_z -= k * f->P_z;

@@ -48,57 +48,50 @@ static int same4(const fc_real a[4], const fc_real b[4])
 }
 
 /* RollPitchAxes.predict_covariances */
-void fc_roll_pitch_predict_covariances(fc_roll_pitch_axes a, fc_real dt, fc_real q_angle,
+void fc_roll_pitch_predict_covariances(const fc_roll_pitch_axes *a, fc_real dt, fc_real q_angle,
                                        fc_real q_bias)
 {
     fc_real P[4];
-    memcpy(P, a.P_roll, sizeof P);
-    fc_paper_kf_predict_covariance(P, dt, q_angle, q_bias, a.P_roll);
-    if (same4(a.P_pitch, P)) {
-        memcpy(a.P_pitch, a.P_roll, sizeof P);
+    memcpy(P, a->P_roll, sizeof P);
+    fc_paper_kf_predict_covariance(P, dt, q_angle, q_bias, a->P_roll);
+    if (same4(a->P_pitch, P)) {
+        memcpy(a->P_pitch, a->P_roll, sizeof P);
     } else {
         fc_real Pp[4];
-        memcpy(Pp, a.P_pitch, sizeof Pp);
-        fc_paper_kf_predict_covariance(Pp, dt, q_angle, q_bias, a.P_pitch);
+        memcpy(Pp, a->P_pitch, sizeof Pp);
+        fc_paper_kf_predict_covariance(Pp, dt, q_angle, q_bias, a->P_pitch);
     }
 }
 
 /* RollPitchAxes.update_angles */
-void fc_roll_pitch_update_angles(fc_roll_pitch_axes a, fc_real r, fc_real y_roll, fc_real y_pitch,
+void fc_roll_pitch_update_angles(const fc_roll_pitch_axes *a, fc_real r, fc_real y_roll, fc_real y_pitch,
                                  fc_kf_gain_rule gain)
 {
     fc_real P[4];
-    memcpy(P, a.P_roll, sizeof P);
-    int shared = same4(a.P_pitch, P);
-    gain(P, r, a.gain_roll, a.P_roll);
+    memcpy(P, a->P_roll, sizeof P);
+    int shared = same4(a->P_pitch, P);
+    gain(P, r, a->gain_roll, a->P_roll);
     if (shared) {
-        memcpy(a.gain_pitch, a.gain_roll, 2 * sizeof *a.gain_roll);
-        memcpy(a.P_pitch, a.P_roll, sizeof P);
+        memcpy(a->gain_pitch, a->gain_roll, 2 * sizeof *a->gain_roll);
+        memcpy(a->P_pitch, a->P_roll, sizeof P);
     } else {
         fc_real Pp[4];
-        memcpy(Pp, a.P_pitch, sizeof Pp);
-        gain(Pp, r, a.gain_pitch, a.P_pitch);
+        memcpy(Pp, a->P_pitch, sizeof Pp);
+        gain(Pp, r, a->gain_pitch, a->P_pitch);
     }
-    fc_real roll = *a.roll + a.gain_roll[0] * y_roll;
-    *a.bias_x += a.gain_roll[1] * y_roll;
-    fc_real pitch = *a.pitch + a.gain_pitch[0] * y_pitch;
-    *a.bias_y += a.gain_pitch[1] * y_pitch;
-    *a.roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
-    *a.pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
+    fc_real roll = *a->roll + a->gain_roll[0] * y_roll;
+    *a->bias_x += a->gain_roll[1] * y_roll;
+    fc_real pitch = *a->pitch + a->gain_pitch[0] * y_pitch;
+    *a->bias_y += a->gain_pitch[1] * y_pitch;
+    *a->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
+    *a->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
 }
 
 /* RollPitchAxes.correct_bias */
-void fc_roll_pitch_correct_bias(fc_roll_pitch_axes a, fc_real z_x, fc_real z_y, fc_real r)
+void fc_roll_pitch_correct_bias(const fc_roll_pitch_axes *a, fc_real z_x, fc_real z_y, fc_real r)
 {
-    fc_paper_kf_bias_update(a.roll, a.bias_x, a.P_roll, z_x - *a.bias_x, r);
-    fc_paper_kf_bias_update(a.pitch, a.bias_y, a.P_pitch, z_y - *a.bias_y, r);
-}
-
-static fc_roll_pitch_axes axes(fc_paper_kf *f)
-{
-    fc_roll_pitch_axes a = {&f->roll, &f->pitch, &f->bias_x, &f->bias_y, f->P_roll, f->P_pitch,
-                            f->gain_roll, f->gain_pitch};
-    return a;
+    fc_paper_kf_bias_update(a->roll, a->bias_x, a->P_roll, z_x - *a->bias_x, r);
+    fc_paper_kf_bias_update(a->pitch, a->bias_y, a->P_pitch, z_y - *a->bias_y, r);
 }
 
 void fc_paper_kf_configure(fc_paper_kf *f)
@@ -160,7 +153,7 @@ void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real 
     if (f->r_loop > 0.0) {
         f->r_step = f->r_loop / dt;
     }
-    fc_roll_pitch_predict_covariances(axes(f), dt, f->q_angle, f->q_bias);
+    fc_roll_pitch_predict_covariances(FC_ROLL_PITCH_AXES(f), dt, f->q_angle, f->q_bias);
 }
 
 int fc_paper_kf_accel_trusted(const fc_paper_kf *f, fc_real norm2)
@@ -183,14 +176,14 @@ void fc_paper_kf_correct(fc_paper_kf *f, fc_real ax, fc_real ay, fc_real az)
 /* correct_innovation: the update with given innovations */
 void fc_paper_kf_correct_innovation(fc_paper_kf *f, fc_real y_roll, fc_real y_pitch)
 {
-    fc_roll_pitch_update_angles(axes(f), f->r_step, y_roll, y_pitch,
+    fc_roll_pitch_update_angles(FC_ROLL_PITCH_AXES(f), f->r_step, y_roll, y_pitch,
                                 fc_paper_kf_measurement_gain);
 }
 
 /* correct_bias: direct measurements of the x and y gyro bias (variance r each) */
 void fc_paper_kf_correct_bias(fc_paper_kf *f, fc_real z_x, fc_real z_y, fc_real r)
 {
-    fc_roll_pitch_correct_bias(axes(f), z_x, z_y, r);
+    fc_roll_pitch_correct_bias(FC_ROLL_PITCH_AXES(f), z_x, z_y, r);
 }
 
 /* took_sample: g becomes the previous gyro sample, the sample is counted (as fc_step does) */

@@ -53,11 +53,16 @@ typedef struct fc_roll_pitch_axes {
     fc_real *P_roll, *P_pitch;         /* [4] each */
     fc_real *gain_roll, *gain_pitch;   /* [2] each */
 } fc_roll_pitch_axes;
-void fc_roll_pitch_predict_covariances(fc_roll_pitch_axes a, fc_real dt, fc_real q_angle,
+/* The axes of a filter f whose fields are named as fc_paper_kf's (a compound literal: valid to
+ * the end of the enclosing block, never kept in a state) */
+#define FC_ROLL_PITCH_AXES(f)                                                                  \
+    (&(fc_roll_pitch_axes){&(f)->roll, &(f)->pitch, &(f)->bias_x, &(f)->bias_y, (f)->P_roll,   \
+                           (f)->P_pitch, (f)->gain_roll, (f)->gain_pitch})
+void fc_roll_pitch_predict_covariances(const fc_roll_pitch_axes *a, fc_real dt, fc_real q_angle,
                                        fc_real q_bias);
-void fc_roll_pitch_update_angles(fc_roll_pitch_axes a, fc_real r, fc_real y_roll, fc_real y_pitch,
+void fc_roll_pitch_update_angles(const fc_roll_pitch_axes *a, fc_real r, fc_real y_roll, fc_real y_pitch,
                                  fc_kf_gain_rule gain);
-void fc_roll_pitch_correct_bias(fc_roll_pitch_axes a, fc_real z_x, fc_real z_y, fc_real r);
+void fc_roll_pitch_correct_bias(const fc_roll_pitch_axes *a, fc_real z_x, fc_real z_y, fc_real r);
 
 /* The equations (papers/kalman.py's functions of the same names): F P F' + Q; the gain and
  * covariance of an angle measurement; a direct bias measurement (P updated in place). */
