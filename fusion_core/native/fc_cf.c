@@ -21,12 +21,7 @@ void fc_cf_configure(fc_cf *f)
 
 fc_estimate fc_cf_estimate(const fc_cf *f)
 {
-    fc_estimate e;
-    memset(&e, 0, sizeof e);
-    e.roll = f->roll;
-    e.pitch = f->pitch;
-    memcpy(e.bias, f->bias, sizeof e.bias);
-    return e;
+    return fc_attitude_estimate(f->roll, f->pitch, f->bias[0], f->bias[1], f->bias[2]);
 }
 
 void fc_cf_reset(fc_cf *f)

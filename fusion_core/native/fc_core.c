@@ -851,7 +851,10 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
         return FC_SKIPPED;
     }
     memcpy(base->gyro_prev, g, sizeof g);
-    *last = fc_base_output(base, ops->estimate(self));
+    ops->estimate(self, last);
+    if (base->delay > 0.0) {  /* fc_base_output: turned ahead by the sensor's delay */
+        *last = fc_base_output(base, *last);
+    }
     base->n_samples += 1;
     if (out) {
         *out = *last;

@@ -39,6 +39,15 @@ typedef struct fc_estimate {
     fc_real vel[3];
 } fc_estimate;
 
+/* The estimate of an attitude filter: roll, pitch and bias, no position (every field written
+ * once, by an initialiser, rather than cleared and then written) */
+static inline fc_estimate fc_attitude_estimate(fc_real roll, fc_real pitch, fc_real bx,
+                                               fc_real by, fc_real bz)
+{
+    fc_estimate e = {roll, pitch, {bx, by, bz}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    return e;
+}
+
 /* The state every estimator has (Estimator._BASE_STATE) and the sample rules' constants. */
 typedef struct fc_base {
     int initialized;
@@ -244,7 +253,7 @@ int fc_base_can_init(const fc_real acc[3]);
 typedef struct fc_ops {
     void (*first_sample)(void *self, const fc_real acc[3], const fc_real gyro[3]);
     void (*advance)(void *self, const fc_real acc[3], const fc_real gyro[3], fc_real dt);
-    fc_estimate (*estimate)(const void *self);
+    void (*estimate)(const void *self, fc_estimate *out);  /* T_estimate, written to *out */
 } fc_ops;
 
 /* Estimator.step for any estimator: the sample rules, then first_sample or advance; *last is the
@@ -292,9 +301,9 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
     {                                                                                         \
         advance((T *)self, acc, gyro, dt);                                                    \
     }                                                                                         \
-    static fc_estimate estimate_op(const void *self)                                          \
+    static void estimate_op(const void *self, fc_estimate *out)                               \
     {                                                                                         \
-        return T##_estimate((const T *)self);                                                 \
+        *out = T##_estimate((const T *)self);                                                 \
     }                                                                                         \
     static const fc_ops OPS = {first_sample_op, advance_op, estimate_op};                     \
     fc_status T##_step(T *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,            \

@@ -51,10 +51,10 @@ void fc_kf_configure(fc_kf *f)
 
 fc_estimate fc_kf_estimate(const fc_kf *f)  /* _estimate */
 {
-    fc_estimate e;
-    memset(&e, 0, sizeof e);
-    fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
     if (f->face) {  /* from the face frame back to the sensor's */
+        fc_estimate e;
+        memset(&e, 0, sizeof e);
+        fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
         const fc_real *C = FC_FACES[f->face];
         fc_real cp = fc_cos(f->pitch);
         fc_real v[3] = {-fc_sin(f->pitch), fc_sin(f->roll) * cp, fc_cos(f->roll) * cp}, up[3];
@@ -63,10 +63,7 @@ fc_estimate fc_kf_estimate(const fc_kf *f)  /* _estimate */
         fc_mat_t_vec(C, b, e.bias);
         return e;
     }
-    e.roll = f->roll;
-    e.pitch = f->pitch;
-    memcpy(e.bias, b, sizeof b);
-    return e;
+    return fc_attitude_estimate(f->roll, f->pitch, f->bias_x, f->bias_y, f->bias_z);
 }
 
 void fc_kf_reset(fc_kf *f)
