@@ -346,6 +346,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
                   and self._zero_rate_update(ax, ay, az, gx, gy, gz, dt))
         filling = False
         reset = rested  # the angles set from a tilt: q rebuilt from them
+        turn = None  # the angles' change that turns q (correct)
         if self._acc_tau > 0.0:
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt,
@@ -367,7 +368,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             learn_bias = lo < raw2 < hi and not clipped
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             if not filling:
-                self.correct(ax, ay, az, learn_bias)
+                turn = self.correct(ax, ay, az, learn_bias)
             elif not rested:  # (a first rest's mean, which no gyro error turned, stands)
                 # the vector still fills: the attitude is its tilt (as cf's and mgcf's), as
                 # uncertain as that vector, its samples turned over their mean age (fill_noise)
@@ -379,8 +380,9 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         if reset:
             self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
         elif (self.roll, self.pitch) != predicted:  # q turned by the correction
-            self.q_att = corrected_quat(self.q_att, up, self.roll, self.pitch,
-                                        self.roll - predicted[0], self.pitch - predicted[1])
+            if turn is None:  # moved by a zero-rate update alone
+                turn = (self.roll - predicted[0], self.pitch - predicted[1])
+            self.q_att = corrected_quat(self.q_att, up, self.roll, self.pitch, *turn)
 
     def _zero_rate_update(
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
@@ -438,20 +440,26 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self.q_step = q_angle
         self.predict_covariances(dt, q_angle)
 
-    def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True) -> None:
+    def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True
+                ) -> tuple[float, float]:
         """Measurement update of both axes with the accelerometer's roll and pitch (the biases
         left alone unless learn_bias, bias_gate, and while an innovation exceeds
         bias_innovation). The innovations are the angles from the predicted attitude's tilt to
         the accelerometer's (building_blocks.tilt_innovation), less what a zero-rate update
-        moved the angles by since."""
+        moved the angles by since. Returns the angles' change since the prediction, that move
+        plus the correction (gain times innovation): the turn of q (corrected_quat), which so
+        does not wait for the arctangents that read the predicted angles."""
         y_roll, y_pitch = tilt_innovation(ax, ay, az, self._up)
         pred_roll, pred_pitch = self._predicted
-        y_roll -= self.roll - pred_roll
-        y_pitch -= self.pitch - pred_pitch
+        moved_roll, moved_pitch = self.roll - pred_roll, self.pitch - pred_pitch
+        y_roll -= moved_roll
+        y_pitch -= moved_pitch
         gate = self._bias_innovation
         if not (-gate <= y_roll <= gate and -gate <= y_pitch <= gate):
             learn_bias = False  # grossly off: the angle only (bias_innovation)
         self.correct_innovation(y_roll, y_pitch, learn_bias)
+        return (moved_roll + self.gain_roll[0] * y_roll,
+                moved_pitch + self.gain_pitch[0] * y_pitch)
 
     def correct_innovation(self, y_roll: float, y_pitch: float, learn_bias: bool = True) -> None:
         """Measurement update with given innovations (accelerometer angle - predicted angle);
