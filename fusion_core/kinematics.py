@@ -52,35 +52,38 @@ def accel_roll_pitch(ax: float, ay: float, az: float) -> tuple[float, float]:
 
 
 def euler_rates(
-    phi: float, theta: float, p: float, q: float, r: float
+    phi: float, theta: float, p: float, q: float, r: float,
+    sc: tuple[float, float, float, float] | None = None,
 ) -> tuple[float, float]:
     """Roll and pitch rates from body rates (Z-Y-X Euler kinematics, Duong Quoc et al. eq. 2).
 
     phi_dot   = p + (q sin(phi) + r cos(phi)) tan(theta)
     theta_dot = q cos(phi) - r sin(phi)
+
+    sc: (sin phi, cos phi, sin theta, cos theta) where the caller has them.
     """
-    sp = sin(phi)
-    cp = cos(phi)
-    ct = cos(theta)
+    sp, cp, st, ct = (sin(phi), cos(phi), sin(theta), cos(theta)) if sc is None else sc
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:  # abs(ct) < _MIN_COS_PITCH
         ct = copysign(_MIN_COS_PITCH, ct)
-    return p + (q * sp + r * cp) * sin(theta) / ct, q * cp - r * sp
+    return p + (q * sp + r * cp) * st / ct, q * cp - r * sp
 
 
 def heun_euler_step(
     phi: float, theta: float,
     p0: float, q0: float, r0: float, p1: float, q1: float, r1: float, dt: float,
+    sc: tuple[float, float, float, float] | None = None,
 ) -> tuple[float, float]:
     """Propagate roll and pitch over dt with Heun's method on the Euler-rate kinematics.
 
     (p0, q0, r0) is the (bias-corrected) body rate at the start of the interval, (p1, q1, r1) at
     its end: the rate is linear over the interval (trapezoid rule), so the local error is O(dt^3).
+    sc: (sin phi, cos phi, sin theta, cos theta) where the caller has them.
     """
     # euler_rates at both ends, written out (this runs once per sample in cf, kf and poskf)
-    sp, cp, ct = sin(phi), cos(phi), cos(theta)
+    sp, cp, st, ct = (sin(phi), cos(phi), sin(theta), cos(theta)) if sc is None else sc
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:
         ct = copysign(_MIN_COS_PITCH, ct)
-    d1p, d1t = p0 + (q0 * sp + r0 * cp) * sin(theta) / ct, q0 * cp - r0 * sp
+    d1p, d1t = p0 + (q0 * sp + r0 * cp) * st / ct, q0 * cp - r0 * sp
     phi1, theta1 = phi + dt * d1p, theta + dt * d1t
     sp, cp, ct = sin(phi1), cos(phi1), cos(theta1)
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:
@@ -90,11 +93,12 @@ def heun_euler_step(
 
 
 def euler_step(
-    phi: float, theta: float, p: float, q: float, r: float, dt: float
+    phi: float, theta: float, p: float, q: float, r: float, dt: float,
+    sc: tuple[float, float, float, float] | None = None,
 ) -> tuple[float, float]:
     """Propagate roll and pitch with the papers' rectangle rule: the end-of-interval body rate
-    (p, q, r) times dt."""
-    dp, dtheta = euler_rates(phi, theta, p, q, r)
+    (p, q, r) times dt; sc as euler_rates'."""
+    dp, dtheta = euler_rates(phi, theta, p, q, r, sc)
     return phi + dt * dp, theta + dt * dtheta
 
 

@@ -8,7 +8,7 @@ and the recommended attitude filter's roll and pitch as its attitude outputs
 from __future__ import annotations
 
 import dataclasses
-from math import cos, sin, sqrt
+from math import cos, nan, sin, sqrt
 from typing import Any, ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
@@ -188,6 +188,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         self.pending: list[tuple[float, float, float, float, float]] = []
         self.turned = (0.0, 0.0)
         self.f_mean = (0.0, 0.0, 0.0)
+        self._sines = (nan, nan, (0.0, 0.0, 0.0, 0.0))  # _tilt_sines' cache: none yet
 
     def _check_nested(self, field: str, snapshot: dict[str, Any], params: dict[str, Any]
                       ) -> None:
@@ -242,11 +243,10 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         dx, dy, dz = ax - mx, ay - my, az - mz
         wx, wy = gx - tilt.bias_x, gy - tilt.bias_y
         roll, pitch = tilt.roll, tilt.pitch
+        sc = self._tilt_sines(roll, pitch)
         # the level-frame acceleration with yaw 0 (the yaw turns it about the vertical, which
         # leaves its norm as it is)
-        lx, ly, lz = level_acceleration(
-            ax, ay, az, sin(roll), cos(roll), sin(pitch), cos(pitch), 0.0, 1.0
-        )
+        lx, ly, lz = level_acceleration(ax, ay, az, sc[0], sc[1], sc[2], sc[3], 0.0, 1.0)
         quiet = (
             sqrt(dx * dx + dy * dy + dz * dz) < self._zupt_acc
             and sqrt(lx * lx + ly * ly + lz * lz) < self._zupt_level_acc
@@ -262,7 +262,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
             quiet_time >= self._force_after or self._slow_enough()
         )
         # 2. tilt stage; yaw from the gyro (Euler kinematics, Duong Quoc et al. eq. 2)
-        tilt.propagate(self.gyro_prev, (gx, gy, gz), dt)
+        tilt.propagate(self.gyro_prev, (gx, gy, gz), dt, sc)
         d_roll = tilt.roll - roll
         turned_roll, turned_pitch = self.turned
         turned_roll += d_roll if -PI <= d_roll <= PI else wrap_angle(d_roll)
@@ -294,7 +294,8 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         self.att.step((ax, ay, az), (gx, gy, gz), dt)
         # 3. yaw from the gyro, the level-frame acceleration with the new attitude
         self.yaw, acc = yaw_and_level_acceleration(tilt.roll, tilt.pitch, self.yaw, wy, gz,
-                                                   (ax, ay, az), dt)
+                                                   (ax, ay, az), dt,
+                                                   self._tilt_sines(tilt.roll, tilt.pitch))
         # 4. [p, v, a] filter per axis (eq. 20-29)
         if dt != self._Q_dt:
             p = self._params
@@ -307,6 +308,18 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         )
         self._x = x
         return self._estimate()
+
+    def _tilt_sines(self, roll: float, pitch: float) -> tuple[float, float, float, float]:
+        """(sin roll, cos roll, sin pitch, cos pitch) of the tilt stage's angles, computed once
+        per pair of angles: the levelling after a sample's update, the next sample's detector
+        and its Euler-rate step read the same four (a cache of a function of the two angles,
+        so never stale, never saved)."""
+        cached = self._sines
+        if cached[0] == roll and cached[1] == pitch:
+            return cached[2]
+        sc = (sin(roll), cos(roll), sin(pitch), cos(pitch))
+        self._sines = (roll, pitch, sc)
+        return sc
 
     def _estimate(self) -> Estimate:
         x = self._x

@@ -28,34 +28,47 @@ void fc_accel_roll_pitch(fc_real ax, fc_real ay, fc_real az, fc_real *roll, fc_r
     *pitch = fc_atan2(-ax, fc_sqrt(ay * ay + az * az));
 }
 
-/* euler_rates (with the fc_cos(pitch) guard of heun_euler_step) */
-static void euler_rates(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real *dphi,
-                        fc_real *dtheta)
+/* euler_rates (with the fc_cos(pitch) guard of heun_euler_step); sc: sin phi, cos phi, sin theta,
+ * cos theta, or NULL */
+static void euler_rates(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r,
+                        const fc_real sc[4], fc_real *dphi, fc_real *dtheta)
 {
-    fc_real sp = fc_sin(phi), cp = fc_cos(phi), ct = fc_cos(theta);
+    fc_real sp, cp, st, ct;
+    if (sc) {
+        sp = sc[0];
+        cp = sc[1];
+        st = sc[2];
+        ct = sc[3];
+    } else {
+        sp = fc_sin(phi);
+        cp = fc_cos(phi);
+        st = fc_sin(theta);
+        ct = fc_cos(theta);
+    }
     if (-MIN_COS_PITCH < ct && ct < MIN_COS_PITCH) {
         ct = fc_copysign(MIN_COS_PITCH, ct);
     }
-    *dphi = p + (q * sp + r * cp) * fc_sin(theta) / ct;
+    *dphi = p + (q * sp + r * cp) * st / ct;
     *dtheta = q * cp - r * sp;
 }
 
 void fc_euler_step(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real dt,
-                   fc_real *phi_out, fc_real *theta_out)
+                   const fc_real sc[4], fc_real *phi_out, fc_real *theta_out)
 {
     fc_real dp, dtheta;
-    euler_rates(phi, theta, p, q, r, &dp, &dtheta);
+    euler_rates(phi, theta, p, q, r, sc, &dp, &dtheta);
     *phi_out = phi + dt * dp;
     *theta_out = theta + dt * dtheta;
 }
 
 void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_real r0, fc_real p1,
-                        fc_real q1, fc_real r1, fc_real dt, fc_real *phi_out, fc_real *theta_out)
+                        fc_real q1, fc_real r1, fc_real dt, const fc_real sc[4], fc_real *phi_out,
+                        fc_real *theta_out)
 {
     fc_real d1p, d1t, d2p, d2t;
-    euler_rates(phi, theta, p0, q0, r0, &d1p, &d1t);
+    euler_rates(phi, theta, p0, q0, r0, sc, &d1p, &d1t);
     fc_real phi1 = phi + dt * d1p, theta1 = theta + dt * d1t;
-    euler_rates(phi1, theta1, p1, q1, r1, &d2p, &d2t);
+    euler_rates(phi1, theta1, p1, q1, r1, NULL, &d2p, &d2t);
     *phi_out = phi + 0.5 * dt * (d1p + d2p);
     *theta_out = theta + 0.5 * dt * (d1t + d2t);
 }

@@ -69,10 +69,13 @@ typedef struct fc_base {
 fc_real fc_wrap_angle(fc_real x);
 fc_real fc_clamp_pitch(fc_real theta);
 void fc_accel_roll_pitch(fc_real ax, fc_real ay, fc_real az, fc_real *roll, fc_real *pitch);
+/* euler_step, heun_euler_step: sc the sines and cosines of phi and theta (sin phi, cos phi,
+ * sin theta, cos theta) where the caller has them, else NULL */
 void fc_euler_step(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real dt,
-                   fc_real *phi_out, fc_real *theta_out);
+                   const fc_real sc[4], fc_real *phi_out, fc_real *theta_out);
 void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_real r0, fc_real p1,
-                        fc_real q1, fc_real r1, fc_real dt, fc_real *phi_out, fc_real *theta_out);
+                        fc_real q1, fc_real r1, fc_real dt, const fc_real sc[4], fc_real *phi_out,
+                        fc_real *theta_out);
 void fc_quat_from_roll_pitch_yaw(fc_real phi, fc_real theta, fc_real psi, fc_real q[4]);
 void fc_quat_roll_pitch(const fc_real q[4], fc_real *roll, fc_real *pitch);
 void fc_quat_gravity_body(const fc_real q[4], fc_real g[3]);

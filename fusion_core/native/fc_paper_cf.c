@@ -43,10 +43,10 @@ static void advance(fc_paper_cf *f, const fc_real a[3], const fc_real g[3], fc_r
     fc_real roll, pitch;
     if (f->trapezoid) {
         const fc_real *w0 = f->base.gyro_prev;
-        fc_heun_euler_step(f->roll, f->pitch, w0[0], w0[1], w0[2], g[0], g[1], g[2], dt, &roll,
-                           &pitch);
+        fc_heun_euler_step(f->roll, f->pitch, w0[0], w0[1], w0[2], g[0], g[1], g[2], dt, NULL,
+                           &roll, &pitch);
     } else {
-        fc_euler_step(f->roll, f->pitch, g[0], g[1], g[2], dt, &roll, &pitch);
+        fc_euler_step(f->roll, f->pitch, g[0], g[1], g[2], dt, NULL, &roll, &pitch);
     }
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {

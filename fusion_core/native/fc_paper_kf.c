@@ -139,14 +139,15 @@ static void first_sample(fc_paper_kf *f, const fc_real a[3], const fc_real g[3])
 }
 
 /* propagate: the angles by the Euler rates, P by the papers' F and Q */
-void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real g[3], fc_real dt)
+void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real g[3], fc_real dt,
+                           const fc_real sc[4])
 {
     fc_real bx = f->bias_x, by = f->bias_y, roll, pitch;
     if (f->trapezoid) {
         fc_heun_euler_step(f->roll, f->pitch, prev[0] - bx, prev[1] - by, prev[2], g[0] - bx,
-                           g[1] - by, g[2], dt, &roll, &pitch);
+                           g[1] - by, g[2], dt, sc, &roll, &pitch);
     } else {
-        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2], dt, &roll, &pitch);
+        fc_euler_step(f->roll, f->pitch, g[0] - bx, g[1] - by, g[2], dt, sc, &roll, &pitch);
     }
     f->roll = -FC_PI <= roll && roll <= FC_PI ? roll : fc_wrap_angle(roll);
     f->pitch = -FC_HALF_PI <= pitch && pitch <= FC_HALF_PI ? pitch : fc_clamp_pitch(pitch);
@@ -195,7 +196,7 @@ void fc_paper_kf_took_sample(fc_paper_kf *f, const fc_real g[3])
 
 static void advance(fc_paper_kf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
-    fc_paper_kf_propagate(f, f->base.gyro_prev, g, dt);
+    fc_paper_kf_propagate(f, f->base.gyro_prev, g, dt, NULL);
     if (fc_paper_kf_accel_trusted(f, a[0] * a[0] + a[1] * a[1] + a[2] * a[2])) {
         fc_paper_kf_correct(f, a[0], a[1], a[2]);
     }

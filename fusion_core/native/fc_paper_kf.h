@@ -34,7 +34,9 @@ void fc_paper_kf_restored(fc_paper_kf *f);
 
 /* The tilt stage: the steps of one sample, for a filter that drives them (the position filters;
  * PaperKalmanFilter's methods of the same names). */
-void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real g[3], fc_real dt);
+/* propagate; sc: the sines and cosines of roll and pitch (sin r, cos r, sin p, cos p), or NULL */
+void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real g[3], fc_real dt,
+                           const fc_real sc[4]);
 int fc_paper_kf_accel_trusted(const fc_paper_kf *f, fc_real norm2);
 void fc_paper_kf_correct(fc_paper_kf *f, fc_real ax, fc_real ay, fc_real az);
 void fc_paper_kf_correct_innovation(fc_paper_kf *f, fc_real y_roll, fc_real y_pitch);

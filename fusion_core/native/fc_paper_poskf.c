@@ -129,10 +129,20 @@ void fc_paper_poskf_level_acceleration(fc_real ax, fc_real ay, fc_real az, fc_re
  * acceleration with the new attitude */
 void fc_paper_poskf_yaw_and_level_acceleration(fc_real roll, fc_real pitch, fc_real *yaw, fc_real wy,
                                                fc_real gz, const fc_real a[3], fc_real dt,
-                                               fc_real acc[3])
+                                               const fc_real sc[4], fc_real acc[3])
 {
-    fc_real y = *yaw;
-    fc_real sr = fc_sin(roll), cr = fc_cos(roll), sp = fc_sin(pitch), cp = fc_cos(pitch);
+    fc_real y = *yaw, sr, cr, sp, cp;
+    if (sc) {
+        sr = sc[0];
+        cr = sc[1];
+        sp = sc[2];
+        cp = sc[3];
+    } else {
+        sr = fc_sin(roll);
+        cr = fc_cos(roll);
+        sp = fc_sin(pitch);
+        cp = fc_cos(pitch);
+    }
     if (cp > 1e-6 || cp < -1e-6) {
         y += dt * (wy * sr + gz * cr) / cp;
         y = *yaw = -FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y);
@@ -233,14 +243,14 @@ static void advance(fc_paper_poskf *f, const fc_real a[3], const fc_real g[3], f
     fc_paper_kf *tilt = &f->tilt;
     fc_real ax = a[0], ay = a[1], az = a[2], gy = g[1], gz = g[2];
     fc_real wy = gy - tilt->bias_y;  /* the bias before this sample's update, for the yaw rate */
-    fc_paper_kf_propagate(tilt, f->base.gyro_prev, g, dt);
+    fc_paper_kf_propagate(tilt, f->base.gyro_prev, g, dt, NULL);
     if (fc_paper_kf_accel_trusted(tilt, ax * ax + ay * ay + az * az)) {
         fc_paper_kf_correct(tilt, ax, ay, az);
     }
     fc_paper_kf_took_sample(tilt, g);
     fc_real acc[3];
     fc_paper_poskf_yaw_and_level_acceleration(tilt->roll, tilt->pitch, &f->yaw, wy, gz, a, dt,
-                                              acc);
+                                              NULL, acc);
     if (dt != f->Q_dt) {
         fc_paper_poskf_process_noise(p->qr_form, p->q, dt, f->Q);
         f->R = f->acc_var_density / dt;

@@ -45,10 +45,11 @@ void fc_paper_poskf_axis_filters(fc_real x[9], fc_real P[6], const fc_real Q[6],
                                  const fc_real acc[3], fc_real r, int with_zupt, fc_real zupt_r);
 void fc_paper_poskf_level_acceleration(fc_real ax, fc_real ay, fc_real az, fc_real sr, fc_real cr,
                                        fc_real sp, fc_real cp, fc_real sy, fc_real cy, fc_real out[3]);
-/* yaw_and_level_acceleration: yaw turned over dt in place, acc the level-frame acceleration. */
+/* yaw_and_level_acceleration: yaw turned over dt in place, acc the level-frame acceleration;
+ * sc: the sines and cosines of roll and pitch (sin r, cos r, sin p, cos p), or NULL. */
 void fc_paper_poskf_yaw_and_level_acceleration(fc_real roll, fc_real pitch, fc_real *yaw, fc_real wy,
                                                fc_real gz, const fc_real a[3], fc_real dt,
-                                               fc_real acc[3]);
+                                               const fc_real sc[4], fc_real acc[3]);
 void fc_paper_poskf_first_axis_states(fc_paper_kf *tilt, const fc_real a[3], const fc_real g[3],
                                       fc_real dt, fc_real acc_var_density, fc_real x[9],
                                       fc_real P[6]);

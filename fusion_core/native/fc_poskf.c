@@ -58,6 +58,7 @@ void fc_poskf_reset(fc_poskf *f)
     f->pending_head = f->pending_count = 0;
     f->turned[0] = f->turned[1] = 0.0;
     memset(f->f_mean, 0, sizeof f->f_mean);
+    f->sines[0] = f->sines[1] = NAN;  /* tilt_sines: none yet */
     f->last = fc_poskf_estimate(f);
 }
 
@@ -76,6 +77,21 @@ static void first_sample(fc_poskf *f, const fc_real a[3], const fc_real g[3])  /
                                      f->P);
     fc_kf_step(&f->att, a, g, f->params.max_dt, NULL);
     memcpy(f->f_mean, a, sizeof f->f_mean);
+}
+
+/* _tilt_sines: sin and cos of the tilt stage's roll and pitch, computed once per pair */
+static const fc_real *tilt_sines(fc_poskf *f, fc_real roll, fc_real pitch)
+{
+    fc_real *c = f->sines;
+    if (!(c[0] == roll && c[1] == pitch)) {
+        c[0] = roll;
+        c[1] = pitch;
+        c[2] = fc_sin(roll);
+        c[3] = fc_cos(roll);
+        c[4] = fc_sin(pitch);
+        c[5] = fc_cos(pitch);
+    }
+    return c + 2;
 }
 
 static int slow_enough(const fc_poskf *f)  /* _slow_enough */
@@ -97,8 +113,8 @@ static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real
     fc_real dx = ax - mx, dy = ay - my, dz = az - mz;
     fc_real wx = gx - tilt->bias_x, wy = gy - tilt->bias_y;
     fc_real roll = tilt->roll, pitch = tilt->pitch, l[3];
-    fc_paper_poskf_level_acceleration(ax, ay, az, fc_sin(roll), fc_cos(roll), fc_sin(pitch), fc_cos(pitch),
-                                      0.0, 1.0, l);
+    const fc_real *sc = tilt_sines(f, roll, pitch);
+    fc_paper_poskf_level_acceleration(ax, ay, az, sc[0], sc[1], sc[2], sc[3], 0.0, 1.0, l);
     int quiet = fc_sqrt(dx * dx + dy * dy + dz * dz) < p->zupt_acc
         && fc_sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) < p->zupt_level_acc
         && fc_sqrt(wx * wx + wy * wy + gz * gz) < p->zupt_gyro;
@@ -114,7 +130,7 @@ static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real
     int stationary = f->stationary = quiet && quiet_time >= window
         && (quiet_time >= p->zupt_force_after || slow_enough(f));
     /* 2. tilt stage */
-    fc_paper_kf_propagate(tilt, f->base.gyro_prev, g, dt);
+    fc_paper_kf_propagate(tilt, f->base.gyro_prev, g, dt, sc);
     fc_real d_roll = tilt->roll - roll;
     fc_real turned_roll = f->turned[0], turned_pitch = f->turned[1];
     turned_roll += -FC_PI <= d_roll && d_roll <= FC_PI ? d_roll : fc_wrap_angle(d_roll);
@@ -155,7 +171,7 @@ static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real
     /* 3. yaw from the gyro, the level-frame acceleration with the new attitude */
     fc_real acc[3];
     fc_paper_poskf_yaw_and_level_acceleration(tilt->roll, tilt->pitch, &f->yaw, wy, gz, a, dt,
-                                              acc);
+                                              tilt_sines(f, tilt->roll, tilt->pitch), acc);
     /* 4. [p, v, a] filter per axis (eq. 20-29) */
     if (dt != f->Q_dt) {
         fc_paper_poskf_process_noise(FC_PAPER_POSKF_QR_FORM_WHITE_JERK, p->q, dt, f->Q);

@@ -30,6 +30,8 @@ typedef struct fc_poskf {
     /* derived from params (PositionKalmanFilter._configure) */
     fc_real acc_var_density, zupt_var, gyro_var_density;
     fc_real Q[6], R, Q_dt;
+    /* tilt_sines' cache (never saved): the tilt angles sines[0..1] and their sines and cosines */
+    fc_real sines[6];
 } fc_poskf;
 
 void fc_poskf_init(fc_poskf *f, const fc_poskf_params *params);

@@ -232,17 +232,19 @@ class PaperKalmanFilter(RollPitchAxes, Estimator):
                                     None, None))
 
     # ----- the tilt stage: the steps one sample takes, for a filter that drives them ---------
-    def propagate(self, prev: Vec3, g: Vec3, dt: float) -> None:
+    def propagate(self, prev: Vec3, g: Vec3, dt: float,
+                  sc: tuple[float, float, float, float] | None = None) -> None:
         """Time update from the previous gyro sample prev to this one, g (Gui et al. eq. 5-22):
-        the angles by the Euler-rate kinematics, P by the papers' F and Q."""
+        the angles by the Euler-rate kinematics, P by the papers' F and Q; sc: the sines and
+        cosines of roll and pitch (kinematics.euler_rates) where the caller has them."""
         bx, by = self.bias_x, self.bias_y
         gx, gy, gz = g
         if self._trapezoid:
             p0, q0, r0 = prev
             roll, pitch = heun_euler_step(self.roll, self.pitch, p0 - bx, q0 - by, r0, gx - bx,
-                                          gy - by, gz, dt)
+                                          gy - by, gz, dt, sc)
         else:
-            roll, pitch = euler_step(self.roll, self.pitch, gx - bx, gy - by, gz, dt)
+            roll, pitch = euler_step(self.roll, self.pitch, gx - bx, gy - by, gz, dt, sc)
         self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
         if self._r_loop > 0.0:

@@ -146,11 +146,14 @@ def level_acceleration(
 
 
 def yaw_and_level_acceleration(roll: float, pitch: float, yaw: float, wy: float, gz: float,
-                               a: Vec3, dt: float) -> tuple[float, Vec3]:
+                               a: Vec3, dt: float,
+                               sc: tuple[float, float, float, float] | None = None
+                               ) -> tuple[float, Vec3]:
     """Yaw from the gyro over dt (the Z-Y-X Euler-rate kinematics, Duong Quoc et al. eq. 2, with
     wy the bias-corrected y rate; held where cos(pitch) is 0) and the level-frame acceleration
-    of the specific force a with the new attitude (level_acceleration)."""
-    sr, cr, sp, cp = sin(roll), cos(roll), sin(pitch), cos(pitch)
+    of the specific force a with the new attitude (level_acceleration); sc: (sin roll,
+    cos roll, sin pitch, cos pitch) where the caller has them."""
+    sr, cr, sp, cp = (sin(roll), cos(roll), sin(pitch), cos(pitch)) if sc is None else sc
     if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
         yaw += dt * (wy * sr + gz * cr) / cp
         yaw = yaw if -PI <= yaw <= PI else wrap_angle(yaw)
