@@ -169,21 +169,26 @@ def new_twin(estimator: Any) -> Any:
 def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
         ) -> dict[str, np.ndarray]:
     """Estimator.run through the C twin: the same outputs, and the estimator's state afterwards
-    is the one the Python run would leave. The samples go through in chunks of RUN_CHUNK, so
-    that, as in the Python run, memory beyond the outputs does not grow with N."""
+    is the one the Python run would leave. The twin writes each output into its array
+    (T_run_columns); the inputs go through in chunks of RUN_CHUNK, so that, as in the Python
+    run, memory beyond the outputs does not grow with N (an input that is not contiguous
+    float64 is copied chunk by chunk)."""
     lib, ffi = lib_and_ffi()
     twin = new_twin(estimator)
-    run_twin = getattr(lib, f"{type(estimator).TWIN}_run")
+    run_twin = getattr(lib, f"{type(estimator).TWIN}_run_columns")
     n = acc.shape[0]
     out = {"roll": np.empty(n), "pitch": np.empty(n), "bias": np.empty((n, 3)),
            "rejected": np.zeros(n, dtype=bool)}
     if estimator.HAS_POSITION:
         out["pos"] = np.empty((n, 3))
         out["vel"] = np.empty((n, 3))
-    est = np.zeros((RUN_CHUNK, ESTIMATE_FIELDS))
-    rejected = np.zeros(RUN_CHUNK, dtype=np.uint8)
-    est_p = ffi.cast("fc_estimate *", ffi.from_buffer(est, require_writable=True))
-    rejected_p = ffi.cast("unsigned char *", ffi.from_buffer(rejected, require_writable=True))
+
+    def column(name: str, lo: int, kind: str = "double *") -> Any:
+        a = out.get(name)  # the output array from sample lo, as the twin's pointer
+        if a is None:
+            return ffi.NULL
+        return ffi.cast(kind, ffi.from_buffer(a[lo:], require_writable=True))
+
     for lo in range(0, n, RUN_CHUNK):
         hi = min(lo + RUN_CHUNK, n)
         a = np.ascontiguousarray(acc[lo:hi], dtype=np.float64)
@@ -191,15 +196,9 @@ def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
         h = np.ascontiguousarray(dt[lo:hi], dtype=np.float64)
         run_twin(twin, hi - lo, ffi.cast("double *", ffi.from_buffer(a)),
                  ffi.cast("double *", ffi.from_buffer(g)),
-                 ffi.cast("double *", ffi.from_buffer(h)), est_p, rejected_p)
-        k = hi - lo
-        out["roll"][lo:hi] = est[:k, 0]
-        out["pitch"][lo:hi] = est[:k, 1]
-        out["bias"][lo:hi] = est[:k, 2:5]
-        out["rejected"][lo:hi] = rejected[:k] != 0
-        if estimator.HAS_POSITION:
-            out["pos"][lo:hi] = est[:k, 5:8]
-            out["vel"][lo:hi] = est[:k, 8:11]
+                 ffi.cast("double *", ffi.from_buffer(h)), column("roll", lo),
+                 column("pitch", lo), column("bias", lo), column("pos", lo), column("vel", lo),
+                 column("rejected", lo, "unsigned char *"))
     take_state(estimator, twin)
     return out
 

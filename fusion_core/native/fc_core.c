@@ -891,3 +891,32 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
     }
     return bad;
 }
+
+long fc_run_columns(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
+                    const fc_real *acc, const fc_real *gyro, const fc_real *dt, fc_real *roll,
+                    fc_real *pitch, fc_real *bias, fc_real *pos, fc_real *vel,
+                    unsigned char *rejected)
+{
+    long bad = 0;
+    for (long i = 0; i < n; i++) {
+        fc_status s = fc_step(ops, self, base, last, acc + 3 * i, gyro + 3 * i, dt[i], NULL);
+        rejected[i] = s > FC_SKIPPED;
+        if (rejected[i]) {
+            base->n_rejected += 1;
+            bad++;
+        }
+        const fc_estimate *e = last;  /* a rejected sample's: the last one */
+        roll[i] = e->roll;
+        pitch[i] = e->pitch;
+        for (int k = 0; k < 3; k++) {
+            bias[3 * i + k] = e->bias[k];
+        }
+        if (pos) {
+            for (int k = 0; k < 3; k++) {
+                pos[3 * i + k] = e->pos[k];
+                vel[3 * i + k] = e->vel[k];
+            }
+        }
+    }
+    return bad;
+}

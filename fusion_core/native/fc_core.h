@@ -270,6 +270,13 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
 long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
             const fc_real *acc, const fc_real *gyro, const fc_real *dt, fc_estimate *out,
             unsigned char *rejected);
+/* fc_run with the estimates written as columns, each where its caller keeps it: roll[n],
+ * pitch[n], bias[n][3], and pos[n][3] and vel[n][3] unless NULL (Estimator.run's arrays,
+ * without an array of whole estimates between) */
+long fc_run_columns(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
+                    const fc_real *acc, const fc_real *gyro, const fc_real *dt, fc_real *roll,
+                    fc_real *pitch, fc_real *bias, fc_real *pos, fc_real *vel,
+                    unsigned char *rejected);
 
 /* T_init(f, params) for an estimator T: params (NULL: the defaults) in, T_configure, T_reset. */
 #define FC_DEFINE_INIT(T)                                                                     \
@@ -318,6 +325,13 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
                  fc_estimate *out, unsigned char *rejected)                                   \
     {                                                                                         \
         return fc_run(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, out, rejected);          \
+    }                                                                                         \
+    long T##_run_columns(T *f, long n, const fc_real *acc, const fc_real *gyro,                \
+                         const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,        \
+                         fc_real *pos, fc_real *vel, unsigned char *rejected)                  \
+    {                                                                                         \
+        return fc_run_columns(&OPS, f, &f->base, &f->last, n, acc, gyro, dt, roll, pitch,      \
+                              bias, pos, vel, rejected);                                      \
     }
 
 #endif /* FC_CORE_H */

@@ -40,6 +40,9 @@ fc_status fc_kf_step(fc_kf *f, const fc_real acc[3], const fc_real gyro[3], fc_r
                      fc_estimate *out);
 long fc_kf_run(fc_kf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                fc_estimate *out, unsigned char *rejected);
+long fc_kf_run_columns(fc_kf *f, long n, const fc_real *acc, const fc_real *gyro,
+                       const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                       fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_kf_estimate(const fc_kf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_kf_restored(fc_kf *f);

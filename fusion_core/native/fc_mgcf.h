@@ -31,6 +31,9 @@ fc_status fc_mgcf_step(fc_mgcf *f, const fc_real acc[3], const fc_real gyro[3], 
                        fc_estimate *out);
 long fc_mgcf_run(fc_mgcf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                  fc_estimate *out, unsigned char *rejected);
+long fc_mgcf_run_columns(fc_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
+                         const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                         fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_mgcf_restored(fc_mgcf *f);

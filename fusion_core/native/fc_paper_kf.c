@@ -64,8 +64,8 @@ void fc_roll_pitch_predict_covariances(const fc_roll_pitch_axes *a, fc_real dt, 
 }
 
 /* RollPitchAxes.update_angles */
-void fc_roll_pitch_update_angles(const fc_roll_pitch_axes *a, fc_real r, fc_real y_roll, fc_real y_pitch,
-                                 fc_kf_gain_rule gain)
+void fc_roll_pitch_update_angles(const fc_roll_pitch_axes *a, fc_real r, fc_real y_roll,
+                                 fc_real y_pitch, fc_kf_gain_rule gain)
 {
     fc_real P[4];
     memcpy(P, a->P_roll, sizeof P);

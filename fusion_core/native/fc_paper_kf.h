@@ -28,6 +28,9 @@ fc_status fc_paper_kf_step(fc_paper_kf *f, const fc_real acc[3], const fc_real g
                            fc_estimate *out);
 long fc_paper_kf_run(fc_paper_kf *f, long n, const fc_real *acc, const fc_real *gyro,
                      const fc_real *dt, fc_estimate *out, unsigned char *rejected);
+long fc_paper_kf_run_columns(fc_paper_kf *f, long n, const fc_real *acc, const fc_real *gyro,
+                             const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                             fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_paper_kf_estimate(const fc_paper_kf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_kf_restored(fc_paper_kf *f);
@@ -62,8 +65,8 @@ typedef struct fc_roll_pitch_axes {
                            (f)->P_pitch, (f)->gain_roll, (f)->gain_pitch})
 void fc_roll_pitch_predict_covariances(const fc_roll_pitch_axes *a, fc_real dt, fc_real q_angle,
                                        fc_real q_bias);
-void fc_roll_pitch_update_angles(const fc_roll_pitch_axes *a, fc_real r, fc_real y_roll, fc_real y_pitch,
-                                 fc_kf_gain_rule gain);
+void fc_roll_pitch_update_angles(const fc_roll_pitch_axes *a, fc_real r, fc_real y_roll,
+                                 fc_real y_pitch, fc_kf_gain_rule gain);
 void fc_roll_pitch_correct_bias(const fc_roll_pitch_axes *a, fc_real z_x, fc_real z_y, fc_real r);
 
 /* The equations (papers/kalman.py's functions of the same names): F P F' + Q; the gain and

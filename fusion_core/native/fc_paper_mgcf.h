@@ -27,6 +27,9 @@ fc_status fc_paper_mgcf_step(fc_paper_mgcf *f, const fc_real acc[3], const fc_re
                              fc_real dt, fc_estimate *out);
 long fc_paper_mgcf_run(fc_paper_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
                        const fc_real *dt, fc_estimate *out, unsigned char *rejected);
+long fc_paper_mgcf_run_columns(fc_paper_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
+                               const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                               fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_paper_mgcf_estimate(const fc_paper_mgcf *f);
 /* The estimate of a quaternion's roll and pitch and a gyro bias (both mgcfs' _estimate). */
 fc_estimate fc_paper_mgcf_quat_estimate(const fc_real q[4], const fc_real bias[3]);

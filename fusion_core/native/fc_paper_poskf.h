@@ -30,6 +30,9 @@ fc_status fc_paper_poskf_step(fc_paper_poskf *f, const fc_real acc[3], const fc_
                               fc_real dt, fc_estimate *out);
 long fc_paper_poskf_run(fc_paper_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
                         const fc_real *dt, fc_estimate *out, unsigned char *rejected);
+long fc_paper_poskf_run_columns(fc_paper_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
+                                const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                                fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_paper_poskf_estimate(const fc_paper_poskf *f);
 /* The position and velocity of the [p, v, a] axis states x (x, y, z axes in turn) into e. */
 void fc_paper_poskf_put_axes(const fc_real x[9], fc_estimate *e);

@@ -28,6 +28,9 @@ fc_status fc_paper_ukf_step(fc_paper_ukf *f, const fc_real acc[3], const fc_real
                             fc_real dt, fc_estimate *out);
 long fc_paper_ukf_run(fc_paper_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
                       const fc_real *dt, fc_estimate *out, unsigned char *rejected);
+long fc_paper_ukf_run_columns(fc_paper_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
+                              const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                              fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_paper_ukf_estimate(const fc_paper_ukf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_paper_ukf_restored(fc_paper_ukf *f);

@@ -41,6 +41,9 @@ fc_status fc_poskf_step(fc_poskf *f, const fc_real acc[3], const fc_real gyro[3]
                         fc_estimate *out);
 long fc_poskf_run(fc_poskf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                   fc_estimate *out, unsigned char *rejected);
+long fc_poskf_run_columns(fc_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
+                          const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                          fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_poskf_estimate(const fc_poskf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_poskf_restored(fc_poskf *f);

@@ -36,6 +36,9 @@ fc_status fc_ukf_step(fc_ukf *f, const fc_real acc[3], const fc_real gyro[3], fc
                       fc_estimate *out);
 long fc_ukf_run(fc_ukf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
                 fc_estimate *out, unsigned char *rejected);
+long fc_ukf_run_columns(fc_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
+                        const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
+                        fc_real *pos, fc_real *vel, unsigned char *rejected);
 fc_estimate fc_ukf_estimate(const fc_ukf *f);
 /* After a restore of the state fields (fc_state.h): recompute what follows from them. */
 void fc_ukf_restored(fc_ukf *f);
