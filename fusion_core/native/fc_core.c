@@ -137,7 +137,7 @@ void fc_quat_mul_rotvec_terms(fc_real q[4], fc_real vx, fc_real vy, fc_real vz, 
     fc_real rx = w * bx + x * c + y * bz - z * by;
     fc_real ry = w * by - x * bz + y * c + z * bx;
     fc_real rz = w * bz + x * by - y * bx + z * c;
-    fc_real n = 1.0 / fc_sqrt(rw * rw + rx * rx + ry * ry + rz * rz);
+    fc_real n = 1.5 - 0.5 * (rw * rw + rx * rx + ry * ry + rz * rz);  /* 1/|r| (Newton) */
     q[0] = rw * n;
     q[1] = rx * n;
     q[2] = ry * n;
