@@ -19,11 +19,6 @@ static void angle_only_gain(const fc_real P[4], fc_real r, fc_real K[2], fc_real
     out[3] = P11;
 }
 
-static int same4(const fc_real a[4], const fc_real b[4])
-{
-    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2] && a[3] == b[3];
-}
-
 void fc_kf_configure(fc_kf *f)
 {
     const fc_kf_params *p = &f->params;
@@ -137,8 +132,13 @@ static void propagate(fc_kf *f, const fc_real g[3], fc_real dt, const fc_real ph
 /* correct_innovation: the biases consider states unless learn_bias */
 static void correct_innovation(fc_kf *f, fc_real y_roll, fc_real y_pitch, int learn_bias)
 {
-    fc_roll_pitch_update_angles(FC_ROLL_PITCH_AXES(f), f->r_step, y_roll, y_pitch,
-                                learn_bias ? fc_paper_kf_measurement_gain : angle_only_gain);
+    if (learn_bias) {  /* (one call per rule: each inlines its gain) */
+        fc_roll_pitch_update_angles(FC_ROLL_PITCH_AXES(f), f->r_step, y_roll, y_pitch,
+                                    fc_paper_kf_measurement_gain);
+    } else {
+        fc_roll_pitch_update_angles(FC_ROLL_PITCH_AXES(f), f->r_step, y_roll, y_pitch,
+                                    angle_only_gain);
+    }
 }
 
 /* correct: the accelerometer's roll and pitch */
@@ -217,7 +217,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     int clipped = f->base.clipped;  /* at the gyro's rail: the rate beyond it is unknown */
     if (clipped) {
         fc_real grow = f->rail_var * dt * dt;
-        int shared = same4(f->P_pitch, f->P_roll);
+        int shared = fc_same4(f->P_pitch, f->P_roll);
         f->P_roll[0] = f->P_roll[0] + grow;
         if (shared) {
             memcpy(f->P_pitch, f->P_roll, sizeof f->P_roll);
