@@ -170,9 +170,9 @@ def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
         ) -> dict[str, np.ndarray]:
     """Estimator.run through the C twin: the same outputs, and the estimator's state afterwards
     is the one the Python run would leave. The twin writes each output into its array
-    (T_run_columns); the inputs go through in chunks of RUN_CHUNK, so that, as in the Python
-    run, memory beyond the outputs does not grow with N (an input that is not contiguous
-    float64 is copied chunk by chunk)."""
+    (T_run_columns) and reads contiguous float64 inputs where they are, in one call; other
+    inputs are copied in chunks of RUN_CHUNK, so that, as in the Python run, memory beyond the
+    outputs does not grow with N."""
     lib, ffi = lib_and_ffi()
     twin = new_twin(estimator)
     run_twin = getattr(lib, f"{type(estimator).TWIN}_run_columns")
@@ -189,8 +189,11 @@ def run(estimator: Any, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
             return ffi.NULL
         return ffi.cast(kind, ffi.from_buffer(a[lo:], require_writable=True))
 
-    for lo in range(0, n, RUN_CHUNK):
-        hi = min(lo + RUN_CHUNK, n)
+    # contiguous float64 inputs go to the twin whole; others are copied chunk by chunk
+    whole = all(x.dtype == np.float64 and x.flags.c_contiguous for x in (acc, gyro, dt))
+    chunk = max(n, 1) if whole else RUN_CHUNK
+    for lo in range(0, n, chunk):
+        hi = min(lo + chunk, n)
         a = np.ascontiguousarray(acc[lo:hi], dtype=np.float64)
         g = np.ascontiguousarray(gyro[lo:hi], dtype=np.float64)
         h = np.ascontiguousarray(dt[lo:hi], dtype=np.float64)

@@ -65,10 +65,24 @@ void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_r
                         fc_real q1, fc_real r1, fc_real dt, const fc_real sc[4], fc_real *phi_out,
                         fc_real *theta_out)
 {
-    fc_real d1p, d1t, d2p, d2t;
-    euler_rates(phi, theta, p0, q0, r0, sc, &d1p, &d1t);
-    fc_real phi1 = phi + dt * d1p, theta1 = theta + dt * d1t;
-    euler_rates(phi1, theta1, p1, q1, r1, NULL, &d2p, &d2t);
+    fc_real d1p, d1t, d2p, d2t, s0[4], s1[4], sa, ca, sb, cb;
+    if (sc) {
+        memcpy(s0, sc, sizeof s0);
+    } else {
+        s0[0] = fc_sin(phi);
+        s0[1] = fc_cos(phi);
+        s0[2] = fc_sin(theta);
+        s0[3] = fc_cos(theta);
+    }
+    euler_rates(phi, theta, p0, q0, r0, s0, &d1p, &d1t);
+    fc_real a = dt * d1p, b = dt * d1t;  /* the step: the end point's sines by angle addition */
+    fc_sin_cos(a, &sa, &ca);
+    fc_sin_cos(b, &sb, &cb);
+    s1[0] = s0[0] * ca + s0[1] * sa;
+    s1[1] = s0[1] * ca - s0[0] * sa;
+    s1[2] = s0[2] * cb + s0[3] * sb;
+    s1[3] = s0[3] * cb - s0[2] * sb;
+    euler_rates(phi + a, theta + b, p1, q1, r1, s1, &d2p, &d2t);
     *phi_out = phi + 0.5 * dt * (d1p + d2p);
     *theta_out = theta + 0.5 * dt * (d1t + d2t);
 }
@@ -242,6 +256,14 @@ void fc_half_angle(fc_real a, fc_real *c, fc_real *s)
     }
     *c = fc_cos(0.5 * a);
     *s = fc_sin(0.5 * a);
+}
+
+void fc_sin_cos(fc_real a, fc_real *s, fc_real *c)
+{
+    fc_real ch, sh;
+    fc_half_angle(a, &ch, &sh);
+    *s = 2.0 * sh * ch;
+    *c = 1.0 - 2.0 * sh * sh;
 }
 
 /* quat_turn_roll_pitch: q with roll + dr and pitch + dp; t: q's up_terms */

@@ -95,6 +95,8 @@ void fc_up_terms(const fc_real q[4], fc_real t[4]);
 fc_real fc_angle_of(fc_real num, fc_real den);
 /* kinematics.half_angle: cos(a/2) and sin(a/2) */
 void fc_half_angle(fc_real a, fc_real *c, fc_real *s);
+/* kinematics.sin_cos: sin a and cos a from half_angle */
+void fc_sin_cos(fc_real a, fc_real *s, fc_real *c);
 /* kinematics.quat_turn_roll_pitch: q with roll + dr and pitch + dp, its yaw kept (t: up_terms) */
 void fc_quat_turn_roll_pitch(fc_real q[4], const fc_real t[4], fc_real dr, fc_real dp);
 void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_real t[4],
