@@ -236,3 +236,28 @@ def test_batch_loop_runs_one_estimators_batch_for_a_profiler(
     with pytest.raises(SystemExit):
         batch_loop.main(["no_such_filter"])
     assert "allowed cf, mgcf, kf, ukf, poskf" in capsys.readouterr().err
+
+
+def test_batch_ratio_refuses_what_it_cannot_run() -> None:
+    from benchmarks import batch_ratio
+
+    with pytest.raises(SystemExit):
+        batch_ratio.main(["--estimator", "nope"])
+    with pytest.raises(SystemExit):
+        batch_ratio.main(["--rounds", "0"])
+    assert set(batch_ratio.VQF_RATIO_TARGETS) <= set(ESTIMATOR_KEYS)
+
+
+def test_batch_ratio_prints_each_twins_median_beside_its_target(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    from benchmarks import batch_ratio
+    from fusion_core import native
+
+    pytest.importorskip("vqf", reason="the peer VQF is in the bench extra")
+    if not native.available():
+        pytest.skip(f"no C twin: {native.reason()}")
+    assert batch_ratio.main(["--rounds", "1", "--repeats", "1", "--estimator", "cf,kf"]) == 0
+    out = capsys.readouterr().out
+    for key in ("cf", "kf"):
+        line = next(ln for ln in out.splitlines() if ln.startswith(key + " "))
+        assert "0.75x" in line and ("met" in line), line  # no timing asserted: the format only
