@@ -60,8 +60,10 @@ class ComplementaryFilter(Estimator):
     rule for mean samples: building_blocks.GYRO_SAMPLING_PARAM), so that pitch +-90 deg is no
     singularity; then, when gate_low <= |f|/g <= gate_high, roll and pitch are blended with the
     measured vector's: angle = a angle_pred + (1 - a) acc_angle with a = tau / (tau + dt) from
-    each sample's own dt (written as angle_pred + (1 - a) wrap(acc_angle - angle_pred), the same
-    number, so roll does not jump at +-180 deg). Around the papers' blend, for real IMUs:
+    each sample's own dt (written as angle_pred + (1 - a) y with y = acc_angle - angle_pred the
+    angle between the two tilts in [-pi, pi], building_blocks.tilt_innovation, so roll does not
+    jump at +-180 deg; the quaternion is turned by the blend's step, corrected_quat). Around the
+    papers' blend, for real IMUs:
     - the measured vector (acc_lowpass > 0; fusion_core.measured_vector): the gate and the
       blend use the accelerometer low-passed in a frame that turns with the gyro (second
       order, after Laidig & Seel 2023); while it fills (after the first sample, and after a
