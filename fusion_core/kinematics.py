@@ -15,6 +15,7 @@ import math
 from math import copysign, cos, sin, sqrt
 from typing import Final
 
+atan: Final = math.atan
 atan2: Final = math.atan2
 asin: Final = math.asin
 hypot: Final = math.hypot
@@ -129,8 +130,13 @@ def quat_from_roll_pitch_yaw(
 
 
 def quat_roll_pitch(w: float, x: float, y: float, z: float) -> tuple[float, float]:
-    """Roll and pitch of a unit quaternion (body to world, Z-Y-X Euler)."""
-    roll = atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    """Roll and pitch of a unit quaternion (body to world, Z-Y-X Euler). Roll is atan2 of
+    sin(roll) cos(pitch) and cos(roll) cos(pitch); where the second is positive (|roll| < 90
+    deg: always in the kf's face frame) the arctangent of their ratio, the same angle to an ulp
+    for half of atan2's cost in glibc (the filters read roll off their quaternion every
+    sample)."""
+    sr, cr = 2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y)
+    roll = atan(sr / cr) if cr > 0.0 else atan2(sr, cr)
     s = 2.0 * (w * y - x * z)
     # max(-1, min(1, s)) (rounding can put |s| a little above 1), the builtins called only then
     return roll, asin(s if -1.0 <= s <= 1.0 else max(-1.0, min(1.0, s)))

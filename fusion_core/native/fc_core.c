@@ -101,7 +101,8 @@ void fc_quat_from_roll_pitch_yaw(fc_real phi, fc_real theta, fc_real psi, fc_rea
 void fc_quat_roll_pitch(const fc_real q[4], fc_real *roll, fc_real *pitch)
 {
     fc_real w = q[0], x = q[1], y = q[2], z = q[3];
-    *roll = fc_atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+    fc_real sr = 2.0 * (w * x + y * z), cr = 1.0 - 2.0 * (x * x + y * y);
+    *roll = cr > 0.0 ? fc_atan(sr / cr) : fc_atan2(sr, cr);
     fc_real s = 2.0 * (w * y - x * z);
     if (!(-1.0 <= s && s <= 1.0)) {
         s = s < 1.0 ? s : 1.0;     /* max(-1, min(1, s)) */

@@ -18,6 +18,7 @@ typedef float fc_real;
 #define fc_cos cosf
 #define fc_tan tanf
 #define fc_asin asinf
+#define fc_atan atanf
 #define fc_atan2 atan2f
 #define fc_sqrt sqrtf
 #define fc_hypot hypotf
@@ -35,6 +36,7 @@ typedef double fc_real;
 #define fc_cos cos
 #define fc_tan tan
 #define fc_asin asin
+#define fc_atan atan
 #define fc_atan2 atan2
 #define fc_sqrt sqrt
 #define fc_hypot hypot

@@ -42,7 +42,7 @@ N = 1500
 LIBM_N = 1000
 ESTIMATORS = ("cf", "mgcf", "kf", "ukf", "poskf")
 """The order of bench_main.c's runs."""
-LIBM = ("sin", "cos", "tan", "asin", "atan2", "exp", "log", "pow", "hypot", "sqrt")
+LIBM = ("sin", "cos", "tan", "asin", "atan2", "exp", "log", "pow", "hypot", "sqrt", "atan")
 """The libm functions the twins call that may round differently (bench_main.c's order)."""
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fno-fast-math", "-ffunction-sections",
           "-fdata-sections", "-Wall", "-Wno-unused-function")
@@ -146,7 +146,8 @@ def libm_table() -> np.ndarray:
              "atan2": rng.normal(0.0, 5.0, LIBM_N), "exp": rng.uniform(-30.0, 5.0, LIBM_N),
              "log": np.exp(rng.uniform(-10.0, 10.0, LIBM_N)),
              "pow": rng.normal(0.0, 3.0, LIBM_N), "hypot": rng.normal(0.0, 5.0, LIBM_N),
-             "sqrt": np.exp(rng.uniform(-20.0, 10.0, LIBM_N))}[name]
+             "sqrt": np.exp(rng.uniform(-20.0, 10.0, LIBM_N)),
+             "atan": rng.normal(0.0, 2.0, LIBM_N)}[name]
         y = (np.where(rng.random(LIBM_N) < 0.8, 2.0, 5.0) if name == "pow"
              else rng.normal(0.0, 5.0, LIBM_N) if two else np.zeros(LIBM_N))
         table[f, :, 0], table[f, :, 1] = x, y
