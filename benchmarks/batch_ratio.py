@@ -14,10 +14,7 @@ from fusion_core import ESTIMATORS, native
 from fusion_core.registry import keys_help
 
 from .common import recording
-from .native import MIN_SAMPLES, _median_seconds, tiled, vqf_batch_us
-
-VQF_RATIO_TARGETS = {"cf": 0.75, "mgcf": 0.9, "kf": 0.75, "ukf": 3.7, "poskf": 1.5}
-"""The batch run per sample as a multiple of VQF's `updateBatch` in the same run, at most."""
+from .native import MIN_SAMPLES, VQF_RATIO_TARGETS, _median_seconds, tiled, vqf_batch_us
 
 
 def main(argv: list[str] | None = None) -> int:

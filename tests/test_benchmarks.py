@@ -96,6 +96,21 @@ def test_the_stream_target_is_three_times_vqfs_update() -> None:
     assert t["per_sample_us_stream.ukf vs vqf"]["met"] is False
 
 
+def test_each_twins_batch_has_its_ratio_to_vqfs_batch_as_a_target() -> None:
+    from benchmarks.native import VQF_RATIO_TARGETS
+
+    results = {"native": {"available": True, "vqf_batch_us_per_sample": 0.2,
+                          "run_us_per_sample": {"kf": 0.16, "poskf": 0.32}}}
+    t = {x["name"]: x for x in report.evaluate_targets(results)}
+    assert VQF_RATIO_TARGETS["kf"] == 0.75 and VQF_RATIO_TARGETS["poskf"] == 1.5
+    assert t["native.kf over vqf_batch"]["measured"] == pytest.approx(0.8)
+    assert t["native.kf over vqf_batch"]["met"] is False
+    assert t["native.poskf over vqf_batch"]["met"] is False
+    results["native"]["run_us_per_sample"] = {"kf": 0.14, "poskf": 0.29}
+    t = {x["name"]: x for x in report.evaluate_targets(results)}
+    assert t["native.kf over vqf_batch"]["met"] and t["native.poskf over vqf_batch"]["met"]
+
+
 def test_fmu_step_and_overhead_per_estimator(bench_json: dict) -> None:
     for key in ESTIMATOR_KEYS:
         step = bench_json["fmu_step_us"][key]
