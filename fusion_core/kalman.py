@@ -267,10 +267,6 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self.meas = measure_start(ZERO3, self._measure)  # the measured vector (acc_lowpass > 0)
         self.rest = REST_START  # rest detector (building_blocks.RestState)
         self.q_att = (1.0, 0.0, 0.0, 0.0)  # the attitude, with a free yaw
-        # within a sample only (propagate sets them, correct reads them): the turned q's
-        # up_terms and the angles it predicted
-        self._up = up_terms(*self.q_att)
-        self._predicted = (0.0, 0.0)
         self.gain_roll = (0.0, 0.0)
         self.gain_pitch = (0.0, 0.0)
         self.face = 0  # index into FACES of the filters' frame; 0: the sensor's own
@@ -329,7 +325,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         bias = (self.bias_x, self.bias_y, self.bias_z)
         phi = body_rotation(prev, (gx, gy, gz), bias, dt, self._trapezoid)
         terms = rotvec_terms(*phi)  # once, for the propagation and the pre-filter
-        self.propagate(gx, gy, gz, dt, phi, terms)
+        up = self.propagate(gx, gy, gz, dt, phi, terms)
         clipped = self.clipped  # at the gyro's rail: the rate beyond it is unknown (gyro_range)
         if clipped:
             grow = self._rail_var * dt * dt
@@ -338,7 +334,6 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             self.P_pitch = (self.P_roll if P_pitch == P
                             else (P_pitch[0] + grow, P_pitch[1], P_pitch[2], P_pitch[3]))
         predicted = (self.roll, self.pitch)
-        up = self._up
         raw2 = ax * ax + ay * ay + az * az
         lo, hi = self._bias_band2
         # at a first rest the angles are its tilt (_zero_rate_update)
@@ -346,7 +341,9 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
                   and self._zero_rate_update(ax, ay, az, gx, gy, gz, dt))
         filling = False
         reset = rested  # the angles set from a tilt: q rebuilt from them
-        turn = None  # the angles' change that turns q (correct)
+        # what a zero-rate update moved the angles by; the correction adds to it (correct), and
+        # q is turned by the sum
+        turn = (self.roll - predicted[0], self.pitch - predicted[1])
         if self._acc_tau > 0.0:
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, filling = measure_step(m, (ax, ay, az), phi, terms, dt,
@@ -368,7 +365,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             learn_bias = lo < raw2 < hi and not clipped
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             if not filling:
-                turn = self.correct(ax, ay, az, learn_bias)
+                turn = self.correct(ax, ay, az, learn_bias, up, turn)
             elif not rested:  # (a first rest's mean, which no gyro error turned, stands)
                 # the vector still fills: the attitude is its tilt (as cf's and mgcf's), as
                 # uncertain as that vector, its samples turned over their mean age (fill_noise)
@@ -380,8 +377,6 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         if reset:
             self.q_att = quat_from_roll_pitch(self.roll, self.pitch)
         elif (self.roll, self.pitch) != predicted:  # q turned by the correction
-            if turn is None:  # moved by a zero-rate update alone
-                turn = (self.roll - predicted[0], self.pitch - predicted[1])
             self.q_att = corrected_quat(self.q_att, up, self.roll, self.pitch, *turn)
 
     def _zero_rate_update(
@@ -420,18 +415,16 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     def propagate(
         self, gx: float, gy: float, gz: float, dt: float, phi: Vec3,
         terms: tuple[float, float, float, float],
-    ) -> None:
+    ) -> tuple[float, float, float, float]:
         """Time update: the attitude quaternion turned by the interval's rotation vector phi
         (with its rotvec_terms), roll and pitch read off it, P by the papers' F and Q
-        (predict_covariance) with the adaptive Q_angle. Keeps the turned q's up_terms for the
-        correction (_up)."""
+        (predict_covariance) with the adaptive Q_angle. Returns the turned q's up_terms, which
+        the correction measures its innovation from."""
         bx, by, bz = self.bias_x, self.bias_y, self.bias_z
         self.q_att = q = quat_mul_rotvec(self.q_att, phi[0], phi[1], phi[2], terms)
-        self._up = up_terms(*q)
         roll, pitch = quat_roll_pitch(*q)
         self.roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-        self._predicted = (self.roll, self.pitch)
         q_angle = self._q_angle
         q_rotation = self._adaptive[0]
         if q_rotation > 0.0:  # gyro_scale_std: a scale error adds up while the sensor turns
@@ -439,19 +432,21 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             q_angle += q_rotation * (wx * wx + wy * wy + wz * wz)
         self.q_step = q_angle
         self.predict_covariances(dt, q_angle)
+        return up_terms(*q)
 
-    def correct(self, ax: float, ay: float, az: float, learn_bias: bool = True
+    def correct(self, ax: float, ay: float, az: float, learn_bias: bool,
+                up: tuple[float, float, float, float], moved: tuple[float, float]
                 ) -> tuple[float, float]:
         """Measurement update of both axes with the accelerometer's roll and pitch (the biases
         left alone unless learn_bias, bias_gate, and while an innovation exceeds
-        bias_innovation). The innovations are the angles from the predicted attitude's tilt to
-        the accelerometer's (building_blocks.tilt_innovation), less what a zero-rate update
-        moved the angles by since. Returns the angles' change since the prediction, that move
-        plus the correction (gain times innovation): the turn of q (corrected_quat), which so
-        does not wait for the arctangents that read the predicted angles."""
-        y_roll, y_pitch = tilt_innovation(ax, ay, az, self._up)
-        pred_roll, pred_pitch = self._predicted
-        moved_roll, moved_pitch = self.roll - pred_roll, self.pitch - pred_pitch
+        bias_innovation). The innovations are the angles from the tilt of the predicted
+        attitude (up: its up_terms, propagate's) to the accelerometer's
+        (building_blocks.tilt_innovation), less what a zero-rate update moved the angles by
+        since (moved). Returns the angles' change since the prediction, that move plus the
+        correction (gain times innovation): the turn of q (corrected_quat), which so does not
+        wait for the arctangents that read the predicted angles."""
+        y_roll, y_pitch = tilt_innovation(ax, ay, az, up)
+        moved_roll, moved_pitch = moved
         y_roll -= moved_roll
         y_pitch -= moved_pitch
         gate = self._bias_innovation

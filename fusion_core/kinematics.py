@@ -52,6 +52,12 @@ def accel_roll_pitch(ax: float, ay: float, az: float) -> tuple[float, float]:
     return atan2(ay, az), atan2(-ax, sqrt(ay * ay + az * az))
 
 
+def roll_pitch_sines(roll: float, pitch: float) -> tuple[float, float, float, float]:
+    """(sin roll, cos roll, sin pitch, cos pitch): what euler_rates, heun_euler_step and the
+    position filters' levelling read of two angles (a caller that has them passes them on)."""
+    return sin(roll), cos(roll), sin(pitch), cos(pitch)
+
+
 def euler_rates(
     phi: float, theta: float, p: float, q: float, r: float,
     sc: tuple[float, float, float, float] | None = None,
@@ -63,7 +69,7 @@ def euler_rates(
 
     sc: (sin phi, cos phi, sin theta, cos theta) where the caller has them.
     """
-    sp, cp, st, ct = (sin(phi), cos(phi), sin(theta), cos(theta)) if sc is None else sc
+    sp, cp, st, ct = roll_pitch_sines(phi, theta) if sc is None else sc
     if -_MIN_COS_PITCH < ct < _MIN_COS_PITCH:  # abs(ct) < _MIN_COS_PITCH
         ct = copysign(_MIN_COS_PITCH, ct)
     return p + (q * sp + r * cp) * st / ct, q * cp - r * sp
@@ -83,7 +89,7 @@ def heun_euler_step(
     of the step: no libm call for a step below 5.7 deg), one sine-cosine pair per angle fewer.
     """
     # euler_rates at both ends, written out (this runs once per sample in the tilt stages)
-    sp, cp, st, c0 = (sin(phi), cos(phi), sin(theta), cos(theta)) if sc is None else sc
+    sp, cp, st, c0 = roll_pitch_sines(phi, theta) if sc is None else sc
     ct = c0 if not -_MIN_COS_PITCH < c0 < _MIN_COS_PITCH else copysign(_MIN_COS_PITCH, c0)
     d1p, d1t = p0 + (q0 * sp + r0 * cp) * st / ct, q0 * cp - r0 * sp
     a, b = dt * d1p, dt * d1t  # the step: phi + a, theta + b
@@ -151,6 +157,15 @@ def quat_gravity_body(w: float, x: float, y: float, z: float) -> tuple[float, fl
     )
 
 
+def _half_angle_series(a2: float) -> tuple[float, float]:
+    """cos(a/2) and sin(a/2)/a by their Taylor series through a^8 in a2 = a^2 (below
+    _SERIES_A2): rotvec_terms' and half_angle's."""
+    return (1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
+                                                              - a2 * (1.0 / 10321920.0)))),
+            0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
+                                                                - a2 * (1.0 / 185794560.0)))))
+
+
 def rotvec_terms(vx: float, vy: float, vz: float) -> tuple[float, float, float, float]:
     """The trigonometry of a rotation vector v of angle a: (cos(a/2), sin(a/2)/a) for
     quat_mul_rotvec and (sin(a)/a, (1 - cos a)/a^2) for rotate_back. Below a^2 = _SERIES_A2
@@ -161,10 +176,7 @@ def rotvec_terms(vx: float, vy: float, vz: float) -> tuple[float, float, float, 
     a2 = vx * vx + vy * vy + vz * vz
     if a2 < _SERIES_A2:
         return (
-            1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
-                                                              - a2 * (1.0 / 10321920.0)))),
-            0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
-                                                                - a2 * (1.0 / 185794560.0)))),
+            *_half_angle_series(a2),
             1.0 - a2 * (1.0 / 6.0 - a2 * (1.0 / 120.0 - a2 * (1.0 / 5040.0
                                                               - a2 * (1.0 / 362880.0)))),
             0.5 - a2 * (1.0 / 24.0 - a2 * (1.0 / 720.0 - a2 * (1.0 / 40320.0
@@ -273,10 +285,8 @@ def half_angle(a: float) -> tuple[float, float]:
     sin(a/2)/a (times a), else a sine-cosine pair."""
     a2 = a * a
     if a2 < _SERIES_A2:
-        return (1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
-                                                                - a2 * (1.0 / 10321920.0)))),
-                a * (0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
-                                                                   - a2 * (1.0 / 185794560.0))))))
+        c, s_over_a = _half_angle_series(a2)
+        return c, a * s_over_a
     return cos(0.5 * a), sin(0.5 * a)
 
 

@@ -8,13 +8,13 @@ and the recommended attitude filter's roll and pitch as its attitude outputs
 from __future__ import annotations
 
 import dataclasses
-from math import cos, nan, sin, sqrt
+from math import nan, sqrt
 from typing import Any, ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import GYRO_SAMPLING_PARAM, zero_rate_psd_param
 from .kalman import AngleBiasKalmanFilter
-from .kinematics import PI, accel_roll_pitch, wrap_angle
+from .kinematics import PI, accel_roll_pitch, roll_pitch_sines, wrap_angle
 from .papers.kalman import PAPER_KF_PARAMS, PaperKalmanFilter
 from .papers.position import (
     JERK_PARAMS,
@@ -317,7 +317,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         cached = self._sines
         if cached[0] == roll and cached[1] == pitch:
             return cached[2]
-        sc = (sin(roll), cos(roll), sin(pitch), cos(pitch))
+        sc = roll_pitch_sines(roll, pitch)
         self._sines = (roll, pitch, sc)
         return sc
 

@@ -28,23 +28,20 @@ void fc_accel_roll_pitch(fc_real ax, fc_real ay, fc_real az, fc_real *roll, fc_r
     *pitch = fc_atan2(-ax, fc_sqrt(ay * ay + az * az));
 }
 
-/* euler_rates (with the fc_cos(pitch) guard of heun_euler_step); sc: sin phi, cos phi, sin theta,
- * cos theta, or NULL */
-static void euler_rates(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r,
-                        const fc_real sc[4], fc_real *dphi, fc_real *dtheta)
+void fc_roll_pitch_sines(fc_real roll, fc_real pitch, fc_real sc[4])
 {
-    fc_real sp, cp, st, ct;
-    if (sc) {
-        sp = sc[0];
-        cp = sc[1];
-        st = sc[2];
-        ct = sc[3];
-    } else {
-        sp = fc_sin(phi);
-        cp = fc_cos(phi);
-        st = fc_sin(theta);
-        ct = fc_cos(theta);
-    }
+    sc[0] = fc_sin(roll);
+    sc[1] = fc_cos(roll);
+    sc[2] = fc_sin(pitch);
+    sc[3] = fc_cos(pitch);
+}
+
+/* euler_rates (with the fc_cos(pitch) guard of heun_euler_step) from sc, the sines and cosines
+ * of phi and theta (fc_roll_pitch_sines) */
+static void euler_rates(const fc_real sc[4], fc_real p, fc_real q, fc_real r, fc_real *dphi,
+                        fc_real *dtheta)
+{
+    fc_real sp = sc[0], cp = sc[1], st = sc[2], ct = sc[3];
     if (-MIN_COS_PITCH < ct && ct < MIN_COS_PITCH) {
         ct = fc_copysign(MIN_COS_PITCH, ct);
     }
@@ -55,8 +52,12 @@ static void euler_rates(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_rea
 void fc_euler_step(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real dt,
                    const fc_real sc[4], fc_real *phi_out, fc_real *theta_out)
 {
-    fc_real dp, dtheta;
-    euler_rates(phi, theta, p, q, r, sc, &dp, &dtheta);
+    fc_real dp, dtheta, s[4];
+    if (!sc) {
+        fc_roll_pitch_sines(phi, theta, s);
+        sc = s;
+    }
+    euler_rates(sc, p, q, r, &dp, &dtheta);
     *phi_out = phi + dt * dp;
     *theta_out = theta + dt * dtheta;
 }
@@ -65,24 +66,20 @@ void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_r
                         fc_real q1, fc_real r1, fc_real dt, const fc_real sc[4], fc_real *phi_out,
                         fc_real *theta_out)
 {
-    fc_real d1p, d1t, d2p, d2t, s0[4], s1[4], sa, ca, sb, cb;
-    if (sc) {
-        memcpy(s0, sc, sizeof s0);
-    } else {
-        s0[0] = fc_sin(phi);
-        s0[1] = fc_cos(phi);
-        s0[2] = fc_sin(theta);
-        s0[3] = fc_cos(theta);
+    fc_real d1p, d1t, d2p, d2t, s[4], s1[4], sa, ca, sb, cb;
+    if (!sc) {
+        fc_roll_pitch_sines(phi, theta, s);
+        sc = s;
     }
-    euler_rates(phi, theta, p0, q0, r0, s0, &d1p, &d1t);
+    euler_rates(sc, p0, q0, r0, &d1p, &d1t);
     fc_real a = dt * d1p, b = dt * d1t;  /* the step: the end point's sines by angle addition */
     fc_sin_cos(a, &sa, &ca);
     fc_sin_cos(b, &sb, &cb);
-    s1[0] = s0[0] * ca + s0[1] * sa;
-    s1[1] = s0[1] * ca - s0[0] * sa;
-    s1[2] = s0[2] * cb + s0[3] * sb;
-    s1[3] = s0[3] * cb - s0[2] * sb;
-    euler_rates(phi + a, theta + b, p1, q1, r1, s1, &d2p, &d2t);
+    s1[0] = sc[0] * ca + sc[1] * sa;
+    s1[1] = sc[1] * ca - sc[0] * sa;
+    s1[2] = sc[2] * cb + sc[3] * sb;
+    s1[3] = sc[3] * cb - sc[2] * sb;
+    euler_rates(s1, p1, q1, r1, &d2p, &d2t);
     *phi_out = phi + 0.5 * dt * (d1p + d2p);
     *theta_out = theta + 0.5 * dt * (d1t + d2t);
 }
@@ -119,16 +116,23 @@ void fc_quat_gravity_body(const fc_real q[4], fc_real g[3])
     g[2] = w * w - x * x - y * y + z * z;
 }
 
+/* _half_angle_series: cos(a/2) and sin(a/2)/a by their Taylor series in a2 = a^2 (a2 below
+ * SERIES_A2) */
+static void half_angle_series(fc_real a2, fc_real *c, fc_real *s_over_a)
+{
+    *c = 1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
+                                                        - a2 * (1.0 / 10321920.0))));
+    *s_over_a = 0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
+                                                             - a2 * (1.0 / 185794560.0))));
+}
+
 /* rotvec_terms: fc_cos(a/2), fc_sin(a/2)/a, fc_sin(a)/a, (1 - cos a)/a^2; below a^2 = SERIES_A2 their
  * Taylor series through a^8 (exact to fc_real precision there), else from one sine-cosine pair */
 void fc_rotvec_terms(fc_real vx, fc_real vy, fc_real vz, fc_real t[4])
 {
     fc_real a2 = vx * vx + vy * vy + vz * vz;
     if (a2 < SERIES_A2) {
-        t[0] = 1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
-                                                              - a2 * (1.0 / 10321920.0))));
-        t[1] = 0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
-                                                                - a2 * (1.0 / 185794560.0))));
+        half_angle_series(a2, &t[0], &t[1]);
         t[2] = 1.0 - a2 * (1.0 / 6.0 - a2 * (1.0 / 120.0 - a2 * (1.0 / 5040.0
                                                               - a2 * (1.0 / 362880.0))));
         t[3] = 0.5 - a2 * (1.0 / 24.0 - a2 * (1.0 / 720.0 - a2 * (1.0 / 40320.0
@@ -249,10 +253,9 @@ void fc_half_angle(fc_real a, fc_real *c, fc_real *s)
 {
     fc_real a2 = a * a;
     if (a2 < SERIES_A2) {
-        *c = 1.0 - a2 * (1.0 / 8.0 - a2 * (1.0 / 384.0 - a2 * (1.0 / 46080.0
-                                                            - a2 * (1.0 / 10321920.0))));
-        *s = a * (0.5 - a2 * (1.0 / 48.0 - a2 * (1.0 / 3840.0 - a2 * (1.0 / 645120.0
-                                                                 - a2 * (1.0 / 185794560.0)))));
+        fc_real s_over_a;
+        half_angle_series(a2, c, &s_over_a);
+        *s = a * s_over_a;
         return;
     }
     *c = fc_cos(0.5 * a);
@@ -857,14 +860,13 @@ int fc_base_can_init(const fc_real acc[3])
     return norm2 >= MIN_INIT_NORM * MIN_INIT_NORM;
 }
 
-fc_estimate fc_base_output(const fc_base *b, fc_estimate e)
+void fc_base_output(const fc_base *b, fc_estimate *e)
 {
     if (b->delay > 0.0 && b->initialized) {
         const fc_real *g = b->gyro_prev;
-        fc_roll_pitch_ahead(e.roll, e.pitch, g[0] - e.bias[0], g[1] - e.bias[1], g[2] - e.bias[2],
-                            b->delay, &e.roll, &e.pitch);
+        fc_roll_pitch_ahead(e->roll, e->pitch, g[0] - e->bias[0], g[1] - e->bias[1],
+                            g[2] - e->bias[2], b->delay, &e->roll, &e->pitch);
     }
-    return e;
 }
 
 fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
@@ -888,14 +890,24 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
     }
     memcpy(base->gyro_prev, g, sizeof g);
     ops->estimate(self, last);
-    if (base->delay > 0.0) {  /* fc_base_output: turned ahead by the sensor's delay */
-        *last = fc_base_output(base, *last);
-    }
+    fc_base_output(base, last);
     base->n_samples += 1;
     if (out) {
         *out = *last;
     }
     return FC_OK;
+}
+
+/* one sample of a batch run: fc_step, a rejection counted; returns whether it was rejected
+ * (*last is then the estimate before it) */
+static int run_sample(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                      const fc_real acc[3], const fc_real gyro[3], fc_real dt)
+{
+    if (fc_step(ops, self, base, last, acc, gyro, dt, NULL) > FC_SKIPPED) {
+        base->n_rejected += 1;
+        return 1;
+    }
+    return 0;
 }
 
 long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, long n,
@@ -904,13 +916,10 @@ long fc_run(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last, lon
 {
     long bad = 0;
     for (long i = 0; i < n; i++) {
-        fc_status s = fc_step(ops, self, base, last, acc + 3 * i, gyro + 3 * i, dt[i], out + i);
-        rejected[i] = s > FC_SKIPPED;
-        if (rejected[i]) {
-            base->n_rejected += 1;
-            out[i] = *last;
-            bad++;
-        }
+        rejected[i] = (unsigned char)run_sample(ops, self, base, last, acc + 3 * i, gyro + 3 * i,
+                                                dt[i]);
+        bad += rejected[i];
+        out[i] = *last;
     }
     return bad;
 }
@@ -922,23 +931,15 @@ long fc_run_columns(const fc_ops *ops, void *self, fc_base *base, fc_estimate *l
 {
     long bad = 0;
     for (long i = 0; i < n; i++) {
-        fc_status s = fc_step(ops, self, base, last, acc + 3 * i, gyro + 3 * i, dt[i], NULL);
-        rejected[i] = s > FC_SKIPPED;
-        if (rejected[i]) {
-            base->n_rejected += 1;
-            bad++;
-        }
-        const fc_estimate *e = last;  /* a rejected sample's: the last one */
-        roll[i] = e->roll;
-        pitch[i] = e->pitch;
-        for (int k = 0; k < 3; k++) {
-            bias[3 * i + k] = e->bias[k];
-        }
+        rejected[i] = (unsigned char)run_sample(ops, self, base, last, acc + 3 * i, gyro + 3 * i,
+                                                dt[i]);
+        bad += rejected[i];
+        roll[i] = last->roll;
+        pitch[i] = last->pitch;
+        memcpy(bias + 3 * i, last->bias, sizeof last->bias);
         if (pos) {
-            for (int k = 0; k < 3; k++) {
-                pos[3 * i + k] = e->pos[k];
-                vel[3 * i + k] = e->vel[k];
-            }
+            memcpy(pos + 3 * i, last->pos, sizeof last->pos);
+            memcpy(vel + 3 * i, last->vel, sizeof last->vel);
         }
     }
     return bad;

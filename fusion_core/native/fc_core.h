@@ -69,8 +69,10 @@ typedef struct fc_base {
 fc_real fc_wrap_angle(fc_real x);
 fc_real fc_clamp_pitch(fc_real theta);
 void fc_accel_roll_pitch(fc_real ax, fc_real ay, fc_real az, fc_real *roll, fc_real *pitch);
-/* euler_step, heun_euler_step: sc the sines and cosines of phi and theta (sin phi, cos phi,
- * sin theta, cos theta) where the caller has them, else NULL */
+/* kinematics.roll_pitch_sines: sin roll, cos roll, sin pitch, cos pitch */
+void fc_roll_pitch_sines(fc_real roll, fc_real pitch, fc_real sc[4]);
+/* euler_step, heun_euler_step: sc the sines and cosines of phi and theta (fc_roll_pitch_sines)
+ * where the caller has them, else NULL */
 void fc_euler_step(fc_real phi, fc_real theta, fc_real p, fc_real q, fc_real r, fc_real dt,
                    const fc_real sc[4], fc_real *phi_out, fc_real *theta_out);
 void fc_heun_euler_step(fc_real phi, fc_real theta, fc_real p0, fc_real q0, fc_real r0, fc_real p1,
@@ -247,9 +249,9 @@ void fc_base_reset(fc_base *b);
  * accelerometer reading as
  * none. Returns FC_OK with acc and gyro rewritten in place, or the rejection. */
 fc_status fc_base_prepare(fc_base *b, fc_real acc[3], fc_real gyro[3], fc_real dt);
-/* Estimator.output: e as the outputs give it, its roll and pitch turned ahead over sensor_delay
- * with the last sample's rate minus e's bias (fc_roll_pitch_ahead) once initialised. */
-fc_estimate fc_base_output(const fc_base *b, fc_estimate e);
+/* Estimator.output: *e as the outputs give it, its roll and pitch turned ahead over sensor_delay
+ * with the last sample's rate minus e's bias (fc_roll_pitch_ahead) once initialised; in place. */
+void fc_base_output(const fc_base *b, fc_estimate *e);
 /* Whether a prepared sample may initialise the filter (its accelerometer norm >= 0.1 g). */
 int fc_base_can_init(const fc_real acc[3]);
 
@@ -298,7 +300,8 @@ long fc_run_columns(const fc_ops *ops, void *self, fc_base *base, fc_estimate *l
 #define FC_DEFINE_RESTORED(T)                                                                 \
     void T##_restored(T *f)                                                                   \
     {                                                                                         \
-        f->last = fc_base_output(&f->base, T##_estimate(f));                                  \
+        f->last = T##_estimate(f);                                                            \
+        fc_base_output(&f->base, &f->last);                                                   \
     }
 
 /* The fc_ops glue of an estimator T (fc_cf, ...), written once: defines T_step and T_run from the

@@ -141,18 +141,13 @@ static void correct_innovation(fc_kf *f, fc_real y_roll, fc_real y_pitch, int le
     }
 }
 
-/* correct: the accelerometer's roll and pitch */
+/* correct: the accelerometer's roll and pitch against up (propagate's); turn: what a zero-rate
+ * update moved the angles by, in, and that plus the correction, out (q's turn) */
 static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias,
-                    const fc_real up[4], fc_real pred_roll, fc_real pred_pitch, fc_real turn[2])
+                    const fc_real up[4], fc_real turn[2])
 {
-    fc_real y_roll, y_pitch, moved_roll = 0.0, moved_pitch = 0.0;
+    fc_real y_roll, y_pitch, moved_roll = turn[0], moved_pitch = turn[1];
     fc_tilt_innovation(ax, ay, az, up, &y_roll, &y_pitch);
-    /* (a branch, not a subtraction of 0: the turn below then does not wait on the arctangents
-     * that read pred off q) */
-    if (f->roll != pred_roll || f->pitch != pred_pitch) {
-        moved_roll = f->roll - pred_roll;
-        moved_pitch = f->pitch - pred_pitch;
-    }
     y_roll -= moved_roll;
     y_pitch -= moved_pitch;
     fc_real gate = f->params.bias_innovation;
@@ -231,8 +226,14 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     /* at a first rest the angles are its tilt (zero_rate_update) */
     int rested = f->rest_time > 0.0 && !clipped && zero_rate_update(f, a, g, dt);
     int filling = 0, reset = rested;  /* the angles set from a tilt: q rebuilt from them */
-    int corrected = 0;
-    fc_real turn[2] = {0.0, 0.0};  /* the angles' change that turns q (correct) */
+    /* what a zero-rate update moved the angles by; the correction adds to it (correct), and q
+     * is turned by the sum (a branch, not a subtraction of 0: q's turn then does not wait on
+     * the arctangents that read pred off q) */
+    fc_real turn[2] = {0.0, 0.0};
+    if (f->roll != pred_roll || f->pitch != pred_pitch) {
+        turn[0] = f->roll - pred_roll;
+        turn[1] = f->pitch - pred_pitch;
+    }
     fc_real r_meas = f->r;
     if (f->acc_tau > 0.0) {
         if (clipped) {
@@ -259,8 +260,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
         if (!filling) {
-            correct(f, a[0], a[1], a[2], learn_bias, up, pred_roll, pred_pitch, turn);
-            corrected = 1;
+            correct(f, a[0], a[1], a[2], learn_bias, up, turn);
         } else if (!rested) {  /* (a first rest's mean, which no gyro error turned, stands) */
             /* the vector still fills: the attitude is its tilt, as uncertain as that vector */
             fc_accel_roll_pitch(a[0], a[1], a[2], &f->roll, &f->pitch);
@@ -274,10 +274,6 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
     if (reset) {
         fc_quat_from_roll_pitch(f->roll, f->pitch, f->q_att);
     } else if (f->roll != pred_roll || f->pitch != pred_pitch) {  /* q turned by the correction */
-        if (!corrected) {  /* moved by a zero-rate update alone */
-            turn[0] = f->roll - pred_roll;
-            turn[1] = f->pitch - pred_pitch;
-        }
         fc_corrected_quat(f->q_att, up, f->roll, f->pitch, turn[0], turn[1]);
     }
 }

@@ -131,18 +131,12 @@ void fc_paper_poskf_yaw_and_level_acceleration(fc_real roll, fc_real pitch, fc_r
                                                fc_real gz, const fc_real a[3], fc_real dt,
                                                const fc_real sc[4], fc_real acc[3])
 {
-    fc_real y = *yaw, sr, cr, sp, cp;
-    if (sc) {
-        sr = sc[0];
-        cr = sc[1];
-        sp = sc[2];
-        cp = sc[3];
-    } else {
-        sr = fc_sin(roll);
-        cr = fc_cos(roll);
-        sp = fc_sin(pitch);
-        cp = fc_cos(pitch);
+    fc_real y = *yaw, s[4];
+    if (!sc) {
+        fc_roll_pitch_sines(roll, pitch, s);
+        sc = s;
     }
+    fc_real sr = sc[0], cr = sc[1], sp = sc[2], cp = sc[3];
     if (cp > 1e-6 || cp < -1e-6) {
         y += dt * (wy * sr + gz * cr) / cp;
         y = *yaw = -FC_PI <= y && y <= FC_PI ? y : fc_wrap_angle(y);
@@ -228,7 +222,8 @@ FC_DEFINE_INIT(fc_paper_poskf)
 void fc_paper_poskf_restored(fc_paper_poskf *f)  /* the tilt stage's last estimate too */
 {
     fc_paper_kf_restored(&f->tilt);
-    f->last = fc_base_output(&f->base, fc_paper_poskf_estimate(f));
+    f->last = fc_paper_poskf_estimate(f);
+    fc_base_output(&f->base, &f->last);
 }
 
 static void first_sample(fc_paper_poskf *f, const fc_real a[3], const fc_real g[3])  /* _init */

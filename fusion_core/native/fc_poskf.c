@@ -68,7 +68,8 @@ void fc_poskf_restored(fc_poskf *f)  /* the nested filters' last estimates too (
 {
     fc_paper_kf_restored(&f->tilt);
     fc_kf_restored(&f->att);
-    f->last = fc_base_output(&f->base, fc_poskf_estimate(f));
+    f->last = fc_poskf_estimate(f);
+    fc_base_output(&f->base, &f->last);
 }
 
 static void first_sample(fc_poskf *f, const fc_real a[3], const fc_real g[3])  /* _init */
@@ -86,10 +87,7 @@ static const fc_real *tilt_sines(fc_poskf *f, fc_real roll, fc_real pitch)
     if (!(c[0] == roll && c[1] == pitch)) {
         c[0] = roll;
         c[1] = pitch;
-        c[2] = fc_sin(roll);
-        c[3] = fc_cos(roll);
-        c[4] = fc_sin(pitch);
-        c[5] = fc_cos(pitch);
+        fc_roll_pitch_sines(roll, pitch, c + 2);
     }
     return c + 2;
 }

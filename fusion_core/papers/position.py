@@ -24,7 +24,7 @@ from math import cos, sin
 from typing import Any, ClassVar, Final
 
 from ..base import ESTIMATE, Estimator, tuple_new
-from ..kinematics import PI, wrap_angle
+from ..kinematics import PI, roll_pitch_sines, wrap_angle
 from ..state import ANGLE, COV, NESTED, REAL, StateSpec
 from ..types import MPU6050_ACC_DENSITY, Estimate, G, Param
 from .common import PAPER_COMMON, Vec3
@@ -153,7 +153,7 @@ def yaw_and_level_acceleration(roll: float, pitch: float, yaw: float, wy: float,
     wy the bias-corrected y rate; held where cos(pitch) is 0) and the level-frame acceleration
     of the specific force a with the new attitude (level_acceleration); sc: (sin roll,
     cos roll, sin pitch, cos pitch) where the caller has them."""
-    sr, cr, sp, cp = (sin(roll), cos(roll), sin(pitch), cos(pitch)) if sc is None else sc
+    sr, cr, sp, cp = roll_pitch_sines(roll, pitch) if sc is None else sc
     if cp > 1e-6 or cp < -1e-6:  # abs(cp) > 1e-6
         yaw += dt * (wy * sr + gz * cr) / cp
         yaw = yaw if -PI <= yaw <= PI else wrap_angle(yaw)
