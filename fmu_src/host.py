@@ -43,6 +43,17 @@ class LogMessage:
     message: str
 
 
+class SerializedState(bytes):
+    """A serialised FMU state and the time it was taken at (where the next doStep starts)."""
+
+    time: float
+
+    def __new__(cls, data: bytes, time: float) -> SerializedState:
+        out = super().__new__(cls, data)
+        out.time = time
+        return out
+
+
 class FmuInstance:
     """An instantiated, initialised co-simulation FMU (see the module docstring).
 
@@ -67,6 +78,7 @@ class FmuInstance:
         self.unzip_dir = Path(extract(str(fmu)) if unzip_dir is None else unzip_dir)
         self.messages: list[LogMessage] = []
         self.time = start_time
+        self._state_times: dict[int, float] = {}
         self._last_step = 0.01  # the communication step sample() falls back to
         self._callbacks = _callbacks(self._on_log)
         self.fmu = FMU2Slave(
@@ -168,31 +180,44 @@ class FmuInstance:
         return out
 
     # ----- state and life cycle -----------------------------------------------------------------
+    # A state holds the FMU's time, and the next doStep must start there (the FMUs refuse any
+    # other communication point), so the host keeps the time of every state it took.
     def get_state(self) -> Any:
         """fmi2GetFMUstate (free it with free_state)."""
-        return self.fmu.getFMUstate()
+        state = self.fmu.getFMUstate()
+        self._state_times[state.value] = self.time
+        return state
 
     def set_state(self, state: Any) -> None:
         self.fmu.setFMUstate(state)
+        self.time = self._state_times.get(state.value, self.time)
 
     def free_state(self, state: Any) -> None:
+        self._state_times.pop(state.value, None)
         self.fmu.freeFMUstate(state)
 
-    def serialize(self) -> bytes:
-        """The current FMU state, serialised."""
+    def serialize(self) -> SerializedState:
+        """The current FMU state, serialised (bytes that also carry the host's time)."""
         state = self.fmu.getFMUstate()
         try:
-            return self.fmu.serializeFMUstate(state)
+            return SerializedState(self.fmu.serializeFMUstate(state), self.time)
         finally:
             self.fmu.freeFMUstate(state)
 
-    def deserialize(self, data: bytes) -> None:
-        """Restore a serialised FMU state into this instance."""
+    def deserialize(self, data: bytes, time: float | None = None) -> None:
+        """Restore a serialised FMU state into this instance; the next sample steps from `time`
+        (default: the time a SerializedState carries; plain bytes keep this host's time)."""
+        errors = sum(m.status == "ERROR" for m in self.messages)
         state = self.fmu.deSerializeFMUstate(data)
         try:
             self.fmu.setFMUstate(state)
         finally:
             self.fmu.freeFMUstate(state)
+        if time is None:
+            time = getattr(data, "time", None)
+        # a pythonfmu FMU answers a refused state with OK and an error in its log
+        if time is not None and sum(m.status == "ERROR" for m in self.messages) == errors:
+            self.time = time
 
     def close(self) -> None:
         """fmi2Terminate and fmi2FreeInstance; remove the extracted FMU if this object made it."""

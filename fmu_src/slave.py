@@ -44,8 +44,14 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Status, Fmi2Variabil
 
 from .variables import Variable
 
-STATE_FORMAT = 1
-"""Version of the FMU state layout (stored in every state; a mismatch is refused)."""
+STATE_FORMAT = 2
+"""Version of the FMU state layout (stored in every state; a mismatch is refused). 2: the
+FMU's time is part of it."""
+
+STEP_TIME_TOLERANCE = 1e-9
+"""How far (relative, at least 1 s's worth) a communication point may lie from the FMU's time,
+as in the native FMUs: masters sum their steps their own way, so the two differ by rounding; a
+skipped or repeated step differs by a whole step."""
 
 _PINNED_GLOBALS: list[dict[str, Any]] = []
 """Extra references to slave-module globals (see FmuSlave.__init_subclass__): 8 bytes per
@@ -116,6 +122,11 @@ class Model(Protocol):
         """Restore a get_state() result; ValueError if it does not fit."""
         ...
 
+    # Optional: `initial_outputs(t) -> Mapping[str, Any]`, the output values of a model set up
+    # for a start at time t (the plant's truth at t). FmuSlave writes them whenever the start
+    # time or a parameter changes before the first step, so a master that reads the outputs
+    # after initialisation (Jacobi) reads the model's own values, not the table's start values.
+
 
 class FmuSlave(Fmi2Slave):
     """Base of every FMU: a variable table and a model object (see the module docstring)."""
@@ -154,7 +165,9 @@ class FmuSlave(Fmi2Slave):
         for var in self.VARIABLES:
             self.register_variable(self._scalar_variable(var), nested=False)
         self._fast_inputs, self._fast_reals, self._fast_integers = self._fast_tables()
+        self._time = 0.0  # the start time, then the end of the last step
         self._model: Model = self.create_model(self.model_parameters())
+        self._write_initial_outputs()
 
     # ----- to be provided by a concrete FMU ---------------------------------------------------
     def start_values(self) -> dict[str, Any]:
@@ -235,6 +248,8 @@ class FmuSlave(Fmi2Slave):
                 params = self.model_parameters()
                 params[var.name] = model_value
                 self._model = self.create_model(params)
+                self._values[var.name] = value
+                self._write_initial_outputs()
             elif not var.tunable:
                 raise ValueError(
                     f"parameter {var.name!r} is fixed after initialisation: set it before "
@@ -247,7 +262,21 @@ class FmuSlave(Fmi2Slave):
             return
         self._values[var.name] = value
 
+    def _write_initial_outputs(self) -> None:
+        initial = getattr(self._model, "initial_outputs", None)
+        if initial is not None:
+            self._values.update(initial(self._time))
+
     # ----- life cycle ---------------------------------------------------------------------------
+    def setup_experiment(self, start_time: float, stop_time: float | None,
+                         tolerance: float | None) -> None:
+        if self._running:
+            self._fmi_log.error(f"setupExperiment(startTime={start_time!r}) after "
+                                "initialisation: ignored")
+            return
+        self._time = float(start_time)
+        self._write_initial_outputs()
+
     def exit_initialization_mode(self) -> None:
         self._running = True
         self._terminated = False
@@ -262,7 +291,11 @@ class FmuSlave(Fmi2Slave):
         why = ("before exitInitializationMode" if not self._running else
                "after terminate" if self._terminated else
                f"with a step size h = {step_size!r} that is not > 0"
-               if not step_size > 0.0 else "")
+               if not step_size > 0.0 else
+               f"at a communication point other than the FMU's time {self._time!r} (the end "
+               "of the last step, or the start time)"
+               if not abs(current_time - self._time) <= STEP_TIME_TOLERANCE * max(
+                   1.0, abs(self._time)) else "")
         if why:
             self._fmi_log.error(f"doStep(t={current_time!r}, h={step_size!r}) {why}: nothing "
                                 "was stepped")
@@ -270,6 +303,7 @@ class FmuSlave(Fmi2Slave):
         try:
             outputs = self._model.step(current_time, step_size, self._view, self._fmi_log)
             self._values.update(outputs)
+            self._time = current_time + step_size
         except Exception:
             self._log_exception(f"doStep(t={current_time!r}, h={step_size!r})")
             return False  # fmi2Discard
@@ -341,6 +375,7 @@ class FmuSlave(Fmi2Slave):
                 "fmu": type(self).__name__,
                 "format": STATE_FORMAT,
                 "running": self._running,
+                "time": self._time,
                 "values": dict(self._values),
                 "model": self._model.get_state(),
             }
@@ -371,6 +406,9 @@ class FmuSlave(Fmi2Slave):
             _check_state_value(var, values[name])
         if not isinstance(state.get("running"), bool):
             raise ValueError(f"state field 'running' = {state.get('running')!r} is not a bool")
+        time = state.get("time")
+        if not (isinstance(time, float) and math.isfinite(time)):
+            raise ValueError(f"state field 'time' = {time!r} is not a finite float")
         params = {
             name: var.to_model(var.coerce(values[name]))
             for name, var in self._variables.items()
@@ -381,6 +419,7 @@ class FmuSlave(Fmi2Slave):
         self._model = model
         self._values.update({n: var.coerce(values[n]) for n, var in self._variables.items()})
         self._running = bool(state["running"])
+        self._time = time
 
     @staticmethod
     def _fmu_state_to_bytes(state: dict[str, Any]) -> bytes:

@@ -37,6 +37,10 @@ class PlantModel:
         self.scenario = get_scenario(int(params["scenario"]))
         self.trajectory = self.scenario.trajectory()
 
+    def initial_outputs(self, t: float) -> dict[str, float]:
+        """The truth at the start time: what a master reads before the first step."""
+        return truth(self.trajectory, t)
+
     def step(self, t: float, h: float, values: Mapping[str, Any], log: FmiLog) -> dict[str, Any]:
         return truth(self.trajectory, t + h)
 

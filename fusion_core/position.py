@@ -64,7 +64,10 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
          the platform is stationary after zupt_window seconds of quiet samples, unless the
          filter is sure it is gliding (see _slow_enough);
       2. tilt: the papers' Kalman filter (PaperKalmanFilter, driven step by step through its
-         tilt-stage methods) propagates roll and pitch with every sample but takes only
+         tilt-stage methods) propagates roll and pitch with every sample; until its first
+         confirmed rest it takes the attitude filter's roll and pitch after each sample (so
+         it is aligned over the first samples and corrected in motion, as that filter is, and
+         one untrusted first sample fades as it does there), and from then on it takes only
          accelerometer samples confirmed stationary: a quiet sample waits zupt_window seconds in
          a queue and is applied (its innovation taken against the tilt of its own time) only if
          every sample since was quiet too, because the first tens of milliseconds of a smooth
@@ -135,7 +138,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
     STATE: ClassVar[StateSpec] = {
         "yaw": ANGLE, "states": REAL, "P": COV, "quiet_time": NONNEG, "stationary": FLAG,
         "pending": Queue(Segments(((NONNEG, 1), (REAL, 4))), 5, PENDING_MAX), "turned": REAL,
-        "f_mean": REAL, "tilt_state": NESTED, "attitude_state": NESTED,
+        "f_mean": REAL, "aligned": FLAG, "tilt_state": NESTED, "attitude_state": NESTED,
     }
 
     def _configure(self) -> None:
@@ -188,6 +191,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         self.pending: list[tuple[float, float, float, float, float]] = []
         self.turned = (0.0, 0.0)
         self.f_mean = (0.0, 0.0, 0.0)
+        self.aligned = False
         self._sines = (nan, nan, (0.0, 0.0, 0.0, 0.0))  # _tilt_sines' cache: none yet
 
     def _check_nested(self, field: str, snapshot: dict[str, Any], params: dict[str, Any]
@@ -288,10 +292,17 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
                     wrap_angle(acc_roll - tilt.roll + turned_roll - then_roll),
                     acc_pitch - tilt.pitch + turned_pitch - then_pitch,
                 )
+                self.aligned = True
         if stationary:
             tilt.correct_bias(gx, gy, self._gyro_var_density / dt)
         tilt.took_sample((gx, gy, gz))
-        self.att.step((ax, ay, az), (gx, gy, gz), dt)
+        att = self.att.step((ax, ay, az), (gx, gy, gz), dt)
+        if not self.aligned:
+            # Until its first confirmed rest the tilt stage levels with the attitude filter's
+            # roll and pitch, which align over the first samples and are corrected in motion:
+            # no single sample (a master's start value, a first sample taken in motion) sets
+            # the levelling for good
+            tilt.roll, tilt.pitch = att[0], att[1]
         # 3. yaw from the gyro, the level-frame acceleration with the new attitude
         self.yaw, acc = yaw_and_level_acceleration(tilt.roll, tilt.pitch, self.yaw, wy, gz,
                                                    (ax, ay, az), dt,

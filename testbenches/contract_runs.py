@@ -83,6 +83,7 @@ def run_contract(
     preset: dict[str, dict[str, Any]] | None = None,
     sensor: dict[str, Any] | None = None,
     calibrate_first: bool = False,
+    master: str = "gauss-seidel",
 ) -> ContractResult:
     """Run the runs and evaluate the contract; `progress` is called after each run; `params`
     are estimator FMU parameters for every run (each estimator must have them); `duration`
@@ -93,7 +94,7 @@ def run_contract(
     `sensor` the ImuSensor parameters of every run but the contract's noise-free ones;
     calibrate_first: each seed's part is calibrated on its own calibration session first, and
     its runs apply the result (testbenches.calibrate.part; not the noise-free extras, whose
-    sensor has no part errors)."""
+    sensor has no part errors); master: how every run steps its FMUs (master.MASTERS)."""
     out = ContractResult()
     extra: dict[tuple[str, str], list[TestbenchResult]] = {}
     jobs_list = contract_jobs(estimators, scenarios, seeds=seeds, jitter=jitter,
@@ -106,7 +107,7 @@ def run_contract(
                 for seed in sorted({j.seed for j in jobs_list if j.kind == "run"})}
     run_one = functools.partial(_run_job, params=params, fmu_dir=fmu_dir, duration=duration,
                                 timing=timing, preset=preset or {}, sensor=sensor or {},
-                                part=part)
+                                part=part, master=master)
     with contextlib.ExitStack() as stack:
         if jobs > 1:
             root = stack.enter_context(tempfile.TemporaryDirectory(prefix="campaign_"))
@@ -123,6 +124,7 @@ def run_contract(
         return out
     for e in estimators:
         out.checks.append(contract.check_t1(extra[("t1", e)]))
+        out.checks.append(contract.check_delay(extra[("t1", e)]))
         out.checks.append(contract.check_t2(extra[("t2_fixed", e)][0],
                                             extra[("t2_jitter", e)][0]))
         out.checks.append(contract.check_t4(*extra[("t4", e)]))
@@ -135,13 +137,15 @@ def run_contract(
 
 def _run_job(job: Job, params: dict[str, Any] | None, fmu_dir: Path | str,
              duration: float | None, timing: bool, preset: dict[str, dict[str, Any]],
-             sensor: dict[str, Any], part: dict[int, dict[str, float]]) -> TestbenchResult:
+             sensor: dict[str, Any], part: dict[int, dict[str, float]],
+             master: str) -> TestbenchResult:
     sensor_params = dict(job.sensor_params) if job.sensor_params else dict(sensor)
     calibration = part.get(job.seed, {}) if job.kind == "run" else {}
     run_params = {**preset.get(job.estimator, {}), **calibration, **(params or {})}
     r = run_testbench(job.estimator, job.scenario, seed=job.seed, jitter=job.jitter,
                       params=run_params, sensor_params=sensor_params, fmu_dir=fmu_dir,
-                      duration=duration if job.kind == "run" else None, evaluate=False)
+                      duration=duration if job.kind == "run" else None, evaluate=False,
+                      master=master)
     return contract.evaluate(r, timing)
 
 

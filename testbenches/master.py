@@ -1,9 +1,17 @@
-"""The testbench master: plant -> sensor -> estimator FMUs, Gauss-Seidel, on fmpy's FMU2Slave.
+"""The testbench master: plant -> sensor -> estimator FMUs on fmpy's FMU2Slave, Gauss-Seidel
+(the default) or Jacobi.
 
-Per communication step [t, t+h] (docs/interface.md, Timing):
+Gauss-Seidel, per communication step [t, t+h] (docs/interface.md, Timing):
   1. plant.doStep(t, h): the plant's outputs are the truth at t+h;
   2. sensor inputs := plant outputs; sensor.doStep(t, h): the IMU sample taken at t+h, dt = h;
   3. estimator inputs := sensor outputs; estimator.doStep(t, h): the estimate at t+h.
+Jacobi, as libcosim, Ecos and parallel containers step: every FMU's inputs := the outputs the
+others had before the step (after initialisation: the plant's truth at the start time, the
+sensor's start values with dt = 0, which the estimator refuses and counts), then every FMU
+steps. Each link adds one step: after doStep(t, h) the estimator's outputs are the estimate of
+the sample of the truth at t - h. CHAIN_DELAY gives each master's delay in steps; the result's
+traces are aligned by it (each estimate beside the truth and the sample it is of), so the
+contract scores what the estimator did, and measured_delay measures what the chain did.
 With jitter > 0 the communication steps are h_k = (1 + jitter u_k) / rate, u_k uniform in
 [-1, 1] from the run's seed, so dt follows. Every FMI call's status is checked (a status of
 fmi2Discard or worse raises FMICallException naming the FMU and the step); the CPU time (of
@@ -49,6 +57,15 @@ from .fmus import (
 
 TRUTH = TRUTH_NAMES
 """The plant's outputs, recorded in this order."""
+MASTERS = ("gauss-seidel", "jacobi")
+LINK_LAG = {"gauss-seidel": 0, "jacobi": 1}
+"""Steps each link of the chain (plant -> sensor, sensor -> estimator) lags under a master."""
+CHAIN_DELAY = {m: 2 * lag for m, lag in LINK_LAG.items()}
+"""Steps from a truth to the estimate of it at the end of the plant -> sensor -> estimator
+chain, as each master declares it (docs/interface.md, Timing)."""
+START_REFUSED = dict(LINK_LAG)
+"""Samples the estimator refuses at the start under each master: under Jacobi its first step
+reads the sensor's start values, which dt = 0 marks as no sample."""
 SENSOR_IN = ("omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z")
 SAMPLE = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt")
 ESTIMATE = ("roll", "pitch", "bias_x", "bias_y", "bias_z")
@@ -89,12 +106,78 @@ class TestbenchResult:
     invalid_samples: int
     step_us: np.ndarray
     true_gyro_bias: tuple[float, float, float]
+    master: str = "gauss-seidel"
+    measured_delay: int = 0
+    """The delay in steps at which the estimate best matches the truth (measured_delay)."""
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[Any] = field(default_factory=list)
 
     @property
     def passed(self) -> bool:
         return all(c.passed for c in self.checks)
+
+    @property
+    def delay(self) -> int:
+        """The chain's declared delay in steps (CHAIN_DELAY), by which the traces are aligned."""
+        return CHAIN_DELAY[self.master]
+
+    @property
+    def start_refused(self) -> int:
+        """Samples the master's start makes the estimator refuse (START_REFUSED)."""
+        return START_REFUSED[self.master]
+
+
+def measured_delay(t_all: np.ndarray, truth_all: np.ndarray, estimate: np.ndarray,
+                   max_delay: int = 4) -> int:
+    """The delay in steps at which an estimate trace best matches the truth.
+
+    truth_all[j] is the truth at t_all[j] (j = 0 the start), estimate[k] the raw output after
+    step k (time t_all[k + 1]); a delay d pairs estimate[k] with truth_all[k + 1 - d]. Scored
+    by the RMSE over the second half of the run (after convergence), all columns together."""
+    n = len(estimate)
+    start = max(n // 2, max_delay)
+    errors = []
+    for d in range(max_delay + 1):
+        k = np.arange(start, n)
+        diff = estimate[k] - truth_all[k + 1 - d]
+        errors.append(float(np.sqrt(np.mean(diff * diff))))
+    return int(np.argmin(errors))
+
+
+def aligned_result(
+    estimator: str, scenario: str, seed: int, rate: float, jitter: float,
+    params: dict[str, Any], sensor_params: dict[str, Any], master: str, t_points: np.ndarray,
+    truth_start: np.ndarray, truth_rows: np.ndarray, sample_rows: np.ndarray,
+    estimate_rows: np.ndarray, invalid: int, step_us: np.ndarray,
+    true_bias: tuple[float, float, float],
+) -> TestbenchResult:
+    """A run's result from its raw rows (row k: the outputs after step k, at t_points[k]) with
+    each estimate beside the truth and the sample it is of, by the master's delay: estimate
+    row k is of the truth at t_{k + 1 - CHAIN_DELAY} (truth_start: at t_0) and of the sample
+    the sensor gave LINK_LAG steps before. Under Jacobi the first row, the estimate of no
+    sample (the sensor's start values), is left out. Every engine's run goes through here."""
+    lag = LINK_LAG[master]
+    n = len(t_points)
+    first = max(0, 2 * lag - 1)
+    truth_all = np.vstack([truth_start, truth_rows])
+    t_all = np.concatenate([[0.0], t_points])
+    rows = np.arange(first, n)
+    truth = truth_all[rows + 1 - 2 * lag]
+    sample = sample_rows[rows - lag]
+    out = estimate_rows[rows]
+    names = ESTIMATE + (POSITION if estimate_rows.shape[1] > len(ESTIMATE) else ())
+    attitude = [TRUTH.index("roll"), TRUTH.index("pitch")]
+    # Each part as its own C-ordered array, the layout the traces always had.
+    return TestbenchResult(
+        estimator=estimator, scenario=scenario, seed=seed, rate=rate, jitter=jitter,
+        params=params, sensor_params=sensor_params, t=t_all[rows + 1 - 2 * lag],
+        truth={name: truth[:, i].copy() for i, name in enumerate(TRUTH)},
+        sample={name: sample[:, i].copy() for i, name in enumerate(SAMPLE)},
+        estimate={name: out[:, i].copy() for i, name in enumerate(names)},
+        invalid_samples=invalid, step_us=step_us[rows], true_gyro_bias=true_bias,
+        master=master,
+        measured_delay=measured_delay(t_all, truth_all[:, attitude], estimate_rows[:, :2]),
+    )
 
 
 def communication_steps(duration: float, rate: float, jitter: float, seed: int) -> np.ndarray:
@@ -118,15 +201,20 @@ def run_testbench(
     sensor_params: dict[str, Any] | None = None,
     fmu_dir: Path | str = DEFAULT_FMU_DIR,
     evaluate: bool = True,
+    master: str = "gauss-seidel",
 ) -> TestbenchResult:
     """Couple ImuPlant -> ImuSensor -> the estimator FMU and run one scenario.
 
     estimator: a fusion_core.ESTIMATORS key; scenario: a name or id of fusion_core.scenarios;
     params: estimator FMU parameters; sensor_params: ImuSensor parameters (seed is set from
-    `seed`). Returns the traces, and with evaluate=True the contract's metrics and checks.
+    `seed`); master: one of MASTERS (the module docstring). Returns the traces aligned by the
+    master's CHAIN_DELAY, and with evaluate=True the contract's metrics and checks.
     """
     if estimator not in ESTIMATOR_FMUS:
         raise ValueError(f"unknown estimator {estimator!r}: allowed {', '.join(ESTIMATOR_FMUS)}")
+    if master not in MASTERS:
+        raise ValueError(f"unknown master {master!r}: allowed {', '.join(MASTERS)}")
+    jacobi = master == "jacobi"
     sc = get_scenario(scenario)
     duration = sc.duration if duration is None else float(duration)
     if not rate > 0.0 or not 0.0 <= jitter < 1.0:
@@ -163,6 +251,11 @@ def run_testbench(
         sample_buf = _view(row, n_truth, n_sample)
         out_buf = _view(row, n_truth + n_sample, n_out)
         row_np = np.frombuffer(row, dtype=np.float64)  # the same memory, for the record
+        # What the outputs read before the first step (a Jacobi master passes them on): the
+        # plant's truth at the start time, the sensor's start values
+        truth_start = plant.fmu.getReal(truth_vr)
+        truth_buf[:] = truth_start
+        sample_buf[:] = sensor.fmu.getReal(sample_vr)
         record = np.empty((n, len(row)))
         step_ns = np.empty(n, dtype=np.int64)
         t_points = np.empty(n)
@@ -180,22 +273,30 @@ def run_testbench(
         # the calls dearer)
         perf = time.thread_time_ns
         t = 0.0
+        set_ns = 0  # Jacobi: the estimator's set-inputs, timed apart from its step and get
         for k, h in enumerate(steps.tolist()):
             # Statuses are ints: fmi2OK 0, fmi2Warning 1 (a rejected sample), failures above.
+            if jacobi:  # every FMU's inputs: the others' outputs before this step
+                a = s_set(s_c, sensor_in_refs, n_in, sensor_in_buf)
+                t0 = perf()
+                b = e_set(e_c, est_in_refs, n_sample, sample_buf)
+                set_ns = perf() - t0
+                if a > 1 or b > 1:
+                    failed(sensor if a > 1 else est, ("fmi2SetReal",), (max(a, b),), t, h)
             a = p_step(p_c, t, h, fmi2True)
             b = p_get(p_c, truth_refs, n_truth, truth_buf)
             if a > 1 or b > 1:
                 failed(plant, ("fmi2DoStep", "fmi2GetReal"), (a, b), t, h)
-            a = s_set(s_c, sensor_in_refs, n_in, sensor_in_buf)
+            a = 0 if jacobi else s_set(s_c, sensor_in_refs, n_in, sensor_in_buf)
             b = s_step(s_c, t, h, fmi2True)
             c = s_get(s_c, sample_refs, n_sample, sample_buf)
             if a > 1 or b > 1 or c > 1:
                 failed(sensor, SET_STEP_GET, (a, b, c), t, h)
             t0 = perf()
-            a = e_set(e_c, est_in_refs, n_sample, sample_buf)
+            a = 0 if jacobi else e_set(e_c, est_in_refs, n_sample, sample_buf)
             b = e_step(e_c, t, h, fmi2True)
             c = e_get(e_c, est_out_refs, n_out, out_buf)
-            step_ns[k] = perf() - t0
+            step_ns[k] = perf() - t0 + set_ns
             if a > 1 or b > 1 or c > 1:
                 failed(est, SET_STEP_GET, (a, b, c), t, h)
             record[k] = row_np
@@ -207,19 +308,10 @@ def run_testbench(
         for handle in (est, sensor, plant):
             handle.free()
 
-    # Each part as its own C-ordered array, the layout the traces always had.
-    truth = record[:, :n_truth].copy()
-    sample = record[:, n_truth:n_truth + n_sample].copy()
-    out = record[:, n_truth + n_sample:].copy()
-    names = ESTIMATE + (POSITION if position else ())
-    result = TestbenchResult(
-        estimator=estimator, scenario=sc.name, seed=seed, rate=rate, jitter=jitter,
-        params=params, sensor_params=sensor_params, t=t_points,
-        truth={name: truth[:, i] for i, name in enumerate(TRUTH)},
-        sample={name: sample[:, i] for i, name in enumerate(SAMPLE)},
-        estimate={name: out[:, i] for i, name in enumerate(names)},
-        invalid_samples=invalid, step_us=step_ns / 1e3, true_gyro_bias=true_bias,  # type: ignore[arg-type]
-    )
+    result = aligned_result(
+        estimator, sc.name, seed, rate, jitter, params, sensor_params, master, t_points,
+        np.array(truth_start), record[:, :n_truth], record[:, n_truth:n_truth + n_sample],
+        record[:, n_truth + n_sample:], invalid, step_ns / 1e3, true_bias)  # type: ignore[arg-type]
     if evaluate:
         from .contract import evaluate as evaluate_contract
 

@@ -12,6 +12,7 @@ from typing import Any
 from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
+from .master import MASTERS
 from .options import (
     add_calibration,
     add_preset,
@@ -52,6 +53,11 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     run.add_argument("--kind", choices=KINDS, default="auto",
                      help="FMUs to run: native (FMI 2.0 from the C twin, FMU_DIR/native/fmi2), "
                      "pythonfmu (FMU_DIR), or auto: native where built (default)")
+    run.add_argument("--master", choices=MASTERS, default="gauss-seidel",
+                     help="how the FMUs step: gauss-seidel (each on the newest outputs of the "
+                     "one before it, the default) or jacobi (each on the others' outputs of "
+                     "the previous step, as libcosim, Ecos and parallel containers do: the "
+                     "chain adds 2 steps of delay, by which the truth is aligned)")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--jobs", type=positive_int, default=2,
                      help="worker processes (2: the campaign on two cores; 1: all in this one)")
@@ -117,14 +123,14 @@ def cmd_run(args: argparse.Namespace) -> int:
                               contract_checks=not args.no_contract, params=params,
                               duration=args.duration, timing=not args.no_timing_check,
                               jobs=args.jobs, preset=preset, sensor=sensor,
-                              calibrate_first=args.calibrate_first)
+                              calibrate_first=args.calibrate_first, master=args.master)
     print(contract_table(result))
     peer_rows = None
     if peers:
         from .peer_runs import peer_table, run_peers
 
         peer_rows = run_peers(peers, scenarios, args.seeds, sensor, args.duration,
-                              calibrate_first=args.calibrate_first)
+                              calibrate_first=args.calibrate_first, master=args.master)
         print("\n" + peer_table(peer_rows))
     summaries = seed_summaries(result, peer_rows)
     if over_several_seeds(summaries):

@@ -200,6 +200,54 @@ def test_a_communication_step_size_that_is_not_positive_is_refused(kf, fmu_recor
     _run(kf, fmu_recording, 10, 20)
 
 
+def test_a_dostep_at_a_communication_point_other_than_the_fmus_time_is_refused(
+        kf, fmu_recording):
+    """doStep must start where the last step ended (or at the start time): a skipped or a
+    repeated step is refused with a log line, as the Reference-FMUs do, and changes nothing."""
+    kf.start()
+    before = _run(kf, fmu_recording, 0, 10)[-1]
+    for t in (0.2, 0.0, 0.09):
+        assert refused(kf.fmu.doStep, t, 0.01)
+    assert sum("communication point" in e for e in _errors(kf)) == 3
+    assert tuple(kf.get(n) for n in ("roll", "pitch", "bias_x", "bias_y", "bias_z")) == before
+    _run(kf, fmu_recording, 10, 20)  # 0.01 * 10 is the sum of ten steps up to rounding
+
+
+def _flip_top_bits(state: bytes, offsets: list[int]) -> bytes:
+    """The state with the top (sign) bit of the little-endian doubles at these byte offsets
+    flipped, its checksum left as it was."""
+    out = bytearray(state)
+    for at in offsets:
+        out[at + 7] ^= 0x80
+    return bytes(out)
+
+
+STATE_HEADER = 88 + 16
+"""Bytes before a native state's values: the header (magic, model, format, counts, length,
+checksum) and the FMI state and time (fmu_instance.c)."""
+
+
+def test_a_state_with_one_or_two_words_changed_or_a_byte_more_is_refused(kf, fmu_recording):
+    """The checksum is a CRC-64: a sign flip of roll, or of roll and pitch together (which a
+    word-wise FNV hash let through, the filter continuing mirrored), is refused, and a state
+    must have exactly its length."""
+    kf.start()
+    _run(kf, fmu_recording, 0, 100)
+    good = kf.serialize(kf.save())
+    roll, pitch = (STATE_HEADER + 8 * kf.vr(n) for n in ("roll", "pitch"))
+    field = len(good) - 8  # the last state field of the filter
+    changed = [_flip_top_bits(good, [roll]), _flip_top_bits(good, [roll, pitch]),
+               _flip_top_bits(good, [field]), _flip_top_bits(good, [roll, field]),
+               good + b"\x00"]
+    before = kf.get("roll")
+    for data in changed:
+        assert refused(kf.deserialize, data)
+    assert len(_errors(kf)) == len(changed)
+    assert kf.get("roll") == before
+    kf.restore(kf.deserialize(good))
+    _run(kf, fmu_recording, 100, 120)
+
+
 def test_setting_an_output_is_refused(kf):
     kf.start()
     assert refused(kf.set, "roll", 1.0)

@@ -2,8 +2,10 @@
 co-simulation FMU.
 
 After doStep(t, h) the outputs are the truth at t+h of the scenario chosen by the Integer
-parameter `scenario`: Z-Y-X Euler angles, body rates consistent with them (inverse Euler-rate
-kinematics), the specific force R^T (a + g e_z) in the body frame, position and velocity.
+parameter `scenario`, and from setupExperiment on until the first step its truth at the start
+time (a Jacobi master passes them on before any step): Z-Y-X Euler angles, body rates
+consistent with them (inverse Euler-rate kinematics), the specific force R^T (a + g e_z) in the
+body frame, position and velocity.
 """
 
 from typing import Any
@@ -40,7 +42,9 @@ class ImuPlant(FmuSlave):
     VARIABLES = variable_table("ImuPlant", lambda: (
         Variable("scenario", "parameter", "Integer", f"Motion: {_ENUM}", 0,
                  variability="fixed", low=min(SCENARIO_BY_ID), high=max(SCENARIO_BY_ID)),
-        *(real_output(name, unit, text + "; the value at the end of the last step",
+        *(real_output(name, unit, text + "; the value at the end of the last step, and before "
+                      "the first step the chosen scenario's value at the start time (the start "
+                      "value is the default scenario's at t = 0)",
                       plant_start()[name], display) for name, unit, display, text in _OUTPUTS),
     ))
 

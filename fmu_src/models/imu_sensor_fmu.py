@@ -39,7 +39,10 @@ class ImuSensor(FmuSlave):
         *(real_output(f"gyro_{a}", "rad/s", f"Gyro sample about body {_AXIS[a]}, taken at the "
                       "end of the last step", 0.0, "deg/s") for a in "xyz"),
         real_output("dt", "s", "Time since the previous sample as the sensor reports it (the "
-                    "step size, plus timestamp jitter if any)", 0.01),
+                    "step size, plus timestamp jitter if any); 0 before the first step, which "
+                    "marks the outputs' start values as no sample (every estimator refuses "
+                    "dt <= 0 and counts it), so a master that passes them on before the first "
+                    "step (Jacobi) plants no false sample", 0.0),
         *(real_output(f"true_bias_{a}", "rad/s", f"The gyro's true total bias about {_AXIS[a]} "
                       "at the last sample (truth for the estimators' bias outputs)", 0.0,
                       "deg/s") for a in "xyz"),

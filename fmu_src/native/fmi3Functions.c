@@ -150,6 +150,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
     (void)stopTimeDefined;
     (void)stopTime;
     inst->time = startTime;
+    fmu_instance_setup(inst);  /* the plant's outputs: its truth at startTime */
     inst->state = FMU_INITIALIZATION;
     return fmi3OK;
 }

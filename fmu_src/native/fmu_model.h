@@ -51,9 +51,13 @@ typedef struct fmu_model {
     /* The fields of the data that make up its state (offsets from the data's start; NULL: none,
      * the data is all derived from the parameters). Only these are saved. */
     const fc_layout *state;
-    /* A model built from the parameter values (at instantiation, exitInitializationMode and
-     * reset); it may write output values (their start values stay otherwise). */
-    void (*setup)(void *data, double *values);
+    /* A model built from the parameter values for a start at time t: at instantiation and
+     * reset, whenever the start time or a parameter changes before step mode (so outputs read
+     * in initialization mode or right after it follow the parameters), at
+     * exitInitializationMode and on a restore. It may write output values: the plant writes
+     * its truth at t, so a master that passes outputs on before the first step (Jacobi) passes
+     * the truth, not a start value (their start values stay otherwise). */
+    void (*setup)(void *data, double *values, double t);
     /* A tunable parameter changed in a running model (values holds the new value). */
     void (*tune)(void *data, const double *values);
     /* One communication step [t, t+h] with the inputs in values; writes the outputs into values.
@@ -106,6 +110,8 @@ fmu_instance *fmu_instance_new(const char *name, fmu_emit emit, const void *call
 void fmu_instance_free(fmu_instance *inst);
 /* Values back to their start values, the model set up from them, state INSTANTIATED. */
 void fmu_instance_reset(fmu_instance *inst);
+/* The model set up anew from the values at the instance's time (fmu_model.setup). */
+void fmu_instance_setup(fmu_instance *inst);
 
 /* Log a line: errors always (when the host gave a logger), the rest while logging is on. */
 void fmu_log(const fmu_instance *inst, int status, const char *format, ...);

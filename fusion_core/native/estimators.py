@@ -130,6 +130,7 @@ def _fill_position(lib: Any, twin: Any, est: Any) -> None:
             twin.pending[i][j] = v
     _set_field(twin, "turned", est.turned)
     _set_field(twin, "f_mean", est.f_mean)
+    twin.aligned = est.aligned
 
 
 def _take_position(twin: Any, est: Any) -> None:
@@ -149,6 +150,7 @@ def _take_position(twin: Any, est: Any) -> None:
                    for i in range(count)]
     est.turned = tuple(float(v) for v in twin.turned)
     est.f_mean = tuple(float(v) for v in twin.f_mean)
+    est.aligned = bool(twin.aligned)
 
 
 def new_twin(estimator: Any) -> Any:

@@ -58,6 +58,7 @@ void fc_poskf_reset(fc_poskf *f)
     f->pending_head = f->pending_count = 0;
     f->turned[0] = f->turned[1] = 0.0;
     memset(f->f_mean, 0, sizeof f->f_mean);
+    f->aligned = 0;
     f->sines[0] = f->sines[1] = NAN;  /* tilt_sines: none yet */
     f->last = fc_poskf_estimate(f);
 }
@@ -159,6 +160,7 @@ static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real
             fc_paper_kf_correct_innovation(
                 tilt, fc_wrap_angle(acc_roll - tilt->roll + turned_roll - then_roll),
                 acc_pitch - tilt->pitch + turned_pitch - then_pitch);
+            f->aligned = 1;
         }
     }
     if (stationary) {
@@ -166,6 +168,10 @@ static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real
     }
     fc_paper_kf_took_sample(tilt, g);
     fc_kf_step(&f->att, a, g, dt, NULL);
+    if (!f->aligned) {  /* until the first confirmed rest: the attitude filter's levelling */
+        tilt->roll = f->att.last.roll;
+        tilt->pitch = f->att.last.pitch;
+    }
     /* 3. yaw from the gyro, the level-frame acceleration with the new attitude */
     fc_real acc[3];
     fc_paper_poskf_yaw_and_level_acceleration(tilt->roll, tilt->pitch, &f->yaw, wy, gz, a, dt,

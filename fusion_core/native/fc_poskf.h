@@ -24,6 +24,7 @@ typedef struct fc_poskf {
     int pending_head, pending_count;
     fc_real turned[2];
     fc_real f_mean[3];
+    int aligned;       /* the tilt stage has taken a confirmed rest's accelerometer */
     fc_paper_kf tilt;  /* the tilt stage */
     fc_kf att;         /* the attitude outputs */
     fc_estimate last;

@@ -179,6 +179,7 @@ static const fc_field POSKF_FIELDS[] = {
     {"pending_count", offsetof(fc_poskf, pending_count), FC_INT, 1, FC_CHECK_COUNT, 2048.0},
     {"turned", offsetof(fc_poskf, turned), FC_DOUBLE, 2, FC_CHECK_REAL, 0.0},
     {"f_mean", offsetof(fc_poskf, f_mean), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"aligned", offsetof(fc_poskf, aligned), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"tilt.base.initialized", offsetof(fc_poskf, tilt.base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"tilt.base.n_samples", offsetof(fc_poskf, tilt.base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
     {"tilt.base.n_rejected", offsetof(fc_poskf, tilt.base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},

@@ -269,7 +269,7 @@ def state_layouts() -> dict[str, list[Entry]]:
         *_entries({"yaw": TWINS["fc_poskf"].STATE["yaw"], **axes,
                    "quiet_time": NONNEG, "stationary": FLAG, "pending": REAL,
                    "pending_head": index(PENDING_MAX), "pending_count": count(PENDING_MAX),
-                   "turned": REAL, "f_mean": REAL}),
+                   "turned": REAL, "f_mean": REAL, "aligned": FLAG}),
         *nested("tilt", "fc_paper_kf"),
         *nested("att", "fc_kf"),
     ]

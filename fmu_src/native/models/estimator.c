@@ -19,9 +19,10 @@ typedef struct model_data {
     FC_T filter;
 } model_data;
 
-static void setup(void *data, double *values)
+static void setup(void *data, double *values, double t)
 {
     model_data *m = (model_data *)data;
+    (void)t;
     FC_PARAMS p;
     memset(&p, 0, sizeof p);  /* no stack garbage in its padding: a state is compared bytewise */
     params_from_values(&p, values);

@@ -13,9 +13,10 @@ typedef struct model_data {
     fc_sensor sensor;
 } model_data;
 
-static void setup(void *data, double *values)
+static void setup(void *data, double *values, double t)
 {
     fc_sensor_params p;
+    (void)t;
     memset(&p, 0, sizeof p);  /* no stack garbage in its padding: a state is compared bytewise */
     params_from_values(&p, values);
     fc_sensor_init(&((model_data *)data)->sensor, &p);

@@ -1,0 +1,216 @@
+"""The testbench chain in the co-simulation engines users run: DNV's libcosim (libcosimpy, FMI
+2.0) and NTNU's Ecos (ecospy, FMI 2.0 and 3.0).
+
+`run_engine` wires ImuPlant -> ImuSensor -> one estimator FMU in the engine, as an integrator
+would (the plant's truth to the sensor's inputs, the sensor's sample to the estimator's
+inputs, the parameters set by name), steps it at a fixed step and records every output after
+every step. Both engines are Jacobi masters: every FMU steps on the others' outputs of the
+previous step. So the result is aligned as the project's own Jacobi master aligns its runs
+(master.aligned_result), the contract's checks apply unchanged, and a run equals
+`run_testbench(..., master="jacobi")` bit for bit (tests/test_engines.py).
+
+Neither engine is a dependency of the estimators: the `engines` extra installs both
+(`pip install '.[engines]'`); Ecos needs the TBB runtime (Debian's libtbb12). `engine_reason`
+says what is missing and how to install it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes.util
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.scenarios import get_scenario
+from fusion_core.synthetic import TRUTH_NAMES
+
+from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, fmu_path
+from .master import (
+    ESTIMATE,
+    POSITION,
+    SAMPLE,
+    SENSOR_IN,
+    TestbenchResult,
+    aligned_result,
+    communication_steps,
+)
+
+ENGINES = {"libcosim": (2,), "ecos": (2, 3)}
+"""Each engine and the FMI versions it runs."""
+INSTALL = "pip install '.[engines]' (libcosimpy, ecospy); Ecos also needs apt-get install libtbb12"
+
+
+def engine_reason(engine: str) -> str | None:
+    """Why `engine` cannot run here (a missing package or library, with the install line), or
+    None when it can."""
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}: allowed {', '.join(ENGINES)}")
+    module = {"libcosim": "libcosimpy", "ecos": "ecospy"}[engine]
+    if engine == "ecos" and ctypes.util.find_library("tbb") is None:
+        return f"Ecos needs the TBB runtime (libtbb.so.12), not found: {INSTALL}"
+    try:
+        __import__(module)
+    except (ImportError, OSError) as err:
+        return f"{module} cannot be imported ({err}): {INSTALL}"
+    return None
+
+
+def chain_fmus(estimator: str, fmu_dir: Path | str, fmi: int) -> dict[str, Path]:
+    """The three FMUs of the chain by component name, native FMI `fmi` ones under fmu_dir
+    (build_fmu.py --out fmu_dir: fmu_dir/native/fmi2, fmu_dir/native/fmi3)."""
+    folder = Path(fmu_dir) / "native" / f"fmi{fmi}"
+    names = {"plant": PLANT_FMU, "sensor": SENSOR_FMU, "estimator": ESTIMATOR_FMUS[estimator]}
+    return {component: fmu_path(name, folder) for component, name in names.items()}
+
+
+WIRES = [("plant", n, "sensor", n) for n in SENSOR_IN] + [
+    ("sensor", n, "estimator", n) for n in SAMPLE]
+"""The chain's connections: (from component, variable, to component, variable)."""
+
+
+def run_engine(
+    engine: str,
+    estimator: str,
+    scenario: str | int,
+    seed: int = 0,
+    *,
+    fmi: int = 2,
+    duration: float | None = None,
+    rate: float = 100.0,
+    params: Mapping[str, Any] | None = None,
+    sensor_params: Mapping[str, Any] | None = None,
+    fmu_dir: Path | str = DEFAULT_FMU_DIR,
+    evaluate: bool = True,
+) -> TestbenchResult:
+    """Run plant -> sensor -> estimator in `engine` (ENGINES) with the native FMI `fmi` FMUs.
+
+    params and sensor_params are FMU parameters by name (Real, Integer, Boolean values);
+    the sensor's seed is set from `seed`. Returns the traces aligned by the Jacobi chain's
+    delay, and with evaluate=True the contract's metrics and checks (T3 measures the whole
+    engine step, not the estimator alone, and is left out)."""
+    why = engine_reason(engine)
+    if why:
+        raise RuntimeError(why)
+    if fmi not in ENGINES[engine]:
+        raise ValueError(f"{engine} runs FMI {', '.join(map(str, ENGINES[engine]))}, not {fmi}")
+    if estimator not in ESTIMATOR_FMUS:
+        raise ValueError(f"unknown estimator {estimator!r}: allowed {', '.join(ESTIMATOR_FMUS)}")
+    sc = get_scenario(scenario)
+    duration = sc.duration if duration is None else float(duration)
+    n = len(communication_steps(duration, rate, 0.0, seed))
+    values: dict[str, dict[str, Any]] = {
+        "plant": {"scenario": sc.id},
+        "sensor": {**(sensor_params or {}), "seed": seed},
+        "estimator": dict(params or {}),
+    }
+    outputs = {"plant": TRUTH_NAMES, "sensor": SAMPLE,
+               "estimator": ESTIMATE + (POSITION if estimator == "poskf" else ())}
+    run = {"libcosim": _run_libcosim, "ecos": _run_ecos}[engine]
+    t0 = time.process_time()
+    rows, invalid = run(chain_fmus(estimator, fmu_dir, fmi), values, outputs, 1.0 / rate, n)
+    cpu = time.process_time() - t0
+    t_points = np.arange(1, n + 1) / rate
+    truth_start = np.array(get_scenario(sc.id).trajectory().truth_at(0.0))
+    result = aligned_result(
+        estimator, sc.name, seed, rate, 0.0, dict(values["estimator"]), values["sensor"],
+        "jacobi", t_points, truth_start, rows["plant"], rows["sensor"], rows["estimator"],
+        invalid, np.full(n, cpu / n * 1e6), (0.0, 0.0, 0.0))
+    result.engine = f"{engine} FMI {fmi}.0"  # type: ignore[attr-defined]
+    result.cpu_s = cpu  # type: ignore[attr-defined]
+    if evaluate:
+        from .contract import evaluate as evaluate_contract
+
+        evaluate_contract(result, timing=False)
+    return result
+
+
+Rows = dict[str, np.ndarray]
+
+
+def _run_libcosim(fmus: Mapping[str, Path], values: Mapping[str, Mapping[str, Any]],
+                  outputs: Mapping[str, tuple[str, ...]], step: float, n: int
+                  ) -> tuple[Rows, int]:
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    log_output_level(CosimLogLevel.ERROR)
+    ex = CosimExecution.from_step_size(step_size=round(step * 1e9))
+    index = {c: ex.add_local_slave(CosimLocalSlave(fmu_path=str(p), instance_name=c))
+             for c, p in fmus.items()}
+    refs = {c: {v.name.decode(): (v.reference, CosimVariableType(v.type))
+                for v in ex.slave_variables(i)} for c, i in index.items()}
+    for c, params in values.items():
+        for name, value in params.items():
+            if name not in refs[c]:
+                raise ValueError(f"libcosim: {fmus[c].stem} has no parameter {name!r} it can "
+                                 "set (libcosim ignores FMI 2.0 Enumeration variables)")
+            vr, kind = refs[c][name]
+            setter = {CosimVariableType.REAL: ex.real_initial_value,
+                      CosimVariableType.INTEGER: ex.integer_initial_value,
+                      CosimVariableType.BOOLEAN: ex.boolean_initial_value}[kind]
+            if not setter(index[c], vr, value):
+                raise ValueError(f"libcosim refused {c}.{name} = {value!r}")
+    for a, va, b, vb in WIRES:
+        ex.connect_real_variables(index[a], refs[a][va][0], index[b], refs[b][vb][0])
+    observer = CosimObserver.create_last_value()
+    ex.add_observer(observer)
+    vrs = {c: [refs[c][v][0] for v in names] for c, names in outputs.items()}
+    rows = {c: np.empty((n, len(names))) for c, names in outputs.items()}
+    for k in range(n):
+        if not ex.step(1):
+            raise RuntimeError(f"libcosim: step {k} failed")
+        for c in outputs:
+            rows[c][k] = observer.last_real_values(index[c], vrs[c])
+    invalid = observer.last_integer_values(index["estimator"],
+                                           [refs["estimator"]["invalid_samples"][0]])[0]
+    return rows, int(invalid)
+
+
+def _run_ecos(fmus: Mapping[str, Path], values: Mapping[str, Mapping[str, Any]],
+              outputs: Mapping[str, tuple[str, ...]], step: float, n: int
+              ) -> tuple[Rows, int]:
+    from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure
+
+    EcosLib.set_log_level("warn")
+    structure = EcosSimulationStructure()
+    for c, p in fmus.items():
+        structure.add_model(c, str(p))
+    for a, va, b, vb in WIRES:
+        structure.make_real_connection(f"{a}::{va}", f"{b}::{vb}")
+    structure.add_parameter_set("chain", {f"{c}::{k}": v for c, params in values.items()
+                                          for k, v in params.items()})
+    sim = EcosSimulation(structure=structure, step_size=step)
+    try:
+        sim.init(parameter_set="chain")
+        _check_ecos_parameters(sim, values)
+        rows = {c: np.empty((n, len(names))) for c, names in outputs.items()}
+        for k in range(n):
+            sim.step(1)
+            for c, names in outputs.items():
+                row = rows[c][k]
+                for i, name in enumerate(names):
+                    row[i] = sim.get_real(f"{c}::{name}")
+        invalid = sim.get_integer("estimator::invalid_samples")
+    finally:
+        with contextlib.suppress(Exception):
+            sim.terminate()
+        sim.free()
+    return rows, int(invalid)
+
+
+def _check_ecos_parameters(sim: Any, values: Mapping[str, Mapping[str, Any]]) -> None:
+    """Ecos skips a parameter it cannot set with a warning only: read each back."""
+    for c, params in values.items():
+        for name, value in params.items():
+            ident = f"{c}::{name}"
+            back = (sim.get_bool(ident) if isinstance(value, bool) else
+                    sim.get_integer(ident) if isinstance(value, int) else sim.get_real(ident))
+            if back != value:
+                raise ValueError(f"Ecos did not set {ident} = {value!r} (it reads {back!r})")
