@@ -28,6 +28,8 @@ from fmpy.fmi2 import (
     fmi2CallbackLoggerTYPE,
 )
 
+from .variables import item_value
+
 INPUTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt")
 """The estimator FMUs' inputs, in the order run_samples sets them."""
 STATUS = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")
@@ -100,7 +102,7 @@ class FmuInstance:
         return [self.variables[n].valueReference for n in names]
 
     def set(self, values: Mapping[str, Any]) -> None:
-        """Set variables by name (Real, Integer, Enumeration by value or item name, Boolean)."""
+        """Set variables by name (Real, Integer, a choice by value or item name, Boolean)."""
         for name, value in values.items():
             var = self.variables[name]
             vr = [var.valueReference]
@@ -109,9 +111,8 @@ class FmuInstance:
             elif var.type == "Boolean":
                 self.fmu.setBoolean(vr, [bool(value)])
             else:
-                if isinstance(value, str) and var.type == "Enumeration":
-                    items = [item.name for item in var.declaredType.items]
-                    value = items.index(value) + 1
+                if isinstance(value, str):
+                    value = item_value(var, value)
                 self.fmu.setInteger(vr, [int(value)])
 
     def get(self, name: str) -> Any:

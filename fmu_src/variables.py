@@ -1,16 +1,23 @@
 """The declarative variable table every FMU of the project is built from.
 
 One `Variable` per FMI scalar variable: name, causality, FMI type, description, start value, unit
-and display unit (Real), allowed range, and for enumerations the item names. `FmuSlave` turns the
+and display unit (Real), allowed range, and for a choice the item names. `FmuSlave` turns the
 table into pythonfmu registrations; `model_description` turns it into the units, ranges and types
-that pythonfmu cannot write. Values are held in their FMI form (an Enumeration as its item
-value 1..n); `to_model` converts to the value a Python model works with.
+that pythonfmu cannot write. Values are held in their FMI form (a choice as its item's value
+1..n); `to_model` converts to the value a Python model works with.
+
+A parameter that is a choice among names (gyro_sampling: point or mean) is an FMI Integer with
+the range 1..n and the items named in its description ("Allowed: 1 = point, 2 = mean"), not an
+FMI Enumeration: the co-simulation engines users run cannot set an Enumeration (libcosim drops
+FMI 2.0 Enumeration variables, Ecos skips them), and every tool can set an Integer.
+`items_in_description` reads the names back for a host that is given an item's name.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -27,7 +34,7 @@ class Variable:
     unit is required for Real variables ("1" when dimensionless); display_unit is a friendlier
     unit for tools (deg for rad). low/high are the allowed range, open or closed; closed bounds
     become min/max in modelDescription.xml, and every bound is stated in the description.
-    items are the names of an Enumeration's values 1..n.
+    items are the names of the values 1..n of an Enumeration or of an Integer choice.
     """
 
     name: str
@@ -69,8 +76,8 @@ class Variable:
 
     def allowed(self) -> str:
         """The allowed values in words, for descriptions and error messages."""
-        if self.type == "Enumeration":
-            return ", ".join(f"{i} = {name}" for i, name in enumerate(self.items or (), 1))
+        if self.items:
+            return ", ".join(f"{i} = {name}" for i, name in enumerate(self.items, 1))
         if self.type == "Boolean":
             return "true or false"
         lo = "-inf" if self.low is None else repr(self.low)
@@ -99,8 +106,8 @@ class Variable:
 
     def to_model(self, value: Any) -> Any:
         """An FMI value in the form the Python model takes; ValueError for an unknown item."""
-        if self.type == "Enumeration":
-            items = self.items or ()
+        if self.items:
+            items = self.items
             known = isinstance(value, int) and not isinstance(value, bool)
             if not (known and 1 <= value <= len(items)):
                 raise ValueError(
@@ -142,8 +149,9 @@ def parameter_variable(param: Any) -> Variable:
     unit, low/high, low_open/high_open, choices, display_unit, tunable).
 
     float -> Real with the Param's unit, int -> Integer, bool -> Boolean, str with choices ->
-    Enumeration whose items are the choices in order (value 1 = the first). The start value is
-    the Param's default; the variability is tunable or fixed as the Param says.
+    Integer 1..n whose items are the choices in order (value 1 = the first; see the module
+    docstring for why not an Enumeration). The start value is the Param's default; the
+    variability is tunable or fixed as the Param says.
     """
     variability: Variability = "tunable" if param.tunable else "fixed"
     common: dict[str, Any] = {
@@ -157,8 +165,8 @@ def parameter_variable(param: Any) -> Variable:
     if param.choices is not None:
         items = tuple(param.choices)
         var = Variable(
-            param.name, "parameter", "Enumeration", param.description, items.index(default) + 1,
-            variability=variability, items=items, type_name=f"{param.name}Choice",
+            param.name, "parameter", "Integer", param.description, items.index(default) + 1,
+            variability=variability, low=1, high=len(items), items=items,
         )
     elif isinstance(default, bool):
         var = Variable(param.name, "parameter", "Boolean", param.description, default,
@@ -175,6 +183,33 @@ def parameter_variable(param: Any) -> Variable:
     how = "tunable while running" if param.tunable else "fixed after initialisation"
     text = f"{param.description.rstrip('.')}. Allowed: {var.allowed()}; default {default!r}; {how}"
     return dataclasses.replace(var, description=text)
+
+
+_ALLOWED_ITEMS = re.compile(r"Allowed: ((?:\d+ = [^,;]+(?:, )?)+);")
+
+
+def items_in_description(description: str | None) -> tuple[str, ...] | None:
+    """The item names of an Integer choice, values 1..n, from its description ("Allowed:
+    1 = point, 2 = mean; ..."), or None where the description names none."""
+    m = _ALLOWED_ITEMS.search(description or "")
+    if m is None:
+        return None
+    pairs = [part.split(" = ", 1) for part in m.group(1).split(", ")]
+    if [int(v) for v, _ in pairs] != list(range(1, len(pairs) + 1)):
+        return None
+    return tuple(name for _, name in pairs)
+
+
+def item_value(variable: Any, name: str) -> int:
+    """The value 1..n of a choice's item `name`, for a variable as fmpy reads it (an Integer
+    choice, or an Enumeration of another FMU); ValueError naming the allowed items."""
+    declared = getattr(variable, "declaredType", None)
+    items = ([item.name for item in declared.items] if declared is not None and
+             getattr(declared, "items", None) else list(
+                 items_in_description(getattr(variable, "description", None)) or ()))
+    if name not in items:
+        raise ValueError(f"{variable.name} = {name!r}: allowed {items or 'a number'}")
+    return items.index(name) + 1
 
 
 _TABLES: dict[str, tuple[Variable, ...]] = {}

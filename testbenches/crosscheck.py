@@ -33,6 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from fmu_src.variables import items_in_description
+
 TOOL = "imu-fusion-fmu"
 IMPORTER = "fmpy"
 STEP = 0.01
@@ -63,9 +65,9 @@ def _typed(variable: Any) -> Any:
     """A variable's start value as Python reads it (fmpy gives strings)."""
     if variable.type == "Real" or variable.type.startswith("Float"):
         return float(variable.start)
-    if variable.type == "Enumeration":  # the item's name is the choice fusion_core takes
-        items = {int(item.value): item.name for item in variable.declaredType.items}
-        return items[int(variable.start)]
+    items = items_in_description(variable.description)
+    if variable.type == "Integer" and items:  # the item's name is the choice fusion_core takes
+        return items[int(variable.start) - 1]
     if variable.type == "Boolean":
         return variable.start in ("true", "1", True)
     if variable.type.startswith("Int") or variable.type == "Integer":

@@ -210,7 +210,11 @@ def _check_ecos_parameters(sim: Any, values: Mapping[str, Mapping[str, Any]]) ->
     for c, params in values.items():
         for name, value in params.items():
             ident = f"{c}::{name}"
-            back = (sim.get_bool(ident) if isinstance(value, bool) else
-                    sim.get_integer(ident) if isinstance(value, int) else sim.get_real(ident))
+            try:
+                back = (sim.get_bool(ident) if isinstance(value, bool) else
+                        sim.get_integer(ident) if isinstance(value, int) else
+                        sim.get_real(ident))
+            except Exception as err:  # ecospy raises a bare Exception for an unknown name
+                raise ValueError(f"Ecos did not set {ident} = {value!r}: {err}") from None
             if back != value:
                 raise ValueError(f"Ecos did not set {ident} = {value!r} (it reads {back!r})")

@@ -20,6 +20,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
+from fmu_src.variables import item_value
 from fusion_core.registry import FILTER, FMU_NAMES, REFERENCES, estimator_class
 
 ESTIMATOR_FMUS = FMU_NAMES
@@ -123,7 +124,7 @@ class FmuHandle:
         return out
 
     def set_parameters(self, params: Mapping[str, Any]) -> None:
-        """Set parameters by name; an enumeration accepts its item name or its value."""
+        """Set parameters by name; a choice accepts its item name or its value."""
         for name, value in params.items():
             var = self.vars.get(name)
             if var is None or var.causality != "parameter":
@@ -136,10 +137,10 @@ class FmuHandle:
                 setter, getter, value = self.fmu.setBoolean, self.fmu.getBoolean, bool(value)
             else:
                 if isinstance(value, str):
-                    items = [item.name for item in var.declaredType.items]
-                    if value not in items:
-                        raise ValueError(f"{self.name}.{name} = {value!r}: allowed {items}")
-                    value = items.index(value) + 1
+                    try:
+                        value = item_value(var, value)
+                    except ValueError as err:
+                        raise ValueError(f"{self.name}: {err}") from None
                 setter, getter, value = self.fmu.setInteger, self.fmu.getInteger, int(value)
             # a native FMU refuses with fmi2Error, a pythonfmu FMU logs and keeps its value
             with contextlib.suppress(FMICallException):

@@ -27,7 +27,7 @@ from fusion_core.scenarios import get_scenario
 
 
 class FastCf(EstimatorSlave):
-    """The ComplementaryFilter FMU's slave (Enumeration parameters)."""
+    """The ComplementaryFilter FMU's slave (Integer choice parameters)."""
 
     key = "cf"
     description = "fast-path test: complementary filter"
@@ -130,7 +130,7 @@ def test_fast_tables_cover_the_real_inputs_and_every_real_and_integer():
     kinds = {v.name: (v.causality, v.type) for v in slave.VARIABLES}
     assert sorted(slave._fast_inputs.values()) == sorted(INPUTS)
     assert {kinds[n][1] for n in slave._fast_reals.values()} == {"Real"}
-    assert {kinds[n][1] for n in slave._fast_integers.values()} == {"Integer", "Enumeration"}
+    assert {kinds[n][1] for n in slave._fast_integers.values()} == {"Integer"}
     assert len(slave._fast_reals) + len(slave._fast_integers) == sum(
         t != "Boolean" for _, t in kinds.values())
     assert slave.get_integer(vrs_of(slave, "gyro_sampling", "invalid_samples")) == [1, 0]

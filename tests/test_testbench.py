@@ -24,6 +24,7 @@ from fusion_core.kinematics import euler_rates
 from fusion_core.scenarios import SCENARIOS
 from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel
 from testbenches import contract, master, run_testbench
+from testbenches.master import CHAIN_DELAY, MASTERS
 
 REPO = Path(__file__).resolve().parent.parent
 KEYS = tuple(ESTIMATORS)
@@ -413,3 +414,39 @@ def test_the_roll_error_wrap_is_numpys_remainder_to_the_bit(values: list[float])
     nan = np.isnan(want)
     assert np.array_equal(np.isnan(got), nan)
     assert np.array_equal(got[~nan].view(np.uint64), want[~nan].view(np.uint64))
+
+
+# ----- the Jacobi master (docs/interface.md, Timing) ----------------------------------------------
+def test_the_chain_delay_is_measured_0_steps_gauss_seidel_and_2_jacobi(fmu_dir: Path) -> None:
+    """The same noise-free sweep under both masters: the measured delay is the declared one,
+    each estimate aligned by it passes T1, and the Jacobi run's only rejected sample is the
+    sensor's start (dt = 0)."""
+    kw = {"duration": 8.0, "fmu_dir": fmu_dir, "sensor_params": contract.NOISE_FREE}
+    runs = {m: run_testbench("kf", "roll_sweep", master=m, **kw) for m in MASTERS}
+    assert {m: r.measured_delay for m, r in runs.items()} == CHAIN_DELAY
+    for r in runs.values():
+        assert contract.check_delay([r]).passed
+        assert contract.check_t1([r]).passed
+        assert all(c.passed for c in r.checks), [c.line() for c in r.checks]
+    assert (runs["gauss-seidel"].invalid_samples, runs["jacobi"].invalid_samples) == (0, 1)
+    assert len(runs["jacobi"].t) == len(runs["gauss-seidel"].t) - 1
+
+
+def test_a_hidden_extra_step_fails_the_chain_delay_check(fmu_dir: Path) -> None:
+    """A Jacobi run whose estimates lag one step more than the master declares: the delay
+    check measures 3 steps against 2 and fails."""
+    r = run_testbench("cf", "roll_sweep", duration=8.0, fmu_dir=fmu_dir, master="jacobi",
+                      sensor_params=contract.NOISE_FREE)
+    lagged = dataclasses.replace(r, measured_delay=r.measured_delay + 1)
+    check = contract.check_delay([lagged])
+    assert not check.passed and (check.measured, check.allowed) == (3, 2)
+
+
+def test_the_contract_holds_under_the_jacobi_master(fmu_dir: Path) -> None:
+    """moderate_dynamics under Jacobi: the accuracy checks pass on the aligned traces, and the
+    RMSE is the Gauss-Seidel run's within a hundredth of a degree."""
+    gs = run_testbench("ukf", "moderate_dynamics", fmu_dir=fmu_dir)
+    jac = run_testbench("ukf", "moderate_dynamics", fmu_dir=fmu_dir, master="jacobi")
+    assert all(c.passed for c in jac.checks), [c.line() for c in jac.checks]
+    for axis in ("rmse_roll_deg", "rmse_pitch_deg"):
+        assert jac.metrics[axis] == pytest.approx(gs.metrics[axis], abs=0.01)

@@ -1,0 +1,92 @@
+"""The FMUs in the co-simulation engines users run: libcosim (FMI 2.0) and Ecos (FMI 2.0 and
+3.0), through testbenches.engines, against the project's own Jacobi master.
+
+For every estimator the whole chain ImuPlant -> ImuSensor -> estimator runs in each engine
+on moderate_dynamics (the realistic sensor, seed 0): the contract's accuracy checks pass on the
+traces aligned by the Jacobi chain's delay, the first half second holds no false start, and
+every output equals the project's Jacobi master bit for bit. Every choice parameter is set in
+both engines and takes effect. Where an engine or its runtime is missing, its tests skip with
+the reason and the install line (testbenches.engines.engine_reason).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fusion_core.types import DEG
+from testbenches import engines
+from testbenches.master import run_testbench
+
+KEYS = list(engines.ESTIMATOR_FMUS)
+RUNS = [(engine, fmi) for engine, versions in engines.ENGINES.items() for fmi in versions]
+EARLY = (0.03, 0.5)
+"""The window of the false level start (docs/interface.md, Timing)."""
+EARLY_MAX_DEG = 1.0
+VEL_AT_10S_MAX = 1.5
+
+
+def _skip_without(engine: str) -> None:
+    why = engines.engine_reason(engine)
+    if why:
+        pytest.skip(why)
+
+
+@pytest.fixture(scope="module")
+def jacobi_runs(built_fmus) -> dict[str, object]:
+    """The project's Jacobi master on the native FMI 2.0 FMUs, per estimator."""
+    folder = built_fmus.native("fmi2", "ImuPlant").parent
+    return {key: run_testbench(key, "moderate_dynamics", 0, master="jacobi", fmu_dir=folder)
+            for key in KEYS}
+
+
+@pytest.mark.heavy
+@pytest.mark.parametrize(("engine", "fmi"), RUNS, ids=[f"{e}-fmi{v}" for e, v in RUNS])
+@pytest.mark.parametrize("key", KEYS)
+def test_the_chain_in_the_engine_holds_the_contract_and_equals_the_jacobi_master(
+        built_fmus, jacobi_runs, engine, fmi, key):
+    _skip_without(engine)
+    fmu_dir = built_fmus.directory
+    r = engines.run_engine(engine, key, "moderate_dynamics", 0, fmi=fmi, fmu_dir=fmu_dir)
+    failed = [c.line() for c in r.checks if not c.passed]
+    assert not failed, failed
+    own = jacobi_runs[key]
+    for name, trace in r.estimate.items():
+        assert np.array_equal(trace, own.estimate[name]), name  # bit for bit
+    assert r.invalid_samples == own.invalid_samples == 1  # the sensor's start: no sample
+    early = (r.t >= EARLY[0]) & (r.t <= EARLY[1])
+    err = np.maximum(np.abs(r.estimate["roll"] - r.truth["roll"]),
+                     np.abs(r.estimate["pitch"] - r.truth["pitch"])) / DEG
+    assert err[early].max() <= EARLY_MAX_DEG
+    if key == "poskf":
+        at = int(np.argmin(np.abs(r.t - 10.0)))
+        vel = np.array([r.estimate[f"vel_{a}"][at] - r.truth[f"vel_{a}"][at] for a in "xyz"])
+        assert np.linalg.norm(vel) <= VEL_AT_10S_MAX
+
+
+@pytest.mark.parametrize("engine", list(engines.ENGINES))
+def test_every_choice_parameter_is_set_in_the_engine_and_takes_effect(built_fmus, engine):
+    """gyro_sampling (an Integer choice: 1 = point, 2 = mean) set to mean in the engine gives
+    the Jacobi master's run with mean, and differs from the run with point."""
+    _skip_without(engine)
+    fmu_dir = built_fmus.directory
+    folder = built_fmus.native("fmi2", "ImuPlant").parent
+    kw = {"duration": 5.0}
+    mean = engines.run_engine(engine, "kf", "roll_sweep", 0, fmu_dir=fmu_dir,
+                              params={"gyro_sampling": 2}, evaluate=False, **kw)
+    point = engines.run_engine(engine, "kf", "roll_sweep", 0, fmu_dir=fmu_dir,
+                               params={"gyro_sampling": 1}, evaluate=False, **kw)
+    own = run_testbench("kf", "roll_sweep", 0, master="jacobi", fmu_dir=folder,
+                        params={"gyro_sampling": "mean"}, evaluate=False, **kw)
+    assert np.array_equal(mean.estimate["roll"], own.estimate["roll"])
+    assert not np.array_equal(mean.estimate["roll"], point.estimate["roll"])
+
+
+def test_a_parameter_an_engine_cannot_set_is_refused_not_ignored(built_fmus):
+    """Ecos skips a parameter it cannot set with a warning only; run_engine reads each one
+    back and refuses the run."""
+    _skip_without("ecos")
+    fmu_dir = built_fmus.directory
+    with pytest.raises(ValueError, match="no_such_parameter"):
+        engines.run_engine("ecos", "kf", "roll_sweep", 0, fmu_dir=fmu_dir, duration=0.1,
+                           params={"no_such_parameter": 1.0}, evaluate=False)
