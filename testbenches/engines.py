@@ -112,14 +112,47 @@ def run_engine(
     run = {"libcosim": _run_libcosim, "ecos": _run_ecos}[engine]
     t0 = time.process_time()
     rows, invalid = run(chain_fmus(estimator, fmu_dir, fmi), values, outputs, 1.0 / rate, n)
-    cpu = time.process_time() - t0
-    t_points = np.arange(1, n + 1) / rate
-    truth_start = np.array(get_scenario(sc.id).trajectory().truth_at(0.0))
+    return _result(engine, f"FMI {fmi}.0", estimator, sc.id, seed, rate,
+                   dict(values["estimator"]), values["sensor"], rows, invalid,
+                   time.process_time() - t0, evaluate)
+
+
+Rows = dict[str, np.ndarray]
+
+
+def run_ssp(engine: str, ssp: Path | str, estimator: str, scenario: str | int, seed: int = 0,
+            *, duration: float | None = None, rate: float = 100.0, evaluate: bool = True
+            ) -> TestbenchResult:
+    """Run an SSP of testbenches.ssp.export_ssp in `engine` as the engine loads it (its
+    parameters from its own parameter sets); estimator, scenario and seed say what it was
+    exported with, for the result's labels and the truth at the start. The result is aligned
+    and evaluated as run_engine's."""
+    why = engine_reason(engine)
+    if why:
+        raise RuntimeError(why)
+    sc = get_scenario(scenario)
+    duration = sc.duration if duration is None else float(duration)
+    n = len(communication_steps(duration, rate, 0.0, seed))
+    outputs = {"plant": TRUTH_NAMES, "sensor": SAMPLE,
+               "estimator": ESTIMATE + (POSITION if estimator == "poskf" else ())}
+    run = {"libcosim": _run_libcosim, "ecos": _run_ecos}[engine]
+    t0 = time.process_time()
+    rows, invalid = run(Path(ssp), {}, outputs, 1.0 / rate, n)
+    return _result(engine, "SSP", estimator, sc.id, seed, rate, {}, {"seed": seed}, rows,
+                   invalid, time.process_time() - t0, evaluate)
+
+
+def _result(engine: str, how: str, estimator: str, scenario: int, seed: int, rate: float,
+            params: dict[str, Any], sensor_params: dict[str, Any], rows: Rows, invalid: int,
+            cpu: float, evaluate: bool) -> TestbenchResult:
+    n = len(rows["plant"])
+    sc = get_scenario(scenario)
+    truth_start = np.array(sc.trajectory().truth_at(0.0))
     result = aligned_result(
-        estimator, sc.name, seed, rate, 0.0, dict(values["estimator"]), values["sensor"],
-        "jacobi", t_points, truth_start, rows["plant"], rows["sensor"], rows["estimator"],
-        invalid, np.full(n, cpu / n * 1e6), (0.0, 0.0, 0.0))
-    result.engine = f"{engine} FMI {fmi}.0"  # type: ignore[attr-defined]
+        estimator, sc.name, seed, rate, 0.0, params, sensor_params, "jacobi",
+        np.arange(1, n + 1) / rate, truth_start, rows["plant"], rows["sensor"],
+        rows["estimator"], invalid, np.full(n, cpu / n * 1e6), (0.0, 0.0, 0.0))
+    result.engine = f"{engine} {how}"  # type: ignore[attr-defined]
     result.cpu_s = cpu  # type: ignore[attr-defined]
     if evaluate:
         from .contract import evaluate as evaluate_contract
@@ -128,12 +161,11 @@ def run_engine(
     return result
 
 
-Rows = dict[str, np.ndarray]
-
-
-def _run_libcosim(fmus: Mapping[str, Path], values: Mapping[str, Mapping[str, Any]],
+def _run_libcosim(fmus: Mapping[str, Path] | Path, values: Mapping[str, Mapping[str, Any]],
                   outputs: Mapping[str, tuple[str, ...]], step: float, n: int
                   ) -> tuple[Rows, int]:
+    """The chain of `fmus` (by component) with `values` set, or an SSP file as libcosim loads
+    it, stepped n times; every output recorded after every step."""
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
@@ -141,24 +173,30 @@ def _run_libcosim(fmus: Mapping[str, Path], values: Mapping[str, Mapping[str, An
     from libcosimpy.CosimSlave import CosimLocalSlave
 
     log_output_level(CosimLogLevel.ERROR)
-    ex = CosimExecution.from_step_size(step_size=round(step * 1e9))
-    index = {c: ex.add_local_slave(CosimLocalSlave(fmu_path=str(p), instance_name=c))
-             for c, p in fmus.items()}
+    nanoseconds = round(step * 1e9)
+    if isinstance(fmus, Path):
+        ex = CosimExecution.from_ssp_file(str(fmus), step_size=nanoseconds)
+        index = {c: ex.slave_index_from_instance_name(c) for c in outputs}
+    else:
+        ex = CosimExecution.from_step_size(step_size=nanoseconds)
+        index = {c: ex.add_local_slave(CosimLocalSlave(fmu_path=str(p), instance_name=c))
+                 for c, p in fmus.items()}
     refs = {c: {v.name.decode(): (v.reference, CosimVariableType(v.type))
                 for v in ex.slave_variables(i)} for c, i in index.items()}
     for c, params in values.items():
         for name, value in params.items():
             if name not in refs[c]:
-                raise ValueError(f"libcosim: {fmus[c].stem} has no parameter {name!r} it can "
-                                 "set (libcosim ignores FMI 2.0 Enumeration variables)")
+                raise ValueError(f"libcosim: the {c} has no parameter {name!r} it can set "
+                                 "(libcosim ignores FMI 2.0 Enumeration variables)")
             vr, kind = refs[c][name]
             setter = {CosimVariableType.REAL: ex.real_initial_value,
                       CosimVariableType.INTEGER: ex.integer_initial_value,
                       CosimVariableType.BOOLEAN: ex.boolean_initial_value}[kind]
             if not setter(index[c], vr, value):
                 raise ValueError(f"libcosim refused {c}.{name} = {value!r}")
-    for a, va, b, vb in WIRES:
-        ex.connect_real_variables(index[a], refs[a][va][0], index[b], refs[b][vb][0])
+    if not isinstance(fmus, Path):
+        for a, va, b, vb in WIRES:
+            ex.connect_real_variables(index[a], refs[a][va][0], index[b], refs[b][vb][0])
     observer = CosimObserver.create_last_value()
     ex.add_observer(observer)
     vrs = {c: [refs[c][v][0] for v in names] for c, names in outputs.items()}
@@ -173,22 +211,28 @@ def _run_libcosim(fmus: Mapping[str, Path], values: Mapping[str, Mapping[str, An
     return rows, int(invalid)
 
 
-def _run_ecos(fmus: Mapping[str, Path], values: Mapping[str, Mapping[str, Any]],
+def _run_ecos(fmus: Mapping[str, Path] | Path, values: Mapping[str, Mapping[str, Any]],
               outputs: Mapping[str, tuple[str, ...]], step: float, n: int
               ) -> tuple[Rows, int]:
+    """As _run_libcosim, in Ecos (an SSP's parameter sets named ssp.PARAMETER_SET applied)."""
     from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure
 
+    from .ssp import PARAMETER_SET
+
     EcosLib.set_log_level("warn")
-    structure = EcosSimulationStructure()
-    for c, p in fmus.items():
-        structure.add_model(c, str(p))
-    for a, va, b, vb in WIRES:
-        structure.make_real_connection(f"{a}::{va}", f"{b}::{vb}")
-    structure.add_parameter_set("chain", {f"{c}::{k}": v for c, params in values.items()
-                                          for k, v in params.items()})
-    sim = EcosSimulation(structure=structure, step_size=step)
+    if isinstance(fmus, Path):
+        sim = EcosSimulation(ssp_path=str(fmus), step_size=step)
+    else:
+        structure = EcosSimulationStructure()
+        for c, p in fmus.items():
+            structure.add_model(c, str(p))
+        for a, va, b, vb in WIRES:
+            structure.make_real_connection(f"{a}::{va}", f"{b}::{vb}")
+        structure.add_parameter_set(PARAMETER_SET, {
+            f"{c}::{k}": v for c, params in values.items() for k, v in params.items()})
+        sim = EcosSimulation(structure=structure, step_size=step)
     try:
-        sim.init(parameter_set="chain")
+        sim.init(parameter_set=PARAMETER_SET)
         _check_ecos_parameters(sim, values)
         rows = {c: np.empty((n, len(names))) for c, names in outputs.items()}
         for k in range(n):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fusion_core.scenarios import get_scenario
 from fusion_core.types import DEG
 from testbenches import engines
 from testbenches.master import run_testbench
@@ -90,3 +91,54 @@ def test_a_parameter_an_engine_cannot_set_is_refused_not_ignored(built_fmus):
     with pytest.raises(ValueError, match="no_such_parameter"):
         engines.run_engine("ecos", "kf", "roll_sweep", 0, fmu_dir=fmu_dir, duration=0.1,
                            params={"no_such_parameter": 1.0}, evaluate=False)
+
+
+# ----- the exported SSP in the engines and as an fmucontainer ------------------------------------
+SSP_RUNS = [("libcosim", 2), ("ecos", 2), ("ecos", 3)]
+
+
+@pytest.mark.parametrize(("engine", "fmi"), SSP_RUNS, ids=[f"{e}-fmi{v}" for e, v in SSP_RUNS])
+def test_the_exported_ssp_runs_its_scenario_in_the_engine_as_the_direct_wiring(
+        built_fmus, tmp_path, engine, fmi):
+    """export-ssp binds each component's parameters to it: the engine runs the exported
+    scenario (moderate_dynamics, not the default static one) and the sensor part's seed, and its
+    outputs equal the same chain wired directly in the engine, bit for bit."""
+    _skip_without(engine)
+    from testbenches.ssp import export_ssp
+
+    ssp = export_ssp("ukf", "moderate_dynamics", tmp_path / "ukf.ssp", seed=3,
+                     params={"gyro_sampling": "point"}, fmu_dir=built_fmus.directory, fmi=fmi)
+    loaded = engines.run_ssp(engine, ssp, "ukf", "moderate_dynamics", 3, duration=10.0)
+    direct = engines.run_engine(engine, "ukf", "moderate_dynamics", 3, fmi=fmi, duration=10.0,
+                                fmu_dir=built_fmus.directory)
+    truth = get_scenario("moderate_dynamics").trajectory().truth(loaded.t[-1:])
+    assert loaded.truth["pitch"][-1] == pytest.approx(truth["pitch"][0], abs=1e-12)
+    assert np.array_equal(loaded.sample["gyro_x"], direct.sample["gyro_x"])  # the same part
+    for name, trace in loaded.estimate.items():
+        assert np.array_equal(trace, direct.estimate[name]), name
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+@pytest.mark.parametrize("sequential", [True, False], ids=["sequential", "parallel"])
+def test_an_fmucontainer_of_the_exported_ssp_equals_the_gauss_seidel_or_jacobi_run(
+        built_fmus, tmp_path, sequential, fmi):
+    """fmucontainer around plant, sensor and estimator, simulated by fmpy: sequential equals
+    the Gauss-Seidel master, parallel the Jacobi master, bit for bit, with the SSP's scenario
+    and seed applied and the estimator's outputs exposed."""
+    pytest.importorskip("fmu_manipulation_toolbox", reason=engines.INSTALL)
+    from fmpy import simulate_fmu
+
+    from testbenches.container import container_from_ssp
+    from testbenches.ssp import export_ssp
+
+    ssp = export_ssp("kf", "moderate_dynamics", tmp_path / "kf.ssp", seed=2,
+                     fmu_dir=built_fmus.directory)
+    fmu = container_from_ssp(ssp, tmp_path / "kf.fmu", sequential=sequential, fmi=fmi)
+    rows = simulate_fmu(str(fmu), stop_time=5.0, output_interval=0.01)
+    master = "gauss-seidel" if sequential else "jacobi"
+    own = run_testbench("kf", "moderate_dynamics", 2, duration=5.0, master=master,
+                        fmu_dir=built_fmus.native("fmi2", "ImuPlant").parent, evaluate=False)
+    first = 1 + (0 if sequential else 1)  # row 0: t = 0; Jacobi's first estimate is of no sample
+    for name in ("roll", "pitch", "bias_x", "bias_y"):
+        assert np.array_equal(rows[name][first:], own.estimate[name]), name
+    assert rows["invalid_samples"][-1] == own.invalid_samples
