@@ -6,7 +6,10 @@
   run         estimator x scenario x seed runs through the FMUs with the contract checks
               (testbenches.contract_runs); prints the contract table, writes DIR/report.json,
               DIR/report.md and plots; exit status 1 on any FAIL.
-  export-ssp  the plant, sensor and estimator FMUs and their connections as an SSP file.
+  export-ssp  the plant, sensor and estimator FMUs and their connections as an SSP file (and
+              as one fmucontainer FMU) that libcosim and Ecos run as exported.
+  engines     every estimator's chain in libcosim and Ecos beside the project's Jacobi master
+              (testbenches.engines; the engines extra).
   broad       accuracy on BROAD's real recordings beside VQF, Madgwick, Mahony (testbenches.broad).
   noise       noise densities of a static recording (Allan deviation), a preset for every
               estimator and the sensor FMU's parameters for that sensor (testbenches.fit).
@@ -35,7 +38,7 @@ from fmu_src.cli import add_build_parser
 from .estimate import add_estimate_parser
 
 TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "budget",
-                      "crosscheck", "calibrate")
+                      "crosscheck", "calibrate", "engines")
 """The commands that need the testbench extra."""
 
 
@@ -52,6 +55,7 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         from .budget import add_budget_parser
         from .calibrate.cli import add_calibrate_parser
         from .crosscheck import add_crosscheck_parser
+        from .engines import add_engines_parser
         from .fit.cli import add_fit_parsers
         from .montecarlo.cli import add_campaign_parser
         from .run_cli import add_run_parser
@@ -59,7 +63,7 @@ def _parser(prog: str) -> argparse.ArgumentParser:
 
         for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
                     add_campaign_parser, add_budget_parser, add_crosscheck_parser,
-                    add_calibrate_parser):
+                    add_calibrate_parser, add_engines_parser):
             add(sub)
     return parser
 

@@ -262,3 +262,97 @@ def _check_ecos_parameters(sim: Any, values: Mapping[str, Mapping[str, Any]]) ->
                 raise ValueError(f"Ecos did not set {ident} = {value!r}: {err}") from None
             if back != value:
                 raise ValueError(f"Ecos did not set {ident} = {value!r} (it reads {back!r})")
+
+
+# ----- the table: every estimator in every engine beside the project's own master ---------------
+ENGINE_TABLE_SCENARIO = "moderate_dynamics"
+EARLY_WINDOW = (0.03, 0.5)
+"""Where a false start shows (docs/guide/engines.md): the largest error in it is a column."""
+TABLE_MARK = "<!-- imu-fusion engines: generated, do not edit -->"
+"""The line before the table in docs/guide/engines.md (tests/test_engines.py regenerates it)."""
+
+
+def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TABLE_SCENARIO,
+                seed: int = 0, estimators: list[str] | None = None
+                ) -> list[dict[str, Any]]:
+    """Per engine x FMI version x estimator (and the project's own Jacobi master): whether the
+    contract's accuracy checks pass, the largest attitude error over EARLY_WINDOW, the largest
+    difference from the project's Jacobi master, the position filter's velocity error at 10 s
+    and the speed in simulated seconds per CPU second. Engines that cannot run here are left
+    out (engine_reason says why)."""
+    from .contract import DEG
+    from .master import run_testbench
+
+    folder = Path(fmu_dir) / "native" / "fmi2"
+    rows = []
+    for key in estimators or list(ESTIMATOR_FMUS):
+        t0 = time.process_time()
+        own = run_testbench(key, scenario, seed, master="jacobi", fmu_dir=folder)
+        own_cpu = time.process_time() - t0
+        runs = [("own Jacobi master", 2, own, own_cpu)]
+        for engine, versions in ENGINES.items():
+            if engine_reason(engine):
+                continue
+            for fmi in versions:
+                r = run_engine(engine, key, scenario, seed, fmi=fmi, fmu_dir=fmu_dir)
+                runs.append((engine, fmi, r, r.cpu_s))  # type: ignore[attr-defined]
+        for name, fmi, r, cpu in runs:
+            early = (r.t >= EARLY_WINDOW[0]) & (r.t <= EARLY_WINDOW[1])
+            err = np.maximum(np.abs(r.estimate["roll"] - r.truth["roll"]),
+                             np.abs(r.estimate["pitch"] - r.truth["pitch"])) / DEG
+            row = {
+                "engine": name, "fmi": fmi, "estimator": key,
+                "accuracy": all(c.passed for c in r.checks if c.name.startswith("accuracy")),
+                "rmse": (r.metrics["rmse_roll_deg"], r.metrics["rmse_pitch_deg"]),
+                "early_max_deg": float(err[early].max()),
+                "max_diff": max(float(np.max(np.abs(r.estimate[k] - own.estimate[k])))
+                                for k in r.estimate),
+                "vel_err_10s": None, "speed": float(r.t[-1] / cpu) if cpu > 0 else None,
+            }
+            if key == "poskf":
+                at = int(np.argmin(np.abs(r.t - 10.0)))
+                row["vel_err_10s"] = float(np.linalg.norm(
+                    [r.estimate[f"vel_{a}"][at] - r.truth[f"vel_{a}"][at] for a in "xyz"]))
+            rows.append(row)
+    return rows
+
+
+def engine_table(rows: list[dict[str, Any]], speed: bool = True) -> str:
+    """The rows as a Markdown table (speed: with the machine-dependent speed column)."""
+    head = ["engine", "FMI", "estimator", "accuracy checks", "RMSE roll/pitch [deg]",
+            "max error 0.03-0.5 s [deg]", "max abs(engine - own Jacobi)",
+            "vel. error at 10 s [m/s]"]
+    if speed:
+        head.append("simulated s per CPU s")
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        cells = [r["engine"], f"{r['fmi']}.0", r["estimator"],
+                 "PASS" if r["accuracy"] else "FAIL", "{:.3f}/{:.3f}".format(*r["rmse"]),
+                 f"{r['early_max_deg']:.3f}", f"{r['max_diff']:.1e}" if r["max_diff"] else "0",
+                 "-" if r["vel_err_10s"] is None else f"{r['vel_err_10s']:.3f}"]
+        if speed:
+            cells.append("-" if r["speed"] is None else f"{r['speed']:.0f}")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def add_engines_parser(sub: Any) -> None:
+    p = sub.add_parser("engines", help="the testbench chain of every estimator in libcosim and "
+                       "Ecos beside the project's Jacobi master: contract accuracy, start, "
+                       "differences, speed")
+    p.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR,
+                   help="built FMUs (dist; the native ones under DIR/native)")
+    p.add_argument("--seed", type=int, default=0, help="sensor part (0)")
+    p.set_defaults(func=cmd_engines)
+
+
+def cmd_engines(args: Any) -> int:
+    for engine in ENGINES:
+        why = engine_reason(engine)
+        if why:
+            print(f"{engine}: left out: {why}")
+    rows = engine_rows(args.fmu_dir, seed=args.seed)
+    print(f"{ENGINE_TABLE_SCENARIO}, seed {args.seed}, step 0.01 s, Jacobi stepping (the truth "
+          "aligned by the chain's 2 steps)\n")
+    print(engine_table(rows))
+    return 0 if all(r["accuracy"] and r["max_diff"] == 0.0 for r in rows) else 1

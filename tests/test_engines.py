@@ -11,6 +11,8 @@ the reason and the install line (testbenches.engines.engine_reason).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -142,3 +144,36 @@ def test_an_fmucontainer_of_the_exported_ssp_equals_the_gauss_seidel_or_jacobi_r
     for name in ("roll", "pitch", "bias_x", "bias_y"):
         assert np.array_equal(rows[name][first:], own.estimate[name]), name
     assert rows["invalid_samples"][-1] == own.invalid_samples
+
+
+# ----- docs/guide/engines.md cannot go stale ------------------------------------------------------
+PAGE = Path(__file__).resolve().parents[1] / "docs" / "guide" / "engines.md"
+
+
+def _recipe(heading: str) -> str:
+    """The first python block after a heading of the page."""
+    text = PAGE.read_text()
+    after = text[text.index(f"\n## {heading}\n"):]
+    return after.split("```python\n", 1)[1].split("```", 1)[0]
+
+
+@pytest.mark.parametrize(("engine", "heading"), [("libcosim", "libcosim"), ("ecos", "Ecos")])
+def test_the_pages_recipe_runs_the_chain_in_the_engine(built_fmus, tmp_path, monkeypatch,
+                                                        engine, heading):
+    _skip_without(engine)
+    (tmp_path / "dist").symlink_to(built_fmus.directory)
+    monkeypatch.chdir(tmp_path)
+    scope: dict[str, object] = {}
+    exec(compile(_recipe(heading), str(PAGE), "exec"), scope)
+    truth = get_scenario("moderate_dynamics").trajectory().truth(np.array([60.0 - 0.02]))
+    assert abs(scope["roll"] - truth["roll"][0]) < np.radians(1.0)
+
+
+@pytest.mark.heavy
+def test_the_pages_table_is_what_imu_fusion_engines_gives(built_fmus):
+    for engine in engines.ENGINES:
+        _skip_without(engine)
+    text = PAGE.read_text()
+    block = text.split(engines.TABLE_MARK + "\n", 1)[1].split("\n\n", 1)[0]
+    rows = engines.engine_rows(built_fmus.directory)
+    assert block == engines.engine_table(rows, speed=False)
