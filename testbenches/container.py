@@ -48,8 +48,10 @@ def _build(ssp: Path, out: Path, sequential: bool, step: float, fmi: int) -> Pat
 
     with tempfile.TemporaryDirectory(prefix="container_") as tmp:
         work = Path(tmp)
-        shutil.copy(ssp, work / "system.ssp")
-        assembly = Assembly("system.ssp", fmu_directory=work, default_step_size=step,
+        # the container's model identifier is its file's stem: out's, so that two containers
+        # loaded in one process do not share a library name
+        shutil.copy(ssp, work / f"{out.stem}.ssp")
+        assembly = Assembly(f"{out.stem}.ssp", fmu_directory=work, default_step_size=step,
                             default_sequential=sequential)
         root = assembly.root
         root.sequential = sequential
@@ -70,9 +72,9 @@ def _build(ssp: Path, out: Path, sequential: bool, step: float, fmi: int) -> Pat
                 root.add_output(embedded["estimator"], v.name, v.name)
         for name in TRUTH_NAMES:
             root.add_output(embedded["plant"], name, f"true_{name}")
-        assembly.make_fmu(fmi_version=fmi, filename="system.fmu")
+        assembly.make_fmu(fmi_version=fmi, filename=f"{out.stem}.fmu")
         out.parent.mkdir(parents=True, exist_ok=True)
-        shutil.move(work / "system.fmu", out)
+        shutil.move(work / f"{out.stem}.fmu", out)
     return out
 
 

@@ -66,8 +66,8 @@ def _typed(variable: Any) -> Any:
     if variable.type == "Real" or variable.type.startswith("Float"):
         return float(variable.start)
     items = items_in_description(variable.description)
-    if variable.type == "Integer" and items:  # the item's name is the choice fusion_core takes
-        return items[int(variable.start) - 1]
+    if variable.type in ("Integer", "Int32") and items:
+        return items[int(variable.start) - 1]  # the item's name is the choice fusion_core takes
     if variable.type == "Boolean":
         return variable.start in ("true", "1", True)
     if variable.type.startswith("Int") or variable.type == "Integer":

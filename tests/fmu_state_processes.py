@@ -21,14 +21,12 @@ from typing import Any
 
 from native_fmu import NativeFmu
 
+from fmu_src.variables import item_value
+
 
 def _value(fmu: NativeFmu, name: str, value: Any) -> Any:
-    """A parameter value as the FMU takes it: an enumeration's item as its 1-based value."""
-    var = fmu.vars[name]
-    if isinstance(value, str):
-        items = [item.name for item in var.declaredType.items]
-        return items.index(value) + 1
-    return value
+    """A parameter value as the FMU takes it: a choice's item as its 1-based value."""
+    return item_value(fmu.vars[name], value) if isinstance(value, str) else value
 
 
 def _outputs(fmu: NativeFmu) -> list[float]:

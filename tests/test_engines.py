@@ -11,12 +11,16 @@ the reason and the install line (testbenches.engines.engine_reason).
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from fusion_core import ESTIMATORS
 from fusion_core.scenarios import get_scenario
+from fusion_core.sensor import SENSOR_PARAMS
 from fusion_core.types import DEG
 from testbenches import engines
 from testbenches.master import run_testbench
@@ -67,22 +71,37 @@ def test_the_chain_in_the_engine_holds_the_contract_and_equals_the_jacobi_master
         assert np.linalg.norm(vel) <= VEL_AT_10S_MAX
 
 
+CHOICES = [("sensor", p.name, p.choices) for p in SENSOR_PARAMS if p.choices] + [
+    ("estimator", p.name, p.choices)
+    for p in ESTIMATORS["kf"].param_specs().values() if p.choices]
+"""Every choice parameter of the chain (the sensor's and the estimator's), an FMI Integer."""
+
+
 @pytest.mark.parametrize("engine", list(engines.ENGINES))
-def test_every_choice_parameter_is_set_in_the_engine_and_takes_effect(built_fmus, engine):
-    """gyro_sampling (an Integer choice: 1 = point, 2 = mean) set to mean in the engine gives
-    the Jacobi master's run with mean, and differs from the run with point."""
+@pytest.mark.parametrize(("component", "name", "items"), CHOICES,
+                         ids=[f"{c}.{n}" for c, n, _ in CHOICES])
+def test_every_choice_parameter_is_set_in_the_engine_and_takes_effect(
+        built_fmus, engine, component, name, items):
+    """Each choice set to its last item (an Integer, len(items)) in the engine gives the Jacobi
+    master's run with that item by name, and a run other than the default's: the samples for
+    a sensor's choice (the master also sets the estimator's gyro_sampling from the sensor's),
+    the estimate for the estimator's."""
     _skip_without(engine)
-    fmu_dir = built_fmus.directory
     folder = built_fmus.native("fmi2", "ImuPlant").parent
-    kw = {"duration": 5.0}
-    mean = engines.run_engine(engine, "kf", "roll_sweep", 0, fmu_dir=fmu_dir,
-                              params={"gyro_sampling": 2}, evaluate=False, **kw)
-    point = engines.run_engine(engine, "kf", "roll_sweep", 0, fmu_dir=fmu_dir,
-                               params={"gyro_sampling": 1}, evaluate=False, **kw)
+    value = len(items)
+    where = "params" if component == "estimator" else "sensor_params"
+    kw = {"duration": 5.0, "evaluate": False}
+    run = engines.run_engine(engine, "kf", "roll_sweep", 0, fmu_dir=built_fmus.directory,
+                             **{where: {name: value}}, **kw)
+    default = engines.run_engine(engine, "kf", "roll_sweep", 0,
+                                 fmu_dir=built_fmus.directory, **kw)
     own = run_testbench("kf", "roll_sweep", 0, master="jacobi", fmu_dir=folder,
-                        params={"gyro_sampling": "mean"}, evaluate=False, **kw)
-    assert np.array_equal(mean.estimate["roll"], own.estimate["roll"])
-    assert not np.array_equal(mean.estimate["roll"], point.estimate["roll"])
+                        **{where: {name: items[-1]}}, **kw)
+    def trace(r: object) -> np.ndarray:
+        return r.sample["gyro_x"] if component == "sensor" else r.estimate["roll"]
+
+    assert np.array_equal(trace(run), trace(own))
+    assert not np.array_equal(trace(run), trace(default))
 
 
 def test_a_parameter_an_engine_cannot_set_is_refused_not_ignored(built_fmus):
@@ -128,15 +147,24 @@ def test_an_fmucontainer_of_the_exported_ssp_equals_the_gauss_seidel_or_jacobi_r
     the Gauss-Seidel master, parallel the Jacobi master, bit for bit, with the SSP's scenario
     and seed applied and the estimator's outputs exposed."""
     pytest.importorskip("fmu_manipulation_toolbox", reason=engines.INSTALL)
-    from fmpy import simulate_fmu
-
     from testbenches.container import container_from_ssp
     from testbenches.ssp import export_ssp
 
     ssp = export_ssp("kf", "moderate_dynamics", tmp_path / "kf.ssp", seed=2,
                      fmu_dir=built_fmus.directory)
-    fmu = container_from_ssp(ssp, tmp_path / "kf.fmu", sequential=sequential, fmi=fmi)
-    rows = simulate_fmu(str(fmu), stop_time=5.0, output_interval=0.01)
+    mode = "sequential" if sequential else "parallel"
+    fmu = container_from_ssp(ssp, tmp_path / f"kf_{mode}_{fmi}.fmu", sequential=sequential,
+                             fmi=fmi)
+    # in a process of its own, as a user runs it (`fmpy simulate`): the container loads the
+    # three FMUs' libraries, which this process may hold already from other tests
+    out = tmp_path / "rows.npy"
+    script = ("import sys, numpy as np\nfrom fmpy import simulate_fmu\n"
+              "np.save(sys.argv[2], simulate_fmu(sys.argv[1], stop_time=5.0, "
+              "output_interval=0.01))\n")
+    proc = subprocess.run([sys.executable, "-c", script, str(fmu), str(out)],
+                          capture_output=True, text=True, timeout=300, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    rows = np.load(out)
     master = "gauss-seidel" if sequential else "jacobi"
     own = run_testbench("kf", "moderate_dynamics", 2, duration=5.0, master=master,
                         fmu_dir=built_fmus.native("fmi2", "ImuPlant").parent, evaluate=False)

@@ -154,8 +154,11 @@ def test_a_pythonfmu_fmu_refuses_crafted_state_bytes_with_a_log_line(built_fmus,
               else [0.05, -0.02, 0.01, 0.2, 0.1, 9.8])
     outputs = [n for n, v in fmu.vars.items() if v.causality == "output" and v.type == "Real"]
 
+    now = [0.0]  # the FMU's time: a doStep must start there
+
     def step(k: int) -> list[float]:
-        fmu.step(0.01 * k, 0.01, **dict(zip(inputs, sample, strict=True)))
+        fmu.step(now[0], 0.01, **dict(zip(inputs, sample, strict=True)))
+        now[0] += 0.01
         return [fmu.get(n) for n in outputs]
 
     for k in range(50):
@@ -170,6 +173,8 @@ def test_a_pythonfmu_fmu_refuses_crafted_state_bytes_with_a_log_line(built_fmus,
         fmu.restore(fmu.deserialize(blob))
         if len([1 for status, _ in fmu.log if status >= 3]) > errors:
             refused += 1
+        else:  # taken: the FMU is at the state's time
+            now[0] = json.loads(blob)["time"]
         out = step(100 + i)
         assert all(math.isfinite(v) for v in out), (blob[:200], out)
     fmu.terminate()
