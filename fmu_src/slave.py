@@ -248,7 +248,6 @@ class FmuSlave(Fmi2Slave):
                 params = self.model_parameters()
                 params[var.name] = model_value
                 self._model = self.create_model(params)
-                self._values[var.name] = value
                 self._write_initial_outputs()
             elif not var.tunable:
                 raise ValueError(

@@ -152,8 +152,8 @@ def _result(engine: str, how: str, estimator: str, scenario: int, seed: int, rat
         estimator, sc.name, seed, rate, 0.0, params, sensor_params, "jacobi",
         np.arange(1, n + 1) / rate, truth_start, rows["plant"], rows["sensor"],
         rows["estimator"], invalid, np.full(n, cpu / n * 1e6), (0.0, 0.0, 0.0))
-    result.engine = f"{engine} {how}"  # type: ignore[attr-defined]
-    result.cpu_s = cpu  # type: ignore[attr-defined]
+    result.engine = f"{engine} {how}"
+    result.cpu_s = cpu
     if evaluate:
         from .contract import evaluate as evaluate_contract
 
@@ -295,7 +295,7 @@ def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TA
                 continue
             for fmi in versions:
                 r = run_engine(engine, key, scenario, seed, fmi=fmi, fmu_dir=fmu_dir)
-                runs.append((engine, fmi, r, r.cpu_s))  # type: ignore[attr-defined]
+                runs.append((engine, fmi, r, r.cpu_s))
         for name, fmi, r, cpu in runs:
             early = (r.t >= EARLY_WINDOW[0]) & (r.t <= EARLY_WINDOW[1])
             err = np.maximum(np.abs(r.estimate["roll"] - r.truth["roll"]),

@@ -109,6 +109,10 @@ class TestbenchResult:
     master: str = "gauss-seidel"
     measured_delay: int = 0
     """The delay in steps at which the estimate best matches the truth (measured_delay)."""
+    engine: str = "the testbench master (fmpy)"
+    """What ran the chain (testbenches.engines runs it in libcosim and Ecos)."""
+    cpu_s: float = 0.0
+    """The CPU time the whole run took, where measured (testbenches.engines)."""
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[Any] = field(default_factory=list)
 
@@ -127,12 +131,11 @@ class TestbenchResult:
         return START_REFUSED[self.master]
 
 
-def measured_delay(t_all: np.ndarray, truth_all: np.ndarray, estimate: np.ndarray,
-                   max_delay: int = 4) -> int:
+def measured_delay(truth_all: np.ndarray, estimate: np.ndarray, max_delay: int = 4) -> int:
     """The delay in steps at which an estimate trace best matches the truth.
 
-    truth_all[j] is the truth at t_all[j] (j = 0 the start), estimate[k] the raw output after
-    step k (time t_all[k + 1]); a delay d pairs estimate[k] with truth_all[k + 1 - d]. Scored
+    truth_all[j] is the truth at t_j (j = 0 the start), estimate[k] the raw output after step k
+    (time t_{k + 1}); a delay d pairs estimate[k] with truth_all[k + 1 - d]. Scored
     by the RMSE over the second half of the run (after convergence), all columns together."""
     n = len(estimate)
     start = max(n // 2, max_delay)
@@ -176,7 +179,7 @@ def aligned_result(
         estimate={name: out[:, i].copy() for i, name in enumerate(names)},
         invalid_samples=invalid, step_us=step_us[rows], true_gyro_bias=true_bias,
         master=master,
-        measured_delay=measured_delay(t_all, truth_all[:, attitude], estimate_rows[:, :2]),
+        measured_delay=measured_delay(truth_all[:, attitude], estimate_rows[:, :2]),
     )
 
 
