@@ -207,8 +207,17 @@ def type_attributes(v: Variable, start: bool = True) -> dict[str, str]:
     return attrs
 
 
+def initial_unknowns(variables: Sequence[Variable]) -> list[tuple[Variable, list[int]]]:
+    """The outputs calculated in initialisation, each with the 0-based positions in
+    `variables` of what it depends on (ModelStructure's InitialUnknowns)."""
+    position = {v.name: i for i, v in enumerate(variables)}
+    return [(v, [position[d] for d in v.depends_on]) for v in variables
+            if v.causality == "output" and v.initial == "calculated"]
+
+
 def decorate(root: Element, variables: Sequence[Variable]) -> None:
-    """Add units, types and ranges to pythonfmu's <fmiModelDescription> element, in place."""
+    """Add units, types and ranges to pythonfmu's <fmiModelDescription> element, in place,
+    and the InitialUnknowns pythonfmu does not write."""
     by_name = {v.name: v for v in variables}
     index = [child.tag for child in root].index("CoSimulation") + 1
     blocks = [unit_definitions(variables), type_definitions(variables)]
@@ -225,6 +234,17 @@ def decorate(root: Element, variables: Sequence[Variable]) -> None:
         attrs = type_attributes(v, start=typed.get("start") is not None)
         typed.attrib.clear()
         typed.attrib.update(attrs)
+    unknowns = initial_unknowns(variables)
+    if unknowns:
+        index = {sv.get("name"): i for i, sv in enumerate(root.iter("ScalarVariable"), 1)}
+        structure = root.find("ModelStructure")
+        assert structure is not None
+        node = structure.find("InitialUnknowns")
+        if node is None:
+            node = SubElement(structure, "InitialUnknowns")
+        for v, _ in unknowns:
+            deps = " ".join(str(index[d]) for d in v.depends_on)
+            SubElement(node, "Unknown", {"index": str(index[v.name]), "dependencies": deps})
 
 
 def project_version() -> str:

@@ -186,7 +186,7 @@ class FmuSlave(Fmi2Slave):
             var.name,
             causality=Fmi2Causality[var.causality],
             variability=Fmi2Variability[var.variability or "continuous"],
-            initial=Fmi2Initial.exact if var.causality == "output" else None,
+            initial=Fmi2Initial[var.initial] if var.causality == "output" else None,
             description=var.description,
             getter=partial(self._values.__getitem__, var.name),
             setter=partial(self._set_value, var),

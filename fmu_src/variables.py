@@ -51,6 +51,12 @@ class Variable:
     high_open: bool = False
     items: tuple[str, ...] | None = None
     type_name: str | None = None
+    initial: Literal["exact", "calculated"] = "exact"
+    """An output's initial: exact (its start value is its value until the first step) or
+    calculated (the FMU computes it in initialisation from depends_on; no start value is
+    written, so a tool reads the value, not a start value that another parameter makes
+    wrong)."""
+    depends_on: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.type == "Real" and not self.unit:
@@ -61,6 +67,8 @@ class Variable:
             raise ValueError(f"Enumeration {self.name!r} needs items and a type_name")
         if not self.description:
             raise ValueError(f"variable {self.name!r} needs a description")
+        if self.initial == "calculated" and self.causality != "output":
+            raise ValueError(f"only outputs are calculated in initialisation: {self.name!r}")
         if self.variability is None:
             object.__setattr__(self, "variability", self._default_variability())
 
@@ -133,10 +141,14 @@ def real_input(
 
 
 def real_output(
-    name: str, unit: str, description: str, start: float = 0.0, display_unit: str | None = None
+    name: str, unit: str, description: str, start: float = 0.0, display_unit: str | None = None,
+    depends_on: tuple[str, ...] = (),
 ) -> Variable:
-    """A continuous Real output with initial="exact" and a start value."""
-    return Variable(name, "output", "Real", description, float(start), unit, display_unit)
+    """A continuous Real output: initial="exact" with a start value, or, depending on
+    parameters (depends_on), initial="calculated" (start is then the value for the parameters'
+    start values, held but not written)."""
+    return Variable(name, "output", "Real", description, float(start), unit, display_unit,
+                    initial="calculated" if depends_on else "exact", depends_on=depends_on)
 
 
 def integer_output(name: str, description: str, start: int = 0) -> Variable:

@@ -75,3 +75,20 @@ def test_the_sensors_outputs_before_the_first_step_are_no_sample(built_fmus, kin
     finally:
         sensor.free()
         kf.free()
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_plants_outputs_are_calculated_in_initialisation_from_the_scenario(built_fmus, kind):
+    """No start value a tool could take for the truth: each output is initial="calculated",
+    listed among the initial unknowns with the scenario as what it depends on."""
+    from fmpy import read_model_description
+
+    path = (built_fmus.path("ImuPlant") if kind == "pythonfmu"
+            else built_fmus.native(kind, "ImuPlant"))
+    md = read_model_description(str(path))
+    outputs = [v for v in md.modelVariables if v.causality == "output"]
+    assert {v.initial for v in outputs} == {"calculated"}
+    assert all(v.start is None for v in outputs)
+    scenario = next(v for v in md.modelVariables if v.name == "scenario")
+    unknowns = {u.variable.name: [d.name for d in u.dependencies] for u in md.initialUnknowns}
+    assert unknowns == {v.name: [scenario.name] for v in outputs}

@@ -43,9 +43,10 @@ class ImuPlant(FmuSlave):
         Variable("scenario", "parameter", "Integer", f"Motion: {_ENUM}", 0,
                  variability="fixed", low=min(SCENARIO_BY_ID), high=max(SCENARIO_BY_ID)),
         *(real_output(name, unit, text + "; the value at the end of the last step, and before "
-                      "the first step the chosen scenario's value at the start time (the start "
-                      "value is the default scenario's at t = 0)",
-                      plant_start()[name], display) for name, unit, display, text in _OUTPUTS),
+                      "the first step the chosen scenario's value at the start time "
+                      "(calculated in initialisation)",
+                      plant_start()[name], display, depends_on=("scenario",))
+          for name, unit, display, text in _OUTPUTS),
     ))
 
     def create_model(self, params: dict[str, Any]) -> PlantModel:

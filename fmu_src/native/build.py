@@ -41,6 +41,7 @@ from fusion_core.native import compiler as twin_compiler
 from fusion_core.native.generate import c_double
 
 from ..model_description import (
+    initial_unknowns,
     project_version,
     type_attributes,
     type_definitions,
@@ -328,14 +329,21 @@ def fmi2_model_description(model: NativeModel, sources: Sequence[str]) -> bytes:
         attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
                  "causality": v.causality, "variability": v.variability or "continuous"}
         if v.causality == "output":
-            attrs["initial"] = "exact"
+            attrs["initial"] = v.initial
             outputs.append(vr + 1)
         sv = SubElement(variables, "ScalarVariable", attrs)
-        SubElement(sv, v.type, type_attributes(v))
+        SubElement(sv, v.type, type_attributes(v, start=v.initial == "exact"))
     structure = SubElement(root, "ModelStructure")
     outs = SubElement(structure, "Outputs")
     for index in outputs:
         SubElement(outs, "Unknown", {"index": str(index)})
+    unknowns = initial_unknowns(model.variables)
+    if unknowns:
+        node = SubElement(structure, "InitialUnknowns")
+        position = {v.name: i for i, v in enumerate(model.variables)}
+        for v, deps in unknowns:
+            SubElement(node, "Unknown", {"index": str(position[v.name] + 1),
+                                         "dependencies": " ".join(str(d + 1) for d in deps)})
     return _pretty(root)
 
 
@@ -379,13 +387,17 @@ def fmi3_model_description(model: NativeModel) -> bytes:
         attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
                  "causality": v.causality, "variability": v.variability or "continuous"}
         if v.causality == "output":
-            attrs["initial"] = "exact"
+            attrs["initial"] = v.initial
             outputs.append(vr)
-        attrs.update(type_attributes(v))
+        attrs.update(type_attributes(v, start=v.initial == "exact"))
         SubElement(variables, FMI3_TYPES[v.type], attrs)
     structure = SubElement(root, "ModelStructure")
     for vr in outputs:
         SubElement(structure, "Output", {"valueReference": str(vr)})
+    for v, deps in initial_unknowns(model.variables):
+        SubElement(structure, "InitialUnknown", {
+            "valueReference": str(model.variables.index(v)),
+            "dependencies": " ".join(str(d) for d in deps)})
     return _pretty(root)
 
 
