@@ -188,7 +188,12 @@ class Calibration:
 
     @classmethod
     def from_json(cls, doc: Mapping[str, Any], where: str = "calibration") -> Calibration:
-        """From the file's content; ValueError saying which entry is missing or wrong."""
+        """From the file's content; ValueError saying which entry is missing or wrong (a file
+        with neither acc_cal nor gyro_cal calibrates nothing, and is refused as not one)."""
+        if not any(f"{sensor}_cal" in doc for sensor in SENSORS):
+            raise ValueError(f"{where}: no acc_cal or gyro_cal entry, so not a calibration (it "
+                             f"holds {', '.join(map(repr, doc)) or 'nothing'}); `imu-fusion "
+                             "calibrate` writes one")
         fields: dict[str, Any] = {}
         for sensor in SENSORS:
             key = f"{sensor}_cal"

@@ -4,12 +4,18 @@ A recording is a CSV file with a header row, or an HDF5 file (a BROAD trial, or 
 and `gyro` [N, 3] with `time` [N] or a `rate` attribute). Columns are found by name: the
 accelerometer as acc_x/acc_y/acc_z (or ax/ay/az, accX/accY/accZ, acc_x_g, ...), the gyro as
 gyro_x/... (or gx/gy/gz, gyrX/..., wx/wy/wz), the time as time/t/timestamp (or --time-column), the
-sampling as dt or --rate. Units are given (--acc-unit g|m/s2, --gyro-unit rad/s|deg/s) or
-detected: a resting accelerometer reads 1 in g and 9.81 in m/s^2, and a gyro that turns faster
-than 35 rad/s (2000 deg/s, the MPU-6050's widest range) is in deg/s. A reference, roll and pitch
-[rad] or a quaternion q_w, q_x, q_y, q_z (sensor to a z-up frame), in the recording or in a
-file of its own (--reference, matched by time), gives the inclination RMSE, beside VQF's on the
-same samples where the `vqf` package is installed.
+sampling as dt or --rate; --column QUANTITY=NAME maps any other name. The delimiter, the
+encoding and a unit stated in a column's name ("Gyroscope X (deg/s)") are read off the file
+(testbenches.reader). Units are given (--acc-unit g|m/s2, --gyro-unit rad/s|deg/s), stated by
+the header, or found from the data: the accelerometer's from its norm (1 in g, 9.81 in m/s^2),
+the gyro's as the unit in which its turn explains the accelerometer's turn of gravity
+(testbenches.gyro_unit). A given or stated gyro unit the data contradict is refused with the
+evidence, and so is a recording whose data cannot tell the unit where none is given. A sample
+without a number in every column is rejected and counted by the estimators, not the file.
+
+A reference, roll and pitch [rad] or a quaternion q_w, q_x, q_y, q_z (sensor to a z-up frame),
+in the recording or in a file of its own (--reference, matched by time), gives the inclination
+RMSE, beside VQF's on the same samples where the `vqf` package is installed.
 
 It writes, per estimator, OUT/<recording>_<estimator>.csv (time, roll, pitch [rad], bias_x..z
 [rad/s], and for the position filter pos_x..z [m], vel_x..z [m/s]) and OUT/<recording>.png.
@@ -20,12 +26,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .options import add_calibration, add_preset, parse_params, with_calibration
+from .reader import TIME_SCALE
 
 ALIASES: dict[str, tuple[str, ...]] = {
     "acc_x": ("acc_x", "ax", "accx", "acc_x_g", "acc_x_ms2", "accelerometer_x", "a_x"),
@@ -39,8 +47,6 @@ ALIASES: dict[str, tuple[str, ...]] = {
 """Column names a recording may use (case and spaces ignored), per quantity."""
 G_STANDARD = 9.80665
 DEG = np.pi / 180.0
-MAX_RAD_S = 35.0
-"""A gyro reading above this [rad/s] (2000 deg/s) is taken as deg/s where the unit is detected."""
 ACC_UNITS = ("auto", "m/s2", "g")
 GYRO_UNITS = ("auto", "rad/s", "deg/s")
 
@@ -56,10 +62,15 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--rate", type=float, default=None,
                    help="sample rate [Hz] where the file has no time or dt")
     p.add_argument("--time-column", default=None, help="the time column's name [s]")
+    p.add_argument("--column", action="append", default=[], metavar="QUANTITY=NAME",
+                   help="the column of a quantity (acc_x..gyro_z, time, dt, roll, pitch, "
+                   "q_w..q_z) where its name is none the reader knows (repeatable)")
     p.add_argument("--acc-unit", choices=ACC_UNITS, default="auto",
-                   help="the accelerometer's unit (auto: from its norm at rest)")
+                   help="the accelerometer's unit (auto: the header's, else from its norm)")
     p.add_argument("--gyro-unit", choices=GYRO_UNITS, default="auto",
-                   help="the gyro's unit (auto: deg/s where it exceeds 35 rad/s)")
+                   help="the gyro's unit (auto: the header's, else the unit in which the "
+                   "gyro's turn explains the accelerometer's turn of gravity; a given or "
+                   "stated unit the data contradict is refused)")
     p.add_argument("--mounting", default=None, metavar="ROLL,PITCH,YAW",
                    help="the rotation [deg] from the sensor's axes to the body's (Z-Y-X), as "
                    "the estimators' mount_roll, mount_pitch, mount_yaw")
@@ -84,47 +95,83 @@ def _norm_name(name: str) -> str:
     return name.strip().lower().replace(" ", "_").replace("-", "_")
 
 
-def _find(header: list[str], quantity: str, given: str | None = None) -> int | None:
-    names = [_norm_name(h) for h in header]
+def _find(names: list[str], quantity: str, given: str | None = None) -> int | None:
+    """The column of a quantity: the one given (by its name as written, with or without its
+    unit), else the first of its aliases."""
+    normed = [_norm_name(n) for n in names]
     wanted = (_norm_name(given),) if given else ALIASES[quantity]
     for alias in wanted:
-        if alias in names:
-            return names.index(alias)
+        if alias in normed:
+            return normed.index(alias)
     return None
 
 
-def read_csv(path: Path, time_column: str | None) -> tuple[dict[str, np.ndarray], list[str]]:
-    """The columns of a CSV file by the header's names (numbers; RecordingError otherwise)."""
-    from .fit.recording import RecordingError, csv_header_rows
+def parse_columns(specs: list[str]) -> dict[str, str]:
+    """--column QUANTITY=NAME options as {quantity: column name}; RecordingError for a quantity
+    that is not one of ALIASES' or a spec without '='."""
+    from .fit.recording import RecordingError
 
-    header, rows = csv_header_rows(path)
-    rows = [r for r in rows if any(c.strip() for c in r)]
-    if not rows:
-        raise RecordingError(f"{path}: a header and no samples")
-    if any(len(r) != len(header) for r in rows):
-        bad = next(i for i, r in enumerate(rows, 2) if len(r) != len(header))
-        raise RecordingError(f"{path}: line {bad} has another number of values than the header "
-                             f"({len(header)})")
+    out = {}
+    for spec in specs:
+        quantity, sep, name = spec.partition("=")
+        quantity = quantity.strip()
+        if not sep or quantity not in (*ALIASES, *EXTRA_COLUMNS):
+            raise RecordingError(f"--column {spec!r}: expected QUANTITY=NAME with QUANTITY one "
+                                 f"of {', '.join((*ALIASES, *EXTRA_COLUMNS))}")
+        out[quantity] = name.strip()
+    return out
+
+
+EXTRA_COLUMNS = ("dt", "roll", "pitch", "q_w", "q_x", "q_y", "q_z")
+"""Columns found by their own name only: the sampling and a reference."""
+
+
+@dataclass
+class Columns:
+    """What read_csv found: each quantity's values, the header names it came from and the unit
+    the header states for it (None: none stated)."""
+
+    values: dict[str, np.ndarray]
+    source: dict[str, str]
+    units: dict[str, str | None]
+    header: list[str]
+    lines: np.ndarray
+
+
+def read_csv(path: Path, time_column: str | None,
+             columns: dict[str, str] | None = None) -> Columns:
+    """The quantities of a delimited text file (testbenches.reader), found by the header's
+    names or the columns given ({quantity: name}); RecordingError otherwise."""
+    from .fit.recording import RecordingError
+    from .reader import TableError, read_table
+
     try:
-        data = np.array(rows, dtype=float)
-    except ValueError as err:
-        raise RecordingError(f"{path}: a value is not a number ({err})") from None
-    cols: dict[str, np.ndarray] = {}
-    for quantity in ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z"):
-        i = _find(header, quantity)
+        table = read_table(path)
+    except TableError as err:
+        raise RecordingError(str(err)) from None
+    given = dict(columns or {})
+    if time_column:
+        given.setdefault("time", time_column)
+    found = Columns({}, {}, {}, table.header, table.lines)
+    for quantity in (*ALIASES, *EXTRA_COLUMNS):
+        name = given.get(quantity)
+        i = None
+        if name is not None:
+            i = _find(table.header, quantity, name)
+            if i is None:
+                i = _find(table.names, quantity, name)
+            if i is None:
+                raise RecordingError(f"{path}: no column {name!r} for {quantity}: the header "
+                                     f"has {', '.join(table.header)}")
+        elif quantity in ALIASES:
+            i = _find(table.names, quantity)
+        else:
+            i = _find(table.names, "time", quantity)
         if i is not None:
-            cols[quantity] = data[:, i]
-    i = _find(header, "time", time_column)
-    if time_column and i is None:
-        raise RecordingError(f"{path}: no column {time_column!r}: the header has "
-                             f"{', '.join(header)}")
-    if i is not None:
-        cols["time"] = data[:, i]
-    for name in ("dt", "roll", "pitch", "q_w", "q_x", "q_y", "q_z"):
-        j = _find(header, "time", name)
-        if j is not None:
-            cols[name] = data[:, j]
-    return cols, header
+            found.values[quantity] = table.column(i)
+            found.source[quantity] = table.header[i]
+            found.units[quantity] = table.units[i]
+    return found
 
 
 def read_hdf5(path: Path) -> dict[str, np.ndarray]:
@@ -148,15 +195,32 @@ def read_hdf5(path: Path) -> dict[str, np.ndarray]:
     return cols
 
 
+def _stated(units: dict[str, str | None], axes: tuple[str, ...], path: Path) -> str | None:
+    """The one unit the header states for these columns (None: none); RecordingError where
+    they state different ones."""
+    from .fit.recording import RecordingError
+
+    stated = {units.get(a) for a in axes} - {None}
+    if len(stated) > 1:
+        raise RecordingError(f"{path}: the header states the units {', '.join(sorted(stated))} "
+                             f"for {', '.join(axes)}: one unit for the three axes serves")
+    return stated.pop() if stated else None
+
+
 def load_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
-                   acc_unit: str = "auto", gyro_unit: str = "auto") -> Any:
-    """The recording in SI units (testbenches.fit.recording.Recording) and the time of each
-    sample [s]; RecordingError saying what is wrong."""
+                   acc_unit: str = "auto", gyro_unit: str = "auto",
+                   columns: dict[str, str] | None = None) -> Any:
+    """The recording in SI units (testbenches.fit.recording.Recording; its `described` says
+    which columns, units and rate were taken and why) and the time of each sample [s];
+    RecordingError saying what is wrong."""
     from .broad.data import NotABroadTrial, load_trial
     from .fit.recording import Recording, RecordingError, load
 
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
+    lines = None
+    units: dict[str, str | None] = {}
+    source: dict[str, str] = {}
     if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
         try:
             load_trial(path)
@@ -166,110 +230,213 @@ def load_recording(path: Path, *, rate: float | None = None, time_column: str | 
             cols = read_hdf5(path)
         else:  # a BROAD trial: its own rate, sampling, delay and reference
             rec = load(path)
+            rec.described = (f"a BROAD trial: {len(rec.dt)} samples at {rec.rate:.4g} Hz, "
+                             "m/s2 and rad/s")
             return rec, np.cumsum(rec.dt) - rec.dt[0]
     else:
-        cols, header = read_csv(path, time_column)
-        missing = [q for q in ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
-                   if q not in cols]
+        found = read_csv(path, time_column, columns)
+        cols, units, source, lines = found.values, found.units, found.source, found.lines
+        missing = [q for q in IMU_AXES if q not in cols]
         if missing:
             raise RecordingError(
                 f"{path}: no column for {', '.join(missing)}: the header has "
-                f"{', '.join(header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, gyro_z "
-                "(or ax, ay, az, gx, gy, gz)")
+                f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
+                "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME")
     acc = np.column_stack([cols[f"acc_{a}"] for a in "xyz"])
     gyro = np.column_stack([cols[f"gyro_{a}"] for a in "xyz"])
     n = len(acc)
     if n < 2:
         raise RecordingError(f"{path}: {n} sample(s); a recording needs many")
-    if not (np.all(np.isfinite(acc)) and np.all(np.isfinite(gyro))):
-        bad = int(np.argmax(~(np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1))))
-        raise RecordingError(f"{path}: sample {bad} is not a number (NaN or infinite)")
+    line_of = (lambda k: f"line {int(lines[k])}") if lines is not None else (
+        lambda k: f"sample {k}")
     if "time" in cols:
-        t = cols["time"]
-        steps = np.diff(t)
-        if not np.all(steps > 0.0):
-            bad = int(np.argmax(~(steps > 0.0))) + 1
-            raise RecordingError(f"{path}: the time does not increase at sample {bad} "
-                                 f"({t[bad - 1]!r} then {t[bad]!r} s)")
-        dt = np.concatenate([[np.median(steps)], steps])
+        t = cols["time"] * TIME_SCALE.get(units.get("time") or "s", 1.0)
+        dt, t = _steps_from_time(t, path, line_of)
     elif "dt" in cols:
-        dt = cols["dt"].copy()
-        dt[0] = float(np.median(dt[1:]))
-        t = np.cumsum(dt) - dt[0]
+        dt = cols["dt"] * TIME_SCALE.get(units.get("dt") or "s", 1.0)
+        dt = dt.copy()
+        dt[0] = float(np.nanmedian(dt[1:]))
+        t = np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - dt[0]
     elif rate:
         dt = np.full(n, 1.0 / rate)
         t = np.arange(n) / rate
     else:
-        raise RecordingError(f"{path}: no time or dt column: give the sample rate (--rate HZ) "
-                             "or the time column's name (--time-column NAME)")
-    acc = acc * _acc_scale(path, acc, acc_unit)
-    gyro = gyro * _gyro_scale(path, gyro, gyro_unit)
-    up = None
-    if all(c in cols for c in ("q_w", "q_x", "q_y", "q_z")):
-        from .broad.metric import gravity_from_quat
-
-        up = gravity_from_quat(np.column_stack([cols[c] for c in ("q_w", "q_x", "q_y", "q_z")]))
-    elif "roll" in cols and "pitch" in cols:
-        from .broad.metric import gravity_from_roll_pitch
-
-        up = gravity_from_roll_pitch(cols["roll"], cols["pitch"])
+        raise RecordingError(f"{path}: no time or dt column: give the sample rate (--rate HZ), "
+                             "the time column's name (--time-column NAME) or map it with "
+                             "--column time=NAME")
+    finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
+    if not finite.any():
+        raise RecordingError(f"{path}: no sample holds numbers in every column")
+    acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
+                                    _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
+    gyro_scale, gyro_how = _gyro_scale(path, acc, gyro, dt, gyro_unit,
+                                       _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path))
+    acc = acc * acc_scale
+    gyro = gyro * gyro_scale
+    up = reference_up(cols, path)
     counts = None if up is None else np.all(np.isfinite(up), axis=1)
-    rec = Recording(path.stem, acc, gyro, dt, 1.0 / float(np.median(dt)), "point", up, counts)
+    period = float(np.nanmedian(dt))
+    rec = Recording(path.stem, acc, gyro, dt, 1.0 / period, "point", up, counts)
+    where = ", ".join(f"{q}={source[q]!r}" for q in (*IMU_AXES, "time", "dt") if q in source)
+    missing_rows = int((~finite).sum())
+    rec.described = (
+        f"{n} samples, {float(np.nansum(dt[1:])):.4g} s at {1.0 / period:.4g} Hz; acc in "
+        f"{acc_how}; gyro in {gyro_how}"
+        + (f"; columns {where}" if where else "")
+        + (f"; {missing_rows} sample(s) without a number in every column, which the "
+           "estimators reject and count" if missing_rows else ""))
     return rec, t
 
 
-def _acc_scale(path: Path, acc: np.ndarray, unit: str) -> float:
-    """The factor to m/s^2: given, or from the median norm (1 g or 9.81 m/s^2 at rest, and
-    near it on average in motion)."""
+IMU_AXES = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
+
+
+def _steps_from_time(t: np.ndarray, path: Path, line_of: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Each sample's dt from a time column: the time since the last sample with a time (a
+    sample without one gets dt NaN, which the estimators reject); RecordingError where the
+    time does not increase."""
+    from .fit.recording import RecordingError
+
+    valid = np.flatnonzero(np.isfinite(t))
+    if len(valid) < 2:
+        raise RecordingError(f"{path}: fewer than two samples with a time")
+    steps = np.diff(t[valid])
+    if not np.all(steps > 0.0):
+        i = int(np.argmax(~(steps > 0.0)))
+        a, b = valid[i], valid[i + 1]
+        raise RecordingError(f"{path}, {line_of(b)}: the time {float(t[b]):.6g} s does not "
+                             f"increase from {float(t[a]):.6g} s on {line_of(a)}")
+    dt = np.full(len(t), np.nan)
+    dt[valid[1:]] = steps
+    dt[valid[0]] = float(np.median(steps))
+    filled = np.interp(np.arange(len(t)), valid, t[valid])  # the time of a sample without one
+    return dt, np.where(np.isfinite(t), t, filled)
+
+
+def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
+               ) -> tuple[float, str]:
+    """The factor to m/s^2 and how it was chosen: given, stated by the header, or from the
+    median norm (1 g or 9.81 m/s^2 at rest, and near it on average in motion); refused where
+    the norm in that unit cannot be gravity's."""
     from .fit.recording import RecordingError
 
     norm = float(np.median(np.linalg.norm(acc, axis=1)))
-    scale = {"m/s2": 1.0, "g": G_STANDARD}.get(unit)
-    if scale is None:
+    chosen = unit if unit != "auto" else stated
+    how = "given" if unit != "auto" else "from the header"
+    if chosen is None:
         if 0.5 < norm < 2.0:
-            scale = G_STANDARD
+            chosen = "g"
         elif 5.0 < norm < 20.0:
-            scale = 1.0
+            chosen = "m/s2"
         else:
             raise RecordingError(
                 f"{path}: the accelerometer's median norm is {norm:.4g}, neither about 1 (g) "
                 "nor about 9.81 (m/s2): give --acc-unit, or check the columns")
+        how = f"from its median norm {norm:.4g}"
+    scale = {"m/s2": 1.0, "g": G_STANDARD}.get(chosen)
+    if scale is None:
+        raise RecordingError(f"{path}: the accelerometer's unit {chosen!r} is not one of g, "
+                             "m/s2")
     si = norm * scale
     if not 4.0 < si < 40.0:
         raise RecordingError(f"{path}: the accelerometer's median norm is {si:.4g} m/s2 in the "
-                             f"unit {unit}, which cannot be right (gravity is 9.81)")
-    return scale
+                             f"unit {chosen} ({how}), which cannot be right (gravity is 9.81)")
+    return scale, f"{chosen} ({how})"
 
 
-def _gyro_scale(path: Path, gyro: np.ndarray, unit: str) -> float:
-    """The factor to rad/s: given, or deg/s where any reading exceeds MAX_RAD_S."""
-    if unit == "deg/s":
-        return DEG
-    if unit == "rad/s":
-        return 1.0
-    return DEG if float(np.max(np.abs(gyro))) > MAX_RAD_S else 1.0
+def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
+                stated: str | None) -> tuple[float, str]:
+    """The factor to rad/s and how it was chosen: the unit in which the gyro's turn explains
+    the accelerometer's turn of gravity (testbenches.gyro_unit). A unit given or stated by the
+    header that the data contradict is refused with the evidence; where the data cannot tell
+    and no unit is given or stated, the recording is refused."""
+    from .fit.recording import RecordingError
+    from .gyro_unit import UNITS, gyro_unit_evidence
+
+    evidence = gyro_unit_evidence(acc, gyro, dt)
+    chosen = unit if unit != "auto" else stated
+    if chosen is not None:
+        how = "given" if unit != "auto" else "from the header"
+        if chosen not in UNITS:
+            raise RecordingError(f"{path}: the gyro's unit {chosen!r} is not one of rad/s, "
+                                 "deg/s")
+        if evidence.unit is not None and evidence.unit != chosen:
+            raise RecordingError(
+                f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
+                f"{evidence.describe()}, so it reads in {evidence.unit}; give --gyro-unit "
+                f"{evidence.unit}, or check the columns")
+        return UNITS[chosen], f"{chosen} ({how}" + (
+            ", and the data agree)" if evidence.unit else ")")
+    if evidence.unit is None:
+        raise RecordingError(
+            f"{path}: the gyro's unit cannot be told from the data (the gyro turns gravity "
+            "measurably in neither rad/s nor deg/s: too little motion): give --gyro-unit rad/s "
+            "or deg/s")
+    return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})"
 
 
 def reference_by_time(path: Path, t: np.ndarray) -> np.ndarray:
     """The up direction [N, 3] of a reference file (time with roll, pitch or q_w..q_z) at the
-    recording's times (linear between the reference's samples; NaN outside them)."""
-    from .broad.metric import gravity_from_quat, gravity_from_roll_pitch
+    recording's times (linear between the reference's samples; NaN outside them and where the
+    reference has no valid row); RecordingError where it cannot serve."""
     from .fit.recording import RecordingError
 
-    cols, header = read_csv(path, None)
+    found = read_csv(path, None)
+    cols, header = found.values, found.header
     if "time" not in cols:
         raise RecordingError(f"{path}: a reference needs a time column [s]; it has "
                              f"{', '.join(header)}")
-    if all(c in cols for c in ("q_w", "q_x", "q_y", "q_z")):
-        up = gravity_from_quat(np.column_stack([cols[c] for c in ("q_w", "q_x", "q_y", "q_z")]))
-    elif "roll" in cols and "pitch" in cols:
-        up = gravity_from_roll_pitch(cols["roll"], cols["pitch"])
-    else:
+    up = reference_up(cols, path)
+    if up is None:
         raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, q_y, "
                              f"q_z; it has {', '.join(header)}")
-    out = np.column_stack([np.interp(t, cols["time"], up[:, i], left=np.nan, right=np.nan)
+    ref_t = cols["time"] * TIME_SCALE.get(found.units.get("time") or "s", 1.0)
+    keep = np.isfinite(ref_t) & np.all(np.isfinite(up), axis=1)
+    if not keep.any():
+        raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
+                             "attitude")
+    lo, hi = float(ref_t[keep].min()), float(ref_t[keep].max())
+    if hi < t[0] or lo > t[-1]:
+        raise RecordingError(f"{path}: the reference's time ({lo:.6g} to {hi:.6g} s) does not "
+                             f"overlap the recording's ({t[0]:.6g} to {t[-1]:.6g} s): both "
+                             "must count from the same instant")
+    out = np.column_stack([np.interp(t, ref_t[keep], up[keep, i], left=np.nan, right=np.nan)
                            for i in range(3)])
     return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+QUAT_NORM_TOLERANCE = 0.1
+"""A reference quaternion whose norm is further than this from 1 is no rotation: its row is
+left out (and counted)."""
+
+
+def reference_up(cols: dict[str, np.ndarray], path: Path) -> np.ndarray | None:
+    """The up direction [N, 3] of the reference columns (None: there are none); rows of
+    invalid quaternions NaN; RecordingError where nothing in them can be an attitude or roll
+    and pitch are not in rad."""
+    from .broad.metric import gravity_from_quat, gravity_from_roll_pitch
+    from .fit.recording import RecordingError
+
+    if all(c in cols for c in ("q_w", "q_x", "q_y", "q_z")):
+        q = np.column_stack([cols[c] for c in ("q_w", "q_x", "q_y", "q_z")])
+        norm = np.linalg.norm(q, axis=1)
+        valid = np.isfinite(norm) & (np.abs(norm - 1.0) <= QUAT_NORM_TOLERANCE)
+        if not valid.any():
+            raise RecordingError(f"{path}: none of the reference's {len(q)} quaternions is a "
+                                 f"rotation (norm within {QUAT_NORM_TOLERANCE} of 1; median "
+                                 f"norm {float(np.nanmedian(norm)):.4g})")
+        up = np.full((len(q), 3), np.nan)
+        up[valid] = gravity_from_quat(q[valid] / norm[valid, None])
+        return up
+    if "roll" in cols and "pitch" in cols:
+        roll, pitch = cols["roll"], cols["pitch"]
+        if np.nanmax(np.abs(roll)) > np.pi + 1e-6 or np.nanmax(np.abs(pitch)) > np.pi / 2 + 1e-6:
+            raise RecordingError(
+                f"{path}: the reference's roll reaches {float(np.nanmax(np.abs(roll))):.4g} and "
+                f"its pitch {float(np.nanmax(np.abs(pitch))):.4g}, beyond pi and pi/2: they "
+                "are in degrees? a reference gives roll and pitch in rad")
+        return gravity_from_roll_pitch(roll, pitch)
+    return None
 
 
 # ----- running ---------------------------------------------------------------------------------
@@ -299,14 +466,25 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     from fusion_core.registry import KEYS, create
 
     from .broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
+    from .fit.recording import RecordingError
     from .options import choose
 
     keys = choose(args.estimator, list(KEYS), "estimator")
     rec, t = load_recording(args.recording, rate=args.rate, time_column=args.time_column,
-                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit)
+                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
+                            columns=parse_columns(args.column))
+    print(f"{args.recording}: {rec.described}")
     if args.reference is not None:
         rec.up_ref = reference_by_time(args.reference, t)
         rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
+    if rec.up_ref is not None:  # scored where every estimator and VQF took the sample
+        rec.counts = rec.counted & _valid(rec)
+        scored = int(rec.counts.sum())
+        if scored == 0:
+            raise RecordingError(f"{args.recording}: no sample has both a valid reference and "
+                                 "numbers in every column: nothing to score")
+        print(f"reference: {scored} of {len(rec.counts)} samples scored (the others lack a "
+              "valid reference or a number)")
     preset = with_calibration(load_preset(args.preset), args.calibration)
     estimators = {k: create(k, estimator_params(args, preset[k])) for k in keys}
     args.out.mkdir(parents=True, exist_ok=True)
@@ -324,7 +502,6 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     vqf_rmse, vqf_note = None, ""
     if rec.up_ref is not None:
         vqf_rmse, vqf_note = _vqf(rec)
-    print(f"{rec.name}: {len(rec.dt)} samples, {rec.duration:.1f} s at {rec.rate:.4g} Hz")
     print(f"{'estimator':<10} {'rejected':>8} {'incl. RMSE [deg]':>17}  output")
     for key, rejected, rmse, path in rows:
         shown = f"{rmse:17.4f}" if rmse is not None else f"{'-':>17}"
@@ -352,11 +529,20 @@ def _vqf(rec: Any) -> tuple[float | None, str]:
     from .broad.metric import inclination_rmse_deg
     from .peers import PeerUnavailable, run_vqf
 
+    valid = _valid(rec)
     try:
-        up = run_vqf(rec.acc, rec.gyro, rec.rate)
+        up_valid = run_vqf(rec.acc[valid], rec.gyro[valid], rec.rate)
     except PeerUnavailable as err:
         return None, f"(VQF not run: {str(err).split('; ')[-1]})"
+    up = np.full((len(valid), 3), np.nan)
+    up[valid] = up_valid  # VQF takes no sample the estimators rejected
     return inclination_rmse_deg(up, rec.up_ref, rec.counted), "VQF on the same samples"
+
+
+def _valid(rec: Any) -> np.ndarray:
+    """The samples with a number in every column and a dt (the others the estimators reject)."""
+    return (np.all(np.isfinite(rec.acc), 1) & np.all(np.isfinite(rec.gyro), 1)
+            & np.isfinite(rec.dt))
 
 
 def _plot(path: Path, t: np.ndarray, traces: dict[str, dict[str, np.ndarray]], rec: Any) -> str:

@@ -73,11 +73,12 @@ def test_an_hdf5_recording_with_a_rate(tmp_path):
     ("time,acc_x,acc_y,acc_z,gyro_x,gyro_y\n0,0,0,9.8,0,0\n0.01,0,0,9.8,0,0\n",
      "no column for gyro_z"),
     ("time,ax,ay,az,gx,gy,gz\n0,0,0,9.8,0,0,0\n0.02,0,0,9.8,0,0,0\n0.01,0,0,9.8,0,0,0\n",
-     "the time does not increase at sample 2"),
+     "line 4: the time 0.01 s does not increase from 0.02 s on line 3"),
     ("time,ax,ay,az,gx,gy,gz\n0,0,0,98,0,0,0\n0.01,0,0,98,0,0,0\n",
      "neither about 1 (g) nor about 9.81"),
     ("ax,ay,az,gx,gy,gz\n0,0,9.8,0,0,0\n0,0,9.8,0,0,0\n", "give the sample rate"),
-    ("time,ax,ay,az,gx,gy,gz\n0,0,0,9.8,0,0,x\n0.01,0,0,9.8,0,0,0\n", "not a number"),
+    ("time,ax,ay,az,gx,gy,gz\n0,0,0,9.8,0,0,x\n0.01,0,0,9.8,0,0,0\n",
+     "line 2, column 'gz': 'x' is not a number"),
 ])
 def test_a_bad_file_gets_one_line_that_says_what_is_wrong(tmp_path, content, says):
     path = tmp_path / "bad.csv"
@@ -118,3 +119,155 @@ def test_a_calibration_file_is_applied_at_every_estimators_input(tmp_path, capsy
     assert main(["estimate", str(EXAMPLE), "--calibration", str(path), "--out",
                  str(tmp_path), "--no-plots"]) == 2
     assert "gyro_cal_zz=2.0 is out of range" in capsys.readouterr().err
+
+
+# ----- a file as a logger or a spreadsheet writes it, and units that cannot be silently wrong -----
+def _logger_file(path: Path, delimiter: str = ",", bom: bool = False, deg: bool = True,
+                 g: bool = True, header_units: bool = True) -> None:
+    """tilt_motion.csv as a logger writes it: its own column names with units in them."""
+    ex = _example()
+    acc = ex["acc"] / 9.80665 if g else ex["acc"]
+    gyro = np.degrees(ex["gyro"]) if deg else ex["gyro"]
+    au, gu = ("(g)" if g else "(m/s^2)"), ("(deg/s)" if deg else "(rad/s)")
+    names = ["Time (s)"] + [f"Accelerometer {a} {au if header_units else ''}".strip()
+                            for a in "XYZ"] + [
+        f"Gyroscope {a} {gu if header_units else ''}".strip() for a in "XYZ"]
+    rows = [delimiter.join(names)] + [delimiter.join(f"{v:.9g}" for v in row) for row in
+                                      np.column_stack([ex["time"], acc, gyro])]
+    path.write_text(("\ufeff" if bom else "") + "\n".join(rows) + "\n", encoding="utf-8")
+
+
+def _kf_roll(tmp_path: Path, name: str) -> np.ndarray:
+    return np.loadtxt(tmp_path / f"{name}_kf.csv", delimiter=",", skiprows=1)[:, 1]
+
+
+@pytest.mark.parametrize(("delimiter", "bom"), [(",", False), (";", True), ("\t", False)])
+def test_a_loggers_header_delimiter_and_byte_order_mark_are_read(tmp_path, capsys, delimiter,
+                                                                 bom):
+    """Names like 'Gyroscope X (deg/s)', units in them, semicolons or tabs, a UTF-8 BOM as
+    spreadsheets write: the same estimate as from the SI file, and the choices printed."""
+    path = tmp_path / "logger.csv"
+    _logger_file(path, delimiter, bom)
+    assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
+                 "--no-plots"]) == 0
+    said = capsys.readouterr().out
+    assert "acc in g (from the header)" in said and "gyro in deg/s (from the header" in said
+    ex = _example()
+    want = create("kf").run(ex["acc"], ex["gyro"], np.full(len(ex["time"]), 0.01))
+    assert np.max(np.abs(_kf_roll(tmp_path, "logger") - want["roll"])) < 1e-6
+
+
+def test_a_column_map_names_what_the_reader_does_not_know(tmp_path):
+    ex = _example()
+    path = tmp_path / "odd.csv"
+    np.savetxt(path, np.column_stack([ex["time"], ex["acc"], ex["gyro"]]), delimiter=",",
+               header="when,f1,f2,f3,w1,w2,w3", comments="")
+    mapping = [f"--column={q}={n}" for q, n in (("time", "when"), ("acc_x", "f1"),
+               ("acc_y", "f2"), ("acc_z", "f3"), ("gyro_x", "w1"), ("gyro_y", "w2"),
+               ("gyro_z", "w3"))]
+    assert main(["estimate", str(path), "--estimator", "kf", *mapping, "--out", str(tmp_path),
+                 "--no-plots"]) == 0
+
+
+def test_rows_without_numbers_are_rejected_one_by_one_not_the_file(tmp_path, capsys):
+    ex = _example()
+    gyro = ex["gyro"].copy()
+    gyro[100:105] = np.nan
+    path = tmp_path / "gaps.csv"
+    np.savetxt(path, np.column_stack([ex["time"], ex["acc"], gyro]), delimiter=",",
+               header="time,ax,ay,az,gx,gy,gz", comments="")
+    assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
+                 "--no-plots"]) == 0
+    out = capsys.readouterr().out
+    assert "5 sample(s) without a number" in out
+    assert next(r for r in out.splitlines() if r.startswith("kf ")).split()[1] == "5"
+
+
+def test_the_gyro_unit_is_found_from_the_data_in_motion_in_both_units(tmp_path, capsys):
+    for deg in (True, False):
+        path = tmp_path / f"moving_{deg}.csv"
+        _logger_file(path, deg=deg, header_units=False)
+        assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
+                     "--no-plots"]) == 0
+        unit = "deg/s" if deg else "rad/s"
+        assert f"gyro in {unit} (from the data" in capsys.readouterr().out
+
+
+def _still(path: Path, bias_deg_s: float, deg: bool) -> None:
+    """A sensor at rest tilted 10 deg for 60 s at 100 Hz with a gyro bias."""
+    rng = np.random.default_rng(1)
+    n = 6000
+    acc = np.array([0.0, np.sin(0.17), np.cos(0.17)]) * 9.80665 + 0.02 * rng.standard_normal(
+        (n, 3))
+    gyro = np.radians(bias_deg_s + 0.05 * rng.standard_normal((n, 3)))
+    gyro = np.degrees(gyro) if deg else gyro
+    np.savetxt(path, np.column_stack([np.arange(n) / 100.0, acc, gyro]), delimiter=",",
+               header="time,ax,ay,az,gx,gy,gz", comments="")
+
+
+def test_a_still_recording_in_deg_s_with_a_bias_is_not_read_as_rad_s(tmp_path, capsys):
+    """Read as rad/s, 0.3 deg/s of bias would turn the filters by 17 deg/s: the data say deg/s
+    (the accelerometer sees no such turn), and the roll stays at the tilt."""
+    path = tmp_path / "still.csv"
+    _still(path, 0.3, deg=True)
+    assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
+                 "--no-plots"]) == 0
+    assert "gyro in deg/s (from the data" in capsys.readouterr().out
+    assert np.max(np.abs(np.degrees(_kf_roll(tmp_path, "still")) - 9.74)) < 1.0
+
+
+def test_a_given_gyro_unit_the_data_contradict_is_refused_with_the_evidence(tmp_path):
+    path = tmp_path / "still.csv"
+    _still(path, 0.3, deg=True)
+    proc = subprocess.run([sys.executable, "-m", "testbenches", "estimate", str(path),
+                           "--gyro-unit", "rad/s", "--out", str(tmp_path), "--no-plots"],
+                          capture_output=True, text=True, timeout=120, cwd=REPO)
+    assert proc.returncode == 2
+    assert "the gyro's unit rad/s (given) contradicts the data" in proc.stderr
+    assert "missed by rad/s:" in proc.stderr and "give --gyro-unit deg/s" in proc.stderr
+
+
+def test_a_recording_that_cannot_tell_its_gyro_unit_is_refused_unless_told(tmp_path, capsys):
+    """At rest with a calibrated gyro neither unit turns gravity measurably: refused with the
+    option to give; given, it runs."""
+    path = tmp_path / "quiet.csv"
+    _still(path, 0.0, deg=False)
+    assert main(["estimate", str(path), "--out", str(tmp_path), "--no-plots"]) == 2
+    assert "give --gyro-unit rad/s or deg/s" in capsys.readouterr().err
+    assert main(["estimate", str(path), "--gyro-unit", "rad/s", "--estimator", "kf",
+                 "--out", str(tmp_path), "--no-plots"]) == 0
+
+
+def _reference(path: Path, time: np.ndarray, roll: np.ndarray, pitch: np.ndarray) -> None:
+    np.savetxt(path, np.column_stack([time, roll, pitch]), delimiter=",",
+               header="time,roll,pitch", comments="")
+
+
+@pytest.mark.parametrize(("make", "says"), [
+    ("degrees", "are in degrees? a reference gives roll and pitch in rad"),
+    ("no overlap", "does not overlap the recording's"),
+    ("zero quaternions", "none of the reference's 1000 quaternions is a rotation"),
+])
+def test_a_reference_that_cannot_serve_is_refused_not_scored_as_nan(tmp_path, capsys, make,
+                                                                     says):
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
+    ref = tmp_path / "ref.csv"
+    t, roll, pitch = truth[:, 0], truth[:, 1], truth[:, 2]
+    if make == "degrees":
+        _reference(ref, t, np.degrees(roll), np.degrees(pitch))
+    elif make == "no overlap":
+        _reference(ref, t + 1000.0, roll, pitch)
+    else:
+        np.savetxt(ref, np.column_stack([t, np.zeros((len(t), 4))]), delimiter=",",
+                   header="time,q_w,q_x,q_y,q_z", comments="")
+    assert main(["estimate", str(EXAMPLE), "--reference", str(ref), "--out", str(tmp_path),
+                 "--no-plots"]) == 2
+    assert says in capsys.readouterr().err
+
+
+def test_a_file_without_a_calibration_in_it_is_refused_as_calibration(tmp_path, capsys):
+    path = tmp_path / "calibration.json"
+    path.write_text('{"foo": 1}')
+    assert main(["estimate", str(EXAMPLE), "--calibration", str(path), "--out",
+                 str(tmp_path), "--no-plots"]) == 2
+    assert "no acc_cal or gyro_cal entry, so not a calibration" in capsys.readouterr().err

@@ -1,0 +1,116 @@
+"""The gyro's unit found from the recording itself: the unit in which the gyro's integrated turn
+explains how the accelerometer sees gravity turn.
+
+A sensor that turns sees gravity turn the other way in its own frame: du/dt = -omega x u for the
+unit vector u of gravity in the sensor's frame. So over a short window the accelerometer's
+direction at its end is predicted from its direction at the start and the gyro's readings taken
+in a unit: in the right unit the prediction meets the measured direction to within the noise and
+the linear acceleration; in a unit 57.3 times off it misses by the turn itself. A rate about the
+vertical turns nothing gravity shows, in either unit, and is neither evidence for nor against.
+
+This decides the unit whenever the gyro reads enough, in one of the two units, to turn gravity
+measurably over a window: in motion, and at rest too where a gyro bias of a few tenths of a deg/s
+would, read as rad/s, turn gravity by degrees per second that the accelerometer does not see. A
+recording where neither unit predicts a turn the accelerometer could tell from its noise is
+undecided, and the caller asks for the unit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
+"""The candidate units and their factor to rad/s."""
+WINDOW_S = 0.25
+"""Window over which the gyro's turn is compared with gravity's [s]: long enough that a turn of
+a few deg/s moves gravity by more than the accelerometer's noise after the low-pass, short
+enough that linear acceleration changes little within it."""
+LOWPASS_S = 0.05
+"""Moving-average length on the accelerometer before its direction is taken [s]."""
+QUIET_G = 0.15
+"""Only windows whose two ends read a norm within this fraction of gravity's count: a sample
+under strong linear acceleration does not point along gravity."""
+MIN_TURN_DEG = 1.0
+"""A window counts where one unit's prediction turns gravity by at least this much [deg]."""
+MIN_WINDOWS = 10
+"""Fewer counting windows than this: undecided."""
+MIN_RATIO = 3.0
+"""The other unit's miss must be at least this many times the chosen one's."""
+
+
+@dataclass(frozen=True)
+class UnitEvidence:
+    """What the data say: each unit's median miss [deg] over the windows that count, how many
+    windows counted, and the unit they point to (None: undecided)."""
+
+    miss_deg: dict[str, float]
+    windows: int
+    unit: str | None
+
+    def describe(self) -> str:
+        misses = ", ".join(f"{u}: {m:.3g} deg" for u, m in self.miss_deg.items())
+        return (f"over {self.windows} windows of {WINDOW_S} s, gravity's turn is missed by "
+                f"{misses} (median)")
+
+
+def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
+    if n <= 1:
+        return x
+    c = np.cumsum(np.vstack([np.zeros((1, x.shape[1])), x]), axis=0)
+    out = (c[n:] - c[:-n]) / n
+    pad = np.repeat(out[:1], n - 1, axis=0)
+    return np.vstack([pad, out])
+
+
+def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> UnitEvidence:
+    """The evidence for each unit of `gyro` [N, 3] (numbers as read) from `acc` [N, 3] (any
+    unit: only its direction and its norm relative to the median are used) and `dt` [N] [s]
+    (rows with a non-finite value are left out of every window that holds them)."""
+    acc, gyro, dt = (np.asarray(a, dtype=float) for a in (acc, gyro, dt))
+    n = len(dt)
+    period = float(np.nanmedian(dt)) if n else 0.0
+    if not (n > 2 and period > 0.0):
+        return UnitEvidence(dict.fromkeys(UNITS, float("nan")), 0, None)
+    k = max(1, round(WINDOW_S / period))
+    finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
+    acc = np.where(finite[:, None], acc, 0.0)
+    gyro = np.where(finite[:, None], gyro, 0.0)
+    dt = np.where(finite, dt, 0.0)
+    smooth = _moving_average(acc, max(1, round(LOWPASS_S / period)))
+    norm = np.linalg.norm(smooth, axis=1)
+    g = float(np.median(norm[finite])) if finite.any() else 0.0
+    if not g > 0.0 or n <= k:
+        return UnitEvidence(dict.fromkeys(UNITS, float("nan")), 0, None)
+    u = smooth / np.where(norm > 0.0, norm, 1.0)[:, None]
+    quiet = finite & (np.abs(norm / g - 1.0) < QUIET_G)
+    bad = np.concatenate([[0], np.cumsum(~finite)])
+    starts = np.arange(0, n - k)
+    ends = starts + k
+    usable = quiet[starts] & quiet[ends] & (bad[ends + 1] - bad[starts] == 0)
+    starts, ends = starts[usable], ends[usable]
+    misses: dict[str, np.ndarray] = {}
+    turns: dict[str, np.ndarray] = {}
+    for unit, scale in UNITS.items():
+        v = u[starts].copy()
+        for j in range(1, k + 1):  # du/dt = -omega x u, omega at the sample ending each step
+            w = gyro[starts + j] * scale
+            v = v - np.cross(w, v) * dt[starts + j][:, None]
+            v /= np.linalg.norm(v, axis=1, keepdims=True)
+        cos_miss = np.clip(np.sum(v * u[ends], axis=1), -1.0, 1.0)
+        cos_turn = np.clip(np.sum(v * u[starts], axis=1), -1.0, 1.0)
+        misses[unit] = np.degrees(np.arccos(cos_miss))
+        turns[unit] = np.degrees(np.arccos(cos_turn))
+    counts = np.zeros(len(starts), dtype=bool)
+    for unit in UNITS:
+        counts |= turns[unit] >= MIN_TURN_DEG
+    windows = int(counts.sum())
+    median = {unit: float(np.median(m[counts])) if windows else float("nan")
+              for unit, m in misses.items()}
+    unit = None
+    if windows >= MIN_WINDOWS:
+        best, other = sorted(UNITS, key=lambda x: median[x])
+        if median[other] >= MIN_RATIO * max(median[best], 1e-3):
+            unit = best
+    return UnitEvidence(median, windows, unit)
