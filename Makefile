@@ -60,8 +60,9 @@ embedded: setup
 wheel: setup
 	$(BIN)/python -m build --no-isolation --outdir dist-wheel .
 
+# On every core, with the reason of each skipped test listed at the end.
 test: setup
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto -rs
 
 # The fast tier: everything but the tests that need built FMUs, the heavy integration runs and
 # the slow campaigns, on two workers.

@@ -43,9 +43,14 @@ TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign",
 
 
 def _parser(prog: str) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = parser.add_subparsers(dest="command", required=True)
+    # The commands are listed once, by argparse from each one's help; the module docstring's
+    # last paragraph says what they need.
+    parser = argparse.ArgumentParser(
+        prog=prog, description="IMU sensor-fusion estimators as FMUs: the project's commands "
+        f"(`{prog} COMMAND --help` for one).", epilog=__doc__.strip().split("\n\n")[-1],
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     add_estimate_parser(sub)
     add_build_parser(sub)
     from . import missing_modules
@@ -66,6 +71,15 @@ def _parser(prog: str) -> argparse.ArgumentParser:
                     add_calibrate_parser, add_engines_parser):
             add(sub)
     return parser
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("imu-fusion-fmu")
+    except PackageNotFoundError:
+        return "(not installed)"
 
 
 def main(argv: list[str] | None = None, prog: str = "imu-fusion") -> int:

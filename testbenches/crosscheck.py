@@ -264,7 +264,7 @@ def add_crosscheck_parser(sub: argparse._SubParsersAction) -> None:  # type: ign
     """The crosscheck subcommand."""
     p = sub.add_parser("crosscheck", help="the native FMUs and their results in the FMI "
                        "Cross-Check layout, validated by fmpy",
-                       description=__doc__.splitlines()[0])
+                       description=" ".join(__doc__.split("\n\n")[0].split()))
     p.add_argument("--fmu-dir", type=Path, default=Path("dist"),
                    help="where build-fmus put the FMUs (native/fmi2 and native/fmi3 under it)")
     p.add_argument("--out", type=Path, default=Path("reports/crosscheck"),

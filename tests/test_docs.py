@@ -62,3 +62,25 @@ def test_no_product_file_points_at_the_ci_folder_beside_the_project() -> None:
                 if "../shared" in text or "shared/INTERFACE" in text:
                     hits.append(str(path.relative_to(REPO)))
     assert hits == []
+
+
+def test_the_readmes_python_runs_as_written() -> None:
+    """The README's Python block, executed: every name it uses exists and it computes what its
+    comments say (a sensor at rest rolled 10 deg)."""
+    text = (REPO / "README.md").read_text()
+    block = text.split("```python\n", 1)[1].split("```", 1)[0]
+    scope: dict[str, object] = {}
+    exec(compile(block, "README.md", "exec"), scope)  # noqa: S102
+    import numpy as np
+
+    assert abs(np.degrees(scope["out"]["roll"][-1]) - 10.0) < 0.1  # type: ignore[index]
+    assert scope["est"].roll == 0.0  # type: ignore[attr-defined]
+
+
+def test_the_command_line_says_its_version_and_lists_each_command_once() -> None:
+    from testbenches.cli import _parser, _version
+
+    parser = _parser("imu-fusion")
+    text = parser.format_help()
+    assert text.count("estimate  ") == 1 and "--version" in text
+    assert _version() != "(not installed)"
