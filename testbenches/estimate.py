@@ -501,7 +501,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         rows.append((key, int(out["rejected"].sum()), rmse, path))
     vqf_rmse, vqf_note = None, ""
     if rec.up_ref is not None:
-        vqf_rmse, vqf_note = _vqf(rec)
+        vqf_rmse, vqf_note = _vqf(rec, estimator_params(args, preset[keys[0]]))
     print(f"{'estimator':<10} {'rejected':>8} {'incl. RMSE [deg]':>17}  output")
     for key, rejected, rmse, path in rows:
         shown = f"{rmse:17.4f}" if rmse is not None else f"{'-':>17}"
@@ -524,14 +524,30 @@ def _write_csv(path: Path, t: np.ndarray, out: dict[str, np.ndarray]) -> None:
                fmt="%.17g")
 
 
-def _vqf(rec: Any) -> tuple[float | None, str]:
-    """VQF's inclination RMSE on the same samples, or why there is none."""
+def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The samples as every estimator's input stage makes them of the parameters: calibrated
+    (M (raw - b)), then turned by the mounting into the filter's frame."""
+    from fusion_core.base import mounting_matrix
+    from fusion_core.calibration import Calibration
+
+    acc, gyro = Calibration.from_params(params).apply(acc, gyro)
+    r = np.asarray(mounting_matrix(float(params.get("mount_roll", 0.0)),
+                                   float(params.get("mount_pitch", 0.0)),
+                                   float(params.get("mount_yaw", 0.0)))).reshape(3, 3)
+    return acc @ r.T, gyro @ r.T
+
+
+def _vqf(rec: Any, params: dict[str, Any]) -> tuple[float | None, str]:
+    """VQF's inclination RMSE on the samples the estimators took (their calibration and
+    mounting applied, the samples they reject left out), or why there is none."""
     from .broad.metric import inclination_rmse_deg
     from .peers import PeerUnavailable, run_vqf
 
     valid = _valid(rec)
+    acc, gyro = conditioned(rec.acc[valid], rec.gyro[valid], params)
     try:
-        up_valid = run_vqf(rec.acc[valid], rec.gyro[valid], rec.rate)
+        up_valid = run_vqf(acc, gyro, rec.rate)
     except PeerUnavailable as err:
         return None, f"(VQF not run: {str(err).split('; ')[-1]})"
     up = np.full((len(valid), 3), np.nan)

@@ -271,3 +271,26 @@ def test_a_file_without_a_calibration_in_it_is_refused_as_calibration(tmp_path, 
     assert main(["estimate", str(EXAMPLE), "--calibration", str(path), "--out",
                  str(tmp_path), "--no-plots"]) == 2
     assert "no acc_cal or gyro_cal entry, so not a calibration" in capsys.readouterr().err
+
+
+def test_vqf_runs_on_the_samples_the_estimators_take_mounted(tmp_path, capsys):
+    """A sensor mounted x-up (--mounting 0,90,0): the raw file holds the example's samples
+    turned back by the mounting, so the estimators' input is the example's, and VQF's row
+    equals VQF's on the example itself."""
+    pytest.importorskip("vqf", reason="the bench extra: pip install -e '.[bench]'")
+    from fusion_core.base import mounting_matrix
+
+    ex = _example()
+    r = np.asarray(mounting_matrix(0.0, np.pi / 2, 0.0)).reshape(3, 3)
+    raw = tmp_path / "mounted.csv"
+    np.savetxt(raw, np.column_stack([ex["time"], ex["acc"] @ r, ex["gyro"] @ r]),
+               delimiter=",", header="time,ax,ay,az,gx,gy,gz", comments="", fmt="%.17g")
+
+    def vqf_row(path: Path, *extra: str) -> float:
+        assert main(["estimate", str(path), "--estimator", "kf", "--reference", str(TRUTH),
+                     "--gyro-unit", "rad/s", "--out", str(tmp_path), "--no-plots",
+                     *extra]) == 0
+        out = capsys.readouterr().out
+        return float(next(r for r in out.splitlines() if r.startswith("vqf ")).split()[2])
+
+    assert vqf_row(raw, "--mounting", "0,90,0") == pytest.approx(vqf_row(EXAMPLE), abs=1e-3)
