@@ -32,7 +32,13 @@ from typing import Any
 
 import numpy as np
 
-from .options import add_calibration, add_preset, parse_params, with_calibration
+from .options import (
+    add_calibration,
+    add_preset,
+    add_recording_options,
+    parse_params,
+    with_calibration,
+)
 from .reader import TIME_SCALE
 
 ALIASES: dict[str, tuple[str, ...]] = {
@@ -47,8 +53,6 @@ ALIASES: dict[str, tuple[str, ...]] = {
 """Column names a recording may use (case and spaces ignored), per quantity."""
 G_STANDARD = 9.80665
 DEG = np.pi / 180.0
-ACC_UNITS = ("auto", "m/s2", "g")
-GYRO_UNITS = ("auto", "rad/s", "deg/s")
 
 
 def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -59,18 +63,7 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--estimator", default="all", help="all or a comma list of the estimators")
     add_preset(p)
     add_calibration(p)
-    p.add_argument("--rate", type=float, default=None,
-                   help="sample rate [Hz] where the file has no time or dt")
-    p.add_argument("--time-column", default=None, help="the time column's name [s]")
-    p.add_argument("--column", action="append", default=[], metavar="QUANTITY=NAME",
-                   help="the column of a quantity (acc_x..gyro_z, time, dt, roll, pitch, "
-                   "q_w..q_z) where its name is none the reader knows (repeatable)")
-    p.add_argument("--acc-unit", choices=ACC_UNITS, default="auto",
-                   help="the accelerometer's unit (auto: the header's, else from its norm)")
-    p.add_argument("--gyro-unit", choices=GYRO_UNITS, default="auto",
-                   help="the gyro's unit (auto: the header's, else the unit in which the "
-                   "gyro's turn explains the accelerometer's turn of gravity; a given or "
-                   "stated unit the data contradict is refused)")
+    add_recording_options(p)
     p.add_argument("--mounting", default=None, metavar="ROLL,PITCH,YAW",
                    help="the rotation [deg] from the sensor's axes to the body's (Z-Y-X), as "
                    "the estimators' mount_roll, mount_pitch, mount_yaw")
@@ -291,6 +284,15 @@ def load_recording(path: Path, *, rate: float | None = None, time_column: str | 
 IMU_AXES = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 
 
+def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
+    """load_recording with the options add_recording_options defines, the choices printed."""
+    rec, t = load_recording(path, rate=args.rate, time_column=args.time_column,
+                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
+                            columns=parse_columns(args.column))
+    print(f"{path}: {rec.described}")
+    return rec, t
+
+
 def _steps_from_time(t: np.ndarray, path: Path, line_of: Any) -> tuple[np.ndarray, np.ndarray]:
     """Each sample's dt from a time column: the time since the last sample with a time (a
     sample without one gets dt NaN, which the estimators reject); RecordingError where the
@@ -470,10 +472,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     from .options import choose
 
     keys = choose(args.estimator, list(KEYS), "estimator")
-    rec, t = load_recording(args.recording, rate=args.rate, time_column=args.time_column,
-                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
-                            columns=parse_columns(args.column))
-    print(f"{args.recording}: {rec.described}")
+    rec, t = recording_from_args(args.recording, args)
     if args.reference is not None:
         rec.up_ref = reference_by_time(args.reference, t)
         rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)

@@ -8,11 +8,12 @@ in a unit: in the right unit the prediction meets the measured direction to with
 the linear acceleration; in a unit 57.3 times off it misses by the turn itself. A rate about the
 vertical turns nothing gravity shows, in either unit, and is neither evidence for nor against.
 
-This decides the unit whenever the gyro reads enough, in one of the two units, to turn gravity
-measurably over a window: in motion, and at rest too where a gyro bias of a few tenths of a deg/s
-would, read as rad/s, turn gravity by degrees per second that the accelerometer does not see. A
-recording where neither unit predicts a turn the accelerometer could tell from its noise is
-undecided, and the caller asks for the unit.
+Only windows in which the accelerometer sees gravity turn count: there the wrong unit misses by
+about the turn itself (57 times too little) or by 56 times it (too much), while the right one
+misses by the noise, the linear acceleration and the gyro's bias over the window. A window at
+rest is no evidence: a gyro bias, which turns nothing, would there favour whichever unit makes
+the readings smallest. So a recording without turns (a still one) is undecided, and the caller
+asks for the unit.
 """
 
 from __future__ import annotations
@@ -32,8 +33,10 @@ LOWPASS_S = 0.05
 QUIET_G = 0.15
 """Only windows whose two ends read a norm within this fraction of gravity's count: a sample
 under strong linear acceleration does not point along gravity."""
-MIN_TURN_DEG = 1.0
-"""A window counts where one unit's prediction turns gravity by at least this much [deg]."""
+MIN_TURN_DEG = 3.0
+"""A window counts where the accelerometer sees gravity turn by at least this much [deg]: well
+above its noise after the low-pass (about 0.1 deg) and above what a MEMS gyro's bias (a few
+deg/s before calibration) adds to the right unit's miss over a window."""
 MIN_WINDOWS = 10
 """Fewer counting windows than this: undecided."""
 MIN_RATIO = 3.0
@@ -90,8 +93,10 @@ def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> Uni
     ends = starts + k
     usable = quiet[starts] & quiet[ends] & (bad[ends + 1] - bad[starts] == 0)
     starts, ends = starts[usable], ends[usable]
+    seen = np.degrees(np.arccos(np.clip(np.sum(u[starts] * u[ends], axis=1), -1.0, 1.0)))
+    counts = seen >= MIN_TURN_DEG
+    starts, ends = starts[counts], ends[counts]
     misses: dict[str, np.ndarray] = {}
-    turns: dict[str, np.ndarray] = {}
     for unit, scale in UNITS.items():
         v = u[starts].copy()
         for j in range(1, k + 1):  # du/dt = -omega x u, omega at the sample ending each step
@@ -99,14 +104,9 @@ def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> Uni
             v = v - np.cross(w, v) * dt[starts + j][:, None]
             v /= np.linalg.norm(v, axis=1, keepdims=True)
         cos_miss = np.clip(np.sum(v * u[ends], axis=1), -1.0, 1.0)
-        cos_turn = np.clip(np.sum(v * u[starts], axis=1), -1.0, 1.0)
         misses[unit] = np.degrees(np.arccos(cos_miss))
-        turns[unit] = np.degrees(np.arccos(cos_turn))
-    counts = np.zeros(len(starts), dtype=bool)
-    for unit in UNITS:
-        counts |= turns[unit] >= MIN_TURN_DEG
-    windows = int(counts.sum())
-    median = {unit: float(np.median(m[counts])) if windows else float("nan")
+    windows = len(starts)
+    median = {unit: float(np.median(m)) if windows else float("nan")
               for unit, m in misses.items()}
     unit = None
     if windows >= MIN_WINDOWS:

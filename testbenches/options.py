@@ -24,6 +24,23 @@ def add_preset(parser: argparse.ArgumentParser, flag: str = "--preset", more: st
                         help=f"{PRESET_HELP}{more} (recommended)")
 
 
+def add_recording_options(parser: argparse.ArgumentParser) -> None:
+    """How a recording is read: the options every command that reads one takes (estimate,
+    calibrate, noise, tune; testbenches.estimate.load_recording)."""
+    parser.add_argument("--rate", type=positive_float, default=None,
+                        help="sample rate [Hz] where the file has no time or dt column")
+    parser.add_argument("--time-column", default=None, help="the time column's name [s]")
+    parser.add_argument("--column", action="append", default=[], metavar="QUANTITY=NAME",
+                        help="the column of a quantity (acc_x..gyro_z, time, dt, roll, pitch, "
+                        "q_w..q_z) where its name is none the reader knows (repeatable)")
+    parser.add_argument("--acc-unit", choices=("auto", "m/s2", "g"), default="auto",
+                        help="the accelerometer's unit (auto: the header's, else from its norm)")
+    parser.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s"), default="auto",
+                        help="the gyro's unit (auto: the header's, else the unit in which the "
+                        "gyro's turn explains the accelerometer's turn of gravity; a given or "
+                        "stated unit the data contradict is refused)")
+
+
 def add_calibration(parser: argparse.ArgumentParser) -> None:
     """The --calibration option of every command that runs estimators: a part's calibration
     (fusion_core.calibration), applied at each estimator's input."""

@@ -206,19 +206,38 @@ def _still(path: Path, bias_deg_s: float, deg: bool) -> None:
 
 
 def test_a_still_recording_in_deg_s_with_a_bias_is_not_read_as_rad_s(tmp_path, capsys):
-    """Read as rad/s, 0.3 deg/s of bias would turn the filters by 17 deg/s: the data say deg/s
-    (the accelerometer sees no such turn), and the roll stays at the tilt."""
+    """Read as rad/s, 0.3 deg/s of bias would turn the filters by 17 deg/s. At rest the data
+    cannot tell a unit (a bias turns nothing, in either unit), so the command asks for it
+    rather than guess; told deg/s, the roll stays at the tilt."""
     path = tmp_path / "still.csv"
     _still(path, 0.3, deg=True)
     assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
-                 "--no-plots"]) == 0
-    assert "gyro in deg/s (from the data" in capsys.readouterr().out
+                 "--no-plots"]) == 2
+    assert "give --gyro-unit rad/s or deg/s" in capsys.readouterr().err
+    assert main(["estimate", str(path), "--gyro-unit", "deg/s", "--estimator", "kf",
+                 "--out", str(tmp_path), "--no-plots"]) == 0
     assert np.max(np.abs(np.degrees(_kf_roll(tmp_path, "still")) - 9.74)) < 1.0
 
 
+@pytest.mark.parametrize("bias_deg_s", [0.0, 5.0])
+@pytest.mark.parametrize("deg", [True, False], ids=["deg/s", "rad/s"])
+def test_the_gyro_unit_from_the_data_holds_with_an_uncalibrated_bias(tmp_path, capsys,
+                                                                      bias_deg_s, deg):
+    """A gyro bias of 5 deg/s (a MEMS part before calibration) turns nothing the accelerometer
+    sees: only the turns decide, and they decide right in either unit."""
+    ex = _example()
+    gyro = ex["gyro"] + np.radians(bias_deg_s)
+    path = tmp_path / "biased.csv"
+    np.savetxt(path, np.column_stack([ex["time"], ex["acc"], np.degrees(gyro) if deg else gyro]),
+               delimiter=",", header="time,ax,ay,az,gx,gy,gz", comments="")
+    assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
+                 "--no-plots"]) == 0
+    assert f"gyro in {'deg/s' if deg else 'rad/s'} (from the data" in capsys.readouterr().out
+
+
 def test_a_given_gyro_unit_the_data_contradict_is_refused_with_the_evidence(tmp_path):
-    path = tmp_path / "still.csv"
-    _still(path, 0.3, deg=True)
+    path = tmp_path / "moving.csv"
+    _logger_file(path, deg=True, header_units=False)
     proc = subprocess.run([sys.executable, "-m", "testbenches", "estimate", str(path),
                            "--gyro-unit", "rad/s", "--out", str(tmp_path), "--no-plots"],
                           capture_output=True, text=True, timeout=120, cwd=REPO)

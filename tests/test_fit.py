@@ -97,7 +97,8 @@ def test_a_csv_without_the_imu_columns_is_refused_naming_them(tmp_path):
 
 def test_the_noise_command_line(tmp_path):
     csv = static_csv(tmp_path / "static.csv", 30.0, 100.0)
-    proc = subprocess.run([sys.executable, "-m", "testbenches", "noise", str(csv), "--out",
+    proc = subprocess.run([sys.executable, "-m", "testbenches", "noise", str(csv),
+                           "--gyro-unit", "rad/s", "--out",
                            str(tmp_path / "out"), "--no-plots"], cwd=REPO, capture_output=True,
                           text=True, timeout=120, check=False)
     assert proc.returncode == 0, proc.stderr
@@ -199,7 +200,7 @@ def test_noise_gives_the_gyro_range_to_every_estimator_and_the_sensor(tmp_path, 
     from testbenches.__main__ import main
 
     path = static_csv(tmp_path / "static.csv", 60.0, 100.0)
-    assert main(["noise", str(path), "--gyro-range", "500", "--no-plots",
+    assert main(["noise", str(path), "--gyro-unit", "rad/s", "--gyro-range", "500", "--no-plots",
                  "--out", str(tmp_path / "out")]) == 0
     assert "+-500 deg/s" in capsys.readouterr().out
     preset = load_preset(tmp_path / "out" / "preset.json")
@@ -208,3 +209,25 @@ def test_noise_gives_the_gyro_range_to_every_estimator_and_the_sensor(tmp_path, 
     assert sensor["gyro_range"] == math.radians(500.0)
     kf = ESTIMATORS["kf"](**preset["kf"])  # an estimator takes it
     assert kf.params["gyro_range"] == math.radians(500.0)
+
+
+def test_noise_reads_a_static_recording_in_g_and_deg_s_with_its_units_in_the_header(tmp_path):
+    """A logger's static file: units in its header, g and deg/s. The same densities as from the
+    SI file (it was refused as 'not static: rotation seen in the gyro')."""
+    import json
+
+    from testbenches.__main__ import main
+
+    si = static_csv(tmp_path / "si.csv", 30.0, 100.0)
+    data = np.loadtxt(si, delimiter=",", skiprows=1)
+    logger = tmp_path / "logger.csv"
+    np.savetxt(logger, np.column_stack([data[:, 0], data[:, 1:4] / 9.80665,
+                                        np.degrees(data[:, 4:7])]), delimiter=";",
+               header="Time (s);Accelerometer X (g);Accelerometer Y (g);Accelerometer Z (g);"
+               "Gyroscope X (deg/s);Gyroscope Y (deg/s);Gyroscope Z (deg/s)", comments="")
+    for path, extra in ((si, ["--gyro-unit", "rad/s"]), (logger, [])):
+        assert main(["noise", str(path), *extra, "--no-plots", "--out",
+                     str(tmp_path / path.stem)]) == 0
+    a, b = (json.loads((tmp_path / n / "noise.json").read_text()) for n in ("si", "logger"))
+    assert b["gyro_psd"] == pytest.approx(a["gyro_psd"], rel=1e-6)
+    assert b["acc_psd"] == pytest.approx(a["acc_psd"], rel=1e-6)

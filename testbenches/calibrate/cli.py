@@ -30,7 +30,7 @@ import numpy as np
 from fusion_core.calibration import Calibration
 from fusion_core.types import G
 
-from ..options import positive_float
+from ..options import add_recording_options, positive_float
 from . import ferraris as fer
 from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
 from .tedaldi import CalibrationRefused, Fit, Session, calibrate_session
@@ -43,13 +43,7 @@ def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: igno
                        description=__doc__.split("\n\n")[0])
     p.add_argument("recording", type=Path, help="the session: CSV (or HDF5) with acc_x..z, "
                    "gyro_x..z and a time column (or --rate)")
-    p.add_argument("--rate", type=positive_float, default=None,
-                   help="sample rate [Hz] where the file has no time column")
-    p.add_argument("--time-column", default=None, help="the time column's name [s]")
-    p.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s"), default="auto",
-                   help="the gyro columns' unit (auto: from their size)")
-    p.add_argument("--acc-unit", choices=("auto", "m/s2", "g"), default="auto",
-                   help="the accelerometer columns' unit (auto: from the norm at rest)")
+    add_recording_options(p)
     p.add_argument("--sections", type=Path, default=None, metavar="FILE.json",
                    help="imucal's section list (x_p ... z_a, x_rot ... z_rot): Ferraris's "
                    "calibration beside")
@@ -123,10 +117,9 @@ def _matrix_rows(label: str, m: np.ndarray) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Calibrate, write calibration.json and calibration.png, print the result."""
-    from ..estimate import load_recording
+    from ..estimate import recording_from_args
 
-    rec, t = load_recording(args.recording, rate=args.rate, time_column=args.time_column,
-                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit)
+    rec, t = recording_from_args(args.recording, args)
     acc, gyro, dt, g = rec.acc, rec.gyro, rec.dt, args.gravity
     rate = 1.0 / float(np.median(dt))
     gyro_range = math.radians(args.gyro_range)

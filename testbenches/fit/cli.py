@@ -13,6 +13,7 @@ from fusion_core.registry import estimator_class
 from ..options import (
     add_calibration,
     add_preset,
+    add_recording_options,
     non_negative_float,
     positive_float,
     positive_int,
@@ -28,8 +29,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     noise.add_argument("file", type=Path, help="a static recording: CSV (acc_x..z [m/s2], "
                        "gyro_x..z [rad/s], optional time or dt [s]) or a BROAD trial (its rest "
                        "segment is used)")
-    noise.add_argument("--rate", type=positive_float, default=None,
-                       help="sampling rate [Hz] of a CSV without time or dt columns")
+    add_recording_options(noise)
     noise.add_argument("--out", type=Path, default=Path("reports/noise"),
                        help="folder for noise.json, preset.json, sensor.json, allan.png")
     noise.add_argument("--gyro-range", type=positive_float, default=2000.0, metavar="DEG_S",
@@ -59,8 +59,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     tune.add_argument("--max-worse", type=non_negative_float, default=0.03,
                       help="how much worse than at the start any one fit recording may end, a "
                       "fraction (0.03)")
-    tune.add_argument("--rate", type=positive_float, default=None,
-                      help="sampling rate [Hz] of CSV files without time or dt columns")
+    add_recording_options(tune)
     tune.add_argument("--fmu", action="store_true",
                       help="confirm the fitted preset through the estimator's FMU")
     tune.add_argument("--fmu-dir", type=Path, default=Path("dist"), help="built FMUs (dist)")
@@ -70,10 +69,11 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_noise(args: argparse.Namespace) -> int:
+    from ..estimate import recording_from_args
     from .noise import run_noise
-    from .recording import load, rest
+    from .recording import rest
 
-    rec = rest(load(args.file, args.rate))
+    rec = rest(recording_from_args(args.file, args)[0])
     noise = run_noise(rec, args.out, plots=not args.no_plots,
                       gyro_range=math.radians(args.gyro_range))
     g, a = noise["gyro_density"]["mean"], noise["acc_density"]["mean"]
@@ -95,11 +95,11 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
     from fusion_core.presets import load_preset
 
-    from .recording import load
+    from ..estimate import recording_from_args
     from .tune import fmu_score, tune, write
 
-    fit_recs = [load(p, args.rate) for p in args.files]
-    val_recs = [load(p, args.rate) for p in args.validate]
+    fit_recs = [recording_from_args(p, args)[0] for p in args.files]
+    val_recs = [recording_from_args(p, args)[0] for p in args.validate]
     start = with_calibration(load_preset(args.start), args.calibration)[args.estimator]
     names = [n.strip() for n in args.params.split(",")] if args.params else None
     with tqdm(total=args.max_evaluations, unit="run", file=sys.stderr) as bar:
