@@ -266,10 +266,11 @@ def load_recording(path: Path, *, rate: float | None = None, time_column: str | 
                                        _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path))
     acc = acc * acc_scale
     gyro = gyro * gyro_scale
-    up = reference_up(cols, path)
+    up, ref_quat = reference_up(cols, path)
     counts = None if up is None else np.all(np.isfinite(up), axis=1)
     period = float(np.nanmedian(dt))
     rec = Recording(path.stem, acc, gyro, dt, 1.0 / period, "point", up, counts)
+    rec.ref_quat = ref_quat
     where = ", ".join(f"{q}={source[q]!r}" for q in (*IMU_AXES, "time", "dt") if q in source)
     missing_rows = int((~finite).sum())
     rec.described = (
@@ -377,7 +378,7 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})"
 
 
-def reference_by_time(path: Path, t: np.ndarray) -> np.ndarray:
+def reference_by_time(path: Path, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """The up direction [N, 3] of a reference file (time with roll, pitch or q_w..q_z) at the
     recording's times (linear between the reference's samples; NaN outside them and where the
     reference has no valid row); RecordingError where it cannot serve."""
@@ -388,7 +389,7 @@ def reference_by_time(path: Path, t: np.ndarray) -> np.ndarray:
     if "time" not in cols:
         raise RecordingError(f"{path}: a reference needs a time column [s]; it has "
                              f"{', '.join(header)}")
-    up = reference_up(cols, path)
+    up, quat = reference_up(cols, path)
     if up is None:
         raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, q_y, "
                              f"q_z; it has {', '.join(header)}")
@@ -404,7 +405,15 @@ def reference_by_time(path: Path, t: np.ndarray) -> np.ndarray:
                              "must count from the same instant")
     out = np.column_stack([np.interp(t, ref_t[keep], up[keep, i], left=np.nan, right=np.nan)
                            for i in range(3)])
-    return out / np.linalg.norm(out, axis=1, keepdims=True)
+    q_at = None
+    if quat is not None:  # componentwise between neighbours of one sign, renormalised
+        q = quat[keep].copy()
+        flips = np.cumsum(np.concatenate([[0], np.sum(q[1:] * q[:-1], axis=1) < 0.0])) % 2
+        q[flips == 1] *= -1.0
+        q_at = np.column_stack([np.interp(t, ref_t[keep], q[:, i], left=np.nan,
+                                          right=np.nan) for i in range(4)])
+        q_at /= np.linalg.norm(q_at, axis=1, keepdims=True)
+    return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
 
 
 QUAT_NORM_TOLERANCE = 0.1
@@ -412,10 +421,12 @@ QUAT_NORM_TOLERANCE = 0.1
 left out (and counted)."""
 
 
-def reference_up(cols: dict[str, np.ndarray], path: Path) -> np.ndarray | None:
-    """The up direction [N, 3] of the reference columns (None: there are none); rows of
-    invalid quaternions NaN; RecordingError where nothing in them can be an attitude or roll
-    and pitch are not in rad."""
+def reference_up(cols: dict[str, np.ndarray], path: Path
+                 ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The up direction [N, 3] of the reference columns in the sensor frame, taking the
+    reference's world frame as z-up, and for a quaternion reference the unit quaternions
+    [N, 4] (rows of invalid ones NaN in both; None, None: no reference columns); RecordingError
+    where nothing in them can be an attitude or roll and pitch are not in rad."""
     from .broad.metric import gravity_from_quat, gravity_from_roll_pitch
     from .fit.recording import RecordingError
 
@@ -427,9 +438,9 @@ def reference_up(cols: dict[str, np.ndarray], path: Path) -> np.ndarray | None:
             raise RecordingError(f"{path}: none of the reference's {len(q)} quaternions is a "
                                  f"rotation (norm within {QUAT_NORM_TOLERANCE} of 1; median "
                                  f"norm {float(np.nanmedian(norm)):.4g})")
-        up = np.full((len(q), 3), np.nan)
-        up[valid] = gravity_from_quat(q[valid] / norm[valid, None])
-        return up
+        unit = np.full((len(q), 4), np.nan)
+        unit[valid] = q[valid] / norm[valid, None]
+        return gravity_from_quat(unit), unit
     if "roll" in cols and "pitch" in cols:
         roll, pitch = cols["roll"], cols["pitch"]
         if np.nanmax(np.abs(roll)) > np.pi + 1e-6 or np.nanmax(np.abs(pitch)) > np.pi / 2 + 1e-6:
@@ -437,8 +448,63 @@ def reference_up(cols: dict[str, np.ndarray], path: Path) -> np.ndarray | None:
                 f"{path}: the reference's roll reaches {float(np.nanmax(np.abs(roll))):.4g} and "
                 f"its pitch {float(np.nanmax(np.abs(pitch))):.4g}, beyond pi and pi/2: they "
                 "are in degrees? a reference gives roll and pitch in rad")
-        return gravity_from_roll_pitch(roll, pitch)
-    return None
+        return gravity_from_roll_pitch(roll, pitch), None
+    return None, None
+
+
+WORLD_UP_SPREAD_DEG = 10.0
+"""The most the accelerometer at rest may scatter around the reference's vertical (median
+angle) for that vertical to be taken."""
+WORLD_UP_TILT_DEG = 5.0
+"""A reference vertical further than this from the world frame's z axis is taken as the
+reference's up (a y-up motion-capture frame), and said so."""
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Each v [N, 3] rotated by the unit quaternion q [N, 4] (w first): R(q) v."""
+    w, u = q[:, :1], q[:, 1:]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def align_reference_world(rec: Any, path: Path) -> str:
+    """For a quaternion reference (rec.ref_quat, sensor to world): the world's vertical as the
+    accelerometer at rest sees it, heading-free (the mean over quiet samples of the measured
+    direction turned into the world frame), and the reference's up in the sensor frame
+    recomputed about it where the world frame is not z-up. Returns what was found, for the
+    printout; RecordingError where no vertical explains the accelerometer."""
+    from .fit.recording import RecordingError
+
+    q = getattr(rec, "ref_quat", None)
+    if q is None:
+        return ""
+    norm = np.linalg.norm(rec.acc, axis=1)
+    quiet = np.isfinite(norm) & np.all(np.isfinite(q), axis=1)
+    quiet &= np.abs(norm / np.nanmedian(norm) - 1.0) < 0.05
+    if quiet.sum() < 10:
+        return ""
+    seen = _rotate(q[quiet], rec.acc[quiet] / norm[quiet, None])
+    up = seen.mean(axis=0)
+    up /= np.linalg.norm(up)
+    spread = float(np.degrees(np.median(np.arccos(np.clip(seen @ up, -1.0, 1.0)))))
+    if spread > WORLD_UP_SPREAD_DEG:
+        raise RecordingError(
+            f"{path}: no vertical of the reference's world frame explains the accelerometer at "
+            f"rest (it scatters {spread:.3g} deg around the best one): is the quaternion the "
+            "sensor-to-world rotation, w first (q_w, q_x, q_y, q_z), and of the same sensor?")
+    tilt = float(np.degrees(np.arccos(np.clip(up[2], -1.0, 1.0))))
+    if tilt <= WORLD_UP_TILT_DEG:
+        return f"reference: its world frame is z-up (within {tilt:.2g} deg)"
+    axis = int(np.argmax(np.abs(up)))
+    off = float(np.degrees(np.arccos(min(1.0, abs(float(up[axis]))))))
+    if off <= WORLD_UP_TILT_DEG:  # frames are laid along their axes: that axis, exactly
+        up = np.eye(3)[axis] * np.sign(up[axis])
+        found = f"{'+' if up[axis] > 0 else '-'}{'xyz'[axis]} (within {off:.2g} deg)"
+    else:
+        found = f"({up[0]:+.3f}, {up[1]:+.3f}, {up[2]:+.3f}), {tilt:.3g} deg from z"
+    conj = q * np.array([1.0, -1.0, -1.0, -1.0])
+    rec.up_ref = _rotate(conj, np.broadcast_to(up, (len(q), 3)).copy())
+    return f"reference: its world frame's up is {found}: scored about that vertical"
 
 
 # ----- running ---------------------------------------------------------------------------------
@@ -474,8 +540,11 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     keys = choose(args.estimator, list(KEYS), "estimator")
     rec, t = recording_from_args(args.recording, args)
     if args.reference is not None:
-        rec.up_ref = reference_by_time(args.reference, t)
+        rec.up_ref, rec.ref_quat = reference_by_time(args.reference, t)
         rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
+    found = align_reference_world(rec, args.reference or args.recording)
+    if found:
+        print(found)
     if rec.up_ref is not None:  # scored where every estimator and VQF took the sample
         rec.counts = rec.counted & _valid(rec)
         scored = int(rec.counts.sum())

@@ -313,3 +313,59 @@ def test_vqf_runs_on_the_samples_the_estimators_take_mounted(tmp_path, capsys):
         return float(next(r for r in out.splitlines() if r.startswith("vqf ")).split()[2])
 
     assert vqf_row(raw, "--mounting", "0,90,0") == pytest.approx(vqf_row(EXAMPLE), abs=1e-3)
+
+
+def _quat_zyx(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Sensor-to-world unit quaternions (w first) of Z-Y-X Euler angles."""
+    cr, sr, cp, sp = np.cos(roll / 2), np.sin(roll / 2), np.cos(pitch / 2), np.sin(pitch / 2)
+    cy, sy = np.cos(yaw / 2), np.sin(yaw / 2)
+    return np.column_stack([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+                            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    w1, x1, y1, z1 = a.T
+    w2, x2, y2, z2 = b.T
+    return np.column_stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _kf_rmse(text: str) -> float:
+    return float(next(r for r in text.splitlines() if r.startswith("kf ")).split()[2])
+
+
+def test_a_reference_whose_world_frame_is_y_up_is_aligned_heading_free(tmp_path, capsys):
+    """Motion capture often has y up: the same attitudes in a y-up world frame score as in
+    the z-up one, and the command says which vertical it found."""
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
+    q = _quat_zyx(truth[:, 1], truth[:, 2], truth[:, 3])
+    to_y_up = np.tile([np.cos(-np.pi / 4), np.sin(-np.pi / 4), 0.0, 0.0], (len(q), 1))
+    header = "time,q_w,q_x,q_y,q_z"
+    z_up, y_up = tmp_path / "z.csv", tmp_path / "y.csv"
+    np.savetxt(z_up, np.column_stack([truth[:, 0], q]), delimiter=",", header=header,
+               comments="")
+    np.savetxt(y_up, np.column_stack([truth[:, 0], _quat_mul(to_y_up, q)]), delimiter=",",
+               header=header, comments="")
+    rmse = {}
+    for path in (z_up, y_up):
+        assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference", str(path),
+                     "--out", str(tmp_path), "--no-plots"]) == 0
+        out = capsys.readouterr().out
+        rmse[path.stem] = _kf_rmse(out)
+    assert "world frame's up is +y" in out
+    assert rmse["y"] == pytest.approx(rmse["z"], abs=1e-4)
+
+
+def test_a_quaternion_reference_of_another_sensor_is_refused(tmp_path, capsys):
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
+    rng = np.random.default_rng(2)
+    q = rng.standard_normal((len(truth), 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    path = tmp_path / "random.csv"
+    np.savetxt(path, np.column_stack([truth[:, 0], q]), delimiter=",",
+               header="time,q_w,q_x,q_y,q_z", comments="")
+    assert main(["estimate", str(EXAMPLE), "--reference", str(path), "--out", str(tmp_path),
+                 "--no-plots"]) == 2
+    assert "no vertical of the reference's world frame explains" in capsys.readouterr().err

@@ -43,6 +43,8 @@ class Recording:
     counts: np.ndarray | None = None
     sensor_delay: float = 0.0
     """How long the samples lag the reference [s] (the estimators' sensor_delay; 0 for a CSV)."""
+    ref_quat: np.ndarray | None = None
+    """A quaternion reference's unit quaternions [N, 4], sensor to world (None: none)."""
     described: str = ""
     """Which columns, units and rate were taken, and why (testbenches.estimate.load_recording)."""
 
