@@ -130,7 +130,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         from .peer_runs import peer_table, run_peers
 
         peer_rows = run_peers(peers, scenarios, args.seeds, sensor, args.duration,
-                              calibrate_first=args.calibrate_first, master=args.master)
+                              calibrate_first=args.calibrate_first)
         print("\n" + peer_table(peer_rows))
     summaries = seed_summaries(result, peer_rows)
     if over_several_seeds(summaries):
