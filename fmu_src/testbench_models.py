@@ -16,6 +16,7 @@ from fusion_core.sensor import ImuSensorModel
 from fusion_core.synthetic import TRUTH_NAMES, Trajectory
 
 from .slave import FmiLog
+from .variables import Variable
 
 
 def truth(trajectory: Trajectory, t: float) -> dict[str, float]:
@@ -56,22 +57,41 @@ class PlantModel:
                              f"parameter scenario = {self.scenario.id}")
 
 
+INPUTS_AT = Variable(
+    "inputs_at", "parameter", "Integer",
+    "When the inputs set before doStep(t, h) hold: 1 = end (at t+h: the plant stepped first, "
+    "as a Gauss-Seidel master has it; the sample covers [t, t+h]) or 2 = start (at t: the "
+    "plant's outputs of the step before, as libcosim, Ecos and parallel containers pass them; "
+    "the sample covers the step before). Matters where the steps vary: dt is then the right "
+    "step's. Allowed: 1 = end, 2 = start; default 'end'; fixed after initialisation",
+    1, variability="fixed", low=1, high=2, items=("end", "start"))
+"""The sensor FMU's master timing parameter (its own, not the sensor model's)."""
+
+
+def sample_interval(h: float, values: Mapping[str, Any]) -> float:
+    """The interval a sensor sample covers: the step h where the inputs hold at its end, the
+    step before (last_step) where they hold at its start (the first sample: h)."""
+    last = values["last_step"]
+    return h if values["inputs_at"] == 1 or not last > 0.0 else last
+
+
 class SensorModel:
     """ImuSensorModel behind the FmuSlave model protocol."""
 
     def __init__(self, params: dict[str, Any]) -> None:
-        self.model = ImuSensorModel(**params)
+        self.model = ImuSensorModel(**{k: v for k, v in params.items() if k != INPUTS_AT.name})
 
     def step(self, t: float, h: float, values: Mapping[str, Any], log: FmiLog) -> dict[str, Any]:
         acc, gyro, dt = self.model.sample(
             (values["omega_x"], values["omega_y"], values["omega_z"]),
             (values["f_x"], values["f_y"], values["f_z"]),
-            h,
+            sample_interval(h, values),
         )
         bias = self.model.gyro_bias
         return {"acc_x": acc[0], "acc_y": acc[1], "acc_z": acc[2],
                 "gyro_x": gyro[0], "gyro_y": gyro[1], "gyro_z": gyro[2], "dt": dt,
-                "true_bias_x": bias[0], "true_bias_y": bias[1], "true_bias_z": bias[2]}
+                "true_bias_x": bias[0], "true_bias_y": bias[1], "true_bias_z": bias[2],
+                "last_step": h}
 
     def set_parameter(self, name: str, value: Any) -> None:
         self.model.set_param(name, value)

@@ -61,6 +61,8 @@ def _build(ssp: Path, out: Path, sequential: bool, step: float, fmi: int) -> Pat
             for p in _parameters(ssp, component):
                 value = str(p.value).lower() if isinstance(p.value, bool) else str(p.value)
                 root.add_start_value(embedded[component], p.name, value)
+        # the sensor's inputs hold at a step's end where the container steps in order
+        root.add_start_value(embedded["sensor"], "inputs_at", "1" if sequential else "2")
         with zipfile.ZipFile(ssp) as z:
             source = _sources(z)["estimator"]
             with z.open(source) as f, tempfile.NamedTemporaryFile(suffix=".fmu") as copy:

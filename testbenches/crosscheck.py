@@ -111,11 +111,15 @@ def plant_reference(md: Any, n: int) -> dict[str, np.ndarray]:
 def sensor_reference(md: Any, inputs: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
     """ImuSensor: ImuSensorModel with the FMU's start values, one sample per step of the inputs
     at its start."""
+    from fmu_src.testbench_models import INPUTS_AT
     from fusion_core.sensor import ImuSensorModel
 
-    model = ImuSensorModel(**_parameters(md))
+    # the sensor model's own parameters (inputs_at is the FMU's: its default, the end of the
+    # step, gives the sample of the step's inputs over h, as here)
+    model = ImuSensorModel(**{k: v for k, v in _parameters(md).items() if k != INPUTS_AT.name})
     names = _outputs(md)
     rows = [_start_row(md, names)]
+    times = _times(n)
     for k in range(n):
         acc, gyro, dt = model.sample(
             tuple(inputs[f"omega_{a}"][k] for a in "xyz"),
@@ -123,7 +127,8 @@ def sensor_reference(md: Any, inputs: dict[str, np.ndarray], n: int) -> dict[str
         bias = model.gyro_bias
         values = {"acc_x": acc[0], "acc_y": acc[1], "acc_z": acc[2], "gyro_x": gyro[0],
                   "gyro_y": gyro[1], "gyro_z": gyro[2], "dt": dt, "true_bias_x": bias[0],
-                  "true_bias_y": bias[1], "true_bias_z": bias[2]}
+                  "true_bias_y": bias[1], "true_bias_z": bias[2],
+                  "last_step": times[k + 1] - times[k]}  # the step fmpy passed
         rows.append([values[name] for name in names])
     table = np.array(rows)
     return {name: table[:, i] for i, name in enumerate(names)}

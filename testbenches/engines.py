@@ -104,7 +104,8 @@ def run_engine(
     n = len(communication_steps(duration, rate, 0.0, seed))
     values: dict[str, dict[str, Any]] = {
         "plant": {"scenario": sc.id},
-        "sensor": {**(sensor_params or {}), "seed": seed},
+        # a Jacobi engine hands the sensor the plant's outputs of the step before
+        "sensor": {**(sensor_params or {}), "seed": seed, "inputs_at": 2},
         "estimator": dict(params or {}),
     }
     outputs = {"plant": TRUTH_NAMES, "sensor": SAMPLE,

@@ -222,7 +222,9 @@ def run_testbench(
     duration = sc.duration if duration is None else float(duration)
     if not rate > 0.0 or not 0.0 <= jitter < 1.0:
         raise ValueError(f"rate={rate!r} must be > 0 and jitter={jitter!r} in [0, 1)")
-    sensor_params = {**(sensor_params or {}), "seed": seed}
+    # the sensor's inputs hold at the step's end (Gauss-Seidel) or its start (Jacobi)
+    sensor_params = {"inputs_at": "start" if jacobi else "end", **(sensor_params or {}),
+                     "seed": seed}
     # The estimator integrates the gyro by the rule the sensor's samples call for
     params = {"gyro_sampling": sensor_params.get("gyro_sampling", "point"), **(params or {})}
     steps = communication_steps(duration, rate, jitter, seed)

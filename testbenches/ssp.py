@@ -134,8 +134,10 @@ def export_ssp(
                    if p.choices}
     values: dict[str, dict[str, Any]] = {
         "plant": {"scenario": sc.id},
-        "sensor": {"seed": seed, **{k: _item(sensor_choices, k, v)
-                                    for k, v in (sensor_params or {}).items()}},
+        # every engine that runs an SSP steps Jacobi: the sensor's inputs hold at a step's
+        # start (container.container_from_ssp sets it per container)
+        "sensor": {"seed": seed, "inputs_at": 2, **{k: _item(sensor_choices, k, v)
+                                                    for k, v in (sensor_params or {}).items()}},
         "estimator": {k: _item(est_choices, k, v) for k, v in (params or {}).items()},
     }
     components = "\n      ".join(_component(c, paths[c], values[c]) for c in paths)

@@ -450,3 +450,20 @@ def test_the_contract_holds_under_the_jacobi_master(fmu_dir: Path) -> None:
     assert all(c.passed for c in jac.checks), [c.line() for c in jac.checks]
     for axis in ("rmse_roll_deg", "rmse_pitch_deg"):
         assert jac.metrics[axis] == pytest.approx(gs.metrics[axis], abs=0.01)
+
+
+def test_t2_holds_under_jacobi_where_the_sensor_knows_its_inputs_hold_at_a_steps_start(
+        fmu_dir: Path) -> None:
+    """Jittered steps under Jacobi: the sensor's inputs are the plant's outputs of the step
+    before, so its sample covers that step (inputs_at = start, which the Jacobi master sets).
+    Left at end, the sample's dt is the next step's and T2 fails by far."""
+    kw = {"duration": 15.0, "fmu_dir": fmu_dir, "master": "jacobi"}
+    fixed = run_testbench("mgcf", contract.T2_SCENARIO, sensor_params=contract.NOISE_FREE, **kw)
+    jittered = run_testbench("mgcf", contract.T2_SCENARIO, jitter=contract.T2_JITTER,
+                             sensor_params=contract.NOISE_FREE, **kw)
+    assert jittered.sensor_params["inputs_at"] == "start"
+    assert contract.check_t2(fixed, jittered).passed
+    wrong = run_testbench("mgcf", contract.T2_SCENARIO, jitter=contract.T2_JITTER,
+                          sensor_params={**contract.NOISE_FREE, "inputs_at": "end"}, **kw)
+    assert wrong.sensor_params["inputs_at"] == "end"
+    assert not contract.check_t2(fixed, wrong).passed

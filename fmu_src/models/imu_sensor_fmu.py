@@ -1,16 +1,18 @@
 """ImuSensor FMU: the MEMS IMU error model (fusion_core.sensor) as an FMI 2.0 co-simulation FMU.
 
 Inputs: the plant's true body rates omega_* [rad/s] and specific force f_* [m/s2], set before
-doStep(t, h). Outputs after doStep(t, h): the IMU sample taken at t+h, acc_* [m/s2], gyro_* [rad/s]
-and dt [s] (h, or h with timestamp jitter), and the gyro's true bias at that sample
-(true_bias_*, the truth for the estimators' bias outputs). A realistic MPU-6050-class IMU by
-default (fusion_core.sensor); seeded and reproducible.
+doStep(t, h). Outputs after doStep(t, h): the IMU sample of those inputs, acc_* [m/s2], gyro_*
+[rad/s] and dt [s], and the gyro's true bias at that sample (true_bias_*, the truth for the
+estimators' bias outputs). The parameter inputs_at says when the inputs hold: at t+h (end, a
+Gauss-Seidel master: dt is h) or at t (start, a Jacobi master: the inputs are the plant's
+outputs of the step before, so the sample covers the step before, and dt is that step's h).
+A realistic MPU-6050-class IMU by default (fusion_core.sensor); seeded and reproducible.
 """
 
 from typing import Any
 
 from fmu_src.slave import FmuSlave
-from fmu_src.testbench_models import SensorModel
+from fmu_src.testbench_models import INPUTS_AT, SensorModel
 from fmu_src.variables import parameter_variable, real_input, real_output, variable_table
 from fusion_core import G
 from fusion_core.sensor import SENSOR_PARAMS
@@ -46,7 +48,11 @@ class ImuSensor(FmuSlave):
         *(real_output(f"true_bias_{a}", "rad/s", f"The gyro's true total bias about {_AXIS[a]} "
                       "at the last sample (truth for the estimators' bias outputs)", 0.0,
                       "deg/s") for a in "xyz"),
+        real_output("last_step", "s", "The communication step size h of the last doStep (0 "
+                    "before the first): with inputs_at = start, the interval the next sample "
+                    "covers"),
         *(parameter_variable(p) for p in SENSOR_PARAMS),
+        INPUTS_AT,
     ))
 
     def create_model(self, params: dict[str, Any]) -> SensorModel:

@@ -1,8 +1,9 @@
 /* sensor.c: the MEMS IMU error model (fc_sensor.h, the twin of fusion_core.sensor) as an FMU
  * model (fmu_model.h). Inputs: the true body rates omega_* and specific force f_*; after
- * doStep(t, h) the outputs are the IMU sample taken at t+h (acc_*, gyro_*, dt) and the gyro's
- * true bias then (true_bias_*). config.h, generated from the FMU's variable table, gives the
- * value references and how the parameter values fill fc_sensor_params. */
+ * doStep(t, h) the outputs are the IMU sample of the inputs (acc_*, gyro_*, dt) and the gyro's
+ * true bias then (true_bias_*); inputs_at says whether the inputs hold at t+h or at t.
+ * config.h, generated from the FMU's variable table, gives the value references and how the
+ * parameter values fill fc_sensor_params. */
 #include <string.h>
 
 #include "config.h"
@@ -34,10 +35,13 @@ static int step(void *data, double *v, double t, double h, char *message, size_t
     const double omega[3] = {v[VR_omega_x], v[VR_omega_y], v[VR_omega_z]};
     const double f[3] = {v[VR_f_x], v[VR_f_y], v[VR_f_z]};
     double acc[3], gyro[3], dt, bias[3];
+    /* the interval the sample covers: h where the inputs hold at t+h (inputs_at = end), the
+     * step before where they hold at t (start; the first sample: h) */
+    double interval = v[VR_inputs_at] == 1.0 || !(v[VR_last_step] > 0.0) ? h : v[VR_last_step];
     (void)t;
     (void)message;
     (void)size;
-    if (fc_sensor_sample(s, omega, f, h, acc, gyro, &dt) != 0) {
+    if (fc_sensor_sample(s, omega, f, interval, acc, gyro, &dt) != 0) {
         return 0;  /* unreachable: the plumbing refuses h <= 0 */
     }
     fc_sensor_gyro_bias(s, bias);
@@ -51,6 +55,7 @@ static int step(void *data, double *v, double t, double h, char *message, size_t
     v[VR_true_bias_x] = bias[0];
     v[VR_true_bias_y] = bias[1];
     v[VR_true_bias_z] = bias[2];
+    v[VR_last_step] = h;
     return 0;
 }
 
