@@ -26,7 +26,7 @@ def add_preset(parser: argparse.ArgumentParser, flag: str = "--preset", more: st
 
 def add_recording_options(parser: argparse.ArgumentParser) -> None:
     """How a recording is read: the options every command that reads one takes (estimate,
-    calibrate, noise, tune; testbenches.estimate.load_recording)."""
+    calibrate, noise, tune; testbenches.fit.recording.load_recording)."""
     parser.add_argument("--rate", type=positive_float, default=None,
                         help="sample rate [Hz] where the file has no time or dt column")
     parser.add_argument("--time-column", default=None, help="the time column's name [s]")

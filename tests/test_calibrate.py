@@ -125,7 +125,7 @@ def test_the_command_writes_the_calibration_and_its_plot(tmp_path, capsys) -> No
 
 @needs_imucal_data
 def test_ferraris_on_the_imucal_session_gives_imucals_scale_errors() -> None:
-    from testbenches.estimate import load_recording
+    from testbenches.fit.recording import load_recording
 
     rec, _ = load_recording(SESSION, rate=102.4, acc_unit="m/s2", gyro_unit="deg/s")
     acc_fit, gyro_fit = fer.ferraris(rec.acc, rec.gyro, rec.dt, fer.read_sections(SECTIONS))

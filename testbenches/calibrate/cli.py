@@ -117,7 +117,7 @@ def _matrix_rows(label: str, m: np.ndarray) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Calibrate, write calibration.json and calibration.png, print the result."""
-    from ..estimate import recording_from_args
+    from ..fit.recording import recording_from_args
 
     rec, t = recording_from_args(args.recording, args)
     acc, gyro, dt, g = rec.acc, rec.gyro, rec.dt, args.gravity

@@ -69,9 +69,8 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_noise(args: argparse.Namespace) -> int:
-    from ..estimate import recording_from_args
     from .noise import run_noise
-    from .recording import rest
+    from .recording import recording_from_args, rest
 
     rec = rest(recording_from_args(args.file, args)[0])
     noise = run_noise(rec, args.out, plots=not args.no_plots,
@@ -95,7 +94,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
     from fusion_core.presets import load_preset
 
-    from ..estimate import recording_from_args
+    from .recording import recording_from_args
     from .tune import fmu_score, tune, write
 
     fit_recs = [recording_from_args(p, args)[0] for p in args.files]

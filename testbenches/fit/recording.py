@@ -1,8 +1,9 @@
-"""Recordings as arrays in SI units: the Recording every command works on, and `load` for a
-CSV file in SI units or a BROAD trial (the commands read theirs with the options they are given,
-testbenches.estimate.recording_from_args; both through the one reader, testbenches.reader).
+"""Recordings as arrays in SI units: the Recording every command works on, and the one way a
+recording file becomes one: `load_recording` (every command, with the options it is given:
+`recording_from_args`), over the table reader (testbenches.reader), the units found or checked
+(testbenches.gyro_unit); `load` for a CSV file in SI units or a BROAD trial.
 
-CSV: a header row naming the columns (testbenches.estimate.ALIASES); the accelerometer and the
+CSV: a header row naming the columns (ALIASES, or --column maps); the accelerometer and the
 gyro are required; `time` or `dt` give the sampling (else --rate); a reference for `tune` is
 either quaternion columns q_w, q_x, q_y, q_z (sensor to world) or roll and pitch [rad]. BROAD
 trials (HDF5 or .mat, testbenches.broad.data) bring their own rate and reference, and `rest()`
@@ -11,6 +12,7 @@ finds their rest segment (the start, before `movement` begins).
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,6 +21,7 @@ import numpy as np
 
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
+from ..reader import TIME_SCALE
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -47,7 +50,7 @@ class Recording:
     ref_quat: np.ndarray | None = None
     """A quaternion reference's unit quaternions [N, 4], sensor to world (None: none)."""
     described: str = ""
-    """Which columns, units and rate were taken, and why (testbenches.estimate.load_recording)."""
+    """Which columns, units and rate were taken, and why (load_recording)."""
 
     @property
     def sensor(self) -> dict[str, Any]:
@@ -73,17 +76,15 @@ class Recording:
 
 
 def load(path: str | Path, rate: float | None = None) -> Recording:
-    """A BROAD trial (by content) or a CSV file in SI units (m/s^2, rad/s), read by the one
-    reader (testbenches.estimate.load_recording, which checks the units against the data);
-    RecordingError saying what is wrong."""
+    """A BROAD trial (by content) or a CSV file in SI units (m/s^2, rad/s), read by
+    load_recording (which checks the units against the data); RecordingError saying what is
+    wrong."""
     path = Path(path)
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
     try:
         trial = load_trial(path)
     except NotABroadTrial:
-        from ..estimate import load_recording
-
         return load_recording(path, rate=rate, acc_unit="m/s2", gyro_unit="rad/s")[0]
     up = gravity_from_quat(trial.opt_quat)
     return Recording(trial.name, trial.acc, trial.gyro, np.full(trial.n, trial.dt), trial.rate,
@@ -98,3 +99,339 @@ def rest(rec: Recording) -> Recording:
         return rec
     first = int(np.argmax(rec.counts))
     return rec.slice(0, first)
+
+
+ALIASES: dict[str, tuple[str, ...]] = {
+    "acc_x": ("acc_x", "ax", "accx", "acc_x_g", "acc_x_ms2", "accelerometer_x", "a_x"),
+    "acc_y": ("acc_y", "ay", "accy", "acc_y_g", "acc_y_ms2", "accelerometer_y", "a_y"),
+    "acc_z": ("acc_z", "az", "accz", "acc_z_g", "acc_z_ms2", "accelerometer_z", "a_z"),
+    "gyro_x": ("gyro_x", "gx", "gyrx", "gyr_x", "gyro_x_dps", "gyroscope_x", "wx", "g_x"),
+    "gyro_y": ("gyro_y", "gy", "gyry", "gyr_y", "gyro_y_dps", "gyroscope_y", "wy", "g_y"),
+    "gyro_z": ("gyro_z", "gz", "gyrz", "gyr_z", "gyro_z_dps", "gyroscope_z", "wz", "g_z"),
+    "time": ("time", "t", "timestamp", "time_s"),
+}
+"""Column names a recording may use (case and spaces ignored), per quantity."""
+G_STANDARD = 9.80665
+
+
+# ----- reading ---------------------------------------------------------------------------------
+
+def _norm_name(name: str) -> str:
+    return name.strip().lower().replace(" ", "_").replace("-", "_")
+
+
+def _find(names: list[str], quantity: str, given: str | None = None) -> int | None:
+    """The column of a quantity: the one given (by its name as written, with or without its
+    unit), else the first of its aliases."""
+    normed = [_norm_name(n) for n in names]
+    wanted = (_norm_name(given),) if given else ALIASES[quantity]
+    for alias in wanted:
+        if alias in normed:
+            return normed.index(alias)
+    return None
+
+
+def parse_columns(specs: list[str]) -> dict[str, str]:
+    """--column QUANTITY=NAME options as {quantity: column name}; RecordingError for a quantity
+    that is not one of ALIASES' or a spec without '='."""
+
+    out = {}
+    for spec in specs:
+        quantity, sep, name = spec.partition("=")
+        quantity = quantity.strip()
+        if not sep or quantity not in (*ALIASES, *EXTRA_COLUMNS):
+            raise RecordingError(f"--column {spec!r}: expected QUANTITY=NAME with QUANTITY one "
+                                 f"of {', '.join((*ALIASES, *EXTRA_COLUMNS))}")
+        out[quantity] = name.strip()
+    return out
+
+
+EXTRA_COLUMNS = ("dt", "roll", "pitch", "q_w", "q_x", "q_y", "q_z")
+"""Columns found by their own name only: the sampling and a reference."""
+
+
+@dataclass
+class Columns:
+    """What read_csv found: each quantity's values, the header names it came from and the unit
+    the header states for it (None: none stated)."""
+
+    values: dict[str, np.ndarray]
+    source: dict[str, str]
+    units: dict[str, str | None]
+    header: list[str]
+    lines: np.ndarray
+
+
+def read_csv(path: Path, time_column: str | None,
+             columns: dict[str, str] | None = None) -> Columns:
+    """The quantities of a delimited text file (testbenches.reader), found by the header's
+    names or the columns given ({quantity: name}); RecordingError otherwise."""
+    from ..reader import TableError, read_table
+
+    try:
+        table = read_table(path)
+    except TableError as err:
+        raise RecordingError(str(err)) from None
+    given = dict(columns or {})
+    if time_column:
+        given.setdefault("time", time_column)
+    found = Columns({}, {}, {}, table.header, table.lines)
+    for quantity in (*ALIASES, *EXTRA_COLUMNS):
+        name = given.get(quantity)
+        i = None
+        if name is not None:
+            i = _find(table.header, quantity, name)
+            if i is None:
+                i = _find(table.names, quantity, name)
+            if i is None:
+                raise RecordingError(f"{path}: no column {name!r} for {quantity}: the header "
+                                     f"has {', '.join(table.header)}")
+        elif quantity in ALIASES:
+            i = _find(table.names, quantity)
+        else:
+            i = _find(table.names, "time", quantity)
+        if i is not None:
+            found.values[quantity] = table.column(i)
+            found.source[quantity] = table.header[i]
+            found.units[quantity] = table.units[i]
+    return found
+
+
+def read_hdf5(path: Path) -> dict[str, np.ndarray]:
+    """acc, gyro [N, 3] and time [N] (or rate) from an HDF5 file that is not a BROAD trial."""
+    import h5py
+
+
+    with h5py.File(path, "r") as f:
+        if "acc" not in f or "gyro" not in f:
+            raise RecordingError(f"{path}: an HDF5 recording holds datasets acc and gyro [N, 3] "
+                                 f"(and time [N] or a rate attribute); it has "
+                                 f"{', '.join(f.keys()) or 'none'}")
+        acc, gyro = np.asarray(f["acc"], float), np.asarray(f["gyro"], float)
+        cols = {f"acc_{a}": acc[:, i] for i, a in enumerate("xyz")}
+        cols.update({f"gyro_{a}": gyro[:, i] for i, a in enumerate("xyz")})
+        if "time" in f:
+            cols["time"] = np.asarray(f["time"], float)
+        elif "rate" in f.attrs:
+            cols["time"] = np.arange(len(acc)) / float(f.attrs["rate"])
+    return cols
+
+
+def _stated(units: dict[str, str | None], axes: tuple[str, ...], path: Path) -> str | None:
+    """The one unit the header states for these columns (None: none); RecordingError where
+    they state different ones."""
+
+    stated = {units.get(a) for a in axes} - {None}
+    if len(stated) > 1:
+        raise RecordingError(f"{path}: the header states the units {', '.join(sorted(stated))} "
+                             f"for {', '.join(axes)}: one unit for the three axes serves")
+    return stated.pop() if stated else None
+
+
+def load_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
+                   acc_unit: str = "auto", gyro_unit: str = "auto",
+                   columns: dict[str, str] | None = None) -> Any:
+    """The recording in SI units (testbenches.fit.recording.Recording; its `described` says
+    which columns, units and rate were taken and why) and the time of each sample [s];
+    RecordingError saying what is wrong."""
+    from ..broad.data import NotABroadTrial, load_trial
+
+    if not path.is_file():
+        raise RecordingError(f"{path}: no such file")
+    lines = None
+    units: dict[str, str | None] = {}
+    source: dict[str, str] = {}
+    if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
+        try:
+            load_trial(path)
+        except NotABroadTrial:
+            if path.suffix.lower() == ".mat":
+                raise RecordingError(f"{path}: a .mat file must be a BROAD trial") from None
+            cols = read_hdf5(path)
+        else:  # a BROAD trial: its own rate, sampling, delay and reference
+            rec = load(path)
+            rec.described = (f"a BROAD trial: {len(rec.dt)} samples at {rec.rate:.4g} Hz, "
+                             "m/s2 and rad/s")
+            return rec, np.cumsum(rec.dt) - rec.dt[0]
+    else:
+        found = read_csv(path, time_column, columns)
+        cols, units, source, lines = found.values, found.units, found.source, found.lines
+        missing = [q for q in IMU_AXES if q not in cols]
+        if missing:
+            raise RecordingError(
+                f"{path}: no column for {', '.join(missing)}: the header has "
+                f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
+                "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME")
+    acc = np.column_stack([cols[f"acc_{a}"] for a in "xyz"])
+    gyro = np.column_stack([cols[f"gyro_{a}"] for a in "xyz"])
+    n = len(acc)
+    if n < 2:
+        raise RecordingError(f"{path}: {n} sample(s); a recording needs many")
+    line_of = (lambda k: f"line {int(lines[k])}") if lines is not None else (
+        lambda k: f"sample {k}")
+    if "time" in cols:
+        t = cols["time"] * TIME_SCALE.get(units.get("time") or "s", 1.0)
+        dt, t = _steps_from_time(t, path, line_of)
+    elif "dt" in cols:
+        dt = cols["dt"] * TIME_SCALE.get(units.get("dt") or "s", 1.0)
+        dt = dt.copy()
+        dt[0] = float(np.nanmedian(dt[1:]))
+        t = np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - dt[0]
+    elif rate:
+        dt = np.full(n, 1.0 / rate)
+        t = np.arange(n) / rate
+    else:
+        raise RecordingError(f"{path}: no time or dt column: give the sample rate (--rate HZ), "
+                             "the time column's name (--time-column NAME) or map it with "
+                             "--column time=NAME")
+    finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
+    if not finite.any():
+        raise RecordingError(f"{path}: no sample holds numbers in every column")
+    acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
+                                    _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
+    gyro_scale, gyro_how = _gyro_scale(path, acc, gyro, dt, gyro_unit,
+                                       _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path))
+    acc = acc * acc_scale
+    gyro = gyro * gyro_scale
+    up, ref_quat = reference_up(cols, path)
+    counts = None if up is None else np.all(np.isfinite(up), axis=1)
+    period = float(np.nanmedian(dt))
+    rec = Recording(path.stem, acc, gyro, dt, 1.0 / period, "point", up, counts)
+    rec.ref_quat = ref_quat
+    where = ", ".join(f"{q}={source[q]!r}" for q in (*IMU_AXES, "time", "dt") if q in source)
+    missing_rows = int((~finite).sum())
+    rec.described = (
+        f"{n} samples, {float(np.nansum(dt[1:])):.4g} s at {1.0 / period:.4g} Hz; acc in "
+        f"{acc_how}; gyro in {gyro_how}"
+        + (f"; columns {where}" if where else "")
+        + (f"; {missing_rows} sample(s) without a number in every column, which the "
+           "estimators reject and count" if missing_rows else ""))
+    return rec, t
+
+
+IMU_AXES = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
+
+
+def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
+    """load_recording with the options add_recording_options defines, the choices printed."""
+    rec, t = load_recording(path, rate=args.rate, time_column=args.time_column,
+                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
+                            columns=parse_columns(args.column))
+    print(f"{path}: {rec.described}")
+    return rec, t
+
+
+def _steps_from_time(t: np.ndarray, path: Path, line_of: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Each sample's dt from a time column: the time since the last sample with a time (a
+    sample without one gets dt NaN, which the estimators reject); RecordingError where the
+    time does not increase."""
+
+    valid = np.flatnonzero(np.isfinite(t))
+    if len(valid) < 2:
+        raise RecordingError(f"{path}: fewer than two samples with a time")
+    steps = np.diff(t[valid])
+    if not np.all(steps > 0.0):
+        i = int(np.argmax(~(steps > 0.0)))
+        a, b = valid[i], valid[i + 1]
+        raise RecordingError(f"{path}, {line_of(b)}: the time {float(t[b]):.6g} s does not "
+                             f"increase from {float(t[a]):.6g} s on {line_of(a)}")
+    dt = np.full(len(t), np.nan)
+    dt[valid[1:]] = steps
+    dt[valid[0]] = float(np.median(steps))
+    filled = np.interp(np.arange(len(t)), valid, t[valid])  # the time of a sample without one
+    return dt, np.where(np.isfinite(t), t, filled)
+
+
+def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
+               ) -> tuple[float, str]:
+    """The factor to m/s^2 and how it was chosen: given, stated by the header, or from the
+    median norm (1 g or 9.81 m/s^2 at rest, and near it on average in motion); refused where
+    the norm in that unit cannot be gravity's."""
+
+    norm = float(np.median(np.linalg.norm(acc, axis=1)))
+    chosen = unit if unit != "auto" else stated
+    how = "given" if unit != "auto" else "from the header"
+    if chosen is None:
+        if 0.5 < norm < 2.0:
+            chosen = "g"
+        elif 5.0 < norm < 20.0:
+            chosen = "m/s2"
+        else:
+            raise RecordingError(
+                f"{path}: the accelerometer's median norm is {norm:.4g}, neither about 1 (g) "
+                "nor about 9.81 (m/s2): give --acc-unit, or check the columns")
+        how = f"from its median norm {norm:.4g}"
+    scale = {"m/s2": 1.0, "g": G_STANDARD}.get(chosen)
+    if scale is None:
+        raise RecordingError(f"{path}: the accelerometer's unit {chosen!r} is not one of g, "
+                             "m/s2")
+    si = norm * scale
+    if not 4.0 < si < 40.0:
+        raise RecordingError(f"{path}: the accelerometer's median norm is {si:.4g} m/s2 in the "
+                             f"unit {chosen} ({how}), which cannot be right (gravity is 9.81)")
+    return scale, f"{chosen} ({how})"
+
+
+def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
+                stated: str | None) -> tuple[float, str]:
+    """The factor to rad/s and how it was chosen: the unit in which the gyro's turn explains
+    the accelerometer's turn of gravity (testbenches.gyro_unit). A unit given or stated by the
+    header that the data contradict is refused with the evidence; where the data cannot tell
+    and no unit is given or stated, the recording is refused."""
+    from ..gyro_unit import UNITS, gyro_unit_evidence
+
+    evidence = gyro_unit_evidence(acc, gyro, dt)
+    chosen = unit if unit != "auto" else stated
+    if chosen is not None:
+        how = "given" if unit != "auto" else "from the header"
+        if chosen not in UNITS:
+            raise RecordingError(f"{path}: the gyro's unit {chosen!r} is not one of rad/s, "
+                                 "deg/s")
+        if evidence.unit is not None and evidence.unit != chosen:
+            raise RecordingError(
+                f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
+                f"{evidence.describe()}, so it reads in {evidence.unit}; give --gyro-unit "
+                f"{evidence.unit}, or check the columns")
+        return UNITS[chosen], f"{chosen} ({how}" + (
+            ", and the data agree)" if evidence.unit else ")")
+    if evidence.unit is None:
+        raise RecordingError(
+            f"{path}: the gyro's unit cannot be told from the data (the gyro turns gravity "
+            "measurably in neither rad/s nor deg/s: too little motion): give --gyro-unit rad/s "
+            "or deg/s")
+    return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})"
+
+
+QUAT_NORM_TOLERANCE = 0.1
+"""A reference quaternion whose norm is further than this from 1 is no rotation: its row is
+left out (and counted)."""
+
+
+def reference_up(cols: dict[str, np.ndarray], path: Path
+                 ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The up direction [N, 3] of the reference columns in the sensor frame, taking the
+    reference's world frame as z-up, and for a quaternion reference the unit quaternions
+    [N, 4] (rows of invalid ones NaN in both; None, None: no reference columns); RecordingError
+    where nothing in them can be an attitude or roll and pitch are not in rad."""
+    from ..broad.metric import gravity_from_quat, gravity_from_roll_pitch
+
+    if all(c in cols for c in ("q_w", "q_x", "q_y", "q_z")):
+        q = np.column_stack([cols[c] for c in ("q_w", "q_x", "q_y", "q_z")])
+        norm = np.linalg.norm(q, axis=1)
+        valid = np.isfinite(norm) & (np.abs(norm - 1.0) <= QUAT_NORM_TOLERANCE)
+        if not valid.any():
+            raise RecordingError(f"{path}: none of the reference's {len(q)} quaternions is a "
+                                 f"rotation (norm within {QUAT_NORM_TOLERANCE} of 1; median "
+                                 f"norm {float(np.nanmedian(norm)):.4g})")
+        unit = np.full((len(q), 4), np.nan)
+        unit[valid] = q[valid] / norm[valid, None]
+        return gravity_from_quat(unit), unit
+    if "roll" in cols and "pitch" in cols:
+        roll, pitch = cols["roll"], cols["pitch"]
+        if np.nanmax(np.abs(roll)) > np.pi + 1e-6 or np.nanmax(np.abs(pitch)) > np.pi / 2 + 1e-6:
+            raise RecordingError(
+                f"{path}: the reference's roll reaches {float(np.nanmax(np.abs(roll))):.4g} and "
+                f"its pitch {float(np.nanmax(np.abs(pitch))):.4g}, beyond pi and pi/2: they "
+                "are in degrees? a reference gives roll and pitch in rad")
+        return gravity_from_roll_pitch(roll, pitch), None
+    return None, None
