@@ -27,6 +27,7 @@ import numpy as np
 
 from fusion_core.scenarios import get_scenario
 from fusion_core.synthetic import TRUTH_NAMES
+from fusion_core.types import DEG
 
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, PLANT_FMU, SENSOR_FMU, fmu_path
 from .master import (
@@ -92,30 +93,18 @@ def run_engine(
     the sensor's seed is set from `seed`. Returns the traces aligned by the Jacobi chain's
     delay, and with evaluate=True the contract's metrics and checks (T3 measures the whole
     engine step, not the estimator alone, and is left out)."""
-    why = engine_reason(engine)
-    if why:
-        raise RuntimeError(why)
     if fmi not in ENGINES[engine]:
         raise ValueError(f"{engine} runs FMI {', '.join(map(str, ENGINES[engine]))}, not {fmi}")
     if estimator not in ESTIMATOR_FMUS:
         raise ValueError(f"unknown estimator {estimator!r}: allowed {', '.join(ESTIMATOR_FMUS)}")
-    sc = get_scenario(scenario)
-    duration = sc.duration if duration is None else float(duration)
-    n = len(communication_steps(duration, rate, 0.0, seed))
     values: dict[str, dict[str, Any]] = {
-        "plant": {"scenario": sc.id},
+        "plant": {"scenario": get_scenario(scenario).id},
         # a Jacobi engine hands the sensor the plant's outputs of the step before
         "sensor": {**(sensor_params or {}), "seed": seed, "inputs_at": 2},
         "estimator": dict(params or {}),
     }
-    outputs = {"plant": TRUTH_NAMES, "sensor": SAMPLE,
-               "estimator": ESTIMATE + (POSITION if estimator == "poskf" else ())}
-    run = {"libcosim": _run_libcosim, "ecos": _run_ecos}[engine]
-    t0 = time.process_time()
-    rows, invalid = run(chain_fmus(estimator, fmu_dir, fmi), values, outputs, 1.0 / rate, n)
-    return _result(engine, f"FMI {fmi}.0", estimator, sc.id, seed, rate,
-                   dict(values["estimator"]), values["sensor"], rows, invalid,
-                   time.process_time() - t0, evaluate)
+    return _run(engine, f"FMI {fmi}.0", chain_fmus(estimator, fmu_dir, fmi), values, estimator,
+                scenario, seed, duration, rate, evaluate)
 
 
 Rows = dict[str, np.ndarray]
@@ -128,6 +117,15 @@ def run_ssp(engine: str, ssp: Path | str, estimator: str, scenario: str | int, s
     parameters from its own parameter sets); estimator, scenario and seed say what it was
     exported with, for the result's labels and the truth at the start. The result is aligned
     and evaluated as run_engine's."""
+    return _run(engine, "SSP", Path(ssp), {}, estimator, scenario, seed, duration, rate,
+                evaluate)
+
+
+def _run(engine: str, how: str, source: Mapping[str, Path] | Path,
+         values: Mapping[str, Mapping[str, Any]], estimator: str, scenario: str | int, seed: int,
+         duration: float | None, rate: float, evaluate: bool) -> TestbenchResult:
+    """The chain of `source` (FMUs by component, set to `values`, or an SSP file) stepped in
+    `engine` at `rate` over the scenario's duration, as a result aligned and evaluated."""
     why = engine_reason(engine)
     if why:
         raise RuntimeError(why)
@@ -138,9 +136,10 @@ def run_ssp(engine: str, ssp: Path | str, estimator: str, scenario: str | int, s
                "estimator": ESTIMATE + (POSITION if estimator == "poskf" else ())}
     run = {"libcosim": _run_libcosim, "ecos": _run_ecos}[engine]
     t0 = time.process_time()
-    rows, invalid = run(Path(ssp), {}, outputs, 1.0 / rate, n)
-    return _result(engine, "SSP", estimator, sc.id, seed, rate, {}, {"seed": seed}, rows,
-                   invalid, time.process_time() - t0, evaluate)
+    rows, invalid = run(source, values, outputs, 1.0 / rate, n)
+    return _result(engine, how, estimator, sc.id, seed, rate,
+                   dict(values.get("estimator", {})), dict(values.get("sensor", {"seed": seed})),
+                   rows, invalid, time.process_time() - t0, evaluate)
 
 
 def _result(engine: str, how: str, estimator: str, scenario: int, seed: int, rate: float,
@@ -273,6 +272,21 @@ TABLE_MARK = "<!-- imu-fusion engines: generated, do not edit -->"
 """The line before the table in docs/guide/engines.md (tests/test_engines.py regenerates it)."""
 
 
+def early_error_deg(r: TestbenchResult) -> float:
+    """The largest attitude error [deg] over EARLY_WINDOW, where a false start shows."""
+    early = (r.t >= EARLY_WINDOW[0]) & (r.t <= EARLY_WINDOW[1])
+    err = np.maximum(np.abs(r.estimate["roll"] - r.truth["roll"]),
+                     np.abs(r.estimate["pitch"] - r.truth["pitch"])) / DEG
+    return float(err[early].max())
+
+
+def velocity_error(r: TestbenchResult, at_s: float = 10.0) -> float:
+    """The position filter's velocity error [m/s] at the sample nearest at_s."""
+    k = int(np.argmin(np.abs(r.t - at_s)))
+    return float(np.linalg.norm([r.estimate[f"vel_{a}"][k] - r.truth[f"vel_{a}"][k]
+                                 for a in "xyz"]))
+
+
 def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TABLE_SCENARIO,
                 seed: int = 0, estimators: list[str] | None = None
                 ) -> list[dict[str, Any]]:
@@ -281,7 +295,6 @@ def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TA
     difference from the project's Jacobi master, the position filter's velocity error at 10 s
     and the speed in simulated seconds per CPU second. Engines that cannot run here are left
     out (engine_reason says why)."""
-    from .contract import DEG
     from .master import run_testbench
 
     folder = Path(fmu_dir) / "native" / "fmi2"
@@ -298,23 +311,16 @@ def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TA
                 r = run_engine(engine, key, scenario, seed, fmi=fmi, fmu_dir=fmu_dir)
                 runs.append((engine, fmi, r, r.cpu_s))
         for name, fmi, r, cpu in runs:
-            early = (r.t >= EARLY_WINDOW[0]) & (r.t <= EARLY_WINDOW[1])
-            err = np.maximum(np.abs(r.estimate["roll"] - r.truth["roll"]),
-                             np.abs(r.estimate["pitch"] - r.truth["pitch"])) / DEG
-            row = {
+            rows.append({
                 "engine": name, "fmi": fmi, "estimator": key,
                 "accuracy": all(c.passed for c in r.checks if c.name.startswith("accuracy")),
                 "rmse": (r.metrics["rmse_roll_deg"], r.metrics["rmse_pitch_deg"]),
-                "early_max_deg": float(err[early].max()),
+                "early_max_deg": early_error_deg(r),
                 "max_diff": max(float(np.max(np.abs(r.estimate[k] - own.estimate[k])))
                                 for k in r.estimate),
-                "vel_err_10s": None, "speed": float(r.t[-1] / cpu) if cpu > 0 else None,
-            }
-            if key == "poskf":
-                at = int(np.argmin(np.abs(r.t - 10.0)))
-                row["vel_err_10s"] = float(np.linalg.norm(
-                    [r.estimate[f"vel_{a}"][at] - r.truth[f"vel_{a}"][at] for a in "xyz"]))
-            rows.append(row)
+                "vel_err_10s": velocity_error(r) if key == "poskf" else None,
+                "speed": float(r.t[-1] / cpu) if cpu > 0 else None,
+            })
     return rows
 
 

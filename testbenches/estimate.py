@@ -204,7 +204,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     if found:
         print(found)
     if rec.up_ref is not None:  # scored where every estimator and VQF took the sample
-        rec.counts = rec.counted & _valid(rec)
+        rec.counts = rec.counted & rec.valid
         scored = int(rec.counts.sum())
         if scored == 0:
             raise RecordingError(f"{args.recording}: no sample has both a valid reference and "
@@ -270,7 +270,7 @@ def _vqf(rec: Any, params: dict[str, Any]) -> tuple[float | None, str]:
     from .broad.metric import inclination_rmse_deg
     from .peers import PeerUnavailable, run_vqf
 
-    valid = _valid(rec)
+    valid = rec.valid
     acc, gyro = conditioned(rec.acc[valid], rec.gyro[valid], params)
     try:
         up_valid = run_vqf(acc, gyro, rec.rate)
@@ -279,12 +279,6 @@ def _vqf(rec: Any, params: dict[str, Any]) -> tuple[float | None, str]:
     up = np.full((len(valid), 3), np.nan)
     up[valid] = up_valid  # VQF takes no sample the estimators rejected
     return inclination_rmse_deg(up, rec.up_ref, rec.counted), "VQF on the same samples"
-
-
-def _valid(rec: Any) -> np.ndarray:
-    """The samples with a number in every column and a dt (the others the estimators reject)."""
-    return (np.all(np.isfinite(rec.acc), 1) & np.all(np.isfinite(rec.gyro), 1)
-            & np.isfinite(rec.dt))
 
 
 def _plot(path: Path, t: np.ndarray, traces: dict[str, dict[str, np.ndarray]], rec: Any) -> str:

@@ -21,14 +21,11 @@ import pytest
 from fusion_core import ESTIMATORS
 from fusion_core.scenarios import get_scenario
 from fusion_core.sensor import SENSOR_PARAMS
-from fusion_core.types import DEG
 from testbenches import engines
 from testbenches.master import run_testbench
 
 KEYS = list(engines.ESTIMATOR_FMUS)
 RUNS = [(engine, fmi) for engine, versions in engines.ENGINES.items() for fmi in versions]
-EARLY = (0.03, 0.5)
-"""The window of the false level start (docs/interface.md, Timing)."""
 EARLY_MAX_DEG = 1.0
 VEL_AT_10S_MAX = 1.5
 
@@ -61,14 +58,9 @@ def test_the_chain_in_the_engine_holds_the_contract_and_equals_the_jacobi_master
     for name, trace in r.estimate.items():
         assert np.array_equal(trace, own.estimate[name]), name  # bit for bit
     assert r.invalid_samples == own.invalid_samples == 1  # the sensor's start: no sample
-    early = (r.t >= EARLY[0]) & (r.t <= EARLY[1])
-    err = np.maximum(np.abs(r.estimate["roll"] - r.truth["roll"]),
-                     np.abs(r.estimate["pitch"] - r.truth["pitch"])) / DEG
-    assert err[early].max() <= EARLY_MAX_DEG
+    assert engines.early_error_deg(r) <= EARLY_MAX_DEG  # over engines.EARLY_WINDOW
     if key == "poskf":
-        at = int(np.argmin(np.abs(r.t - 10.0)))
-        vel = np.array([r.estimate[f"vel_{a}"][at] - r.truth[f"vel_{a}"][at] for a in "xyz"])
-        assert np.linalg.norm(vel) <= VEL_AT_10S_MAX
+        assert engines.velocity_error(r, 10.0) <= VEL_AT_10S_MAX
 
 
 CHOICES = [("sensor", p.name, p.choices) for p in SENSOR_PARAMS if p.choices] + [

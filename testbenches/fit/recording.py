@@ -31,6 +31,11 @@ class RecordingError(ValueError):
     """A file that cannot serve: what is wrong and what is allowed."""
 
 
+def valid_samples(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> np.ndarray:
+    """Rows with a finite accelerometer, gyro and dt."""
+    return np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
+
+
 @dataclass
 class Recording:
     """acc, gyro [N, 3]; dt [N] (dt[0] = the nominal period); up_ref [N, 3] the reference up
@@ -56,6 +61,12 @@ class Recording:
     def sensor(self) -> dict[str, Any]:
         """The estimators' parameters that describe the recording's sensor."""
         return {"gyro_sampling": self.gyro_sampling, "sensor_delay": self.sensor_delay}
+
+    @property
+    def valid(self) -> np.ndarray:
+        """The samples with a number in every column and a dt (the others the estimators
+        reject and count)."""
+        return valid_samples(self.acc, self.gyro, self.dt)
 
     @property
     def counted(self) -> np.ndarray:
@@ -284,7 +295,7 @@ def load_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(f"{path}: no time or dt column: give the sample rate (--rate HZ), "
                              "the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
-    finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
+    finite = valid_samples(acc, gyro, dt)
     if not finite.any():
         raise RecordingError(f"{path}: no sample holds numbers in every column")
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
