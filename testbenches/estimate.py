@@ -1,7 +1,8 @@
 """`imu-fusion estimate RECORDING`: the estimators on a user's own recording.
 
-A recording is a CSV file with a header row, or an HDF5 file (a BROAD trial, or datasets `acc`
-and `gyro` [N, 3] with `time` [N] or a `rate` attribute). Columns are found by name: the
+A recording is a delimited text file (CSV) with a header row, a Parquet file, an HDF5 file or a
+MATLAB .mat file (a BROAD trial, or columns as 1-D datasets or variables, acc and gyro also as
+[N, 3] ones, with a time column or a `rate`; testbenches.reader). Columns are found by name: the
 accelerometer as acc_x/acc_y/acc_z (or ax/ay/az, accX/accY/accZ, acc_x_g, ...), the gyro as
 gyro_x/... (or gx/gy/gz, gyrX/..., wx/wy/wz), the time as time/t/timestamp (or --time-column), the
 sampling as dt or --rate; --column QUANTITY=NAME maps any other name. The delimiter, the
@@ -17,9 +18,12 @@ A reference, roll and pitch [rad] or a quaternion q_w, q_x, q_y, q_z (sensor to 
 in the recording or in a file of its own (--reference, matched by time), gives the inclination
 RMSE, beside VQF's on the same samples where the `vqf` package is installed.
 
-It writes, per estimator, OUT/<recording>_<estimator>.csv (time, roll, pitch [rad], bias_x..z
-[rad/s], and for the position filter pos_x..z [m], vel_x..z [m/s]) and OUT/<recording>.png.
-A file that cannot serve gets one line saying what was wrong.
+It writes, per estimator, OUT/<recording>_<estimator>.csv (or .parquet, .h5 with --format):
+time, roll, pitch [rad], bias_x..z [rad/s], and for the position filter pos_x..z [m],
+vel_x..z [m/s] (--outputs chooses, --every N keeps every Nth sample), and OUT/<recording>.png.
+The recording is read, run and written in blocks, the estimators in parallel through their C
+twin, so memory does not grow with its length; a progress bar shows on a terminal. A file that
+cannot serve gets one line saying what was wrong, and no output file.
 """
 
 from __future__ import annotations
@@ -31,25 +35,35 @@ from typing import Any
 
 import numpy as np
 
-from .fit.recording import read_csv, recording_from_args, reference_up  # the one reader
+from .fit.recording import read_columns, reference_up  # the one reader
 from .options import (
     add_calibration,
     add_preset,
     add_recording_options,
     parse_params,
+    positive_int,
     with_calibration,
 )
 from .reader import TIME_SCALE
+from .table_out import FORMATS, TableWriter
+
+OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", "bias_z"),
+           "pos": ("pos_x", "pos_y", "pos_z"), "vel": ("vel_x", "vel_y", "vel_z"),
+           "rejected": ("rejected",)}
+"""The output groups --outputs chooses from, and their columns."""
+PLOT_POINTS = 20000
+"""The plot keeps at most about twice this many samples per line (every kth, k doubling)."""
 
 G_STANDARD = 9.80665
 DEG = np.pi / 180.0
 
 
 def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    p = sub.add_parser("estimate", help="run estimators on your own recording (CSV or HDF5)",
+    p = sub.add_parser("estimate", help="run estimators on your own recording (CSV, Parquet, "
+                       "HDF5, MAT)",
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.set_defaults(func=cmd_estimate)
-    p.add_argument("recording", type=Path, help="CSV or HDF5 recording")
+    p.add_argument("recording", type=Path, help="the recording: CSV, Parquet, HDF5 or MAT")
     p.add_argument("--estimator", default="all", help="all or a comma list of the estimators")
     add_preset(p)
     add_calibration(p)
@@ -69,45 +83,65 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
                    "reference, matched by time")
     p.add_argument("--out", type=Path, default=Path("reports/estimate"),
                    help="output folder (reports/estimate)")
+    p.add_argument("--format", choices=tuple(FORMATS), default="csv",
+                   help="the outputs' format (csv)")
+    p.add_argument("--outputs", default="roll,pitch,bias,pos,vel", metavar="LIST",
+                   help=f"which outputs to write beside time: a comma list of {', '.join(OUTPUTS)} "
+                   "(default roll,pitch,bias,pos,vel; pos and vel for the position filter)")
+    p.add_argument("--every", type=positive_int, default=1, metavar="N",
+                   help="write every Nth sample (the estimators still take every one)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plot")
 
 
-def reference_by_time(path: Path, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """The up direction [N, 3] of a reference file (time with roll, pitch or q_w..q_z) at the
-    recording's times (linear between the reference's samples; NaN outside them and where the
-    reference has no valid row); RecordingError where it cannot serve."""
-    from .fit.recording import RecordingError
+class Reference:
+    """A reference file (time with roll, pitch or q_w..q_z), read whole (a reference is a
+    recording's companion, not its bulk), matched to a recording's times by `at`."""
 
-    found = read_csv(path, None)
-    cols, header = found.values, found.header
-    if "time" not in cols:
-        raise RecordingError(f"{path}: a reference needs a time column [s]; it has "
-                             f"{', '.join(header)}")
-    up, quat = reference_up(cols, path)
-    if up is None:
-        raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, q_y, "
-                             f"q_z; it has {', '.join(header)}")
-    ref_t = cols["time"] * TIME_SCALE.get(found.units.get("time") or "s", 1.0)
-    keep = np.isfinite(ref_t) & np.all(np.isfinite(up), axis=1)
-    if not keep.any():
-        raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
-                             "attitude")
-    lo, hi = float(ref_t[keep].min()), float(ref_t[keep].max())
-    if hi < t[0] or lo > t[-1]:
-        raise RecordingError(f"{path}: the reference's time ({lo:.6g} to {hi:.6g} s) does not "
-                             f"overlap the recording's ({t[0]:.6g} to {t[-1]:.6g} s): both "
-                             "must count from the same instant")
-    out = np.column_stack([np.interp(t, ref_t[keep], up[keep, i], left=np.nan, right=np.nan)
-                           for i in range(3)])
-    q_at = None
-    if quat is not None:  # componentwise between neighbours of one sign, renormalised
-        q = quat[keep].copy()
-        flips = np.cumsum(np.concatenate([[0], np.sum(q[1:] * q[:-1], axis=1) < 0.0])) % 2
-        q[flips == 1] *= -1.0
-        q_at = np.column_stack([np.interp(t, ref_t[keep], q[:, i], left=np.nan,
-                                          right=np.nan) for i in range(4)])
-        q_at /= np.linalg.norm(q_at, axis=1, keepdims=True)
-    return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
+    def __init__(self, path: Path) -> None:
+        from .fit.recording import RecordingError
+
+        cols, found = read_columns(path)
+        if "time" not in cols:
+            raise RecordingError(f"{path}: a reference needs a time column [s]; it has "
+                                 f"{', '.join(found.header)}")
+        up, quat = reference_up(cols, path)
+        if up is None:
+            raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, "
+                                 f"q_y, q_z; it has {', '.join(found.header)}")
+        t = cols["time"] * TIME_SCALE.get(found.units.get("time") or "s", 1.0)
+        keep = np.isfinite(t) & np.all(np.isfinite(up), axis=1)
+        if not keep.any():
+            raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
+                                 "attitude")
+        self.path, self.t, self.up = path, t[keep], up[keep]
+        self.quat = None
+        if quat is not None:  # componentwise between neighbours of one sign, renormalised
+            q = quat[keep].copy()
+            flips = np.cumsum(np.concatenate([[0], np.sum(q[1:] * q[:-1], axis=1) < 0.0])) % 2
+            q[flips == 1] *= -1.0
+            self.quat = q
+
+    @property
+    def span(self) -> tuple[float, float]:
+        return float(self.t.min()), float(self.t.max())
+
+    def overlap_error(self, first: float, last: float) -> str:
+        lo, hi = self.span
+        return (f"{self.path}: the reference's time ({lo:.6g} to {hi:.6g} s) does not overlap "
+                f"the recording's ({first:.6g} to {last:.6g} s): both must count from the same "
+                "instant")
+
+    def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """The up direction [n, 3] at the times t (linear between the reference's samples; NaN
+        outside them) and, for a quaternion reference, the unit quaternions [n, 4]."""
+        out = np.column_stack([np.interp(t, self.t, self.up[:, i], left=np.nan, right=np.nan)
+                               for i in range(3)])
+        q_at = None
+        if self.quat is not None:
+            q_at = np.column_stack([np.interp(t, self.t, self.quat[:, i], left=np.nan,
+                                              right=np.nan) for i in range(4)])
+            q_at /= np.linalg.norm(q_at, axis=1, keepdims=True)
+        return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
 
 
 WORLD_UP_SPREAD_DEG = 10.0
@@ -125,22 +159,22 @@ def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return v + w * t + np.cross(u, t)
 
 
-def align_reference_world(rec: Any, path: Path) -> str:
+def find_world_up(rec: Any, path: Path) -> tuple[np.ndarray | None, str]:
     """For a quaternion reference (rec.ref_quat, sensor to world): the world's vertical as the
     accelerometer at rest sees it, heading-free (the mean over quiet samples of the measured
-    direction turned into the world frame), and the reference's up in the sensor frame
-    recomputed about it where the world frame is not z-up. Returns what was found, for the
-    printout; RecordingError where no vertical explains the accelerometer."""
+    direction turned into the world frame), where it is not the world frame's z axis (None
+    where it is, or where there is nothing to tell), and what was found, for the printout;
+    RecordingError where no vertical explains the accelerometer."""
     from .fit.recording import RecordingError
 
     q = getattr(rec, "ref_quat", None)
     if q is None:
-        return ""
+        return None, ""
     norm = np.linalg.norm(rec.acc, axis=1)
     quiet = np.isfinite(norm) & np.all(np.isfinite(q), axis=1)
     quiet &= np.abs(norm / np.nanmedian(norm) - 1.0) < 0.05
     if quiet.sum() < 10:
-        return ""
+        return None, ""
     seen = _rotate(q[quiet], rec.acc[quiet] / norm[quiet, None])
     up = seen.mean(axis=0)
     up /= np.linalg.norm(up)
@@ -152,7 +186,7 @@ def align_reference_world(rec: Any, path: Path) -> str:
             "sensor-to-world rotation, w first (q_w, q_x, q_y, q_z), and of the same sensor?")
     tilt = float(np.degrees(np.arccos(np.clip(up[2], -1.0, 1.0))))
     if tilt <= WORLD_UP_TILT_DEG:
-        return f"reference: its world frame is z-up (within {tilt:.2g} deg)"
+        return None, f"reference: its world frame is z-up (within {tilt:.2g} deg)"
     axis = int(np.argmax(np.abs(up)))
     off = float(np.degrees(np.arccos(min(1.0, abs(float(up[axis]))))))
     if off <= WORLD_UP_TILT_DEG:  # frames are laid along their axes: that axis, exactly
@@ -160,9 +194,13 @@ def align_reference_world(rec: Any, path: Path) -> str:
         found = f"{'+' if up[axis] > 0 else '-'}{'xyz'[axis]} (within {off:.2g} deg)"
     else:
         found = f"({up[0]:+.3f}, {up[1]:+.3f}, {up[2]:+.3f}), {tilt:.3g} deg from z"
+    return up, f"reference: its world frame's up is {found}: scored about that vertical"
+
+
+def about_world_up(q: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """The world's up `up` [3] in the sensor frame for sensor-to-world quaternions q [n, 4]."""
     conj = q * np.array([1.0, -1.0, -1.0, -1.0])
-    rec.up_ref = _rotate(conj, np.broadcast_to(up, (len(q), 3)).copy())
-    return f"reference: its world frame's up is {found}: scored about that vertical"
+    return _rotate(conj, np.broadcast_to(up, (len(q), 3)).copy())
 
 
 # ----- running ---------------------------------------------------------------------------------
@@ -187,67 +225,265 @@ def estimator_params(args: argparse.Namespace, entry: dict[str, Any]) -> dict[st
     return params
 
 
+def output_columns(spec: str, position: bool) -> list[str]:
+    """The output columns --outputs names (time first), for an estimator with or without a
+    position; ValueError naming an unknown group."""
+    from .options import choose
+
+    groups = choose(spec, list(OUTPUTS), "output")
+    if not position:
+        groups = [g for g in groups if g not in ("pos", "vel")]
+    return ["time", *(c for g in groups for c in OUTPUTS[g])]
+
+
+def _columns(out: dict[str, np.ndarray], t: np.ndarray, names: list[str], keep: slice | np.ndarray
+             ) -> list[np.ndarray]:
+    pick = {"time": t, "roll": out["roll"], "pitch": out["pitch"],
+            "rejected": out["rejected"].astype(float)}
+    for group in ("bias", "pos", "vel"):
+        if group in out:
+            pick.update({f"{group}_{a}": out[group][:, i] for i, a in enumerate("xyz")})
+    return [pick[n][keep] for n in names]
+
+
+class Score:
+    """An inclination RMSE [deg] summed block by block (BROAD's rule: the counted samples with
+    a reference and an estimate)."""
+
+    def __init__(self) -> None:
+        self.sum_sq, self.n = 0.0, 0
+
+    def add(self, up: np.ndarray, rec: Any) -> None:
+        from .broad.metric import inclination_error
+
+        if rec.up_ref is None:
+            return
+        e = inclination_error(up, rec.up_ref)[rec.counted]
+        e = e[np.isfinite(e)]
+        self.sum_sq += float(np.sum(e * e))
+        self.n += len(e)
+
+    @property
+    def rmse(self) -> float:
+        return float(np.degrees(np.sqrt(self.sum_sq / self.n))) if self.n else float("nan")
+
+
+class Thinned:
+    """Every kth sample of a long series, k doubling whenever more than 2 * PLOT_POINTS are
+    kept: what a plot of any length shows."""
+
+    def __init__(self) -> None:
+        self.k, self.rows = 1, np.empty(0, dtype=np.int64)
+        self.values: dict[str, np.ndarray] = {}
+
+    def add(self, row0: int, values: dict[str, np.ndarray]) -> None:
+        """A block's series (each [n] or [n, m]) from the recording's row row0."""
+        rows = np.arange(row0, row0 + len(next(iter(values.values()))))
+        keep = rows % self.k == 0
+        self.rows = np.concatenate([self.rows, rows[keep]])
+        for name, v in values.items():
+            old = self.values.get(name)
+            self.values[name] = v[keep] if old is None else np.concatenate([old, v[keep]])
+        while len(self.rows) > 2 * PLOT_POINTS:
+            self.k *= 2
+            keep = self.rows % self.k == 0
+            self.rows = self.rows[keep]
+            self.values = {name: v[keep] for name, v in self.values.items()}
+
+
+class _Run:
+    """One estimator over a recording's blocks: its outputs written, its score and plot trace
+    kept."""
+
+    def __init__(self, key: str, est: Any, path: Path, fmt: str, names: list[str]) -> None:
+        self.key, self.est = key, est
+        self.writer = TableWriter(path, fmt, names)
+        self.score, self.trace, self.rejected = Score(), Thinned(), 0
+
+    def block(self, rec: Any, t: np.ndarray, row0: int, every: int) -> None:
+        from .broad.metric import gravity_from_roll_pitch
+
+        out = self.est.run(rec.acc, rec.gyro, rec.dt)
+        keep = np.flatnonzero((row0 + np.arange(len(t))) % every == 0)
+        self.writer.write(_columns(out, t, self.writer.names, keep))
+        up = gravity_from_roll_pitch(out["roll"], out["pitch"])
+        self.score.add(up, rec)
+        self.trace.add(row0, {"t": t, "up": up})
+        self.rejected += int(out["rejected"].sum())
+
+
+class _VqfRun:
+    """VQF on the samples the estimators took (their calibration and mounting applied, the
+    samples they reject left out), block by block; `note` says why there is none."""
+
+    def __init__(self, rate: float, params: dict[str, Any]) -> None:
+        from .peers import PeerUnavailable, VqfStream
+
+        self.params, self.score, self.trace = params, Score(), Thinned()
+        try:
+            self.stream: Any = VqfStream(rate)
+            self.note = "VQF on the same samples"
+        except PeerUnavailable as err:
+            self.stream, self.note = None, f"(VQF not run: {str(err).split('; ')[-1]})"
+
+    def block(self, rec: Any, t: np.ndarray, row0: int, every: int) -> None:
+        if self.stream is None:
+            return
+        valid = rec.valid
+        acc, gyro = conditioned(rec.acc[valid], rec.gyro[valid], self.params)
+        up = np.full((len(valid), 3), np.nan)
+        up[valid] = self.stream(acc, gyro)  # VQF takes no sample the estimators rejected
+        self.score.add(up, rec)
+        self.trace.add(row0, {"t": t, "up": up})
+
+
+def _read_ahead(blocks: Any) -> Any:
+    """The blocks of an iterator, the next one read by a thread of its own while the caller
+    works on the last (the reader's exceptions raised in the caller, in order)."""
+    import queue
+    import threading
+
+    ready: queue.Queue[Any] = queue.Queue(maxsize=1)
+    stop = threading.Event()
+
+    def read() -> None:
+        try:
+            for block in blocks:
+                while not stop.is_set():
+                    try:
+                        ready.put((block, None), timeout=0.1)
+                        break
+                    except queue.Full:
+                        continue
+                if stop.is_set():
+                    return
+            ready.put((None, None))
+        except BaseException as err:  # handed to the caller
+            ready.put((None, err))
+
+    thread = threading.Thread(target=read, daemon=True)
+    thread.start()
+    try:
+        while True:
+            block, err = ready.get()
+            if err is not None:
+                raise err
+            if block is None:
+                return
+            yield block
+    finally:
+        stop.set()
+
+
+def _progress(source: Any) -> Any:
+    from tqdm import tqdm
+
+    return tqdm(total=source.rows, unit="sample", unit_scale=True, disable=None,
+                desc=source.name, leave=False)
+
+
 def cmd_estimate(args: argparse.Namespace) -> int:
+    from concurrent.futures import ThreadPoolExecutor
+
     from fusion_core.presets import load_preset
     from fusion_core.registry import KEYS, create
 
-    from .broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
-    from .fit.recording import RecordingError
+    from .fit.recording import source_from_args
     from .options import choose
 
     keys = choose(args.estimator, list(KEYS), "estimator")
-    rec, t = recording_from_args(args.recording, args)
-    if args.reference is not None:
-        rec.up_ref, rec.ref_quat = reference_by_time(args.reference, t)
-        rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
-    found = align_reference_world(rec, args.reference or args.recording)
-    if found:
-        print(found)
-    if rec.up_ref is not None:  # scored where every estimator and VQF took the sample
-        rec.counts = rec.counted & rec.valid
-        scored = int(rec.counts.sum())
-        if scored == 0:
-            raise RecordingError(f"{args.recording}: no sample has both a valid reference and "
-                                 "numbers in every column: nothing to score")
-        print(f"reference: {scored} of {len(rec.counts)} samples scored (the others lack a "
-              "valid reference or a number)")
     preset = with_calibration(load_preset(args.preset), args.calibration)
-    estimators = {k: create(k, estimator_params(args, preset[k])) for k in keys}
+    estimators = {key: create(key, estimator_params(args, preset[key])) for key in keys}
+    names = {key: output_columns(args.outputs, est.HAS_POSITION)
+             for key, est in estimators.items()}
+    source = source_from_args(args.recording, args)
+    print(f"{args.recording}: {source.choices}")
+    reference = Reference(args.reference) if args.reference is not None else None
     args.out.mkdir(parents=True, exist_ok=True)
-    rows, traces = [], {}
-    for key, est in estimators.items():
-        out = est.run(rec.acc, rec.gyro, rec.dt)
-        traces[key] = out
-        path = args.out / f"{rec.name}_{key}.csv"
-        _write_csv(path, t, out)
-        rmse = None
-        if rec.up_ref is not None:
-            rmse = inclination_rmse_deg(gravity_from_roll_pitch(out["roll"], out["pitch"]),
-                                        rec.up_ref, rec.counted)
-        rows.append((key, int(out["rejected"].sum()), rmse, path))
-    vqf_rmse, vqf_note = None, ""
-    if rec.up_ref is not None:
-        vqf_rmse, vqf_note = _vqf(rec, estimator_params(args, preset[keys[0]]))
+    runs: list[Any] = []
+    try:
+        for key, est in estimators.items():
+            path = args.out / f"{source.name}_{key}{FORMATS[args.format]}"
+            runs.append(_Run(key, est, path, args.format, names[key]))
+        vqf, found = _run_blocks(args, source, reference, runs, ThreadPoolExecutor, keys, preset)
+    except BaseException:
+        for run in runs:
+            run.writer.discard()
+        raise
+    print(found["read"])
+    for line in found["notes"]:
+        print(line)
     print(f"{'estimator':<10} {'rejected':>8} {'incl. RMSE [deg]':>17}  output")
-    for key, rejected, rmse, path in rows:
-        shown = f"{rmse:17.4f}" if rmse is not None else f"{'-':>17}"
-        print(f"{key:<10} {rejected:>8} {shown}  {path}")
-    if rec.up_ref is not None:
-        shown = f"{vqf_rmse:17.4f}" if vqf_rmse is not None else f"{'-':>17}"
-        print(f"{'vqf':<10} {'-':>8} {shown}  {vqf_note}")
+    scored = found["scored"]
+    for run in runs:
+        shown = f"{run.score.rmse:17.4f}" if scored else f"{'-':>17}"
+        print(f"{run.key:<10} {run.rejected:>8} {shown}  {run.writer.commit()}")
+    if scored and vqf is not None:
+        shown = f"{vqf.score.rmse:17.4f}" if vqf.stream is not None else f"{'-':>17}"
+        print(f"{'vqf':<10} {'-':>8} {shown}  {vqf.note}")
     if not args.no_plots:
-        print(_plot(args.out / f"{rec.name}.png", t, traces, rec))
+        print(_plot(args.out / f"{source.name}.png", runs, vqf if scored else None,
+                    found["trace"], source.name))
     return 0
 
 
-def _write_csv(path: Path, t: np.ndarray, out: dict[str, np.ndarray]) -> None:
-    names = ["time", "roll", "pitch", "bias_x", "bias_y", "bias_z"]
-    cols = [t, out["roll"], out["pitch"], *out["bias"].T]
-    if "pos" in out:
-        names += [f"{q}_{a}" for q in ("pos", "vel") for a in "xyz"]
-        cols += [*out["pos"].T, *out["vel"].T]
-    np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(names), comments="",
-               fmt="%.17g")
+def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | None,
+                runs: list[Any], pool_type: Any, keys: list[str], preset: dict[str, Any]
+                ) -> tuple[Any, dict[str, Any]]:
+    """Every block through every estimator (in parallel: the C twin runs without the GIL) and
+    VQF where there is a reference; what was read, found and scored."""
+    import os
+
+    from .fit.recording import RecordingError
+
+    world_up, notes, vqf = None, [], None
+    n = missing = scored = 0
+    first_t = last_t = float("nan")
+    truth = Thinned()
+    duration = 0.0
+    workers = max(1, min(len(runs) + 1, os.cpu_count() or 1))
+    with pool_type(workers) as pool, _progress(source) as bar:
+        for rec, t in _read_ahead(source.blocks()):
+            if reference is not None:
+                if n == 0 and reference.span[1] < t[0]:
+                    raise RecordingError(reference.overlap_error(float(t[0]), float("nan")))
+                rec.up_ref, rec.ref_quat = reference.at(t)
+                rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
+            if n == 0:
+                world_up, note = find_world_up(rec, args.reference or args.recording)
+                notes += [note] if note else []
+                if rec.up_ref is not None:
+                    vqf = _VqfRun(source.rate, estimator_params(args, preset[keys[0]]))
+            if world_up is not None and rec.ref_quat is not None:
+                rec.up_ref = about_world_up(rec.ref_quat, world_up)
+            if rec.up_ref is not None:  # scored where every estimator and VQF took the sample
+                rec.counts = rec.counted & rec.valid
+                scored += int(rec.counts.sum())
+                truth.add(n, {"t": t, "up": rec.up_ref})
+            tasks = [*runs, *([vqf] if vqf is not None else [])]
+            done = [pool.submit(r.block, rec, t, n, args.every) for r in tasks]
+            for job in done:
+                job.result()
+            if n == 0:
+                first_t = float(t[0])
+            last_t = float(t[-1])
+            duration += float(np.nansum(rec.dt[1:] if n == 0 else rec.dt))
+            missing += int((~rec.valid).sum())
+            n += len(t)
+            bar.update(len(t))
+    if reference is not None and scored == 0:
+        lo, hi = reference.span
+        if hi < first_t or lo > last_t:
+            raise RecordingError(reference.overlap_error(first_t, last_t))
+    if vqf is not None or reference is not None or scored:
+        if scored == 0:
+            raise RecordingError(f"{args.recording}: no sample has both a valid reference and "
+                                 "numbers in every column: nothing to score")
+        notes.append(f"reference: {scored} of {n} samples scored (the others lack a valid "
+                     "reference or a number)")
+    found = {"read": f"read {source.summary(n, duration, missing, choices=False)}", "notes": notes,
+             "scored": scored, "trace": truth}
+    return vqf, found
 
 
 def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]
@@ -264,24 +500,10 @@ def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]
     return acc @ r.T, gyro @ r.T
 
 
-def _vqf(rec: Any, params: dict[str, Any]) -> tuple[float | None, str]:
-    """VQF's inclination RMSE on the samples the estimators took (their calibration and
-    mounting applied, the samples they reject left out), or why there is none."""
-    from .broad.metric import inclination_rmse_deg
-    from .peers import PeerUnavailable, run_vqf
-
-    valid = rec.valid
-    acc, gyro = conditioned(rec.acc[valid], rec.gyro[valid], params)
-    try:
-        up_valid = run_vqf(acc, gyro, rec.rate)
-    except PeerUnavailable as err:
-        return None, f"(VQF not run: {str(err).split('; ')[-1]})"
-    up = np.full((len(valid), 3), np.nan)
-    up[valid] = up_valid  # VQF takes no sample the estimators rejected
-    return inclination_rmse_deg(up, rec.up_ref, rec.counted), "VQF on the same samples"
-
-
-def _plot(path: Path, t: np.ndarray, traces: dict[str, dict[str, np.ndarray]], rec: Any) -> str:
+def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> str:
+    """The up direction each estimator finds (its three components: readable at any attitude,
+    where roll is not near 90 deg of pitch), the reference's, and with a reference each one's
+    inclination error; every series thinned alike (Thinned)."""
     try:
         import matplotlib
 
@@ -289,21 +511,36 @@ def _plot(path: Path, t: np.ndarray, traces: dict[str, dict[str, np.ndarray]], r
         import matplotlib.pyplot as plt
     except ImportError:
         return "(no plot: matplotlib is not installed)"
-    fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 5.5))
-    for key, out in traces.items():
-        axes[0].plot(t, np.degrees(out["roll"]), lw=0.9, label=key)
-        axes[1].plot(t, np.degrees(out["pitch"]), lw=0.9, label=key)
-    if rec.up_ref is not None:
-        up = rec.up_ref
-        ref_roll = np.degrees(np.arctan2(up[:, 1], up[:, 2]))
-        ref_pitch = np.degrees(np.arctan2(-up[:, 0], np.hypot(up[:, 1], up[:, 2])))
-        axes[0].plot(t, ref_roll, "k--", lw=0.8, label="reference")
-        axes[1].plot(t, ref_pitch, "k--", lw=0.8, label="reference")
-    axes[0].set_ylabel("roll [deg]")
-    axes[1].set_ylabel("pitch [deg]")
-    axes[1].set_xlabel("time [s]")
-    axes[0].legend(fontsize=8, ncol=3)
-    axes[0].set_title(rec.name)
+    from .broad.metric import inclination_error
+
+    scored = len(truth.rows) > 0
+    fig, axes = plt.subplots(4 if scored else 3, 1, sharex=True,
+                             figsize=(9, 8.5 if scored else 6.5))
+    series = [(run.key, run.trace) for run in runs]
+    if vqf is not None and vqf.stream is not None:
+        series.append(("vqf", vqf.trace))
+    for key, trace in series:
+        if not trace.values:
+            continue
+        t, up = trace.values["t"], trace.values["up"]
+        for i, ax in enumerate(axes[:3]):
+            ax.plot(t, up[:, i], lw=0.9, label=key)
+        if scored:  # the same rows: every series is thinned alike
+            _, a, b = np.intersect1d(trace.rows, truth.rows, return_indices=True)
+            err = np.degrees(inclination_error(up[a], truth.values["up"][b]))
+            axes[3].plot(t[a], np.maximum(err, 1e-3), lw=0.8, label=key)
+    if scored:
+        for i, ax in enumerate(axes[:3]):
+            ax.plot(truth.values["t"], truth.values["up"][:, i], "k--", lw=0.8,
+                    label="reference")
+        axes[3].set_ylabel("inclination\nerror [deg]")
+        axes[3].set_yscale("log")
+    for i, ax in enumerate(axes[:3]):
+        ax.set_ylabel(f"up, {'xyz'[i]}")
+        ax.set_ylim(-1.05, 1.05)
+    axes[-1].set_xlabel("time [s]")
+    axes[0].legend(fontsize=8, ncol=4, loc="lower right")
+    axes[0].set_title(f"{name}: the up direction in the sensor frame (gravity's, unit length)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -71,11 +71,18 @@ def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> Uni
     """The evidence for each unit of `gyro` [N, 3] (numbers as read) from `acc` [N, 3] (any
     unit: only its direction and its norm relative to the median are used) and `dt` [N] [s]
     (rows with a non-finite value are left out of every window that holds them)."""
+    return verdict(window_misses(acc, gyro, dt))
+
+
+def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str, np.ndarray]:
+    """Each unit's miss [deg] in every window that counts (gyro_unit_evidence's data), so that
+    the windows of a recording's blocks can be pooled before the verdict."""
     acc, gyro, dt = (np.asarray(a, dtype=float) for a in (acc, gyro, dt))
+    none = {unit: np.empty(0) for unit in UNITS}
     n = len(dt)
     period = float(np.nanmedian(dt)) if n else 0.0
     if not (n > 2 and period > 0.0):
-        return UnitEvidence(dict.fromkeys(UNITS, float("nan")), 0, None)
+        return none
     k = max(1, round(WINDOW_S / period))
     finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
     acc = np.where(finite[:, None], acc, 0.0)
@@ -85,7 +92,7 @@ def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> Uni
     norm = np.linalg.norm(smooth, axis=1)
     g = float(np.median(norm[finite])) if finite.any() else 0.0
     if not g > 0.0 or n <= k:
-        return UnitEvidence(dict.fromkeys(UNITS, float("nan")), 0, None)
+        return none
     u = smooth / np.where(norm > 0.0, norm, 1.0)[:, None]
     quiet = finite & (np.abs(norm / g - 1.0) < QUIET_G)
     bad = np.concatenate([[0], np.cumsum(~finite)])
@@ -105,7 +112,13 @@ def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> Uni
             v /= np.linalg.norm(v, axis=1, keepdims=True)
         cos_miss = np.clip(np.sum(v * u[ends], axis=1), -1.0, 1.0)
         misses[unit] = np.degrees(np.arccos(cos_miss))
-    windows = len(starts)
+    return misses
+
+
+def verdict(misses: dict[str, np.ndarray]) -> UnitEvidence:
+    """The unit the windows' misses point to: the one whose median miss is at least MIN_RATIO
+    times smaller than the other's, over at least MIN_WINDOWS windows (else undecided)."""
+    windows = len(next(iter(misses.values())))
     median = {unit: float(np.median(m)) if windows else float("nan")
               for unit, m in misses.items()}
     unit = None

@@ -71,6 +71,22 @@ def run_vqf(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
     return gravity_from_quat(_vqf_batch(acc, gyro, rate, "the VQF peer")["quat6D"])
 
 
+class VqfStream:
+    """VQF 6D with the package's defaults run block after block, its state carried from one
+    block to the next (so the blocks of a recording give what run_vqf gives on the whole):
+    calling it with acc, gyro [n, 3] gives the block's up direction [n, 3]."""
+
+    def __init__(self, rate: float) -> None:
+        self._filter = _import("vqf", "the VQF peer").VQF(1.0 / rate)
+
+    def __call__(self, acc: np.ndarray, gyro: np.ndarray) -> np.ndarray:
+        if len(acc) == 0:
+            return np.empty((0, 3))
+        out = self._filter.updateBatch(np.ascontiguousarray(gyro, dtype=float),
+                                       np.ascontiguousarray(acc, dtype=float))
+        return gravity_from_quat(out["quat6D"])
+
+
 def up_ahead(up: np.ndarray, rate: np.ndarray, delay: float) -> np.ndarray:
     """The up direction [N, 3] in the sensor frame delay [s] later, the sensor turning at rate
     [N, 3] rad/s (its frame): a direction fixed in the world turns by -rate * delay in it."""

@@ -1,25 +1,41 @@
-"""Reading a recording's table as a logger or a spreadsheet wrote it.
+"""Reading a recording's table as a logger, a spreadsheet or a data tool wrote it.
 
-`read_table` reads a delimited text file: the encoding (UTF-8 with or without a byte-order mark,
-else Latin-1), the delimiter (comma, semicolon, tab or bar; a decimal comma with semicolons) and
-the header row are found from the file; a unit stated in a column's name ("Gyroscope X (deg/s)",
-"acc_x [m/s^2]") is read off it. Values become floats; an empty cell, NaN or inf is kept as
-not-a-number (the estimators reject such a sample and count it, so one bad row does not refuse
-a file); text where a number belongs is refused naming the file's line, the column and the
-value. Line numbers are the file's, counting the header as line 1.
+`open_table(path)` opens a file as named columns read in blocks of rows, so that a recording of
+any length is read in bounded memory:
+
+- delimited text (CSV and its kin): the encoding (UTF-8 with or without a byte-order mark, else
+  Latin-1), the delimiter (comma, semicolon, tab or bar; a decimal comma with semicolons) and
+  the header row are found from the file's start; pyarrow's CSV reader parses it, and where it
+  cannot (text where a number belongs, a row of the wrong length, padded cells) the file is read
+  by Python's csv module, which names the file's line, the column and the value;
+- Parquet: its columns (a timestamp column as seconds);
+- HDF5 (that is not a BROAD trial) and MATLAB .mat (v5, or v7.3 which is HDF5): the top level's
+  one-dimensional datasets or variables of one length are columns, and an [N, 3] one (acc, gyro)
+  is three (acc_x, acc_y, acc_z); a scalar `rate` (attribute or variable) is the sample rate.
+
+A unit stated in a column's name ("Gyroscope X (deg/s)", "acc_x [m/s^2]") or, in Parquet and
+HDF5, in the column's `unit` or `units` metadata, is read off it. Values become floats; an empty
+cell, NaN or inf is kept as not-a-number (the estimators reject such a sample and count it, so
+one bad row does not refuse a file). Line numbers are the file's, counting the header as line 1;
+other formats count rows from 1.
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import re
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 DELIMITERS = ",;\t|"
+BLOCK_ROWS = 1 << 18
+"""Rows per block: a few MB per column, few enough Python round trips per million rows."""
+SNIFF_BYTES = 1 << 16
+"""How much of a text file's start the delimiter, encoding and header are found from."""
 
 UNIT_ALIASES: dict[str, str] = {
     "rad/s": "rad/s", "rads": "rad/s", "rad/sec": "rad/s", "rps": "rad/s",
@@ -40,24 +56,6 @@ class TableError(ValueError):
     """A file that cannot be read as a table: where, what, and what would serve."""
 
 
-@dataclass
-class Table:
-    """A recording's table: the header as written, each column's name without its unit and
-    the unit it states (None where it states none), the values [rows, columns] (NaN where a
-    cell held none) and each row's line in the file."""
-
-    path: Path
-    header: list[str]
-    names: list[str]
-    units: list[str | None]
-    data: np.ndarray
-    lines: np.ndarray
-    delimiter: str
-
-    def column(self, index: int) -> np.ndarray:
-        return self.data[:, index]
-
-
 def split_unit(name: str) -> tuple[str, str | None]:
     """A header cell as (name, unit): "Gyroscope X (deg/s)" -> ("Gyroscope X", "deg/s"); a
     bracketed part that is no unit known here stays in the name."""
@@ -69,84 +67,386 @@ def split_unit(name: str) -> tuple[str, str | None]:
     return name.strip(), None
 
 
-def _decode(path: Path) -> str:
-    raw = path.read_bytes()
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        return raw.decode("latin-1")
+def _unit_of(name: str, stated: Any) -> tuple[str, str | None]:
+    """(name, unit) of a column whose metadata may state its unit (bytes or text)."""
+    bare, unit = split_unit(name)
+    if unit is None and stated is not None:
+        text = stated.decode() if isinstance(stated, bytes) else str(stated)
+        unit = UNIT_ALIASES.get(text.replace(" ", "").lower())
+    return bare, unit
 
 
-def _delimiter(text: str, path: Path) -> str:
-    """The delimiter that splits the header and the first rows into the same number (> 1) of
-    cells."""
-    lines = [line for line in text.splitlines()[:20] if line.strip()]
-    if not lines:
-        raise TableError(f"{path}: empty file")
-    best, best_cells = None, 1
-    for d in DELIMITERS:
-        counts = [len(next(csv.reader([line], delimiter=d))) for line in lines]
-        if len(set(counts)) == 1 and counts[0] > best_cells:
-            best, best_cells = d, counts[0]
-    if best is None:
-        raise TableError(f"{path}: no delimiter splits the header and the first rows alike "
-                         f"(tried comma, semicolon, tab and bar); line 1 reads {lines[0][:80]!r}")
-    return best
+@dataclass
+class TableSource:
+    """A file's table opened for reading in blocks: the header as written, each column's name
+    without its unit and the unit it states (None where it states none), the number of rows
+    where the format says it (None for text), file-level numbers (`rate`) and the format."""
+
+    path: Path
+    header: list[str]
+    names: list[str]
+    units: list[str | None]
+    kind: str
+    rows: int | None
+    _read: Callable[[list[int], int], Iterator[np.ndarray]]
+    _where: Callable[[int], str]
+    attrs: dict[str, float] = field(default_factory=dict)
+
+    def blocks(self, columns: list[int], rows: int = BLOCK_ROWS) -> Iterator[np.ndarray]:
+        """The chosen columns as float64 [n, len(columns)], `rows` rows at a time (the last
+        block shorter), from the first row; TableError where a row cannot be read."""
+        return self._read(columns, rows)
+
+    def read(self, columns: list[int]) -> np.ndarray:
+        """Every row of the chosen columns [N, len(columns)]."""
+        parts = list(self.blocks(columns))
+        return np.concatenate(parts) if parts else np.empty((0, len(columns)))
+
+    def where(self, row: int) -> str:
+        """Where the row (counting from 0) is in the file, as its reader counts: "line 201"."""
+        return self._where(row)
 
 
-def read_table(path: str | Path) -> Table:
-    """The table of a delimited text file (the module docstring); TableError saying where and
+def open_table(path: str | Path) -> TableSource:
+    """The file's table (the module docstring), by its content and suffix; TableError saying
     what is wrong."""
     path = Path(path)
     if not path.is_file():
         raise TableError(f"{path}: no such file")
-    text = _decode(path)
-    delimiter = _delimiter(text, path)
-    reader = csv.reader(io.StringIO(text), delimiter=delimiter)
-    header: list[str] | None = None
-    rows: list[list[str]] = []
-    lines: list[int] = []
-    for line_no, row in enumerate(reader, 1):
-        if not row or not any(c.strip() for c in row):
-            continue
-        if header is None:
-            header = [c.strip() for c in row]
-            continue
-        if len(row) != len(header):
-            raise TableError(f"{path}, line {line_no}: {len(row)} values where the header has "
-                             f"{len(header)} columns")
-        rows.append(row)
-        lines.append(reader.line_num)
-    if header is None:
+    suffix = path.suffix.lower()
+    with path.open("rb") as f:
+        magic = f.read(8)
+    if magic.startswith(b"PAR1") or suffix in (".parquet", ".pq"):
+        return _parquet(path)
+    if magic.startswith(b"\x89HDF") or suffix in (".h5", ".hdf5"):
+        return _hdf5(path)
+    if suffix == ".mat":
+        return _mat(path)
+    return _text(path)
+
+
+def read_table(path: str | Path) -> tuple[TableSource, np.ndarray]:
+    """The file's table and every row of every column [N, columns]."""
+    source = open_table(path)
+    return source, source.read(list(range(len(source.header))))
+
+
+# ----- delimited text --------------------------------------------------------------------------
+
+@dataclass
+class _TextLayout:
+    encoding: str
+    delimiter: str
+    header_line: int  # the header's line in the file, from 1
+    header: list[str]
+    decimal_comma: bool
+    padded: bool  # cells with spaces around the number: Python's float reads those
+
+
+def _sniff(path: Path) -> _TextLayout:
+    with path.open("rb") as f:
+        raw = f.read(SNIFF_BYTES)
+    encoding = "utf-8"
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        if err.start >= len(raw) - 4 and len(raw) == SNIFF_BYTES:  # a character cut at the end
+            text = raw[:err.start].decode("utf-8-sig")
+        else:
+            encoding, text = "latin-1", raw.decode("latin-1")
+    if len(raw) == SNIFF_BYTES:  # the last line may be cut
+        text = text[:text.rfind("\n") + 1] or text
+    lines = text.splitlines()
+    numbered = [(i + 1, line) for i, line in enumerate(lines) if line.strip()]
+    if not numbered:
         raise TableError(f"{path}: empty file")
-    if not rows:
-        raise TableError(f"{path}: a header and no samples")
-    decimal_comma = delimiter == ";" and _decimal_comma(rows)
-    if decimal_comma:
-        rows = [[c.replace(",", ".") for c in row] for row in rows]
-    try:  # numpy's own conversion where every cell is a number
-        data = np.array(rows, dtype=float)
-    except ValueError:  # cell by cell: empty cells as NaN, text refused by line and column
-        data = np.empty((len(rows), len(header)))
-        for i, row in enumerate(rows):
-            for j, cell in enumerate(row):
-                data[i, j] = _number(cell, path, lines[i], header[j])
-    names, units = zip(*(split_unit(h) for h in header), strict=True)
-    return Table(path, header, list(names), list(units), data, np.asarray(lines), delimiter)
+    first = [line for _, line in numbered[:20]]
+    delimiter, best_cells = None, 1
+    for d in DELIMITERS:
+        counts = [len(next(csv.reader([line], delimiter=d))) for line in first]
+        if len(set(counts)) == 1 and counts[0] > best_cells:
+            delimiter, best_cells = d, counts[0]
+    if delimiter is None:
+        raise TableError(f"{path}: no delimiter splits the header and the first rows alike "
+                         f"(tried comma, semicolon, tab and bar); line {numbered[0][0]} reads "
+                         f"{first[0][:80]!r}")
+    header_line, header_text = numbered[0]
+    header = [c.strip() for c in next(csv.reader([header_text], delimiter=delimiter))]
+    cells = [c for _, line in numbered[1:50]
+             for c in next(csv.reader([line], delimiter=delimiter)) if c.strip()]
+    decimal_comma = (delimiter == ";" and any("," in c for c in cells)
+                     and not any("." in c for c in cells))
+    padded = any(c != c.strip() for c in cells)
+    return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded)
 
 
-def _decimal_comma(rows: list[list[str]]) -> bool:
-    sample = [c for row in rows[:50] for c in row if c.strip()]
-    return any("," in c for c in sample) and not any("." in c for c in sample)
+def _text(path: Path) -> TableSource:
+    layout = _sniff(path)
+    names, units = zip(*(split_unit(h) for h in layout.header), strict=True)
+
+    def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
+        if layout.padded:
+            yield from _python_blocks(path, layout, columns, rows, 0)
+            return
+        done = 0
+        try:
+            for block in _arrow_blocks(path, layout, columns, rows):
+                yield block
+                done += len(block)
+        except _ArrowFailed:  # Python's reader names the line, or reads what arrow would not
+            yield from _python_blocks(path, layout, columns, rows, done)
+
+    def where(row: int) -> str:
+        return f"line {_line_of_row(path, layout, row)}"
+
+    return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
+                       where)
 
 
-def _number(cell: str, path: Path, line: int, column: str) -> float:
+class _ArrowFailed(Exception):
+    pass
+
+
+def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
+                  ) -> Iterator[np.ndarray]:
+    import pyarrow as pa
+    import pyarrow.csv as pc
+
+    keys = [f"c{i}" for i in range(len(layout.header))]
+    wanted = [keys[i] for i in columns]
+    try:
+        reader = pc.open_csv(
+            path,
+            read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.header_line,
+                                        encoding="utf8" if layout.encoding == "utf-8"
+                                        else "latin1", block_size=1 << 22),
+            parse_options=pc.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
+            convert_options=pc.ConvertOptions(
+                column_types=dict.fromkeys(wanted, pa.float64()), include_columns=wanted,
+                decimal_point="," if layout.decimal_comma else "."))
+        pending: list[np.ndarray] = []
+        held = 0
+        for batch in reader:
+            part = np.column_stack([batch.column(k).to_numpy(zero_copy_only=False)
+                                    for k in wanted]) if wanted else np.empty((batch.num_rows,
+                                                                               0))
+            pending.append(part)
+            held += len(part)
+            while held >= rows:
+                merged = np.concatenate(pending)
+                yield merged[:rows]
+                rest = merged[rows:]
+                pending, held = ([rest] if len(rest) else []), len(rest)
+        if held:
+            yield np.concatenate(pending)
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as err:
+        raise _ArrowFailed(str(err)) from None
+
+
+def _rows(path: Path, layout: _TextLayout) -> Iterator[tuple[int, list[str]]]:
+    """(line, cells) of every data row, blank lines skipped."""
+    with path.open(encoding="utf-8-sig" if layout.encoding == "utf-8" else layout.encoding,
+                   newline="") as f:
+        reader = csv.reader(f, delimiter=layout.delimiter)
+        for row in reader:
+            if reader.line_num <= layout.header_line or not row or not any(
+                    c.strip() for c in row):
+                continue
+            yield reader.line_num, row
+
+
+def _line_of_row(path: Path, layout: _TextLayout, row: int) -> int:
+    for k, (line, _) in enumerate(_rows(path, layout)):
+        if k == row:
+            return line
+    return -1
+
+
+def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int, skip: int
+                   ) -> Iterator[np.ndarray]:
+    """The rows from row `skip` on, cell by cell: an empty cell as NaN, text refused by line
+    and column."""
+    width = len(layout.header)
+    block: list[list[float]] = []
+    for k, (line, row) in enumerate(_rows(path, layout)):
+        if len(row) != width:
+            raise TableError(f"{path}, line {line}: {len(row)} values where the header has "
+                             f"{width} columns")
+        if k < skip:
+            continue
+        block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma)
+                      for j in columns])
+        if len(block) == rows:
+            yield np.array(block, dtype=float).reshape(len(block), len(columns))
+            block = []
+    if block:
+        yield np.array(block, dtype=float).reshape(len(block), len(columns))
+
+
+def _number(cell: str, path: Path, line: int, column: str, decimal_comma: bool) -> float:
     text = cell.strip()
+    if decimal_comma:
+        text = text.replace(",", ".")
     if not text:
         return float("nan")  # a missing value: that sample is rejected and counted
     try:
         return float(text)
     except ValueError:
-        raise TableError(f"{path}, line {line}, column {column!r}: {cell.strip()[:40]!r} is not "
+        raise TableError(f"{path}, line {line}, column {column!r}: {text[:40]!r} is not "
                          "a number (a number serves; an empty cell or NaN marks a missing "
                          "value, whose sample is rejected and counted)") from None
+
+
+# ----- Parquet ---------------------------------------------------------------------------------
+
+def _parquet(path: Path) -> TableSource:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        pf = pq.ParquetFile(path)
+    except (pa.ArrowInvalid, OSError) as err:
+        raise TableError(f"{path}: not a readable Parquet file ({err})") from None
+    schema = pf.schema_arrow
+    header = list(schema.names)
+    named = [_unit_of(f.name, (f.metadata or {}).get(b"unit", (f.metadata or {}).get(b"units")))
+             for f in schema]
+
+    def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
+        wanted = [header[i] for i in columns]
+        for batch in pf.iter_batches(batch_size=rows, columns=wanted):
+            yield np.column_stack([_arrow_float(batch.column(k), path, k)
+                                   for k in wanted]) if wanted else np.empty((batch.num_rows, 0))
+
+    return TableSource(path, header, [n for n, _ in named], [u for _, u in named], "parquet",
+                       pf.metadata.num_rows, read, lambda row: f"row {row + 1}")
+
+
+def _arrow_float(column: Any, path: Path, name: str) -> np.ndarray:
+    """A Parquet column as float64: numbers as they are, a timestamp or duration as seconds."""
+    import pyarrow as pa
+
+    kind = column.type
+    if pa.types.is_timestamp(kind) or pa.types.is_duration(kind):
+        scale = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}[kind.unit]
+        ints = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
+        return np.asarray(ints, dtype=float) * scale
+    if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
+        raise TableError(f"{path}, column {name!r}: holds {kind}, not numbers")
+    return np.asarray(column.cast(pa.float64()).to_numpy(zero_copy_only=False), dtype=float)
+
+
+# ----- HDF5 and MAT ----------------------------------------------------------------------------
+
+def _columns_of(arrays: dict[str, Any], path: Path
+                ) -> tuple[list[str], list[tuple[str, int | None]], int]:
+    """The columns of named arrays: each 1-D one of the common length, each [N, 3] (or [3, N])
+    as name_x, name_y, name_z. Returns the names, each name's (array, axis index) and N."""
+    lengths = []
+    for a in arrays.values():
+        shape = tuple(a.shape)
+        if len(shape) == 1 and shape[0] > 1:
+            lengths.append(shape[0])
+        elif len(shape) == 2 and 3 in shape and max(shape) > 3:
+            lengths.append(max(shape))
+    if not lengths:
+        raise TableError(f"{path}: no dataset or variable of samples: columns are 1-D arrays of "
+                         "one length, or [N, 3] arrays (acc, gyro); it has "
+                         f"{', '.join(f'{k} {tuple(v.shape)}' for k, v in arrays.items())}")
+    n = max(set(lengths), key=lengths.count)
+    header: list[str] = []
+    where: list[tuple[str, int | None]] = []
+    for name, a in arrays.items():
+        shape = tuple(a.shape)
+        if shape == (n,):
+            header.append(name)
+            where.append((name, None))
+        elif len(shape) == 2 and max(shape) == n and 3 in shape:
+            for i, axis in enumerate("xyz"):
+                header.append(f"{name}_{axis}")
+                where.append((name, i))
+    return header, where, n
+
+
+def _array_source(path: Path, kind: str, arrays: dict[str, Any], units: dict[str, Any],
+                  attrs: dict[str, float]) -> TableSource:
+    header, where, n = _columns_of(arrays, path)
+    named = [_unit_of(h, units.get(src)) for h, (src, _) in zip(header, where, strict=True)]
+
+    def column(i: int, lo: int, hi: int) -> np.ndarray:
+        src, axis = where[i]
+        a = arrays[src]
+        if axis is None:
+            return np.asarray(a[lo:hi], dtype=float)
+        if a.shape[0] == n:
+            return np.asarray(a[lo:hi, axis], dtype=float)
+        return np.asarray(a[axis, lo:hi], dtype=float)
+
+    def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
+        for lo in range(0, n, rows):
+            hi = min(lo + rows, n)
+            yield np.column_stack([column(i, lo, hi) for i in columns]) if columns else \
+                np.empty((hi - lo, 0))
+
+    return TableSource(path, header, [nm for nm, _ in named], [u for _, u in named], kind, n,
+                       read, lambda row: f"row {row + 1}", attrs)
+
+
+def _hdf5(path: Path) -> TableSource:
+    import h5py
+
+    try:
+        f = h5py.File(path, "r")
+    except OSError as err:
+        raise TableError(f"{path}: not a readable HDF5 file ({err})") from None
+    arrays = {k: v for k, v in f.items() if isinstance(v, h5py.Dataset)}
+    units = {k: v.attrs.get("unit", v.attrs.get("units")) for k, v in arrays.items()}
+    attrs = _rate(dict(f.attrs), arrays)
+    return _array_source(path, "hdf5", arrays, units, attrs)
+
+
+def _rate(attrs: dict[str, Any], arrays: dict[str, Any]) -> dict[str, float]:
+    """A scalar `rate` (or fs, sample_rate) [Hz] among the file's attributes or variables."""
+    for key in ("rate", "fs", "sample_rate", "sampling_rate"):
+        value = attrs.get(key, arrays.get(key))
+        if value is None:
+            continue
+        value = np.asarray(value[()] if hasattr(value, "shape") else value)
+        if value.size == 1 and value.dtype.kind in "fiu":
+            return {"rate": float(value.reshape(-1)[0])}
+    return {}
+
+
+def _mat(path: Path) -> TableSource:
+    import h5py
+
+    if h5py.is_hdf5(path):  # MATLAB v7.3: HDF5, arrays stored transposed
+        return _hdf5(path)
+    import scipy.io
+
+    try:
+        data = scipy.io.loadmat(path, squeeze_me=True)
+    except (ValueError, NotImplementedError, OSError) as err:
+        raise TableError(f"{path}: not a readable MATLAB file ({err})") from None
+    arrays = {k: np.asarray(v) for k, v in data.items() if not k.startswith("__")}
+    arrays = {k: v for k, v in arrays.items() if v.dtype.kind in "fiu"}
+    return _array_source(path, "mat", arrays, {}, _rate({}, arrays))
+
+
+def describe_kind(source: TableSource) -> str:
+    """The format as the printout names it."""
+    if source.kind == "text":
+        return "text"
+    return {"parquet": "Parquet", "hdf5": "HDF5", "mat": "MATLAB"}[source.kind]
+
+
+__all__ = [
+    "BLOCK_ROWS",
+    "TIME_SCALE",
+    "UNIT_ALIASES",
+    "TableError",
+    "TableSource",
+    "open_table",
+    "read_table",
+    "split_unit",
+]

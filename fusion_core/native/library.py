@@ -9,6 +9,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +40,9 @@ first where it loads (same platform); elsewhere the library is built or Python r
 
 _lib: Any = None
 _ffi: Any = None
+_loading = threading.RLock()
+"""Held while the library (or the stream's entry point) loads: a thread that asks meanwhile
+waits for the outcome instead of reading a half-set one (and running in Python)."""
 _reason: str | None = "not loaded yet"
 _path: Path | None = None
 _tried = False
@@ -138,22 +142,29 @@ def build_stream(force: bool = False) -> Path:
 def stream_extension() -> Any:
     """The stream's compiled entry point (built on first use), or None where it cannot be had
     (stream_reason() says why: stream() then steps through the cffi call)."""
-    global _stream, _stream_reason
-    if _stream is None and _stream_reason == "not loaded yet":
-        import importlib.machinery
-        import importlib.util
-
-        try:
-            path = STREAM_PREBUILT if STREAM_PREBUILT.is_file() else build_stream()
-            loader = importlib.machinery.ExtensionFileLoader("_fc_stream", str(path))
-            spec = importlib.util.spec_from_file_location("_fc_stream", path, loader=loader)
-            assert spec is not None
-            module = importlib.util.module_from_spec(spec)
-            loader.exec_module(module)
-            _stream, _stream_reason = module, None
-        except (RuntimeError, OSError, ImportError) as err:
-            _stream_reason = str(err)
+    if _stream is not None or _stream_reason != "not loaded yet":
+        return _stream
+    with _loading:
+        if _stream is None and _stream_reason == "not loaded yet":
+            _load_stream()
     return _stream
+
+
+def _load_stream() -> None:
+    global _stream, _stream_reason
+    import importlib.machinery
+    import importlib.util
+
+    try:
+        path = STREAM_PREBUILT if STREAM_PREBUILT.is_file() else build_stream()
+        loader = importlib.machinery.ExtensionFileLoader("_fc_stream", str(path))
+        spec = importlib.util.spec_from_file_location("_fc_stream", path, loader=loader)
+        assert spec is not None
+        module = importlib.util.module_from_spec(spec)
+        loader.exec_module(module)
+        _stream, _stream_reason = module, None
+    except (RuntimeError, OSError, ImportError) as err:
+        _stream_reason = str(err)
 
 
 def stream_reason() -> str | None:
@@ -190,7 +201,14 @@ def cdef(real: str = "double") -> str:
 
 def _load() -> None:
     global _lib, _ffi, _reason, _tried, _path
-    _tried = True
+    try:
+        _load_library()
+    finally:
+        _tried = True
+
+
+def _load_library() -> None:
+    global _lib, _ffi, _reason, _path
     try:
         import cffi  # type: ignore[import-untyped]
     except ImportError as err:
@@ -218,9 +236,11 @@ def _load() -> None:
 
 
 def available() -> bool:
-    """Whether the C twin is built and loaded (building it on first use)."""
+    """Whether the C twin is built and loaded (building it on first use; thread-safe)."""
     if not _tried:
-        _load()
+        with _loading:
+            if not _tried:
+                _load()
     return _lib is not None
 
 

@@ -13,6 +13,7 @@ finds their rest segment (the start, before `movement` begins).
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -163,30 +164,23 @@ EXTRA_COLUMNS = ("dt", "roll", "pitch", "q_w", "q_x", "q_y", "q_z")
 
 @dataclass
 class Columns:
-    """What read_csv found: each quantity's values, the header names it came from and the unit
-    the header states for it (None: none stated)."""
+    """Where each quantity is in a table: its column index, the header name it came from and
+    the unit the header states for it (None: none stated)."""
 
-    values: dict[str, np.ndarray]
+    index: dict[str, int]
     source: dict[str, str]
     units: dict[str, str | None]
     header: list[str]
-    lines: np.ndarray
 
 
-def read_csv(path: Path, time_column: str | None,
-             columns: dict[str, str] | None = None) -> Columns:
-    """The quantities of a delimited text file (testbenches.reader), found by the header's
-    names or the columns given ({quantity: name}); RecordingError otherwise."""
-    from ..reader import TableError, read_table
-
-    try:
-        table = read_table(path)
-    except TableError as err:
-        raise RecordingError(str(err)) from None
+def find_columns(table: Any, time_column: str | None = None,
+                 columns: dict[str, str] | None = None) -> Columns:
+    """The quantities of a table (testbenches.reader.TableSource), found by the header's names
+    or the columns given ({quantity: name}); RecordingError for a given name it lacks."""
     given = dict(columns or {})
     if time_column:
         given.setdefault("time", time_column)
-    found = Columns({}, {}, {}, table.header, table.lines)
+    found = Columns({}, {}, {}, table.header)
     for quantity in (*ALIASES, *EXTRA_COLUMNS):
         name = given.get(quantity)
         i = None
@@ -195,37 +189,44 @@ def read_csv(path: Path, time_column: str | None,
             if i is None:
                 i = _find(table.names, quantity, name)
             if i is None:
-                raise RecordingError(f"{path}: no column {name!r} for {quantity}: the header "
-                                     f"has {', '.join(table.header)}")
+                raise RecordingError(f"{table.path}: no column {name!r} for {quantity}: the "
+                                     f"header has {', '.join(table.header)}")
         elif quantity in ALIASES:
             i = _find(table.names, quantity)
         else:
             i = _find(table.names, "time", quantity)
         if i is not None:
-            found.values[quantity] = table.column(i)
+            found.index[quantity] = i
             found.source[quantity] = table.header[i]
             found.units[quantity] = table.units[i]
     return found
 
 
-def read_hdf5(path: Path) -> dict[str, np.ndarray]:
-    """acc, gyro [N, 3] and time [N] (or rate) from an HDF5 file that is not a BROAD trial."""
-    import h5py
+def open_table(path: Path) -> Any:
+    """testbenches.reader.open_table, its TableError as a RecordingError."""
+    from ..reader import TableError
+    from ..reader import open_table as open_any
+
+    try:
+        return open_any(path)
+    except TableError as err:
+        raise RecordingError(str(err)) from None
 
 
-    with h5py.File(path, "r") as f:
-        if "acc" not in f or "gyro" not in f:
-            raise RecordingError(f"{path}: an HDF5 recording holds datasets acc and gyro [N, 3] "
-                                 f"(and time [N] or a rate attribute); it has "
-                                 f"{', '.join(f.keys()) or 'none'}")
-        acc, gyro = np.asarray(f["acc"], float), np.asarray(f["gyro"], float)
-        cols = {f"acc_{a}": acc[:, i] for i, a in enumerate("xyz")}
-        cols.update({f"gyro_{a}": gyro[:, i] for i, a in enumerate("xyz")})
-        if "time" in f:
-            cols["time"] = np.asarray(f["time"], float)
-        elif "rate" in f.attrs:
-            cols["time"] = np.arange(len(acc)) / float(f.attrs["rate"])
-    return cols
+def read_columns(path: Path, time_column: str | None = None,
+                 columns: dict[str, str] | None = None) -> tuple[dict[str, np.ndarray], Columns]:
+    """Every row of the quantities a file holds ({quantity: values}) and where they were
+    found; RecordingError where the file cannot be read."""
+    from ..reader import TableError
+
+    table = open_table(path)
+    found = find_columns(table, time_column, columns)
+    names = list(found.index)
+    try:
+        data = table.read([found.index[q] for q in names])
+    except TableError as err:
+        raise RecordingError(str(err)) from None
+    return {q: data[:, k] for k, q in enumerate(names)}, found
 
 
 def _stated(units: dict[str, str | None], axes: tuple[str, ...], path: Path) -> str | None:
@@ -239,118 +240,281 @@ def _stated(units: dict[str, str | None], axes: tuple[str, ...], path: Path) -> 
     return stated.pop() if stated else None
 
 
-def load_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
+PREFIX_ROWS = 1 << 18
+"""The units, the first sample's dt and the reference's checks are decided on the first this
+many samples (at 100 Hz, 44 minutes), so that a recording of any length is read once, in
+blocks; the rest is converted as they decided."""
+
+
+@dataclass
+class _Clock:
+    """Each sample's dt and time from a time column, a dt column or a rate, block after block
+    (the last time stamp carried across blocks)."""
+
+    kind: str  # "time", "dt" or "rate"
+    scale: float
+    first_dt: float
+    path: Path
+    where: Any
+    last_t: float | None = None
+    last_row: int = -1
+    total: float = 0.0
+
+    def __call__(self, raw: np.ndarray | None, row0: int, n: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        if self.kind == "rate":
+            return np.full(n, self.first_dt), (row0 + np.arange(n)) * self.first_dt
+        assert raw is not None
+        if self.kind == "dt":
+            dt = raw * self.scale
+            if row0 == 0:
+                dt = dt.copy()
+                dt[0] = self.first_dt
+            t = self.total + np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - self.first_dt
+            self.total = float(t[-1] + self.first_dt)
+            return dt, t
+        return self._from_time(raw * self.scale, row0)
+
+    def _from_time(self, t: np.ndarray, row0: int) -> tuple[np.ndarray, np.ndarray]:
+        """A sample's dt is the time since the last sample with a time (a sample without one
+        gets dt NaN, which the estimators reject, and as its time that last time plus the
+        nominal period per sample since)."""
+        valid = np.flatnonzero(np.isfinite(t))
+        dt = np.full(len(t), np.nan)
+        times = t[valid]
+        rows = row0 + valid
+        if self.last_t is not None:
+            times_all = np.concatenate([[self.last_t], times])
+            rows_all = np.concatenate([[self.last_row], rows])
+        else:
+            times_all, rows_all = times, rows
+        steps = np.diff(times_all)
+        if not np.all(steps > 0.0):
+            i = int(np.argmax(~(steps > 0.0)))
+            raise RecordingError(
+                f"{self.path}, {self.where(int(rows_all[i + 1]))}: the time "
+                f"{float(times_all[i + 1]):.6g} s does not increase from "
+                f"{float(times_all[i]):.6g} s on {self.where(int(rows_all[i]))}")
+        if self.last_t is not None:
+            dt[valid] = steps
+        elif len(valid):
+            dt[valid[1:]] = steps
+            dt[valid[0]] = self.first_dt
+        if len(rows_all) == 0:  # no time yet: the period per sample from the first
+            return dt, (row0 + np.arange(len(t))) * self.first_dt
+        here = row0 + np.arange(len(t))
+        k = np.searchsorted(rows_all, here, side="right") - 1  # the last sample with a time
+        k = np.maximum(k, 0)
+        at = times_all[k] + (here - rows_all[k]) * self.first_dt
+        if len(valid):
+            self.last_t, self.last_row = float(times[-1]), int(rows[-1])
+        return dt, np.where(np.isfinite(t), t, at)
+
+
+@dataclass
+class RecordingSource:
+    """A recording opened for reading in blocks, in SI units: each block a Recording of those
+    samples and their times [s]; the units, columns and rate decided on its first samples
+    (`choices` says which and why); `rows` the number of samples where the format says it
+    (None for text until read)."""
+
+    path: Path
+    name: str
+    rate: float
+    choices: str
+    rows: int | None
+    _blocks: Any
+
+    def blocks(self, rows: int | None = None) -> Iterator[tuple[Recording, np.ndarray]]:
+        """(Recording, time [s]) of each block of samples, from the first; RecordingError where
+        a row cannot serve."""
+        from ..reader import BLOCK_ROWS, TableError
+
+        try:
+            yield from self._blocks(rows or BLOCK_ROWS)
+        except TableError as err:
+            raise RecordingError(str(err)) from None
+
+    def load(self) -> tuple[Recording, np.ndarray]:
+        """The whole recording and its times; its `described` says what was read."""
+        parts = list(self.blocks())
+        rec = concatenate([p for p, _ in parts])
+        t = np.concatenate([t for _, t in parts])
+        rec.described = self.summary(len(rec.dt), float(np.nansum(rec.dt[1:])),
+                                     int((~rec.valid).sum()))
+        return rec, t
+
+    def summary(self, n: int, duration: float, missing: int, choices: bool = True) -> str:
+        """What was read: the count and length, the choices (unless told not to), the samples
+        without numbers."""
+        return (f"{n} samples, {duration:.4g} s at {self.rate:.4g} Hz"
+                + (f"; {self.choices}" if choices else "")
+                + (f"; {missing} sample(s) without a number in every column, which the "
+                   "estimators reject and count" if missing else ""))
+
+
+def concatenate(parts: list[Recording]) -> Recording:
+    """The blocks of one recording as one."""
+    first = parts[0]
+
+    def joined(name: str) -> np.ndarray | None:
+        values = [getattr(p, name) for p in parts]
+        return None if values[0] is None else np.concatenate(values)
+
+    rec = Recording(first.name, joined("acc"), joined("gyro"), joined("dt"), first.rate,
+                    first.gyro_sampling, joined("up_ref"), joined("counts"), first.sensor_delay,
+                    joined("ref_quat"))
+    return rec
+
+
+def _broad_source(path: Path) -> RecordingSource:
+    rec = load(path)
+    t = np.cumsum(rec.dt) - rec.dt[0]
+
+    def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
+        for lo in range(0, len(rec.dt), rows):
+            part = rec.slice(lo, lo + rows)
+            part.ref_quat = None
+            yield part, t[lo:lo + rows]
+
+    return RecordingSource(path, rec.name, rec.rate, "a BROAD trial: m/s2 and rad/s, its own "
+                           "rate, sampling, delay and reference", len(rec.dt), blocks)
+
+
+def open_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
                    acc_unit: str = "auto", gyro_unit: str = "auto",
-                   columns: dict[str, str] | None = None) -> Any:
-    """The recording in SI units (testbenches.fit.recording.Recording; its `described` says
-    which columns, units and rate were taken and why) and the time of each sample [s];
-    RecordingError saying what is wrong."""
-    from ..broad.data import NotABroadTrial, load_trial
+                   columns: dict[str, str] | None = None) -> RecordingSource:
+    """The recording opened for reading in blocks (RecordingSource), its units, columns and
+    rate decided from its first PREFIX_ROWS samples: given, stated by the file, or from the
+    data (which must not contradict what is given or stated); RecordingError saying what is
+    wrong."""
+    from ..reader import TableError
 
     if not path.is_file():
         raise RecordingError(f"{path}: no such file")
-    lines = None
-    units: dict[str, str | None] = {}
-    source: dict[str, str] = {}
     if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
         try:
             load_trial(path)
         except NotABroadTrial:
-            if path.suffix.lower() == ".mat":
-                raise RecordingError(f"{path}: a .mat file must be a BROAD trial") from None
-            cols = read_hdf5(path)
-        else:  # a BROAD trial: its own rate, sampling, delay and reference
-            rec = load(path)
-            rec.described = (f"a BROAD trial: {len(rec.dt)} samples at {rec.rate:.4g} Hz, "
-                             "m/s2 and rad/s")
-            return rec, np.cumsum(rec.dt) - rec.dt[0]
-    else:
-        found = read_csv(path, time_column, columns)
-        cols, units, source, lines = found.values, found.units, found.source, found.lines
-        missing = [q for q in IMU_AXES if q not in cols]
-        if missing:
-            raise RecordingError(
-                f"{path}: no column for {', '.join(missing)}: the header has "
-                f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
-                "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME")
-    acc = np.column_stack([cols[f"acc_{a}"] for a in "xyz"])
-    gyro = np.column_stack([cols[f"gyro_{a}"] for a in "xyz"])
-    n = len(acc)
+            pass
+        else:
+            return _broad_source(path)
+    table = open_table(path)
+    found = find_columns(table, time_column, columns)
+    missing = [q for q in IMU_AXES if q not in found.index]
+    if missing:
+        raise RecordingError(
+            f"{path}: no column for {', '.join(missing)}: the header has "
+            f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
+            "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME")
+    names = list(found.index)
+    wanted = [found.index[q] for q in names]
+    try:
+        prefix_block = next(table.blocks(wanted, PREFIX_ROWS), np.empty((0, len(names))))
+    except TableError as err:
+        raise RecordingError(str(err)) from None
+    prefix = {q: prefix_block[:, k] for k, q in enumerate(names)}
+    units = found.units
+    n = len(prefix_block)
     if n < 2:
         raise RecordingError(f"{path}: {n} sample(s); a recording needs many")
-    line_of = (lambda k: f"line {int(lines[k])}") if lines is not None else (
-        lambda k: f"sample {k}")
-    if "time" in cols:
-        t = cols["time"] * TIME_SCALE.get(units.get("time") or "s", 1.0)
-        dt, t = _steps_from_time(t, path, line_of)
-    elif "dt" in cols:
-        dt = cols["dt"] * TIME_SCALE.get(units.get("dt") or "s", 1.0)
-        dt = dt.copy()
-        dt[0] = float(np.nanmedian(dt[1:]))
-        t = np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - dt[0]
+    rate = rate or table.attrs.get("rate")
+    if "time" in prefix:
+        scale = TIME_SCALE.get(units.get("time") or "s", 1.0)
+        t = prefix["time"] * scale
+        valid = np.flatnonzero(np.isfinite(t))
+        if len(valid) < 2:
+            raise RecordingError(f"{path}: fewer than two samples with a time")
+        steps = np.diff(t[valid])
+        first = float(np.median(steps)) if np.all(steps > 0.0) else float("nan")
+        clock = _Clock("time", scale, first, path, table.where)
+    elif "dt" in prefix:
+        scale = TIME_SCALE.get(units.get("dt") or "s", 1.0)
+        clock = _Clock("dt", scale, float(np.nanmedian(prefix["dt"][1:])) * scale, path,
+                       table.where)
     elif rate:
-        dt = np.full(n, 1.0 / rate)
-        t = np.arange(n) / rate
+        clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
     else:
         raise RecordingError(f"{path}: no time or dt column: give the sample rate (--rate HZ), "
                              "the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
+    dt, _ = _Clock(**{**clock.__dict__})(prefix.get(clock.kind), 0, n)
+    acc = np.column_stack([prefix[f"acc_{a}"] for a in "xyz"])
+    gyro = np.column_stack([prefix[f"gyro_{a}"] for a in "xyz"])
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
         raise RecordingError(f"{path}: no sample holds numbers in every column")
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
                                     _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
-    gyro_scale, gyro_how = _gyro_scale(path, acc, gyro, dt, gyro_unit,
-                                       _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path))
-    acc = acc * acc_scale
-    gyro = gyro * gyro_scale
-    up, ref_quat = reference_up(cols, path)
-    counts = None if up is None else np.all(np.isfinite(up), axis=1)
+
+    def more() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """The blocks after the first, as read (for the gyro unit's evidence)."""
+        evidence_clock = _Clock(**{**clock.__dict__})
+        row0 = 0
+        for block in table.blocks(wanted, PREFIX_ROWS):
+            d, _ = evidence_clock(block[:, names.index(clock.kind)] if clock.kind != "rate"
+                                  else None, row0, len(block))
+            if row0 > 0:
+                yield (block[:, [names.index(f"acc_{a}") for a in "xyz"]],
+                       block[:, [names.index(f"gyro_{a}") for a in "xyz"]], d)
+            row0 += len(block)
+
+    gyro_scale, gyro_how, used = _gyro_scale(
+        path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
+        more if n == PREFIX_ROWS else None)
     period = float(np.nanmedian(dt))
-    rec = Recording(path.stem, acc, gyro, dt, 1.0 / period, "point", up, counts)
-    rec.ref_quat = ref_quat
-    where = ", ".join(f"{q}={source[q]!r}" for q in (*IMU_AXES, "time", "dt") if q in source)
-    missing_rows = int((~finite).sum())
-    rec.described = (
-        f"{n} samples, {float(np.nansum(dt[1:])):.4g} s at {1.0 / period:.4g} Hz; acc in "
-        f"{acc_how}; gyro in {gyro_how}"
-        + (f"; columns {where}" if where else "")
-        + (f"; {missing_rows} sample(s) without a number in every column, which the "
-           "estimators reject and count" if missing_rows else ""))
-    return rec, t
+    if n == PREFIX_ROWS:  # the file may go on
+        acc_how += f" over the first {n} samples"
+        gyro_how += f" over the first {used} samples"
+    where = ", ".join(f"{q}={found.source[q]!r}" for q in (*IMU_AXES, "time", "dt")
+                      if q in found.source)
+    choices = (f"acc in {acc_how}; gyro in {gyro_how}" + (f"; columns {where}" if where else "")
+               + ("" if table.kind == "text" else f"; read as {table.kind}"))
+    name = path.stem
+
+    def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
+        run_clock = _Clock(**{**clock.__dict__})
+        row0 = 0
+        for block in table.blocks(wanted, rows):
+            cols = {q: block[:, k] for k, q in enumerate(names)}
+            dt, t = run_clock(cols.get(run_clock.kind), row0, len(block))
+            acc = np.column_stack([cols[f"acc_{a}"] for a in "xyz"]) * acc_scale
+            gyro = np.column_stack([cols[f"gyro_{a}"] for a in "xyz"]) * gyro_scale
+            up, ref_quat = reference_up(cols, path)
+            counts = None if up is None else np.all(np.isfinite(up), axis=1)
+            rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts)
+            rec.ref_quat = ref_quat
+            row0 += len(block)
+            yield rec, t
+
+    return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks)
+
+
+def load_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
+                   acc_unit: str = "auto", gyro_unit: str = "auto",
+                   columns: dict[str, str] | None = None) -> Any:
+    """The recording in SI units (Recording; its `described` says which columns, units and
+    rate were taken and why) and the time of each sample [s] (open_recording, read whole);
+    RecordingError saying what is wrong."""
+    return open_recording(path, rate=rate, time_column=time_column, acc_unit=acc_unit,
+                          gyro_unit=gyro_unit, columns=columns).load()
 
 
 IMU_AXES = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 
 
+def source_from_args(path: Path, args: argparse.Namespace) -> RecordingSource:
+    """open_recording with the options add_recording_options defines."""
+    return open_recording(path, rate=args.rate, time_column=args.time_column,
+                          acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
+                          columns=parse_columns(args.column))
+
+
 def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
     """load_recording with the options add_recording_options defines, the choices printed."""
-    rec, t = load_recording(path, rate=args.rate, time_column=args.time_column,
-                            acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
-                            columns=parse_columns(args.column))
+    rec, t = source_from_args(path, args).load()
     print(f"{path}: {rec.described}")
     return rec, t
-
-
-def _steps_from_time(t: np.ndarray, path: Path, line_of: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Each sample's dt from a time column: the time since the last sample with a time (a
-    sample without one gets dt NaN, which the estimators reject); RecordingError where the
-    time does not increase."""
-
-    valid = np.flatnonzero(np.isfinite(t))
-    if len(valid) < 2:
-        raise RecordingError(f"{path}: fewer than two samples with a time")
-    steps = np.diff(t[valid])
-    if not np.all(steps > 0.0):
-        i = int(np.argmax(~(steps > 0.0)))
-        a, b = valid[i], valid[i + 1]
-        raise RecordingError(f"{path}, {line_of(b)}: the time {float(t[b]):.6g} s does not "
-                             f"increase from {float(t[a]):.6g} s on {line_of(a)}")
-    dt = np.full(len(t), np.nan)
-    dt[valid[1:]] = steps
-    dt[valid[0]] = float(np.median(steps))
-    filled = np.interp(np.arange(len(t)), valid, t[valid])  # the time of a sample without one
-    return dt, np.where(np.isfinite(t), t, filled)
 
 
 def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
@@ -384,15 +548,25 @@ def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
 
 
 def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
-                stated: str | None) -> tuple[float, str]:
-    """The factor to rad/s and how it was chosen: the unit in which the gyro's turn explains
-    the accelerometer's turn of gravity (testbenches.gyro_unit). A unit given or stated by the
-    header that the data contradict is refused with the evidence; where the data cannot tell
-    and no unit is given or stated, the recording is refused."""
-    from ..gyro_unit import UNITS, gyro_unit_evidence
+                stated: str | None, more: Any = None) -> tuple[float, str, int]:
+    """The factor to rad/s, how it was chosen and over how many samples: the unit in which the
+    gyro's turn explains the accelerometer's turn of gravity (testbenches.gyro_unit), the
+    windows of further blocks (`more`: (acc, gyro, dt) each) pooled while the first cannot
+    tell and no unit is given. A unit given or stated by the header that the data contradict
+    is refused with the evidence; where the data cannot tell and no unit is given or stated,
+    the recording is refused."""
+    from ..gyro_unit import UNITS, verdict, window_misses
 
-    evidence = gyro_unit_evidence(acc, gyro, dt)
+    misses = window_misses(acc, gyro, dt)
+    evidence, used = verdict(misses), len(dt)
     chosen = unit if unit != "auto" else stated
+    if chosen is None and evidence.unit is None and more is not None:
+        for a, g, d in more():
+            extra = window_misses(a, g, d)
+            misses = {u: np.concatenate([misses[u], extra[u]]) for u in misses}
+            evidence, used = verdict(misses), used + len(d)
+            if evidence.unit is not None:
+                break
     if chosen is not None:
         how = "given" if unit != "auto" else "from the header"
         if chosen not in UNITS:
@@ -404,13 +578,13 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
                 f"{evidence.describe()}, so it reads in {evidence.unit}; give --gyro-unit "
                 f"{evidence.unit}, or check the columns")
         return UNITS[chosen], f"{chosen} ({how}" + (
-            ", and the data agree)" if evidence.unit else ")")
+            ", and the data agree)" if evidence.unit else ")"), used
     if evidence.unit is None:
         raise RecordingError(
             f"{path}: the gyro's unit cannot be told from the data (the gyro turns gravity "
             "measurably in neither rad/s nor deg/s: too little motion): give --gyro-unit rad/s "
             "or deg/s")
-    return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})"
+    return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
 
 
 QUAT_NORM_TOLERANCE = 0.1
