@@ -29,9 +29,10 @@ class BenchConfig:
     testbench_estimators: tuple[str, ...] = ESTIMATOR_KEYS
     scaling_sizes: tuple[int, ...] = (1_000, 10_000, 100_000, 1_000_000)
     scaling_estimators: tuple[str, ...] = ESTIMATOR_KEYS
+    long_rows: int = 2_000_000
     peers: bool = True
     sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "native", "campaign",
-                                 "scaling")
+                                 "scaling", "estimate_2e6")
     campaign_seeds: int = 300
     quick: bool = False
 
@@ -46,6 +47,7 @@ class BenchConfig:
             testbench_s={100.0: 5.0, 1000.0: 1.0},
             testbench_repeats=1,
             scaling_sizes=(1_000, 10_000, 100_000),
+            long_rows=200_000,
             campaign_seeds=60,
             quick=True,
         )

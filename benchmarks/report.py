@@ -180,6 +180,20 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
                 f"{at['us_per_step']:.0f} us per testbench step, of which the estimator FMU "
                 f"{est:.0f} us; the rest is the ImuPlant and ImuSensor FMUs and the master",
             ))
+    long = r.get("estimate_2e6")
+    if long:
+        from .long_file import ESTIMATE_VS_READ, PEAK_MB
+
+        for fmt, run in long["runs"].items():
+            out.append(_target(
+                f"estimate_2e6.{fmt}.vs_pyarrow_read", run["vs_pyarrow_read"],
+                f"<= {ESTIMATE_VS_READ:g}", run["vs_pyarrow_read"] <= ESTIMATE_VS_READ,
+                "the five estimators' C twins take about 2 us per sample each, run in "
+                "parallel on the machine's cores, while pyarrow's read uses every core"
+                + ("; formatting every double as text" if fmt == "csv" else "")))
+            out.append(_target(
+                f"estimate_2e6.{fmt}.peak_mb", run["peak_mb"], f"<= {PEAK_MB:g}",
+                run["peak_mb"] <= PEAK_MB, "blocks in flight and the libraries loaded"))
     sc = r.get("scaling")
     if sc:
         for key, s in sc.items():
@@ -373,6 +387,17 @@ def format_table(r: dict[str, Any]) -> str:
                 lines.append(f"  {key:<11}memory growth beyond the outputs "
                              f"{_fmt(t['measured'], 2)} B per extra sample (target "
                              f"{t['target'].split('<= ')[1]}): {_verdict(t)}")
+    if "estimate_2e6" in r:
+        long = r["estimate_2e6"]
+        lines += ["", f"imu-fusion estimate, every estimator and the plot, on {long['rows']} "
+                  f"rows ({long['file_mb']:.0f} MB of CSV); pyarrow reads it in "
+                  f"{long['pyarrow_read_s']:.2f} s",
+                  f"  {'format':<9}{'seconds':>9}{'x read':>8}{'peak MB':>9}"]
+        for fmt, run in long["runs"].items():
+            lines.append(f"  {fmt:<9}{run['seconds']:>9.2f}{run['vs_pyarrow_read']:>8.1f}"
+                         f"{run['peak_mb']:>9.0f}  "
+                         f"{_verdict(targets.get(f'estimate_2e6.{fmt}.vs_pyarrow_read'))}, "
+                         f"{_verdict(targets.get(f'estimate_2e6.{fmt}.peak_mb'))}")
     missed = [t for t in r.get("targets", []) if t["met"] is False]
     if missed:
         lines += ["", "Targets not met, and what limits them:"]

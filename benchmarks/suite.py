@@ -25,6 +25,7 @@ from .common import (
 from .config import ESTIMATOR_KEYS, BenchConfig
 from .estimators import STREAM, step_factories, stream_factories
 from .fmu import build_fmus, fmu_steps
+from .long_file import estimate_section
 from .native import native_section
 from .native_fmu import native_fmu_section
 from .peers import PEERS, available_peers
@@ -167,6 +168,10 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
     if "scaling" in config.sections:
         log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
         results["scaling"] = scaling(config.scaling_estimators, config.scaling_sizes, rec)
+    if "estimate_2e6" in config.sections:
+        log(f"imu-fusion estimate on a {config.long_rows}-row CSV, beside pyarrow's read of it")
+        with tempfile.TemporaryDirectory(prefix="bench_long_") as tmp:
+            results["estimate_2e6"] = estimate_section(Path(tmp), config.long_rows)
     results["machine"]["load_average_end"] = load_average()
     results["targets"] = evaluate_targets(results)
     return results

@@ -29,6 +29,7 @@ TINY = dict(
     scaling_sizes=(300, 600),
     scaling_estimators=("cf",),
     campaign_seeds=4,  # 40 runs a campaign: the section's fields, not its figures
+    long_rows=3000,
 )
 
 
@@ -48,10 +49,20 @@ def bench_json(built_fmus, tmp_path_factory: pytest.TempPathFactory) -> dict:
 
 def test_json_holds_every_section_of_the_issue(bench_json: dict) -> None:
     for key in ("per_sample_us", "fmu_step_us", "fmu_overhead_us", "testbench", "scaling",
-                "machine", "repeats", "targets"):
+                "machine", "repeats", "targets", "estimate_2e6"):
         assert key in bench_json, key
     assert bench_json["repeats"] == 1
     assert bench_json["machine"]["cpu_count"] >= 1
+
+
+def test_the_long_file_is_timed_beside_pyarrows_read_in_every_format(bench_json: dict) -> None:
+    long = bench_json["estimate_2e6"]
+    assert long["rows"] == 3000 and long["pyarrow_read_s"] > 0
+    assert set(long["runs"]) == {"csv", "parquet", "hdf5"}
+    names = {t["name"] for t in bench_json["targets"]}
+    for fmt, run in long["runs"].items():
+        assert run["seconds"] > 0 and run["peak_mb"] > 0
+        assert {f"estimate_2e6.{fmt}.vs_pyarrow_read", f"estimate_2e6.{fmt}.peak_mb"} <= names
 
 
 def test_campaign_section_measures_both_worker_counts_or_says_why_not(bench_json: dict) -> None:

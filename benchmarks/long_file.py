@@ -1,0 +1,92 @@
+"""`imu-fusion estimate` on a long recording: seconds and peak memory beside pyarrow reading
+the same file in the same run (the floor: what reading alone costs on this machine).
+
+The recording is written by `long_recording`: ROWS samples at 100 Hz of a sensor turning in
+roll and pitch, six significant digits per value as a logger writes them, seeded. The command
+runs in a child process of its own (every estimator, the plot, each output format) so that its
+peak resident memory is its own.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROWS = 2_000_000
+RATE_HZ = 100.0
+ESTIMATE_VS_READ = 10.0
+"""The aim: estimate with every estimator and the plot in at most this many times pyarrow's
+read of the same file."""
+PEAK_MB = 600.0
+"""The aim: the command's peak resident memory at most this [MB], whatever the length."""
+
+_CHILD = """
+import json, resource, sys, time
+from testbenches.cli import main
+t0 = time.perf_counter()
+status = main(sys.argv[1:])
+seconds = time.perf_counter() - t0
+print(json.dumps({"status": status, "seconds": seconds,
+                  "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}))
+"""
+
+
+def long_recording(path: Path, rows: int = ROWS, seed: int = 0) -> Path:
+    """A CSV of `rows` samples (time [s], acc [m/s^2], gyro [rad/s]) as a logger writes it."""
+    import pyarrow as pa
+    import pyarrow.csv as pc
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(rows) / RATE_HZ
+    roll = 0.6 * np.sin(2 * np.pi * 0.2 * t) * np.sin(2 * np.pi * 0.011 * t)
+    pitch = 0.4 * np.sin(2 * np.pi * 0.13 * t + 1.0)
+    g = 9.80665
+    acc = np.column_stack([-g * np.sin(pitch), g * np.cos(pitch) * np.sin(roll),
+                           g * np.cos(pitch) * np.cos(roll)]) + rng.normal(0, 0.05, (rows, 3))
+    gyro = np.column_stack([np.gradient(roll, t), np.gradient(pitch, t), np.zeros(rows)])
+    gyro += rng.normal(0.0, 0.005, (rows, 3))
+    columns = {"time": np.round(t, 2)}
+    columns.update({f"acc_{a}": np.round(acc[:, i], 4) for i, a in enumerate("xyz")})
+    columns.update({f"gyro_{a}": np.round(gyro[:, i], 6) for i, a in enumerate("xyz")})
+    pc.write_csv(pa.table(columns), path)
+    return path
+
+
+def _pyarrow_read_s(path: Path, repeats: int) -> float:
+    import pyarrow.csv as pc
+
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        pc.read_csv(path)
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def _estimate(path: Path, out: Path, *extra: str) -> dict[str, Any]:
+    proc = subprocess.run([sys.executable, "-c", _CHILD, "estimate", str(path), "--out",
+                           str(out), *extra], capture_output=True, text=True, check=False)
+    got = json.loads(proc.stdout.strip().splitlines()[-1]) if proc.returncode == 0 else {}
+    if got.get("status") != 0:
+        raise RuntimeError(f"imu-fusion estimate failed: {proc.stderr.strip()[-400:]}")
+    return dict(got)
+
+
+def estimate_section(tmp: Path, rows: int = ROWS, repeats: int = 3) -> dict[str, Any]:
+    """Seconds and peak MB of `imu-fusion estimate` (every estimator and the plot) per output
+    format, and pyarrow's read of the same file (best of `repeats`) in the same run."""
+    path = long_recording(tmp / "long.csv", rows)
+    read_s = _pyarrow_read_s(path, repeats)
+    runs = {}
+    for fmt in ("csv", "parquet", "hdf5"):
+        got = _estimate(path, tmp / f"out_{fmt}", "--format", fmt)
+        got["vs_pyarrow_read"] = got["seconds"] / read_s
+        runs[fmt] = got
+    return {"rows": rows, "file_mb": path.stat().st_size / 1e6, "pyarrow_read_s": read_s,
+            "runs": runs}
