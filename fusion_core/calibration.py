@@ -48,6 +48,11 @@ OFF_DIAGONAL_LIMIT: Final = 0.2
 MPU-6050's cross-axis sensitivity is +-2 %, but a part soldered askew on its board, or a
 session whose poses are the faces of a case the part sits in at an angle, adds the angle to
 the case; imucal's example session has 6 deg)."""
+FILE_ENTRIES: Final = ("units", "method", "input_units", "gravity", "recording", "acc", "gyro",
+                       "poses", "static_intervals", "detector", "turn_degrees", "sections",
+                       "held_out", "comparisons")
+"""What a calibration file may hold beside acc_cal and gyro_cal: what `imu-fusion calibrate`
+measured and how (units must be the SI ones the matrices and offsets are in)."""
 MAX_CONDITION: Final = 3.0
 """The entries' ranges keep a calibration matrix's condition number (largest over smallest
 singular value) below this for any combination of them (2.74 at the worst corner; 1 for the
@@ -194,11 +199,27 @@ class Calibration:
             raise ValueError(f"{where}: no acc_cal or gyro_cal entry, so not a calibration (it "
                              f"holds {', '.join(map(repr, doc)) or 'nothing'}); `imu-fusion "
                              "calibrate` writes one")
+        unknown = [k for k in doc if k not in (*(f"{s}_cal" for s in SENSORS), *FILE_ENTRIES)]
+        if unknown:
+            raise ValueError(f"{where}: unknown entr{'y' if len(unknown) == 1 else 'ies'} "
+                             f"{', '.join(map(repr, unknown))}: a calibration file holds acc_cal "
+                             f"and gyro_cal, and beside them {', '.join(FILE_ENTRIES)}")
+        units = doc.get("units")
+        if units is not None:
+            wrong = {s: units.get(s) for s in SENSORS if isinstance(units, dict)
+                     and units.get(s) not in (None, OFFSET_UNIT[s])}
+            if not isinstance(units, dict) or wrong:
+                raise ValueError(f"{where}: units {units!r}: the file's offsets are in m/s2 "
+                                 "(acc) and rad/s (gyro), and say so or nothing")
         fields: dict[str, Any] = {}
         for sensor in SENSORS:
             key = f"{sensor}_cal"
             part = doc.get(key, {"matrix": [IDENTITY[i:i + 3] for i in (0, 3, 6)],
                                  "offset": [0.0, 0.0, 0.0]})
+            if not isinstance(part, dict) or set(part) != {"matrix", "offset"}:
+                got = ", ".join(map(repr, part)) if isinstance(part, dict) else repr(part)
+                raise ValueError(f"{where}: {key} must be {{\"matrix\": 3x3 numbers, "
+                                 f"\"offset\": 3 numbers}} and nothing else; it holds {got}")
             try:
                 rows = part["matrix"]
                 m = tuple(float(v) for row in rows for v in row)

@@ -201,3 +201,39 @@ def test_run_calibrate_first_through_the_fmus_gives_the_campaigns_figures(built_
     row = run_row(run)
     (fmu_run,) = result.runs
     assert fmu_run.metrics["rmse_roll_deg"] == pytest.approx(row["rmse_roll_deg"], abs=1e-9)
+
+
+@needs_imucal_data
+def test_a_six_face_session_is_calibrated_by_ferraris_on_the_sections_it_finds(tmp_path,
+                                                                               capsys) -> None:
+    """The shipped imucal session as a user first tries it: the counter column is named as no
+    time; with the rate, Ferraris's method on the session's own sections (no --sections), and
+    each held-out pose and move meets the calibration far better than the raw data."""
+    assert main(["calibrate", str(SESSION), "--gyro-unit", "deg/s", "--out",
+                 str(tmp_path)]) == 2
+    assert "'n_samples' counts samples, which is no time" in capsys.readouterr().err
+    assert main(["calibrate", str(SESSION), "--rate", "102.4", "--gyro-unit", "deg/s",
+                 "--gravity", "9.81", "--out", str(tmp_path)]) == 0
+    said = capsys.readouterr().out
+    assert "Ferraris's on the six poses and three full turns found in the session" in said
+    doc = json.loads((tmp_path / "calibration.json").read_text())
+    assert doc["method"] == "ferraris" and set(doc["sections"]) == set(fer.SECTIONS)
+    held_acc = np.array(doc["acc"]["residual_held_out"])
+    held_gyro = np.degrees(doc["gyro"]["residual_held_out"])
+    assert len(held_acc) >= 4 and len(held_gyro) >= 4
+    assert np.sqrt(np.mean(held_acc ** 2)) < 0.02  # raw: 0.55 m/s2 at the same poses
+    assert np.sqrt(np.mean(held_gyro ** 2)) < 1.5  # deg, moves of about 90 deg by hand
+    assert (tmp_path / "calibration.png").stat().st_size > 10_000
+
+
+def test_tedaldis_held_out_residuals_are_each_pose_left_out() -> None:
+    _, acc, gyro, dt, _ = simulated(1)
+    session = calibrate_session(acc, gyro, dt)
+    from testbenches.calibrate.heldout import tedaldi_held_out
+
+    held = tedaldi_held_out(session, 9.80665)
+    assert len(held.acc) == len(session.statics) and len(held.gyro) == len(session.turns)
+    # left out, a pose is met less well than in the fit, but still to a few mm/s2
+    assert np.sqrt(np.mean(held.acc ** 2)) > np.sqrt(np.mean(session.acc.after ** 2))
+    assert np.sqrt(np.mean(held.acc ** 2)) < 0.01
+    assert np.degrees(np.sqrt(np.mean(held.gyro ** 2))) < 0.2

@@ -114,3 +114,26 @@ def test_the_file_round_trips_and_says_what_is_wrong(tmp_path) -> None:
     with pytest.raises(ValueError, match=r"calibration.json: calibration acc_cal: entry "
                                          r"acc_cal_zz=0.0 is out of range"):
         Calibration.read(path)
+
+
+@pytest.mark.parametrize(("doc", "says"), [
+    ({"acc_cal": {"matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "offset": [0, 0, 0]},
+      "gyro_call": {}}, "unknown entry 'gyro_call': a calibration file holds acc_cal and "
+     "gyro_cal"),
+    ({"acc_cal": {"matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}},
+     "acc_cal must be {\"matrix\": 3x3 numbers, \"offset\": 3 numbers} and nothing else; it "
+     "holds 'matrix'"),
+    ({"gyro_cal": {"matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "offset": [0, 0, 0],
+                   "scale": 2}}, "it holds 'matrix', 'offset', 'scale'"),
+    ({"gyro_cal": {"matrix": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "offset": [0.3, 0, 0]},
+      "units": {"acc": "m/s2", "gyro": "deg/s"}}, "the file's offsets are in m/s2 (acc) and "
+     "rad/s (gyro)"),
+])
+def test_a_calibration_file_is_checked_against_its_schema(tmp_path, doc, says) -> None:
+    """A misspelt entry, a missing or extra key, offsets in another unit: each refused by
+    name, never read as no calibration."""
+    path = tmp_path / "calibration.json"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(ValueError) as err:
+        Calibration.read(path)
+    assert says in str(err.value)

@@ -33,6 +33,7 @@ from fusion_core.types import G
 from ..options import add_recording_options, positive_float
 from . import ferraris as fer
 from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
+from .heldout import HeldOut, ferraris_held_out, tedaldi_held_out
 from .tedaldi import CalibrationRefused, Fit, Session, calibrate_session
 
 
@@ -56,10 +57,13 @@ def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: igno
     p.set_defaults(func=run)
 
 
-def _fit_json(fit: Fit, unit: str) -> dict[str, Any]:
-    return {"matrix_std": fit.matrix_std.tolist(), "offset_std": fit.offset_std.tolist(),
-            "residual_before": fit.before.tolist(), "residual_after": fit.after.tolist(),
-            "residual_unit": unit, **fit.extra}
+def _fit_json(fit: Fit, unit: str, held: np.ndarray, spans: list[tuple[int, int]]
+              ) -> dict[str, Any]:
+    std = {"matrix_std": fit.matrix_std.tolist(), "offset_std": fit.offset_std.tolist()} \
+        if np.all(np.isfinite(fit.matrix_std)) else {}
+    return {**std, "residual_before": fit.before.tolist(), "residual_after": fit.after.tolist(),
+            "residual_unit": unit, "residual_held_out": held.tolist(),
+            "held_out_samples": [list(s) for s in spans], **fit.extra}
 
 
 def _calibration(acc: Fit, gyro: Fit, extra: dict[str, Any]) -> Calibration:
@@ -132,12 +136,15 @@ def run(args: argparse.Namespace) -> int:
     comparisons: dict[str, Any] = {}
     given = fer.read_sections(args.sections) if args.sections else None
     lines = [f"{args.recording}: {len(acc)} samples at {rate:.4g} Hz"]
+    own = None
+    if given is not None or session is None:
+        own = _own_sections(acc, gyro, dt, g)
+    sections: dict[str, tuple[int, int]] | None = None
     if given is not None:
         f_acc, f_gyro = fer.ferraris(acc, gyro, dt, given, g)
         comparisons["ferraris"] = {"acc_matrix": f_acc.matrix.tolist(),
                                    "gyro_matrix": f_gyro.matrix.tolist(),
                                    **fer.summary(f_acc, f_gyro)}
-        own = _own_sections(acc, gyro, dt, g)
         if own is not None:
             comparisons["ferraris_own_sections"] = {
                 "sections": {k: list(v) for k, v in own[0].items()},
@@ -149,22 +156,38 @@ def run(args: argparse.Namespace) -> int:
                                      "gyro_matrix": peer[1].tolist()}
     if session is not None:
         acc_fit, gyro_fit, method = session.acc, session.gyro, "tedaldi"
+        held = tedaldi_held_out(session, g)
     elif given is not None:
-        acc_fit, gyro_fit, method = f_acc, f_gyro, "ferraris"
-        lines.append(f"Tedaldi's method refused ({refused}); Ferraris's from the sections")
+        acc_fit, gyro_fit, method, sections = f_acc, f_gyro, "ferraris", given
+        lines.append(f"Tedaldi's method refused ({refused}); Ferraris's on the sections given")
+    elif own is not None:
+        sections, acc_fit, gyro_fit = own
+        method = "ferraris"
+        lines.append(f"Tedaldi's method refused ({refused}); Ferraris's on the six poses and "
+                     "three full turns found in the session")
     else:
-        print(f"error: {args.recording}: {refused}", file=sys.stderr)
+        print(f"error: {args.recording}: {refused}; nor does it hold Ferraris's six poses (each "
+              "axis held up and down, still) with a full turn about each axis between two of "
+              "them (give their samples with --sections FILE.json where the session has them)",
+              file=sys.stderr)
         return 2
+    if sections is not None:
+        held = ferraris_held_out(acc, gyro, dt, sections, acc_fit, gyro_fit, g)
     extra: dict[str, Any] = {
         "method": method,
         "units": {"acc": "m/s2", "gyro": "rad/s", "matrix": "1"},
         "input_units": {"acc": args.acc_unit, "gyro": args.gyro_unit},
         "gravity": g,
         "recording": str(args.recording),
-        "acc": _fit_json(acc_fit, "m/s2 (| |a| - g | per pose)"),
+        "acc": _fit_json(acc_fit, "m/s2 (| |a| - g | per pose)", held.acc, held.acc_spans),
         "gyro": _fit_json(gyro_fit, "rad (gravity direction per turn)" if method == "tedaldi"
-                          else "rad (| turn - 2 pi | per turn)"),
+                          else "rad (| turn - 2 pi | per turn)", held.gyro, held.gyro_spans),
+        "held_out": ("each pose and turn under a fit without it (leave one out)"
+                     if method == "tedaldi" else "the session's other poses and the moves "
+                     "between them, under the calibration fitted to Ferraris's sections"),
     }
+    if sections is not None:
+        extra["sections"] = {k: list(v) for k, v in sections.items()}
     if session is not None:
         extra["poses"] = len(session.statics)
         extra["static_intervals"] = [[s.start, s.stop] for s in session.statics]
@@ -178,21 +201,18 @@ def run(args: argparse.Namespace) -> int:
     cal.write(args.out / "calibration.json")
     if session is not None:
         spans = [(s.start, s.stop, "static") for s in session.statics]
-        labels = [str(k) for k in range(len(session.statics))]
     else:
-        assert given is not None
+        assert sections is not None
         spans = [(lo, hi, "static" if name in fer.POSES else "turn")
-                 for name, (lo, hi) in given.items()]
-        labels = list(fer.POSES)
-    _plot(args.out / "calibration.png", t, acc, gyro, spans, labels, acc_fit, gyro_fit,
-          method, g)
-    lines += _report(method, session, acc_fit, gyro_fit, comparisons)
+                 for name, (lo, hi) in sections.items()]
+    _plot(args.out / "calibration.png", t, acc, gyro, spans, acc_fit, gyro_fit, held, method)
+    lines += _report(method, session, acc_fit, gyro_fit, held, comparisons)
     lines.append(f"wrote {args.out / 'calibration.json'} and {args.out / 'calibration.png'}")
     print("\n".join(lines))
     return 0
 
 
-def _report(method: str, session: Session | None, acc_fit: Fit, gyro_fit: Fit,
+def _report(method: str, session: Session | None, acc_fit: Fit, gyro_fit: Fit, held: HeldOut,
             comparisons: dict[str, Any]) -> list[str]:
     lines = []
     if session is not None:
@@ -208,9 +228,12 @@ def _report(method: str, session: Session | None, acc_fit: Fit, gyro_fit: Fit,
                          + f"matrix up to {np.max(fit.matrix_std):.2g}, offset up to "
                          f"{np.max(fit.offset_std):.2g}")
     lines.append(f"  acc residual per pose: before {_rms(acc_fit.before):.4f}, after "
-                 f"{_rms(acc_fit.after):.4f} m/s2 (RMS)")
+                 f"{_rms(acc_fit.after):.4f}, held out {_rms(held.acc):.4f} m/s2 (RMS; "
+                 f"{len(held.acc)} poses held out)")
     lines.append(f"  gyro residual per turn: before {math.degrees(_rms(gyro_fit.before)):.3f}, "
-                 f"after {math.degrees(_rms(gyro_fit.after)):.3f} deg (RMS)")
+                 f"after {math.degrees(_rms(gyro_fit.after)):.3f}, held out "
+                 f"{math.degrees(_rms(held.gyro)):.3f} deg (RMS; {len(held.gyro)} moves held "
+                 "out)")
     for name, comp in comparisons.items():
         lines.append(f"{name}:")
         lines.append(_matrix_rows("acc matrix", np.array(comp["acc_matrix"])))
@@ -223,8 +246,10 @@ def _rms(x: np.ndarray) -> float:
 
 
 def _plot(path: Path, t: np.ndarray, acc: np.ndarray, gyro: np.ndarray,
-          spans: list[tuple[int, int, str]], labels: list[str], acc_fit: Fit, gyro_fit: Fit,
-          method: str, g: float) -> None:
+          spans: list[tuple[int, int, str]], acc_fit: Fit, gyro_fit: Fit, held: HeldOut,
+          method: str) -> None:
+    """The session with the fit's intervals shaded; per pose and per turn the residual of the
+    raw data, of the fit on its own data, and held out (heldout.py), against time."""
     try:
         import matplotlib
 
@@ -232,7 +257,8 @@ def _plot(path: Path, t: np.ndarray, acc: np.ndarray, gyro: np.ndarray,
         import matplotlib.pyplot as plt
     except ImportError:
         return
-    fig, axes = plt.subplots(3, 1, figsize=(10, 9))
+    g = float(np.median(np.linalg.norm(acc, axis=1)))
+    fig, axes = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
     ax = axes[0]
     ax.plot(t, np.linalg.norm(acc, axis=1) / g, lw=0.7, label="|acc| [g]")
     ax.plot(t, np.degrees(np.linalg.norm(gyro, axis=1)) / 100.0, lw=0.7,
@@ -240,31 +266,35 @@ def _plot(path: Path, t: np.ndarray, acc: np.ndarray, gyro: np.ndarray,
     for lo, hi, kind in spans:
         ax.axvspan(t[lo], t[hi - 1], color="tab:green" if kind == "static" else "tab:orange",
                    alpha=0.2, lw=0)
-    ax.set_xlabel("time [s]")
-    ax.set_title("the session; the static intervals found shaded" if method == "tedaldi" else
-                 "the session; the sections given shaded (poses green, turns orange)")
+    ax.set_title(f"the session; what {method}'s fit used shaded (poses green, turns orange)")
     ax.legend(loc="upper right")
-    ax = axes[1]
-    k = np.arange(len(acc_fit.before))
-    ax.bar(k - 0.2, acc_fit.before, 0.4, label="raw")
-    ax.bar(k + 0.2, acc_fit.after, 0.4, label="calibrated")
-    ax.set_yscale("log")
-    ax.set_xticks(k, labels)
-    ax.set_xlabel("pose")
-    ax.set_ylabel("| |a| - g | [m/s2]")
-    ax.set_title(f"accelerometer residual per pose ({method})")
-    ax.legend()
-    ax = axes[2]
-    k = np.arange(len(gyro_fit.before))
-    ax.bar(k - 0.2, np.degrees(gyro_fit.before), 0.4, label="raw less the bias")
-    ax.bar(k + 0.2, np.degrees(gyro_fit.after), 0.4, label="calibrated")
-    if method != "tedaldi":
-        ax.set_xticks(k, list(fer.TURNS))
-    ax.set_xlabel("turn")
-    ax.set_ylabel("deg")
-    ax.set_title("gyro residual per turn (predicted against measured gravity direction)"
-                 if method == "tedaldi" else "gyro residual per full turn")
-    ax.legend()
+    fitted = [(lo, hi) for lo, hi, kind in spans if kind == "static"]
+    for ax, fit, held_res, held_spans, unit, scale, what in (
+            (axes[1], acc_fit, held.acc, held.acc_spans, "| |a| - g | [m/s2]", 1.0, "pose"),
+            (axes[2], gyro_fit, held.gyro, held.gyro_spans, "[deg]", math.degrees(1.0),
+             "turn")):
+        mid = lambda s: 0.5 * (t[s[0]] + t[min(s[1], len(t)) - 1])  # noqa: E731
+        if what == "pose":
+            at = [mid(s) for s in fitted]
+        elif method == "tedaldi":
+            at = [mid(s) for s in held_spans]
+        else:
+            at = [mid((lo, hi)) for lo, hi, kind in spans if kind == "turn"]
+        if len(at) == len(fit.after):
+            ax.semilogy(at, np.maximum(fit.before * scale, 1e-6), "v", color="0.6",
+                        label="raw" if what == "pose" else "raw less the bias")
+            ax.semilogy(at, np.maximum(fit.after * scale, 1e-6), "o", mfc="none",
+                        color="tab:blue", label="fit, on its own data")
+        if len(held_res):
+            ax.semilogy([mid(s) for s in held_spans], np.maximum(held_res * scale, 1e-6), "s",
+                        color="tab:red", label="held out (a fit without it)")
+        ax.set_ylabel(unit)
+        ax.set_title(f"accelerometer residual per {what}" if what == "pose" else
+                     "gyro residual per turn: gravity's predicted against measured direction"
+                     if method == "tedaldi" else
+                     "gyro residual: full turn (fit) and moves between poses (held out)")
+        ax.legend(loc="best", fontsize=8)
+    axes[2].set_xlabel("time [s]")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

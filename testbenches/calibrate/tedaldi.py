@@ -130,6 +130,7 @@ class Turn:
     dt: np.ndarray  # [k - 1] sample intervals
     up_from: np.ndarray
     up_to: np.ndarray
+    span: tuple[int, int] = (0, 0)  # its samples in the session [start, stop)
 
 
 class _Integrator:
@@ -190,6 +191,8 @@ class Session:
     acc: Fit
     gyro: Fit
     turn_degrees: np.ndarray
+    turns: list[Turn] = field(default_factory=list)
+    """The turns the gyro's fit used."""
 
 
 def distinct_directions(statics: list[Static]) -> int:
@@ -257,7 +260,7 @@ def _turns(acc_fit: Fit, statics: list[Static], gyro: np.ndarray, dt: np.ndarray
                 f"between samples {lo} and {hi} the gyro reached its range "
                 f"(+-{math.degrees(gyro_range):.0f} deg/s): the rate beyond it is lost; turn "
                 "the sensor more slowly between poses (a turn of 90-180 deg in a second or two)")
-        turns.append(Turn(gyro[lo:hi], dt[lo + 1:hi], ua, ub))
+        turns.append(Turn(gyro[lo:hi], dt[lo + 1:hi], ua, ub, (int(lo), int(hi))))
         degrees.append(math.degrees(math.acos(float(np.clip(ua @ ub, -1.0, 1.0)))))
     return turns, np.array(degrees)
 
@@ -304,4 +307,4 @@ def calibrate_session(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
     turns, degrees = _turns(acc_fit, statics, gyro, dt, gyro_range)
     used = _check_turns(turns, degrees, bias)
     gyro_fit = fit_gyro(used, bias, bias_std)
-    return Session(statics, threshold, k, floor, acc_fit, gyro_fit, degrees)
+    return Session(statics, threshold, k, floor, acc_fit, gyro_fit, degrees, used)

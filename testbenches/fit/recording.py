@@ -158,6 +158,9 @@ def parse_columns(specs: list[str]) -> dict[str, str]:
     return out
 
 
+COUNTER_NAMES = ("n_samples", "sample", "samples", "sample_index", "index", "idx", "counter",
+                 "count", "frame", "n")
+"""Column names of a sample counter: no time, and said so where the time is missing."""
 EXTRA_COLUMNS = ("dt", "roll", "pitch", "q_w", "q_x", "q_y", "q_z")
 """Columns found by their own name only: the sampling and a reference."""
 
@@ -435,8 +438,12 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
     else:
-        raise RecordingError(f"{path}: no time or dt column: give the sample rate (--rate HZ), "
-                             "the time column's name (--time-column NAME) or map it with "
+        counters = [h for h, nm in zip(table.header, table.names, strict=True)
+                    if _norm_name(nm) in COUNTER_NAMES]
+        hint = (f" ({', '.join(map(repr, counters))} counts samples, which is no time)"
+                if counters else "")
+        raise RecordingError(f"{path}: no time or dt column{hint}: give the sample rate (--rate "
+                             "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
     dt, _ = _Clock(**{**clock.__dict__})(prefix.get(clock.kind), 0, n)
     acc = np.column_stack([prefix[f"acc_{a}"] for a in "xyz"])
