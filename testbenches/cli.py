@@ -1,7 +1,8 @@
 """`imu-fusion COMMAND ...` (and `python -m testbenches COMMAND ...`): the project's command line.
 
-  estimate    the estimators on your own recording (CSV or HDF5): estimates as CSV, a plot, and
-              with a reference the RMSE beside VQF's (testbenches.estimate).
+  estimate    the estimators on your own recording (CSV, Parquet, HDF5, MAT): estimates as CSV,
+              Parquet or HDF5, a plot, and with a reference the RMSE beside VQF's
+              (testbenches.estimate).
   build-fmus  build and validate the FMUs (fmu_src.cli; also `python build_fmu.py`).
   run         estimator x scenario x seed runs through the FMUs with the contract checks
               (testbenches.contract_runs); prints the contract table, writes DIR/report.json,
@@ -23,9 +24,12 @@
               for --calibration (testbenches.calibrate).
   crosscheck  the native FMUs with fusion_core's reference results and fmpy's in the FMI
               Cross-Check layout, validated by fmpy's cross-check tools (testbenches.crosscheck).
+  docs        the docs' generated figures, tables and pictures checked against (or made again
+              by) their commands (testbenches.docs_figures).
 
-`estimate` needs only the estimators (and h5py for HDF5, matplotlib for its plot, vqf for the
-comparison); the other commands need the testbench extra, and say so where it is missing.
+`estimate` needs only the estimators (and pyarrow for speed and Parquet, h5py for HDF5, scipy
+for MAT, matplotlib for its plot, vqf for the comparison); the other commands need the
+testbench extra, and say so where it is missing.
 """
 
 from __future__ import annotations
@@ -60,6 +64,7 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         from .budget import add_budget_parser
         from .calibrate.cli import add_calibrate_parser
         from .crosscheck import add_crosscheck_parser
+        from .docs_figures import add_docs_parser
         from .engines import add_engines_parser
         from .fit.cli import add_fit_parsers
         from .montecarlo.cli import add_campaign_parser
@@ -68,7 +73,7 @@ def _parser(prog: str) -> argparse.ArgumentParser:
 
         for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
                     add_campaign_parser, add_budget_parser, add_crosscheck_parser,
-                    add_calibrate_parser, add_engines_parser):
+                    add_calibrate_parser, add_engines_parser, add_docs_parser):
             add(sub)
     return parser
 

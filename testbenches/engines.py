@@ -268,8 +268,6 @@ def _check_ecos_parameters(sim: Any, values: Mapping[str, Mapping[str, Any]]) ->
 ENGINE_TABLE_SCENARIO = "moderate_dynamics"
 EARLY_WINDOW = (0.03, 0.5)
 """Where a false start shows (docs/guide/engines.md): the largest error in it is a column."""
-TABLE_MARK = "<!-- imu-fusion engines: generated, do not edit -->"
-"""The line before the table in docs/guide/engines.md (tests/test_engines.py regenerates it)."""
 
 
 def early_error_deg(r: TestbenchResult) -> float:

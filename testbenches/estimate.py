@@ -29,6 +29,7 @@ cannot serve gets one line saying what was wrong, and no output file.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 from typing import Any
@@ -91,6 +92,8 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--every", type=positive_int, default=1, metavar="N",
                    help="write every Nth sample (the estimators still take every one)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plot")
+    p.add_argument("--no-vqf", action="store_true",
+                   help="with a reference, leave out VQF's row (and its line in the plot)")
 
 
 class Reference:
@@ -375,9 +378,17 @@ def _read_ahead(blocks: Any) -> Any:
         stop.set()
 
 
-def _progress(source: Any) -> Any:
-    from tqdm import tqdm
+class _NoBar(contextlib.nullcontext):  # type: ignore[type-arg]
+    def update(self, n: int) -> None:
+        pass
 
+
+def _progress(source: Any) -> Any:
+    """A progress bar on a terminal (tqdm, where installed)."""
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return _NoBar()
     return tqdm(total=source.rows, unit="sample", unit_scale=True, disable=None,
                 desc=source.name, leave=False)
 
@@ -452,7 +463,7 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
             if n == 0:
                 world_up, note = find_world_up(rec, args.reference or args.recording)
                 notes += [note] if note else []
-                if rec.up_ref is not None:
+                if rec.up_ref is not None and not args.no_vqf:
                     vqf = _VqfRun(source.rate, estimator_params(args, preset[keys[0]]))
             if world_up is not None and rec.ref_quat is not None:
                 rec.up_ref = about_world_up(rec.ref_quat, world_up)

@@ -185,7 +185,7 @@ def _text(path: Path) -> TableSource:
     names, units = zip(*(split_unit(h) for h in layout.header), strict=True)
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
-        if layout.padded:
+        if layout.padded or not _has_pyarrow():
             yield from _python_blocks(path, layout, columns, rows, 0)
             return
         done = 0
@@ -205,6 +205,15 @@ def _text(path: Path) -> TableSource:
 
 class _ArrowFailed(Exception):
     pass
+
+
+def _has_pyarrow() -> bool:
+    """pyarrow parses text fast; without it Python's csv module reads the same file."""
+    try:
+        import pyarrow.csv  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
 
 def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int

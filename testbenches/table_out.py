@@ -29,14 +29,17 @@ class TableWriter:
         self._sink: Any = None
         self._writer: Any = None
         if fmt == "csv":
-            import pyarrow as pa
-            import pyarrow.csv as pc
-
             self._sink = self.partial.open("wb")
             self._sink.write((",".join(self.names) + "\n").encode())
-            schema = pa.schema([(n, pa.float64()) for n in self.names])
-            self._writer = pc.CSVWriter(self._sink, schema,
-                                        write_options=pc.WriteOptions(include_header=False))
+            try:
+                import pyarrow as pa
+                import pyarrow.csv as pc
+            except ImportError:  # numpy writes the same digits, slower
+                self._writer = None
+            else:
+                schema = pa.schema([(n, pa.float64()) for n in self.names])
+                self._writer = pc.CSVWriter(
+                    self._sink, schema, write_options=pc.WriteOptions(include_header=False))
         elif fmt == "parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq
@@ -62,6 +65,8 @@ class TableWriter:
                 ds = self._sink[name]
                 ds.resize((self.rows + n,))
                 ds[self.rows:] = values
+        elif self._writer is None:  # CSV without pyarrow
+            np.savetxt(self._sink, np.column_stack(columns), delimiter=",", fmt="%.17g")
         else:
             import pyarrow as pa
 

@@ -187,13 +187,3 @@ def test_the_pages_recipe_runs_the_chain_in_the_engine(built_fmus, tmp_path, mon
     exec(compile(_recipe(heading), str(PAGE), "exec"), scope)
     truth = get_scenario("moderate_dynamics").trajectory().truth(np.array([60.0 - 0.02]))
     assert abs(scope["roll"] - truth["roll"][0]) < np.radians(1.0)
-
-
-@pytest.mark.heavy
-def test_the_pages_table_is_what_imu_fusion_engines_gives(built_fmus):
-    for engine in engines.ENGINES:
-        _skip_without(engine)
-    text = PAGE.read_text()
-    block = text.split(engines.TABLE_MARK + "\n", 1)[1].split("\n\n", 1)[0]
-    rows = engines.engine_rows(built_fmus.directory)
-    assert block == engines.engine_table(rows, speed=False)

@@ -135,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
         refused = str(err)
     comparisons: dict[str, Any] = {}
     given = fer.read_sections(args.sections) if args.sections else None
-    lines = [f"{args.recording}: {len(acc)} samples at {rate:.4g} Hz"]
+    lines: list[str] = []
     own = None
     if given is not None or session is None:
         own = _own_sections(acc, gyro, dt, g)

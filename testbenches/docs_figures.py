@@ -1,0 +1,278 @@
+"""`imu-fusion docs [--check | --write] [NAME ...]`: the figures, tables and pictures of the
+README and the docs that a command makes, made again by that command.
+
+A page holds a generated block between two marks:
+
+    <!-- generated: NAME -->
+    ...
+    <!-- end generated: NAME -->
+
+and a picture is a file the page shows. FIGURES names each one, the command a reader runs to
+reproduce it, what it needs (built FMUs, a data set) and how it is made; everything is seeded,
+so a text block must match to the character and a picture to its pixels (PICTURE_TOLERANCE of
+them may differ, for font rendering between machines). `--check` (the default) says which no
+longer match and exits 1; `--write` makes them again. tests/test_docs_figures.py runs the check
+for every figure whose needs are met here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import re
+import sys
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+PICTURE_TOLERANCE = 0.002
+"""The share of a picture's pixels that may differ from the page's: fonts render a little
+differently between machines; a changed curve moves far more pixels than this."""
+IMUCAL_SESSION = "example_ferraris_session.csv"
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One generated figure: where it is (a page's block, or a picture file), the command that
+    makes it, what that needs, and the function that makes it (text for a block; for a picture
+    it writes the file it is given). `make` takes the context (fmu_dir, data folders)."""
+
+    name: str
+    page: str
+    command: str
+    make: Callable[[dict[str, Path]], str] | Callable[[dict[str, Path], Path], None]
+    picture: str | None = None
+    needs: tuple[str, ...] = ()
+
+
+def _captured(argv: list[str], cwd: Path) -> str:
+    """What `imu-fusion ARGV` prints, run in cwd."""
+    from .cli import main
+
+    out = io.StringIO()
+    here = Path.cwd()
+    try:
+        os.chdir(cwd)
+        with contextlib.redirect_stdout(out):
+            status = main(argv)
+    finally:
+        os.chdir(here)
+    if status != 0:
+        raise RuntimeError(f"imu-fusion {' '.join(argv)} exited with {status}")
+    return out.getvalue()
+
+
+# ----- the figures ------------------------------------------------------------------------------
+
+ESTIMATE_ARGS = ["estimate", "examples/tilt_motion.csv", "--reference",
+                 "examples/tilt_motion_truth.csv", "--no-vqf"]
+
+
+def estimate_output(ctx: dict[str, Path]) -> str:
+    with tempfile.TemporaryDirectory() as tmp:
+        text = _captured([*ESTIMATE_ARGS, "--no-plots", "--out", tmp], REPO)
+        text = text.replace(tmp, "reports/estimate")
+    return "```text\n" + text.rstrip() + "\n```"
+
+
+def estimate_picture(ctx: dict[str, Path], path: Path) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        _captured([*ESTIMATE_ARGS, "--out", tmp], REPO)
+        Path(tmp, "tilt_motion.png").replace(path)
+
+
+def calibrate_output(ctx: dict[str, Path]) -> str:
+    with tempfile.TemporaryDirectory() as tmp:
+        text = _captured(["calibrate", IMUCAL_SESSION, "--rate", "102.4", "--gyro-unit",
+                          "deg/s", "--gravity", "9.81", "--out", tmp], ctx["imucal"])
+        text = text.replace(tmp, "calibration")
+    return "```text\n" + text.rstrip() + "\n```"
+
+
+def calibrate_picture(ctx: dict[str, Path], path: Path) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        _captured(["calibrate", IMUCAL_SESSION, "--rate", "102.4", "--gyro-unit", "deg/s",
+                   "--gravity", "9.81", "--out", tmp], ctx["imucal"])
+        Path(tmp, "calibration.png").replace(path)
+
+
+def fmu_picture(ctx: dict[str, Path], path: Path) -> None:
+    """The README's picture: the native FMI 3.0 AngleBiasKalmanFilter FMU in fmpy on the
+    example, as examples/plot_example.py draws it."""
+    import importlib.util
+
+    from fmpy import simulate_fmu
+    from fmpy.util import read_csv, write_csv
+
+    fmu = ctx["fmus"] / "native" / "fmi3" / "AngleBiasKalmanFilter.fmu"
+    spec = importlib.util.spec_from_file_location("plot_example",
+                                                  REPO / "examples" / "plot_example.py")
+    assert spec is not None and spec.loader is not None
+    plot_example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(plot_example)
+    with tempfile.TemporaryDirectory() as tmp:
+        result = simulate_fmu(str(fmu), input=read_csv(str(REPO / "examples" /
+                                                           "tilt_motion.csv")),
+                              output_interval=0.01)
+        out = Path(tmp) / "out.csv"
+        write_csv(str(out), result)
+        plot_example.plot(plot_example.read(out),
+                          plot_example.read(REPO / "examples" / "tilt_motion_truth.csv"),
+                          "AngleBiasKalmanFilter.fmu on examples/tilt_motion.csv", path)
+
+
+def engines_table(ctx: dict[str, Path]) -> str:
+    from .engines import engine_rows, engine_table
+
+    return engine_table(engine_rows(ctx["fmus"]), speed=False)
+
+
+FIGURES: tuple[Figure, ...] = (
+    Figure("fmu-example", "README.md",
+           "fmpy simulate dist/native/fmi3/AngleBiasKalmanFilter.fmu --input-file "
+           "examples/tilt_motion.csv --output-interval 0.01 --output-file out.csv; python "
+           "examples/plot_example.py out.csv examples/tilt_motion_truth.csv "
+           "docs/fmu_example.png", fmu_picture, "docs/fmu_example.png", ("fmus",)),
+    Figure("estimate-example", "docs/guide/estimate.md", "imu-fusion " + " ".join(
+        ESTIMATE_ARGS) + " --no-plots", estimate_output),
+    Figure("estimate-picture", "docs/guide/estimate.md", "imu-fusion " + " ".join(
+        ESTIMATE_ARGS), estimate_picture, "docs/estimate_example.png"),
+    Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
+           engines_table, needs=("fmus", "engines")),
+    Figure("calibrate-imucal", "docs/results/calibration.md",
+           f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s "
+           "--gravity 9.81", calibrate_output, needs=("imucal",)),
+    Figure("calibrate-picture", "docs/results/calibration.md",
+           f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s "
+           "--gravity 9.81", calibrate_picture, "docs/calibration_example.png", ("imucal",)),
+)
+"""Every generated figure of the README and the docs."""
+
+
+# ----- blocks and pictures ----------------------------------------------------------------------
+
+def block_pattern(name: str) -> re.Pattern[str]:
+    return re.compile(rf"(<!-- generated: {re.escape(name)} -->\n)(.*?)(<!-- end generated: "
+                      rf"{re.escape(name)} -->)", re.S)
+
+
+def block(page: Path, name: str) -> str:
+    """The text of a page's generated block; ValueError where the page has none of that name."""
+    m = block_pattern(name).search(page.read_text(encoding="utf-8"))
+    if m is None:
+        raise ValueError(f"{page}: no generated block {name!r} (marks <!-- generated: {name} "
+                         f"--> and <!-- end generated: {name} -->)")
+    return m.group(2).removesuffix("\n")
+
+
+def replace_block(page: Path, name: str, text: str) -> None:
+    block(page, name)  # it is there
+    new = block_pattern(name).sub(lambda m: m.group(1) + text + "\n" + m.group(3),
+                                  page.read_text(encoding="utf-8"))
+    page.write_text(new, encoding="utf-8")
+
+
+def pixels_differ(a: Path, b: Path) -> float:
+    """The share of pixels that differ between two pictures (1.0 where their sizes do)."""
+    import matplotlib.image as mpimg
+
+    x, y = mpimg.imread(a), mpimg.imread(b)
+    if x.shape != y.shape:
+        return 1.0
+    return float(np.mean(np.any(np.abs(x - y) > 1.0 / 255.0, axis=-1)))
+
+
+def context(fmu_dir: Path | None = None, imucal: Path | None = None) -> dict[str, Path]:
+    """What the figures need that is here: the built FMUs, imucal's session."""
+    ctx: dict[str, Path] = {}
+    fmus = fmu_dir or REPO / "dist"
+    if (fmus / "native" / "fmi3" / "AngleBiasKalmanFilter.fmu").is_file():
+        ctx["fmus"] = fmus
+    from .engines import ENGINES, engine_reason
+
+    if all(engine_reason(e) is None for e in ENGINES):
+        ctx["engines"] = REPO
+    data = imucal or REPO.parent / "shared" / "data" / "imucal"
+    if (data / IMUCAL_SESSION).is_file():
+        ctx["imucal"] = data
+    return ctx
+
+
+def missing(figure: Figure, ctx: dict[str, Path]) -> list[str]:
+    """What a figure needs that is not here."""
+    return [n for n in figure.needs if n not in ctx]
+
+
+def check(figure: Figure, ctx: dict[str, Path], root: Path = REPO) -> str | None:
+    """None where the figure in the pages under root matches its command, else what
+    differs."""
+    if figure.picture is None:
+        want = figure.make(ctx)  # type: ignore[call-arg]
+        have = block(root / figure.page, figure.name)
+        if want == have:
+            return None
+        diff = next((i for i, (a, b) in enumerate(zip(want, have, strict=False)) if a != b),
+                    min(len(want), len(have)))
+        return (f"{figure.page}, block {figure.name}: differs from its command's output at "
+                f"character {diff} (page: {have[diff:diff + 60]!r}; command: "
+                f"{want[diff:diff + 60]!r})")
+    with tempfile.TemporaryDirectory() as tmp:
+        made = Path(tmp) / "made.png"
+        figure.make(ctx, made)  # type: ignore[call-arg]
+        shown = root / figure.picture
+        if not shown.is_file():
+            return f"{figure.picture}: missing"
+        share = pixels_differ(made, shown)
+    if share <= PICTURE_TOLERANCE:
+        return None
+    return (f"{figure.picture}: {100 * share:.2f} % of its pixels differ from what its command "
+            f"draws (at most {100 * PICTURE_TOLERANCE:g} % may)")
+
+
+def write(figure: Figure, ctx: dict[str, Path]) -> None:
+    if figure.picture is None:
+        replace_block(REPO / figure.page, figure.name, figure.make(ctx))  # type: ignore[call-arg]
+    else:
+        figure.make(ctx, REPO / figure.picture)  # type: ignore[call-arg]
+
+
+def add_docs_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    p = sub.add_parser("docs", help="check (or make again) the docs' generated figures",
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("names", nargs="*", help="which figures (all)")
+    p.add_argument("--write", action="store_true", help="make them again instead of checking")
+    p.add_argument("--fmu-dir", type=Path, default=None, help="built FMUs (dist)")
+    p.add_argument("--imucal", type=Path, default=None,
+                   help=f"the folder of imucal's {IMUCAL_SESSION}")
+    p.set_defaults(func=cmd_docs)
+
+
+def cmd_docs(args: argparse.Namespace) -> int:
+    from .options import choose
+
+    names = choose(",".join(args.names) or "all", [f.name for f in FIGURES], "figure")
+    ctx = context(args.fmu_dir, args.imucal)
+    stale = 0
+    for figure in (f for f in FIGURES if f.name in names):
+        lacking = missing(figure, ctx)
+        if lacking:
+            print(f"{figure.name}: skipped, needs {', '.join(lacking)} (--fmu-dir, --imucal)")
+            continue
+        if args.write:
+            write(figure, ctx)
+            print(f"{figure.name}: made ({figure.picture or figure.page})")
+            continue
+        problem = check(figure, ctx)
+        print(f"{figure.name}: {'matches' if problem is None else problem}")
+        stale += problem is not None
+    return 1 if stale else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit("use: imu-fusion docs")

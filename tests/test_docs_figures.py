@@ -1,0 +1,78 @@
+"""Documentation that cannot go stale: every generated figure, table and picture of the README
+and the docs matches what its command gives (testbenches.docs_figures), and a figure changed
+on purpose is caught."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from testbenches import docs_figures as figs
+
+REPO = Path(__file__).resolve().parents[1]
+BY_NAME = {f.name: f for f in figs.FIGURES}
+WHERE = {"imucal": "imucal's session beside the project in ../shared/data/imucal",
+         "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)"}
+
+
+def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, Path]:
+    ctx = figs.context(imucal=None)
+    ctx.pop("fmus", None)  # the FMUs of this checkout, built for the session, never dist/'s
+    if "fmus" in figure.needs:
+        built = request.getfixturevalue("built_fmus")
+        built.native("fmi3", "AngleBiasKalmanFilter")
+        ctx["fmus"] = built.directory
+    lacking = figs.missing(figure, ctx)
+    if lacking:
+        pytest.skip(f"{figure.name} needs {', '.join(lacking)}: " + "; ".join(
+            WHERE[n] for n in lacking))
+    return ctx
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.heavy) if n ==
+                                  "engines-table" else n for n in BY_NAME])
+def test_every_generated_figure_matches_its_command(name: str, request) -> None:
+    figure = BY_NAME[name]
+    problem = figs.check(figure, _context(figure, request))
+    assert problem is None, f"{problem}; make it again with: imu-fusion docs --write {name}"
+
+
+def test_every_page_mark_is_a_registered_figure_and_every_figure_is_shown() -> None:
+    marks = set()
+    for page in [REPO / "README.md", *sorted((REPO / "docs").rglob("*.md"))]:
+        text = page.read_text(encoding="utf-8")
+        marks |= set(re.findall(r"<!-- generated: ([\w-]+) -->", text))
+    assert marks == {f.name for f in figs.FIGURES if f.picture is None}
+    for figure in figs.FIGURES:
+        if figure.picture is not None:
+            shown = Path(figure.picture).name
+            assert shown in (REPO / figure.page).read_text(encoding="utf-8"), figure.name
+
+
+def test_a_block_changed_on_purpose_is_caught(tmp_path: Path) -> None:
+    figure = BY_NAME["estimate-example"]
+    page = tmp_path / figure.page
+    page.parent.mkdir(parents=True)
+    text = (REPO / figure.page).read_text(encoding="utf-8")
+    page.write_text(text.replace("0.5996", "0.5997", 1), encoding="utf-8")
+    problem = figs.check(figure, {}, root=tmp_path)
+    assert problem is not None and "block estimate-example: differs" in problem
+    assert "(page: '7  reports" in problem and "command: '6  reports" in problem
+
+
+def test_a_picture_changed_on_purpose_is_caught(tmp_path: Path) -> None:
+    """The estimate plot as the page shows it matches; drawn with two estimators fewer, it no
+    longer does."""
+    figure = BY_NAME["estimate-picture"]
+    shown = tmp_path / figure.picture
+    shown.parent.mkdir(parents=True)
+    shutil.copy(REPO / figure.picture, shown)
+    assert figs.check(figure, {}, root=tmp_path) is None
+    out = tmp_path / "fewer"
+    figs._captured([*figs.ESTIMATE_ARGS, "--estimator", "cf,kf,ukf", "--out", str(out)], REPO)
+    shutil.copy(out / "tilt_motion.png", shown)
+    problem = figs.check(figure, {}, root=tmp_path)
+    assert problem is not None and "of its pixels differ" in problem
