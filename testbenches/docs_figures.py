@@ -51,16 +51,27 @@ class Figure:
     needs: tuple[str, ...] = ()
 
 
+def _main(argv: list[str]) -> int:
+    """`imu-fusion ARGV` for the commands whose output the docs show (estimate, calibrate)."""
+    from .calibrate.cli import add_calibrate_parser
+    from .estimate import add_estimate_parser
+
+    parser = argparse.ArgumentParser(prog="imu-fusion")
+    sub = parser.add_subparsers(required=True)
+    add_estimate_parser(sub)
+    add_calibrate_parser(sub)
+    args = parser.parse_args(argv)
+    return int(args.func(args))
+
+
 def _captured(argv: list[str], cwd: Path) -> str:
     """What `imu-fusion ARGV` prints, run in cwd."""
-    from .cli import main
-
     out = io.StringIO()
     here = Path.cwd()
     try:
         os.chdir(cwd)
         with contextlib.redirect_stdout(out):
-            status = main(argv)
+            status = _main(argv)
     finally:
         os.chdir(here)
     if status != 0:
