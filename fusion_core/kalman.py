@@ -488,7 +488,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self.meas = measure_turned(self.meas, turn)
         r = self.rest
         self.rest = RestState(*turn((r.wx, r.wy, r.wz)), *turn((r.fx, r.fy, r.fz)), r.quiet_time,
-                              r.measured, *turn((r.ox, r.oy, r.oz)))
+                              r.measured, *turn((r.ox, r.oy, r.oz)), *turn((r.rx, r.ry, r.rz)))
         P_roll, P_pitch, P_z = self.P_roll, self.P_pitch, self.P_z
         vertical = (max(P_roll[0], P_pitch[0]), 0.0, 0.0, P_z)
         old = (P_roll, P_pitch, vertical)

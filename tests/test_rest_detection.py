@@ -16,7 +16,7 @@ import pytest
 
 from fusion_core import ESTIMATORS, native
 from fusion_core.building_blocks import REST_PARAMS
-from fusion_core.registry import ATTITUDE_FILTERS
+from fusion_core.registry import ATTITUDE_FILTERS, create
 from fusion_core.types import DEG, G
 
 RATE = 100.0
@@ -125,7 +125,8 @@ def test_only_a_first_rest_that_the_bias_estimate_misses_by_rest_gyro_aligns() -
 
     th = next(p.default for p in REST_PARAMS if p.name == "rest_gyro")
     mean = (3.0 * th, 0.0, 0.0)
-    rest = RestState(*mean, 0.0, 0.0, G, REST_TIME, 1.0, 0.0, 0.0, G)  # a rest just measured
+    # a rest just measured
+    rest = RestState(*mean, 0.0, 0.0, G, REST_TIME, 1.0, 0.0, 0.0, G, *mean)
     assert uncalibrated_first_rest(0.0, rest, (0.0, 0.0, 0.0), th)
     assert not uncalibrated_first_rest(1.0, rest, (0.0, 0.0, 0.0), th)  # not the first rest
     assert not uncalibrated_first_rest(0.0, rest, (2.5 * th, 0.0, 0.0), th)  # calibrated enough
@@ -223,3 +224,28 @@ def test_a_short_rest_measures_the_bias_of_the_filters_without_a_bias_covariance
     b = (0.16 * DEG, -0.16 * DEG, 0.16 * DEG)
     measured = final_bias(key, backend, [b], [3.0])
     assert measured == pytest.approx(b, rel=0.25)
+
+
+def test_a_slow_swing_from_power_up_teaches_no_bias_at_its_turning_points() -> None:
+    """40 deg of roll at 0.02 Hz, 200 Hz, 600 s, never still: at each turning point gravity
+    stands for a second while the rate ramps through zero. Every attitude filter stays within
+    a tenth of VQF's figures on it (VQF 6D: 0.86 deg RMSE, 1.64 max) and learns no bias
+    (the complementary filters learned 0.3-0.7 deg/s there, 1.67 / 4.1 deg)."""
+    from testbenches.broad.metric import gravity_from_roll_pitch, inclination_error
+
+    rate, n = 200.0, 120_000
+    t = np.arange(n) / rate
+    amp, f = np.radians(40.0), 0.02
+    roll = amp * np.sin(2 * np.pi * f * t)
+    rng = np.random.default_rng(0)
+    acc = np.column_stack([np.zeros(n), G * np.sin(roll), G * np.cos(roll)])
+    acc += rng.normal(0.0, 0.03, (n, 3))
+    gyro = np.column_stack([amp * 2 * np.pi * f * np.cos(2 * np.pi * f * t), np.zeros(n),
+                            np.zeros(n)]) + rng.normal(0.0, 0.002, (n, 3))
+    up = np.column_stack([np.zeros(n), np.sin(roll), np.cos(roll)])
+    for key in ("cf", "mgcf", "kf", "ukf"):
+        out = create(key).run(acc, gyro, np.full(n, 1.0 / rate))
+        err = np.degrees(inclination_error(gravity_from_roll_pitch(out["roll"], out["pitch"]),
+                                           up))
+        assert np.sqrt(np.mean(err ** 2)) < 0.086 and err.max() < 0.164, key
+        assert np.degrees(np.abs(out["bias"][:, 0]).max()) < 0.15, key

@@ -14,9 +14,9 @@ from .sampling import REAL_GYRO_DENSITY, Vec3, on_the_mark
 class RestState(NamedTuple):
     """The rest detector's state: running means of the rate (wx, wy, wz) and of the specific
     force (fx, fy, fz), the quiet time [s], measured: 1.0 once a rest has lasted rest_time (the
-    bias has been measured), else 0.0, and the mean specific force (ox, oy, oz) where the quiet
-    time had lasted REST_MEAN_TAU (REST_TURN). The C twin holds the same eleven numbers in order
-    (fc_real rest[FC_REST_SIZE])."""
+    bias has been measured), else 0.0, the mean specific force (ox, oy, oz) and the mean rate
+    (rx, ry, rz) where the quiet time had lasted REST_MEAN_TAU (REST_TURN). The C twin holds the
+    same fourteen numbers in order (fc_real rest[FC_REST_SIZE])."""
 
     wx: float
     wy: float
@@ -29,10 +29,13 @@ class RestState(NamedTuple):
     ox: float
     oy: float
     oz: float
+    rx: float
+    ry: float
+    rz: float
 
 
 _new = tuple.__new__
-REST_START: Final = RestState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+REST_START: Final = RestState(*(0.0,) * 14)
 """The rest detector's state before the first sample."""
 
 REST_MEAN_TAU: Final = 0.5
@@ -53,7 +56,15 @@ stay small throughout a smooth rotation. Gravity's direction can: a turn about a
 axis moves it. A tenth of the rate threshold bounds the bias error a rest may teach to a tenth of
 what VQF's rule alone admits, and is still some twenty times the noise of a 0.5 s mean of a
 consumer MEMS accelerometer (0.003 m/s^2 against 0.05). A turn about gravity itself stays
-invisible, and leaves roll and pitch alone."""
+invisible, and leaves roll and pitch alone.
+
+The mean rate must stay as still, within REST_TURN * rest_gyro of its value at the same
+instant: at a still sensor it is the bias, constant to the noise of a 0.5 s mean (a
+hundredth of a deg/s on a consumer gyro). At the turning point of a slow swing gravity's
+direction stands for a second or so while the rate passes through zero, and the rate's mean
+ramps: a swing of 40 deg at 0.02 Hz ramps it by 0.6 deg/s per second, so without this the
+rest started there and taught the bias the ramp (0.3-0.7 deg/s; a complementary filter then
+4 deg off). A tenth of the rate threshold is the bias error a rest may teach, as above."""
 
 REST_PARAMS: tuple[Param, ...] = (
     Param(
@@ -157,7 +168,7 @@ def rest_mean_share(dt: float) -> float:
 def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
     """The rest detector's state at the first sample: its means start at that sample, quiet time
     0, the bias not measured yet."""
-    return _new(RestState, (gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az))
+    return _new(RestState, (gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az, gx, gy, gz))
 
 
 def rest_step(
@@ -169,8 +180,8 @@ def rest_step(
     Outside a rest the mean rate less the bias must be below th_gyro (plus bound until a first
     rest has measured the bias); a rest, starting or under way, lasts while the rate and the
     specific force stay within their thresholds of their running means and the mean specific
-    force within REST_TURN of its direction early in the quiet time."""
-    wx, wy, wz, fx, fy, fz, quiet, measured, ox, oy, oz = rest
+    force and the mean rate within REST_TURN of their values early in the quiet time."""
+    wx, wy, wz, fx, fy, fz, quiet, measured, ox, oy, oz, rx, ry, rz = rest
     k = dt / (REST_MEAN_TAU + dt)
     wx += k * (gx - wx)
     wy += k * (gy - wy)
@@ -186,15 +197,20 @@ def rest_step(
         ex, ey, ez = fx - ox, fy - oy, fz - oz
         turn = REST_TURN * th_gyro * rest_time
         still = ex * ex + ey * ey + ez * ez < turn * turn * (fx * fx + fy * fy + fz * fz)
+        if still:  # nor has the mean rate ramped
+            dx, dy, dz = wx - rx, wy - ry, wz - rz
+            ramp = REST_TURN * th_gyro
+            still = dx * dx + dy * dy + dz * dz < ramp * ramp
     if still and quiet < rest_time:  # only a mean rate the bias explains may start a rest
         mx, my, mz = wx - bias[0], wy - bias[1], wz - bias[2]
         lim = th_gyro + bound if measured == 0.0 else th_gyro
         still = mx * mx + my * my + mz * mz < lim * lim
-    if still and quiet < REST_MEAN_TAU:  # the mean settles: the reference follows it
+    if still and quiet < REST_MEAN_TAU:  # the means settle: the references follow them
         ox, oy, oz = fx, fy, fz
+        rx, ry, rz = wx, wy, wz
     quiet = on_the_mark(on_the_mark(quiet + dt, dt, REST_MEAN_TAU), dt, rest_time) if still else 0.0
     return _new(RestState, (wx, wy, wz, fx, fy, fz, quiet,
-                            (1.0 if quiet >= rest_time else measured), ox, oy, oz))
+                            (1.0 if quiet >= rest_time else measured), ox, oy, oz, rx, ry, rz))
 
 
 def first_rest(measured_before: float, rest: RestState) -> bool:

@@ -560,6 +560,9 @@ void fc_rest_start(fc_real rest[FC_REST_SIZE], const fc_real gyro[3], const fc_r
     rest[8] = acc[0];
     rest[9] = acc[1];
     rest[10] = acc[2];
+    rest[11] = gyro[0];
+    rest[12] = gyro[1];
+    rest[13] = gyro[2];
 }
 
 void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz, fc_real ax,
@@ -568,6 +571,7 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
 {
     fc_real wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
     fc_real quiet = rest[6], measured = rest[7], ox = rest[8], oy = rest[9], oz = rest[10];
+    fc_real rx = rest[11], ry = rest[12], rz = rest[13];
     fc_real k = dt / (FC_REST_MEAN_TAU + dt);
     wx += k * (gx - wx);
     wy += k * (gy - wy);
@@ -586,16 +590,26 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
         ez = fz - oz;
         fc_real turn = FC_REST_TURN * th_gyro * rest_time;
         still = ex * ex + ey * ey + ez * ez < turn * turn * (fx * fx + fy * fy + fz * fz);
+        if (still) {  /* nor has the mean rate ramped */
+            dx = wx - rx;
+            dy = wy - ry;
+            dz = wz - rz;
+            fc_real ramp = FC_REST_TURN * th_gyro;
+            still = dx * dx + dy * dy + dz * dz < ramp * ramp;
+        }
     }
     if (still && quiet < rest_time) {  /* only a mean rate the bias explains may start a rest */
         fc_real mx = wx - bias[0], my = wy - bias[1], mz = wz - bias[2];
         fc_real lim = measured == 0.0 ? th_gyro + bound : th_gyro;
         still = mx * mx + my * my + mz * mz < lim * lim;
     }
-    if (still && quiet < FC_REST_MEAN_TAU) {  /* the mean settles: the reference follows it */
+    if (still && quiet < FC_REST_MEAN_TAU) {  /* the means settle: the references follow them */
         ox = fx;
         oy = fy;
         oz = fz;
+        rx = wx;
+        ry = wy;
+        rz = wz;
     }
     quiet = still ? fc_on_the_mark(fc_on_the_mark(quiet + dt, dt, FC_REST_MEAN_TAU), dt, rest_time)
                   : 0.0;
@@ -610,6 +624,9 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
     rest[8] = ox;
     rest[9] = oy;
     rest[10] = oz;
+    rest[11] = rx;
+    rest[12] = ry;
+    rest[13] = rz;
 }
 
 fc_real fc_rest_mean_share(fc_real dt)

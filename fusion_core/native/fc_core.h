@@ -107,7 +107,7 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 #define FC_REST_MEAN_TAU 0.5
 #define FC_REST_TURN 0.1
-#define FC_REST_SIZE 11  /* building_blocks.RestState */
+#define FC_REST_SIZE 14  /* building_blocks.RestState */
 #define FC_SLOWEST_CORRECTION 1e9
 #define FC_FACE_SWITCH_COS 0.5
 extern const fc_real FC_FACES[6][9];
