@@ -172,15 +172,19 @@ class Check:
     allowed: float
     unit: str
     detail: str = ""
+    at_least: bool = False
+    """The measured value must reach `allowed` (a share), not stay below it."""
 
     def line(self) -> str:
         verdict = "PASS" if self.passed else "FAIL"
-        return f"{verdict} {self.name}: measured {self.measured:.4g} {self.unit}, allowed " \
+        bound = "needed at least" if self.at_least else "allowed"
+        return f"{verdict} {self.name}: measured {self.measured:.4g} {self.unit}, {bound} " \
             f"{self.allowed:.4g} {self.unit}{' (' + self.detail + ')' if self.detail else ''}"
 
     def as_dict(self) -> dict[str, Any]:
         return {"name": self.name, "passed": self.passed, "measured": self.measured,
-                "allowed": self.allowed, "unit": self.unit, "detail": self.detail}
+                "allowed": self.allowed, "unit": self.unit, "detail": self.detail,
+                "at_least": self.at_least}
 
 
 def wrap_angles(x: np.ndarray) -> np.ndarray:

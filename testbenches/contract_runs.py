@@ -84,6 +84,8 @@ def run_contract(
     sensor: dict[str, Any] | None = None,
     calibrate_first: bool = False,
     master: str = "gauss-seidel",
+    parts: int = 0,
+    parts_progress: Callable[[], None] | None = None,
 ) -> ContractResult:
     """Run the runs and evaluate the contract; `progress` is called after each run; `params`
     are estimator FMU parameters for every run (each estimator must have them); `duration`
@@ -94,7 +96,9 @@ def run_contract(
     `sensor` the ImuSensor parameters of every run but the contract's noise-free ones;
     calibrate_first: each seed's part is calibrated on its own calibration session first, and
     its runs apply the result (testbenches.calibrate.part; not the noise-free extras, whose
-    sensor has no part errors); master: how every run steps its FMUs (master.MASTERS)."""
+    sensor has no part errors); master: how every run steps its FMUs (master.MASTERS); parts:
+    with the contract's checks, each accuracy check also over that many sensor parts, as
+    delivered and calibrated first (testbenches.parts; 0: none)."""
     out = ContractResult()
     extra: dict[tuple[str, str], list[TestbenchResult]] = {}
     jobs_list = contract_jobs(estimators, scenarios, seeds=seeds, jitter=jitter,
@@ -132,6 +136,11 @@ def run_contract(
         pos = [r for r in out.runs if r.estimator == "poskf" and r.scenario == "translation_2m"
                and r.jitter == 0.0] + extra.get(("position", "poskf"), [])
         out.checks += contract.check_position(pos)
+    if parts:
+        from .parts import part_rmse, parts_checks
+
+        out.checks += parts_checks(part_rmse(estimators, scenarios, preset or {}, sensor or {},
+                                             parts, params, parts_progress))
     return out
 
 

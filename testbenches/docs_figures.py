@@ -138,6 +138,21 @@ def fmu_picture(ctx: dict[str, Path], path: Path) -> None:
                           "AngleBiasKalmanFilter.fmu on examples/tilt_motion.csv", path)
 
 
+def parts_table(ctx: dict[str, Path]) -> str:
+    """The contract's accuracy over 20 parts (testbenches.parts), the defaults, the realistic
+    sensor."""
+    from fusion_core.presets import load_preset
+    from fusion_core.registry import KEYS
+    from fusion_core.scenarios import ESTIMATION_SCENARIOS
+    from fusion_core.sensor import sensor_preset
+
+    from . import parts
+
+    rmse = parts.part_rmse(list(KEYS), list(ESTIMATION_SCENARIOS), load_preset("recommended"),
+                           sensor_preset("realistic"))
+    return parts.parts_table(rmse)
+
+
 def engines_table(ctx: dict[str, Path]) -> str:
     from .engines import engine_rows, engine_table
 
@@ -154,6 +169,8 @@ FIGURES: tuple[Figure, ...] = (
         ESTIMATE_ARGS) + " --no-plots", estimate_output),
     Figure("estimate-picture", "docs/guide/estimate.md", "imu-fusion " + " ".join(
         ESTIMATE_ARGS), estimate_picture, "docs/estimate_example.png"),
+    Figure("contract-parts", "docs/results/contract.md", "imu-fusion run (its checks over 20 "
+           "parts; testbenches.parts.parts_table)", parts_table),
     Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
            engines_table, needs=("fmus", "engines")),
     Figure("calibrate-imucal", "docs/results/calibration.md",

@@ -20,11 +20,15 @@ from .options import (
     choose,
     jitter_fraction,
     load_sensor,
+    non_negative_int,
     parse_params,
     positive_float,
     positive_int,
     with_calibration,
 )
+from .parts import CALIBRATED_SHARE, PARTS
+
+CALIBRATED_PCT = f"{100 * CALIBRATED_SHARE:g}"
 
 
 def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -44,6 +48,10 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     add_sensor(run)
     run.add_argument("--seeds", type=positive_int, default=1,
                      help="seeds per estimator x scenario (1)")
+    run.add_argument("--parts", type=non_negative_int, default=PARTS, metavar="N",
+                     help=f"state each accuracy check over N sensor parts too, as delivered (the "
+                     f"typical part within the bound) and calibrated first ({CALIBRATED_PCT} "
+                     f"%% of parts within it), through the C twins; 0: no ({PARTS})")
     run.add_argument("--jitter", type=jitter_fraction, default=0.0,
                      help="communication-step jitter, fraction of the period (0)")
     run.add_argument("--duration", type=positive_float, default=None,
@@ -113,9 +121,15 @@ def cmd_run(args: argparse.Namespace) -> int:
                          contract_checks=not args.no_contract)
     fmu_dir = kind_dir(args.fmu_dir, args.kind)
     print(f"FMUs: {fmu_dir}", file=sys.stderr)
-    with tqdm(total=len(jobs), unit="run", file=sys.stderr) as bar:
+    parts = 0 if args.no_contract else args.parts
+    n_parts = 2 * parts * len(estimators) * len(scenarios)
+    with tqdm(total=len(jobs) + n_parts, unit="run", file=sys.stderr) as bar:
         def progress(job: object) -> None:
             bar.set_postfix_str(f"{job.estimator} {job.scenario}")  # type: ignore[attr-defined]
+            bar.update()
+
+        def part_done() -> None:
+            bar.set_postfix_str(f"over {parts} parts")
             bar.update()
 
         result = run_contract(estimators=estimators, scenarios=scenarios, seeds=args.seeds,
@@ -123,7 +137,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                               contract_checks=not args.no_contract, params=params,
                               duration=args.duration, timing=not args.no_timing_check,
                               jobs=args.jobs, preset=preset, sensor=sensor,
-                              calibrate_first=args.calibrate_first, master=args.master)
+                              calibrate_first=args.calibrate_first, master=args.master,
+                              parts=parts, parts_progress=part_done)
     print(contract_table(result))
     peer_rows = None
     if peers:

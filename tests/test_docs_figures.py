@@ -32,8 +32,8 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
     return ctx
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.heavy) if n ==
-                                  "engines-table" else n for n in BY_NAME])
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.heavy) if n in (
+    "engines-table", "contract-parts") else n for n in BY_NAME])
 def test_every_generated_figure_matches_its_command(name: str, request) -> None:
     figure = BY_NAME[name]
     problem = figs.check(figure, _context(figure, request))

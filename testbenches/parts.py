@@ -1,0 +1,95 @@
+"""The accuracy contract over sensor parts (interface v4): a user's part is any part.
+
+Every estimator on every scenario runs on PARTS parts of the sensor (seeds 0 to PARTS - 1:
+each draws its own bias, bias instability, scale and cross-axis errors), as delivered and
+calibrated first by the project's own calibration (testbenches.calibrate.part: the part's
+calibration session, Tedaldi's method, its matrices applied). The runs go through the C twins
+of the plant, the sensor and the estimator (testbenches.montecarlo.simulate), which give what
+the FMUs give to the bit (tests/test_montecarlo.py), so the check costs seconds, not the
+FMUs' minutes.
+
+The rule (docs/interface.md): per estimator and scenario, as delivered the typical part meets
+the bound (a share of at least RAW_SHARE of the parts: the median part), and calibrated first
+at least CALIBRATED_SHARE of them. A part meets it where both its roll and its pitch RMSE are
+within the scenario's bounds (testbenches.contract.accuracy_limits).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from .contract import Check, accuracy_limits, compute_metrics
+
+PARTS = 20
+"""Sensor parts (seeds) each accuracy check is stated over."""
+RAW_SHARE = 0.5
+"""As delivered, the typical part (the median) within the bound."""
+CALIBRATED_SHARE = 0.95
+"""Calibrated first, all but one part in twenty within the bound."""
+HOW = {False: ("as delivered", RAW_SHARE), True: ("calibrated first", CALIBRATED_SHARE)}
+
+
+def part_rmse(estimators: Sequence[str], scenarios: Sequence[str], preset: dict[str, Any],
+              sensor: dict[str, Any], parts: int = PARTS, params: dict[str, Any] | None = None,
+              progress: Callable[[], None] | None = None
+              ) -> dict[tuple[bool, str, str], np.ndarray]:
+    """Roll and pitch RMSE [deg] per part [parts, 2], keyed (calibrated first, estimator,
+    scenario)."""
+    from .montecarlo.plan import Run
+    from .montecarlo.simulate import simulate
+
+    out: dict[tuple[bool, str, str], np.ndarray] = {}
+    for calibrated in (False, True):
+        for scenario in scenarios:
+            for estimator in estimators:
+                rows = []
+                for seed in range(parts):
+                    run = Run("part", estimator, scenario, seed, None, sensor,
+                              {**preset.get(estimator, {}), **(params or {})}, {},
+                              calibrate_first=calibrated)
+                    m = compute_metrics(simulate(run))
+                    rows.append((m["rmse_roll_deg"], m["rmse_pitch_deg"]))
+                    if progress:
+                        progress()
+                out[(calibrated, estimator, scenario)] = np.array(rows)
+    return out
+
+
+def parts_checks(rmse: dict[tuple[bool, str, str], np.ndarray]) -> list[Check]:
+    """One check per (as delivered or calibrated first, estimator, scenario): the share of
+    parts within the bound against the rule's share."""
+    checks = []
+    for (calibrated, estimator, scenario), values in rmse.items():
+        label, needed = HOW[calibrated]
+        lim = accuracy_limits(estimator, scenario)
+        within = float(np.mean((values[:, 0] <= lim[0]) & (values[:, 1] <= lim[1])))
+        median = np.median(values, axis=0)
+        checks.append(Check(
+            f"accuracy over {len(values)} parts, {label}: {estimator} {scenario}",
+            within >= needed, 100.0 * within, 100.0 * needed, "% of parts",
+            f"within {lim[0]:g}/{lim[1]:g} deg; median part {median[0]:.3f}/{median[1]:.3f}, "
+            f"worst {values[:, 0].max():.3f}/{values[:, 1].max():.3f}", at_least=True))
+    return checks
+
+
+def parts_table(rmse: dict[tuple[bool, str, str], np.ndarray]) -> str:
+    """Markdown: per estimator and scenario the bound and, as delivered and calibrated first,
+    the share of parts within it, the median part's and the worst part's roll/pitch RMSE."""
+    rows = ["| estimator | scenario | bound [deg] | as delivered: within | median | worst | "
+            "calibrated first: within | median | worst |", "|---|---|---|---|---|---|---|---|---|"]
+    keys = sorted({(e, s) for _, e, s in rmse}, key=lambda k: (k[1], k[0]))
+    for estimator, scenario in keys:
+        lim = accuracy_limits(estimator, scenario)
+        cells = [estimator, scenario, f"{lim[0]:.3g} / {lim[1]:.3g}"]
+        for calibrated in (False, True):
+            v = rmse[(calibrated, estimator, scenario)]
+            within = float(np.mean((v[:, 0] <= lim[0]) & (v[:, 1] <= lim[1])))
+            mark = "" if within >= HOW[calibrated][1] else " **(not met)**"
+            med, worst = np.median(v, axis=0), v.max(axis=0)
+            cells += [f"{100 * within:.0f} %{mark}", f"{med[0]:.3f} / {med[1]:.3f}",
+                      f"{worst[0]:.3f} / {worst[1]:.3f}"]
+        rows.append("| " + " | ".join(cells) + " |")
+    return "\n".join(rows)
