@@ -153,6 +153,33 @@ def parts_table(ctx: dict[str, Path]) -> str:
     return parts.parts_table(rmse)
 
 
+def embedded_table(ctx: dict[str, Path]) -> str:
+    """`make embedded`'s table: each twin on the Cortex-M7 (double) and the Cortex-M4F (float)
+    under QEMU, on moderate_dynamics through the realistic sensor (BROAD_DIR unset)."""
+    import json
+    from unittest import mock
+
+    from .embedded.cli import main as embedded_main
+
+    with tempfile.TemporaryDirectory() as tmp, mock.patch.dict(os.environ, clear=False) as env:
+        env.pop("BROAD_DIR", None)
+        with contextlib.redirect_stdout(io.StringIO()):
+            embedded_main(out=Path(tmp))
+        report = json.loads(Path(tmp, "report.json").read_text())
+    double = report["cortex-m7-double"]["estimators"]
+    single = report["cortex-m4f-float"]["estimators"]
+    rows = ["| | Cortex-M7, double: largest difference from the desktop | instructions per "
+            "sample | RAM per instance [B] | flash [B] | Cortex-M4F, float: largest difference "
+            "from double | instructions per sample | RAM [B] |",
+            "|---|---|---|---|---|---|---|---|"]
+    for key, d in double.items():
+        f = single[key]
+        rows.append(f"| {key} | {d['max_abs_diff']:.2g} | {d['insns_per_sample']:.0f} | "
+                    f"{d['ram_bytes']} | {d['flash_bytes']} | {f['max_abs_diff']:.2g} | "
+                    f"{f['insns_per_sample']:.0f} | {f['ram_bytes']} |")
+    return "\n".join(rows)
+
+
 def engines_table(ctx: dict[str, Path]) -> str:
     from .engines import engine_rows, engine_table
 
@@ -171,6 +198,8 @@ FIGURES: tuple[Figure, ...] = (
         ESTIMATE_ARGS), estimate_picture, "docs/estimate_example.png"),
     Figure("contract-parts", "docs/results/contract.md", "imu-fusion run (its checks over 20 "
            "parts; testbenches.parts.parts_table)", parts_table),
+    Figure("embedded-table", "docs/guide/backends.md", "make embedded", embedded_table,
+           needs=("embedded",)),
     Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
            engines_table, needs=("fmus", "engines")),
     Figure("calibrate-imucal", "docs/results/calibration.md",
@@ -222,7 +251,11 @@ def context(fmu_dir: Path | None = None, imucal: Path | None = None) -> dict[str
     fmus = fmu_dir or REPO / "dist"
     if (fmus / "native" / "fmi3" / "AngleBiasKalmanFilter.fmu").is_file():
         ctx["fmus"] = fmus
+    from .embedded.build import missing_tools
     from .engines import ENGINES, engine_reason
+
+    if not missing_tools():
+        ctx["embedded"] = REPO
 
     if all(engine_reason(e) is None for e in ENGINES):
         ctx["engines"] = REPO

@@ -15,7 +15,9 @@ from testbenches import docs_figures as figs
 REPO = Path(__file__).resolve().parents[1]
 BY_NAME = {f.name: f for f in figs.FIGURES}
 WHERE = {"imucal": "imucal's session beside the project in ../shared/data/imucal",
-         "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)"}
+         "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)",
+         "embedded": "arm-none-eabi-gcc and qemu-system-arm (apt-get install gcc-arm-none-eabi "
+                     "libnewlib-arm-none-eabi qemu-system-arm)"}
 
 
 def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, Path]:
@@ -33,7 +35,7 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.heavy) if n in (
-    "engines-table", "contract-parts") else n for n in BY_NAME])
+    "engines-table", "contract-parts", "embedded-table") else n for n in BY_NAME])
 def test_every_generated_figure_matches_its_command(name: str, request) -> None:
     figure = BY_NAME[name]
     problem = figs.check(figure, _context(figure, request))
