@@ -98,6 +98,7 @@ def test_poses_not_spread_over_the_sphere_are_refused() -> None:
         check_spread(statics)
 
 
+@pytest.mark.heavy  # a session calibrated (and refitted per pose): seconds
 def test_the_command_writes_the_calibration_and_its_plot(tmp_path, capsys) -> None:
     t, acc, gyro, _, part = simulated(1)
     csv = tmp_path / "session.csv"
@@ -226,6 +227,7 @@ def test_a_six_face_session_is_calibrated_by_ferraris_on_the_sections_it_finds(t
     assert (tmp_path / "calibration.png").stat().st_size > 10_000
 
 
+@pytest.mark.heavy  # a session calibrated (and refitted per pose): seconds
 def test_tedaldis_held_out_residuals_are_each_pose_left_out() -> None:
     _, acc, gyro, dt, _ = simulated(1)
     session = calibrate_session(acc, gyro, dt)

@@ -34,8 +34,18 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
     return ctx
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.heavy) if n in (
-    "engines-table", "contract-parts", "embedded-table") else n for n in BY_NAME])
+HEAVY = ("engines-table", "contract-parts", "embedded-table")
+"""Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
+
+
+def _marks(name: str) -> list[pytest.MarkDecorator]:
+    marks = [pytest.mark.heavy] if name in HEAVY else []
+    if "fmus" in BY_NAME[name].needs:  # built for the session: `make test-fast` leaves it out
+        marks.append(pytest.mark.fmu)
+    return marks
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=_marks(n)) for n in BY_NAME])
 def test_every_generated_figure_matches_its_command(name: str, request) -> None:
     figure = BY_NAME[name]
     problem = figs.check(figure, _context(figure, request))

@@ -65,7 +65,8 @@ def test_every_numeric_parameter_has_a_finite_range() -> None:
                 p.validate(v)
 
 
-@pytest.mark.parametrize("backend", ["native", "python"])
+@pytest.mark.parametrize("backend", [
+    "native", pytest.param("python", marks=pytest.mark.heavy)])  # Python: seconds per key
 @pytest.mark.parametrize("key", KEYS)
 def test_each_end_of_each_range_keeps_the_estimates_finite(key: str, backend: str) -> None:
     if backend == "native" and not native.available():
