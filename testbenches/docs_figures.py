@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import io
 import os
 import re
@@ -153,6 +154,140 @@ def parts_table(ctx: dict[str, Path]) -> str:
     return parts.parts_table(rmse)
 
 
+CALIBRATED_PARTS = 200
+
+
+@functools.lru_cache(maxsize=1)
+def _calibrated_parts() -> dict[str, dict[bool, np.ndarray]]:
+    """Roll and pitch RMSE [deg] of every estimator and of VQF on moderate_dynamics over
+    CALIBRATED_PARTS parts of the realistic sensor, as delivered (False) and calibrated first
+    (True): the runs of `imu-fusion campaign --scenario moderate_dynamics --seeds 200
+    [--calibrate-first]` (testbenches.parts gives them through the same C twins) and of
+    `imu-fusion run ... --peers vqf`."""
+    from fusion_core.presets import load_preset
+    from fusion_core.registry import KEYS
+    from fusion_core.sensor import sensor_preset
+
+    from .parts import part_rmse
+    from .peer_runs import run_peers
+    from .peers import PEERS
+
+    sensor = sensor_preset("realistic")
+    rmse = part_rmse(list(KEYS), ["moderate_dynamics"], load_preset("recommended"), sensor,
+                     CALIBRATED_PARTS)
+    out: dict[str, dict[bool, np.ndarray]] = {}
+    for (calibrated, key, _), values in rmse.items():
+        out.setdefault(key, {})[calibrated] = values
+    for calibrated in (False, True):
+        rows = run_peers({"vqf": PEERS["vqf"]}, ["moderate_dynamics"], CALIBRATED_PARTS, sensor,
+                         calibrate_first=calibrated)
+        out.setdefault("vqf", {})[calibrated] = np.array(
+            [(r.rmse_roll_deg, r.rmse_pitch_deg) for r in rows])
+    return out
+
+
+def _half_row(key: str) -> tuple[float, float]:
+    from .contract import DEFAULTS_MODERATE_SHARE, PAPER_MODERATE
+
+    roll, pitch = PAPER_MODERATE[key]
+    return DEFAULTS_MODERATE_SHARE * roll, DEFAULTS_MODERATE_SHARE * pitch
+
+
+def _within(values: np.ndarray, bound: tuple[float, float]) -> float:
+    return 100.0 * float(np.mean((values[:, 0] <= bound[0]) & (values[:, 1] <= bound[1])))
+
+
+def calibrated_parts_table(ctx: dict[str, Path]) -> str:
+    """docs/results/calibration.md: each estimator's half row, calibrated first and as
+    delivered, over CALIBRATED_PARTS parts; VQF on the same samples beside."""
+    runs = _calibrated_parts()
+    pair = lambda v: f"{v[0]:.3f} / {v[1]:.3f}"  # noqa: E731
+    rows = ["| roll / pitch RMSE [deg] | half the row | calibrated first: mean | median | "
+            "within | as delivered: mean | within |", "|---|---|---|---|---|---|---|"]
+    for key in ("ukf", "mgcf", "kf", "cf", "poskf", "vqf"):
+        half = _half_row("ukf" if key == "vqf" else key)
+        cal, raw = runs[key][True], runs[key][False]
+        name = "VQF, the same samples calibrated alike" if key == "vqf" else key
+        whose = " (UKF's half row)" if key == "vqf" else ""
+        rows.append(f"| {name} | {'' if key == 'vqf' else pair(half)} | "
+                    f"{pair(cal.mean(axis=0))} | {pair(np.median(cal, axis=0))} | "
+                    f"{_within(cal, half):.1f} %{whose} | "
+                    f"{pair(raw.mean(axis=0))} | {_within(raw, half):.1f} % |")
+    return "\n".join(rows)
+
+
+def readme_calibrated_part(ctx: dict[str, Path]) -> str:
+    """The README's result line of the same runs."""
+    runs = _calibrated_parts()
+    ukf, vqf = runs["ukf"][True].mean(axis=0), runs["vqf"][True].mean(axis=0)
+    half = _half_row("ukf")
+    return (f"- **A calibrated part**: {CALIBRATED_PARTS} parts of the realistic sensor on "
+            "`moderate_dynamics`, each calibrated\n  first on its own session by `imu-fusion "
+            "calibrate`'s code: every estimator's mean RMSE within\n  half its row of the "
+            f"paper's Table 1 (UKF {ukf[0]:.3f}/{ukf[1]:.3f} deg against {half[0]:.3f}/"
+            f"{half[1]:.3f}; VQF on the same\n  calibrated samples {vqf[0]:.3f}/{vqf[1]:.3f}) "
+            "(`imu-fusion campaign --scenario moderate_dynamics --seeds 200\n  "
+            "--calibrate-first`; [docs/results/calibration.md](docs/results/calibration.md)).")
+
+
+def _stats(v: np.ndarray) -> tuple[str, str, str]:
+    mean, median, p95 = v.mean(axis=0), np.median(v, axis=0), np.percentile(v, 95, axis=0)
+    return tuple(f"{a[0]:.2f} / {a[1]:.2f}" for a in (mean, median, p95))  # type: ignore[return-value]
+
+
+def campaigns_parts_table(ctx: dict[str, Path]) -> str:
+    """docs/guide/campaigns.md: moderate_dynamics over CALIBRATED_PARTS parts as delivered,
+    each estimator beside VQF, and the share within its row."""
+    from .contract import PAPER_MODERATE
+
+    runs = _calibrated_parts()
+    rows = [f"| moderate_dynamics, {CALIBRATED_PARTS} parts | mean | median | p95 | within "
+            "its row |", "|---|---|---|---|---|"]
+    for key in ("cf", "mgcf", "kf", "ukf", "vqf"):
+        v = runs[key][False]
+        if key == "vqf":
+            rows.append("| VQF (peer) | " + " | ".join(_stats(v)) + " | - |")
+            continue
+        row = PAPER_MODERATE[key]
+        within = _within(v, row)
+        note = f" (row {row[0]:.2f} / {row[1]:.2f})" if within < 100.0 else ""
+        rows.append(f"| {key} | " + " | ".join(_stats(v)) + f" | {within:.0f} %{note} |")
+    return "\n".join(rows)
+
+
+SCENARIO_PARTS = 100
+SCENARIO_TABLE = ("static_level", "roll_sweep", "pitch_sweep", "roll_pitch", "vibration",
+                  "high_dynamics", "translation_2m")
+
+
+def campaigns_scenarios_table(ctx: dict[str, Path]) -> str:
+    """docs/guide/campaigns.md: kf, ukf and VQF on the contract's other scenarios over
+    SCENARIO_PARTS parts as delivered: mean, 95th percentile, share within the bound."""
+    from fusion_core.presets import load_preset
+    from fusion_core.sensor import sensor_preset
+
+    from .contract import accuracy_limits
+    from .parts import part_rmse
+    from .peer_runs import run_peers
+    from .peers import PEERS
+
+    sensor = sensor_preset("realistic")
+    ours = part_rmse(["kf", "ukf"], list(SCENARIO_TABLE), load_preset("recommended"), sensor,
+                     SCENARIO_PARTS, calibrated_first=(False,))
+    rows = ["| scenario | kf | ukf | VQF (peer) |", "|---|---|---|---|"]
+    for scenario in SCENARIO_TABLE:
+        peer = run_peers({"vqf": PEERS["vqf"]}, [scenario], SCENARIO_PARTS, sensor)
+        cells = []
+        for v in (ours[(False, "kf", scenario)], ours[(False, "ukf", scenario)],
+                  np.array([(r.rmse_roll_deg, r.rmse_pitch_deg) for r in peer])):
+            lim = accuracy_limits("kf", scenario)
+            mean, p95 = v.mean(axis=0), np.percentile(v, 95, axis=0)
+            cells.append(f"{mean[0]:.2f}/{mean[1]:.2f}, {p95[0]:.2f}/{p95[1]:.2f}, "
+                         f"{_within(v, lim):.0f} %")
+        rows.append(f"| {scenario} | " + " | ".join(cells) + " |")
+    return "\n".join(rows)
+
+
 def embedded_table(ctx: dict[str, Path]) -> str:
     """`make embedded`'s table: each twin on the Cortex-M7 (double) and the Cortex-M4F (float)
     under QEMU, on moderate_dynamics through the realistic sensor (BROAD_DIR unset)."""
@@ -198,6 +333,20 @@ FIGURES: tuple[Figure, ...] = (
         ESTIMATE_ARGS), estimate_picture, "docs/estimate_example.png"),
     Figure("contract-parts", "docs/results/contract.md", "imu-fusion run (its checks over 20 "
            "parts; testbenches.parts.parts_table)", parts_table),
+    Figure("calibrated-parts", "docs/results/calibration.md",
+           "imu-fusion campaign --estimator all --scenario moderate_dynamics --seeds 200 "
+           "[--calibrate-first]; imu-fusion run --scenario moderate_dynamics --seeds 200 "
+           "--peers vqf [--calibrate-first]", calibrated_parts_table, needs=("vqf",)),
+    Figure("readme-calibrated-part", "README.md",
+           "imu-fusion campaign --scenario moderate_dynamics --seeds 200 --calibrate-first",
+           readme_calibrated_part, needs=("vqf",)),
+    Figure("campaigns-parts", "docs/guide/campaigns.md",
+           "python -m testbenches run --estimator cf,mgcf,kf,ukf --scenario moderate_dynamics "
+           "--seeds 200 --peers vqf --no-contract --no-plots", campaigns_parts_table,
+           needs=("vqf",)),
+    Figure("campaigns-scenarios", "docs/guide/campaigns.md",
+           "python -m testbenches run --estimator kf,ukf --scenario SCENARIO --seeds 100 "
+           "--peers vqf --no-contract --no-plots", campaigns_scenarios_table, needs=("vqf",)),
     Figure("embedded-table", "docs/guide/backends.md", "make embedded", embedded_table,
            needs=("embedded",)),
     Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
@@ -256,6 +405,12 @@ def context(fmu_dir: Path | None = None, imucal: Path | None = None) -> dict[str
 
     if not missing_tools():
         ctx["embedded"] = REPO
+    try:
+        import vqf  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        ctx["vqf"] = REPO
 
     if all(engine_reason(e) is None for e in ENGINES):
         ctx["engines"] = REPO

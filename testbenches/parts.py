@@ -34,15 +34,16 @@ HOW = {False: ("as delivered", RAW_SHARE), True: ("calibrated first", CALIBRATED
 
 def part_rmse(estimators: Sequence[str], scenarios: Sequence[str], preset: dict[str, Any],
               sensor: dict[str, Any], parts: int = PARTS, params: dict[str, Any] | None = None,
-              progress: Callable[[], None] | None = None
+              progress: Callable[[], None] | None = None,
+              calibrated_first: Sequence[bool] = (False, True),
               ) -> dict[tuple[bool, str, str], np.ndarray]:
     """Roll and pitch RMSE [deg] per part [parts, 2], keyed (calibrated first, estimator,
-    scenario)."""
+    scenario), as delivered and (or) calibrated first."""
     from .montecarlo.plan import Run
     from .montecarlo.simulate import simulate
 
     out: dict[tuple[bool, str, str], np.ndarray] = {}
-    for calibrated in (False, True):
+    for calibrated in calibrated_first:
         for scenario in scenarios:
             for estimator in estimators:
                 rows = []

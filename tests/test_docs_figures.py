@@ -16,6 +16,7 @@ REPO = Path(__file__).resolve().parents[1]
 BY_NAME = {f.name: f for f in figs.FIGURES}
 WHERE = {"imucal": "imucal's session beside the project in ../shared/data/imucal",
          "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)",
+         "vqf": "the peers (pip install -e '.[bench]')",
          "embedded": "arm-none-eabi-gcc and qemu-system-arm (apt-get install gcc-arm-none-eabi "
                      "libnewlib-arm-none-eabi qemu-system-arm)"}
 
@@ -34,12 +35,15 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
     return ctx
 
 
-HEAVY = ("engines-table", "contract-parts", "embedded-table")
+HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenarios")
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
+SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts")
+"""Figures of 200 parts calibrated first: minutes (`make test-slow`)."""
 
 
 def _marks(name: str) -> list[pytest.MarkDecorator]:
     marks = [pytest.mark.heavy] if name in HEAVY else []
+    marks += [pytest.mark.slow] if name in SLOW else []
     if "fmus" in BY_NAME[name].needs:  # built for the session: `make test-fast` leaves it out
         marks.append(pytest.mark.fmu)
     return marks
