@@ -114,6 +114,48 @@ def calibrate_picture(ctx: dict[str, Path], path: Path) -> None:
         Path(tmp, "calibration.png").replace(path)
 
 
+IMUCAL_SECTIONS = "example_ferraris_session_list.json"
+
+
+def _scales(matrix: list[list[float]]) -> tuple[np.ndarray, np.ndarray]:
+    """A calibration matrix's scale factors (the inverse's column norms) and misalignments [deg]
+    (each column's angle from its axis), as testbenches.calibrate.ferraris.summary gives."""
+    inverse = np.linalg.inv(np.asarray(matrix))
+    scales = np.linalg.norm(inverse, axis=0)
+    angles = np.degrees(np.arccos(np.minimum(1.0, np.abs(np.diag(inverse)) / scales)))
+    return scales, angles
+
+
+def imucal_table(ctx: dict[str, Path]) -> str:
+    """docs/results/calibration.md: ours beside imucal's on imucal's session, with its section
+    list and with the sections our detector finds."""
+    import json
+
+    with tempfile.TemporaryDirectory() as tmp:
+        _captured(["calibrate", IMUCAL_SESSION, "--rate", "102.4", "--gyro-unit", "deg/s",
+                   "--acc-unit", "m/s2", "--sections", IMUCAL_SECTIONS, "--gravity", "9.81",
+                   "--out", tmp], ctx["imucal"])
+        comp = json.loads(Path(tmp, "calibration.json").read_text())["comparisons"]
+    columns = ("imucal", "ferraris", "ferraris_own_sections")
+    rows = ["| | imucal (Ferraris) | ours, Ferraris on the given sections | ours, Ferraris on "
+            "the sections our detector finds |", "|---|---|---|---|"]
+    for sensor, label in (("gyro", "gyro"), ("acc", "accelerometer")):
+        found = [_scales(comp[c][f"{sensor}_matrix"]) for c in columns]
+        rows.append(f"| {label} scale x / y / z | " + " | ".join(
+            " / ".join(f"{v:.4f}" for v in sc) for sc, _ in found) + " |")
+        rows.append(f"| {label} misalignment x / y / z [deg] | " + " | ".join(
+            " / ".join(f"{v:.2f}" for v in an) for _, an in found) + " |")
+    diffs = []
+    for c in columns:
+        d = [float(np.max(np.abs(np.asarray(comp[c][f"{s}_matrix"])
+                                 - np.asarray(comp["imucal"][f"{s}_matrix"]))))
+             for s in ("acc", "gyro")]
+        diffs.append("0" if max(d) == 0.0 else f"{d[0]:.2g} / {d[1]:.2g}")
+    rows.append("| largest difference from imucal's matrix entries, accelerometer / gyro | "
+                + " | ".join(diffs) + " |")
+    return "\n".join(rows)
+
+
 def fmu_picture(ctx: dict[str, Path], path: Path) -> None:
     """The README's picture: the native FMI 3.0 AngleBiasKalmanFilter FMU in fmpy on the
     example, as examples/plot_example.py draws it."""
@@ -351,6 +393,10 @@ FIGURES: tuple[Figure, ...] = (
            needs=("embedded",)),
     Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
            engines_table, needs=("fmus", "engines")),
+    Figure("imucal-table", "docs/results/calibration.md",
+           f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s --acc-unit "
+           f"m/s2 --sections {IMUCAL_SECTIONS} --gravity 9.81", imucal_table,
+           needs=("imucal", "imucal-package")),
     Figure("calibrate-imucal", "docs/results/calibration.md",
            f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s "
            "--gravity 9.81", calibrate_output, needs=("imucal",)),
@@ -405,12 +451,12 @@ def context(fmu_dir: Path | None = None, imucal: Path | None = None) -> dict[str
 
     if not missing_tools():
         ctx["embedded"] = REPO
-    try:
-        import vqf  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        ctx["vqf"] = REPO
+    for module, need in (("vqf", "vqf"), ("imucal", "imucal-package")):
+        try:
+            __import__(module)
+        except ImportError:
+            continue
+        ctx[need] = REPO
 
     if all(engine_reason(e) is None for e in ENGINES):
         ctx["engines"] = REPO

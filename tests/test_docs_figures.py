@@ -17,6 +17,7 @@ BY_NAME = {f.name: f for f in figs.FIGURES}
 WHERE = {"imucal": "imucal's session beside the project in ../shared/data/imucal",
          "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)",
          "vqf": "the peers (pip install -e '.[bench]')",
+         "imucal-package": "imucal (pip install -e '.[bench]')",
          "embedded": "arm-none-eabi-gcc and qemu-system-arm (apt-get install gcc-arm-none-eabi "
                      "libnewlib-arm-none-eabi qemu-system-arm)"}
 
