@@ -117,19 +117,12 @@ def calibrate_picture(ctx: dict[str, Path], path: Path) -> None:
 IMUCAL_SECTIONS = "example_ferraris_session_list.json"
 
 
-def _scales(matrix: list[list[float]]) -> tuple[np.ndarray, np.ndarray]:
-    """A calibration matrix's scale factors (the inverse's column norms) and misalignments [deg]
-    (each column's angle from its axis), as testbenches.calibrate.ferraris.summary gives."""
-    inverse = np.linalg.inv(np.asarray(matrix))
-    scales = np.linalg.norm(inverse, axis=0)
-    angles = np.degrees(np.arccos(np.minimum(1.0, np.abs(np.diag(inverse)) / scales)))
-    return scales, angles
-
-
 def imucal_table(ctx: dict[str, Path]) -> str:
     """docs/results/calibration.md: ours beside imucal's on imucal's session, with its section
     list and with the sections our detector finds."""
     import json
+
+    from .calibrate.ferraris import scales_and_misalignment
 
     with tempfile.TemporaryDirectory() as tmp:
         _captured(["calibrate", IMUCAL_SESSION, "--rate", "102.4", "--gyro-unit", "deg/s",
@@ -140,7 +133,7 @@ def imucal_table(ctx: dict[str, Path]) -> str:
     rows = ["| | imucal (Ferraris) | ours, Ferraris on the given sections | ours, Ferraris on "
             "the sections our detector finds |", "|---|---|---|---|"]
     for sensor, label in (("gyro", "gyro"), ("acc", "accelerometer")):
-        found = [_scales(comp[c][f"{sensor}_matrix"]) for c in columns]
+        found = [scales_and_misalignment(comp[c][f"{sensor}_matrix"]) for c in columns]
         rows.append(f"| {label} scale x / y / z | " + " | ".join(
             " / ".join(f"{v:.4f}" for v in sc) for sc, _ in found) + " |")
         rows.append(f"| {label} misalignment x / y / z [deg] | " + " | ".join(
@@ -236,7 +229,9 @@ def _half_row(key: str) -> tuple[float, float]:
 
 
 def _within(values: np.ndarray, bound: tuple[float, float]) -> float:
-    return 100.0 * float(np.mean((values[:, 0] <= bound[0]) & (values[:, 1] <= bound[1])))
+    from .parts import share_within
+
+    return 100.0 * share_within(values, bound)
 
 
 def calibrated_parts_table(ctx: dict[str, Path]) -> str:

@@ -59,6 +59,12 @@ def part_rmse(estimators: Sequence[str], scenarios: Sequence[str], preset: dict[
     return out
 
 
+def share_within(values: np.ndarray, bound: tuple[float, float]) -> float:
+    """The share of parts (rows: roll, pitch RMSE) whose roll and pitch are both within the
+    bound."""
+    return float(np.mean((values[:, 0] <= bound[0]) & (values[:, 1] <= bound[1])))
+
+
 def parts_checks(rmse: dict[tuple[bool, str, str], np.ndarray]) -> list[Check]:
     """One check per (as delivered or calibrated first, estimator, scenario): the share of
     parts within the bound against the rule's share."""
@@ -66,7 +72,7 @@ def parts_checks(rmse: dict[tuple[bool, str, str], np.ndarray]) -> list[Check]:
     for (calibrated, estimator, scenario), values in rmse.items():
         label, needed = HOW[calibrated]
         lim = accuracy_limits(estimator, scenario)
-        within = float(np.mean((values[:, 0] <= lim[0]) & (values[:, 1] <= lim[1])))
+        within = share_within(values, lim)
         median = np.median(values, axis=0)
         checks.append(Check(
             f"accuracy over {len(values)} parts, {label}: {estimator} {scenario}",
@@ -87,7 +93,7 @@ def parts_table(rmse: dict[tuple[bool, str, str], np.ndarray]) -> str:
         cells = [estimator, scenario, f"{lim[0]:.3g} / {lim[1]:.3g}"]
         for calibrated in (False, True):
             v = rmse[(calibrated, estimator, scenario)]
-            within = float(np.mean((v[:, 0] <= lim[0]) & (v[:, 1] <= lim[1])))
+            within = share_within(v, lim)
             mark = "" if within >= HOW[calibrated][1] else " **(not met)**"
             med, worst = np.median(v, axis=0), v.max(axis=0)
             cells += [f"{100 * within:.0f} %{mark}", f"{med[0]:.3f} / {med[1]:.3f}",

@@ -442,13 +442,6 @@ def _mat(path: Path) -> TableSource:
     return _array_source(path, "mat", arrays, {}, _rate({}, arrays))
 
 
-def describe_kind(source: TableSource) -> str:
-    """The format as the printout names it."""
-    if source.kind == "text":
-        return "text"
-    return {"parquet": "Parquet", "hdf5": "HDF5", "mat": "MATLAB"}[source.kind]
-
-
 __all__ = [
     "BLOCK_ROWS",
     "TIME_SCALE",

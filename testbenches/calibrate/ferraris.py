@@ -146,9 +146,16 @@ def summary(acc_fit: Fit, gyro_fit: Fit) -> dict[str, Any]:
     columns and the axes the misalignments."""
     out: dict[str, Any] = {}
     for sensor, fit in (("acc", acc_fit), ("gyro", gyro_fit)):
-        inverse = np.linalg.inv(fit.matrix)
-        scales = np.linalg.norm(inverse, axis=0)
-        angles = [math.degrees(math.acos(min(1.0, abs(inverse[i, i]) / scales[i])))
-                  for i in range(3)]
-        out[sensor] = {"scale": scales.tolist(), "misalignment_deg": angles}
+        scales, angles = scales_and_misalignment(fit.matrix)
+        out[sensor] = {"scale": scales, "misalignment_deg": angles}
     return out
+
+
+def scales_and_misalignment(matrix: Any) -> tuple[list[float], list[float]]:
+    """A calibration matrix's scale factors (its inverse's column norms) and misalignments
+    [deg] (the angle of each of those columns from its axis)."""
+    inverse = np.linalg.inv(np.asarray(matrix, dtype=float))
+    scales = np.linalg.norm(inverse, axis=0)
+    angles = [math.degrees(math.acos(min(1.0, abs(inverse[i, i]) / scales[i])))
+              for i in range(3)]
+    return scales.tolist(), angles

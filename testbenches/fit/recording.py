@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -445,7 +445,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(f"{path}: no time or dt column{hint}: give the sample rate (--rate "
                              "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
-    dt, _ = _Clock(**{**clock.__dict__})(prefix.get(clock.kind), 0, n)
+    dt, _ = replace(clock)(prefix.get(clock.kind), 0, n)
     acc = np.column_stack([prefix[f"acc_{a}"] for a in "xyz"])
     gyro = np.column_stack([prefix[f"gyro_{a}"] for a in "xyz"])
     finite = valid_samples(acc, gyro, dt)
@@ -456,7 +456,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
 
     def more() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """The blocks after the first, as read (for the gyro unit's evidence)."""
-        evidence_clock = _Clock(**{**clock.__dict__})
+        evidence_clock = replace(clock)
         row0 = 0
         for block in table.blocks(wanted, PREFIX_ROWS):
             d, _ = evidence_clock(block[:, names.index(clock.kind)] if clock.kind != "rate"
@@ -480,7 +480,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     name = path.stem
 
     def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
-        run_clock = _Clock(**{**clock.__dict__})
+        run_clock = replace(clock)
         row0 = 0
         for block in table.blocks(wanted, rows):
             cols = {q: block[:, k] for k, q in enumerate(names)}
