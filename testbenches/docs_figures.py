@@ -325,6 +325,42 @@ def campaigns_scenarios_table(ctx: dict[str, Path]) -> str:
     return "\n".join(rows)
 
 
+UNCALIBRATED_PARTS = 40
+
+
+def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
+    """docs/guide/own-sensor.md: static_tilted on UNCALIBRATED_PARTS parts whose gyro and
+    accelerometer were not calibrated at start-up (the sensor's `calibration` none), each filter
+    with VQF's rest rule (rest_bias_bound 0) and with the default; mean roll/pitch RMSE."""
+    from fusion_core.presets import load_preset
+    from fusion_core.sensor import sensor_preset
+
+    from .parts import part_rmse
+    from .peer_runs import run_peers
+    from .peers import PEERS
+
+    sensor = {**sensor_preset("realistic"), "calibration": "none"}
+    keys = ["cf", "mgcf", "kf", "ukf"]
+    preset = load_preset("recommended")
+    pair = lambda v: f"{v[0]:.2g}/{v[1]:.2g}"  # noqa: E731
+    vqf_rule = part_rmse(keys, ["static_tilted"], preset, sensor, UNCALIBRATED_PARTS,
+                         {"rest_bias_bound": 0.0}, calibrated_first=(False,))
+    default = part_rmse(keys, ["static_tilted"], preset, sensor, UNCALIBRATED_PARTS,
+                        calibrated_first=(False,))
+    how = {"cf": "only at rest, aligning at the first", "mgcf": "only at rest, aligning at the "
+           "first", "kf": "also from the accelerometer", "ukf": "also from the accelerometer"}
+    rows = ["| filter | `rest_bias_bound` 0 (VQF's rule) | default (20 deg/s) | how it learns "
+            "its bias |", "|---|---|---|---|"]
+    for key in keys:
+        k = (False, key, "static_tilted")
+        rows.append(f"| {key} | {pair(vqf_rule[k].mean(axis=0))} | "
+                    f"{pair(default[k].mean(axis=0))} | {how[key]} |")
+    peer = run_peers({"vqf": PEERS["vqf"]}, ["static_tilted"], UNCALIBRATED_PARTS, sensor)
+    vqf = np.mean([(r.rmse_roll_deg, r.rmse_pitch_deg) for r in peer], axis=0)
+    rows.append(f"| VQF | {pair(vqf)} | | |")
+    return "\n".join(rows)
+
+
 def embedded_table(ctx: dict[str, Path]) -> str:
     """`make embedded`'s table: each twin on the Cortex-M7 (double) and the Cortex-M4F (float)
     under QEMU, on moderate_dynamics through the realistic sensor (BROAD_DIR unset)."""
@@ -384,6 +420,10 @@ FIGURES: tuple[Figure, ...] = (
     Figure("campaigns-scenarios", "docs/guide/campaigns.md",
            "python -m testbenches run --estimator kf,ukf --scenario SCENARIO --seeds 100 "
            "--peers vqf --no-contract --no-plots", campaigns_scenarios_table, needs=("vqf",)),
+    Figure("uncalibrated-rest", "docs/guide/own-sensor.md",
+           "python -m testbenches run --scenario static_tilted --seeds 40 --sensor "
+           "uncalibrated.json --peers vqf [--param rest_bias_bound=0] --no-contract",
+           uncalibrated_rest_table, needs=("vqf",)),
     Figure("embedded-table", "docs/guide/backends.md", "make embedded", embedded_table,
            needs=("embedded",)),
     Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
