@@ -400,6 +400,38 @@ def vqf_contract_table(ctx: dict[str, Path]) -> str:
     return "\n".join(rows)
 
 
+BUDGET_EXCERPT = (("ukf", "roll_sweep", False), ("ukf", "roll_sweep", True),
+                  ("cf", "pitch_sweep", False), ("ukf", "moderate_dynamics", False),
+                  ("kf", "moderate_dynamics", False), ("ukf", "high_dynamics", False),
+                  ("kf", "high_dynamics", False))
+"""The error budget's excerpt in docs/results/contract.md: (estimator, scenario, with constant
+noise: gyro_scale_std and disturbance_time 0, as the papers have it)."""
+
+
+def budget_excerpt(ctx: dict[str, Path]) -> str:
+    """`python -m testbenches budget`'s rows of BUDGET_EXCERPT (seeds 0-2, the recommended
+    preset, the realistic sensor): full, three sources off, motion only."""
+    from fusion_core.presets import load_preset
+    from fusion_core.sensor import sensor_preset
+
+    from .budget import error_budget
+
+    sensor, preset = sensor_preset("realistic"), load_preset("recommended")
+    pair = lambda v: f"{v[0]:.2f}/{v[1]:.2f}"  # noqa: E731
+    rows = ["| estimator, scenario | bound | full | -gyro_scale | -gyro_cross | -calibration | "
+            "motion only |", "|---|---|---|---|---|---|---|"]
+    for key, scenario, constant in BUDGET_EXCERPT:
+        params = {key: {**preset[key], **({"gyro_scale_std": 0.0, "disturbance_time": 0.0}
+                                          if constant else {})}}
+        (row,) = error_budget([key], [scenario], 3, sensor, params)
+        label = f"{key} {scenario}" + (", constant noise" if constant else "")
+        rows.append(f"| {label} | {row.limit[0]:g}/{row.limit[1]:g} | {pair(row.full)} | "
+                    + " | ".join(pair(row.without[n]) for n in ("gyro_scale", "gyro_cross",
+                                                                 "calibration"))
+                    + f" | {pair(row.motion_only)} |")
+    return "\n".join(rows)
+
+
 def embedded_table(ctx: dict[str, Path]) -> str:
     """`make embedded`'s table: each twin on the Cortex-M7 (double) and the Cortex-M4F (float)
     under QEMU, on moderate_dynamics through the realistic sensor (BROAD_DIR unset)."""
@@ -466,6 +498,9 @@ FIGURES: tuple[Figure, ...] = (
     Figure("contract-vqf", "docs/results/contract.md",
            "python -m testbenches run --peers vqf (shaking, gyro_clipping: --seeds 20)",
            vqf_contract_table, needs=("vqf",)),
+    Figure("budget-excerpt", "docs/results/contract.md",
+           "python -m testbenches budget --estimator ... --scenario ... (seeds 0-2)",
+           budget_excerpt),
     Figure("embedded-table", "docs/guide/backends.md", "make embedded", embedded_table,
            needs=("embedded",)),
     Figure("engines-table", "docs/guide/engines.md", "imu-fusion engines --fmu-dir dist",
