@@ -17,6 +17,7 @@ BY_NAME = {f.name: f for f in figs.FIGURES}
 WHERE = {"imucal": "imucal's session beside the project in ../shared/data/imucal",
          "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)",
          "vqf": "the peers (pip install -e '.[bench]')",
+         "broad": "BROAD's trials beside the project in ../shared/data/broad",
          "imucal-package": "imucal (pip install -e '.[bench]')",
          "embedded": "arm-none-eabi-gcc and qemu-system-arm (apt-get install gcc-arm-none-eabi "
                      "libnewlib-arm-none-eabi qemu-system-arm)"}
@@ -38,7 +39,7 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
 
 HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenarios")
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
-SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts")
+SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "readme-broad")
 """Figures of 200 parts calibrated first: minutes (`make test-slow`)."""
 
 
