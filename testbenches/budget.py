@@ -27,7 +27,7 @@ import numpy as np
 from fusion_core.registry import keys_help
 from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
-from .contract import accuracy_limits, compute_metrics
+from .contract import accuracy_limits
 from .options import add_calibration, add_preset, add_sensor, choose, positive_int, with_calibration
 
 SOURCES: dict[str, tuple[str, dict[str, Any]]] = {
@@ -72,15 +72,12 @@ class BudgetRow:
 
 def _rmse(estimator: str, scenario: str, seeds: int, sensor: dict[str, Any],
           params: dict[str, Any]) -> tuple[float, float]:
-    from .montecarlo.plan import Run
-    from .montecarlo.simulate import simulate
+    """The mean roll and pitch RMSE over the seeds (the parts of testbenches.parts)."""
+    from .parts import part_rmse
 
-    vals = []
-    for seed in range(seeds):
-        m = compute_metrics(simulate(Run("budget", estimator, scenario, seed, None, sensor,
-                                         params, {})))
-        vals.append((m["rmse_roll_deg"], m["rmse_pitch_deg"]))
-    roll, pitch = np.mean(vals, axis=0)
+    runs = part_rmse([estimator], [scenario], {estimator: params}, sensor, seeds,
+                     calibrated_first=(False,))
+    roll, pitch = runs[(False, estimator, scenario)].mean(axis=0)
     return float(roll), float(pitch)
 
 

@@ -206,9 +206,7 @@ def _calibrated_parts() -> dict[str, dict[bool, np.ndarray]]:
     from fusion_core.registry import KEYS
     from fusion_core.sensor import sensor_preset
 
-    from .parts import part_rmse
-    from .peer_runs import run_peers
-    from .peers import PEERS
+    from .parts import part_rmse, vqf_rmse
 
     sensor = sensor_preset("realistic")
     rmse = part_rmse(list(KEYS), ["moderate_dynamics"], load_preset("recommended"), sensor,
@@ -216,11 +214,8 @@ def _calibrated_parts() -> dict[str, dict[bool, np.ndarray]]:
     out: dict[str, dict[bool, np.ndarray]] = {}
     for (calibrated, key, _), values in rmse.items():
         out.setdefault(key, {})[calibrated] = values
-    for calibrated in (False, True):
-        rows = run_peers({"vqf": PEERS["vqf"]}, ["moderate_dynamics"], CALIBRATED_PARTS, sensor,
-                         calibrate_first=calibrated)
-        out.setdefault("vqf", {})[calibrated] = np.array(
-            [(r.rmse_roll_deg, r.rmse_pitch_deg) for r in rows])
+    out["vqf"] = {calibrated: vqf_rmse("moderate_dynamics", sensor, CALIBRATED_PARTS, calibrated)
+                  for calibrated in (False, True)}
     return out
 
 
@@ -307,19 +302,16 @@ def campaigns_scenarios_table(ctx: dict[str, Path]) -> str:
     from fusion_core.sensor import sensor_preset
 
     from .contract import accuracy_limits
-    from .parts import part_rmse
-    from .peer_runs import run_peers
-    from .peers import PEERS
+    from .parts import part_rmse, vqf_rmse
 
     sensor = sensor_preset("realistic")
     ours = part_rmse(["kf", "ukf"], list(SCENARIO_TABLE), load_preset("recommended"), sensor,
                      SCENARIO_PARTS, calibrated_first=(False,))
     rows = ["| scenario | kf | ukf | VQF (peer) |", "|---|---|---|---|"]
     for scenario in SCENARIO_TABLE:
-        peer = run_peers({"vqf": PEERS["vqf"]}, [scenario], SCENARIO_PARTS, sensor)
         cells = []
         for v in (ours[(False, "kf", scenario)], ours[(False, "ukf", scenario)],
-                  np.array([(r.rmse_roll_deg, r.rmse_pitch_deg) for r in peer])):
+                  vqf_rmse(scenario, sensor, SCENARIO_PARTS)):
             lim = accuracy_limits("kf", scenario)
             mean, p95 = v.mean(axis=0), np.percentile(v, 95, axis=0)
             cells.append(f"{mean[0]:.2f}/{mean[1]:.2f}, {p95[0]:.2f}/{p95[1]:.2f}, "
@@ -338,9 +330,7 @@ def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
     from fusion_core.presets import load_preset
     from fusion_core.sensor import sensor_preset
 
-    from .parts import part_rmse
-    from .peer_runs import run_peers
-    from .peers import PEERS
+    from .parts import part_rmse, vqf_rmse
 
     sensor = {**sensor_preset("realistic"), "calibration": "none"}
     keys = ["cf", "mgcf", "kf", "ukf"]
@@ -358,8 +348,7 @@ def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
         k = (False, key, "static_tilted")
         rows.append(f"| {key} | {pair(vqf_rule[k].mean(axis=0))} | "
                     f"{pair(default[k].mean(axis=0))} | {how[key]} |")
-    peer = run_peers({"vqf": PEERS["vqf"]}, ["static_tilted"], UNCALIBRATED_PARTS, sensor)
-    vqf = np.mean([(r.rmse_roll_deg, r.rmse_pitch_deg) for r in peer], axis=0)
+    vqf = vqf_rmse("static_tilted", sensor, UNCALIBRATED_PARTS).mean(axis=0)
     rows.append(f"| VQF | {pair(vqf)} | | |")
     return "\n".join(rows)
 
@@ -377,9 +366,7 @@ def vqf_contract_table(ctx: dict[str, Path]) -> str:
     from fusion_core.sensor import sensor_preset
 
     from .contract import ACCURACY
-    from .parts import PARTS, part_rmse
-    from .peer_runs import run_peers
-    from .peers import PEERS
+    from .parts import PARTS, part_rmse, vqf_rmse
 
     sensor, preset = sensor_preset("realistic"), load_preset("recommended")
     pair = lambda v: f"{v[0]:.2f}/{v[1]:.2f}"  # noqa: E731
@@ -389,8 +376,7 @@ def vqf_contract_table(ctx: dict[str, Path]) -> str:
         parts = PARTS if scenario in MEAN_OF_PARTS else 1
         ours = part_rmse(list(KEYS), [scenario], preset, sensor, parts,
                          calibrated_first=(False,))
-        peer = run_peers({"vqf": PEERS["vqf"]}, [scenario], parts, sensor)
-        vqf = np.mean([(r.rmse_roll_deg, r.rmse_pitch_deg) for r in peer], axis=0)
+        vqf = vqf_rmse(scenario, sensor, parts).mean(axis=0)
         bound = ACCURACY.get(scenario)
         verdict = "-" if bound is None else (
             "PASS" if vqf[0] <= bound[0] and vqf[1] <= bound[1] else "FAIL")

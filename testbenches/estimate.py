@@ -239,14 +239,13 @@ def output_columns(spec: str, position: bool) -> list[str]:
     return ["time", *(c for g in groups for c in OUTPUTS[g])]
 
 
-def _columns(out: dict[str, np.ndarray], t: np.ndarray, names: list[str], keep: slice | np.ndarray
+def _columns(out: dict[str, np.ndarray], t: np.ndarray, names: list[str], keep: slice
              ) -> list[np.ndarray]:
-    pick = {"time": t, "roll": out["roll"], "pitch": out["pitch"],
-            "rejected": out["rejected"].astype(float)}
+    pick = {"time": t, "roll": out["roll"], "pitch": out["pitch"], "rejected": out["rejected"]}
     for group in ("bias", "pos", "vel"):
         if group in out:
             pick.update({f"{group}_{a}": out[group][:, i] for i, a in enumerate("xyz")})
-    return [pick[n][keep] for n in names]
+    return [np.asarray(pick[n][keep], dtype=float) for n in names]
 
 
 class Score:
@@ -307,7 +306,7 @@ class _Run:
         from .broad.metric import gravity_from_roll_pitch
 
         out = self.est.run(rec.acc, rec.gyro, rec.dt)
-        keep = np.flatnonzero((row0 + np.arange(len(t))) % every == 0)
+        keep = slice(-row0 % every, None, every)  # the recording's rows 0, every, 2 every, ...
         self.writer.write(_columns(out, t, self.writer.names, keep))
         up = gravity_from_roll_pitch(out["roll"], out["pitch"])
         self.score.add(up, rec)
@@ -394,8 +393,6 @@ def _progress(source: Any) -> Any:
 
 
 def cmd_estimate(args: argparse.Namespace) -> int:
-    from concurrent.futures import ThreadPoolExecutor
-
     from fusion_core.presets import load_preset
     from fusion_core.registry import KEYS, create
 
@@ -416,7 +413,8 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         for key, est in estimators.items():
             path = args.out / f"{source.name}_{key}{FORMATS[args.format]}"
             runs.append(_Run(key, est, path, args.format, names[key]))
-        vqf, found = _run_blocks(args, source, reference, runs, ThreadPoolExecutor, keys, preset)
+        vqf_params = estimator_params(args, preset[keys[0]])  # calibration and mounting
+        vqf, found = _run_blocks(args, source, reference, runs, vqf_params)
     except BaseException:
         for run in runs:
             run.writer.discard()
@@ -439,11 +437,12 @@ def cmd_estimate(args: argparse.Namespace) -> int:
 
 
 def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | None,
-                runs: list[Any], pool_type: Any, keys: list[str], preset: dict[str, Any]
-                ) -> tuple[Any, dict[str, Any]]:
+                runs: list[Any], vqf_params: dict[str, Any]) -> tuple[Any, dict[str, Any]]:
     """Every block through every estimator (in parallel: the C twin runs without the GIL) and
-    VQF where there is a reference; what was read, found and scored."""
+    VQF where there is a reference (on the samples as `vqf_params` condition them); what was
+    read, found and scored."""
     import os
+    from concurrent.futures import ThreadPoolExecutor
 
     from .fit.recording import RecordingError
 
@@ -453,7 +452,7 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
     truth = Thinned()
     duration = 0.0
     workers = max(1, min(len(runs) + 1, os.cpu_count() or 1))
-    with pool_type(workers) as pool, _progress(source) as bar:
+    with ThreadPoolExecutor(workers) as pool, _progress(source) as bar:
         for rec, t in _read_ahead(source.blocks()):
             if reference is not None:
                 if n == 0 and reference.span[1] < t[0]:
@@ -464,7 +463,7 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                 world_up, note = find_world_up(rec, args.reference or args.recording)
                 notes += [note] if note else []
                 if rec.up_ref is not None and not args.no_vqf:
-                    vqf = _VqfRun(source.rate, estimator_params(args, preset[keys[0]]))
+                    vqf = _VqfRun(source.rate, vqf_params)
             if world_up is not None and rec.ref_quat is not None:
                 rec.up_ref = about_world_up(rec.ref_quat, world_up)
             if rec.up_ref is not None:  # scored where every estimator and VQF took the sample

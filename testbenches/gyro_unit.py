@@ -67,16 +67,11 @@ def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
     return np.vstack([pad, out])
 
 
-def gyro_unit_evidence(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> UnitEvidence:
-    """The evidence for each unit of `gyro` [N, 3] (numbers as read) from `acc` [N, 3] (any
-    unit: only its direction and its norm relative to the median are used) and `dt` [N] [s]
-    (rows with a non-finite value are left out of every window that holds them)."""
-    return verdict(window_misses(acc, gyro, dt))
-
-
 def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str, np.ndarray]:
-    """Each unit's miss [deg] in every window that counts (gyro_unit_evidence's data), so that
-    the windows of a recording's blocks can be pooled before the verdict."""
+    """Each unit's miss [deg] in every window that counts, for `gyro` [N, 3] (numbers as read),
+    `acc` [N, 3] (any unit: only its direction and its norm relative to the median are used)
+    and `dt` [N] [s] (rows with a non-finite value are left out of every window that holds
+    them); the windows of a recording's blocks are pooled before the verdict."""
     acc, gyro, dt = (np.asarray(a, dtype=float) for a in (acc, gyro, dt))
     none = {unit: np.empty(0) for unit in UNITS}
     n = len(dt)

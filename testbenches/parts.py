@@ -59,6 +59,18 @@ def part_rmse(estimators: Sequence[str], scenarios: Sequence[str], preset: dict[
     return out
 
 
+def vqf_rmse(scenario: str, sensor: dict[str, Any], parts: int = PARTS,
+             calibrate_first: bool = False) -> np.ndarray:
+    """VQF's roll and pitch RMSE [deg] per part [parts, 2] on the same samples (the peer runs of
+    `imu-fusion run --peers vqf`, testbenches.peer_runs)."""
+    from .peer_runs import run_peers
+    from .peers import PEERS
+
+    rows = run_peers({"vqf": PEERS["vqf"]}, [scenario], parts, sensor,
+                     calibrate_first=calibrate_first)
+    return np.array([(r.rmse_roll_deg, r.rmse_pitch_deg) for r in rows])
+
+
 def share_within(values: np.ndarray, bound: tuple[float, float]) -> float:
     """The share of parts (rows: roll, pitch RMSE) whose roll and pitch are both within the
     bound."""

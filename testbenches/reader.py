@@ -125,12 +125,6 @@ def open_table(path: str | Path) -> TableSource:
     return _text(path)
 
 
-def read_table(path: str | Path) -> tuple[TableSource, np.ndarray]:
-    """The file's table and every row of every column [N, columns]."""
-    source = open_table(path)
-    return source, source.read(list(range(len(source.header))))
-
-
 # ----- delimited text --------------------------------------------------------------------------
 
 @dataclass
@@ -449,6 +443,5 @@ __all__ = [
     "TableError",
     "TableSource",
     "open_table",
-    "read_table",
     "split_unit",
 ]

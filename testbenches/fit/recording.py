@@ -98,6 +98,12 @@ def load(path: str | Path, rate: float | None = None) -> Recording:
         trial = load_trial(path)
     except NotABroadTrial:
         return load_recording(path, rate=rate, acc_unit="m/s2", gyro_unit="rad/s")[0]
+    return trial_recording(trial)
+
+
+def trial_recording(trial: Any) -> Recording:
+    """A BROAD trial (testbenches.broad.data.BroadTrial) as a Recording: its rate, sampling,
+    delay and reference, scored over its movement samples."""
     up = gravity_from_quat(trial.opt_quat)
     return Recording(trial.name, trial.acc, trial.gyro, np.full(trial.n, trial.dt), trial.rate,
                      trial.gyro_sampling, up, trial.movement & np.all(np.isfinite(up), axis=1),
@@ -364,21 +370,18 @@ def concatenate(parts: list[Recording]) -> Recording:
         values = [getattr(p, name) for p in parts]
         return None if values[0] is None else np.concatenate(values)
 
-    rec = Recording(first.name, joined("acc"), joined("gyro"), joined("dt"), first.rate,
-                    first.gyro_sampling, joined("up_ref"), joined("counts"), first.sensor_delay,
-                    joined("ref_quat"))
-    return rec
+    return Recording(first.name, joined("acc"), joined("gyro"), joined("dt"), first.rate,
+                     first.gyro_sampling, joined("up_ref"), joined("counts"), first.sensor_delay,
+                     joined("ref_quat"))
 
 
-def _broad_source(path: Path) -> RecordingSource:
-    rec = load(path)
+def _broad_source(path: Path, trial: Any) -> RecordingSource:
+    rec = trial_recording(trial)
     t = np.cumsum(rec.dt) - rec.dt[0]
 
     def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
         for lo in range(0, len(rec.dt), rows):
-            part = rec.slice(lo, lo + rows)
-            part.ref_quat = None
-            yield part, t[lo:lo + rows]
+            yield rec.slice(lo, lo + rows), t[lo:lo + rows]
 
     return RecordingSource(path, rec.name, rec.rate, "a BROAD trial: m/s2 and rad/s, its own "
                            "rate, sampling, delay and reference", len(rec.dt), blocks)
@@ -397,11 +400,9 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(f"{path}: no such file")
     if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
         try:
-            load_trial(path)
+            return _broad_source(path, load_trial(path))
         except NotABroadTrial:
             pass
-        else:
-            return _broad_source(path)
     table = open_table(path)
     found = find_columns(table, time_column, columns)
     missing = [q for q in IMU_AXES if q not in found.index]
@@ -446,8 +447,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                              "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
     dt, _ = replace(clock)(prefix.get(clock.kind), 0, n)
-    acc = np.column_stack([prefix[f"acc_{a}"] for a in "xyz"])
-    gyro = np.column_stack([prefix[f"gyro_{a}"] for a in "xyz"])
+    acc, gyro = _vectors(prefix)
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
         raise RecordingError(f"{path}: no sample holds numbers in every column")
@@ -459,11 +459,10 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         evidence_clock = replace(clock)
         row0 = 0
         for block in table.blocks(wanted, PREFIX_ROWS):
-            d, _ = evidence_clock(block[:, names.index(clock.kind)] if clock.kind != "rate"
-                                  else None, row0, len(block))
+            cols = {q: block[:, k] for k, q in enumerate(names)}
+            d, _ = evidence_clock(cols.get(clock.kind), row0, len(block))
             if row0 > 0:
-                yield (block[:, [names.index(f"acc_{a}") for a in "xyz"]],
-                       block[:, [names.index(f"gyro_{a}") for a in "xyz"]], d)
+                yield (*_vectors(cols), d)
             row0 += len(block)
 
     gyro_scale, gyro_how, used = _gyro_scale(
@@ -485,8 +484,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         for block in table.blocks(wanted, rows):
             cols = {q: block[:, k] for k, q in enumerate(names)}
             dt, t = run_clock(cols.get(run_clock.kind), row0, len(block))
-            acc = np.column_stack([cols[f"acc_{a}"] for a in "xyz"]) * acc_scale
-            gyro = np.column_stack([cols[f"gyro_{a}"] for a in "xyz"]) * gyro_scale
+            acc, gyro = _vectors(cols)
+            acc, gyro = acc * acc_scale, gyro * gyro_scale
             up, ref_quat = reference_up(cols, path)
             counts = None if up is None else np.all(np.isfinite(up), axis=1)
             rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts)
@@ -495,6 +494,12 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             yield rec, t
 
     return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks)
+
+
+def _vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The accelerometer and gyro [n, 3] of a block's columns."""
+    return (np.column_stack([cols[f"acc_{a}"] for a in "xyz"]),
+            np.column_stack([cols[f"gyro_{a}"] for a in "xyz"]))
 
 
 def load_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
