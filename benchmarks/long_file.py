@@ -32,8 +32,12 @@ from testbenches.cli import main
 t0 = time.perf_counter()
 status = main(sys.argv[1:])
 seconds = time.perf_counter() - t0
-print(json.dumps({"status": status, "seconds": seconds,
-                  "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}))
+try:  # this process's own peak: ru_maxrss would carry the parent's over the exec
+    with open("/proc/self/status") as f:
+        peak_mb = next(int(l.split()[1]) for l in f if l.startswith("VmHWM:")) / 1024.0
+except (OSError, StopIteration):
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+print(json.dumps({"status": status, "seconds": seconds, "peak_mb": peak_mb}))
 """
 
 
@@ -69,6 +73,29 @@ def _pyarrow_read_s(path: Path, repeats: int) -> float:
     return best
 
 
+def _estimators_alone_s(path: Path) -> dict[str, float]:
+    """Seconds of each estimator's C twin on the file's samples already in memory (no reading,
+    conditioning, writing or plot): what the command cannot go below but by running them on
+    more cores."""
+    import pyarrow.csv as pc
+
+    from fusion_core import native
+    from fusion_core.registry import REGISTRY
+
+    table = pc.read_csv(path)
+    acc = np.column_stack([table[f"acc_{a}"].to_numpy() for a in "xyz"])
+    gyro = np.column_stack([table[f"gyro_{a}"].to_numpy() for a in "xyz"])
+    dt = np.full(len(acc), 1.0 / RATE_HZ)
+    seconds = {}
+    for entry in REGISTRY:
+        if not native.available() or entry.twin is None:
+            continue
+        t0 = time.perf_counter()
+        native.run(entry.cls(), acc, gyro, dt)
+        seconds[entry.key] = time.perf_counter() - t0
+    return seconds
+
+
 def _estimate(path: Path, out: Path, *extra: str) -> dict[str, Any]:
     proc = subprocess.run([sys.executable, "-c", _CHILD, "estimate", str(path), "--out",
                            str(out), *extra], capture_output=True, text=True, check=False)
@@ -80,13 +107,16 @@ def _estimate(path: Path, out: Path, *extra: str) -> dict[str, Any]:
 
 def estimate_section(tmp: Path, rows: int = ROWS, repeats: int = 3) -> dict[str, Any]:
     """Seconds and peak MB of `imu-fusion estimate` (every estimator and the plot) per output
-    format, and pyarrow's read of the same file (best of `repeats`) in the same run."""
+    format, pyarrow's read of the same file (best of `repeats`) and the estimators' C twins
+    alone on its samples, in the same run."""
     path = long_recording(tmp / "long.csv", rows)
     read_s = _pyarrow_read_s(path, repeats)
+    alone = _estimators_alone_s(path)
     runs = {}
     for fmt in ("csv", "parquet", "hdf5"):
         got = _estimate(path, tmp / f"out_{fmt}", "--format", fmt)
         got["vs_pyarrow_read"] = got["seconds"] / read_s
         runs[fmt] = got
     return {"rows": rows, "file_mb": path.stat().st_size / 1e6, "pyarrow_read_s": read_s,
-            "runs": runs}
+            "estimators_alone_s": alone, "estimators_alone_sum_s": sum(alone.values()),
+            "estimators_alone_vs_pyarrow_read": sum(alone.values()) / read_s, "runs": runs}

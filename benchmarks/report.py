@@ -188,8 +188,10 @@ def evaluate_targets(r: dict[str, Any]) -> list[dict[str, Any]]:
             out.append(_target(
                 f"estimate_2e6.{fmt}.vs_pyarrow_read", run["vs_pyarrow_read"],
                 f"<= {ESTIMATE_VS_READ:g}", run["vs_pyarrow_read"] <= ESTIMATE_VS_READ,
-                "the five estimators' C twins take about 2 us per sample each, run in "
-                "parallel on the machine's cores, while pyarrow's read uses every core"
+                f"the estimators' C twins alone, summed over one core each, take "
+                f"{long.get('estimators_alone_vs_pyarrow_read', float('nan')):.1f}x the read; "
+                "they run in parallel on the machine's cores, while pyarrow's read uses every "
+                "core"
                 + ("; formatting every double as text" if fmt == "csv" else "")))
             out.append(_target(
                 f"estimate_2e6.{fmt}.peak_mb", run["peak_mb"], f"<= {PEAK_MB:g}",

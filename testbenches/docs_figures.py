@@ -639,7 +639,10 @@ def add_docs_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[ty
     p = sub.add_parser("docs", help="check (or make again) the docs' generated figures",
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("names", nargs="*", help="which figures (all)")
-    p.add_argument("--write", action="store_true", help="make them again instead of checking")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true",
+                      help="say which no longer match and exit 1 if any (the default)")
+    mode.add_argument("--write", action="store_true", help="make them again instead of checking")
     p.add_argument("--fmu-dir", type=Path, default=None, help="built FMUs (dist)")
     p.add_argument("--imucal", type=Path, default=None,
                    help=f"the folder of imucal's {IMUCAL_SESSION}")

@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -52,8 +53,9 @@ OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", 
            "pos": ("pos_x", "pos_y", "pos_z"), "vel": ("vel_x", "vel_y", "vel_z"),
            "rejected": ("rejected",)}
 """The output groups --outputs chooses from, and their columns."""
-PLOT_POINTS = 20000
-"""The plot keeps at most about twice this many samples per line (every kth, k doubling)."""
+PLOT_POINTS = 5000
+"""The plot keeps at most about twice this many samples per line (every kth, k doubling): a
+few per pixel column of the figure."""
 
 G_STANDARD = 9.80665
 DEG = np.pi / 180.0
@@ -280,12 +282,18 @@ class Thinned:
 
     def add(self, row0: int, values: dict[str, np.ndarray]) -> None:
         """A block's series (each [n] or [n, m]) from the recording's row row0."""
-        rows = np.arange(row0, row0 + len(next(iter(values.values()))))
-        keep = rows % self.k == 0
-        self.rows = np.concatenate([self.rows, rows[keep]])
-        for name, v in values.items():
+        n = len(next(iter(values.values())))
+        self.add_at(row0, n, lambda i: {name: v[i] for name, v in values.items()})
+
+    def add_at(self, row0: int, n: int,
+               make: Callable[[np.ndarray], dict[str, np.ndarray]]) -> None:
+        """A block of n rows from row row0 whose series `make` gives at the block's indices
+        it is passed: only the rows kept are computed."""
+        at = np.flatnonzero(np.arange(row0, row0 + n) % self.k == 0)
+        self.rows = np.concatenate([self.rows, row0 + at])
+        for name, v in make(at).items():
             old = self.values.get(name)
-            self.values[name] = v[keep] if old is None else np.concatenate([old, v[keep]])
+            self.values[name] = v if old is None else np.concatenate([old, v])
         while len(self.rows) > 2 * PLOT_POINTS:
             self.k *= 2
             keep = self.rows % self.k == 0
@@ -308,9 +316,13 @@ class _Run:
         out = self.est.run(rec.acc, rec.gyro, rec.dt)
         keep = slice(-row0 % every, None, every)  # the recording's rows 0, every, 2 every, ...
         self.writer.write(_columns(out, t, self.writer.names, keep))
-        up = gravity_from_roll_pitch(out["roll"], out["pitch"])
-        self.score.add(up, rec)
-        self.trace.add(row0, {"t": t, "up": up})
+        if rec.up_ref is None:  # the up direction for the plot's rows only
+            self.trace.add_at(row0, len(t), lambda i: {
+                "t": t[i], "up": gravity_from_roll_pitch(out["roll"][i], out["pitch"][i])})
+        else:
+            up = gravity_from_roll_pitch(out["roll"], out["pitch"])
+            self.score.add(up, rec)
+            self.trace.add(row0, {"t": t, "up": up})
         self.rejected += int(out["rejected"].sum())
 
 
@@ -408,6 +420,10 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     print(f"{args.recording}: {source.choices}")
     reference = Reference(args.reference) if args.reference is not None else None
     args.out.mkdir(parents=True, exist_ok=True)
+    if not args.no_plots:  # the plotting library loads while the estimators run
+        import threading
+
+        threading.Thread(target=_import_pyplot, daemon=True).start()
     runs: list[Any] = []
     try:
         for key, est in estimators.items():
@@ -508,6 +524,14 @@ def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]
                                    float(params.get("mount_pitch", 0.0)),
                                    float(params.get("mount_yaw", 0.0)))).reshape(3, 3)
     return acc @ r.T, gyro @ r.T
+
+
+def _import_pyplot() -> None:
+    with contextlib.suppress(ImportError):
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot
 
 
 def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> str:

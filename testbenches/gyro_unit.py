@@ -39,6 +39,10 @@ above its noise after the low-pass (about 0.1 deg) and above what a MEMS gyro's 
 deg/s before calibration) adds to the right unit's miss over a window."""
 MIN_WINDOWS = 10
 """Fewer counting windows than this: undecided."""
+MAX_WINDOWS = 20000
+"""At most this many counting windows of a block are compared, spread evenly over it: the
+windows start at every sample and overlap, and a median over this many is as sure as over all
+of a long recording's (the comparison is most of the time a long file takes to open)."""
 MIN_RATIO = 3.0
 """The other unit's miss must be at least this many times the chosen one's."""
 
@@ -96,7 +100,9 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str
     usable = quiet[starts] & quiet[ends] & (bad[ends + 1] - bad[starts] == 0)
     starts, ends = starts[usable], ends[usable]
     seen = np.degrees(np.arccos(np.clip(np.sum(u[starts] * u[ends], axis=1), -1.0, 1.0)))
-    counts = seen >= MIN_TURN_DEG
+    counts = np.flatnonzero(seen >= MIN_TURN_DEG)
+    if len(counts) > MAX_WINDOWS:  # evenly spread over the recording
+        counts = counts[np.linspace(0, len(counts) - 1, MAX_WINDOWS).astype(np.int64)]
     starts, ends = starts[counts], ends[counts]
     misses: dict[str, np.ndarray] = {}
     for unit, scale in UNITS.items():

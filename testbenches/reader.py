@@ -210,6 +210,19 @@ def _has_pyarrow() -> bool:
     return True
 
 
+def _float64(column: Any) -> np.ndarray:
+    """A pyarrow float64 array as numpy, its nulls NaN. Read from its buffers: pyarrow's
+    to_numpy imports pandas on its first call, a quarter of a second on every command."""
+    validity, data = column.buffers()
+    n, offset = len(column), column.offset
+    x = np.frombuffer(data, dtype=np.float64, count=offset + n)[offset:]
+    if column.null_count:
+        valid = np.unpackbits(np.frombuffer(validity, dtype=np.uint8),
+                              bitorder="little")[offset:offset + n].astype(bool)
+        x = np.where(valid, x, np.nan)
+    return x
+
+
 def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
                   ) -> Iterator[np.ndarray]:
     import pyarrow as pa
@@ -230,9 +243,8 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
         pending: list[np.ndarray] = []
         held = 0
         for batch in reader:
-            part = np.column_stack([batch.column(k).to_numpy(zero_copy_only=False)
-                                    for k in wanted]) if wanted else np.empty((batch.num_rows,
-                                                                               0))
+            part = np.column_stack([_float64(batch.column(k)) for k in wanted]) if wanted \
+                else np.empty((batch.num_rows, 0))
             pending.append(part)
             held += len(part)
             while held >= rows:
