@@ -18,6 +18,8 @@
               on others (testbenches.fit).
   campaign    a Monte Carlo campaign of seeded runs on Dask, resumable, with percentiles and
               confidence intervals (testbenches.montecarlo).
+  battery     every attitude filter beside VQF on a battery of motions x parts of three
+              sensor classes (testbenches.battery).
   budget      the sensor's error budget: each scenario's RMSE with one group of the IMU's
               errors switched off at a time (testbenches.budget).
   calibrate   a part's calibration from a session of static poses and turns: calibration.json
@@ -41,8 +43,8 @@ from fmu_src.cli import add_build_parser
 
 from .estimate import add_estimate_parser
 
-TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "budget",
-                      "crosscheck", "calibrate", "engines")
+TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "battery",
+                      "budget", "crosscheck", "calibrate", "engines")
 """The commands that need the testbench extra."""
 
 
@@ -60,6 +62,7 @@ def _parser(prog: str) -> argparse.ArgumentParser:
     from . import missing_modules
 
     if not missing_modules():
+        from .battery import add_battery_parser
         from .broad.cli import add_broad_parser
         from .budget import add_budget_parser
         from .calibrate.cli import add_calibrate_parser
@@ -72,8 +75,9 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         from .ssp import add_ssp_parser
 
         for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
-                    add_campaign_parser, add_budget_parser, add_crosscheck_parser,
-                    add_calibrate_parser, add_engines_parser, add_docs_parser):
+                    add_campaign_parser, add_battery_parser, add_budget_parser,
+                    add_crosscheck_parser, add_calibrate_parser, add_engines_parser,
+                    add_docs_parser):
             add(sub)
     return parser
 

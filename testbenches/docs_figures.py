@@ -28,6 +28,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -478,6 +479,55 @@ def engines_table(ctx: dict[str, Path]) -> str:
     return engine_table(engine_rows(ctx["fmus"]), speed=False)
 
 
+@functools.lru_cache(maxsize=1)
+def _battery() -> Any:
+    from .battery import MOTIONS, PARTS, SENSOR_CLASSES, run_battery
+
+    return run_battery(list(MOTIONS), list(SENSOR_CLASSES), PARTS, scheduler=None)
+
+
+def battery_classes() -> str:
+    from .battery import classes_text
+
+    return classes_text()
+
+
+def battery_overview(ctx: dict[str, Path]) -> str:
+    from .battery import overview_table
+
+    return overview_table(_battery())
+
+
+def battery_picture(ctx: dict[str, Path], path: Path) -> None:
+    from .battery import plot
+
+    plot(_battery(), path)
+
+
+def _battery_motion(name: str) -> Callable[[dict[str, Path]], str]:
+    def make(ctx: dict[str, Path]) -> str:
+        from .battery import motion_text
+
+        return motion_text(_battery(), name)
+
+    return make
+
+
+def _battery_figures() -> tuple[Figure, ...]:
+    from .battery import MOTIONS
+
+    command = "imu-fusion battery"
+    return (
+        Figure("battery-classes", "docs/results/battery/index.md", command,
+               lambda ctx: battery_classes()),
+        Figure("battery-overview", "docs/results/battery/index.md", command, battery_overview,
+               needs=("vqf",)),
+        Figure("battery-picture", "docs/results/battery/index.md", command, battery_picture,
+               "docs/results/battery/battery.png", ("vqf",)),
+        *(Figure(f"battery-{m}", f"docs/results/battery/{m}.md", f"{command} --motion {m}",
+                 _battery_motion(m), needs=("vqf",)) for m in MOTIONS))
+
+
 FIGURES: tuple[Figure, ...] = (
     Figure("fmu-example", "README.md",
            "fmpy simulate dist/native/fmi3/AngleBiasKalmanFilter.fmu --input-file "
@@ -531,6 +581,7 @@ FIGURES: tuple[Figure, ...] = (
     Figure("calibrate-picture", "docs/results/calibration.md",
            f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s "
            "--gravity 9.81", calibrate_picture, "docs/calibration_example.png", ("imucal",)),
+    *_battery_figures(),
 )
 """Every generated figure of the README and the docs."""
 

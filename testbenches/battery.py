@@ -1,0 +1,481 @@
+"""`imu-fusion battery`: every attitude filter beside VQF on a battery of motions, each run on
+many parts of more than one class of sensor.
+
+The contract's scenarios test what the seed papers ask; a user's recording is a hand, a pendulum,
+a vehicle, a shaker or a slow turntable, on a part of their own. The battery crosses motion
+classes (MOTIONS: as wide as the real sets the filters are measured on) with sensor classes
+(SENSOR_CLASSES: the realistic MPU-6050 of the testbench, a better and a worse part, each with
+its own rate, noise, bias instability, scale and cross-axis errors, range and resolution) and
+runs every attitude filter of the registry and VQF (package defaults) on the same samples of
+PARTS parts (seeds) of each class. The score is BROAD's: the inclination error, the angle
+between the estimated and the true up direction, its RMSE per part after the rest a motion
+starts with and SETTLE_S more.
+
+Each filter is given what a user of that sensor gives it: the parameters that follow from the
+sensor's noise and range (fusion_core.presets.noise_preset, what `imu-fusion noise` writes for a
+static recording), the rest at their recommended values. VQF takes no noise parameters.
+
+The truth comes from the trajectory (fusion_core.synthetic), the samples from the sensor model's
+C twin (fusion_core.sensor), the filters from theirs: a run is deterministic, and the battery is
+split over a Dask cluster (a LocalCluster by default, or the user's scheduler).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fusion_core.synthetic import (
+    VECTOR,
+    Ops,
+    Signal,
+    Trajectory,
+    add,
+    after_rest,
+    constant,
+    sine,
+    spec_of,
+    with_spec,
+)
+from fusion_core.types import DEG, G
+
+PARTS = 20
+"""Parts (seeds) of each sensor class every motion runs on."""
+REST_S = 3.0
+"""The rest a motion starts with [s], as recordings do (longer than the filters' rest_time, so
+their rest detectors meet it); the slow rotation has none: it turns from power-up."""
+SETTLE_S = 5.0
+"""Seconds after the rest left out of the score: the filters' and VQF's start."""
+
+
+def accel_sine(acc: float, freq: float, phase: float = 0.0) -> Signal:
+    """A position sine whose acceleration amplitude is acc [m/s^2]."""
+    return sine(acc / (2.0 * math.pi * freq) ** 2, freq, phase)
+
+
+def swell(peak_acc: float, freq: float, period: float, phase: float = 0.0) -> Signal:
+    """A position tone of acceleration amplitude peak_acc [m/s^2] at freq [Hz] whose envelope
+    swells from 0 to 1 and back every `period` s: bursts."""
+    from fusion_core.scenarios import swelling_sine
+
+    return swelling_sine(peak_acc / (2.0 * math.pi * freq) ** 2, freq, period, phase)
+
+
+def _pendulum_arm(length: float, angle: Signal, axis: int) -> Signal:
+    """A pendulum's position along y (axis 1: length sin angle) or z (axis 2: length (1 - cos
+    angle), zero at the bottom), its derivatives by the chain rule: the sensor hangs at the arm's
+    end, the arm along its -z axis, so its accelerometer reads along the arm but for the swing's
+    departure from a harmonic one (g (sin a - a), 0.06 g at 40 deg)."""
+
+    def f(t: Any, ops: Ops = VECTOR) -> tuple[Any, Any, Any]:
+        a, da, dda = angle(t, ops)
+        s, c = ops.sin(a), ops.cos(a)
+        if axis == 1:
+            return length * s, length * c * da, length * (c * dda - s * da * da)
+        return length * (1.0 - c), length * s * da, length * (s * dda + c * da * da)
+
+    return with_spec(f, "pendulum_arm", length, axis, spec_of(angle))
+
+
+def _handheld_slow() -> Trajectory:
+    return Trajectory(
+        roll=add(sine(30 * DEG, 0.15), sine(10 * DEG, 0.42, 0.6)),
+        pitch=add(sine(25 * DEG, 0.12, 1.0), sine(8 * DEG, 0.37)),
+        yaw=sine(60 * DEG, 0.05),
+        pos=(accel_sine(0.4, 0.3), accel_sine(0.3, 0.23, 1.1), accel_sine(0.2, 0.37, 0.4)))
+
+
+def _handheld_fast() -> Trajectory:
+    return Trajectory(
+        roll=add(sine(50 * DEG, 0.7), sine(20 * DEG, 1.3, 0.5)),
+        pitch=add(sine(40 * DEG, 0.6, 1.0), sine(15 * DEG, 1.1, 0.2)),
+        yaw=add(sine(90 * DEG, 0.3), sine(20 * DEG, 0.9)),
+        pos=(accel_sine(2.0, 1.0), accel_sine(1.5, 0.8, 1.1), accel_sine(1.0, 1.2, 0.4)))
+
+
+def _translation() -> Trajectory:
+    return Trajectory(
+        roll=sine(5 * DEG, 0.2), pitch=sine(5 * DEG, 0.17, 1.0), yaw=sine(10 * DEG, 0.05),
+        pos=(accel_sine(3.0, 0.5), accel_sine(1.5, 0.35, 1.1), accel_sine(1.0, 0.7, 0.4)))
+
+
+def _waving() -> Trajectory:
+    return Trajectory(
+        roll=add(sine(60 * DEG, 1.0), sine(15 * DEG, 0.21)),
+        pitch=add(sine(45 * DEG, 0.8, 1.0), sine(10 * DEG, 0.17)),
+        yaw=sine(60 * DEG, 0.5),
+        pos=(accel_sine(0.6 * G, 1.2), accel_sine(0.4 * G, 0.9, 1.1),
+             accel_sine(0.3 * G, 1.5, 0.4)))
+
+
+PENDULUM_M = 1.0
+"""The pendulum's length [m]: its swing at the natural 0.5 Hz."""
+
+
+def _pendulum() -> Trajectory:
+    freq = math.sqrt(G / PENDULUM_M) / (2.0 * math.pi)
+    swing = sine(40 * DEG, freq)
+    return Trajectory(roll=swing, pitch=sine(2 * DEG, 0.31 * freq),
+                      pos=(constant(), _pendulum_arm(PENDULUM_M, swing, 1),
+                           _pendulum_arm(PENDULUM_M, swing, 2)))
+
+
+def _vehicle() -> Trajectory:
+    # Accelerating, braking and turning for tens of seconds (0.2-0.3 g), a little body roll and
+    # pitch, road bumps and engine vibration.
+    return Trajectory(
+        roll=add(sine(3 * DEG, 0.07), sine(0.5 * DEG, 1.7)),
+        pitch=add(sine(2 * DEG, 0.05, 1.0), sine(0.5 * DEG, 1.3)),
+        yaw=add(sine(120 * DEG, 0.02), sine(30 * DEG, 0.06)),
+        pos=(accel_sine(0.3 * G, 0.05), accel_sine(0.25 * G, 0.07, 1.1),
+             add(swell(0.2 * G, 3.0, 7.0), accel_sine(0.1 * G, 13.7, 0.3))))
+
+
+def _slow_rotation() -> Trajectory:
+    return Trajectory(roll=sine(40 * DEG, 0.02))
+
+
+def _shaking() -> Trajectory:
+    from fusion_core.scenarios import SCENARIOS
+
+    return SCENARIOS["shaking"].trajectory()
+
+
+def _clipping() -> Trajectory:
+    from fusion_core.scenarios import SCENARIOS
+
+    return SCENARIOS["gyro_clipping"].trajectory()
+
+
+def _disturbed() -> Trajectory:
+    # A sensor on a bench or a tool, knocked and jolted: bursts of 0.5-1.5 g at 4-9 Hz, while it
+    # tilts slowly.
+    return Trajectory(
+        roll=sine(20 * DEG, 0.1), pitch=sine(15 * DEG, 0.13, 1.0), yaw=sine(30 * DEG, 0.04),
+        pos=(swell(1.5 * G, 6.1, 7.0), swell(1.0 * G, 4.3, 11.0, 1.0),
+             swell(0.5 * G, 8.9, 5.0, 2.0)))
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A motion class: its trajectory, how long it runs and how long it rests first."""
+
+    name: str
+    what: str
+    build: Callable[[], Trajectory]
+    duration: float
+    rest: float = REST_S
+    fade: float = 2.0
+    """Seconds over which the motion sets in after the rest (synthetic.after_rest): long where
+    its positions are large, so that fading them in adds little acceleration."""
+
+    def trajectory(self) -> Trajectory:
+        motion = self.build()
+        return after_rest(motion, self.rest, self.fade) if self.rest > 0.0 else motion
+
+
+MOTIONS: dict[str, Motion] = {m.name: m for m in (
+    Motion("handheld_slow", "a hand turning the sensor slowly: 30-40 deg at 0.1-0.4 Hz, "
+           "0.2-0.4 m/s2 of linear acceleration", _handheld_slow, 120.0),
+    Motion("handheld_fast", "a hand turning it fast: 60-70 deg at 0.6-1.3 Hz (to 450 deg/s), "
+           "1-2 m/s2", _handheld_fast, 60.0),
+    Motion("translation", "carried back and forth: 1-3 m/s2 at 0.35-0.7 Hz, tilts of 5 deg",
+           _translation, 120.0),
+    Motion("waving", "hand waving with translation: 60-75 deg at 0.8-1 Hz, 0.3-0.6 g at "
+           "0.9-1.5 Hz", _waving, 60.0),
+    Motion("pendulum", f"a {PENDULUM_M:g} m pendulum swinging 40 deg at its 0.5 Hz: the "
+           "accelerometer reads nearly along the arm", _pendulum, 120.0),
+    Motion("vehicle", "accelerating, braking and turning (0.2-0.3 g for tens of seconds), "
+           "bumps and vibration", _vehicle, 300.0, fade=20.0),
+    Motion("slow_rotation", "a slow roll of 40 deg at 0.02 Hz from power-up, never still",
+           _slow_rotation, 600.0, rest=0.0),
+    Motion("shaking", "shaken by hand: 2.6 g RMS at 2.7-5.2 Hz while it turns 20-40 deg "
+           "(the contract's shaking)", _shaking, 90.0),
+    Motion("clipping", "swings beyond the gyro's range (the contract's gyro_clipping: 2390 "
+           "deg/s peak)", _clipping, 60.0),
+    Motion("disturbed", "knocks and jolts: bursts of 0.5-1.5 g at 4-9 Hz over slow tilts",
+           _disturbed, 120.0),
+)}
+
+
+@dataclass(frozen=True)
+class SensorClass:
+    """A class of sensor: its sample rate and the sensor model's parameters (fusion_core.sensor;
+    each part draws its own errors from them)."""
+
+    name: str
+    what: str
+    rate: float
+    params: dict[str, Any] = field(default_factory=dict)
+
+    def value(self, name: str) -> Any:
+        from fusion_core.sensor import SENSOR_PARAMS
+
+        default = next(p.default for p in SENSOR_PARAMS if p.name == name)
+        return self.params.get(name, default)
+
+
+SENSOR_CLASSES: dict[str, SensorClass] = {s.name: s for s in (
+    SensorClass("better", "a better part at 200 Hz: half the MPU-6050's noise densities and "
+                "a third of its bias instability, gyro scale and cross-axis errors of 0.2 % "
+                "(1 sigma)", 200.0,
+                {"gyro_psd": (0.0025 * DEG) ** 2, "acc_psd": (200e-6 * G) ** 2,
+                 "gyro_bias_instability": 0.001 * DEG, "gyro_scale_std": 0.002,
+                 "gyro_cross_axis_std": 0.002}),
+    SensorClass("mpu6050", "the testbench's realistic MPU-6050 at 100 Hz (its datasheet's "
+                "noise, 1 % scale and 0.67 % cross-axis errors)", 100.0),
+    SensorClass("worse", "a worse part at 50 Hz: three times the MPU-6050's noise densities "
+                "and bias instability, 2 % scale and 1.3 % cross-axis errors, +-1000 deg/s, "
+                "14 bits, 21 Hz low-pass", 50.0,
+                {"gyro_psd": (0.015 * DEG) ** 2, "acc_psd": (1200e-6 * G) ** 2,
+                 "gyro_bias_instability": 0.009 * DEG, "acc_bias_instability": 0.3e-3 * G,
+                 "gyro_scale_std": 0.02, "gyro_cross_axis_std": 0.013,
+                 "gyro_range": 1000.0 * DEG, "bits": 14, "dlpf_cfg": 4}),
+)}
+
+
+def filter_keys() -> list[str]:
+    """The registry's attitude filters (the position filter's attitude is a kf's)."""
+    from fusion_core.registry import REGISTRY
+
+    return [e.key for e in REGISTRY if e.attitude_filter]
+
+
+def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:
+    """Each filter's parameters for a sensor of this class: the recommended values with what
+    follows from its noise and range (presets.noise_preset), one sample's accelerometer noise
+    taken at the class's rate with its quantisation."""
+    from fusion_core.presets import noise_preset
+
+    acc_density = math.sqrt(sensor.value("acc_psd"))
+    lsb = sensor.value("acc_range") / 2.0 ** (int(sensor.value("bits")) - 1)
+    acc_sample_std = math.sqrt(acc_density ** 2 * sensor.rate + lsb ** 2 / 12.0)
+    preset = noise_preset(math.sqrt(sensor.value("gyro_psd")), acc_density, acc_sample_std,
+                          sensor.value("gyro_range"))
+    return {key: preset[key] for key in filter_keys()}
+
+
+def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str]
+              ) -> dict[str, float]:
+    """One part's inclination RMSE [deg] per filter and VQF on one motion."""
+    from fusion_core.registry import create
+    from fusion_core.sensor import ImuSensorModel
+
+    from .broad.metric import gravity_from_roll_pitch, inclination_error
+    from .peers import PEERS
+
+    m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
+    n = round((m.rest + m.duration) * s.rate) + 1
+    t = np.arange(n) / s.rate
+    truth = m.trajectory().truth(t)
+    sample = ImuSensorModel(**{**s.params, "seed": seed}).run(truth["omega"], truth["f"],
+                                                              1.0 / s.rate)
+    true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
+    scored = t >= m.rest + SETTLE_S
+    params = filter_params(s)
+
+    def rmse(up: np.ndarray) -> float:
+        e = inclination_error(up, true_up)[scored]
+        return math.degrees(math.sqrt(float(np.mean(e * e))))
+
+    out = {}
+    for key in filters:
+        o = create(key, params[key]).run(sample["acc"], sample["gyro"], sample["dt"])
+        out[key] = rmse(gravity_from_roll_pitch(o["roll"], o["pitch"]))
+    out["vqf"] = rmse(PEERS["vqf"](sample["acc"], sample["gyro"], s.rate))
+    return out
+
+
+def _cell(motion: str, sensor: str, parts: int, filters: Sequence[str]) -> dict[str, list[float]]:
+    rows = [part_rmse(motion, sensor, seed, filters) for seed in range(parts)]
+    return {key: [r[key] for r in rows] for key in rows[0]}
+
+
+Results = dict[str, dict[str, dict[str, list[float]]]]
+"""motion -> sensor class -> filter (and "vqf") -> inclination RMSE [deg] per part."""
+
+
+def run_battery(motions: Sequence[str], sensors: Sequence[str], parts: int = PARTS,
+                scheduler: str | None = "local", workers: int = 2,
+                progress: Callable[[], None] | None = None) -> Results:
+    """Every motion x sensor class on `parts` parts, each (motion, class) a Dask task on the
+    cluster `scheduler` names (runner.connect), or with None one after the other in this
+    process (the same numbers: every run is seeded)."""
+    filters = filter_keys()
+    out: Results = {m: {} for m in motions}
+    if scheduler is None:
+        for m in motions:
+            for s in sensors:
+                out[m][s] = _cell(m, s, parts, filters)
+                if progress:
+                    progress()
+        return out
+    from dask.distributed import as_completed
+
+    from .montecarlo.runner import connect
+
+    client, cluster = connect(scheduler, workers)
+    try:
+        futures = {client.submit(_cell, m, s, parts, filters, pure=False): (m, s)
+                   for m in motions for s in sensors}
+        for future in as_completed(futures):
+            m, s = futures[future]
+            out[m][s] = future.result()
+            if progress:
+                progress()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return {m: {s: out[m][s] for s in sensors} for m in motions}
+
+
+def stats(values: Sequence[float]) -> tuple[float, float]:
+    """Mean and 95th percentile over the parts."""
+    v = np.asarray(values, dtype=float)
+    return float(np.mean(v)), float(np.percentile(v, 95))
+
+
+def verdicts(cell: dict[str, list[float]]) -> dict[str, Any]:
+    """The issue's aims on one (motion, sensor class): the best filter's mean ahead of VQF's,
+    and kf's and ukf's within 5 % of it."""
+    vqf = stats(cell["vqf"])[0]
+    ours = {k: stats(v)[0] for k, v in cell.items() if k != "vqf"}
+    best = min(ours, key=lambda k: ours[k])
+    return {"best": best, "best_vs_vqf": ours[best] / vqf,
+            "kf_ukf_vs_vqf": max(ours.get("kf", math.nan), ours.get("ukf", math.nan)) / vqf}
+
+
+def motion_table(results: Results, motion: str) -> str:
+    """Markdown: per sensor class each filter's mean / p95 over the parts beside VQF's."""
+    sensors = list(results[motion])
+    keys = list(next(iter(results[motion].values())))
+    head = "| sensor class | " + " | ".join(
+        "VQF" if k == "vqf" else k for k in keys) + " | best / VQF |"
+    rows = [head, "|" + "---|" * (len(keys) + 2)]
+    for s in sensors:
+        cell = results[motion][s]
+        v = verdicts(cell)
+        cells = [f"{stats(cell[k])[0]:.3f} / {stats(cell[k])[1]:.3f}" for k in keys]
+        rows.append(f"| {s} | " + " | ".join(cells) + f" | {v['best']} {v['best_vs_vqf']:.2f} |")
+    return "\n".join(rows)
+
+
+def classes_text() -> str:
+    """Markdown: the sensor classes, one item each."""
+    return "\n".join(f"- **{c.name}**: {c.what}." for c in SENSOR_CLASSES.values())
+
+
+def motion_text(results: Results, motion: str) -> str:
+    """A motion's page body: what it is and its table."""
+    what = MOTIONS[motion].what
+    return f"{what[0].upper()}{what[1:]}.\n\n{motion_table(results, motion)}"
+
+
+def overview_table(results: Results) -> str:
+    """Markdown: per motion and sensor class the best filter's mean against VQF's, and kf's
+    and ukf's worse against VQF's (1.00: level)."""
+    sensors = list(next(iter(results.values())))
+    rows = ["| motion | " + " | ".join(f"{s}: best / VQF | {s}: kf, ukf / VQF"
+                                        for s in sensors) + " |",
+            "|---|" + "---|---|" * len(sensors)]
+    for motion, by_sensor in results.items():
+        cells = []
+        for s in sensors:
+            v = verdicts(by_sensor[s])
+            cells += [f"{v['best']} {v['best_vs_vqf']:.2f}", f"{v['kf_ukf_vs_vqf']:.2f}"]
+        rows.append(f"| [{motion}]({motion}.md) | " + " | ".join(cells) + " |")
+    return "\n".join(rows)
+
+
+def plot(results: Results, path: Path) -> None:
+    """Per sensor class, each motion's best filter and kf/ukf against VQF (ratio of mean
+    inclination RMSE: below 1 is ahead)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    motions = list(results)
+    sensors = list(next(iter(results.values())))
+    fig, axes = plt.subplots(1, len(sensors), sharex=True, sharey=True,
+                             figsize=(3.2 * len(sensors) + 1, 4.8))
+    axes = np.atleast_1d(axes)
+    y = np.arange(len(motions))
+    for ax, s in zip(axes, sensors, strict=True):
+        v = [verdicts(results[m][s]) for m in motions]
+        ax.barh(y - 0.2, [x["best_vs_vqf"] for x in v], 0.4, label="best of ours")
+        ax.barh(y + 0.2, [x["kf_ukf_vs_vqf"] for x in v], 0.4, label="kf, ukf (worse)")
+        ax.axvline(1.0, color="k", lw=0.8)
+        ax.set_title(s)
+        ax.set_xlabel("mean RMSE / VQF's")
+    axes[0].set_yticks(y, motions)
+    axes[0].invert_yaxis()
+    parts = len(next(iter(results[motions[0]].values()))["vqf"])
+    fig.suptitle(f"mean inclination RMSE against VQF's over {parts} parts (below 1: ahead)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8)
+    fig.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    from .options import positive_int
+
+    p = sub.add_parser(
+        "battery", help="every attitude filter beside VQF on a battery of motions x parts of "
+        "three sensor classes", description=__doc__.split("\n\n")[0])
+    p.add_argument("--motion", default="all", help=f"all, or some of {', '.join(MOTIONS)}")
+    p.add_argument("--sensor", default="all",
+                   help=f"all, or some of {', '.join(SENSOR_CLASSES)}")
+    p.add_argument("--parts", type=positive_int, default=PARTS,
+                   help=f"parts (seeds) of each sensor class (default {PARTS})")
+    p.add_argument("--scheduler", default="local",
+                   help="'local' (a LocalCluster, the default) or a Dask scheduler's address")
+    p.add_argument("--workers", type=positive_int, default=2,
+                   help="workers of the LocalCluster (default 2)")
+    p.add_argument("--out", type=Path, default=Path("reports/battery"),
+                   help="where battery.json, battery.md, one page per motion and the plot go")
+    p.add_argument("--no-plots", action="store_true", help="no battery.png")
+    p.set_defaults(func=cmd_battery)
+
+
+def cmd_battery(args: argparse.Namespace) -> int:
+    import json
+
+    from tqdm import tqdm
+
+    from .options import choose
+
+    motions = choose(args.motion, list(MOTIONS), "motion")
+    sensors = choose(args.sensor, list(SENSOR_CLASSES), "sensor class")
+    with tqdm(total=len(motions) * len(sensors), desc="battery", unit="cell",
+              disable=None) as bar:
+        results = run_battery(motions, sensors, args.parts, args.scheduler, args.workers,
+                              lambda: bar.update(1))
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "battery.json").write_text(json.dumps(
+        {"parts": args.parts, "settle_s": SETTLE_S,
+         "motions": {m: MOTIONS[m].what for m in motions},
+         "sensor_classes": {s: {"what": SENSOR_CLASSES[s].what, "rate": SENSOR_CLASSES[s].rate,
+                                "params": SENSOR_CLASSES[s].params,
+                                "filter_params": filter_params(SENSOR_CLASSES[s])}
+                            for s in sensors},
+         "rmse_deg": results}, indent=1))
+    overview = overview_table(results)
+    (args.out / "battery.md").write_text(overview + "\n")
+    for m in motions:
+        (args.out / f"{m}.md").write_text(f"# {m}\n\n{motion_text(results, m)}\n")
+    print(overview)
+    if not args.no_plots:
+        plot(results, args.out / "battery.png")
+        print(f"plot: {args.out / 'battery.png'}")
+    print(f"written: {args.out}/battery.json, battery.md and one page per motion")
+    return 0

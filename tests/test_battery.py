@@ -1,0 +1,104 @@
+"""The battery of motions and parts (testbenches.battery): its motions are the physics they
+say, each filter gets the parameters its sensor's noise gives, and the Dask run gives the
+numbers the in-process run gives."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from fusion_core.presets import noise_preset
+from fusion_core.types import DEG, G
+from testbenches import battery
+from testbenches.battery import MOTIONS, SENSOR_CLASSES
+
+
+def _truth(name: str, rate: float = 200.0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    m = MOTIONS[name]
+    t = np.arange(round((m.rest + min(m.duration, 60.0)) * rate) + 1) / rate
+    return t, m.trajectory().truth(t)
+
+
+def test_the_pendulums_accelerometer_reads_along_its_arm() -> None:
+    """Only the swing's departure from a harmonic one (g (sin a - a), 0.06 g at 40 deg) and
+    the slow pitch sway push the specific force off the arm (the sensor's z axis)."""
+    t, x = _truth("pendulum")
+    moving = t >= MOTIONS["pendulum"].rest + MOTIONS["pendulum"].fade
+    across = np.hypot(x["f"][moving, 0], x["f"][moving, 1])
+    assert across.max() < 0.08 * G
+    assert np.degrees(np.abs(x["roll"][moving])).max() == pytest.approx(40.0, abs=0.5)
+
+
+@pytest.mark.parametrize("name", list(MOTIONS))
+def test_a_motion_rests_and_then_sets_in_without_a_jolt(name: str) -> None:
+    """The rest is still and level; fading the motion in adds no specific force beyond what
+    the motion itself reaches (a fade too short for large positions jolts by several g)."""
+    m = MOTIONS[name]
+    t, x = _truth(name)
+    norm = np.linalg.norm(x["f"], axis=1)
+    rest = t < m.rest
+    assert np.allclose(norm[rest], G) and np.allclose(x["omega"][rest], 0.0)
+    fade = (t >= m.rest) & (t < m.rest + m.fade)
+    after = t >= m.rest + m.fade
+    if fade.any():
+        assert np.abs(norm[fade] - G).max() <= np.abs(norm[after] - G).max() + 0.05 * G
+
+
+def test_the_slow_rotation_turns_from_power_up_and_never_rests() -> None:
+    t, x = _truth("slow_rotation", 100.0)
+    rate = np.linalg.norm(x["omega"], axis=1)
+    assert MOTIONS["slow_rotation"].rest == 0.0
+    assert rate[t > 0.0].min() > 0.0
+    assert np.degrees(rate.max()) == pytest.approx(40.0 * 2 * math.pi * 0.02, rel=1e-3)
+
+
+@pytest.mark.parametrize("name", list(SENSOR_CLASSES))
+def test_each_filter_gets_what_its_sensors_noise_gives(name: str) -> None:
+    c = SENSOR_CLASSES[name]
+    params = battery.filter_params(c)
+    gyro_density = math.sqrt(c.value("gyro_psd"))
+    assert params["kf"]["Q_angle"] == pytest.approx(gyro_density ** 2)
+    assert params["ukf"]["gyro_psd"] == pytest.approx(gyro_density ** 2)
+    for key in battery.filter_keys():
+        assert params[key]["gyro_range"] == c.value("gyro_range")
+    acc_std = params["cf"]["acc_noise"] * G  # one sample's noise at the class's rate
+    density_part = math.sqrt(c.value("acc_psd") * c.rate)
+    assert density_part <= acc_std <= 1.2 * density_part
+    assert noise_preset(gyro_density, math.sqrt(c.value("acc_psd")), acc_std,
+                        c.value("gyro_range"))["mgcf"] == params["mgcf"]
+
+
+def test_the_worse_part_clips_where_the_better_one_does_not() -> None:
+    """The classes' ranges are the sensor model's: on the clipping motion the worse part's
+    gyro sits at its +-1000 deg/s far more often."""
+    from fusion_core.sensor import ImuSensorModel
+
+    _, x = _truth("clipping", 200.0)
+    share = {}
+    for name in ("better", "worse"):
+        c = SENSOR_CLASSES[name]
+        g = ImuSensorModel(**c.params).run(x["omega"], x["f"], 1.0 / 200.0)["gyro"]
+        share[name] = float(np.mean(np.abs(g) >= 0.999 * c.value("gyro_range")))
+    assert share["worse"] > 3 * share["better"]
+    assert SENSOR_CLASSES["worse"].value("gyro_range") == pytest.approx(1000 * DEG)
+
+
+@pytest.mark.heavy
+def test_the_command_on_a_local_cluster_gives_the_in_process_numbers(tmp_path, capsys) -> None:
+    pytest.importorskip("vqf")
+    pytest.importorskip("dask.distributed")
+    from testbenches.cli import main
+
+    status = main(["battery", "--motion", "pendulum,disturbed", "--sensor", "worse", "--parts",
+                   "2", "--out", str(tmp_path), "--no-plots"])
+    assert status == 0
+    got = json.loads((tmp_path / "battery.json").read_text())["rmse_deg"]
+    here = battery.run_battery(["pendulum", "disturbed"], ["worse"], 2, scheduler=None)
+    assert got == here
+    for name in ("pendulum", "disturbed"):
+        page = (tmp_path / f"{name}.md").read_text()
+        assert "| worse |" in page and "VQF" in page
+    assert "[pendulum](pendulum.md)" in capsys.readouterr().out
