@@ -230,6 +230,9 @@ SENSOR_CLASSES: dict[str, SensorClass] = {s.name: s for s in (
                  "gyro_cross_axis_std": 0.002}),
     SensorClass("mpu6050", "the testbench's realistic MPU-6050 at 100 Hz (its datasheet's "
                 "noise, 1 % scale and 0.67 % cross-axis errors)", 100.0),
+    SensorClass("mpu6050_raw", "the same MPU-6050 as delivered, not even its gyro averaged "
+                "at start-up: turn-on biases of its datasheet's tolerances (6.7 deg/s, 17-27 mg, "
+                "1 sigma)", 100.0, {"calibration": "none"}),
     SensorClass("worse", "a worse part at 50 Hz: three times the MPU-6050's noise densities "
                 "and bias instability, 2 % scale and 1.3 % cross-axis errors, +-1000 deg/s, "
                 "14 bits, 21 Hz low-pass", 50.0,
@@ -261,9 +264,11 @@ def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:
     return {key: preset[key] for key in filter_keys()}
 
 
-def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str]
+def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
+              overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True
               ) -> dict[str, float]:
-    """One part's inclination RMSE [deg] per filter and VQF on one motion."""
+    """One part's inclination RMSE [deg] per filter (its parameters with `overrides[key]` over
+    them) and, with vqf, VQF's on one motion."""
     from fusion_core.registry import create
     from fusion_core.sensor import ImuSensorModel
 
@@ -286,14 +291,18 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str]
 
     out = {}
     for key in filters:
-        o = create(key, params[key]).run(sample["acc"], sample["gyro"], sample["dt"])
+        o = create(key, {**params[key], **(overrides or {}).get(key, {})}).run(
+            sample["acc"], sample["gyro"], sample["dt"])
         out[key] = rmse(gravity_from_roll_pitch(o["roll"], o["pitch"]))
-    out["vqf"] = rmse(PEERS["vqf"](sample["acc"], sample["gyro"], s.rate))
+    if vqf:
+        out["vqf"] = rmse(PEERS["vqf"](sample["acc"], sample["gyro"], s.rate))
     return out
 
 
-def _cell(motion: str, sensor: str, parts: int, filters: Sequence[str]) -> dict[str, list[float]]:
-    rows = [part_rmse(motion, sensor, seed, filters) for seed in range(parts)]
+def _cell(motion: str, sensor: str, parts: int, filters: Sequence[str],
+          overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True
+          ) -> dict[str, list[float]]:
+    rows = [part_rmse(motion, sensor, seed, filters, overrides, vqf) for seed in range(parts)]
     return {key: [r[key] for r in rows] for key in rows[0]}
 
 
@@ -307,14 +316,26 @@ def run_battery(motions: Sequence[str], sensors: Sequence[str], parts: int = PAR
     """Every motion x sensor class on `parts` parts, each (motion, class) a Dask task on the
     cluster `scheduler` names (runner.connect), or with None one after the other in this
     process (the same numbers: every run is seeded)."""
-    filters = filter_keys()
-    out: Results = {m: {} for m in motions}
+    variants = run_variants({"": {}}, motions, sensors, parts, scheduler, workers, progress,
+                            filter_keys(), vqf=True)
+    return variants[""]
+
+
+def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequence[str],
+                 sensors: Sequence[str], parts: int = PARTS, scheduler: str | None = "local",
+                 workers: int = 2, progress: Callable[[], None] | None = None,
+                 filters: Sequence[str] | None = None, vqf: bool = False
+                 ) -> dict[str, Results]:
+    """The battery once per variant (name -> filter -> parameter overrides) on one cluster:
+    each (variant, motion, class) a task."""
+    filters = list(filters or filter_keys())
+    cells = [(v, m, s) for v in variants for m in motions for s in sensors]
+    out: dict[str, Results] = {v: {m: {} for m in motions} for v in variants}
     if scheduler is None:
-        for m in motions:
-            for s in sensors:
-                out[m][s] = _cell(m, s, parts, filters)
-                if progress:
-                    progress()
+        for v, m, s in cells:
+            out[v][m][s] = _cell(m, s, parts, filters, variants[v], vqf)
+            if progress:
+                progress()
         return out
     from dask.distributed import as_completed
 
@@ -322,18 +343,18 @@ def run_battery(motions: Sequence[str], sensors: Sequence[str], parts: int = PAR
 
     client, cluster = connect(scheduler, workers)
     try:
-        futures = {client.submit(_cell, m, s, parts, filters, pure=False): (m, s)
-                   for m in motions for s in sensors}
+        futures = {client.submit(_cell, m, s, parts, filters, variants[v], vqf, pure=False):
+                   (v, m, s) for v, m, s in cells}
         for future in as_completed(futures):
-            m, s = futures[future]
-            out[m][s] = future.result()
+            v, m, s = futures[future]
+            out[v][m][s] = future.result()
             if progress:
                 progress()
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
-    return {m: {s: out[m][s] for s in sensors} for m in motions}
+    return {v: {m: {s: out[v][m][s] for s in sensors} for m in motions} for v in variants}
 
 
 def stats(values: Sequence[float]) -> tuple[float, float]:

@@ -20,6 +20,8 @@
               confidence intervals (testbenches.montecarlo).
   battery     every attitude filter beside VQF on a battery of motions x parts of three
               sensor classes (testbenches.battery).
+  mechanisms  what each mechanism of the recommended attitude filters is worth out of sample
+              (BROAD's motion folds and the battery; testbenches.mechanisms).
   budget      the sensor's error budget: each scenario's RMSE with one group of the IMU's
               errors switched off at a time (testbenches.budget).
   calibrate   a part's calibration from a session of static poses and turns: calibration.json
@@ -44,7 +46,7 @@ from fmu_src.cli import add_build_parser
 from .estimate import add_estimate_parser
 
 TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "battery",
-                      "budget", "crosscheck", "calibrate", "engines")
+                      "mechanisms", "budget", "crosscheck", "calibrate", "engines")
 """The commands that need the testbench extra."""
 
 
@@ -70,12 +72,14 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         from .docs_figures import add_docs_parser
         from .engines import add_engines_parser
         from .fit.cli import add_fit_parsers
+        from .mechanisms import add_mechanisms_parser
         from .montecarlo.cli import add_campaign_parser
         from .run_cli import add_run_parser
         from .ssp import add_ssp_parser
 
         for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
-                    add_campaign_parser, add_battery_parser, add_budget_parser,
+                    add_campaign_parser, add_battery_parser, add_mechanisms_parser,
+                    add_budget_parser,
                     add_crosscheck_parser, add_calibrate_parser, add_engines_parser,
                     add_docs_parser):
             add(sub)

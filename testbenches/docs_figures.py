@@ -513,6 +513,23 @@ def _battery_motion(name: str) -> Callable[[dict[str, Path]], str]:
     return make
 
 
+def mechanisms_table(ctx: dict[str, Path]) -> str:
+    from .battery import PARTS
+    from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
+    from .broad.run import collect_paths
+    from .mechanisms import MECHANISMS, battery_worth, broad_worth, worth_table
+
+    from fusion_core.registry import ATTITUDE_FILTERS
+
+    trials = [load_trial(f) for f in collect_paths([ctx["broad"]])]
+    found = find_trials_json([ctx["broad"]])
+    info = load_trials_json(found) if found else None
+    worth = broad_worth(trials, [trial_groups(t.name, info) for t in trials],
+                        list(ATTITUDE_FILTERS), MECHANISMS)
+    battery_worth(worth, PARTS, "local", 2)
+    return worth_table(worth)
+
+
 def _battery_figures() -> tuple[Figure, ...]:
     from .battery import MOTIONS
 
@@ -582,6 +599,8 @@ FIGURES: tuple[Figure, ...] = (
            f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s "
            "--gravity 9.81", calibrate_picture, "docs/calibration_example.png", ("imucal",)),
     *_battery_figures(),
+    Figure("mechanisms-table", "docs/results/mechanisms.md", "imu-fusion mechanisms DIR",
+           mechanisms_table, needs=("broad",)),
 )
 """Every generated figure of the README and the docs."""
 

@@ -37,10 +37,13 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
     return ctx
 
 
-HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenarios")
+HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenarios",
+         *(f.name for f in figs.FIGURES if f.name.startswith("battery-")))
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
-SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "readme-broad")
-"""Figures of 200 parts calibrated first: minutes (`make test-slow`)."""
+SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "readme-broad",
+        "mechanisms-table")
+"""Figures of 200 parts calibrated first, BROAD's trials or the battery ten times: minutes
+(`make test-slow`)."""
 
 
 def _marks(name: str) -> list[pytest.MarkDecorator]:

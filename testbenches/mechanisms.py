@@ -1,0 +1,287 @@
+"""`imu-fusion mechanisms DIR`: what each mechanism of the recommended attitude filters is
+worth on recordings it was not chosen on.
+
+A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the longer vector, the
+scale-error process noise, rest detection and its turn-on rule, the bias gates, the accelerometer
+gate) is switched off by the parameter values that turn it off, everything else at the
+recommended values, and the filter is scored with and without it two ways:
+
+- **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
+  on three folds' trials, by the rule `broad --cv` chooses grid points with (the smallest regret
+  over the training folds), and scored on the fourth fold's; the cross-validated mean is over
+  every trial's error under the decision made without its fold. Keeping or dropping is then the
+  one value chosen by data, and its worth is the cross-validated mean of always dropping it
+  minus that of deciding per fold.
+- **The battery** (testbenches.battery): every motion class x sensor class on PARTS parts, with
+  and without it; the geometric mean over the cells of the ratio of the mean RMSE without to
+  with (above 1: the mechanism helps) and the worst cell.
+
+A mechanism keeps its place where both say it lowers the error; where neither does, it is a
+candidate to drop; otherwise the table says which way each points. The grid values of the other
+parameters were chosen with every mechanism on, which favours keeping: a mechanism that does
+not earn its place even so does not earn it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+TIE = 0.005
+"""Relative differences below this count as level (half a percent of the error)."""
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A mechanism of the recommended filters and the parameter values that switch it off."""
+
+    name: str
+    what: str
+    off: dict[str, float]
+
+    def applies(self, key: str) -> bool:
+        """Whether estimator `key` has it (every parameter that switches it off)."""
+        from fusion_core.registry import ESTIMATORS
+
+        specs = ESTIMATORS[key].param_specs()
+        return all(p in specs for p in self.off)
+
+
+MECHANISMS: tuple[Mechanism, ...] = (
+    Mechanism("prefilter", "the accelerometer pre-filter in a frame turning with the gyro, with "
+              "the adaptive noise and slow band that ride on it (acc_lowpass 0)",
+              {"acc_lowpass": 0.0, "disturbance_time": 0.0}),
+    Mechanism("adaptive_noise", "measurement noise and pre-filter length that follow the "
+              "measured linear acceleration (disturbance_time 0)", {"disturbance_time": 0.0}),
+    Mechanism("longer_vector", "the vector grows where slow linear acceleration reaches it "
+              "(acc_lowpass_stretch 1)", {"acc_lowpass_stretch": 1.0}),
+    Mechanism("scale_noise", "process noise for the gyro's scale error while it turns "
+              "(gyro_scale_std 0)", {"gyro_scale_std": 0.0}),
+    Mechanism("rest", "rest detection and its zero-rate update (rest_time 0)", {"rest_time": 0.0}),
+    Mechanism("turn_on_rest", "before the first rest, a rest may start within the turn-on bias "
+              "bound of the estimate (rest_bias_bound 0: VQF's rule)", {"rest_bias_bound": 0.0}),
+    Mechanism("bias_gate", "no bias learning while linear acceleration reaches the vector "
+              "(bias_gate 0)", {"bias_gate": 0.0}),
+    Mechanism("bias_innovation", "no bias learning from a tilt innovation beyond 10 deg "
+              "(bias_innovation pi)", {"bias_innovation": math.pi}),
+    Mechanism("acc_gate", "no correction from a sample whose norm is outside 0.5-2 g "
+              "(gate_low 1e-6, gate_high 1000)", {"gate_low": 1e-6, "gate_high": 1000.0}),
+)
+"""Every mechanism the recommended attitude filters have on top of their paper's filter that a
+parameter switches off."""
+BY_NAME = {m.name: m for m in MECHANISMS}
+
+
+@dataclass
+class Worth:
+    """One mechanism of one estimator: BROAD with and without, the folds' decisions and the
+    battery's ratio."""
+
+    key: str
+    mechanism: str
+    broad_on: dict[str, float]
+    broad_off: dict[str, float]
+    kept_in: list[str]
+    """The folds whose training trials decided to keep it."""
+    cv_decided: dict[str, float]
+    """trial -> RMSE [deg] under the decision made without its fold."""
+    battery_ratio: float = math.nan
+    """Geometric mean over the battery's cells of mean RMSE without / with."""
+    battery_worst: tuple[str, float] = ("", math.nan)
+    """The cell where dropping it helps most: (motion/class, ratio without / with)."""
+
+    def broad_gain(self) -> float:
+        """Cross-validated mean of always dropping it minus that of deciding per fold [deg]."""
+        return float(np.mean(list(self.broad_off.values()))
+                     - np.mean(list(self.cv_decided.values())))
+
+    def verdict(self) -> str:
+        broad = self.broad_gain() / float(np.mean(list(self.broad_off.values())))
+        says = {"BROAD": "keep" if broad > TIE else ("drop" if broad < -TIE else "level")}
+        if math.isfinite(self.battery_ratio):
+            r = self.battery_ratio - 1.0
+            says["battery"] = "keep" if r > TIE else ("drop" if r < -TIE else "level")
+        votes = set(says.values())
+        if votes == {"keep"} or votes == {"keep", "level"}:
+            return "keeps its place"
+        if "keep" not in votes:
+            return "drop: no gain out of sample"
+        return "mixed: " + ", ".join(f"{k} {v}" for k, v in says.items())
+
+
+def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
+           training: Sequence[str]) -> bool:
+    """Whether the training folds keep the mechanism: the smaller regret (each training fold's
+    mean RMSE over the better of the two on it, the worst fold's), ties to the lower training
+    mean, and a level outcome to dropping it (the simpler filter)."""
+    def fold_mean(values: dict[str, float], fold: str) -> float:
+        return float(np.mean([v for t, v in values.items() if folds[t] == fold]))
+
+    regret = {}
+    for name, values in (("on", on), ("off", off)):
+        regret[name] = max(fold_mean(values, f) / min(fold_mean(on, f), fold_mean(off, f))
+                           for f in training)
+    if abs(regret["on"] - regret["off"]) > 1e-12:
+        return regret["on"] < regret["off"]
+    mean_on = np.mean([v for t, v in on.items() if folds[t] in training])
+    mean_off = np.mean([v for t, v in off.items() if folds[t] in training])
+    return bool(mean_on < mean_off)
+
+
+def broad_worth(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimators: Sequence[str],
+                mechanisms: Sequence[Mechanism] = MECHANISMS,
+                progress: Callable[[], None] | None = None) -> dict[tuple[str, str], Worth]:
+    """Each (estimator, mechanism it has): its BROAD errors with and without and the folds'
+    decisions."""
+    from .broad.cv import FOLDS, _rmse, fold_of
+    from .broad.run import run_fusion_core
+
+    folds = {t.name: fold_of(g) for t, g in zip(trials, groups, strict=True)}
+    present = [f for f in FOLDS if f in folds.values()]
+    if len(present) < 2:
+        raise ValueError("the mechanisms' cross-validation needs trials of at least two motion "
+                         f"folds ({', '.join(FOLDS)})")
+
+    def errors(key: str, params: dict[str, float]) -> dict[str, float]:
+        out = {}
+        for trial in trials:
+            r = run_fusion_core(key, params, trial)
+            out[trial.name] = _rmse(trial, r["roll"], r["pitch"])
+            if progress:
+                progress()
+        return out
+
+    worth = {}
+    for key in estimators:
+        on = errors(key, {})
+        for m in mechanisms:
+            if not m.applies(key):
+                continue
+            off = errors(key, m.off)
+            kept, decided = [], {}
+            for fold in present:
+                keep = decide(on, off, folds, [f for f in present if f != fold])
+                kept += [fold] if keep else []
+                decided.update({t: (on if keep else off)[t] for t in on if folds[t] == fold})
+            worth[(key, m.name)] = Worth(key, m.name, on, off, kept, decided)
+    return worth
+
+
+def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: str | None,
+                  workers: int, progress: Callable[[], None] | None = None) -> None:
+    """Fill each Worth's battery ratio: the battery with every filter at its defaults and once
+    per mechanism with it switched off in the filters that have it."""
+    from .battery import MOTIONS, SENSOR_CLASSES, run_variants, stats
+
+    keys = sorted({k for k, _ in worth}, key=list(dict.fromkeys(k for k, _ in worth)).index)
+    names = list(dict.fromkeys(m for _, m in worth))
+    variants: dict[str, dict[str, dict[str, Any]]] = {"": {}}
+    for name in names:
+        variants[name] = {k: BY_NAME[name].off for k in keys if (k, name) in worth}
+    results = run_variants(variants, list(MOTIONS), list(SENSOR_CLASSES), parts, scheduler,
+                           workers, progress, keys)
+    for (key, name), w in worth.items():
+        ratios = {}
+        for motion in MOTIONS:
+            for sensor in SENSOR_CLASSES:
+                on = stats(results[""][motion][sensor][key])[0]
+                off = stats(results[name][motion][sensor][key])[0]
+                ratios[f"{motion}/{sensor}"] = off / on
+        w.battery_ratio = float(np.exp(np.mean(np.log(list(ratios.values())))))
+        cell = min(ratios, key=lambda c: ratios[c])
+        w.battery_worst = (cell, ratios[cell])
+
+
+def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
+    """Markdown: per estimator and mechanism, BROAD's means with and without, the folds that
+    keep it, the cross-validated gain, the battery's ratio and the verdict."""
+    rows = ["| estimator | mechanism | BROAD with | without | folds keeping it | CV gain [deg] "
+            "| battery without / with | worst cell | verdict |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for (key, name), w in worth.items():
+        worst = (f"{w.battery_worst[0]} {w.battery_worst[1]:.2f}"
+                 if math.isfinite(w.battery_worst[1]) else "-")
+        ratio = f"{w.battery_ratio:.3f}" if math.isfinite(w.battery_ratio) else "-"
+        rows.append(
+            f"| {key} | {name} | {np.mean(list(w.broad_on.values())):.3f} | "
+            f"{np.mean(list(w.broad_off.values())):.3f} | {len(w.kept_in)} of 4 | "
+            f"{w.broad_gain():+.3f} | {ratio} | {worst} | {w.verdict()} |")
+    return "\n".join(rows)
+
+
+def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    from .options import positive_int
+
+    p = sub.add_parser(
+        "mechanisms", help="what each mechanism of the recommended attitude filters is worth "
+        "out of sample: BROAD's folds and the battery", description=__doc__.split("\n\n")[0])
+    p.add_argument("paths", nargs="+", type=Path, help="BROAD trial files or folders")
+    p.add_argument("--estimator", default="all", help="all, or some of cf, mgcf, kf, ukf")
+    p.add_argument("--mechanism", default="all",
+                   help=f"all, or some of {', '.join(m.name for m in MECHANISMS)}")
+    p.add_argument("--parts", type=int, default=None,
+                   help="parts of each sensor class in the battery (default: the battery's; "
+                   "0 leaves the battery out)")
+    p.add_argument("--trials-json", type=Path, default=None,
+                   help="BROAD's trials.json (default: beside the files)")
+    p.add_argument("--scheduler", default="local",
+                   help="'local' (a LocalCluster, the default) or a Dask scheduler's address")
+    p.add_argument("--workers", type=positive_int, default=2,
+                   help="workers of the LocalCluster (default 2)")
+    p.add_argument("--out", type=Path, default=Path("reports/mechanisms"),
+                   help="where mechanisms.json and mechanisms.md go")
+    p.set_defaults(func=cmd_mechanisms)
+
+
+def cmd_mechanisms(args: argparse.Namespace) -> int:
+    import json
+
+    from tqdm import tqdm
+
+    from fusion_core.registry import ATTITUDE_FILTERS
+
+    from .battery import PARTS
+    from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
+    from .broad.run import collect_paths
+    from .options import choose
+
+    keys = choose(args.estimator, list(ATTITUDE_FILTERS), "estimator")
+    chosen = [BY_NAME[n] for n in choose(args.mechanism, list(BY_NAME), "mechanism")]
+    parts = PARTS if args.parts is None else args.parts
+    files = collect_paths(args.paths)
+    if not files:
+        raise ValueError(f"no trial files in {', '.join(map(str, args.paths))}")
+    trials = [load_trial(f) for f in files]
+    found = args.trials_json or find_trials_json(args.paths)
+    info = load_trials_json(found) if found else None
+    groups = [trial_groups(t.name, info) for t in trials]
+    runs = sum(len(trials) * (1 + sum(m.applies(k) for m in chosen)) for k in keys)
+    with tqdm(total=runs, desc="BROAD", unit="run", disable=None) as bar:
+        worth = broad_worth(trials, groups, keys, chosen, lambda: bar.update(1))
+    if parts > 0:
+        from .battery import MOTIONS, SENSOR_CLASSES
+
+        cells = (1 + len({m for _, m in worth})) * len(MOTIONS) * len(SENSOR_CLASSES)
+        with tqdm(total=cells, desc="battery", unit="cell", disable=None) as bar:
+            battery_worth(worth, parts, args.scheduler, args.workers, lambda: bar.update(1))
+    table = worth_table(worth)
+    print(table)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "mechanisms.md").write_text(table + "\n")
+    (args.out / "mechanisms.json").write_text(json.dumps({
+        "parts": parts, "tie": TIE,
+        "mechanisms": {m.name: {"what": m.what, "off": m.off} for m in chosen},
+        "worth": [{"estimator": w.key, "mechanism": w.mechanism, "broad_on_deg": w.broad_on,
+                   "broad_off_deg": w.broad_off, "folds_keeping": w.kept_in,
+                   "cv_decided_deg": w.cv_decided, "cv_gain_deg": w.broad_gain(),
+                   "battery_off_over_on": w.battery_ratio,
+                   "battery_worst_cell": list(w.battery_worst), "verdict": w.verdict()}
+                  for w in worth.values()]}, indent=1))
+    print(f"written: {args.out}/mechanisms.md, mechanisms.json")
+    return 0

@@ -1,0 +1,84 @@
+"""What each mechanism is worth (testbenches.mechanisms): the switches are real parameter
+values of the filters, the keep-or-drop decision follows the training folds only, and the
+command runs end to end on two BROAD slices."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from fusion_core.registry import ATTITUDE_FILTERS, ESTIMATORS, create
+from testbenches.mechanisms import MECHANISMS, Worth, decide
+
+DATA = Path(os.environ.get("BROAD_DIR",
+                           Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"))
+TRIALS = (DATA / "10_undisturbed_slow_translation_A.hdf5",
+          DATA / "01_undisturbed_slow_rotation_A.mat")
+
+
+@pytest.mark.parametrize("mechanism", MECHANISMS, ids=lambda m: m.name)
+def test_each_switch_is_a_change_the_filters_that_have_it_accept(mechanism) -> None:
+    owners = [k for k in ATTITUDE_FILTERS if mechanism.applies(k)]
+    assert owners, f"{mechanism.name} belongs to no attitude filter"
+    for key in owners:
+        specs = ESTIMATORS[key].param_specs()
+        assert any(specs[p].default != v for p, v in mechanism.off.items())
+        create(key, dict(mechanism.off))  # a valid parameter set
+
+
+FOLDS = {"a1": "slow", "a2": "slow", "b1": "fast", "c1": "trans", "d1": "dist"}
+
+
+def test_the_training_folds_decide_and_the_held_out_one_does_not() -> None:
+    on = {"a1": 1.0, "a2": 1.0, "b1": 1.0, "c1": 1.0, "d1": 5.0}
+    off = {"a1": 2.0, "a2": 2.0, "b1": 2.0, "c1": 2.0, "d1": 1.0}
+    # with the disturbed fold held out, every training fold is better with it
+    assert decide(on, off, FOLDS, ["slow", "fast", "trans"])
+    # with it in training, its regret (5x) outweighs the others' (2x)
+    assert not decide(on, off, FOLDS, ["slow", "fast", "dist"])
+
+
+def test_a_level_outcome_drops_the_mechanism() -> None:
+    same = {t: 1.0 for t in FOLDS}
+    assert not decide(same, dict(same), FOLDS, ["slow", "fast", "trans", "dist"])
+
+
+def test_the_verdict_needs_both_ways_of_scoring() -> None:
+    on, off = {"a1": 1.0, "b1": 1.0}, {"a1": 2.0, "b1": 2.0}
+    w = Worth("kf", "rest", on, off, ["slow", "fast"], dict(on), battery_ratio=1.2)
+    assert w.broad_gain() == pytest.approx(1.0) and w.verdict() == "keeps its place"
+    w.battery_ratio = 0.9
+    assert w.verdict().startswith("mixed: BROAD keep, battery drop")
+    level = Worth("kf", "acc_gate", on, dict(on), [], dict(on), battery_ratio=1.001)
+    assert level.verdict().startswith("drop")
+
+
+@pytest.mark.skipif(not all(p.is_file() for p in TRIALS),
+                    reason=f"no BROAD trials in {DATA} (set BROAD_DIR)")
+def test_the_command_on_two_slices(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("h5py")
+    from testbenches.broad.data import load_trial
+    from testbenches.cli import main
+
+    import h5py
+
+    files = []
+    for source in TRIALS:
+        trial = load_trial(source).head(45.0)
+        path = tmp_path / f"{trial.name}.hdf5"
+        with h5py.File(path, "w") as f:
+            f["imu_acc"], f["imu_gyr"] = trial.acc, trial.gyro
+            f["opt_quat"], f["movement"] = trial.opt_quat, trial.movement
+            f.attrs["sampling_rate"] = trial.rate
+        files.append(str(path))
+    out = tmp_path / "m"
+    assert main(["mechanisms", *files, "--estimator", "kf", "--mechanism", "prefilter,rest",
+                 "--parts", "0", "--out", str(out)]) == 0
+    report = json.loads((out / "mechanisms.json").read_text())
+    prefilter = next(w for w in report["worth"] if w["mechanism"] == "prefilter")
+    assert set(prefilter["folds_keeping"]) == {"slow_rotation", "translation"}
+    assert prefilter["cv_gain_deg"] > 0.0
+    assert "| kf | prefilter |" in capsys.readouterr().out
