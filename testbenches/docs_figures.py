@@ -514,12 +514,12 @@ def _battery_motion(name: str) -> Callable[[dict[str, Path]], str]:
 
 
 def mechanisms_table(ctx: dict[str, Path]) -> str:
+    from fusion_core.registry import ATTITUDE_FILTERS
+
     from .battery import PARTS
     from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
     from .broad.run import collect_paths
     from .mechanisms import MECHANISMS, battery_worth, broad_worth, worth_table
-
-    from fusion_core.registry import ATTITUDE_FILTERS
 
     trials = [load_trial(f) for f in collect_paths([ctx["broad"]])]
     found = find_trials_json([ctx["broad"]])

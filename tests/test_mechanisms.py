@@ -60,10 +60,10 @@ def test_the_verdict_needs_both_ways_of_scoring() -> None:
                     reason=f"no BROAD trials in {DATA} (set BROAD_DIR)")
 def test_the_command_on_two_slices(tmp_path: Path, capsys) -> None:
     pytest.importorskip("h5py")
+    import h5py
+
     from testbenches.broad.data import load_trial
     from testbenches.cli import main
-
-    import h5py
 
     files = []
     for source in TRIALS:
