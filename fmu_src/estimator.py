@@ -20,7 +20,6 @@ from collections.abc import Mapping
 from functools import partial
 from operator import itemgetter
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, ClassVar
 
 from fusion_core import G, InvalidSample
@@ -39,34 +38,6 @@ from .variables import (
 )
 
 AXES = ("x", "y", "z")
-NO_BIAS_STATE = "always 0: this filter has no gyro-bias state"
-"""zero_bias reason for a filter without any bias state."""
-Z_BIAS_REST_ONLY = (
-    "while z is the axis nearest to up, a bias about it does not change the accelerometer's "
-    "tilt, so only the zero-rate update at rest (rest_time > 0, the default) observes it: 0 "
-    "until the sensor has rested or lain on another face (tilt_axes='nearest_face', the "
-    "default), and 0 throughout with neither"
-)
-"""zero_bias reason for bias_z of the [angle, bias] Kalman filter (and of the position filter,
-whose attitude is that filter's)."""
-NO_BIAS_OUTPUTS: Mapping[str, str] = MappingProxyType({f"bias_{a}": NO_BIAS_STATE for a in AXES})
-"""zero_bias of a filter without a bias state: all three bias outputs are 0."""
-Z_BIAS_AT_REST_ONLY: Mapping[str, str] = MappingProxyType({"bias_z": Z_BIAS_REST_ONLY})
-"""zero_bias of the per-axis [angle, bias] Kalman filters: bias_z can stay 0."""
-NO_Z_BIAS: Mapping[str, str] = MappingProxyType({
-    "bias_z": "always 0: the papers' filter has no bias state about z, which no accelerometer "
-              "tilt observes"})
-"""zero_bias of the papers' per-axis [angle, bias] Kalman filter (and of their position filter,
-whose attitude is that filter's)."""
-ZERO_BIAS: Mapping[str, Mapping[str, str]] = MappingProxyType({
-    "AngleBiasKalmanFilter": Z_BIAS_AT_REST_ONLY,
-    "PositionKalmanFilter": Z_BIAS_AT_REST_ONLY,
-    "PaperComplementaryFilter": NO_BIAS_OUTPUTS,
-    "PaperKalmanFilter": NO_Z_BIAS,
-    "PaperPositionKalmanFilter": NO_Z_BIAS,
-})
-"""The bias outputs each estimator class leaves at 0 whatever it is given, with the reason, for
-their descriptions (by class name; a class not named here estimates all three)."""
 PAPER_NOTE = (" Built with the preset 'paper': the paper's own filter at its values "
               "(fusion_core.papers.{name}).")
 """What a paper's filter adds to its FMU's description."""
@@ -93,7 +64,7 @@ def estimator_table(key: str, entry: Mapping[str, Any]
     starts = {k: v for k, v in entry.items() if k != FILTER}
     table = variable_table(
         f"{cls.__name__} {json.dumps(starts, sort_keys=True)}",
-        partial(estimator_variables, cls, ZERO_BIAS.get(cls.__name__), starts))
+        partial(estimator_variables, cls, cls.ZERO_BIAS or None, starts))
     return cls, table
 
 

@@ -169,6 +169,9 @@ class Estimator:
     """The C twin's prefix (fusion_core/native: fc_cf for fc_cf_step, fc_cf_run, ...) where this
     exact class has one; a subclass, which may change the Python methods, has none of its own."""
     HAS_POSITION: ClassVar[bool] = False
+    ZERO_BIAS: ClassVar[dict[str, str]] = {}
+    """The bias outputs this filter leaves at 0 whatever it is given, each with the reason (its
+    FMU's variable descriptions say it); the others are estimated."""
     COMMON: ClassVar[tuple[Param, ...]] = COMMON_PARAMS
     """The parameters every estimator shares (a paper's reference filter, which knows no gyro
     range, leaves gyro_range out: fusion_core.papers)."""

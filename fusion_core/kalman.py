@@ -115,6 +115,16 @@ def measured_axis(P: tuple[float, float, float, float], var: float, age: float
     return (var + P11 * age * age, c, c, P11)
 
 
+Z_BIAS_REST_ONLY: Final = (
+    "while z is the axis nearest to up, a bias about it does not change the accelerometer's "
+    "tilt, so only the zero-rate update at rest (rest_time > 0, the default) observes it: 0 "
+    "until the sensor has rested or lain on another face (tilt_axes='nearest_face', the "
+    "default), and 0 throughout with neither"
+)
+"""Why bias_z of the [angle, bias] Kalman filter (and of the position filter, whose attitude is
+that filter's) can stay 0 (Estimator.ZERO_BIAS)."""
+
+
 class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     """The recommended 2-state [angle, gyro bias] Kalman filter for roll and for pitch.
 
@@ -222,6 +232,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         KALMAN_MAX_CORRECTION_TIME,
     )
     TWIN: ClassVar[str | None] = "fc_kf"
+    ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": Z_BIAS_REST_ONLY}
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "bias_x": REAL, "bias_y": REAL, "P_roll": COV,
         "P_pitch": COV, "bias_z": REAL, "P_z": NONNEG, "meas": MEASURE_CHECK, "rest": REST,

@@ -13,7 +13,7 @@ from typing import Any, ClassVar, Final
 
 from .base import ESTIMATE, Estimator, tuple_new
 from .building_blocks import GYRO_SAMPLING_PARAM, zero_rate_psd_param
-from .kalman import AngleBiasKalmanFilter
+from .kalman import Z_BIAS_REST_ONLY, AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, roll_pitch_sines, wrap_angle
 from .papers.kalman import PAPER_KF_PARAMS, PaperKalmanFilter
 from .papers.position import (
@@ -135,6 +135,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         *TILT_PARAMS,
     )
     TWIN: ClassVar[str | None] = "fc_poskf"
+    ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": Z_BIAS_REST_ONLY}
     STATE: ClassVar[StateSpec] = {
         "yaw": ANGLE, "states": REAL, "P": COV, "quiet_time": NONNEG, "stationary": FLAG,
         "pending": Queue(Segments(((NONNEG, 1), (REAL, 4))), 5, PENDING_MAX), "turned": REAL,

@@ -49,6 +49,8 @@ class PaperComplementaryFilter(Estimator):
     PARAMS = (TAU_PARAM, *PAPER_GATE, PAPER_SAMPLING)
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_cf"
+    ZERO_BIAS: ClassVar[dict[str, str]] = {
+        f"bias_{a}": "always 0: this filter has no gyro-bias state" for a in "xyz"}
     STATE: ClassVar[StateSpec] = {"roll": ANGLE, "pitch": HALF_ANGLE}
 
     def _configure(self) -> None:

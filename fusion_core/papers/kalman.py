@@ -170,6 +170,12 @@ class RollPitchAxes:
         )
 
 
+NO_Z_BIAS: Final = ("always 0: the papers' filter has no bias state about z, which no "
+                    "accelerometer tilt observes")
+"""Why bias_z of the papers' per-axis Kalman filter (and of their position filter, whose
+attitude is that filter's) is 0 (Estimator.ZERO_BIAS)."""
+
+
 class PaperKalmanFilter(RollPitchAxes, Estimator):
     """Gui et al. eq. 5-26 / Das & Mary eq. 16-27: a 2-state [angle, bias] Kalman filter for
     roll and one for pitch, as the papers write it.
@@ -193,6 +199,7 @@ class PaperKalmanFilter(RollPitchAxes, Estimator):
     PARAMS = PAPER_KF_PARAMS
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_kf"
+    ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": NO_Z_BIAS}
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "bias_x": REAL, "bias_y": REAL, "P_roll": COV,
         "P_pitch": COV,

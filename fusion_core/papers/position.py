@@ -28,7 +28,7 @@ from ..kinematics import PI, roll_pitch_sines, wrap_angle
 from ..state import ANGLE, COV, NESTED, REAL, StateSpec
 from ..types import MPU6050_ACC_DENSITY, Estimate, G, Param
 from .common import PAPER_COMMON, Vec3
-from .kalman import PAPER_KF_PARAMS, PaperKalmanFilter
+from .kalman import NO_Z_BIAS, PAPER_KF_PARAMS, PaperKalmanFilter
 
 Sym3 = tuple[float, float, float, float, float, float]
 """A symmetric 3x3 matrix as its upper triangle (m00, m01, m02, m11, m12, m22)."""
@@ -232,6 +232,7 @@ class PaperPositionKalmanFilter(AxisFiltersState, Estimator):
     )
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_poskf"
+    ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": NO_Z_BIAS}
     STATE: ClassVar[StateSpec] = {"yaw": ANGLE, "states": REAL, "P": COV, "tilt_state": NESTED}
 
     def _configure(self) -> None:
