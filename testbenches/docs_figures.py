@@ -446,6 +446,112 @@ def readme_broad(ctx: dict[str, Path]) -> str:
             "--peers --cv`;\n  [docs/results/broad.md](docs/results/broad.md)).")
 
 
+BROAD_ALL = ["--estimator", "all", "--preset", "all", "--peers", "--cv"]
+"""results/broad.md's command: every estimator with both presets, the peers and the
+cross-validation on the 13 shared trials."""
+
+
+@functools.lru_cache(maxsize=1)
+def _broad_all(data: str) -> tuple[str, dict[str, Any]]:
+    """What `imu-fusion broad DATA` with BROAD_ALL prints, and its report.json."""
+    import json
+
+    with tempfile.TemporaryDirectory() as tmp:
+        printed = _captured(["broad", data, *BROAD_ALL, "--no-plots", "--out", tmp], REPO)
+        return printed, json.loads(Path(tmp, "report.json").read_text())
+
+
+def _between(text: str, first: str, stop: str | None) -> str:
+    """The lines of text from the one starting with `first` to the one before the first after
+    it starting with `stop` (None: to the end), trailing blank lines left out."""
+    lines = text.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(first))
+    end = next((i for i in range(start + 1, len(lines))
+                if stop is not None and lines[i].startswith(stop)), len(lines))
+    return "\n".join(lines[start:end]).rstrip()
+
+
+def broad_groups(ctx: dict[str, Path]) -> str:
+    """report.json's means of `imu-fusion broad` with BROAD_ALL: every estimator with both
+    presets and the peers, mean inclination RMSE over all trials and per BROAD group."""
+    report = _broad_all(str(ctx["broad"]))[1]
+    means = report["mean_inclination_rmse_deg"]
+    names = list(means)
+    rows = ["| group (trials) | " + " | ".join(names) + " |", "|---|" + "---|" * len(names),
+            f"| all ({report['trial_count']}) | "
+            + " | ".join(f"{means[n]:.3f}" for n in names) + " |"]
+    for group, g in report["groups"].items():
+        m = g["mean_inclination_rmse_deg"]
+        rows.append(f"| {group} ({len(g['trials'])}) | "
+                    + " | ".join(f"{m[n]:.3f}" if m[n] is not None else "-" for n in names)
+                    + " |")
+    return "\n".join(rows)
+
+
+def broad_cv(ctx: dict[str, Path]) -> str:
+    """The cross-validation table and each fold's choice, as `broad --cv` prints them."""
+    printed = _broad_all(str(ctx["broad"]))[0]
+    return "```\n" + _between(printed, "estimator  figure", None) + "\n```"
+
+
+def moderate_presets_table(ctx: dict[str, Path]) -> str:
+    """Roll/pitch RMSE of every estimator on moderate_dynamics (seed 0) with both presets on
+    both sensors, and the paper's Table 1 rows: the C twins of the plant, the sensor and the
+    estimators, which give the FMUs' numbers to the bit."""
+    from fusion_core.presets import load_preset
+    from fusion_core.registry import KEYS
+    from fusion_core.sensor import sensor_preset
+
+    from .contract import PAPER_MODERATE, compute_metrics
+    from .montecarlo.plan import Run
+    from .montecarlo.simulate import simulate
+
+    rows = ["| preset / sensor | " + " | ".join(KEYS) + " |", "|---|" + "---|" * len(KEYS)]
+    for preset in ("recommended", "paper"):
+        params = load_preset(preset)
+        for sensor in ("realistic", "ideal"):
+            cells = []
+            for key in KEYS:
+                m = compute_metrics(simulate(Run("doc", key, "moderate_dynamics", 0, None,
+                                                 sensor_preset(sensor), params[key], {})))
+                cells.append(f"{m['rmse_roll_deg']:.2f}/{m['rmse_pitch_deg']:.2f}")
+            rows.append(f"| {preset} / {sensor} | " + " | ".join(cells) + " |")
+    held = {"cf": " (CCF)", "kf": " (CCF)", "poskf": ""}
+    rows.append("| Duong Quoc et al. Table 1 | " + " | ".join(
+        f"{PAPER_MODERATE[k][0]:.2f}/{PAPER_MODERATE[k][1]:.2f}{held.get(k, '')}"
+        for k in KEYS) + " |")
+    return "\n".join(rows)
+
+
+SCALE_CLASSES = ((0.01, 0.02 / 3.0), (0.005, 0.0033), (0.0025, 0.0025), (0.001, 0.001))
+"""results/broad.md's gyro scale and cross-axis classes (1 sigma): the realistic sensor's, and
+calibrated gyros."""
+
+
+def scale_parts_table(ctx: dict[str, Path]) -> str:
+    """The UKF and VQF over 40 parts of each gyro scale class on moderate_dynamics: seed 0, the
+    mean, the median and the share within half the paper's row."""
+    from .parts import part_rmse, share_within, vqf_rmse
+
+    parts, half = 40, _half_row("ukf")
+    rows = ["| gyro scale / cross-axis (1 sigma) | UKF seed 0 | UKF mean | UKF median | UKF "
+            "within half its row | VQF mean | VQF within |", "|---|---|---|---|---|---|---|"]
+    for scale, cross in SCALE_CLASSES:
+        sensor = {"gyro_scale_std": scale, "gyro_cross_axis_std": cross}
+        ukf = part_rmse(["ukf"], ["moderate_dynamics"], {}, sensor, parts,
+                        calibrated_first=(False,))[(False, "ukf", "moderate_dynamics")]
+        vqf = vqf_rmse("moderate_dynamics", sensor, parts)
+        name = f"{100 * scale:g} % / {100 * cross:.2g} %"
+        rows.append(
+            f"| {name} | {ukf[0, 0]:.2f}/{ukf[0, 1]:.2f} | "
+            f"{ukf[:, 0].mean():.2f}/{ukf[:, 1].mean():.2f} | "
+            f"{np.median(ukf[:, 0]):.2f}/{np.median(ukf[:, 1]):.2f} | "
+            f"{100 * share_within(ukf, half):.0f} % | "
+            f"{vqf[:, 0].mean():.2f}/{vqf[:, 1].mean():.2f} | "
+            f"{100 * share_within(vqf, half):.0f} % |")
+    return "\n".join(rows)
+
+
 def embedded_table(ctx: dict[str, Path]) -> str:
     """`make embedded`'s table: each twin on the Cortex-M7 (double) and the Cortex-M4F (float)
     under QEMU, on moderate_dynamics through the realistic sensor (BROAD_DIR unset)."""
@@ -504,6 +610,25 @@ def battery_picture(ctx: dict[str, Path], path: Path) -> None:
     plot(_battery(), path)
 
 
+def readme_battery(ctx: dict[str, Path]) -> str:
+    """The README's battery line: in how many cells (motion class x sensor class) the best of
+    ours and kf, ukf are ahead of VQF, and where they are furthest behind."""
+    from .battery import PARTS, verdicts
+
+    results = _battery()
+    cells = {(m, s): verdicts(c) for m, by in results.items() for s, c in by.items()}
+    ahead = sum(v["best_vs_vqf"] < 1.0 for v in cells.values())
+    level = sum(v["kf_ukf_vs_vqf"] <= 1.05 for v in cells.values())
+    worst = max(cells, key=lambda k: cells[k]["kf_ukf_vs_vqf"])
+    sensors = len(next(iter(results.values())))
+    return (f"- **A battery of motions and parts**: {len(results)} motion classes x {sensors} "
+            f"sensor classes x {PARTS} parts\n  beside VQF on the same samples: the best of ours "
+            f"ahead of VQF in {ahead} of {len(cells)} cells,\n  kf and ukf within 5 % of it or "
+            f"ahead in {level}; furthest behind on {worst[0]} / {worst[1]}\n  "
+            f"({cells[worst]['kf_ukf_vs_vqf']:.2f} times VQF's RMSE) (`imu-fusion battery`; "
+            "[docs/results/battery](docs/results/battery/index.md)).")
+
+
 def _battery_motion(name: str) -> Callable[[dict[str, Path]], str]:
     def make(ctx: dict[str, Path]) -> str:
         from .battery import motion_text
@@ -519,13 +644,20 @@ def mechanisms_table(ctx: dict[str, Path]) -> str:
     from .battery import PARTS
     from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
     from .broad.run import collect_paths
-    from .mechanisms import MECHANISMS, battery_worth, broad_worth, worth_table
+    from .mechanisms import (
+        MECHANISMS,
+        battery_worth,
+        broad_worth,
+        contract_worth,
+        worth_table,
+    )
 
     trials = [load_trial(f) for f in collect_paths([ctx["broad"]])]
     found = find_trials_json([ctx["broad"]])
     info = load_trials_json(found) if found else None
     worth = broad_worth(trials, [trial_groups(t.name, info) for t in trials],
                         list(ATTITUDE_FILTERS), MECHANISMS)
+    contract_worth(worth, PARTS)
     battery_worth(worth, PARTS, "local", 2)
     return worth_table(worth)
 
@@ -537,6 +669,7 @@ def _battery_figures() -> tuple[Figure, ...]:
     return (
         Figure("battery-classes", "docs/results/battery/index.md", command,
                lambda ctx: battery_classes()),
+        Figure("readme-battery", "README.md", command, readme_battery, needs=("vqf",)),
         Figure("battery-overview", "docs/results/battery/index.md", command, battery_overview,
                needs=("vqf",)),
         Figure("battery-picture", "docs/results/battery/index.md", command, battery_picture,
@@ -599,6 +732,16 @@ FIGURES: tuple[Figure, ...] = (
            f"imu-fusion calibrate {IMUCAL_SESSION} --rate 102.4 --gyro-unit deg/s "
            "--gravity 9.81", calibrate_picture, "docs/calibration_example.png", ("imucal",)),
     *_battery_figures(),
+    Figure("broad-groups", "docs/results/broad.md",
+           "imu-fusion broad DIR " + " ".join(BROAD_ALL), broad_groups, needs=("broad", "vqf")),
+    Figure("broad-cv", "docs/results/broad.md", "imu-fusion broad DIR " + " ".join(BROAD_ALL),
+           broad_cv, needs=("broad", "vqf")),
+    Figure("broad-moderate", "docs/results/broad.md",
+           "imu-fusion run --scenario moderate_dynamics --no-contract --preset PRESET --sensor "
+           "SENSOR", moderate_presets_table),
+    Figure("broad-scale-parts", "docs/results/broad.md",
+           "imu-fusion run --estimator ukf --scenario moderate_dynamics --seeds 40 --sensor "
+           "SENSOR.json --peers vqf --no-contract", scale_parts_table, needs=("vqf",)),
     Figure("mechanisms-table", "docs/results/mechanisms.md", "imu-fusion mechanisms DIR",
            mechanisms_table, needs=("broad",)),
 )

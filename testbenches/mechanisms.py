@@ -16,10 +16,16 @@ recommended values, and the filter is scored with and without it two ways:
   and without it; the geometric mean over the cells of the ratio of the mean RMSE without to
   with (above 1: the mechanism helps) and the worst cell.
 
-A mechanism keeps its place where both say it lowers the error; where neither does, it is a
-candidate to drop; otherwise the table says which way each points. The grid values of the other
-parameters were chosen with every mechanism on, which favours keeping: a mechanism that does
-not earn its place even so does not earn it.
+- **The contract over parts** (testbenches.parts, as delivered): the accuracy checks that pass
+  with it and fail without. A mechanism the contract needs keeps its place whatever the rest.
+
+Otherwise a mechanism keeps its place where BROAD and the battery's mean both say it lowers the
+error, or where neither does but one of the battery's cells needs it (MOTION_CLASS_GAIN); where
+nothing does, it is a candidate to drop; else the table says which way each points. Mechanisms
+can cover for each other (the two bias gates): one switched off at a time shows what the other
+leaves, and `bias_gates` switches both. The
+grid values of the other parameters were chosen with every mechanism on, which favours keeping:
+a mechanism that does not earn its place even so does not earn it.
 """
 
 from __future__ import annotations
@@ -35,6 +41,10 @@ import numpy as np
 
 TIE = 0.005
 """Relative differences below this count as level (half a percent of the error)."""
+MOTION_CLASS_GAIN = 1.1
+"""A mechanism that neither BROAD nor the battery's mean keeps still keeps its place where on one
+of the battery's cells (a motion class on a sensor class, 20 parts) the error without it is this
+many times the error with it: a mechanism made for one kind of motion."""
 
 
 @dataclass(frozen=True)
@@ -70,6 +80,9 @@ MECHANISMS: tuple[Mechanism, ...] = (
               "(bias_gate 0)", {"bias_gate": 0.0}),
     Mechanism("bias_innovation", "no bias learning from a tilt innovation beyond 10 deg "
               "(bias_innovation pi)", {"bias_innovation": math.pi}),
+    Mechanism("bias_gates", "both gates on bias learning at once (bias_gate 0, bias_innovation "
+              "pi): each covers much of what the other does", {"bias_gate": 0.0,
+                                                                "bias_innovation": math.pi}),
     Mechanism("acc_gate", "no correction from a sample whose norm is outside 0.5-2 g "
               "(gate_low 1e-6, gate_high 1000)", {"gate_low": 1e-6, "gate_high": 1000.0}),
 )
@@ -95,6 +108,11 @@ class Worth:
     """Geometric mean over the battery's cells of mean RMSE without / with."""
     battery_worst: tuple[str, float] = ("", math.nan)
     """The cell where dropping it helps most: (motion/class, ratio without / with)."""
+    battery_best: tuple[str, float] = ("", math.nan)
+    """The cell where it helps most: (motion/class, ratio without / with)."""
+    contract_lost: list[str] | None = None
+    """The contract's checks over parts (as delivered) that pass with it and fail without
+    (None: not run)."""
 
     def broad_gain(self) -> float:
         """Cross-validated mean of always dropping it minus that of deciding per fold [deg]."""
@@ -102,6 +120,9 @@ class Worth:
                      - np.mean(list(self.cv_decided.values())))
 
     def verdict(self) -> str:
+        if self.contract_lost:
+            n = len(self.contract_lost)
+            return f"keeps its place: the contract needs it ({n} check{'s' if n != 1 else ''})"
         broad = self.broad_gain() / float(np.mean(list(self.broad_off.values())))
         says = {"BROAD": "keep" if broad > TIE else ("drop" if broad < -TIE else "level")}
         if math.isfinite(self.battery_ratio):
@@ -110,9 +131,12 @@ class Worth:
         votes = set(says.values())
         if votes == {"keep"} or votes == {"keep", "level"}:
             return "keeps its place"
-        if "keep" not in votes:
-            return "drop: no gain out of sample"
-        return "mixed: " + ", ".join(f"{k} {v}" for k, v in says.items())
+        if "keep" in votes:
+            return "mixed: " + ", ".join(f"{k} {v}" for k, v in says.items())
+        cell, ratio = self.battery_best
+        if ratio >= MOTION_CLASS_GAIN:
+            return f"keeps its place for {cell}"
+        return "drop: no gain out of sample"
 
 
 def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
@@ -196,22 +220,49 @@ def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: st
         w.battery_ratio = float(np.exp(np.mean(np.log(list(ratios.values())))))
         cell = min(ratios, key=lambda c: ratios[c])
         w.battery_worst = (cell, ratios[cell])
+        cell = max(ratios, key=lambda c: ratios[c])
+        w.battery_best = (cell, ratios[cell])
+
+
+def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
+                   progress: Callable[[], None] | None = None) -> None:
+    """Fill each Worth's contract_lost: the contract's accuracy checks over `parts` parts (as
+    delivered, the realistic sensor; testbenches.parts) with the filter at its defaults and
+    with the mechanism off."""
+    from fusion_core.scenarios import ESTIMATION_SCENARIOS
+
+    from .contract import accuracy_limits
+    from .parts import HOW, part_rmse, share_within
+
+    def passing(key: str, params: dict[str, float]) -> set[str]:
+        rmse = part_rmse([key], ESTIMATION_SCENARIOS, {}, {}, parts, params,
+                         calibrated_first=(False,))
+        if progress:
+            progress()
+        return {s for (_, _, s), v in rmse.items()
+                if share_within(v, accuracy_limits(key, s)) >= HOW[False][1]}
+
+    base = {key: passing(key, {}) for key in dict.fromkeys(k for k, _ in worth)}
+    for (key, name), w in worth.items():
+        w.contract_lost = sorted(base[key] - passing(key, BY_NAME[name].off))
 
 
 def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
     """Markdown: per estimator and mechanism, BROAD's means with and without, the folds that
     keep it, the cross-validated gain, the battery's ratio and the verdict."""
     rows = ["| estimator | mechanism | BROAD with | without | folds keeping it | CV gain [deg] "
-            "| battery without / with | worst cell | verdict |",
-            "|---|---|---|---|---|---|---|---|---|"]
+            "| battery without / with | cell it helps most | cell it costs most | contract checks "
+            "lost without | verdict |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
     for (key, name), w in worth.items():
-        worst = (f"{w.battery_worst[0]} {w.battery_worst[1]:.2f}"
-                 if math.isfinite(w.battery_worst[1]) else "-")
+        lost = "-" if w.contract_lost is None else (", ".join(w.contract_lost) or "none")
+        worst, best = ((f"{c} {r:.2f}" if math.isfinite(r) else "-")
+                       for c, r in (w.battery_worst, w.battery_best))
         ratio = f"{w.battery_ratio:.3f}" if math.isfinite(w.battery_ratio) else "-"
         rows.append(
             f"| {key} | {name} | {np.mean(list(w.broad_on.values())):.3f} | "
             f"{np.mean(list(w.broad_off.values())):.3f} | {len(w.kept_in)} of 4 | "
-            f"{w.broad_gain():+.3f} | {ratio} | {worst} | {w.verdict()} |")
+            f"{w.broad_gain():+.3f} | {ratio} | {best} | {worst} | {lost} | {w.verdict()} |")
     return "\n".join(rows)
 
 
@@ -226,8 +277,8 @@ def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ign
     p.add_argument("--mechanism", default="all",
                    help=f"all, or some of {', '.join(m.name for m in MECHANISMS)}")
     p.add_argument("--parts", type=int, default=None,
-                   help="parts of each sensor class in the battery (default: the battery's; "
-                   "0 leaves the battery out)")
+                   help="parts of each sensor class in the battery and of the contract's checks "
+                   "(default: the battery's; 0 leaves both out)")
     p.add_argument("--trials-json", type=Path, default=None,
                    help="BROAD's trials.json (default: beside the files)")
     p.add_argument("--scheduler", default="local",
@@ -267,6 +318,10 @@ def cmd_mechanisms(args: argparse.Namespace) -> int:
     if parts > 0:
         from .battery import MOTIONS, SENSOR_CLASSES
 
+        with tqdm(total=len(worth) + len(keys), desc="contract", unit="filter",
+                  disable=None) as bar:
+            contract_worth(worth, parts, lambda: bar.update(1))
+
         cells = (1 + len({m for _, m in worth})) * len(MOTIONS) * len(SENSOR_CLASSES)
         with tqdm(total=cells, desc="battery", unit="cell", disable=None) as bar:
             battery_worth(worth, parts, args.scheduler, args.workers, lambda: bar.update(1))
@@ -281,7 +336,9 @@ def cmd_mechanisms(args: argparse.Namespace) -> int:
                    "broad_off_deg": w.broad_off, "folds_keeping": w.kept_in,
                    "cv_decided_deg": w.cv_decided, "cv_gain_deg": w.broad_gain(),
                    "battery_off_over_on": w.battery_ratio,
-                   "battery_worst_cell": list(w.battery_worst), "verdict": w.verdict()}
+                   "battery_worst_cell": list(w.battery_worst),
+                   "battery_best_cell": list(w.battery_best),
+                   "contract_checks_lost": w.contract_lost, "verdict": w.verdict()}
                   for w in worth.values()]}, indent=1))
     print(f"written: {args.out}/mechanisms.md, mechanisms.json")
     return 0

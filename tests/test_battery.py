@@ -102,3 +102,13 @@ def test_the_command_on_a_local_cluster_gives_the_in_process_numbers(tmp_path, c
         page = (tmp_path / f"{name}.md").read_text()
         assert "| worse |" in page and "VQF" in page
     assert "[pendulum](pendulum.md)" in capsys.readouterr().out
+
+
+def test_every_motion_has_its_page_in_the_docs_navigation() -> None:
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    nav = (root / "mkdocs.yml").read_text()
+    for name in MOTIONS:
+        assert (root / "docs" / "results" / "battery" / f"{name}.md").is_file(), name
+        assert f"results/battery/{name}.md" in nav, name

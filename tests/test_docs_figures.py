@@ -38,10 +38,11 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
 
 
 HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenarios",
+         "broad-scale-parts",
          *(f.name for f in figs.FIGURES if f.name.startswith("battery-")))
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
 SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "readme-broad",
-        "mechanisms-table")
+        "mechanisms-table", "broad-groups", "broad-cv")
 """Figures of 200 parts calibrated first, BROAD's trials or the battery ten times: minutes
 (`make test-slow`)."""
 

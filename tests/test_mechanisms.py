@@ -52,8 +52,13 @@ def test_the_verdict_needs_both_ways_of_scoring() -> None:
     assert w.broad_gain() == pytest.approx(1.0) and w.verdict() == "keeps its place"
     w.battery_ratio = 0.9
     assert w.verdict().startswith("mixed: BROAD keep, battery drop")
-    level = Worth("kf", "acc_gate", on, dict(on), [], dict(on), battery_ratio=1.001)
+    level = Worth("kf", "acc_gate", on, dict(on), [], dict(on), battery_ratio=1.001,
+                  battery_best=("shaking/worse", 1.05))
     assert level.verdict().startswith("drop")
+    level.battery_best = ("slow_combined/mpu6050", 1.3)  # made for one kind of motion
+    assert level.verdict() == "keeps its place for slow_combined/mpu6050"
+    level.contract_lost = ["high_dynamics"]
+    assert level.verdict().startswith("keeps its place: the contract needs it")
 
 
 @pytest.mark.skipif(not all(p.is_file() for p in TRIALS),

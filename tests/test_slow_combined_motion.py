@@ -22,8 +22,7 @@ import pytest
 
 from fusion_core import ESTIMATORS, synthetic
 from fusion_core.sensor import ImuSensorModel
-from fusion_core.synthetic import Signal, Trajectory, add, after_rest, sine
-from fusion_core.types import DEG
+from fusion_core.synthetic import Trajectory, after_rest
 from testbenches.broad.metric import gravity_from_roll_pitch, inclination_error
 
 RATE = 100.0
@@ -37,21 +36,12 @@ Up = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 """A filter run: acc, gyro [N, 3], dt [N] -> the up direction [N, 3]."""
 
 
-def _accel_sine(acc: float, freq: float, phase: float = 0.0) -> Signal:
-    return sine(acc / (2.0 * math.pi * freq) ** 2, freq, phase)
-
-
 def slow_combined(rest: float = 0.0) -> Trajectory:
-    """Turns of +-60 deg at 0.5 Hz (and slower tones) while the sensor is carried back and forth
-    by 0.6-1 m/s2 at 0.12-0.2 Hz: periods of 5-8 s, longer than the measured vector's 1.5 s.
-    rest > 0: level and still for that long [s], then the motion fades in over 2 s."""
-    motion = Trajectory(
-        roll=add(sine(60 * DEG, 0.5), sine(20 * DEG, 0.13, 0.7)),
-        pitch=add(sine(42 * DEG, 0.4, 1.0), sine(10 * DEG, 0.11)),
-        yaw=sine(60 * DEG, 0.07),
-        pos=(_accel_sine(1.0, 0.15), _accel_sine(0.8, 0.195, 1.1), _accel_sine(0.6, 0.135, 0.4)),
-    )
-    return after_rest(motion, rest) if rest > 0.0 else motion
+    """The battery's slow combined motion (testbenches.battery.slow_combined); rest > 0: level
+    and still for that long [s], then the motion fades in over 2 s."""
+    from testbenches.battery import slow_combined as motion
+
+    return after_rest(motion(), rest) if rest > 0.0 else motion()
 
 
 def mean_rmse_deg(run: Up, rest: float = 0.0) -> float:
