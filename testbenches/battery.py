@@ -497,7 +497,7 @@ def plot(results: Results, path: Path) -> None:
 
 
 def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    from .options import positive_int
+    from .options import add_cluster, positive_int
 
     p = sub.add_parser(
         "battery", help="every attitude filter beside VQF on a battery of motions x parts of "
@@ -507,10 +507,7 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
                    help=f"all, or some of {', '.join(SENSOR_CLASSES)}")
     p.add_argument("--parts", type=positive_int, default=PARTS,
                    help=f"parts (seeds) of each sensor class (default {PARTS})")
-    p.add_argument("--scheduler", default="local",
-                   help="'local' (a LocalCluster, the default) or a Dask scheduler's address")
-    p.add_argument("--workers", type=positive_int, default=2,
-                   help="workers of the LocalCluster (default 2)")
+    add_cluster(p)
     p.add_argument("--out", type=Path, default=Path("reports/battery"),
                    help="where battery.json, battery.md, one page per motion and the plot go")
     p.add_argument("--no-plots", action="store_true", help="no battery.png")

@@ -267,7 +267,7 @@ def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
 
 
 def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    from .options import positive_int
+    from .options import add_cluster
 
     p = sub.add_parser(
         "mechanisms", help="what each mechanism of the recommended attitude filters is worth "
@@ -281,10 +281,7 @@ def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ign
                    "(default: the battery's; 0 leaves both out)")
     p.add_argument("--trials-json", type=Path, default=None,
                    help="BROAD's trials.json (default: beside the files)")
-    p.add_argument("--scheduler", default="local",
-                   help="'local' (a LocalCluster, the default) or a Dask scheduler's address")
-    p.add_argument("--workers", type=positive_int, default=2,
-                   help="workers of the LocalCluster (default 2)")
+    add_cluster(p)
     p.add_argument("--out", type=Path, default=Path("reports/mechanisms"),
                    help="where mechanisms.json and mechanisms.md go")
     p.set_defaults(func=cmd_mechanisms)

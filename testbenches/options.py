@@ -61,6 +61,16 @@ def with_calibration(entries: dict[str, dict[str, Any]], path: Path | None
     return {key: {**values, **params} for key, values in entries.items()}
 
 
+def add_cluster(parser: argparse.ArgumentParser) -> None:
+    """The Dask options of every command that splits its runs over a cluster: a LocalCluster
+    by default, or the user's scheduler."""
+    parser.add_argument("--scheduler", default="local",
+                        help="local (a LocalCluster, the default) or the address HOST:PORT of "
+                        "your own Dask scheduler")
+    parser.add_argument("--workers", type=positive_int, default=2,
+                        help="LocalCluster processes (2)")
+
+
 def add_sensor(parser: argparse.ArgumentParser) -> None:
     """The --sensor option every command that simulates the sensor takes (default realistic)."""
     parser.add_argument("--sensor", default="realistic", help=f"{SENSOR_HELP} (realistic)")

@@ -12,6 +12,7 @@ from fusion_core.scenarios import ESTIMATION_SCENARIOS
 from ..fmus import ESTIMATOR_FMUS
 from ..options import (
     add_calibration,
+    add_cluster,
     add_preset,
     add_sensor,
     non_negative_int,
@@ -47,10 +48,7 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--calibrate-first", action="store_true",
                    help="calibrate each run's sensor part on its own calibration session first "
                    "(the calibrate command's code) and apply its matrices")
-    p.add_argument("--scheduler", default="local",
-                   help="local (a LocalCluster, the default) or the address HOST:PORT of your "
-                   "own Dask scheduler")
-    p.add_argument("--workers", type=positive_int, default=2, help="LocalCluster processes (2)")
+    add_cluster(p)
     p.add_argument("--batch-size", type=positive_int, default=None,
                    help="runs per Dask task (default: about 8 tasks per worker, at most 200)")
     p.add_argument("--retries", type=non_negative_int, default=2,
