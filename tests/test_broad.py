@@ -543,3 +543,33 @@ def test_cv_draws_in_sample_against_cross_validated_per_fold(tmp_path: Path) -> 
     assert main(["broad", str(a), str(b), "--estimator", "kf", "--out", str(tmp_path / "np"),
                  "--no-plots", "--cv-grid", "scale_time=0.25,0.5"]) == 0
     assert not (tmp_path / "np" / "cv.png").exists()
+
+
+def test_the_nested_cv_chooses_each_folds_procedure_and_point_without_it() -> None:
+    """Nested leave-one-fold-out on a made-up error matrix: what a fold's own trials say changes
+    its score, never its choice."""
+    import numpy as np
+
+    from testbenches.broad.cv import EstimatorCv, _Allowed, nested_cv
+
+    grid = [{"acc_lowpass_stretch": s, "acc_lowpass": a} for s in (1.0, 2.0) for a in (1.0, 2.0)]
+    trials = [f"t{i}" for i in range(8)]
+    columns = {f: [2 * k, 2 * k + 1] for k, f in enumerate(("a", "b", "c", "d"))}
+    rng = np.random.default_rng(3)
+    errors = 0.5 + rng.uniform(0.0, 0.2, (len(grid), len(trials)))
+
+    def run(errors: np.ndarray) -> EstimatorCv:
+        cv = EstimatorCv("kf", {"acc_lowpass_stretch": 2.0, "acc_lowpass": 1.0}, grid=grid,
+                         errors=errors.copy())
+        cv.in_sample = {t: 0.0 for t in trials}
+        nested_cv(cv, columns, _Allowed("kf", grid, None))
+        return cv
+
+    base = run(errors)
+    assert set(base.nested) == set(trials) and set(base.nested_procedure) == set(columns)
+    changed = errors.copy()
+    changed[:, columns["a"]] = [[9.0, 9.0], [0.1, 0.1], [5.0, 5.0], [7.0, 7.0]]
+    other = run(changed)
+    assert other.nested_procedure["a"] == base.nested_procedure["a"]
+    point = [i for i in range(len(grid)) if base.nested["t0"] == errors[i, 0]]
+    assert point and other.nested["t0"] == changed[point[0], 0]  # the same point, rescored

@@ -137,7 +137,9 @@ def cmd_broad(args: argparse.Namespace) -> int:
                            constrained=not args.cv_unconstrained, plot=not args.no_plots,
                            choice=args.cv_choice or "regret")
           if run_cv else None)
-    extra = {"cv_mean_inclination_rmse_deg": cv.cv_means()} if cv is not None else None
+    extra = ({"cv_mean_inclination_rmse_deg": cv.cv_means(),
+              "nested_cv_mean_inclination_rmse_deg": cv.nested_means()}
+             if cv is not None else None)
     paths = write_reports(result, args.out, plot=not args.no_plots, extra=extra)
     print("\nmean_inclination_rmse_deg: " + ", ".join(
         f"{k} {v:.3f}" for k, v in result.means().items()))

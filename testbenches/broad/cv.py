@@ -109,12 +109,21 @@ class EstimatorCv:
     refused: dict[str, str] = field(default_factory=dict)
     """Grid points a fold or the scan ranked above its choice but the constraint refused (the
     point as NAME=V,... -> why: the first contract check it fails)."""
+    nested: dict[str, float] = field(default_factory=dict)
+    """trial -> RMSE [deg] under nested cross-validation (nested_cv): the procedure as well as
+    the point chosen without the trial's fold."""
+    nested_procedure: dict[str, str] = field(default_factory=dict)
+    """fold -> the procedure (PROCEDURES) the other folds chose by their own inner
+    cross-validation."""
 
     def in_sample_mean(self) -> float:
         return float(np.mean(list(self.in_sample.values())))
 
     def cv_mean(self) -> float:
         return float(np.mean(list(self.held_out.values())))
+
+    def nested_mean(self) -> float:
+        return float(np.mean(list(self.nested.values()))) if self.nested else float("nan")
 
     def scan_mean(self) -> float:
         return float(self.errors[self.grid.index(self.scan_choice)].mean())
@@ -124,6 +133,8 @@ class EstimatorCv:
                 "cv_held_out_deg": self.held_out, "chosen_per_fold": self.chosen,
                 "in_sample_mean_deg": self.in_sample_mean(), "cv_mean_deg": self.cv_mean(),
                 "scan_choice": self.scan_choice, "scan_choice_mean_deg": self.scan_mean(),
+                "nested_deg": self.nested, "nested_mean_deg": self.nested_mean(),
+                "nested_procedure_per_fold": self.nested_procedure,
                 "refused_by_contract": self.refused,
                 "grid_points": self.grid,
                 "grid_errors_deg": [[float(v) for v in row] for row in self.errors]}
@@ -153,6 +164,9 @@ class CvResult:
 
     def cv_means(self) -> dict[str, float]:
         return {k: e.cv_mean() for k, e in self.estimators.items()}
+
+    def nested_means(self) -> dict[str, float]:
+        return {k: e.nested_mean() for k, e in self.estimators.items() if e.nested}
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -239,6 +253,7 @@ def cross_validate(
             for j, n in enumerate(names):
                 if folds[n] == fold:
                     cv.held_out[n] = float(cv.errors[chosen, j])
+        nested_cv(cv, columns, allowed)
         out[key] = cv
     peer_rows: dict[str, dict[str, float]] = {}
     for name, peer in (peers or {}).items():
@@ -254,6 +269,72 @@ def cross_validate(
                 progress(f"{name} {trial.name[:28]}")
     return CvResult(names, folds, out, peer_rows, {k: [float(v) for v in grid[k]] for k in grid},
                     constraint is not None, choice)
+
+
+PROCEDURES: tuple[tuple[str, str], ...] = (("regret", "grid"), ("mean", "grid"),
+                                          ("regret", "no longer vector"),
+                                          ("mean", "no longer vector"))
+"""What the nested cross-validation chooses between, besides the point: the choice rule
+(CHOICES) and the grid, whole or without the longer vector (its points with
+acc_lowpass_stretch 1: the mechanism left out). An estimator without acc_lowpass_stretch has
+the whole grid only."""
+
+
+def _pick(cv: EstimatorCv, folds: list[list[int]], points: list[int], allowed: _Allowed,
+          choice: str) -> int:
+    """The point among `points` chosen on the training folds' columns (as _choose, without
+    recording what the constraint refused)."""
+    idx = np.asarray(points)
+    mean = cv.errors[np.ix_(idx, [j for cols in folds for j in cols])].mean(axis=1)
+    if choice == "mean":
+        order = np.argsort(mean, kind="stable")
+    else:
+        per_fold = np.stack([cv.errors[np.ix_(idx, cols)].mean(axis=1) for cols in folds], axis=1)
+        best = []
+        for f in range(len(folds)):
+            first = _first_allowed(idx[np.argsort(per_fold[:, f], kind="stable")], cv, allowed,
+                                   record=False)
+            best.append(per_fold[points.index(first), f])
+        regret = (per_fold / np.maximum(best, np.finfo(float).tiny)).max(axis=1)
+        order = np.lexsort((mean, regret))
+    return _first_allowed(idx[order], cv, allowed, record=False)
+
+
+def nested_cv(cv: EstimatorCv, columns: dict[str, list[int]], allowed: _Allowed) -> None:
+    """Nested leave-one-fold-out: for each outer fold, each procedure (PROCEDURES) is scored by
+    an inner leave-one-fold-out over the other folds alone, the best one (ties: the first) then
+    chooses its point on all of them, and the outer fold is scored with that point. The outer
+    fold is seen by no choice: neither the point's, nor the rule's, nor the grid's. Fills
+    cv.nested and cv.nested_procedure (nothing with fewer than three folds: an inner split
+    needs two)."""
+    present = list(columns)
+    if len(present) < 3:
+        return
+    names = list(cv.in_sample)
+    n_points = len(cv.grid)
+    grids = {"grid": list(range(n_points))}
+    if "acc_lowpass_stretch" in cv.defaults:
+        grids["no longer vector"] = [i for i, p in enumerate(cv.grid)
+                                     if p["acc_lowpass_stretch"] == 1.0]
+    procedures = [p for p in PROCEDURES if p[1] in grids and grids[p[1]]]
+    for outer in present:
+        training = [f for f in present if f != outer]
+        scores = []
+        for choice, grid in procedures:
+            errors = []
+            try:
+                for inner in training:
+                    rest = [columns[f] for f in training if f != inner]
+                    chosen = _pick(cv, rest, grids[grid], allowed, choice)
+                    errors += [float(cv.errors[chosen, j]) for j in columns[inner]]
+            except ValueError:  # the constraint allows no point of this grid
+                errors = [float("inf")]
+            scores.append(float(np.mean(errors)))
+        choice, grid = procedures[int(np.argmin(scores))]
+        chosen = _pick(cv, [columns[f] for f in training], grids[grid], allowed, choice)
+        cv.nested_procedure[outer] = f"{choice}, {grid}"
+        for j in columns[outer]:
+            cv.nested[names[j]] = float(cv.errors[chosen, j])
 
 
 def _point_label(point: dict[str, float]) -> str:
@@ -355,7 +436,10 @@ def cv_table(result: CvResult) -> str:
     lines = ["BROAD inclination RMSE [deg], leave one motion fold out (testbenches.broad.cv)",
              head, "-" * len(head)]
     for key, e in result.estimators.items():
-        for label, values in (("in-sample", e.in_sample), ("cv", e.held_out)):
+        for label, values in (("in-sample", e.in_sample), ("cv", e.held_out),
+                              ("nested cv", e.nested)):
+            if not values:
+                continue
             cells = " ".join(f"{result.fold_mean(values, f):18.3f}" for f in present)
             lines.append(f"{key:10s} {label:10s} {cells} {np.mean(list(values.values())):7.3f}")
     for name, values in result.peers.items():
@@ -375,6 +459,13 @@ def cv_table(result: CvResult) -> str:
                      f"({e.scan_mean():.3f}); {chosen}")
         for point, why in e.refused.items():
             lines.append(f"        refused {point}: {why}")
+    if any(e.nested_procedure for e in result.estimators.values()):
+        lines.append("")
+        lines.append("nested: the procedure (choice rule, grid) each fold's training folds chose "
+                     "by their own inner cross-validation:")
+        for key, e in result.estimators.items():
+            lines.append(f"  {key:5s} " + "; ".join(f"{f}: {p}"
+                                                   for f, p in e.nested_procedure.items()))
     return "\n".join(lines)
 
 
