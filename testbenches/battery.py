@@ -307,7 +307,8 @@ def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:
     from fusion_core.presets import noise_preset
 
     acc_density = math.sqrt(sensor.value("acc_psd"))
-    lsb = sensor.value("acc_range") / 2.0 ** (int(sensor.value("bits")) - 1)
+    bits = int(sensor.value("bits"))  # 0: no quantisation
+    lsb = sensor.value("acc_range") / 2.0 ** (bits - 1) if bits > 0 else 0.0
     acc_sample_std = math.sqrt(acc_density ** 2 * sensor.rate + lsb ** 2 / 12.0)
     preset = noise_preset(math.sqrt(sensor.value("gyro_psd")), acc_density, acc_sample_std,
                           sensor.value("gyro_range"))

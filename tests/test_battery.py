@@ -112,3 +112,13 @@ def test_every_motion_has_its_page_in_the_docs_navigation() -> None:
     for name in MOTIONS:
         assert (root / "docs" / "results" / "battery" / f"{name}.md").is_file(), name
         assert f"results/battery/{name}.md" in nav, name
+
+
+def test_a_sensor_without_quantisation_adds_no_converter_noise() -> None:
+    """bits 0 turns quantisation off: one sample's accelerometer noise is then its white noise
+    alone, not a step of twice the range."""
+    from testbenches.battery import SensorClass
+
+    c = SensorClass("ideal_adc", "no converter", 100.0, {"bits": 0})
+    std = battery.filter_params(c)["cf"]["acc_noise"] * G
+    assert std == pytest.approx(math.sqrt(c.value("acc_psd") * c.rate))
