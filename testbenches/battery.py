@@ -323,7 +323,7 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
     from fusion_core.registry import create
     from fusion_core.sensor import ImuSensorModel
 
-    from .broad.metric import gravity_from_roll_pitch, inclination_error
+    from .broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
     from .peers import PEERS
 
     m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
@@ -338,8 +338,7 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
     params = filter_params(s)
 
     def rmse(up: np.ndarray) -> float:
-        e = inclination_error(up, true_up)[scored]
-        return math.degrees(math.sqrt(float(np.mean(e * e))))
+        return inclination_rmse_deg(up, true_up, scored)
 
     out = {}
     for key in filters:

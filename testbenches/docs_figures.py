@@ -502,19 +502,16 @@ def moderate_presets_table(ctx: dict[str, Path]) -> str:
     from fusion_core.registry import KEYS
     from fusion_core.sensor import sensor_preset
 
-    from .contract import PAPER_MODERATE, compute_metrics
-    from .montecarlo.plan import Run
-    from .montecarlo.simulate import simulate
+    from .contract import PAPER_MODERATE
+    from .parts import part_rmse
 
     rows = ["| preset / sensor | " + " | ".join(KEYS) + " |", "|---|" + "---|" * len(KEYS)]
     for preset in ("recommended", "paper"):
-        params = load_preset(preset)
         for sensor in ("realistic", "ideal"):
-            cells = []
-            for key in KEYS:
-                m = compute_metrics(simulate(Run("doc", key, "moderate_dynamics", 0, None,
-                                                 sensor_preset(sensor), params[key], {})))
-                cells.append(f"{m['rmse_roll_deg']:.2f}/{m['rmse_pitch_deg']:.2f}")
+            rmse = part_rmse(KEYS, ["moderate_dynamics"], load_preset(preset),
+                             sensor_preset(sensor), parts=1, calibrated_first=(False,))
+            cells = [f"{r[0, 0]:.2f}/{r[0, 1]:.2f}"
+                     for r in (rmse[(False, key, "moderate_dynamics")] for key in KEYS)]
             rows.append(f"| {preset} / {sensor} | " + " | ".join(cells) + " |")
     held = {"cf": " (CCF)", "kf": " (CCF)", "poskf": ""}
     rows.append("| Duong Quoc et al. Table 1 | " + " | ".join(
@@ -642,24 +639,10 @@ def mechanisms_table(ctx: dict[str, Path]) -> str:
     from fusion_core.registry import ATTITUDE_FILTERS
 
     from .battery import PARTS
-    from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
-    from .broad.run import collect_paths
-    from .mechanisms import (
-        MECHANISMS,
-        battery_worth,
-        broad_worth,
-        contract_worth,
-        worth_table,
-    )
+    from .mechanisms import MECHANISMS, load_trials, measure, worth_table
 
-    trials = [load_trial(f) for f in collect_paths([ctx["broad"]])]
-    found = find_trials_json([ctx["broad"]])
-    info = load_trials_json(found) if found else None
-    worth = broad_worth(trials, [trial_groups(t.name, info) for t in trials],
-                        list(ATTITUDE_FILTERS), MECHANISMS)
-    contract_worth(worth, PARTS)
-    battery_worth(worth, PARTS, "local", 2)
-    return worth_table(worth)
+    trials, groups = load_trials([ctx["broad"]])
+    return worth_table(measure(trials, groups, list(ATTITUDE_FILTERS), MECHANISMS, PARTS))
 
 
 def _battery_figures() -> tuple[Figure, ...]:

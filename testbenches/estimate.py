@@ -526,24 +526,24 @@ def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]
     return acc @ r.T, gyro @ r.T
 
 
-def _import_pyplot() -> None:
-    with contextlib.suppress(ImportError):
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot
-
-
-def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> str:
-    """The up direction each estimator finds (its three components: readable at any attitude,
-    where roll is not near 90 deg of pitch), the reference's, and with a reference each one's
-    inclination error; every series thinned alike (Thinned)."""
+def _import_pyplot() -> Any:
+    """matplotlib's pyplot on the Agg backend, or None where matplotlib is not installed."""
     try:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
+        return None
+    return plt
+
+
+def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> str:
+    """The up direction each estimator finds (its three components: readable at any attitude,
+    where roll is not near 90 deg of pitch), the reference's, and with a reference each one's
+    inclination error; every series thinned alike (Thinned)."""
+    plt = _import_pyplot()
+    if plt is None:
         return "(no plot: matplotlib is not installed)"
     from .broad.metric import inclination_error
 

@@ -287,7 +287,53 @@ def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ign
     p.set_defaults(func=cmd_mechanisms)
 
 
+def load_trials(paths: Sequence[Path], trials_json: Path | None = None
+                ) -> tuple[list[Any], list[list[str]]]:
+    """The BROAD trials of the files and folders and each one's groups (from trials.json, given
+    or found beside them, else from the names)."""
+    from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
+    from .broad.run import collect_paths
+
+    files = collect_paths(paths)
+    if not files:
+        raise ValueError(f"no trial files in {', '.join(map(str, paths))}")
+    trials = [load_trial(f) for f in files]
+    found = trials_json or find_trials_json(paths)
+    info = load_trials_json(found) if found else None
+    return trials, [trial_groups(t.name, info) for t in trials]
+
+
+def measure(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimators: Sequence[str],
+            mechanisms: Sequence[Mechanism], parts: int, scheduler: str | None = "local",
+            workers: int = 2, bar: Callable[..., Any] | None = None
+            ) -> dict[tuple[str, str], Worth]:
+    """Every Worth of the estimators' mechanisms: BROAD's, and with parts > 0 the contract's
+    and the battery's. bar(total=, desc=, unit=): a progress bar per stage (tqdm's
+    signature), or None."""
+    import contextlib
+
+    def stage(total: int, desc: str, unit: str) -> Any:
+        return bar(total=total, desc=desc, unit=unit) if bar else contextlib.nullcontext()
+
+    def step(b: Any) -> Callable[[], None] | None:
+        return b.update if b is not None else None
+
+    runs = sum(len(trials) * (1 + sum(m.applies(k) for m in mechanisms)) for k in estimators)
+    with stage(runs, "BROAD", "run") as b:
+        worth = broad_worth(trials, groups, estimators, mechanisms, step(b))
+    if parts > 0:
+        from .battery import MOTIONS, SENSOR_CLASSES
+
+        with stage(len(worth) + len(estimators), "contract", "filter") as b:
+            contract_worth(worth, parts, step(b))
+        cells = (1 + len({m for _, m in worth})) * len(MOTIONS) * len(SENSOR_CLASSES)
+        with stage(cells, "battery", "cell") as b:
+            battery_worth(worth, parts, scheduler, workers, step(b))
+    return worth
+
+
 def cmd_mechanisms(args: argparse.Namespace) -> int:
+    import functools
     import json
 
     from tqdm import tqdm
@@ -295,33 +341,14 @@ def cmd_mechanisms(args: argparse.Namespace) -> int:
     from fusion_core.registry import ATTITUDE_FILTERS
 
     from .battery import PARTS
-    from .broad.data import find_trials_json, load_trial, load_trials_json, trial_groups
-    from .broad.run import collect_paths
     from .options import choose
 
     keys = choose(args.estimator, list(ATTITUDE_FILTERS), "estimator")
     chosen = [BY_NAME[n] for n in choose(args.mechanism, list(BY_NAME), "mechanism")]
     parts = PARTS if args.parts is None else args.parts
-    files = collect_paths(args.paths)
-    if not files:
-        raise ValueError(f"no trial files in {', '.join(map(str, args.paths))}")
-    trials = [load_trial(f) for f in files]
-    found = args.trials_json or find_trials_json(args.paths)
-    info = load_trials_json(found) if found else None
-    groups = [trial_groups(t.name, info) for t in trials]
-    runs = sum(len(trials) * (1 + sum(m.applies(k) for m in chosen)) for k in keys)
-    with tqdm(total=runs, desc="BROAD", unit="run", disable=None) as bar:
-        worth = broad_worth(trials, groups, keys, chosen, lambda: bar.update(1))
-    if parts > 0:
-        from .battery import MOTIONS, SENSOR_CLASSES
-
-        with tqdm(total=len(worth) + len(keys), desc="contract", unit="filter",
-                  disable=None) as bar:
-            contract_worth(worth, parts, lambda: bar.update(1))
-
-        cells = (1 + len({m for _, m in worth})) * len(MOTIONS) * len(SENSOR_CLASSES)
-        with tqdm(total=cells, desc="battery", unit="cell", disable=None) as bar:
-            battery_worth(worth, parts, args.scheduler, args.workers, lambda: bar.update(1))
+    trials, groups = load_trials(args.paths, args.trials_json)
+    worth = measure(trials, groups, keys, chosen, parts, args.scheduler, args.workers,
+                    functools.partial(tqdm, disable=None))
     table = worth_table(worth)
     print(table)
     args.out.mkdir(parents=True, exist_ok=True)

@@ -281,23 +281,23 @@ the whole grid only."""
 
 
 def _pick(cv: EstimatorCv, folds: list[list[int]], points: list[int], allowed: _Allowed,
-          choice: str) -> int:
-    """The point among `points` chosen on the training folds' columns (as _choose, without
-    recording what the constraint refused)."""
+          choice: str, record: bool = False) -> int:
+    """The grid point among `points` chosen on the training trials (folds: each training
+    fold's columns) among those allowed lets be chosen, by choice (CHOICES); with record, the
+    points the constraint refused ahead of it go to cv.refused."""
     idx = np.asarray(points)
     mean = cv.errors[np.ix_(idx, [j for cols in folds for j in cols])].mean(axis=1)
     if choice == "mean":
-        order = np.argsort(mean, kind="stable")
-    else:
-        per_fold = np.stack([cv.errors[np.ix_(idx, cols)].mean(axis=1) for cols in folds], axis=1)
-        best = []
-        for f in range(len(folds)):
-            first = _first_allowed(idx[np.argsort(per_fold[:, f], kind="stable")], cv, allowed,
-                                   record=False)
-            best.append(per_fold[points.index(first), f])
-        regret = (per_fold / np.maximum(best, np.finfo(float).tiny)).max(axis=1)
-        order = np.lexsort((mean, regret))
-    return _first_allowed(idx[order], cv, allowed, record=False)
+        return _first_allowed(idx[np.argsort(mean, kind="stable")], cv, allowed, record)
+    per_fold = np.stack([cv.errors[np.ix_(idx, cols)].mean(axis=1) for cols in folds], axis=1)
+    best = []
+    for f in range(len(folds)):
+        first = _first_allowed(idx[np.argsort(per_fold[:, f], kind="stable")], cv, allowed,
+                               record=False)
+        best.append(per_fold[points.index(first), f])
+    # (a fold whose best is exact: the other points' regret is as large as a float's)
+    regret = (per_fold / np.maximum(best, np.finfo(float).tiny)).max(axis=1)
+    return _first_allowed(idx[np.lexsort((mean, regret))], cv, allowed, record)
 
 
 def nested_cv(cv: EstimatorCv, columns: dict[str, list[int]], allowed: _Allowed) -> None:
@@ -374,17 +374,9 @@ def _first_allowed(order: np.ndarray, cv: EstimatorCv, allowed: _Allowed,
 
 
 def _choose(cv: EstimatorCv, folds: list[list[int]], allowed: _Allowed, choice: str) -> int:
-    """The grid point chosen on the training trials (folds: each training fold's columns) among
-    those allowed lets be chosen, by choice (CHOICES)."""
-    mean = cv.errors[:, [j for cols in folds for j in cols]].mean(axis=1)
-    if choice == "mean":
-        return _first_allowed(np.argsort(mean, kind="stable"), cv, allowed)
-    per_fold = np.stack([cv.errors[:, cols].mean(axis=1) for cols in folds], axis=1)
-    best = [per_fold[_first_allowed(np.argsort(per_fold[:, f], kind="stable"), cv, allowed,
-                                    record=False), f] for f in range(len(folds))]
-    # (a fold whose best is exact: the other points' regret is as large as a float's)
-    regret = (per_fold / np.maximum(best, np.finfo(float).tiny)).max(axis=1)
-    return _first_allowed(np.lexsort((mean, regret)), cv, allowed)
+    """The grid point chosen on the training trials among every point of the grid (_pick),
+    the refused ones ahead of it recorded."""
+    return _pick(cv, folds, list(range(len(cv.grid))), allowed, choice, record=True)
 
 
 def check_grid(grid: Grid, estimators: Sequence[str]) -> None:
