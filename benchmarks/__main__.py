@@ -1,5 +1,6 @@
-"""`python -m benchmarks [--quick] [--out DIR] [--fmu-dir DIR]`: run the speed benchmarks,
-print the table (every target beside its measurement) and write DIR/bench.json."""
+"""`python -m benchmarks [--quick] [--out DIR] [--fmu-dir DIR] [--docs]`: run the speed
+benchmarks, print the table (every target beside its measurement) and write DIR/bench.json;
+with --docs also docs/results/speed.json, the measurement docs/results/speed.md shows."""
 
 from __future__ import annotations
 
@@ -21,7 +22,12 @@ def main(argv: list[str] | None = None) -> int:
                         help="folder for bench.json (default: reports)")
     parser.add_argument("--fmu-dir", type=Path, default=None,
                         help="use the FMUs in this folder instead of building them")
+    parser.add_argument("--docs", action="store_true",
+                        help="also keep the results as docs/results/speed.json and write "
+                        "docs/results/speed.md's table of them (a full run only)")
     args = parser.parse_args(argv)
+    if args.docs and args.quick:
+        parser.error("--docs: the documentation shows a full run; leave out --quick")
     from .suite import run_benchmarks  # imports fusion_core: only now
 
     config = BenchConfig.quick_config(args.fmu_dir) if args.quick else BenchConfig(
@@ -32,6 +38,10 @@ def main(argv: list[str] | None = None) -> int:
     print(format_table(results))
     path = write_json(results, args.out)
     print(f"\nwrote {path} ({results['wall_s']} s)")
+    if args.docs:
+        from testbenches.docs_figures import write_speed
+
+        print(f"wrote {', '.join(map(str, write_speed(results)))}")
     return 0
 
 

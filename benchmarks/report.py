@@ -414,3 +414,9 @@ def write_json(r: dict[str, Any], out_dir: Path) -> Path:
     path = out_dir / "bench.json"
     path.write_text(json.dumps(r, indent=2, allow_nan=False) + "\n", encoding="utf-8")
     return path
+
+
+
+DOCS_JSON = Path(__file__).resolve().parents[1] / "docs" / "results" / "speed.json"
+"""The full run docs/results/speed.md shows (its block `speed-bench` is format_table of it,
+testbenches.docs_figures.speed_table, checked by tests/test_docs_figures.py)."""

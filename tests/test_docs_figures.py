@@ -14,7 +14,8 @@ from testbenches import docs_figures as figs
 
 REPO = Path(__file__).resolve().parents[1]
 BY_NAME = {f.name: f for f in figs.FIGURES}
-WHERE = {"imucal": "imucal's session beside the project in ../shared/data/imucal",
+WHERE = {"checkout": "the project's source checkout (benchmarks/)",
+         "imucal": "imucal's session beside the project in ../shared/data/imucal",
          "engines": "libcosimpy and ecospy (pip install '.[engines]'; apt-get install libtbb12)",
          "vqf": "the peers (pip install -e '.[bench]')",
          "broad": "BROAD's trials beside the project in ../shared/data/broad",
@@ -41,10 +42,10 @@ HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenari
          "broad-scale-parts",
          *(f.name for f in figs.FIGURES if f.name.startswith("battery-")))
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
-SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "readme-broad",
-        "mechanisms-table", "broad-groups", "broad-cv")
-"""Figures of 200 parts calibrated first, BROAD's trials or the battery ten times: minutes
-(`make test-slow`)."""
+SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "campaigns-makefile",
+        "readme-broad", "mechanisms-table", "broad-groups", "broad-cv")
+"""Figures of 200 parts calibrated first, `make campaign`'s 17,500 runs, BROAD's trials or the
+battery ten times: minutes (`make test-slow`)."""
 
 
 def _marks(name: str) -> list[pytest.MarkDecorator]:
