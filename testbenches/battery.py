@@ -302,16 +302,19 @@ def filter_keys() -> list[str]:
 
 def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:
     """Each filter's parameters for a sensor of this class: the recommended values with what
-    follows from its noise and range (presets.noise_preset), one sample's accelerometer noise
-    taken at the class's rate with its quantisation."""
+    follows from its noise, range and the gyro bias its parts start with (presets.noise_preset:
+    what its calibration leaves, sensor.CALIBRATION), one sample's accelerometer noise taken at
+    the class's rate with its quantisation."""
     from fusion_core.presets import noise_preset
+    from fusion_core.sensor import CALIBRATION
 
     acc_density = math.sqrt(sensor.value("acc_psd"))
     bits = int(sensor.value("bits"))  # 0: no quantisation
     lsb = sensor.value("acc_range") / 2.0 ** (bits - 1) if bits > 0 else 0.0
     acc_sample_std = math.sqrt(acc_density ** 2 * sensor.rate + lsb ** 2 / 12.0)
+    gyro_bias_std = max(CALIBRATION[sensor.value("calibration")][0])
     preset = noise_preset(math.sqrt(sensor.value("gyro_psd")), acc_density, acc_sample_std,
-                          sensor.value("gyro_range"))
+                          sensor.value("gyro_range"), gyro_bias_std)
     return {key: preset[key] for key in filter_keys()}
 
 

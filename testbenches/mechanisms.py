@@ -2,8 +2,8 @@
 worth on recordings it was not chosen on.
 
 A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the longer vector, the
-scale-error process noise, rest detection and its turn-on rule, the bias gates, the accelerometer
-gate) is switched off by the parameter values that turn it off, everything else at the
+scale-error process noise, rest detection and its turn-on rule, the bias gates) is switched off
+by the parameter values that turn it off, everything else at the
 recommended values, and the filter is scored with and without it two ways:
 
 - **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
@@ -56,11 +56,13 @@ class Mechanism:
     off: dict[str, float]
 
     def applies(self, key: str) -> bool:
-        """Whether estimator `key` has it (every parameter that switches it off)."""
+        """Whether estimator `key` has it on by default: every parameter that switches it off,
+        none of them at its off value already (a mechanism dropped from the defaults, or a pair
+        of which one is dropped, is not scored again)."""
         from fusion_core.registry import ESTIMATORS
 
         specs = ESTIMATORS[key].param_specs()
-        return all(p in specs for p in self.off)
+        return all(p in specs and specs[p].default != v for p, v in self.off.items())
 
 
 MECHANISMS: tuple[Mechanism, ...] = (
@@ -83,11 +85,11 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("bias_gates", "both gates on bias learning at once (bias_gate 0, bias_innovation "
               "pi): each covers much of what the other does", {"bias_gate": 0.0,
                                                                 "bias_innovation": math.pi}),
-    Mechanism("acc_gate", "no correction from a sample whose norm is outside 0.5-2 g "
-              "(gate_low 1e-6, gate_high 1000)", {"gate_low": 1e-6, "gate_high": 1000.0}),
 )
 """Every mechanism the recommended attitude filters have on top of their paper's filter that a
-parameter switches off."""
+parameter switches off. Dropped by this test and off by default, their parameters kept for a
+user's own values: the accelerometer gate of cf and kf (building_blocks.ACC_GATE_PARAMS), the
+UKF's bias gate (ukf.UKF_BIAS_GATE_PARAM)."""
 BY_NAME = {m.name: m for m in MECHANISMS}
 
 

@@ -10,7 +10,9 @@ import math
 import numpy as np
 import pytest
 
+from fusion_core.kalman import RECOMMENDED_INIT_BIAS_STD
 from fusion_core.presets import noise_preset
+from fusion_core.sensor import CALIBRATION
 from fusion_core.types import DEG, G
 from testbenches import battery
 from testbenches.battery import MOTIONS, SENSOR_CLASSES
@@ -69,6 +71,24 @@ def test_each_filter_gets_what_its_sensors_noise_gives(name: str) -> None:
     assert density_part <= acc_std <= 1.2 * density_part
     assert noise_preset(gyro_density, math.sqrt(c.value("acc_psd")), acc_std,
                         c.value("gyro_range"))["mgcf"] == params["mgcf"]
+    bias_std = max(CALIBRATION[c.value("calibration")][0])  # what the part starts with
+    for key in ("kf", "ukf"):
+        assert params[key]["init_bias_std"] == max(bias_std, RECOMMENDED_INIT_BIAS_STD)
+
+
+def test_an_uncalibrated_part_that_never_rests_learns_its_bias_with_its_prior() -> None:
+    """The slow roll from power-up on parts as delivered (turn-on gyro biases of degrees per
+    second, no rest to measure them): with the prior the part's class gives, the UKF learns its
+    three biases from the accelerometer; with a calibrated part's prior it holds them near zero
+    and the tilt runs off by tens of degrees."""
+    from fusion_core.kalman import RECOMMENDED_INIT_BIAS_STD as CALIBRATED
+
+    wide = [battery.part_rmse("slow_rotation", "mpu6050_raw", seed, ["ukf"], vqf=False)["ukf"]
+            for seed in range(8)]
+    narrow = [battery.part_rmse("slow_rotation", "mpu6050_raw", seed, ["ukf"],
+                                {"ukf": {"init_bias_std": CALIBRATED}}, vqf=False)["ukf"]
+              for seed in range(8)]
+    assert max(wide) < 5.0 < 10.0 < np.mean(narrow)
 
 
 def test_the_worse_part_clips_where_the_better_one_does_not() -> None:

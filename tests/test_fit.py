@@ -76,6 +76,17 @@ def test_noise_writes_the_files_and_its_preset_is_the_defaults_derivation(tmp_pa
     assert sensor["gyro_psd"] == pytest.approx(GYRO_DENSITY**2, rel=0.3)
 
 
+def test_noise_gives_an_uncalibrated_part_a_bias_prior_of_its_turn_on_spread(tmp_path):
+    """--gyro-bias-std (a datasheet's turn-on tolerance) widens the Kalman filters' bias prior;
+    below the recommended prior (a calibrated part's residual) it stays."""
+    rec = load(static_csv(tmp_path / "static.csv", 60.0, 100.0))
+    for spread, prior in ((6.7 * DEG, 6.7 * DEG), (0.01 * DEG, 0.3 * DEG)):
+        run_noise(rec, tmp_path / "out", plots=False, gyro_bias_std=spread)
+        preset = load_preset(tmp_path / "out" / "preset.json")
+        assert preset["kf"]["init_bias_std"] == pytest.approx(prior)
+        assert preset["ukf"]["init_bias_std"] == pytest.approx(prior)
+
+
 def test_noise_refuses_a_recording_that_is_not_static(tmp_path):
     rec = load(static_csv(tmp_path / "turning.csv", 60.0, 100.0, turn=0.2 * DEG))
     with pytest.raises(RecordingError, match="not static"):
@@ -115,7 +126,7 @@ def test_log_space_where_a_range_spans_decades_and_within_the_allowed_range():
     q = dimension(specs["Q_angle"], specs["Q_angle"].default)
     assert q.log and q.low == pytest.approx(specs["Q_angle"].default / 100)
     gate = dimension(specs["gate_low"], 0.5)
-    assert not gate.log and gate.low > 0.0 and gate.high <= 1.0
+    assert not gate.log and gate.low >= 0.0 and gate.high <= 1.0
     names = [p.name for p in tunable("mgcf", ["all"])]
     assert "w0" in names and "max_dt" not in names and "gyro_sampling" not in names
     with pytest.raises(ValueError, match="cannot be fitted"):

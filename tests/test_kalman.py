@@ -211,13 +211,16 @@ def test_with_the_measured_vector_the_bias_gate_judges_what_reaches_it(
 
     if backend == "native" and native.reason() is not None:
         pytest.skip(f"no C twin: {native.reason()}")
+    from fusion_core.building_blocks import BIAS_GATE
+
     t = np.arange(6000) * 0.01
     bias = 0.3 * DEG
-    shaken = ESTIMATORS[key](rest_time=0.0).run(
+    on = {"rest_time": 0.0, "bias_gate": BIAS_GATE}  # the UKF's is off by default
+    shaken = ESTIMATORS[key](**on).run(
         *_level_with_gyro_bias(G * np.sign(np.sin(2 * math.pi * 4.0 * t + 0.1)), bias),
         backend=backend)
     assert shaken["bias"][-1, 0] > 0.5 * bias
-    pushed = ESTIMATORS[key](rest_time=0.0).run(
+    pushed = ESTIMATORS[key](**on).run(
         *_level_with_gyro_bias(np.full(len(t), 0.4 * G), bias), backend=backend)
     assert np.all(pushed["bias"][:, 0] == 0.0)
 

@@ -77,12 +77,13 @@ def test_the_simulation_schedule_is_duong_quocs_section_4_1(rho: float, w0: floa
     assert scheduled_w0(rho, SCHEDULES["simulation"]) == w0
 
 
-ONLY_GYRO = {"cf": {"acc_lowpass": 0.0},
+ONLY_GYRO = {"cf": {"acc_lowpass": 0.0, "gate_high": 2.0},
              "mgcf": {"filter": "paper"},
-             "kf": {"acc_lowpass": 0.0, "rest_time": 0.0},
+             "kf": {"acc_lowpass": 0.0, "rest_time": 0.0, "gate_high": 2.0},
              "ukf": {"acc_lowpass": 0.0, "rest_time": 0.0}, "poskf": {"filter": "paper"}}
-"""Options that would let the accelerometer in: off, so that only the gyro moves roll (the
-papers' mgcf gates a norm of 3 g out, their position filter's attitude is its tilt stage's)."""
+"""Options that would let the accelerometer in: off, and cf's and kf's gate closed above 2 g,
+so that only the gyro moves roll (the papers' mgcf gates a norm of 3 g out, their position
+filter's attitude is its tilt stage's)."""
 
 
 @pytest.mark.parametrize("key", KEYS)

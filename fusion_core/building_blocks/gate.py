@@ -10,25 +10,27 @@ from ..types import DEG, G, Param
 
 ACC_GATE_PARAMS: tuple[Param, ...] = (
     Param(
-        "gate_low", 0.5,
+        "gate_low", 0.0,
         "Accelerometer gate, lower bound of |acc|/g: below it the accelerometer correction is "
-        "skipped (free fall, strong deceleration)",
-        low=0.0, low_open=True, high=1.0,
+        "skipped (free fall, strong deceleration); 0 = no lower bound",
+        low=0.0, high=1.0,
     ),
     Param(
-        "gate_high", 2.0,
+        "gate_high", 1000.0,
         "Accelerometer gate, upper bound of |acc|/g: above it the accelerometer correction is "
-        "skipped (strong linear acceleration)",
+        "skipped (strong linear acceleration); 1000 = no upper bound",
         low=1.0, high=1000.0,  # a reading beyond 1000 g is no reading (base.MAX_ACC_NORM)
     ),
 )
-"""Gui et al.'s accelerometer-magnitude gate. The papers give no bounds. Recommended, 0.5 g to
-2 g: with the pre-filter on (ACC_LOWPASS_PARAM) the gate sees the filtered vector, whose norm
-stays near g while the raw one swings, so only gross disturbances need closing it; a narrow gate
-then only adds rejections. The papers' filters' 0.9-1.1 g (fusion_core.papers.common) is our
-reading for the raw accelerometer: it skips samples with 0.1 g or more of linear acceleration
-along gravity, yet stays open at rest for an uncalibrated MEMS accelerometer (scale error up to
-about 3 %)."""
+"""Gui et al.'s accelerometer-magnitude gate. The papers give no bounds; their filters' 0.9-1.1
+g (fusion_core.papers.common) is our reading for the raw accelerometer: it skips samples with
+0.1 g or more of linear acceleration along gravity, yet stays open at rest for an uncalibrated
+MEMS accelerometer (scale error up to about 3 %). Recommended: open (0 and 1000 g). With the
+pre-filter on (ACC_LOWPASS_PARAM) the gate sees the filtered vector, whose norm stays near g
+while the raw one swings, and the adaptive noise already weighs a vector off g down by the
+linear acceleration it measures; a gate on top changes no error on recordings its choice did
+not see (`imu-fusion mechanisms`, docs/results/mechanisms.md), so the recommended filters
+keep the parameter for a user's own bounds and close nothing by default."""
 
 
 def gate_bounds2(params: dict) -> tuple[float, float]:

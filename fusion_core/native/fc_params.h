@@ -20,7 +20,7 @@
 
 typedef struct fc_cf_params {
     fc_real tau;                  /* (0.0, 1000000.0] [s] */
-    fc_real gate_low;             /* (0.0, 1.0] */
+    fc_real gate_low;             /* [0.0, 1.0] */
     fc_real gate_high;            /* [1.0, 1000.0] */
     fc_real acc_lowpass;          /* [0.0, 1000000.0] [s] */
     fc_real rest_time;            /* [0.0, 1000000.0] [s] */
@@ -72,8 +72,8 @@ typedef struct fc_cf_params {
 static inline void fc_cf_params_default(fc_cf_params *p)
 {
     p->tau = 1.0;
-    p->gate_low = 0.5;
-    p->gate_high = 2.0;
+    p->gate_low = 0.0;
+    p->gate_high = 1000.0;
     p->acc_lowpass = 1.5;
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
@@ -127,7 +127,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
 
 typedef struct fc_paper_cf_params {
     fc_real tau;           /* (0.0, 1000000.0] [s] */
-    fc_real gate_low;      /* (0.0, 1.0] */
+    fc_real gate_low;      /* [0.0, 1.0] */
     fc_real gate_high;     /* [1.0, 1000.0] */
     int gyro_sampling;     /* one of 'point', 'mean' */
     fc_real max_dt;        /* (0.0, 1000000.0] [s] */
@@ -398,7 +398,7 @@ typedef struct fc_kf_params {
     fc_real gyro_scale_std;       /* [0.0, 0.5] */
     fc_real scale_time;           /* [0.0, 1000000.0] [s] */
     fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
-    fc_real gate_low;             /* (0.0, 1.0] */
+    fc_real gate_low;             /* [0.0, 1.0] */
     fc_real gate_high;            /* [1.0, 1000.0] */
     fc_real acc_lowpass;          /* [0.0, 1000000.0] [s] */
     fc_real rest_time;            /* [0.0, 1000000.0] [s] */
@@ -455,8 +455,8 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->gyro_scale_std = 0.005;
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
-    p->gate_low = 0.5;
-    p->gate_high = 2.0;
+    p->gate_low = 0.0;
+    p->gate_high = 1000.0;
     p->acc_lowpass = 1.5;
     p->rest_time = 1.5;
     p->rest_gyro = 0.03490658503988659;
@@ -513,7 +513,7 @@ typedef struct fc_paper_kf_params {
     fc_real Q_bias;        /* [0.0, 1.0] [rad2/s3] */
     fc_real R_measure;     /* (0.0, 100.0] [rad2] */
     fc_real R_loop_time;   /* [0.0, 1000000.0] [s] */
-    fc_real gate_low;      /* (0.0, 1.0] */
+    fc_real gate_low;      /* [0.0, 1.0] */
     fc_real gate_high;     /* [1.0, 1000.0] */
     int gyro_sampling;     /* one of 'point', 'mean' */
     fc_real max_dt;        /* (0.0, 1000000.0] [s] */
@@ -671,7 +671,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->rest_acc = 0.5;
     p->rest_bias_bound = 0.3490658503988659;
     p->zaru_psd = 1.949551486634935e-08;
-    p->bias_gate = 0.05;
+    p->bias_gate = 0.0;
     p->bias_innovation = 0.17453292519943295;
     p->slow_band_time = 0.15;
     p->acc_lowpass_stretch = 2.0;
@@ -822,7 +822,7 @@ typedef struct fc_poskf_params {
     fc_real Q_bias;            /* [0.0, 1.0] [rad2/s3] */
     fc_real R_measure;         /* (0.0, 100.0] [rad2] */
     fc_real R_loop_time;       /* [0.0, 1000000.0] [s] */
-    fc_real gate_low;          /* (0.0, 1.0] */
+    fc_real gate_low;          /* [0.0, 1.0] */
     fc_real gate_high;         /* [1.0, 1000.0] */
     int gyro_sampling;         /* one of 'point', 'mean' */
     fc_real max_dt;            /* (0.0, 1000000.0] [s] */
@@ -927,7 +927,7 @@ typedef struct fc_paper_poskf_params {
     fc_real Q_bias;        /* [0.0, 1.0] [rad2/s3] */
     fc_real R_measure;     /* (0.0, 100.0] [rad2] */
     fc_real R_loop_time;   /* [0.0, 1000000.0] [s] */
-    fc_real gate_low;      /* (0.0, 1.0] */
+    fc_real gate_low;      /* [0.0, 1.0] */
     fc_real gate_high;     /* [1.0, 1000.0] */
     int gyro_sampling;     /* one of 'point', 'mean' */
     fc_real max_dt;        /* (0.0, 1000000.0] [s] */

@@ -36,6 +36,12 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
                        help="the gyro's full-scale range setting [deg/s] from its datasheet or "
                        "its configuration (a static recording cannot show it): every estimator "
                        "treats a sample at it as clipped (2000, the MPU-6050 class's widest)")
+    noise.add_argument("--gyro-bias-std", type=non_negative_float, default=0.0,
+                       metavar="DEG_S", help="the spread (1 sigma) of the gyro bias the part "
+                       "starts a run with where it runs without a start-up calibration: its "
+                       "datasheet's zero-rate offset tolerance (a static recording shows one "
+                       "start's bias, not the spread); the Kalman filters' bias prior is at "
+                       "least this (0: a part calibrated at start-up)")
     noise.add_argument("--no-plots", action="store_true", help="skip allan.png")
 
     tune = sub.add_parser(
@@ -74,7 +80,8 @@ def cmd_noise(args: argparse.Namespace) -> int:
 
     rec = rest(recording_from_args(args.file, args)[0])
     noise = run_noise(rec, args.out, plots=not args.no_plots,
-                      gyro_range=math.radians(args.gyro_range))
+                      gyro_range=math.radians(args.gyro_range),
+                      gyro_bias_std=math.radians(args.gyro_bias_std))
     g, a = noise["gyro_density"]["mean"], noise["acc_density"]["mean"]
     print(f"{rec.name}: {rec.duration:.0f} s at {rec.rate:g} Hz")
     print(f"  gyro white noise {noise['gyro_density_deg_s_sqrt_hz']:.4g} deg/s/sqrt(Hz) "
@@ -82,6 +89,9 @@ def cmd_noise(args: argparse.Namespace) -> int:
     print(f"  acc white noise {noise['acc_density_ug_sqrt_hz']:.4g} ug/sqrt(Hz) "
           f"(acc_psd {a * a:.4g} m2/s3)")
     print(f"  gyro range +-{args.gyro_range:g} deg/s (gyro_range {noise['gyro_range']:.6g} rad/s)")
+    if args.gyro_bias_std > 0.0:
+        print(f"  gyro turn-on bias +-{args.gyro_bias_std:g} deg/s (1 sigma): the Kalman "
+              "filters' init_bias_std at least that")
     if "note" in noise:
         print(f"  note: {noise['note']}")
     print(f"wrote {args.out}/noise.json, preset.json, sensor.json"

@@ -114,7 +114,8 @@ def analyse(rec: Recording) -> tuple[dict[str, Any], dict[str, list[AllanFit]]]:
 def preset_for(noise: dict[str, Any]) -> dict[str, dict[str, float]]:
     """The recommended-style preset for every estimator (fusion_core.presets.noise_preset)."""
     return noise_preset(noise["gyro_density"]["mean"], noise["acc_density"]["mean"],
-                        noise["acc_sample_std"], noise.get("gyro_range", GYRO_RANGE_DEFAULT))
+                        noise["acc_sample_std"], noise.get("gyro_range", GYRO_RANGE_DEFAULT),
+                        noise.get("gyro_bias_std", 0.0))
 
 
 def sensor_params(noise: dict[str, Any]) -> dict[str, float]:
@@ -167,13 +168,18 @@ def plot(fits: dict[str, list[AllanFit]], path: Path, title: str) -> None:
 
 
 def run_noise(rec: Recording, out_dir: Path, plots: bool = True,
-              gyro_range: float = GYRO_RANGE_DEFAULT) -> dict[str, Any]:
+              gyro_range: float = GYRO_RANGE_DEFAULT, gyro_bias_std: float = 0.0
+              ) -> dict[str, Any]:
     """Write noise.json, preset.json, sensor.json (and allan.png) into out_dir; return the
     noise.json content. gyro_range [rad/s]: the gyro's full-scale setting, which goes to every
-    estimator and to the sensor model."""
+    estimator and to the sensor model; gyro_bias_std [rad/s]: the spread of the bias a part
+    starts with where it is not calibrated at start-up (presets.noise_preset), from its
+    datasheet."""
     noise, fits = analyse(rec)
     noise["gyro_range"] = gyro_range
     noise["units"]["gyro_range"] = "rad/s"
+    noise["gyro_bias_std"] = gyro_bias_std
+    noise["units"]["gyro_bias_std"] = "rad/s"
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "noise.json").write_text(json.dumps(noise, indent=1))
     (out_dir / "preset.json").write_text(json.dumps(preset_for(noise), indent=1))
