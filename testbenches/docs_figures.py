@@ -298,14 +298,26 @@ def campaigns_parts_table(ctx: dict[str, Path]) -> str:
     return "\n".join(rows)
 
 
+def _bench_report() -> Any:
+    """benchmarks.report of the source checkout (benchmarks/ is not part of the installed
+    package: `imu-fusion` run from .venv/bin does not have it on its path)."""
+    if str(REPO) not in sys.path:
+        sys.path.append(str(REPO))
+    import benchmarks.report
+
+    return benchmarks.report
+
+
 def speed_table(ctx: dict[str, Path]) -> str:
     """docs/results/speed.md: `make bench`'s table of the run kept in docs/results/speed.json
     (written by `python -m benchmarks --docs`); refused where that run lacks an estimator of
     the registry, so that a new estimator's speed cannot go unshown."""
     import json
 
-    from benchmarks.report import DOCS_JSON, format_table
     from fusion_core.registry import KEYS
+
+    report = _bench_report()
+    DOCS_JSON, format_table = report.DOCS_JSON, report.format_table
 
     r = json.loads(DOCS_JSON.read_text(encoding="utf-8"))
     lacking = [k for k in KEYS if k not in r.get("per_sample_us_stream", {})]
@@ -320,8 +332,7 @@ def write_speed(results: dict[str, Any]) -> list[Path]:
     of it (`python -m benchmarks --docs`)."""
     import json
 
-    from benchmarks.report import DOCS_JSON
-
+    DOCS_JSON = _bench_report().DOCS_JSON
     DOCS_JSON.write_text(json.dumps(results, indent=1, allow_nan=False) + "\n",
                          encoding="utf-8")
     page = DOCS_JSON.with_name("speed.md")
