@@ -55,11 +55,12 @@ class Figure:
 
 def _main(argv: list[str]) -> int:
     """`imu-fusion ARGV` for the commands whose output the docs show (estimate, calibrate,
-    broad, campaign)."""
+    broad, campaign, run)."""
     from .broad.cli import add_broad_parser
     from .calibrate.cli import add_calibrate_parser
     from .estimate import add_estimate_parser
     from .montecarlo.cli import add_campaign_parser
+    from .run_cli import add_run_parser
 
     parser = argparse.ArgumentParser(prog="imu-fusion")
     sub = parser.add_subparsers(required=True)
@@ -67,6 +68,7 @@ def _main(argv: list[str]) -> int:
     add_calibrate_parser(sub)
     add_broad_parser(sub)
     add_campaign_parser(sub)
+    add_run_parser(sub)
     args = parser.parse_args(argv)
     return int(args.func(args))
 
@@ -178,6 +180,46 @@ def fmu_picture(ctx: dict[str, Path], path: Path) -> None:
         plot_example.plot(plot_example.read(out),
                           plot_example.read(REPO / "examples" / "tilt_motion_truth.csv"),
                           "AngleBiasKalmanFilter.fmu on examples/tilt_motion.csv", path)
+
+
+def readme_contract(ctx: dict[str, Path]) -> str:
+    """README.md: what `make run` states (`imu-fusion run` on the FMUs of ctx["fmus"], the
+    defaults, the realistic sensor): its checks on one part and over PARTS parts, and each
+    check over parts not met, by how and scenario."""
+    import json
+
+    from .parts import HOW, PARTS
+
+    with tempfile.TemporaryDirectory() as tmp:
+        argv = ["run", "--fmu-dir", str(ctx["fmus"]), "--out", tmp, "--no-plots"]
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            _main(argv)  # exit status 1 where a check FAILs: the figure says which
+        report = json.loads((Path(tmp) / "report.json").read_text(encoding="utf-8"))
+    checks = report["checks"] + [c for r in report["runs"] for c in r["checks"]]
+    over = [c for c in checks if c["name"].startswith(f"accuracy over {PARTS} parts")]
+    one = [c for c in checks if c not in over]
+    missed = []
+    for how, share in HOW.values():
+        scenarios: dict[str, list[str]] = {}
+        for c in over:
+            head, _, what = c["name"].partition(": ")
+            if c["passed"] or not head.endswith(how):
+                continue
+            key, scenario = what.split(" ", 1)
+            scenarios.setdefault(scenario, []).append(f"{key} {c['measured']:.0f} %")
+        if scenarios:
+            missed.append(f"{how} ({100 * share:.0f} % of parts asked): " + "; ".join(
+                f"`{sc}` {', '.join(cells)}" for sc, cells in scenarios.items()))
+    count = lambda cs: f"{sum(c['passed'] for c in cs)} of {len(cs)}"  # noqa: E731
+    text = (f"- **The contract**: `make run` states {len(checks)} checks with the defaults on "
+            f"the realistic sensor: on one part (seed 0, through the FMUs) {count(one)} PASS; "
+            f"over {PARTS} parts (the share of parts within each accuracy bound, as delivered "
+            f"and calibrated first) {count(over)} PASS.")
+    if missed:
+        text += " Not met yet, the share of parts within: " + "; ".join(missed) + "."
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, 96, subsequent_indent="  ", break_on_hyphens=False))
 
 
 def parts_table(ctx: dict[str, Path]) -> str:
@@ -770,6 +812,8 @@ FIGURES: tuple[Figure, ...] = (
         ESTIMATE_ARGS) + " --no-plots", estimate_output),
     Figure("estimate-picture", "docs/guide/estimate.md", "imu-fusion " + " ".join(
         ESTIMATE_ARGS), estimate_picture, "docs/estimate_example.png"),
+    Figure("readme-contract", "README.md", "make run (imu-fusion run --fmu-dir dist)",
+           readme_contract, needs=("fmus",)),
     Figure("contract-parts", "docs/results/contract.md", "imu-fusion run (its checks over 20 "
            "parts; testbenches.parts.parts_table)", parts_table),
     Figure("calibrated-parts", "docs/results/calibration.md",

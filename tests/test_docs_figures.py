@@ -38,8 +38,8 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
     return ctx
 
 
-HEAVY = ("engines-table", "contract-parts", "embedded-table", "campaigns-scenarios",
-         "broad-scale-parts",
+HEAVY = ("engines-table", "contract-parts", "readme-contract", "embedded-table",
+         "campaigns-scenarios", "broad-scale-parts",
          *(f.name for f in figs.FIGURES if f.name.startswith("battery-")))
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
 SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "campaigns-makefile",
