@@ -786,6 +786,27 @@ def mechanisms_table(ctx: dict[str, Path]) -> str:
     return worth_table(measure(trials, groups, list(ATTITUDE_FILTERS), MECHANISMS, PARTS))
 
 
+def mechanisms_count(ctx: dict[str, Path]) -> str:
+    """docs/results/mechanisms.md: per attitude filter, the values its defaults take from data
+    (broad.cv.CV_GRID's parameters it has, chosen by the cross-validation) and the mechanisms
+    kept and dropped by `imu-fusion mechanisms` (each a keep-or-drop choice made on data)."""
+    from fusion_core.registry import ATTITUDE_FILTERS, ESTIMATORS
+
+    from .broad.cv import CV_GRID
+    from .mechanisms import MECHANISMS
+
+    rows = ["| estimator | scanned values (`broad --cv`) | mechanisms on | dropped |",
+            "|---|---|---|---|"]
+    for key in ATTITUDE_FILTERS:
+        specs = ESTIMATORS[key].param_specs()
+        grid = [name for name in CV_GRID if name in specs]
+        on = [m.name for m in MECHANISMS if m.applies(key)]
+        off = [m.name for m in MECHANISMS if m.dropped(key)]
+        rows.append(f"| {key} | {len(grid)}: {', '.join(grid)} | {len(on)}: {', '.join(on)} | "
+                    f"{len(off)}: {', '.join(off) or '-'} |")
+    return "\n".join(rows)
+
+
 def _battery_figures() -> tuple[Figure, ...]:
     from .battery import MOTIONS
 
@@ -872,6 +893,8 @@ FIGURES: tuple[Figure, ...] = (
     Figure("broad-scale-parts", "docs/results/broad.md",
            "imu-fusion run --estimator ukf --scenario moderate_dynamics --seeds 40 --sensor "
            "SENSOR.json --peers vqf --no-contract", scale_parts_table, needs=("vqf",)),
+    Figure("mechanisms-count", "docs/results/mechanisms.md", "imu-fusion mechanisms --help; "
+           "imu-fusion broad --help (the grid)", mechanisms_count),
     Figure("mechanisms-table", "docs/results/mechanisms.md", "imu-fusion mechanisms DIR",
            mechanisms_table, needs=("broad",)),
 )

@@ -2,8 +2,9 @@
 worth on recordings it was not chosen on.
 
 A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the longer vector, the
-scale-error process noise, rest detection and its turn-on rule, the bias gates) is switched off
-by the parameter values that turn it off, everything else at the
+scale-error process noise, rest detection and its turn-on rule, the bias gates, the
+accelerometer gate) on by default is switched off by the parameter values that turn it off,
+everything else at the
 recommended values, and the filter is scored with and without it two ways:
 
 - **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
@@ -64,6 +65,14 @@ class Mechanism:
         specs = ESTIMATORS[key].param_specs()
         return all(p in specs and specs[p].default != v for p, v in self.off.items())
 
+    def dropped(self, key: str) -> bool:
+        """Whether estimator `key` has its parameters with every one at its off value by
+        default: a mechanism this test dropped from its defaults."""
+        from fusion_core.registry import ESTIMATORS
+
+        specs = ESTIMATORS[key].param_specs()
+        return all(p in specs and specs[p].default == v for p, v in self.off.items())
+
 
 MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("prefilter", "the accelerometer pre-filter in a frame turning with the gyro, with "
@@ -85,11 +94,13 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("bias_gates", "both gates on bias learning at once (bias_gate 0, bias_innovation "
               "pi): each covers much of what the other does", {"bias_gate": 0.0,
                                                                 "bias_innovation": math.pi}),
+    Mechanism("acc_gate", "no correction from a sample whose norm is outside gate_low-gate_high "
+              "g (gate_low 0, gate_high 1000)", {"gate_low": 0.0, "gate_high": 1000.0}),
 )
 """Every mechanism the recommended attitude filters have on top of their paper's filter that a
-parameter switches off. Dropped by this test and off by default, their parameters kept for a
-user's own values: the accelerometer gate of cf and kf (building_blocks.ACC_GATE_PARAMS), the
-UKF's bias gate (ukf.UKF_BIAS_GATE_PARAM)."""
+parameter switches off, and those this test dropped (off by default, Mechanism.dropped; their
+parameters kept for a user's own values): the accelerometer gate of cf and kf
+(building_blocks.ACC_GATE_PARAMS), the UKF's bias gate (ukf.UKF_BIAS_GATE_PARAM)."""
 BY_NAME = {m.name: m for m in MECHANISMS}
 
 
