@@ -4,6 +4,7 @@ memory error under valgrind. Skipped, with the reason, where the twin cannot be 
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -117,6 +118,21 @@ def test_backend_names_are_checked_and_auto_falls_back_to_python() -> None:
         Tuned().run(rec["acc"][:5], rec["gyro"][:5], rec["dt"][:5], backend="native")
     auto = Tuned().run(rec["acc"][:50], rec["gyro"][:50], rec["dt"][:50])
     assert np.isfinite(auto["roll"]).all()
+
+
+def test_every_twin_of_the_registry_is_in_the_library_by_its_files_alone() -> None:
+    """library.SOURCES and HEADERS come from the directory (no hand list to extend): every
+    class's TWIN prefix names a source and a header there, each header after those it
+    includes."""
+    from fusion_core.native import library
+    from fusion_core.registry import CLASSES
+
+    for cls in CLASSES:
+        assert f"{cls.TWIN}.c" in library.SOURCES and f"{cls.TWIN}.h" in library.HEADERS
+    for i, name in enumerate(library.HEADERS):
+        text = (library.HERE / name).read_text()
+        for included in re.findall(r'#include "(fc_\w+\.h)"', text):
+            assert included in library.DATA_HEADERS or included in library.HEADERS[:i], name
 
 
 def test_available_and_reason_agree() -> None:

@@ -14,20 +14,41 @@ from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve().parent
-SOURCES = (
-    "fc_core.c", "fc_noise.c", "fc_paper_cf.c", "fc_paper_mgcf.c", "fc_paper_kf.c",
-    "fc_paper_ukf.c", "fc_paper_poskf.c", "fc_cf.c", "fc_mgcf.c", "fc_kf.c", "fc_ukf.c",
-    "fc_poskf.c", "fc_sensor.c", "fc_plant.c", "fc_state.c", "fc_state_tables.c",
-)
-"""The C sources, in link order."""
-HEADERS = (
-    "fc_core.h", "fc_noise.h", "fc_params.h", "fc_state.h", "fc_paper_cf.h", "fc_paper_mgcf.h",
-    "fc_paper_kf.h", "fc_paper_ukf.h", "fc_paper_poskf.h", "fc_cf.h", "fc_mgcf.h", "fc_kf.h",
-    "fc_ukf.h", "fc_poskf.h", "fc_sensor.h", "fc_plant.h",
-)
-"""The headers, in the order the binding declares them."""
 DATA_HEADERS = ("fc_scenarios.h", "fc_real.h")
 """Headers the binding does not declare, compiled in: the scenarios' signal nodes, the real type."""
+EXTENSION_SOURCES = ("fc_stream_ext.c",)
+"""C sources of the directory that are not the library (the stream's CPython entry point)."""
+
+
+def _sources() -> tuple[str, ...]:
+    """Every fc_*.c of the twin's directory but the extension: a new twin (the prefix a class's
+    TWIN names) joins the library by its files alone."""
+    return tuple(sorted(p.name for p in HERE.glob("fc_*.c") if p.name not in EXTENSION_SOURCES))
+
+
+def _headers() -> tuple[str, ...]:
+    """Every fc_*.h but DATA_HEADERS, each after the headers it includes (the binding declares
+    a type before its use), else by name."""
+    names = sorted(p.name for p in HERE.glob("fc_*.h") if p.name not in DATA_HEADERS)
+    includes = {n: [m for m in re.findall(r'#include "(fc_\w+\.h)"', (HERE / n).read_text())
+                    if m in names] for n in names}
+    order: list[str] = []
+
+    def visit(name: str) -> None:
+        if name not in order:
+            for included in includes[name]:
+                visit(included)
+            order.append(name)
+
+    for name in names:
+        visit(name)
+    return tuple(order)
+
+
+SOURCES = _sources()
+"""The library's C sources."""
+HEADERS = _headers()
+"""The headers, in the order the binding declares them."""
 CFLAGS = ("-std=c99", "-O2", "-fno-semantic-interposition", "-fPIC", "-shared",
           "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
