@@ -172,6 +172,15 @@ class Estimator:
     ZERO_BIAS: ClassVar[dict[str, str]] = {}
     """The bias outputs this filter leaves at 0 whatever it is given, each with the reason (its
     FMU's variable descriptions say it); the others are estimated."""
+    BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = ()
+    """The gyro axes (0 x, 1 y, 2 z) whose bias the filter learns while it moves, not only at
+    rest: those the contract scores the bias error of."""
+    SCANNED: ClassVar[tuple[str, ...]] = ()
+    """The parameters sensor physics fixes nothing for, whose recommended values came from a
+    coarse scan: what `imu-fusion tune` fits by default (the class docstring says why each).
+    The noise-derived ones come from `imu-fusion noise`, the rest detector's thresholds and the
+    pre-filter's time constant are VQF's published values: fitting those too on a handful of
+    recordings fits the recordings' motions, not the sensor."""
     COMMON: ClassVar[tuple[Param, ...]] = COMMON_PARAMS
     """The parameters every estimator shares (a paper's reference filter, which knows no gyro
     range, leaves gyro_range out: fusion_core.papers)."""

@@ -104,6 +104,8 @@ class ComplementaryFilter(Estimator):
         STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_cf"
+    BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = ()
+    SCANNED: ClassVar[tuple[str, ...]] = ("tau",)
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "meas": MEASURE_CHECK, "q_att": UNIT, "bias": REAL,
         "rest": REST,

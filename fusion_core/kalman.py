@@ -232,6 +232,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         KALMAN_MAX_CORRECTION_TIME,
     )
     TWIN: ClassVar[str | None] = "fc_kf"
+    BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1)
+    SCANNED: ClassVar[tuple[str, ...]] = ("Q_bias",)
     ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": Z_BIAS_REST_ONLY}
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "bias_x": REAL, "bias_y": REAL, "P_roll": COV,

@@ -108,6 +108,8 @@ class GainScheduledComplementaryFilter(Estimator):
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
     TWIN: ClassVar[str | None] = "fc_mgcf"
+    BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1, 2)
+    SCANNED: ClassVar[tuple[str, ...]] = ("w0", "zeta")
     STATE: ClassVar[StateSpec] = {
         "q": UNIT, "bias": REAL, "w0_now": NONNEG, "meas": MEASURE_CHECK, "rest": REST,
     }

@@ -135,6 +135,8 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         *TILT_PARAMS,
     )
     TWIN: ClassVar[str | None] = "fc_poskf"
+    BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1)
+    SCANNED: ClassVar[tuple[str, ...]] = ("q",)
     ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": Z_BIAS_REST_ONLY}
     STATE: ClassVar[StateSpec] = {
         "yaw": ANGLE, "states": REAL, "P": COV, "quiet_time": NONNEG, "stationary": FLAG,

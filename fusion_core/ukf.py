@@ -170,6 +170,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         KALMAN_MAX_CORRECTION_TIME,
     )
     TWIN: ClassVar[str | None] = "fc_ukf"
+    BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1, 2)
+    SCANNED: ClassVar[tuple[str, ...]] = ("bias_psd",)
     STATE: ClassVar[StateSpec] = {
         "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "meas": MEASURE_CHECK, "rest": REST,
     }

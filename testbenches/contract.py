@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from fusion_core.registry import KEYS
+from fusion_core.registry import ESTIMATORS, KEYS
 from fusion_core.sensor import SENSOR_PRESETS
 from fusion_core.types import DEG
 
@@ -236,8 +236,7 @@ def compute_metrics(result: Any) -> dict[str, float]:
     )
     bias_true = np.asarray(result.true_gyro_bias)
     bias_est = np.array([result.estimate[f"bias_{a}"][-1] for a in "xyz"])
-    observable = {"cf": [], "kf": [0, 1], "poskf": [0, 1], "mgcf": [0, 1, 2], "ukf": [0, 1, 2]}
-    axes = observable.get(result.estimator, [])
+    axes = list(ESTIMATORS[result.estimator].BIAS_IN_MOTION)
     metrics = {
         "rmse_roll_deg": scored_rmse(err_roll, keep),
         "rmse_pitch_deg": scored_rmse(err_pitch, keep),

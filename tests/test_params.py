@@ -84,3 +84,13 @@ def test_max_dt_below_one_second_accepts_ordinary_samples(key: str) -> None:
     out = make(key, max_dt=0.05).run(rec["acc_meas"], rec["gyro_meas"], rec["dt"])
     rejected = int(out["rejected"].sum())
     assert rejected == 0, f"{rejected} of {len(out['rejected'])} valid samples rejected"
+
+
+@pytest.mark.parametrize("key", KEYS)
+def test_what_a_class_declares_of_its_parameters_and_biases_holds(key: str) -> None:
+    """SCANNED names tunable parameters of the class (what `tune` fits by default), and the
+    axes whose bias it learns in motion (the contract scores them) are outputs it estimates."""
+    cls = estimator_class(key)
+    specs = cls.param_specs()
+    assert cls.SCANNED and all(specs[name].tunable for name in cls.SCANNED)
+    assert all(f"bias_{'xyz'[axis]}" not in cls.ZERO_BIAS for axis in cls.BIAS_IN_MOTION)

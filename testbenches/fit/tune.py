@@ -1,9 +1,10 @@
 """`python -m testbenches tune`: an estimator's tunable parameters fitted to recordings with a
 reference, and checked on others.
 
-By default it fits the parameters physics leaves open (SCANNED); --params names others. The
-objective is the mean inclination RMSE [deg] over the fit recordings (BROAD's metric: the angle
-between the estimated and the reference up direction, over the samples that count), each run
+By default it fits the parameters physics leaves open (the class's Estimator.SCANNED); --params
+names others. The objective is the mean inclination RMSE [deg] over the fit recordings (BROAD's
+metric: the angle between the estimated and the reference up direction, over the samples that
+count), each run
 through fusion_core (the C twin where it is built). Each parameter stays within its allowed
 range and is searched in log space where the range reaches decades above the start (noise
 densities, time constants: a factor matters, not a difference).
@@ -36,24 +37,10 @@ from fusion_core.types import Param
 from ..broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
 from .recording import Recording, RecordingError
 
-SCANNED: dict[str, tuple[str, ...]] = {
-    "cf": ("tau",),
-    "mgcf": ("w0", "zeta"),
-    "kf": ("Q_bias",),
-    "ukf": ("bias_psd",),
-    "poskf": ("q",),
-}
-"""What tune fits by default: the parameters the recommended preset took from a coarse scan,
-because sensor physics fixes nothing for them (the classes' docstrings). The noise-derived ones
-come from `noise`, the rest detector's thresholds and the pre-filter's time constant are VQF's
-published values; fitting them too on a handful of recordings fits the recordings' motions, not
-the sensor (on four BROAD trials all six of mgcf's: fit 0.592 -> 0.551 deg, four other trials
-0.775 -> 0.843 deg). --params all fits every tunable one."""
 MAX_WORSE = 0.03
 """No fit recording may end more than 3 % worse than at the start: a parameter set that buys
 the mean by trading one recording (one kind of motion) for another is what does not carry over
-to other recordings. On four BROAD trials, mgcf's w0 and zeta without this bound: fit 0.592 ->
-0.582 deg, four other trials 0.775 -> 0.830; with it 0.592 -> 0.588 and 0.775 -> 0.786."""
+to other recordings (the validation recordings show it)."""
 PENALTY = 10.0
 """The objective adds PENALTY times every fit recording's excess over its bound [deg]."""
 SPAN = 100.0
@@ -84,7 +71,7 @@ def tunable(key: str, names: Sequence[str] | None = None,
             cls: type[Estimator] | None = None) -> list[Param]:
     """The parameters to fit of estimator key's class cls (the recommended one unless given):
     the named ones (["all"]: every tunable float parameter of the class's PARAMS, not the sample
-    rules or the mounting), by default SCANNED[key] (for a paper's filter: all); ValueError
+    rules or the mounting), by default the class's SCANNED (for a paper's filter: all); ValueError
     naming an unknown or untunable one."""
     cls = cls or ESTIMATORS[key]
     specs = cls.param_specs()
@@ -93,7 +80,7 @@ def tunable(key: str, names: Sequence[str] | None = None,
     if names is not None and list(names) == ["all"]:
         return allowed
     if not names:
-        names = SCANNED[key] if cls is ESTIMATORS[key] else [p.name for p in allowed]
+        names = cls.SCANNED if cls is ESTIMATORS[key] else [p.name for p in allowed]
     out = []
     for name in names:
         if name not in specs:
