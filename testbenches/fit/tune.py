@@ -4,10 +4,9 @@ reference, and checked on others.
 By default it fits the parameters physics leaves open (the class's Estimator.SCANNED); --params
 names others. The objective is the mean inclination RMSE [deg] over the fit recordings (BROAD's
 metric: the angle between the estimated and the reference up direction, over the samples that
-count), each run
-through fusion_core (the C twin where it is built). Each parameter stays within its allowed
-range and is searched in log space where the range reaches decades above the start (noise
-densities, time constants: a factor matters, not a difference).
+count), each run through fusion_core (the C twin where it is built). Each parameter stays
+within its allowed range and is searched in log space where the range reaches decades above the
+start (noise densities, time constants: a factor matters, not a difference).
 
 Method: scipy.optimize.minimize(method="Powell") with bounds. Powell's method needs no
 derivatives (the RMSE of a filter run has none to offer, and is a little rough in its
