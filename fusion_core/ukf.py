@@ -6,7 +6,6 @@ fusion_core.measured_vector around it (UnscentedKalmanFilter).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import ClassVar, Final
 
@@ -64,12 +63,6 @@ ACC_GATE: Final = 1.0
 """The update is skipped while the measured vector's norm is off g by a whole g or more
 (||f|/g - 1| >= 1): a vector of 2 g is no gravity direction, and one near 0 (free fall) none
 either."""
-UKF_BIAS_GATE_PARAM = dataclasses.replace(BIAS_GATE_PARAM, default=0.0)
-"""The kf's bias gate (building_blocks.BIAS_GATE_PARAM), off by default here: the UKF's three
-bias states are consider states while the innovation is beyond bias_innovation or the vector
-unsettled, which catches what the gate would; with the gate on top no error changes on
-recordings its choice did not see (`imu-fusion mechanisms`, docs/results/mechanisms.md), while
-with neither the bias learns from sustained linear acceleration (high_dynamics)."""
 
 
 def measured_covariance(P: tuple[float, ...], X: tuple[float, float, float], var: float,
@@ -111,11 +104,10 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     acceleration that reaches it, capped at max_correction_time), the gyro's scale uncertainty
     while it turns (building_blocks.ADAPTIVE_NOISE_PARAMS), a gyro at its rail (the rate beyond
     it grows Q, no bias is learned), rest detection with a zero-rate update of the bias states
-    (rest_time > 0), and the bias learned only while the measured and the predicted gravity
-    direction are within bias_innovation, the slow band of the measured vector
-    (measured_vector.gate_norm2; without the vector the raw sample) within bias_gate of g (off
-    by default: UKF_BIAS_GATE_PARAM) and the measured vector settled (else the biases are
-    consider states). While the measured vector fills, X
+    (rest_time > 0), and the bias learned only while the slow band of the measured vector
+    (measured_vector.gate_norm2; without the vector the raw sample) is within bias_gate of g,
+    the measured and the predicted gravity direction within bias_innovation and the measured
+    vector settled (else the biases are consider states). While the measured vector fills, X
     is its direction, with that vector's variance and the covariance with the bias of the turn
     a bias error gave its samples, and at the first rest the rest's mean direction with that
     mean's variance and no covariance with the bias, as in the kf (kalman.AngleBiasKalmanFilter;
@@ -163,7 +155,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
-        UKF_BIAS_GATE_PARAM,
+        BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
         BAND_PARAM,
         STRETCH_PARAM,

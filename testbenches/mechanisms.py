@@ -18,15 +18,16 @@ recommended values, and the filter is scored with and without it two ways:
   with (above 1: the mechanism helps) and the worst cell.
 
 - **The contract over parts** (testbenches.parts, as delivered): the accuracy checks that pass
-  with it and fail without. A mechanism the contract needs keeps its place whatever the rest.
+  with it and fail without. A mechanism the contract needs keeps its place whatever the rest;
+  its scenarios count as cells of a battery too (the mean RMSE over the parts without / with).
 
 Otherwise a mechanism keeps its place where BROAD and the battery's mean both say it lowers the
-error, or where neither does but one of the battery's cells needs it (MOTION_CLASS_GAIN); where
-nothing does, it is a candidate to drop; else the table says which way each points. Mechanisms
-can cover for each other (the two bias gates): one switched off at a time shows what the other
-leaves, and `bias_gates` switches both. The
-grid values of the other parameters were chosen with every mechanism on, which favours keeping:
-a mechanism that does not earn its place even so does not earn it.
+error, or where neither does but one of the battery's cells or the contract's scenarios needs it
+(MOTION_CLASS_GAIN); where nothing does, it is a candidate to drop; else the table says which
+way each points. Mechanisms can cover for each other (the two bias gates): one switched off at
+a time shows what the other leaves, and `bias_gates` switches both. The grid values of the
+other parameters were chosen with every mechanism on, which favours keeping: a mechanism that
+does not earn its place even so does not earn it.
 """
 
 from __future__ import annotations
@@ -100,7 +101,7 @@ MECHANISMS: tuple[Mechanism, ...] = (
 """Every mechanism the recommended attitude filters have on top of their paper's filter that a
 parameter switches off, and those this test dropped (off by default, Mechanism.dropped; their
 parameters kept for a user's own values): the accelerometer gate of cf and kf
-(building_blocks.ACC_GATE_PARAMS), the UKF's bias gate (ukf.UKF_BIAS_GATE_PARAM)."""
+(building_blocks.ACC_GATE_PARAMS)."""
 BY_NAME = {m.name: m for m in MECHANISMS}
 
 
@@ -126,6 +127,9 @@ class Worth:
     contract_lost: list[str] | None = None
     """The contract's checks over parts (as delivered) that pass with it and fail without
     (None: not run)."""
+    contract_best: tuple[str, float] = ("", math.nan)
+    """The contract's scenario where it helps most: (scenario, mean RMSE over the parts
+    without / with): the contract's scenarios are a battery of motions too."""
 
     def broad_gain(self) -> float:
         """Cross-validated mean of always dropping it minus that of deciding per fold [deg]."""
@@ -149,6 +153,9 @@ class Worth:
         cell, ratio = self.battery_best
         if ratio >= MOTION_CLASS_GAIN:
             return f"keeps its place for {cell}"
+        scenario, ratio = self.contract_best
+        if ratio >= MOTION_CLASS_GAIN:
+            return f"keeps its place for the contract's {scenario} ({ratio:.2f}x without)"
         return "drop: no gain out of sample"
 
 
@@ -247,17 +254,22 @@ def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
     from .contract import accuracy_limits
     from .parts import HOW, part_rmse, share_within
 
-    def passing(key: str, params: dict[str, float]) -> set[str]:
+    def passing(key: str, params: dict[str, float]) -> tuple[set[str], dict[str, float]]:
         rmse = part_rmse([key], ESTIMATION_SCENARIOS, {}, {}, parts, params,
                          calibrated_first=(False,))
         if progress:
             progress()
-        return {s for (_, _, s), v in rmse.items()
-                if share_within(v, accuracy_limits(key, s)) >= HOW[False][1]}
+        return ({s for (_, _, s), v in rmse.items()
+                 if share_within(v, accuracy_limits(key, s)) >= HOW[False][1]},
+                {s: float(np.mean(v)) for (_, _, s), v in rmse.items()})
 
     base = {key: passing(key, {}) for key in dict.fromkeys(k for k, _ in worth)}
     for (key, name), w in worth.items():
-        w.contract_lost = sorted(base[key] - passing(key, BY_NAME[name].off))
+        passed, mean = passing(key, BY_NAME[name].off)
+        w.contract_lost = sorted(base[key][0] - passed)
+        w.contract_best = max(((s, mean[s] / base[key][1][s]) for s in mean
+                               if base[key][1][s] > 0.0), key=lambda c: c[1],
+                              default=("", math.nan))
 
 
 def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
@@ -375,7 +387,8 @@ def cmd_mechanisms(args: argparse.Namespace) -> int:
                    "battery_off_over_on": w.battery_ratio,
                    "battery_worst_cell": list(w.battery_worst),
                    "battery_best_cell": list(w.battery_best),
-                   "contract_checks_lost": w.contract_lost, "verdict": w.verdict()}
+                   "contract_checks_lost": w.contract_lost,
+                   "contract_best": list(w.contract_best), "verdict": w.verdict()}
                   for w in worth.values()]}, indent=1))
     print(f"written: {args.out}/mechanisms.md, mechanisms.json")
     return 0

@@ -56,6 +56,8 @@ def test_the_verdict_needs_both_ways_of_scoring() -> None:
     level = Worth("kf", "acc_gate", on, dict(on), [], dict(on), battery_ratio=1.001,
                   battery_best=("shaking/worse", 1.05))
     assert level.verdict().startswith("drop")
+    level.contract_best = ("high_dynamics", 1.25)  # a contract scenario is a cell too
+    assert level.verdict().startswith("keeps its place for the contract's high_dynamics")
     level.battery_best = ("slow_combined/mpu6050", 1.3)  # made for one kind of motion
     assert level.verdict() == "keeps its place for slow_combined/mpu6050"
     level.contract_lost = ["high_dynamics"]
