@@ -416,7 +416,6 @@ def write_json(r: dict[str, Any], out_dir: Path) -> Path:
     return path
 
 
-
 DOCS_JSON = Path(__file__).resolve().parents[1] / "docs" / "results" / "speed.json"
 """The full run docs/results/speed.md shows (its block `speed-bench` is format_table of it,
 testbenches.docs_figures.speed_table, checked by tests/test_docs_figures.py)."""

@@ -187,6 +187,7 @@ def readme_contract(ctx: dict[str, Path]) -> str:
     defaults, the realistic sensor): its checks on one part and over PARTS parts, and each
     check over parts not met, by how and scenario."""
     import json
+    import textwrap
 
     from .parts import HOW, PARTS
 
@@ -210,15 +211,15 @@ def readme_contract(ctx: dict[str, Path]) -> str:
         if scenarios:
             missed.append(f"{how} ({100 * share:.0f} % of parts asked): " + "; ".join(
                 f"`{sc}` {', '.join(cells)}" for sc, cells in scenarios.items()))
-    count = lambda cs: f"{sum(c['passed'] for c in cs)} of {len(cs)}"  # noqa: E731
+    def count(cs: list[dict[str, Any]]) -> str:
+        return f"{sum(c['passed'] for c in cs)} of {len(cs)}"
+
     text = (f"- **The contract**: `make run` states {len(checks)} checks with the defaults on "
             f"the realistic sensor: on one part (seed 0, through the FMUs) {count(one)} PASS; "
             f"over {PARTS} parts (the share of parts within each accuracy bound, as delivered "
             f"and calibrated first) {count(over)} PASS.")
     if missed:
         text += " Not met yet, the share of parts within: " + "; ".join(missed) + "."
-    import textwrap
-
     return "\n".join(textwrap.wrap(text, 96, subsequent_indent="  ", break_on_hyphens=False))
 
 
@@ -359,14 +360,12 @@ def speed_table(ctx: dict[str, Path]) -> str:
     from fusion_core.registry import KEYS
 
     report = _bench_report()
-    DOCS_JSON, format_table = report.DOCS_JSON, report.format_table
-
-    r = json.loads(DOCS_JSON.read_text(encoding="utf-8"))
+    r = json.loads(report.DOCS_JSON.read_text(encoding="utf-8"))
     lacking = [k for k in KEYS if k not in r.get("per_sample_us_stream", {})]
     if lacking:
-        raise ValueError(f"{DOCS_JSON} has no figures of {', '.join(lacking)}: measure again "
-                         "with python -m benchmarks --docs")
-    return "```text\n" + format_table(r) + "\n```"
+        raise ValueError(f"{report.DOCS_JSON} has no figures of {', '.join(lacking)}: measure "
+                         "again with python -m benchmarks --docs")
+    return "```text\n" + report.format_table(r) + "\n```"
 
 
 def write_speed(results: dict[str, Any]) -> list[Path]:
@@ -374,12 +373,11 @@ def write_speed(results: dict[str, Any]) -> list[Path]:
     of it (`python -m benchmarks --docs`)."""
     import json
 
-    DOCS_JSON = _bench_report().DOCS_JSON
-    DOCS_JSON.write_text(json.dumps(results, indent=1, allow_nan=False) + "\n",
-                         encoding="utf-8")
-    page = DOCS_JSON.with_name("speed.md")
+    path = _bench_report().DOCS_JSON
+    path.write_text(json.dumps(results, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    page = path.with_name("speed.md")
     replace_block(page, "speed-bench", speed_table({}))
-    return [DOCS_JSON, page]
+    return [path, page]
 
 
 def makefile_campaign() -> list[str]:
@@ -411,11 +409,14 @@ def campaigns_makefile_table(ctx: dict[str, Path]) -> str:
             if _main(argv) != 0:
                 raise RuntimeError(f"python -m testbenches {' '.join(words)} failed")
         rows = [r for r in read_rows(Path(tmp)) if r["status"] == "ok"]
+    cell: dict[tuple[str, str], list[list[float]]] = {}
+    for r in rows:
+        cell.setdefault((r["estimator"], r["scenario"]), []).append(
+            [r["rmse_roll_deg"], r["rmse_pitch_deg"]])
     order = {k: i for i, k in enumerate(KEYS)}  # the registry's order, the Makefile's scenarios
-    keys = sorted({r["estimator"] for r in rows}, key=order.__getitem__)
+    keys = sorted({k for k, _ in cell}, key=order.__getitem__)
     scenarios = words[words.index("--scenario") + 1].split(",")
-    parts = {len([r for r in rows if r["estimator"] == k and r["scenario"] == s])
-             for k in keys for s in scenarios}
+    parts = {len(cell.get((k, s), [])) for k in keys for s in scenarios}
     lines = [f"Parts per cell: {', '.join(map(str, sorted(parts)))}. Cells: roll / pitch mean, "
              "roll / pitch 95th percentile [deg], share of parts within the contract's bound.",
              "", "| estimator | " + " | ".join(scenarios) + " |",
@@ -423,8 +424,7 @@ def campaigns_makefile_table(ctx: dict[str, Path]) -> str:
     for key in keys:
         cells = []
         for scenario in scenarios:
-            v = np.array([[r["rmse_roll_deg"], r["rmse_pitch_deg"]] for r in rows
-                          if r["estimator"] == key and r["scenario"] == scenario])
+            v = np.array(cell[(key, scenario)])
             mean, p95 = v.mean(axis=0), np.percentile(v, 95, axis=0)
             cells.append(f"{mean[0]:.2f}/{mean[1]:.2f}, {p95[0]:.2f}/{p95[1]:.2f}, "
                          f"{_within(v, accuracy_limits(key, scenario)):.0f} %")

@@ -4,8 +4,8 @@ worth on recordings it was not chosen on.
 A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the longer vector, the
 scale-error process noise, rest detection and its turn-on rule, the bias gates, the
 accelerometer gate) on by default is switched off by the parameter values that turn it off,
-everything else at the
-recommended values, and the filter is scored with and without it two ways:
+everything else at the recommended values, and the filter is scored with and without it two
+ways:
 
 - **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
   on three folds' trials, by the rule `broad --cv` chooses grid points with (the smallest regret
@@ -57,22 +57,28 @@ class Mechanism:
     what: str
     off: dict[str, float]
 
+    def _at_off(self, key: str) -> list[bool] | None:
+        """For each parameter that switches it off, whether estimator `key`'s default is
+        already its off value; None where the estimator lacks one of them."""
+        from fusion_core.registry import ESTIMATORS
+
+        specs = ESTIMATORS[key].param_specs()
+        if not all(p in specs for p in self.off):
+            return None
+        return [specs[p].default == v for p, v in self.off.items()]
+
     def applies(self, key: str) -> bool:
         """Whether estimator `key` has it on by default: every parameter that switches it off,
         none of them at its off value already (a mechanism dropped from the defaults, or a pair
         of which one is dropped, is not scored again)."""
-        from fusion_core.registry import ESTIMATORS
-
-        specs = ESTIMATORS[key].param_specs()
-        return all(p in specs and specs[p].default != v for p, v in self.off.items())
+        at_off = self._at_off(key)
+        return at_off is not None and not any(at_off)
 
     def dropped(self, key: str) -> bool:
         """Whether estimator `key` has its parameters with every one at its off value by
         default: a mechanism this test dropped from its defaults."""
-        from fusion_core.registry import ESTIMATORS
-
-        specs = ESTIMATORS[key].param_specs()
-        return all(p in specs and specs[p].default == v for p, v in self.off.items())
+        at_off = self._at_off(key)
+        return at_off is not None and all(at_off)
 
 
 MECHANISMS: tuple[Mechanism, ...] = (
