@@ -85,6 +85,9 @@ def test_noise_gives_an_uncalibrated_part_a_bias_prior_of_its_turn_on_spread(tmp
         preset = load_preset(tmp_path / "out" / "preset.json")
         assert preset["kf"]["init_bias_std"] == pytest.approx(prior)
         assert preset["ukf"]["init_bias_std"] == pytest.approx(prior)
+    with pytest.raises(ValueError, match=r"would not load.*--gyro-bias-std"):  # beyond any prior
+        run_noise(rec, tmp_path / "absurd", plots=False, gyro_bias_std=1e6 * DEG)
+    assert not (tmp_path / "absurd").exists()
 
 
 def test_noise_refuses_a_recording_that_is_not_static(tmp_path):

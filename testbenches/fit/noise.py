@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from fusion_core.presets import noise_preset
+from fusion_core.registry import create
 from fusion_core.types import DEG, GYRO_RANGE_DEFAULT, G
 
 from .allan import AllanFit, allan_deviation, fit
@@ -180,9 +181,16 @@ def run_noise(rec: Recording, out_dir: Path, plots: bool = True,
     noise["units"]["gyro_range"] = "rad/s"
     noise["gyro_bias_std"] = gyro_bias_std
     noise["units"]["gyro_bias_std"] = "rad/s"
+    preset = preset_for(noise)
+    for key, params in preset.items():  # a preset no estimator takes is refused, not written
+        try:
+            create(key, params)
+        except ValueError as err:
+            raise ValueError(f"{rec.name}: the preset for {key} would not load ({err}): check "
+                             "--gyro-range and --gyro-bias-std") from None
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "noise.json").write_text(json.dumps(noise, indent=1))
-    (out_dir / "preset.json").write_text(json.dumps(preset_for(noise), indent=1))
+    (out_dir / "preset.json").write_text(json.dumps(preset, indent=1))
     (out_dir / "sensor.json").write_text(json.dumps(sensor_params(noise), indent=1))
     if plots:
         plot(fits, out_dir / "allan.png",
