@@ -495,6 +495,127 @@ def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
     return "\n".join(rows)
 
 
+def broad_gyro_table(ctx: dict[str, Path]) -> str:
+    """Each BROAD trial's gyro against its reference, no estimator involved
+    (testbenches.broad.gyro, as `--gyro-fit` prints it): its lag, the fit's residual per window
+    at no lag and at the lag, its bias, scale and largest cross-axis errors."""
+    from .broad.gyro import fit_delay, fit_gyro
+    from .mechanisms import load_trials
+
+    trials, _ = load_trials([ctx["broad"]])
+    rows = ["| trial | lag [ms] | residual per window, no lag -> lag [deg] | bias x/y/z [deg/s] "
+            "| scale errors x/y/z [%] | largest cross-axis [%] |", "|---|---|---|---|---|---|"]
+    for trial in trials:
+        lag = fit_delay(trial).as_dict()
+        fit = fit_gyro(trial).as_dict()
+        bias = " / ".join(f"{v:+.2f}" for v in fit["bias_dps"])
+        scale = " / ".join(f"{v:+.2f}" for v in fit["scale_error_pct"])
+        rows.append(f"| {trial.name} | {lag['delay_ms']:.2f} | "
+                    f"{lag['residual_deg_at_zero']:.3f} -> {lag['residual_deg_at_delay']:.3f} | "
+                    f"{bias} | {scale} | {fit['max_abs_cross_axis_pct']:.2f} |")
+    return "\n".join(rows)
+
+
+CONSTANT_NOISE = {"gyro_scale_std": 0.0, "disturbance_time": 0.0}
+"""The papers' constant measurement and process noise: no gyro scale uncertainty, no measured
+disturbance."""
+
+
+def constant_noise_table(ctx: dict[str, Path]) -> str:
+    """docs/results/contract.md: the sweeps and high_dynamics on seed 0's part, each attitude
+    filter with its defaults and with constant noise (CONSTANT_NOISE), against the bound."""
+    from fusion_core.presets import load_preset
+    from fusion_core.sensor import sensor_preset
+
+    from .contract import accuracy_limits
+    from .parts import part_rmse
+
+    keys, scenarios = ["cf", "mgcf", "kf", "ukf"], ["roll_sweep", "pitch_sweep", "high_dynamics"]
+    preset, sensor = load_preset("recommended"), sensor_preset("realistic")
+    default = part_rmse(keys, scenarios, preset, sensor, 1, calibrated_first=(False,))
+    constant = part_rmse(keys, scenarios, preset, sensor, 1, CONSTANT_NOISE,
+                         calibrated_first=(False,))
+    pair = lambda v: f"{v[0]:.2f}/{v[1]:.2f}"  # noqa: E731
+    rows = ["| scenario (bound) | filter | defaults | constant noise |", "|---|---|---|---|"]
+    for scenario in scenarios:
+        bound = pair(accuracy_limits("kf", scenario))
+        for key in keys:
+            k = (False, key, scenario)
+            rows.append(f"| {scenario} ({bound}) | {key} | {pair(default[k][0])} | "
+                        f"{pair(constant[k][0])} |")
+    return "\n".join(rows)
+
+
+def broad_noise_table(ctx: dict[str, Path]) -> str:
+    """docs/guide/own-sensor.md: `imu-fusion noise` on each BROAD trial's rest segment, over the
+    13 trials, beside the reference sensor's values the recommended defaults are derived from
+    (fusion_core.presets.noise_preset)."""
+    from fusion_core import DEG
+    from fusion_core.building_blocks.sampling import REAL_GYRO_DENSITY
+    from fusion_core.position import REAL_ACC_DENSITY
+    from fusion_core.presets import REFERENCE_ACC_SAMPLE_STD
+
+    from .fit.noise import analyse
+    from .fit.recording import rest, trial_recording
+    from .mechanisms import load_trials
+
+    trials, _ = load_trials([ctx["broad"]])
+    found = [analyse(rest(trial_recording(t)))[0] for t in trials]
+    rests = [f["recording"]["duration_s"] for f in found]
+    rows = ["| quantity (rest segments of " + f"{rests and min(rests):.0f}-{max(rests):.0f} s) "
+            "| lowest | median | highest | the recommended defaults' |", "|---|---|---|---|---|"]
+    for label, values, default in (
+            ("gyro density [deg/s/sqrt(Hz)]",
+             [f["gyro_density"]["mean"] / DEG for f in found], REAL_GYRO_DENSITY / DEG),
+            ("accelerometer density [m/s^2/sqrt(Hz)]",
+             [f["acc_density"]["mean"] for f in found], REAL_ACC_DENSITY),
+            ("one accelerometer sample's std [m/s^2]",
+             [f["acc_sample_std"] for f in found], REFERENCE_ACC_SAMPLE_STD)):
+        rows.append(f"| {label} | {min(values):.2g} | {float(np.median(values)):.2g} | "
+                    f"{max(values):.2g} | {default:.2g} |")
+    return "\n".join(rows)
+
+
+def slow_roll_table(ctx: dict[str, Path]) -> str:
+    from .slow_roll import table
+
+    return table()
+
+
+def recovery_table(ctx: dict[str, Path]) -> str:
+    from .recovery import table
+
+    return table()
+
+
+def uncalibrated_moving_table(ctx: dict[str, Path]) -> str:
+    """docs/guide/own-sensor.md: roll_pitch (never at rest) on UNCALIBRATED_PARTS parts whose
+    gyro and accelerometer were not calibrated at start-up, each filter with the default bias
+    prior and the Kalman filters with one of the part class's turn-on bias (3 deg/s), beside
+    VQF; mean roll/pitch RMSE."""
+    from fusion_core import DEG
+    from fusion_core.presets import load_preset
+    from fusion_core.sensor import sensor_preset
+
+    from .parts import part_rmse, vqf_rmse
+
+    sensor = {**sensor_preset("realistic"), "calibration": "none"}
+    keys, preset = ["cf", "mgcf", "kf", "ukf"], load_preset("recommended")
+    pair = lambda v: f"{v[0]:.1f}/{v[1]:.1f}"  # noqa: E731
+    default = part_rmse(keys, ["roll_pitch"], preset, sensor, UNCALIBRATED_PARTS,
+                        calibrated_first=(False,))
+    wide = part_rmse(["kf", "ukf"], ["roll_pitch"], preset, sensor, UNCALIBRATED_PARTS,
+                     {"init_bias_std": 3.0 * DEG}, calibrated_first=(False,))
+    rows = ["| filter | default `init_bias_std` | `init_bias_std` 3 deg/s |", "|---|---|---|"]
+    for key in keys:
+        k = (False, key, "roll_pitch")
+        rows.append(f"| {key} | {pair(default[k].mean(axis=0))} | "
+                    f"{pair(wide[k].mean(axis=0)) if k in wide else ''} |")
+    rows.append(f"| VQF | {pair(vqf_rmse('roll_pitch', sensor, UNCALIBRATED_PARTS).mean(axis=0))}"
+                " | |")
+    return "\n".join(rows)
+
+
 MEAN_OF_PARTS = ("shaking", "gyro_clipping")
 """Scenarios whose bound is VQF's mean over 20 parts: their rows are means over those parts."""
 
@@ -859,9 +980,24 @@ FIGURES: tuple[Figure, ...] = (
            "python -m testbenches run --scenario static_tilted --seeds 40 --sensor "
            "uncalibrated.json --peers vqf [--param rest_bias_bound=0] --no-contract",
            uncalibrated_rest_table, needs=("vqf",)),
+    Figure("uncalibrated-moving", "docs/guide/own-sensor.md",
+           "python -m testbenches run --scenario roll_pitch --seeds 40 --sensor "
+           "uncalibrated.json --peers vqf [--param init_bias_std=0.0524] --no-contract",
+           uncalibrated_moving_table, needs=("vqf",)),
     Figure("contract-vqf", "docs/results/contract.md",
            "python -m testbenches run --peers vqf (shaking, gyro_clipping: --seeds 20)",
            vqf_contract_table, needs=("vqf",)),
+    Figure("robustness-recovery", "docs/results/robustness.md", "python -m testbenches.recovery",
+           recovery_table),
+    Figure("contract-constant-noise", "docs/results/contract.md",
+           "python -m testbenches run --scenario roll_sweep,pitch_sweep,high_dynamics "
+           "--no-contract [--param gyro_scale_std=0 --param disturbance_time=0]",
+           constant_noise_table),
+    Figure("broad-noise", "docs/guide/own-sensor.md",
+           "imu-fusion noise TRIAL (each BROAD trial's rest segment)", broad_noise_table,
+           needs=("broad",)),
+    Figure("slow-roll", "docs/guide/own-sensor.md", "python -m testbenches.slow_roll",
+           slow_roll_table, needs=("vqf",)),
     Figure("budget-excerpt", "docs/results/contract.md",
            "python -m testbenches budget --estimator ... --scenario ... (seeds 0-2)",
            budget_excerpt),
@@ -890,6 +1026,9 @@ FIGURES: tuple[Figure, ...] = (
     Figure("broad-moderate", "docs/results/broad.md",
            "imu-fusion run --scenario moderate_dynamics --no-contract --preset PRESET --sensor "
            "SENSOR", moderate_presets_table),
+    Figure("broad-gyro", "docs/results/broad.md",
+           "imu-fusion broad DIR --gyro-fit (the lag and fit of each trial's gyro)",
+           broad_gyro_table, needs=("broad",)),
     Figure("broad-scale-parts", "docs/results/broad.md",
            "imu-fusion run --estimator ukf --scenario moderate_dynamics --seeds 40 --sensor "
            "SENSOR.json --peers vqf --no-contract", scale_parts_table, needs=("vqf",)),

@@ -99,3 +99,36 @@ def test_a_picture_changed_on_purpose_is_caught(tmp_path: Path) -> None:
     shutil.copy(out / "tilt_motion.png", shown)
     problem = figs.check(figure, {}, root=tmp_path)
     assert problem is not None and "of its pixels differ" in problem
+
+
+MEASURED = re.compile(r"\d+\.\d+/\d+\.\d+\s*deg(?!/)|\d+\.\d+\s*->\s*\d+\.\d+\s*deg(?!/)"
+                      r"|\d\.\d{3,}\s*deg(?!/)")
+"""What a measured accuracy looks like in prose: a roll/pitch pair in deg, a before -> after in
+deg, a figure in deg to a thousandth. Such a figure belongs in a generated block."""
+
+
+def _prose(text: str) -> str:
+    """A page without its generated blocks and code blocks (blank lines in their place)."""
+    blank = lambda m: "\n" * m.group(0).count("\n")  # noqa: E731
+    text = re.sub(r"<!-- generated: ([\w-]+) -->.*?<!-- end generated: \1 -->", blank, text,
+                  flags=re.S)
+    return re.sub(r"```.*?```", blank, text, flags=re.S)
+
+
+def test_no_page_quotes_a_measured_accuracy_outside_a_generated_block() -> None:
+    """A measured figure typed into prose goes stale with the next change of a default; the
+    pages refer to their generated tables instead."""
+    found = []
+    for page in [REPO / "README.md", *sorted((REPO / "docs").rglob("*.md"))]:
+        for number, line in enumerate(_prose(page.read_text(encoding="utf-8")).splitlines(), 1):
+            if MEASURED.search(line):
+                found.append(f"{page.relative_to(REPO)}:{number}: {line.strip()}")
+    assert not found, "measured figures in prose:\n" + "\n".join(found)
+
+
+def test_the_prose_check_sees_a_typed_figure() -> None:
+    page = ("kf 0.17/0.28 deg against 0.17/0.24\n<!-- generated: x -->\n0.50/0.40 deg\n"
+            "<!-- end generated: x -->\nfrom 0.507 to 0.524 deg, 1.33 -> 0.40 deg, 0.005 deg/s\n")
+    hits = [line for line in _prose(page).splitlines() if MEASURED.search(line)]
+    assert hits == ["kf 0.17/0.28 deg against 0.17/0.24",
+                    "from 0.507 to 0.524 deg, 1.33 -> 0.40 deg, 0.005 deg/s"]
