@@ -174,13 +174,13 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     While the measured vector fills (its first acc_lowpass, a mean of the turned samples so far)
     the angles are its tilt, as the complementary filters' are: a first sample taken in a moving
     hand is off by its linear acceleration, and corrected with the noise of a settled vector it
-    stays so for tens of seconds (on a hand-held start 2.5 deg RMS instead of 1.0, VQF 0.9:
-    tests/test_start_alignment.py). Their variance is then the vector's: one sample's averaged
+    stays so for tens of seconds (tests/test_start_alignment.py holds a hand-held start near
+    VQF's). Their variance is then the vector's: one sample's averaged
     over the fill, the disturbance that reaches it, and the turn a bias error b gives it over
     its samples' mean age (b age), whose covariance with the bias is -age P_bias, as the
     propagation's is -t P_bias (without it an uncalibrated gyro's first corrections after the
-    fill move the bias by the vector's own turn: 40 parts that never rest, init_bias_std 3
-    deg/s, 5.8 deg instead of 3.1). At the first rest the angles are the rest's tilt and their
+    fill move the bias by the vector's own turn: docs/guide/own-sensor.md, parts that never
+    rest). At the first rest the angles are the rest's tilt and their
     variance that of its mean (building_blocks.rest_mean_share), with no covariance with a bias
     they were not measured with; a vector still filling then leaves them.
 

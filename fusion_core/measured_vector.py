@@ -31,11 +31,8 @@ Four things follow, and this module is each of them:
    g sigma |w| times the difference of their delays. That is no linear acceleration, and the
    process noise already holds it (ADAPTIVE_NOISE_PARAMS' rotation term), so the statistic
    leaves it out: counted as disturbance, it slows the correction in exactly the rotations
-   where a gyro's scale error asks for a faster one (the realistic sensor's high_dynamics, seed
-   0: kf 2.17/3.41 deg with it counted, 2.02/3.21 without; on BROAD's 13 trials, whose gyro's
-   scale errors are smaller, the cross-validated means move by at most 0.003 deg either way:
-   `python -m testbenches broad DIR --cv`). The
-   statistic rises within DISTURBANCE_ATTACK (a disturbance that starts counts before a filter
+   where a gyro's scale error asks for a faster one (the realistic sensor's high_dynamics).
+   The statistic rises within DISTURBANCE_ATTACK (a disturbance that starts counts before a filter
    learns a gyro bias from it) and decays over disturbance_time.
 3. A gyro sample at its rail (the sensor's gyro_range, base.Estimator) is no measurement of the
    rate: the vectors turned with it are wrong by the rate beyond the rail, as the attitude is.
@@ -43,25 +40,24 @@ Four things follow, and this module is each of them:
    the accelerometer until it has reached the full length: until then the vector holds samples
    turned by the rotation the gyro did not measure. The vector itself goes on: started again
    from the sample at the rail it would be that one sample's tilt, and on the synthetic
-   gyro_clipping scenario the complementary filter's error was three times larger so.
+   gyro_clipping scenario the complementary filter's error would be several times larger.
 
 4. The vector grows longer (up to acc_lowpass_stretch times, STRETCH_PARAM) where linear
    acceleration slower than it reaches it: a hand carrying a turning sensor back and forth with
    periods of 5-8 s passes a 1.5 s vector at about two thirds of its amplitude, and the filters
-   then trust a vector degrees off (BROAD's combined trial 32: VQF, whose vector is 3 s long,
-   0.56 deg, the kf 0.78). A longer vector costs in two ways. It turns with the gyro's scale
+   then trust a vector degrees off (BROAD's combined trial 32, where VQF's 3 s vector is
+   ahead). A longer vector costs in two ways. It turns with the gyro's scale
    error for longer, so it grows only by the share of the slow band that the turn of the longer
    vector would not explain (`stretched`, with the mean square rate over a stage, `rate2`): in
    BROAD's rotation trials and in the contract's sweeps it keeps its length. And it turns with
    the estimated gyro bias for longer: the attitude and the vector then drift together, and the
    innovation a bias error leaves shrinks from the correction time to the correction time less
-   the vector's lag, so a bias learned wrongly is unlearned more slowly. A filter started in a
-   moving hand learns 0.2-0.3 deg/s of bias from its first seconds, and with a 3 s vector it
-   kept 0.9 deg of error after 10 s instead of 0.4 (tests/test_start_alignment.py). So the
-   vector grows only once a rest has measured the bias (the filters' rest detector,
-   `bias_measured`), as at the start of most recordings and of every BROAD trial.
-   Measured with the defaults (`python -m testbenches broad DIR --cv`, the 13 shared trials):
-   docs/results/broad.md.
+   the vector's lag, so a bias learned wrongly is unlearned more slowly: a filter started in a
+   moving hand learns a wrong bias from its first seconds, and a long vector keeps it
+   (tests/test_start_alignment.py). So the vector grows only once a rest has measured the bias
+   (the filters' rest detector, `bias_measured`), as at the start of most recordings and of
+   every BROAD trial. What each of these is worth out of sample: docs/results/mechanisms.md
+   (`imu-fusion mechanisms`).
 
 The statistic of the adaptive length (`dist`: the raw sample against the full-length reference)
 is the first-order pre-filter's, kept: it decides whether there is anything to average.
@@ -293,12 +289,10 @@ def gate_norm2(m: Measure, c: MeasureConstants, raw2: float) -> float:
     sustained for a second or more shows in its norm, while a shaking hand's 3-8 Hz, which
     keeps the raw sample's norm off g at almost every sample and which the vector does not
     hold, leaves the bias free to learn what a start-up calibration left (0.16 deg/s on the
-    realistic sensor, 0.5-1.3 deg of tilt over a shaking's correction time). Over 20 parts of
-    the realistic sensor (`python -m testbenches run --scenario shaking,high_dynamics --seeds 20
-    --estimator kf,ukf --no-contract`), roll/pitch RMSE: shaking kf 0.45/0.44 deg against
-    0.56/0.55 with the raw sample's norm, ukf 0.44/0.44 against 0.56/0.56; high_dynamics kf
-    2.65/3.77 against 3.06/3.77, ukf 2.46/4.07 against 2.69/4.11; vibration kf 0.17/0.19
-    against 0.15/0.18; BROAD unchanged (kf 0.511)."""
+    realistic sensor, tenths of a degree of tilt over a shaking's correction time). The
+    contract's shaking and high_dynamics over parts show the difference (`python -m
+    testbenches run --scenario shaking,high_dynamics --seeds 20 --estimator kf,ukf
+    --no-contract`)."""
     if c.dist_tau > 0.0 and c.band > 0.0:
         s0, s1, s2 = m.s
         return s0 * s0 + s1 * s1 + s2 * s2

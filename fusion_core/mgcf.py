@@ -49,7 +49,7 @@ MGCF_ACC_LOWPASS = dataclasses.replace(ACC_LOWPASS_PARAM, default=1.0)
 """The mgcf's acc_lowpass: 1 s, not the 1.5 s of the others. Its integral term (Ki = w0^2)
 learns a bias from every error its correction passes, and a longer vector turned by a gyro with
 scale errors carries more of them: tests/test_paper_rows.py holds the defaults to half the
-paper's row on moderate_dynamics, which 1.5 s leaves in pitch (0.69 against 0.66 deg), and the
+paper's row on moderate_dynamics, which 1.5 s leaves in pitch, and the
 cross-validation on BROAD chooses among the values that keep it (`python -m testbenches broad
 DIR --cv`; testbenches.broad.feasible)."""
 

@@ -12,16 +12,17 @@ from ..types import Param
 
 RECOMMENDED_GYRO_SCALE_STD: Final = 0.005
 """Recommended gyro_scale_std: the scale-factor errors of BROAD's gyro, fitted against its optical
-reference on the nine trials that turn (testbenches.broad.gyro, no estimator involved), are
--0.53 to +0.74 % per axis; an MPU-6050's datasheet tolerance is +-3 % (1 % as 3 sigma)."""
+reference on the nine trials that turn (testbenches.broad.gyro, no estimator involved;
+docs/results/broad.md, "What the errors came from"), are within about half a percent per axis;
+an MPU-6050's datasheet tolerance is +-3 % (1 % as 3 sigma)."""
 
 RECOMMENDED_SCALE_TIME: Final = 0.5
 """Recommended scale_time [s]: how long a scale error adds up in one direction, about one swing
 of a hand-held or robot motion. Physics leaves its exact value open, and two kinds of evidence
-pull it apart: on BROAD (scale errors of at most 0.74 %) every motion fold, chosen without,
-asks for 0.25 s (testbenches.broad.cv.CV_GRID cross-validates it with the other open
-parameters), while the realistic sensor's scenarios (scale errors of 1 %) ask for more (kf
-high_dynamics over 8 parts: 2.59/4.01 deg at 0.25 s, 2.50/3.59 at 0.5, 2.59/3.23 at 1). The
+pull it apart: BROAD's folds (smaller scale errors) ask for less (testbenches.broad.cv.CV_GRID
+cross-validates it with the other open parameters), while the realistic sensor's scenarios
+(scale errors of 1 %) ask for more (`python -m testbenches run --estimator kf --scenario
+high_dynamics --seeds 8 --param scale_time=0.25`, and 1). The
 process noise a scale error adds belongs to the sensor class, which one IMU's recordings cannot
 show; 0.5 s holds on both (docs/results/broad.md)."""
 

@@ -63,8 +63,8 @@ instant: at a still sensor it is the bias, constant to the noise of a 0.5 s mean
 hundredth of a deg/s on a consumer gyro). At the turning point of a slow swing gravity's
 direction stands for a second or so while the rate passes through zero, and the rate's mean
 ramps: a swing of 40 deg at 0.02 Hz ramps it by 0.6 deg/s per second, so without this the
-rest started there and taught the bias the ramp (0.3-0.7 deg/s; a complementary filter then
-4 deg off). A tenth of the rate threshold is the bias error a rest may teach, as above."""
+rest started there and taught the bias the ramp (testbenches.slow_roll). A tenth of the rate
+threshold is the bias error a rest may teach, as above."""
 
 REST_PARAMS: tuple[Param, ...] = (
     Param(
@@ -124,12 +124,12 @@ standard deviations of the gyro's white noise (sqrt(psd / dt) per axis, three ax
 rest by thresholds on smoothed rates (rest_gyro, 2 deg/s) so that noise and a shaky table do not
 end it; a motion that fades in stays below them for a few tenths of a second, and a bias that
 follows the gyro then learns the motion's first turn: on a sensor held in the hand after a rest
-(the realistic MPU-6050, even a perfect one), the kf learned 0.07 deg/s there, which the bias
-gate (linear acceleration keeps the vector's norm off g) then kept for the whole run, 0.42 deg
-of tilt error against VQF's 0.21; with the gate 0.19. A sample of a still gyro is further than
+(the realistic MPU-6050, even a perfect one), a Kalman filter learned a bias there which its
+bias gate (linear acceleration keeps the vector's norm off g) then kept for the whole run
+(tests/test_rest_detection.py, a turn that fades in). A sample of a still gyro is further than
 five sigma from the mean in a few per million; the first samples of a fading-in turn are tens
-of sigma off. A gyro three times noisier than the filter's psd says (the realistic sensor at 5
-times the MPU-6050's density, static_tilted) loses 2.5 % of its rest samples to it."""
+of sigma off. A gyro several times noisier than the filter's psd says loses a few percent of
+its rest samples to it, and still measures its bias."""
 
 CONSTANT_REST_GYRO_VAR: Final = REAL_GYRO_DENSITY * REAL_GYRO_DENSITY
 """The gyro white-noise PSD [rad^2/s] of the filters without a noise model (cf, mgcf) for
@@ -256,11 +256,11 @@ def bias_at_rest(bias: Vec3, gx: float, gy: float, gz: float, dt: float, rest_ti
     mean of the rest's samples, the earlier estimate counting as much as the rest detector's own
     running mean, so that a short rest measures the bias about as well as its length allows;
     then a follower of time constant rest_time. A follower of that time constant from the start
-    had taken 63 % of a start-up calibration's residual (0.16 deg/s on the realistic sensor) by
-    the end of a 3 s rest (76 % now), and the cf on a hand-held motion after such a rest was at
-    0.41 deg against VQF's 0.21 (0.29 now). A shorter start of the memory measures more of a
-    short rest but follows more of the few deg/s at a slow swing's end where a rest is taken
-    too early (tests/test_rest_detection.py: the mgcf leaves its 1 deg there from 0.1 s)."""
+    takes only 1 - 1/e of a bias by the end of rest_time; this one takes more of a short rest
+    (tests/test_rest_detection.py: a 3 s rest measures the bias to 25 %). A shorter start of
+    the memory measures more of a short rest but follows more of the few deg/s at a slow
+    swing's end where a rest is taken too early (tests/test_rest_detection.py: the mgcf leaves
+    its 1 deg there from 0.1 s)."""
     memory = since + REST_MEAN_TAU
     if memory > rest_time:
         memory = rest_time

@@ -52,7 +52,7 @@ def on_the_mark(t: float, dt: float, mark: float) -> float:
     A count reaches its mark at the sample nearest to it, whatever the rounding of the sum: in
     single precision 150 steps of 0.01 s sum to just under 1.5 s, and a measured vector or a
     rest timed by the raw sum ends a sample later than in double, which alone moves the float
-    build's estimate by 0.07 deg on high_dynamics. Counts compared with a mark pass through this
+    build's estimate visibly on high_dynamics. Counts compared with a mark pass through this
     one at each step (measured_vector.measure_step, rest.rest_step)."""
     d = t - mark
     return mark if -0.5 * dt < d < 0.5 * dt else t

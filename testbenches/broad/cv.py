@@ -51,7 +51,7 @@ slow_band_time: the corner between the disturbance the pre-filter removes and th
 reaches the vector (measured_vector.BAND_PARAM); scale_time: how long a gyro's scale error adds
 up in one direction, a property of the motion rather than of the sensor (ADAPTIVE_NOISE_PARAMS),
 from 0.25 s: below it, where BROAD alone would go, the realistic sensor's high_dynamics
-scenario leaves its 5-deg bound at most points (kf 4.34/5.53 deg over 8 parts at 1.5/0.3/0.03),
+scenario leaves its 5-deg bound at most points (cv.json lists the refused points and why),
 and the folds' choices are made among the points that keep the contract anyway
 (cross_validate's constraint); acc_lowpass_stretch: how much longer the vector may grow where
 slow linear acceleration reaches it (measured_vector.STRETCH_PARAM), from off (1) to VQF's

@@ -81,13 +81,14 @@ class BroadTrial:
     gyro_sampling: str = "mean"
     """What the gyro sample is (the estimators' gyro_sampling): BROAD's myon aktos-t delivers
     the mean rate over the interval ending at each sample (integrating the gyro from the optical
-    reference over 0.5 s windows of the fast-rotation trials, the rectangle rule lands 40 %
-    closer to the reference than the trapezoid rule, 1.08 vs 1.77 deg on trial 06)."""
+    reference over 0.5 s windows of the fast-rotation trials, the rectangle rule lands closer
+    to the reference than the trapezoid rule)."""
     sensor_delay: float = 2.4e-3
     """How long the IMU's samples lag the optical reference [s] (the estimators' sensor_delay):
     shifting the gyro's integration window against the reference's rotation
-    (testbenches.broad.gyro.fit_delay) fits best 2.36-2.51 ms later on every one of the 13
-    published trials, mean 2.42 ms (0.69 of a sample), measured without any estimator; the
+    (testbenches.broad.gyro.fit_delay, no estimator involved) fits best about 0.7 of a sample
+    later on every one of the 13 published trials (docs/results/broad.md, "What the errors came
+    from"); the
     sensor's internal filters and the time-stamping of its samples against the cameras', the
     same in every trial. Uncorrected it is an error of rate x delay in every output (0.4 deg at
     180 deg/s)."""
