@@ -13,8 +13,10 @@ The plumbing is written once and shared by every FMU (Reference-FMUs style):
   build.py              building and validating the FMUs (`python build_fmu.py`);
   host.py               a small fmpy host (one instance, one sample per doStep) for tests,
                         examples and benchmarks; not part of an FMU.
-Each FMU is one short module in fmu_src/models/ whose file name is the model name in
-snake_case plus `_fmu` (a unique top-level module name inside every FMU). A new kind of FMU
+Each estimator of fusion_core.registry is an FMU whose slave module is generated from its
+entry (names.py); the plant and the sensor are one short module each in fmu_src/models/, whose
+file name is the model name in snake_case plus `_fmu` (a unique top-level module name inside
+every FMU). A new kind of FMU
 (the plant, the sensor) is a variable table plus a Python object with step, set_parameter,
 get_state and set_state (`slave.Model`); see tests/test_fmu_base.py for a minimal one.
 """

@@ -1,9 +1,10 @@
 """Build and check the project's FMUs (the library behind `python build_fmu.py`).
 
-Every module fmu_src/models/<snake_name>_fmu.py is one model; its model name (and file name) is
-the CamelCase of <snake_name>. Each model is built as up to three kinds of FMU from its one
-variable table: the pythonfmu FMU (out_dir/<Name>.fmu) and the native FMI 2.0 and FMI 3.0 FMUs
-(out_dir/native/fmi2/<Name>.fmu, out_dir/native/fmi3/<Name>.fmu; fmu_src/native).
+The models are fmu_src.names's: every estimator of fusion_core.registry (its slave module
+generated from its entry) and the testbench's plant and sensor (fmu_src/models). Each model is
+built as up to three kinds of FMU from its one variable table: the pythonfmu FMU
+(out_dir/<Name>.fmu) and the native FMI 2.0 and FMI 3.0 FMUs (out_dir/native/fmi2/<Name>.fmu,
+out_dir/native/fmi3/<Name>.fmu; fmu_src/native).
 
 A pythonfmu FMU carries in resources/ its slave module, fusion_core (the Python sources and,
 where a C compiler built it, the C twin's library beside them: its estimators then step through
@@ -24,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .names import PRESET_FILE, script_path
+from .names import PRESET_FILE, write_script
 
 Preset = dict[str, dict[str, Any]]
 """A preset's entries by estimator key (fusion_core.presets.load_preset)."""
@@ -79,9 +80,11 @@ def _ship_native_library(core: Path) -> None:
 def build(name: str, out_dir: Path, preset: Preset | None = None) -> Path:
     """Build the pythonfmu FMU called name into out_dir/<name>.fmu with the preset's estimator
     class and start values (None: the recommended ones) and return its path."""
-    path = build_script(script_path(name), out_dir, preset)
+    with tempfile.TemporaryDirectory(prefix="fmu_script_") as tmp:
+        script = write_script(name, Path(tmp))
+        path = build_script(script, out_dir, preset)
     if path.name != f"{name}.fmu":
-        raise RuntimeError(f"{script_path(name).name} built {path.name}: its class must be {name}")
+        raise RuntimeError(f"{script.name} built {path.name}: its class must be {name}")
     return path
 
 

@@ -49,6 +49,9 @@ class Entry:
     attitude_filter: bool
     """Whether it is one of the attitude filters with a measured vector of its own (cf, mgcf, kf,
     ukf), the ones whose scanned defaults `broad --cv` cross-validates."""
+    fmu_text: str
+    """Its FMU's modelDescription text: what it estimates, after which paper and equations
+    (fmu_src builds the FMU from the entry; a paper's filter adds a note)."""
 
     @property
     def twin(self) -> str | None:
@@ -57,21 +60,34 @@ class Entry:
 
     @property
     def fmu(self) -> str:
-        """The FMU's model name (fmu_src/models)."""
+        """The FMU's model name: the recommended class's name (fmu_src.names)."""
         return self.cls.__name__
 
 
 REGISTRY: tuple[Entry, ...] = (
     Entry("cf", ComplementaryFilter, PaperComplementaryFilter,
-          "complementary filter (Gui et al. 2015)", True),
+          "complementary filter (Gui et al. 2015)", True,
+          "Complementary filter for roll and pitch from a 6-axis IMU: W. Gui, Y. Tang, "
+          "S. Mukhopadhyay (2015), eq. 1-2; Das & Mary, eq. 1. One IMU sample per doStep; "
+          "the gyro bias measured at rest (rest_time > 0) is subtracted and output."),
     Entry("mgcf", GainScheduledComplementaryFilter, PaperGainScheduledFilter,
-          "modified-gain complementary filter (Duong Quoc et al.)", True),
+          "modified-gain complementary filter (Duong Quoc et al.)", True,
+          "Modified-gain (gain-scheduled) complementary filter for roll and pitch: Duong Quoc "
+          "et al., eq. 7-13 (quaternion PI filter of Mahony et al. 2008 with w0 scheduled on "
+          "||acc|/g - 1|). One IMU sample per doStep."),
     Entry("kf", AngleBiasKalmanFilter, PaperKalmanFilter,
-          "2-state angle/bias Kalman filter (Gui et al., Das & Mary)", True),
+          "2-state angle/bias Kalman filter (Gui et al., Das & Mary)", True,
+          "Two-state [angle, gyro bias] Kalman filter for roll and pitch: W. Gui, Y. Tang, "
+          "S. Mukhopadhyay (2015), eq. 5-26; Das & Mary, eq. 16-27. One IMU sample per doStep."),
     Entry("ukf", UnscentedKalmanFilter, PaperUnscentedKalmanFilter,
-          "unscented Kalman filter (Duong Quoc et al.)", True),
+          "unscented Kalman filter (Duong Quoc et al.)", True,
+          "Unscented Kalman filter for roll and pitch on the gravity direction with three "
+          "gyro-bias states: Duong Quoc et al., eq. 14-17. One IMU sample per doStep."),
     Entry("poskf", PositionKalmanFilter, PaperPositionKalmanFilter,
-          "position Kalman filter (Safitri et al.)", False),
+          "position Kalman filter (Safitri et al.)", False,
+          "Position and velocity Kalman filter with a zero-velocity update: Safitri, Cahyadi, "
+          "Firmansyah, eq. 20-29; tilt from the Gui, Tang, Mukhopadhyay (2015) [angle, bias] "
+          "Kalman filter. One IMU sample per doStep."),
 )
 """Every estimator, in the order of the tables."""
 

@@ -294,3 +294,24 @@ def test_two_presets_built_in_one_process_keep_their_own_start_values(tmp_path):
             for p, spec in cls.param_specs().items():
                 if isinstance(spec.default, float):
                     assert float(starts[p]) == spec.default, (preset, name, p)
+
+
+def test_every_registry_estimator_is_an_fmu_built_from_its_entry(tmp_path):
+    """No estimator has a slave module of its own on disk: the registry entry is the FMU
+    (fmu_src.names.estimator_script), so adding an estimator adds its FMU."""
+    from fmu_src.names import MODELS_DIR, estimator_fmus, model_names, write_script
+    from fusion_core.registry import REGISTRY
+
+    assert {e.fmu for e in REGISTRY} <= set(model_names())
+    on_disk = {p.name for p in MODELS_DIR.glob("*_fmu.py")}
+    for entry in REGISTRY:
+        script = write_script(entry.fmu, tmp_path)
+        assert script.name not in on_disk
+        spec = importlib.util.spec_from_file_location(script.stem, script)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        cls = getattr(module, entry.fmu)
+        assert (cls.key, cls.description) == (entry.key, entry.fmu_text)
+    assert estimator_fmus() == {e.fmu: e.key for e in REGISTRY}
+    with pytest.raises(ValueError, match="no FMU called 'Nothing'"):
+        write_script("Nothing", tmp_path)

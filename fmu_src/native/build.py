@@ -47,7 +47,7 @@ from ..model_description import (
     type_definitions,
     unit_definitions,
 )
-from ..names import script_path
+from ..names import MODELS_DIR, estimator_fmus, script_name
 from ..variables import Variable
 
 HERE = Path(__file__).resolve().parent
@@ -147,21 +147,23 @@ def twin_closure(prefix: str) -> tuple[str, ...]:
 
 
 def native_model(name: str, preset: dict[str, dict[str, Any]] | None = None) -> NativeModel:
-    """The NativeModel of the FMU called name (fmu_src/models/<snake>_fmu.py), with the
-    estimator class and start values of the preset's entry for it (None: the recommended
-    ones; fusion_core.presets.load_preset)."""
+    """The NativeModel of the FMU called name (fmu_src.names: an estimator of the registry,
+    with the estimator class and start values of the preset's entry for it, None: the
+    recommended ones, fusion_core.presets.load_preset; or the plant or the sensor)."""
+    from fusion_core.registry import ENTRY
     from fusion_core.sensor import SENSOR_PARAMS
 
     from ..estimator import estimator_table, model_description
 
-    module = importlib.import_module(f"fmu_src.models.{script_path(name).stem}")
-    cls = getattr(module, name)
-    key = getattr(cls, "key", None)
+    key = estimator_fmus().get(name)
     if key is not None:
         estimator, variables = estimator_table(key, (preset or {}).get(key, {}))
         params = tuple(estimator.param_specs().values())
-        return NativeModel(name, model_description(cls.description, estimator), variables,
+        return NativeModel(name, model_description(ENTRY[key].fmu_text, estimator), variables,
                            "estimator", estimator.TWIN or "", params)
+    if not (MODELS_DIR / script_name(name)).is_file():
+        raise ValueError(f"{name} has no native model")
+    cls = getattr(importlib.import_module(f"fmu_src.models.{script_name(name)[:-3]}"), name)
     if name == "ImuSensor":
         return NativeModel(name, cls.description, cls.VARIABLES, "sensor", "", SENSOR_PARAMS)
     if name == "ImuPlant":
