@@ -17,17 +17,18 @@ from typing import Any
 import numpy as np
 
 from fusion_core import ESTIMATORS, native
+from fusion_core.registry import REGISTRY
 
 from .config import ESTIMATOR_KEYS
 
 MIN_SAMPLES = 200_000
 PYTHON_SAMPLES = 20_000
-NATIVE_TARGETS_US = {"cf": 0.2, "kf": 0.2, "mgcf": 0.25, "poskf": 0.4, "ukf": 1.0}
-"""Per-sample targets of the native batch run [us]."""
-VQF_RATIO_TARGETS = {"cf": 0.75, "mgcf": 0.9, "kf": 0.75, "ukf": 3.7, "poskf": 1.5}
+NATIVE_TARGETS_US = {e.key: e.bench.native_us for e in REGISTRY}
+"""Per-sample targets of the native batch run [us] (the registry's Bench)."""
+VQF_RATIO_TARGETS = {e.key: e.bench.vqf_ratio for e in REGISTRY}
 """Each twin's batch run per sample as a multiple of VQF's C++ `updateBatch` in the same run,
-at most (one pass moves on this VM by up to 15 %: `python -m benchmarks.batch_ratio` gives the
-median over rounds)."""
+at most (the registry's Bench; one pass moves by up to 15 % on a busy machine: `python -m
+benchmarks.batch_ratio` gives the median over rounds)."""
 
 
 def _median_seconds(fn: Any, repeats: int) -> float:

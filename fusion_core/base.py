@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any, ClassVar, Final
+from typing import Any, ClassVar, Final, NamedTuple
 
 import numpy as np
 
@@ -160,6 +160,23 @@ def _restore(template: Any, value: Any) -> Any:
     return value
 
 
+class SensorNoise(NamedTuple):
+    """A sensor's noise as `imu-fusion noise` measures it at rest: what the parameters of
+    Estimator.noise_params follow from (presets.noise_preset)."""
+
+    gyro_density: float
+    """Gyro white-noise density [rad/s/sqrt(Hz)]: the Allan deviation at tau = 1 s."""
+    acc_density: float
+    """Accelerometer white-noise density [m/s^2/sqrt(Hz)]."""
+    acc_sample_std: float
+    """Standard deviation of one accelerometer sample at rest [m/s^2], at the rate the filter
+    runs."""
+    gyro_bias_std: float = 0.0
+    """Spread (1 sigma, per axis) of the gyro bias a part starts a run with [rad/s]: what a
+    start-up calibration leaves, or a datasheet's turn-on tolerance for a part run without
+    one."""
+
+
 class Estimator:
     """Base class of the five estimators. See the module docstring."""
 
@@ -184,6 +201,13 @@ class Estimator:
     COMMON: ClassVar[tuple[Param, ...]] = COMMON_PARAMS
     """The parameters every estimator shares (a paper's reference filter, which knows no gyro
     range, leaves gyro_range out: fusion_core.papers)."""
+
+    @classmethod
+    def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
+        """The parameters of this filter that follow from a sensor's noise, by the derivation
+        its recommended defaults come from (presets.noise_preset adds the gyro range for every
+        estimator); none by default."""
+        return {}
 
     def __init__(self, **params: Any) -> None:
         specs = self.param_specs()

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from .base import ESTIMATE, Estimator, tuple_new
+from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
@@ -49,7 +49,7 @@ from .measured_vector import (
     measure_step,
 )
 from .state import ANGLE, HALF_ANGLE, REAL, REST, UNIT, StateSpec
-from .types import Estimate, Param
+from .types import Estimate, G, Param
 
 
 class ComplementaryFilter(Estimator):
@@ -110,6 +110,13 @@ class ComplementaryFilter(Estimator):
         "roll": ANGLE, "pitch": HALF_ANGLE, "meas": MEASURE_CHECK, "q_att": UNIT, "bias": REAL,
         "rest": REST,
     }
+
+    @classmethod
+    def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
+        """acc_noise = one accelerometer sample's standard deviation over g: the white noise its
+        adaptive noise measures the disturbance against (its time constant comes from the bias
+        a correction must hold off and from a scan, SCANNED)."""
+        return {"acc_noise": noise.acc_sample_std / G}
 
     def _configure(self) -> None:
         p = self._params

@@ -10,7 +10,7 @@ import dataclasses
 from math import cos, sin, sqrt
 from typing import ClassVar, Final
 
-from .base import ESTIMATE, Estimator, tuple_new
+from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
@@ -240,6 +240,18 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         "P_pitch": COV, "bias_z": REAL, "P_z": NONNEG, "meas": MEASURE_CHECK, "rest": REST,
         "q_att": UNIT, "face": index(len(FACES)),
     }
+
+    @classmethod
+    def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
+        """Q_angle and gyro_psd (its zero-rate update) = the gyro's PSD, R_measure = the
+        variance of one sample's tilt, (acc_sample_std / g)^2, and init_bias_std the larger of
+        the recommended prior and the part's bias spread (a part run without its start-up
+        calibration learns its bias from the accelerometer where it never rests, instead of
+        holding it near zero)."""
+        gyro_psd = noise.gyro_density * noise.gyro_density
+        return {"Q_angle": gyro_psd, "R_measure": (noise.acc_sample_std / G) ** 2,
+                "gyro_psd": gyro_psd,
+                "init_bias_std": max(RECOMMENDED_INIT_BIAS_STD, noise.gyro_bias_std)}
 
     def _configure(self) -> None:
         p = self._params

@@ -10,7 +10,7 @@ import dataclasses
 import math
 from typing import ClassVar
 
-from .base import ESTIMATE, Estimator, tuple_new
+from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
     COMPLEMENTARY_ADAPTIVE_PARAMS,
@@ -43,7 +43,7 @@ from .measured_vector import (
 )
 from .papers.mgcf import pi_step
 from .state import NONNEG, REAL, REST, UNIT, StateSpec
-from .types import Estimate, Param
+from .types import Estimate, G, Param
 
 MGCF_ACC_LOWPASS = dataclasses.replace(ACC_LOWPASS_PARAM, default=1.0)
 """The mgcf's acc_lowpass: 1 s, not the 1.5 s of the others. Its integral term (Ki = w0^2)
@@ -113,6 +113,13 @@ class GainScheduledComplementaryFilter(Estimator):
     STATE: ClassVar[StateSpec] = {
         "q": UNIT, "bias": REAL, "w0_now": NONNEG, "meas": MEASURE_CHECK, "rest": REST,
     }
+
+    @classmethod
+    def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
+        """acc_noise = one accelerometer sample's standard deviation over g: the white noise its
+        adaptive noise measures the disturbance against (its time constant comes from the bias
+        a correction must hold off and from a scan, SCANNED)."""
+        return {"acc_noise": noise.acc_sample_std / G}
 
     def _configure(self) -> None:
         p = self._params

@@ -11,7 +11,7 @@ import dataclasses
 from math import nan, sqrt
 from typing import Any, ClassVar, Final
 
-from .base import ESTIMATE, Estimator, tuple_new
+from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
 from .building_blocks import GYRO_SAMPLING_PARAM, zero_rate_psd_param
 from .kalman import Z_BIAS_REST_ONLY, AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, roll_pitch_sines, wrap_angle
@@ -143,6 +143,13 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         "pending": Queue(Segments(((NONNEG, 1), (REAL, 4))), 5, PENDING_MAX), "turned": REAL,
         "f_mean": REAL, "aligned": FLAG, "tilt_state": NESTED, "attitude_state": NESTED,
     }
+
+    @classmethod
+    def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
+        """acc_psd = the accelerometer's PSD and gyro_psd the gyro's (its tilt stage keeps the
+        papers' Q and R, which the position contract was met with)."""
+        return {"acc_psd": noise.acc_density * noise.acc_density,
+                "gyro_psd": noise.gyro_density * noise.gyro_density}
 
     def _configure(self) -> None:
         p = self._params

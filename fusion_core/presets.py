@@ -28,9 +28,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from .kalman import RECOMMENDED_INIT_BIAS_STD
-from .registry import FILTER, KEYS, create
-from .types import GYRO_RANGE_DEFAULT, G
+from .base import SensorNoise
+from .registry import FILTER, KEYS, REGISTRY, create
+from .types import GYRO_RANGE_DEFAULT
 
 PAPER_RULES: dict[str, Any] = {"gyro_sampling": "mean", "sensor_delay": 0.0}
 """What every paper's filter keeps whatever the recording's sensor says: the rectangle rule, and
@@ -63,44 +63,21 @@ recommended values are derived for (BROAD's myon aktos-t: 0.045-0.07 m/s^2 per a
 def noise_preset(gyro_density: float, acc_density: float, acc_sample_std: float,
                  gyro_range: float = GYRO_RANGE_DEFAULT, gyro_bias_std: float = 0.0
                  ) -> dict[str, dict[str, float]]:
-    """The recommended values that follow from a sensor's noise, per estimator: the derivations
-    of the classes' docstrings as one function, which `python -m testbenches noise` applies to
-    a user's own sensor. gyro_density [rad/s/sqrt(Hz)] and acc_density [m/s^2/sqrt(Hz)] are
-    the white-noise densities (the Allan deviation at tau = 1 s), acc_sample_std [m/s^2] the
-    standard deviation of one accelerometer sample at rest at the rate the filter will run.
-
-    kf: Q_angle = the gyro's PSD, R_measure = the variance of one sample's tilt,
-    (acc_sample_std / g)^2, gyro_psd (its zero-rate update) the gyro's PSD; ukf: gyro_psd and
-    zaru_psd the gyro's PSD, acc_noise = acc_sample_std / g; poskf: acc_psd the accelerometer's
-    PSD and gyro_psd the gyro's (its tilt stage keeps the papers' Q and R, which the position
-    contract was met with); cf and mgcf: acc_noise = acc_sample_std / g, the reference their
-    adaptive noise is measured against (their time constants come from the bias a correction must
-    hold off and from scans, see their docstrings). gyro_range [rad/s], the gyro's full-scale
-    setting (a datasheet value no static recording shows), goes to every estimator: a sample at
-    it is clipped (base.Estimator). gyro_bias_std [rad/s], the spread (1 sigma, per axis) of
-    the gyro bias the part starts a run with: the Kalman filters' prior on their bias
-    (init_bias_std) is at least that, so that a part run without its start-up calibration
-    (a datasheet's turn-on tolerance of degrees per second) learns its bias from the
-    accelerometer where it never rests, instead of holding it near zero; below the recommended
-    prior (a calibrated part's residual) the prior stays.
+    """The recommended values that follow from a sensor's noise, per estimator: each class's
+    noise_params (base.SensorNoise; the derivations are theirs), which `imu-fusion noise`
+    applies to a user's own sensor. gyro_density [rad/s/sqrt(Hz)] and acc_density
+    [m/s^2/sqrt(Hz)] are the white-noise densities (the Allan deviation at tau = 1 s),
+    acc_sample_std [m/s^2] the standard deviation of one accelerometer sample at rest at the
+    rate the filter will run, gyro_bias_std [rad/s] the spread of the gyro bias a part starts
+    a run with. gyro_range [rad/s], the gyro's full-scale setting (a datasheet value no static
+    recording shows), goes to every estimator: a sample at it is clipped (base.Estimator).
 
     The recommended defaults are this function at the reference sensor,
     building_blocks.REAL_GYRO_DENSITY, position.REAL_ACC_DENSITY and REFERENCE_ACC_SAMPLE_STD
     (tests/test_presets.py holds them to it; the acc_noise of cf, mgcf and ukf is rounded to
     0.005)."""
-    gyro_psd = gyro_density * gyro_density
-    r = (acc_sample_std / G) ** 2
-    prior = max(RECOMMENDED_INIT_BIAS_STD, gyro_bias_std)
-    own = {
-        "cf": {"acc_noise": acc_sample_std / G},
-        "mgcf": {"acc_noise": acc_sample_std / G},
-        "kf": {"Q_angle": gyro_psd, "R_measure": r, "gyro_psd": gyro_psd,
-               "init_bias_std": prior},
-        "ukf": {"gyro_psd": gyro_psd, "zaru_psd": gyro_psd, "acc_noise": acc_sample_std / G,
-                "init_bias_std": prior},
-        "poskf": {"acc_psd": acc_density * acc_density, "gyro_psd": gyro_psd},
-    }
-    return {key: {**params, "gyro_range": gyro_range} for key, params in own.items()}
+    noise = SensorNoise(gyro_density, acc_density, acc_sample_std, gyro_bias_std)
+    return {e.key: {**e.cls.noise_params(noise), "gyro_range": gyro_range} for e in REGISTRY}
 
 
 def preset_params(preset: str, key: str) -> dict[str, Any]:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from typing import ClassVar, Final
 
-from .base import Estimator
+from .base import Estimator, SensorNoise
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
     ADAPTIVE_NOISE_PARAMS,
@@ -167,6 +167,14 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     STATE: ClassVar[StateSpec] = {
         "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "meas": MEASURE_CHECK, "rest": REST,
     }
+
+    @classmethod
+    def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
+        """gyro_psd and zaru_psd = the gyro's PSD, acc_noise = one accelerometer sample's
+        standard deviation over g, init_bias_std as the kf's (AngleBiasKalmanFilter)."""
+        gyro_psd = noise.gyro_density * noise.gyro_density
+        return {"gyro_psd": gyro_psd, "zaru_psd": gyro_psd, "acc_noise": noise.acc_sample_std / G,
+                "init_bias_std": max(RECOMMENDED_INIT_BIAS_STD, noise.gyro_bias_std)}
 
     def _configure(self) -> None:
         p = self._params

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from fusion_core.registry import ESTIMATORS, KEYS
+from fusion_core.registry import ESTIMATORS, KEYS, REGISTRY
 from fusion_core.sensor import SENSOR_PRESETS
 from fusion_core.types import DEG
 
@@ -68,22 +68,19 @@ NOISE_FREE = {**SENSOR_PRESETS["ideal"], "gyro_psd": 0.0, "acc_psd": 0.0, "bits"
 """ImuSensor parameters of a noise-free sensor (contract checks T1 and T2): the ideal sensor with
 its white noise and quantisation off too."""
 
-PAPER_MODERATE = {"cf": (1.84, 2.03), "mgcf": (1.07, 1.32), "ukf": (0.35, 0.41),
-                  "kf": (1.84, 2.03), "poskf": (1.84, 2.03)}
-"""Duong Quoc et al., moderate dynamics, roll/pitch RMSE [deg]; Kalman filters held to CCF's."""
+PAPER_MODERATE = {e.key: (e.paper_row.roll, e.paper_row.pitch) for e in REGISTRY
+                  if e.paper_row is not None}
+"""Duong Quoc et al., moderate dynamics, roll/pitch RMSE [deg] per estimator (its registry
+entry's paper_row; the Kalman filters are held to CCF's)."""
 DEFAULTS_MODERATE_SHARE = 0.5
 """The defaults on the realistic sensor, moderate_dynamics: at most this share of the paper's row
 (tests/test_paper_rows.py), which a filter with the sensor's noise, bias prior and measured
 vector owes the papers' unmodelled one; a cross-validation keeps it where the defaults do
 (testbenches.broad.feasible)."""
-DEFAULTS_MODERATE_NOT_MET = {
-    "ukf": "not met yet: 0.25/0.29 against 0.175/0.205 (seed 0); 0.03/0.03 on the ideal "
-           "sensor, so the realistic gyro's errors make the rest, its cross-axis errors most "
-           "(seeds 0-2: 0.31/0.36, without them 0.17/0.25; `python -m testbenches budget`), "
-           "which the UKF's bias states chase; over 200 parts 1 meets it, VQF on none "
-           "(docs/guide/campaigns.md)",
-}
-"""Estimators whose defaults do not meet DEFAULTS_MODERATE_SHARE yet, with what they give."""
+DEFAULTS_MODERATE_NOT_MET = {e.key: e.moderate_not_met for e in REGISTRY
+                             if e.moderate_not_met is not None}
+"""Estimators whose defaults do not meet DEFAULTS_MODERATE_SHARE yet, and why (their registry
+entries' moderate_not_met)."""
 
 
 def defaults_moderate_limits(estimator: str) -> tuple[float, float] | None:

@@ -761,7 +761,7 @@ def moderate_presets_table(ctx: dict[str, Path]) -> str:
     both sensors, and the paper's Table 1 rows: the C twins of the plant, the sensor and the
     estimators, which give the FMUs' numbers to the bit."""
     from fusion_core.presets import load_preset
-    from fusion_core.registry import KEYS
+    from fusion_core.registry import ENTRY, KEYS
     from fusion_core.sensor import sensor_preset
 
     from .contract import PAPER_MODERATE
@@ -775,9 +775,9 @@ def moderate_presets_table(ctx: dict[str, Path]) -> str:
             cells = [f"{r[0, 0]:.2f}/{r[0, 1]:.2f}"
                      for r in (rmse[(False, key, "moderate_dynamics")] for key in KEYS)]
             rows.append(f"| {preset} / {sensor} | " + " | ".join(cells) + " |")
-    held = {"cf": " (CCF)", "kf": " (CCF)", "poskf": ""}
     rows.append("| Duong Quoc et al. Table 1 | " + " | ".join(
-        f"{PAPER_MODERATE[k][0]:.2f}/{PAPER_MODERATE[k][1]:.2f}{held.get(k, '')}"
+        "-" if ENTRY[k].paper_row is None else
+        f"{PAPER_MODERATE[k][0]:.2f}/{PAPER_MODERATE[k][1]:.2f} ({ENTRY[k].paper_row.of})"
         for k in KEYS) + " |")
     return "\n".join(rows)
 

@@ -241,6 +241,29 @@ def test_random_short_recordings_give_equal_outputs(samples: list, key: str, pre
     assert_same(out_py, out_c)
 
 
+def memcheck_twins(host: str) -> str:
+    """memcheck_host.c's memcheck_twins.h: every twin of the registry (recommended and the
+    papers'), its header and a CHECK_TWIN in CHECK_ALL_TWINS() with the VARIANT_<twin> the host
+    defines for it, or none (its defaults twice)."""
+    from fusion_core.registry import CLASSES
+
+    twins = [c.TWIN for c in CLASSES if c.TWIN is not None]
+    variants = set(re.findall(r"#define VARIANT_(\w+)", host))
+    checks = " ".join(f"CHECK_TWIN({t}, {f'VARIANT_{t}' if t in variants else '(void)0'});"
+                      for t in twins)
+    return "\n".join([*(f'#include "{t}.h"' for t in twins),
+                      f"#define CHECK_ALL_TWINS() do {{ {checks} }} while (0)", ""])
+
+
+def test_the_memcheck_host_checks_every_twin_of_the_registry() -> None:
+    host = (REPO / "tests" / "native" / "memcheck_host.c").read_text()
+    header = memcheck_twins(host)
+    from fusion_core.registry import CLASSES
+
+    for cls in CLASSES:
+        assert f"CHECK_TWIN({cls.TWIN}, VARIANT_{cls.TWIN})" in header, cls.__name__
+
+
 @pytest.mark.heavy
 @needs_twin
 @pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind is not installed")
@@ -249,7 +272,10 @@ def test_valgrind_finds_no_memory_error_in_a_native_run(tmp_path: Path) -> None:
     assert cc is not None
     exe = tmp_path / "memcheck_host"
     sources = [str(NATIVE / s) for s in native.SOURCES]
+    host = REPO / "tests" / "native" / "memcheck_host.c"
+    (tmp_path / "memcheck_twins.h").write_text(memcheck_twins(host.read_text()))
     subprocess.run([cc, "-std=c99", "-O1", "-g", "-ffp-contract=off", f"-I{NATIVE}",
+                    f"-I{tmp_path}",
                     str(REPO / "tests" / "native" / "memcheck_host.c"), *sources, "-lm",
                     "-o", str(exe)], check=True)
     proc = subprocess.run(["valgrind", "-q", "--error-exitcode=3", "--leak-check=full",

@@ -10,12 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "bench_data.h"
-#include "fc_cf.h"
-#include "fc_kf.h"
-#include "fc_mgcf.h"
-#include "fc_poskf.h"
-#include "fc_ukf.h"
+#include "bench_data.h" /* with every twin's header and BENCH_RUN_ALL, from the registry */
 
 void bench_ticks_start(void);
 uint64_t bench_ticks(void);
@@ -109,11 +104,7 @@ int main(void)
     bench_ticks_start();
     printf("CAL %lu %lu\n", (unsigned long)calibration_ticks(1000000u), 4000000ul);
     for (int rec = 0; rec < BENCH_RECORDINGS; rec++) {
-        RUN(fc_cf, "cf", 0);
-        RUN(fc_mgcf, "mgcf", 1);
-        RUN(fc_kf, "kf", 2);
-        RUN(fc_ukf, "ukf", 3);
-        RUN(fc_poskf, "poskf", 4);
+        BENCH_RUN_ALL();
     }
 #if !(defined(FC_REAL_FLOAT) && FC_REAL_FLOAT) /* the float build calls the float functions */
     for (int fn = 0; fn < BENCH_LIBM_FUNCTIONS; fn++) {
