@@ -58,11 +58,8 @@ typedef struct fc_layout {
     int n_fields;
 } fc_layout;
 
-/* Every layout, and one by the twin's prefix (NULL for an unknown one): fc_state_tables.c. */
-extern const fc_layout FC_CF_LAYOUT, FC_MGCF_LAYOUT, FC_KF_LAYOUT, FC_UKF_LAYOUT, FC_POSKF_LAYOUT,
-    FC_PAPER_CF_LAYOUT, FC_PAPER_MGCF_LAYOUT, FC_PAPER_KF_LAYOUT, FC_PAPER_UKF_LAYOUT,
-    FC_PAPER_POSKF_LAYOUT,
-    FC_SENSOR_LAYOUT;
+/* One layout by the twin's prefix (NULL for an unknown one): fc_state_tables.c. Each layout by
+ * name, FC_<TWIN>_LAYOUT, is declared in fc_state_layouts.h (generated). */
 const fc_layout *fc_state_layout(const char *twin);
 
 /* The number of doubles of a saved state. */

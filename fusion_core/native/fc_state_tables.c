@@ -19,7 +19,7 @@
 #include "fc_poskf.h"
 #include "fc_sensor.h"
 #include "fc_ukf.h"
-#include "fc_state.h"
+#include "fc_state_layouts.h"
 
 static const fc_field CF_FIELDS[] = {
     {"base.initialized", offsetof(fc_cf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},

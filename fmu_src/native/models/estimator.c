@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "config.h"
+#include "fc_state_layouts.h"
 #include "fmu_model.h"
 
 typedef struct model_data {

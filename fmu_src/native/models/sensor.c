@@ -8,6 +8,7 @@
 
 #include "config.h"
 #include "fc_sensor.h"
+#include "fc_state_layouts.h"
 #include "fmu_model.h"
 
 typedef struct model_data {
