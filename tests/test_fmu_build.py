@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import re
 import shutil
 import zipfile
 from pathlib import Path
@@ -56,13 +57,6 @@ BASE_UNITS = {
     "m2/s5": {"m": 2, "s": -5},
     "m2/s3": {"m": 2, "s": -3},
 }
-PAPERS = {
-    "ComplementaryFilter": ("Gui, Y. Tang, S. Mukhopadhyay (2015)", "Das & Mary"),
-    "AngleBiasKalmanFilter": ("Gui, Y. Tang, S. Mukhopadhyay (2015)", "Das & Mary"),
-    "GainScheduledComplementaryFilter": ("Duong Quoc et al.",),
-    "UnscentedKalmanFilter": ("Duong Quoc et al.",),
-    "PositionKalmanFilter": ("Safitri, Cahyadi, Firmansyah",),
-}
 
 
 EXPECTED_CORE = "python" if native.reason() else "native"
@@ -75,7 +69,7 @@ def test_build_command_builds_every_fmu_without_problems(built_fmus):
     lines = built_fmus.output.splitlines()
     assert lines[0].split() == ["FMU", "kind", "core", "size", "variables", "validation",
                                 "problems"]
-    for name in PAPERS:
+    for name in ESTIMATOR_FMUS:
         row = next(line.split() for line in lines if line.startswith(name + " "))
         assert row[1:3] == ["pythonfmu", EXPECTED_CORE], row  # no silent fallback
         assert row[-1] == "0", row  # validation problems
@@ -176,10 +170,14 @@ def test_every_tuning_parameter_is_an_fmu_parameter(fmu_path, fmu_key):
         assert spec.description.rstrip(".") in v.description
 
 
-def test_model_description_names_the_paper(fmu_path, fmu_name):
+def test_model_description_names_the_paper(fmu_path, fmu_key):
+    """The FMU's description is its registry entry's text, which cites its paper's
+    equations."""
+    from fusion_core.registry import ENTRY
+
     md = read_model_description(str(fmu_path))
-    for paper in PAPERS[fmu_name]:
-        assert paper in md.description
+    assert md.description == ENTRY[fmu_key].fmu_text
+    assert re.search(r"eq\. \d+", md.description), md.description
 
 
 def test_state_capabilities_are_declared(fmu_path):
@@ -203,7 +201,7 @@ def test_fmu_carries_fusion_core_and_requirements(fmu_path):
 
 def test_slave_modules_have_unique_names(built_fmus):
     modules = []
-    for name in PAPERS:
+    for name in ESTIMATOR_FMUS:
         with zipfile.ZipFile(built_fmus.path(name)) as z:
             modules.append(z.read("resources/slavemodule.txt").decode().strip())
     assert len(set(modules)) == len(modules)

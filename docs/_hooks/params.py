@@ -1,5 +1,7 @@
 """MkDocs hook: `<!-- params: KEY -->` in a page becomes the table of that estimator's
-parameters, read from its class when the site is built (so the table is never stale)."""
+parameters, read from its class when the site is built (so the table is never stale), and the
+navigation's Estimators section lists every estimator of the registry, estimators/<key>.md
+after the overview (titled by the page's heading)."""
 
 from __future__ import annotations
 
@@ -33,6 +35,19 @@ def params_table(key: str) -> str:
         rows.append(f"| `{name}` | `{_cell(default)}` | {_cell(spec.unit or '')} | "
                     f"{_cell(_range(spec))} | {_cell(spec.description or '')} |")
     return "\n".join(rows)
+
+
+def on_config(config: Any, **_: Any) -> Any:
+    """Every registry estimator's page in the Estimators section of the navigation."""
+    from fusion_core.registry import KEYS
+
+    for section in config["nav"] or []:
+        if isinstance(section, dict) and "Estimators" in section:
+            pages = section["Estimators"]
+            listed = {p if isinstance(p, str) else next(iter(p.values())) for p in pages}
+            pages += [f"estimators/{key}.md" for key in KEYS
+                      if f"estimators/{key}.md" not in listed]
+    return config
 
 
 def on_page_markdown(markdown: str, **_: Any) -> str:
