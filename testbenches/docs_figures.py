@@ -525,12 +525,13 @@ def constant_noise_table(ctx: dict[str, Path]) -> str:
     """docs/results/contract.md: the sweeps and high_dynamics on seed 0's part, each attitude
     filter with its defaults and with constant noise (CONSTANT_NOISE), against the bound."""
     from fusion_core.presets import load_preset
+    from fusion_core.registry import ATTITUDE_FILTERS
     from fusion_core.sensor import sensor_preset
 
     from .contract import accuracy_limits
     from .parts import part_rmse
 
-    keys, scenarios = ["cf", "mgcf", "kf", "ukf"], ["roll_sweep", "pitch_sweep", "high_dynamics"]
+    keys, scenarios = list(ATTITUDE_FILTERS), ["roll_sweep", "pitch_sweep", "high_dynamics"]
     preset, sensor = load_preset("recommended"), sensor_preset("realistic")
     default = part_rmse(keys, scenarios, preset, sensor, 1, calibrated_first=(False,))
     constant = part_rmse(keys, scenarios, preset, sensor, 1, CONSTANT_NOISE,
@@ -595,12 +596,13 @@ def uncalibrated_moving_table(ctx: dict[str, Path]) -> str:
     VQF; mean roll/pitch RMSE."""
     from fusion_core import DEG
     from fusion_core.presets import load_preset
+    from fusion_core.registry import ATTITUDE_FILTERS
     from fusion_core.sensor import sensor_preset
 
     from .parts import part_rmse, vqf_rmse
 
     sensor = {**sensor_preset("realistic"), "calibration": "none"}
-    keys, preset = ["cf", "mgcf", "kf", "ukf"], load_preset("recommended")
+    keys, preset = list(ATTITUDE_FILTERS), load_preset("recommended")
     pair = lambda v: f"{v[0]:.1f}/{v[1]:.1f}"  # noqa: E731
     default = part_rmse(keys, ["roll_pitch"], preset, sensor, UNCALIBRATED_PARTS,
                         calibrated_first=(False,))

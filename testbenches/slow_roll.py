@@ -15,12 +15,14 @@ import sys
 import numpy as np
 
 from fusion_core import G
+from fusion_core.registry import ATTITUDE_FILTERS
 
 RATE_HZ = 200.0
 SECONDS = 600.0
 AMPLITUDE_DEG = 40.0
 FREQUENCY_HZ = 0.02
-FILTERS = ("cf", "mgcf", "kf", "ukf")
+FILTERS = ATTITUDE_FILTERS
+"""The registry's attitude filters."""
 
 
 def recording(seed: int = 0) -> dict[str, np.ndarray]:
