@@ -74,6 +74,8 @@ class Entry:
     """The seed paper's filter (fusion_core.papers)."""
     title: str
     """What it is, for help strings and tables."""
+    cites: str
+    """The papers and equations it implements, for tables (README's)."""
     attitude_filter: bool
     """Whether it is one of the attitude filters with a measured vector of its own (cf, mgcf, kf,
     ukf), the ones whose scanned defaults `broad --cv` cross-validates."""
@@ -102,26 +104,30 @@ class Entry:
 
 REGISTRY: tuple[Entry, ...] = (
     Entry("cf", ComplementaryFilter, PaperComplementaryFilter,
-          title="complementary filter (Gui et al. 2015)", attitude_filter=True,
+          title="complementary filter (Gui et al. 2015)",
+          cites="Gui, Tang, Mukhopadhyay 2015 eq. 1-2; Das & Mary eq. 1", attitude_filter=True,
           fmu_text="Complementary filter for roll and pitch from a 6-axis IMU: W. Gui, Y. Tang, "
           "S. Mukhopadhyay (2015), eq. 1-2; Das & Mary, eq. 1. One IMU sample per doStep; "
           "the gyro bias measured at rest (rest_time > 0) is subtracted and output.",
           paper_row=CCF_ROW, bench=Bench(step_us=1.0, native_us=0.2, vqf_ratio=0.75)),
     Entry("mgcf", GainScheduledComplementaryFilter, PaperGainScheduledFilter,
-          title="modified-gain complementary filter (Duong Quoc et al.)", attitude_filter=True,
+          title="modified-gain complementary filter (Duong Quoc et al.)",
+          cites="Duong Quoc et al. eq. 7-13", attitude_filter=True,
           fmu_text="Modified-gain (gain-scheduled) complementary filter for roll and pitch: "
           "Duong Quoc et al., eq. 7-13 (quaternion PI filter of Mahony et al. 2008 with w0 "
           "scheduled on ||acc|/g - 1|). One IMU sample per doStep.",
           paper_row=PaperRow(1.07, 1.32, "MGCF"),
           bench=Bench(step_us=5.0, native_us=0.25, vqf_ratio=0.9)),
     Entry("kf", AngleBiasKalmanFilter, PaperKalmanFilter,
-          title="2-state angle/bias Kalman filter (Gui et al., Das & Mary)", attitude_filter=True,
+          title="2-state angle/bias Kalman filter (Gui et al., Das & Mary)",
+          cites="Gui et al. eq. 5-26; Das & Mary eq. 16-27", attitude_filter=True,
           fmu_text="Two-state [angle, gyro bias] Kalman filter for roll and pitch: W. Gui, "
           "Y. Tang, S. Mukhopadhyay (2015), eq. 5-26; Das & Mary, eq. 16-27. One IMU sample "
           "per doStep.",
           paper_row=CCF_ROW, bench=Bench(step_us=2.0, native_us=0.2, vqf_ratio=0.75)),
     Entry("ukf", UnscentedKalmanFilter, PaperUnscentedKalmanFilter,
-          title="unscented Kalman filter (Duong Quoc et al.)", attitude_filter=True,
+          title="unscented Kalman filter (Duong Quoc et al.)",
+          cites="Duong Quoc et al. eq. 14-17", attitude_filter=True,
           fmu_text="Unscented Kalman filter for roll and pitch on the gravity direction with "
           "three gyro-bias states: Duong Quoc et al., eq. 14-17. One IMU sample per doStep.",
           paper_row=PaperRow(0.35, 0.41, "UKF"),
@@ -131,7 +137,8 @@ REGISTRY: tuple[Entry, ...] = (
           "errors most (`python -m testbenches budget`), which the UKF's bias states chase; "
           "docs/guide/campaigns.md has the share of 200 parts that meet it, and VQF's"),
     Entry("poskf", PositionKalmanFilter, PaperPositionKalmanFilter,
-          title="position Kalman filter (Safitri et al.)", attitude_filter=False,
+          title="position Kalman filter (Safitri et al.)",
+          cites="Safitri, Cahyadi, Firmansyah eq. 20-29, tilt from `kf`", attitude_filter=False,
           fmu_text="Position and velocity Kalman filter with a zero-velocity update: Safitri, "
           "Cahyadi, Firmansyah, eq. 20-29; tilt from the Gui, Tang, Mukhopadhyay (2015) "
           "[angle, bias] Kalman filter. One IMU sample per doStep.",

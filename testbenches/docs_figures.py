@@ -583,6 +583,25 @@ def slow_roll_table(ctx: dict[str, Path]) -> str:
     return table()
 
 
+def estimators_table(ctx: dict[str, Path]) -> str:
+    """README: every estimator of the registry, its classes (the FMU is named after the
+    recommended one), its papers and equations and the gyro biases it learns."""
+    from fusion_core.registry import REGISTRY
+
+    rows = ["| key | class and FMU | the paper's filter (`--preset paper`) | paper, equations | "
+            "gyro bias learned |", "|---|---|---|---|---|"]
+    for e in REGISTRY:
+        moving = [a for i, a in enumerate("xyz") if i in e.cls.BIAS_IN_MOTION]
+        rest = [a for a in "xyz" if a not in moving]
+        learned = "; ".join(
+            [*([", ".join(moving) + " in motion and at rest"] if moving else []),
+             *([", ".join(rest) + " at rest only"] if rest else [])])
+        also = " (also position, velocity)" if e.cls.HAS_POSITION else ""
+        rows.append(f"| `{e.key}` | `{e.fmu}`{also} | `{e.reference.__name__}` | {e.cites} | "
+                    f"{learned} |")
+    return "\n".join(rows)
+
+
 def recovery_table(ctx: dict[str, Path]) -> str:
     from .recovery import table
 
@@ -956,6 +975,9 @@ FIGURES: tuple[Figure, ...] = (
         ESTIMATE_ARGS) + " --no-plots", estimate_output),
     Figure("estimate-picture", "docs/guide/estimate.md", "imu-fusion " + " ".join(
         ESTIMATE_ARGS), estimate_picture, "docs/estimate_example.png"),
+    Figure("readme-estimators", "README.md", "fusion_core.registry (python -c 'from "
+           "testbenches.docs_figures import estimators_table; print(estimators_table({}))')",
+           estimators_table),
     Figure("readme-contract", "README.md", "make run (imu-fusion run --fmu-dir dist)",
            readme_contract, needs=("fmus",)),
     Figure("contract-parts", "docs/results/contract.md", "imu-fusion run (its checks over 20 "
