@@ -31,6 +31,7 @@ from .building_blocks import (
 )
 from .kalman import KALMAN_MAX_CORRECTION_TIME, RECOMMENDED_INIT_BIAS_STD
 from .kinematics import rotvec_terms
+from .linalg import cholesky3, packed_diagonal, packed_index
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
@@ -47,10 +48,7 @@ from .papers.ukf import (
     N_STATE,
     SIGMA_PARAMS,
     GravityDirectionState,
-    cholesky3,
     measurement_update,
-    packed_diagonal,
-    packed_index,
     predicted_covariance,
     rotation_terms,
     sigma_predict,
