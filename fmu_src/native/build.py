@@ -296,6 +296,33 @@ def _pretty(root: Element) -> bytes:
         indent="  ", encoding="UTF-8")
 
 
+def _description_body(root: Element, model: NativeModel, version: str) -> Element:
+    """What both standards' modelDescription.xml hold after CoSimulation, in order: the unit
+    and type definitions, the log categories, the default experiment; returns the (empty)
+    ModelVariables element."""
+    units = model.variables
+    if version == "3.0":  # the independent variable, time, has a unit of its own
+        units = (*units, Variable("time", "input", "Real", "the independent variable", 0.0, "s"))
+    root.append(unit_definitions(units))
+    types = type_definitions(model.variables, version)
+    if types is not None:
+        root.append(types)
+    _log_categories(root)
+    SubElement(root, "DefaultExperiment",
+               {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.01"})
+    return SubElement(root, "ModelVariables")
+
+
+def _variable_attributes(vr: int, v: Variable) -> dict[str, str]:
+    """The attributes every standard gives a variable: name, value reference (its position in
+    the table), description, causality, variability and, for an output, initial."""
+    attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
+             "causality": v.causality, "variability": v.variability or "continuous"}
+    if v.causality == "output":
+        attrs["initial"] = v.initial
+    return attrs
+
+
 def fmi2_model_description(model: NativeModel, sources: Sequence[str]) -> bytes:
     """modelDescription.xml of the FMI 2.0 co-simulation FMU."""
     root = Element("fmiModelDescription", {"fmiVersion": "2.0", "modelName": model.name,
@@ -318,33 +345,20 @@ def fmi2_model_description(model: NativeModel, sources: Sequence[str]) -> bytes:
     files = SubElement(cs, "SourceFiles")
     for name in sources:
         SubElement(files, "File", {"name": name})
-    root.append(unit_definitions(model.variables))
-    types = type_definitions(model.variables)
-    if types is not None:
-        root.append(types)
-    _log_categories(root)
-    SubElement(root, "DefaultExperiment",
-               {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.01"})
-    variables = SubElement(root, "ModelVariables")
-    outputs = []
+    variables = _description_body(root, model, "2.0")
     for vr, v in enumerate(model.variables):
-        attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
-                 "causality": v.causality, "variability": v.variability or "continuous"}
-        if v.causality == "output":
-            attrs["initial"] = v.initial
-            outputs.append(vr + 1)
-        sv = SubElement(variables, "ScalarVariable", attrs)
+        sv = SubElement(variables, "ScalarVariable", _variable_attributes(vr, v))
         SubElement(sv, v.type, type_attributes(v, start=v.initial == "exact"))
     structure = SubElement(root, "ModelStructure")
     outs = SubElement(structure, "Outputs")
-    for index in outputs:
-        SubElement(outs, "Unknown", {"index": str(index)})
+    for vr, v in enumerate(model.variables):  # FMI 2.0 counts variables from 1
+        if v.causality == "output":
+            SubElement(outs, "Unknown", {"index": str(vr + 1)})
     unknowns = initial_unknowns(model.variables)
     if unknowns:
         node = SubElement(structure, "InitialUnknowns")
-        position = {v.name: i for i, v in enumerate(model.variables)}
         for v, deps in unknowns:
-            SubElement(node, "Unknown", {"index": str(position[v.name] + 1),
+            SubElement(node, "Unknown", {"index": str(model.variables.index(v) + 1),
                                          "dependencies": " ".join(str(d + 1) for d in deps)})
     return _pretty(root)
 
@@ -370,32 +384,20 @@ def fmi3_model_description(model: NativeModel) -> bytes:
         "canReturnEarlyAfterIntermediateUpdate": "false",
         "hasEventMode": "false",
     })
-    time_unit = Variable("time", "input", "Real", "the independent variable", 0.0, "s")
-    root.append(unit_definitions((*model.variables, time_unit)))
-    types = type_definitions(model.variables, "3.0")
-    if types is not None:
-        root.append(types)
-    _log_categories(root)
-    SubElement(root, "DefaultExperiment",
-               {"startTime": "0.0", "stopTime": "10.0", "stepSize": "0.01"})
-    variables = SubElement(root, "ModelVariables")
+    variables = _description_body(root, model, "3.0")
     SubElement(variables, "Float64", {
         "name": "time", "valueReference": str(len(model.variables)), "causality": "independent",
         "variability": "continuous", "unit": "s",
         "description": "Simulation time (the independent variable; value reference after the "
                        "model's variables, which keep the FMI 2.0 FMUs' references)"})
-    outputs = []
     for vr, v in enumerate(model.variables):
-        attrs = {"name": v.name, "valueReference": str(vr), "description": v.description,
-                 "causality": v.causality, "variability": v.variability or "continuous"}
-        if v.causality == "output":
-            attrs["initial"] = v.initial
-            outputs.append(vr)
+        attrs = _variable_attributes(vr, v)
         attrs.update(type_attributes(v, start=v.initial == "exact"))
         SubElement(variables, FMI3_TYPES[v.type], attrs)
     structure = SubElement(root, "ModelStructure")
-    for vr in outputs:
-        SubElement(structure, "Output", {"valueReference": str(vr)})
+    for vr, v in enumerate(model.variables):
+        if v.causality == "output":
+            SubElement(structure, "Output", {"valueReference": str(vr)})
     for v, deps in initial_unknowns(model.variables):
         SubElement(structure, "InitialUnknown", {
             "valueReference": str(model.variables.index(v)),
