@@ -62,12 +62,12 @@ wheel: setup
 
 # On every core, with the reason of each skipped test listed at the end.
 test: setup
-	$(BIN)/python -m pytest -q -n auto -rs
+	$(BIN)/python -m pytest -q -n auto --dist loadgroup -rs
 
 # The fast tier: everything but the tests that need built FMUs, the heavy integration runs and
 # the slow campaigns, on two workers.
 test-fast: setup
-	$(BIN)/python -m pytest -q -n 2 -m 'not slow and not fmu and not heavy'
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup -m 'not slow and not fmu and not heavy'
 
 test-slow: setup
 	$(BIN)/python -m pytest -q -m slow

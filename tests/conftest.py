@@ -1,14 +1,19 @@
-"""FMU test fixtures: the FMUs are built once per session, by the real command line.
+"""FMU test fixtures: the FMUs are built once per test run, by the real command line.
 
-`python build_fmu.py --out <session tmp>` runs in a subprocess (the build imports the slave
-modules; the test process then loads them only from the FMUs). Any test with an `fmu_name`
-argument runs once per estimator FMU.
+`python build_fmu.py --out <run tmp>` runs in a subprocess (the build imports the slave
+modules; the test process then loads them only from the FMUs); under pytest-xdist the workers
+share one build. Any test with an `fmu_name` argument runs once per estimator FMU.
 """
 
 from __future__ import annotations
 
+import contextlib
+import json
+import os
+import shutil
 import subprocess
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -70,28 +75,53 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
         metafunc.parametrize("fmu_name", list(ESTIMATOR_FMUS))
 
 
+@contextlib.contextmanager
+def _locked(path: Path) -> Iterator[None]:
+    """An exclusive lock on path across processes (none where fcntl is missing)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    with open(path, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+def _build_once(tmp_path_factory: pytest.TempPathFactory, name: str, *args: str) -> BuiltFmus:
+    """`python build_fmu.py --out <folder> ARGS`, run once for the whole test run: the
+    pytest-xdist workers' temporary roots share a parent, where the first worker builds under
+    a lock and the others take its folder and output."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent
+    out, record = root / name, root / f"{name}.json"
+    with _locked(root / f"{name}.lock"):
+        if not record.is_file():
+            shutil.rmtree(out, ignore_errors=True)
+            out.mkdir(parents=True)
+            proc = subprocess.run([sys.executable, "build_fmu.py", "--out", str(out), *args],
+                                  cwd=REPO, capture_output=True, text=True, timeout=600)
+            record.write_text(json.dumps({"returncode": proc.returncode,
+                                          "output": proc.stdout + proc.stderr}))
+        done = json.loads(record.read_text())
+    return BuiltFmus(out, done["returncode"], done["output"])
+
+
 @pytest.fixture(scope="session")
 def built_fmus(tmp_path_factory: pytest.TempPathFactory) -> BuiltFmus:
-    """Every FMU, built once into a session temporary folder."""
-    out = tmp_path_factory.mktemp("fmus")
-    proc = subprocess.run(
-        [sys.executable, "build_fmu.py", "--out", str(out)],
-        cwd=REPO, capture_output=True, text=True, timeout=600,
-    )
-    return BuiltFmus(out, proc.returncode, proc.stdout + proc.stderr)
+    """Every FMU, built once for the test run."""
+    return _build_once(tmp_path_factory, "fmus")
 
 
 @pytest.fixture(scope="session")
 def paper_fmus(tmp_path_factory: pytest.TempPathFactory) -> BuiltFmus:
     """Every FMU built with --preset paper (the estimators the papers' filters,
-    fusion_core.papers; the plant and the sensor as always), once into a session temporary
-    folder."""
-    out = tmp_path_factory.mktemp("paper_fmus")
-    proc = subprocess.run(
-        [sys.executable, "build_fmu.py", "--out", str(out), "--preset", "paper"],
-        cwd=REPO, capture_output=True, text=True, timeout=600,
-    )
-    return BuiltFmus(out, proc.returncode, proc.stdout + proc.stderr)
+    fusion_core.papers; the plant and the sensor as always), once for the test run."""
+    return _build_once(tmp_path_factory, "paper_fmus", "--preset", "paper")
 
 
 @pytest.fixture

@@ -1,7 +1,8 @@
 """Mutated FMU states through every native FMU, under AddressSanitizer and UBSan.
 
 tests/native/state_fuzz.c is compiled with each model's own FMU sources (FMI 2.0 and FMI 3.0)
-and feeds it 100,000 mutated states per model and standard, taken from valid ones (before and
+and feeds it mutated states per model and standard (STATES in `make test`, SLOW_STATES in
+`make test-slow`), taken from valid ones (before and
 during initialisation, aligning, in motion, at rest): bit flips, an extreme value in one variable
 or state field, integer fields, the FMI state, the time and header fields out of range,
 truncations, lengths off by one, mostly with the checksum recomputed so that the mutation
@@ -30,8 +31,10 @@ from fmu_src.names import model_names
 from fmu_src.native.build import native_model, stage_sources
 from fusion_core.native import compiler
 
-STATES = 100_000
-"""Mutated states per model and standard."""
+STATES = 20_000
+"""Mutated states per model and standard in `make test`."""
+SLOW_STATES = 100_000
+"""Mutated states per model and standard in `make test-slow`."""
 VALGRIND_STATES = 5_000
 """Under valgrind (no sanitizers in the compiler), which runs some 30 times slower."""
 FUZZ_HOST = REPO / "tests" / "native" / "state_fuzz.c"
@@ -54,7 +57,7 @@ def _sanitizers(cc: str, folder: Path) -> bool:
     return built.returncode == 0 and subprocess.run([str(exe)], check=False).returncode == 0
 
 
-def _fuzz(cc: str, name: str, version: str, folder: Path, mode: str) -> dict:
+def _fuzz(cc: str, name: str, version: str, folder: Path, mode: str, states: int) -> dict:
     sources = folder / f"{name}-{version}"
     files = stage_sources(native_model(name), version, sources)
     exe = sources / "state_fuzz"
@@ -64,7 +67,7 @@ def _fuzz(cc: str, name: str, version: str, folder: Path, mode: str) -> dict:
            "-o", str(exe), str(FUZZ_HOST), *(str(sources / f) for f in files), "-lm"]
     built = subprocess.run(cmd, capture_output=True, text=True, check=False)
     assert built.returncode == 0, built.stderr[-3000:]
-    states = VALGRIND_STATES if mode == "valgrind" else STATES
+    states = min(states, VALGRIND_STATES) if mode == "valgrind" else states
     run = [str(exe), str(states), "36"]
     if mode == "valgrind":
         run = ["valgrind", "-q", "--error-exitcode=9", *run]
@@ -76,7 +79,10 @@ def _fuzz(cc: str, name: str, version: str, folder: Path, mode: str) -> dict:
             if found else None}
 
 
-def test_mutated_states_never_crash_or_corrupt_a_native_fmu() -> None:
+@pytest.mark.parametrize("states", [
+    pytest.param(STATES, id="make-test"),
+    pytest.param(SLOW_STATES, id="slow", marks=pytest.mark.slow)])
+def test_mutated_states_never_crash_or_corrupt_a_native_fmu(states: int) -> None:
     cc = compiler()
     if cc is None:
         pytest.skip("no C compiler (set CC, or install cc, gcc or clang): no native FMUs")
@@ -86,7 +92,7 @@ def test_mutated_states_never_crash_or_corrupt_a_native_fmu() -> None:
                 else "valgrind" if shutil.which("valgrind") else "plain")
         jobs = [(name, v) for name in model_names() for v in ("fmi2", "fmi3")]
         with ThreadPoolExecutor(max_workers=max(os.cpu_count() or 1, 1)) as pool:
-            results = list(pool.map(lambda job: _fuzz(cc, *job, folder, mode), jobs))
+            results = list(pool.map(lambda job: _fuzz(cc, *job, folder, mode, states), jobs))
     print(f"\nmutated FMU states ({'AddressSanitizer + UBSan' if mode == 'asan' else mode}):")
     print(f"{'model':34s} {'FMI':4s} {'tried':>8s} {'refused':>8s} {'accepted':>8s} "
           f"{'non-finite':>10s} {'state bytes':>11s}")

@@ -23,6 +23,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 pytestmark = [
     pytest.mark.heavy,
+    pytest.mark.xdist_group("wheel"),  # one worker builds the dists once (`--dist loadgroup`)
     pytest.mark.skipif(native.compiler() is None,
                        reason="building the platform wheel needs a C compiler"),
 ]
