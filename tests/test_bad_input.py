@@ -179,6 +179,7 @@ def invalid_sample(draw: st.DrawFn) -> tuple[list[float], list[float], float]:
 samples = st.lists(st.one_of(valid_sample(), invalid_sample()), min_size=1, max_size=40)
 
 
+@pytest.mark.heavy  # hypothesis: many recordings per estimator
 @pytest.mark.parametrize("key", KEYS)
 def test_mixed_valid_and_invalid_samples_never_give_a_non_finite_estimate(key: str) -> None:
     cls = estimator_class(key)

@@ -76,6 +76,7 @@ def test_each_filter_gets_what_its_sensors_noise_gives(name: str) -> None:
         assert params[key]["init_bias_std"] == max(bias_std, RECOMMENDED_INIT_BIAS_STD)
 
 
+@pytest.mark.heavy  # parts that never rest
 def test_an_uncalibrated_part_that_never_rests_learns_its_bias_with_its_prior() -> None:
     """The slow roll from power-up on parts as delivered (turn-on gyro biases of degrees per
     second, no rest to measure them): with the prior the part's class gives, the UKF learns its

@@ -38,10 +38,13 @@ HDF5_TRIAL = DATA / "10_undisturbed_slow_translation_A.hdf5"
 MAT_TRIAL = DATA / "01_undisturbed_slow_rotation_A.mat"
 RATE = 285.7142857142857
 
-pytestmark = pytest.mark.skipif(not HDF5_TRIAL.is_file() or not MAT_TRIAL.is_file(),
-                                reason=f"no BROAD trials in {DATA} (set BROAD_DIR to a folder "
-                                "with 10_undisturbed_slow_translation_A.hdf5 and "
-                                "01_undisturbed_slow_rotation_A.mat)")
+pytestmark = [
+    pytest.mark.heavy,  # BROAD's trials: `make test-fast` leaves them out
+    pytest.mark.skipif(not HDF5_TRIAL.is_file() or not MAT_TRIAL.is_file(),
+                       reason=f"no BROAD trials in {DATA} (set BROAD_DIR to a folder "
+                       "with 10_undisturbed_slow_translation_A.hdf5 and "
+                       "01_undisturbed_slow_rotation_A.mat)"),
+]
 
 
 def write_slice(path: Path, seconds: float = 45.0, source: Path = HDF5_TRIAL) -> Path:

@@ -15,6 +15,8 @@ from scipy.spatial.transform import Rotation
 from testbenches.broad.data import BroadTrial, load_trial
 from testbenches.broad.gyro import fit_delay, fit_gyro
 
+pytestmark = pytest.mark.heavy  # gyro fits on synthetic recordings: seconds each
+
 RATE = 285.7142857142857
 SUB = 8  # integration steps per sample interval
 M_TRUE = np.array([[1.008, 0.004, -0.003],

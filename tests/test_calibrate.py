@@ -19,6 +19,8 @@ from testbenches.calibrate.detect import Static
 from testbenches.calibrate.tedaldi import CalibrationRefused, calibrate_session, check_spread
 from testbenches.cli import main
 
+pytestmark = pytest.mark.heavy  # calibration sessions simulated and fitted
+
 REPO = Path(__file__).resolve().parents[1]
 IMUCAL = Path(os.environ.get("IMUCAL_DIR", REPO.parent / "shared" / "data" / "imucal"))
 SESSION = IMUCAL / "example_ferraris_session.csv"

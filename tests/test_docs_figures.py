@@ -39,7 +39,9 @@ def _context(figure: figs.Figure, request: pytest.FixtureRequest) -> dict[str, P
 
 
 HEAVY = ("engines-table", "contract-parts", "readme-contract", "embedded-table",
-         "campaigns-scenarios", "broad-scale-parts",
+         "campaigns-scenarios", "broad-scale-parts", "readme-battery", "broad-gyro",
+         "broad-noise", "contract-vqf", "uncalibrated-rest", "uncalibrated-moving",
+         "calibrate-picture", "calibrate-imucal", "imucal-table", "budget-excerpt",
          *(f.name for f in figs.FIGURES if f.name.startswith("battery-")))
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
 SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "campaigns-makefile",

@@ -47,6 +47,7 @@ def test_the_twins_on_a_microcontroller(tmp_path, capsys) -> None:
     assert "largest roll error after 5 s" in capsys.readouterr().out
 
 
+@pytest.mark.heavy  # every contract scenario through the float twins
 @pytest.mark.skipif(native.reason() is not None, reason=f"no C twin: {native.reason()}")
 def test_the_float_build_keeps_every_contract_rmse_within_a_hundredth_of_a_degree(
         tmp_path) -> None:

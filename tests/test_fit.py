@@ -18,6 +18,8 @@ from testbenches.fit.noise import analyse, run_noise
 from testbenches.fit.recording import Recording, RecordingError, load
 from testbenches.fit.tune import dimension, tunable, tune
 
+pytestmark = pytest.mark.heavy  # the noise and tune commands on recordings
+
 REPO = Path(__file__).resolve().parents[1]
 BROAD = Path(os.environ.get("BROAD_DIR", REPO.parent / "shared" / "data" / "broad"))
 

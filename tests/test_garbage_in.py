@@ -16,6 +16,8 @@ from fusion_core import DEG, G
 from fusion_core.presets import preset_params
 from testbenches.recovery import RECOVERY_BOUND_S, absurd_then_tilt
 
+pytestmark = pytest.mark.heavy  # accuracy after garbage, hypothesis recordings
+
 EXTREMES = [math.nan, math.inf, -math.inf, 1e300, -1e300, 1e-320, -1e-320, 1e6, -1e6, 0.0]
 BAD_DT = [0.0, -1.0, 1e-12, 2.0, math.nan, math.inf]
 

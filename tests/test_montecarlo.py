@@ -15,6 +15,8 @@ from testbenches.montecarlo.store import read_rows
 from testbenches.montecarlo.summary import summarise
 from testbenches.options import load_sensor
 
+pytestmark = pytest.mark.heavy  # Dask campaigns
+
 pytest.importorskip("distributed")
 
 

@@ -29,6 +29,7 @@ def test_the_rule_counts_a_part_within_only_where_roll_and_pitch_both_are() -> N
                                              (True, "kf", "static_level"): calibrated[1:]})
 
 
+@pytest.mark.heavy  # a part through the testbench
 def test_each_part_is_the_seed_the_testbench_runs() -> None:
     """Part k is seed k of the sensor: the RMSE of part 0 is the seed-0 run's (the FMUs give
     the same to the bit: tests/test_montecarlo.py)."""

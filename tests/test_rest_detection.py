@@ -19,6 +19,8 @@ from fusion_core.building_blocks import REST_PARAMS
 from fusion_core.registry import ATTITUDE_FILTERS
 from fusion_core.types import DEG, G
 
+pytestmark = pytest.mark.heavy  # accuracy of the rest detector on swings and rests
+
 RATE = 100.0
 REST_TIME = next(p.default for p in REST_PARAMS if p.name == "rest_time")
 FILTERS = ATTITUDE_FILTERS

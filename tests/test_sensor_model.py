@@ -102,6 +102,7 @@ def test_scale_and_cross_axis_errors_are_a_fixed_matrix_per_seed() -> None:
     assert abs(column[0] - 1.0) < 0.05 and 0.0 < np.abs(column[1:]).max() < 0.04
 
 
+@pytest.mark.heavy  # statistics over long recordings
 def test_bias_instability_wanders_with_its_standard_deviation() -> None:
     model = ImuSensorModel(**{**QUIET, "gyro_bias_instability": 0.003 * DEG,
                               "bias_time_constant": 1.0})

@@ -24,6 +24,8 @@ from native_fmu import NativeFmu
 from fusion_core import ESTIMATORS
 from fusion_core.sensor import ImuSensorModel
 
+pytestmark = pytest.mark.heavy  # crafted states through every twin: seconds each
+
 REPLACEMENTS: tuple[Any, ...] = (
     math.nan, math.inf, -math.inf, 1e300, -1e300, 1e80, -1.0, 0.0, 0.5, 2.5, 7, 2049, 2**70,
     -(2**63), True, False, None, "x", [], [1.0], {}, [[0.0, 1.0]], 3.2, -3.2, 1.6,

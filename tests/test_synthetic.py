@@ -25,6 +25,7 @@ def _stacked(d: dict[str, np.ndarray]) -> np.ndarray:
                             d["vel"]])
 
 
+@pytest.mark.heavy  # every scenario's truth sample by sample: seconds
 @pytest.mark.parametrize("name", list(SCENARIOS))
 def test_truth_at_equals_the_vectorised_truth(name: str) -> None:
     scenario = SCENARIOS[name]

@@ -217,6 +217,7 @@ def test_plant_truth_is_consistent_with_finite_differences(name: str) -> None:
         assert np.max(np.abs(f - d["f"][i])) < 2e-3 * max(1.0, np.abs(acc[i]).max())
 
 
+@pytest.mark.heavy  # statistics over long recordings
 def test_sensor_noise_matches_the_configured_densities_within_5_percent() -> None:
     """40 000 samples at 100 Hz, no quantisation: sample std * sqrt(h) / density in [0.95, 1.05]
     for every axis, the density being sqrt of the configured PSD; the bias random walk's

@@ -18,6 +18,8 @@ from fusion_core import synthetic
 from fusion_core.papers import PaperUnscentedKalmanFilter
 from fusion_core.scenarios import get_scenario
 
+pytestmark = pytest.mark.heavy  # the UKF against a numpy reference over minutes of samples
+
 PAPER_POINT = {"gyro_sampling": "point"}
 """The paper's filter with the rule of the synthetic recordings' point samples."""
 ANGLE_TOL = 1e-9  # rad
