@@ -62,12 +62,21 @@ FMU_BUILDING_FILES = ("test_fmu_state_fuzz.py", "test_fmu_state_processes.py", "
 """Test files that build FMUs of their own (beside the session's built_fmus)."""
 
 
+LONG_FIRST = ("test_wheel.py", "test_fmu_state_fuzz.py", "test_docs_figures.py")
+"""Files whose tests run for minutes (the wheel builds, the state fuzz, the figures that run
+the battery): collected first, so that pytest-xdist starts them first instead of leaving one
+worker on them while the other has finished."""
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Mark `fmu` every test that needs built FMUs: `make test-fast` leaves them out."""
+    """Mark `fmu` every test that needs built FMUs: `make test-fast` leaves them out. The
+    LONG_FIRST files go to the front (their own order kept)."""
     for item in items:
         if ({"built_fmus", "paper_fmus"} & set(getattr(item, "fixturenames", ()))
                 or item.path.name in FMU_BUILDING_FILES):
             item.add_marker(pytest.mark.fmu)
+    first = {name: i for i, name in enumerate(LONG_FIRST)}
+    items.sort(key=lambda item: first.get(item.path.name, len(first)))
 
 
 def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
