@@ -14,9 +14,9 @@ MODELS_DIR = Path(__file__).resolve().parent / "models"
 
 def estimator_fmus() -> dict[str, str]:
     """FMU model name -> estimator key, for every estimator of the registry."""
-    from fusion_core.registry import REGISTRY
+    from fusion_core.registry import FMU_NAMES
 
-    return {e.fmu: e.key for e in REGISTRY}
+    return {name: key for key, name in FMU_NAMES.items()}
 
 
 def model_names() -> list[str]:

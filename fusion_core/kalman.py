@@ -87,6 +87,14 @@ RECOMMENDED_INIT_BIAS_STD: Final = 0.3 * DEG
 realistic MPU-6050's 0.16 deg/s, 1 sigma, its datasheet's drift over 1 K of warm-up), about two
 standard deviations. A larger prior lets the first seconds of motion (a slow translation, a
 ramp of linear acceleration the statistic has not yet measured) into the bias."""
+
+
+def bias_prior(noise: SensorNoise) -> float:
+    """The Kalman filters' init_bias_std for a sensor: the larger of the recommended prior and
+    the part's bias spread (a part run without its start-up calibration learns its bias from
+    the accelerometer where it never rests, instead of holding it near zero)."""
+    return max(RECOMMENDED_INIT_BIAS_STD, noise.gyro_bias_std)
+
 RECOMMENDED_R: Final = (0.05 / G) ** 2
 """Recommended R_measure [rad^2]: the variance of one accelerometer sample's tilt, (0.05 m/s^2 /
 g)^2 = (0.29 deg)^2, from the accelerometer's noise measured at rest on a real MEMS IMU
@@ -244,14 +252,11 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     @classmethod
     def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
         """Q_angle and gyro_psd (its zero-rate update) = the gyro's PSD, R_measure = the
-        variance of one sample's tilt, (acc_sample_std / g)^2, and init_bias_std the larger of
-        the recommended prior and the part's bias spread (a part run without its start-up
-        calibration learns its bias from the accelerometer where it never rests, instead of
-        holding it near zero)."""
+        variance of one sample's tilt, (acc_sample_std / g)^2, and init_bias_std bias_prior's."""
         gyro_psd = noise.gyro_density * noise.gyro_density
         return {"Q_angle": gyro_psd, "R_measure": (noise.acc_sample_std / G) ** 2,
                 "gyro_psd": gyro_psd,
-                "init_bias_std": max(RECOMMENDED_INIT_BIAS_STD, noise.gyro_bias_std)}
+                "init_bias_std": bias_prior(noise)}
 
     def _configure(self) -> None:
         p = self._params

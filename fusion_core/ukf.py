@@ -29,7 +29,7 @@ from .building_blocks import (
     zero_rate_psd_param,
     zero_rate_sample,
 )
-from .kalman import KALMAN_MAX_CORRECTION_TIME, RECOMMENDED_INIT_BIAS_STD
+from .kalman import KALMAN_MAX_CORRECTION_TIME, RECOMMENDED_INIT_BIAS_STD, bias_prior
 from .kinematics import rotvec_terms
 from .linalg import cholesky3, packed_diagonal, packed_index
 from .measured_vector import (
@@ -169,10 +169,10 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     @classmethod
     def noise_params(cls, noise: SensorNoise) -> dict[str, float]:
         """gyro_psd and zaru_psd = the gyro's PSD, acc_noise = one accelerometer sample's
-        standard deviation over g, init_bias_std as the kf's (AngleBiasKalmanFilter)."""
+        standard deviation over g, init_bias_std the kf's (kalman.bias_prior)."""
         gyro_psd = noise.gyro_density * noise.gyro_density
         return {"gyro_psd": gyro_psd, "zaru_psd": gyro_psd, "acc_noise": noise.acc_sample_std / G,
-                "init_bias_std": max(RECOMMENDED_INIT_BIAS_STD, noise.gyro_bias_std)}
+                "init_bias_std": bias_prior(noise)}
 
     def _configure(self) -> None:
         p = self._params

@@ -19,11 +19,11 @@ from pathlib import Path
 
 import pytest
 
-from fusion_core.registry import FMU_NAMES
+from fmu_src.names import estimator_fmus
 
 REPO = Path(__file__).resolve().parents[1]
 
-ESTIMATOR_FMUS: dict[str, str] = {name: key for key, name in FMU_NAMES.items()}
+ESTIMATOR_FMUS: dict[str, str] = estimator_fmus()
 """The estimator FMUs and the fusion_core.ESTIMATORS key each one packages (the registry's)."""
 
 
@@ -85,7 +85,7 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
 
 
 @contextlib.contextmanager
-def _locked(path: Path) -> Iterator[None]:
+def locked(path: Path) -> Iterator[None]:
     """An exclusive lock on path across processes (none where fcntl is missing)."""
     try:
         import fcntl
@@ -108,7 +108,7 @@ def _build_once(tmp_path_factory: pytest.TempPathFactory, name: str, *args: str)
     if os.environ.get("PYTEST_XDIST_WORKER"):
         root = root.parent
     out, record = root / name, root / f"{name}.json"
-    with _locked(root / f"{name}.lock"):
+    with locked(root / f"{name}.lock"):
         if not record.is_file():
             shutil.rmtree(out, ignore_errors=True)
             out.mkdir(parents=True)

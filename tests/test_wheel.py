@@ -4,7 +4,6 @@ where no compiler exists."""
 
 from __future__ import annotations
 
-import contextlib
 import os
 import shutil
 import subprocess
@@ -12,10 +11,10 @@ import sys
 import tarfile
 import venv
 import zipfile
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from conftest import locked
 
 from fusion_core import native
 
@@ -70,29 +69,12 @@ def dists(tmp_path_factory: pytest.TempPathFactory) -> Path:
     if shutil.which("pyproject-build") is None and _missing("build"):
         pytest.skip("the build frontend is not installed (the test extra has it)")
     out = tmp_path_factory.mktemp("dist")
-    with _checkout_lock():
+    # one sdist build in this checkout at a time: the build writes its egg-info and a staging
+    # folder into the checkout, which another worker's build would tar half-removed
+    (REPO / "build").mkdir(exist_ok=True)
+    with locked(REPO / "build" / ".sdist.lock"):
         _build(["--outdir", str(out), str(REPO)], dict(os.environ), REPO)
     return out
-
-
-@contextlib.contextmanager
-def _checkout_lock() -> Iterator[None]:
-    """One sdist build in this checkout at a time: the build writes its egg-info and a staging
-    folder into the checkout, and two pytest-xdist workers that each run this module's fixture
-    would tar each other's half-removed staging folder. (No lock where fcntl is missing.)"""
-    try:
-        import fcntl
-    except ImportError:
-        yield
-        return
-    lock_dir = REPO / "build"
-    lock_dir.mkdir(exist_ok=True)
-    with open(lock_dir / ".sdist.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def _missing(module: str) -> bool:
