@@ -157,6 +157,21 @@ def test_a_loggers_header_delimiter_and_byte_order_mark_are_read(tmp_path, capsy
     assert np.max(np.abs(_kf_roll(tmp_path, "logger") - want["roll"])) < 1e-6
 
 
+@pytest.mark.parametrize(("option", "said"), [
+    (["--gyro-unit", "rad/s"], "--gyro-unit rad/s contradicts the header, which states deg/s"),
+    (["--acc-unit", "m/s2"], "--acc-unit m/s2 contradicts the header, which states g")])
+def test_a_given_unit_the_header_contradicts_is_refused(tmp_path, capsys, option, said):
+    """A unit given on the command line that is not the header's: refused whether or not the
+    data could tell (a quiet recording cannot), and nothing is written."""
+    path = tmp_path / "logger.csv"
+    _logger_file(path)
+    out = tmp_path / "out"
+    assert main(["estimate", str(path), "--estimator", "kf", *option, "--out", str(out),
+                 "--no-plots"]) == 2
+    assert said in capsys.readouterr().err
+    assert not out.exists() or not any(out.iterdir())
+
+
 def test_a_column_map_names_what_the_reader_does_not_know(tmp_path):
     ex = _example()
     path = tmp_path / "odd.csv"

@@ -529,12 +529,23 @@ def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
     return rec, t
 
 
+def _given_against_header(path: Path, sensor: str, option: str, unit: str,
+                          stated: str | None) -> None:
+    """RecordingError where a unit given on the command line is not the one the header states
+    for the same columns: one of the two is wrong, and the data may be too quiet to tell."""
+    if unit != "auto" and stated is not None and unit != stated:
+        raise RecordingError(
+            f"{path}: --{option} {unit} contradicts the header, which states {stated} for the "
+            f"{sensor}: leave --{option} out to take the header's, or rename the columns where "
+            "the header is wrong")
+
+
 def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
                ) -> tuple[float, str]:
     """The factor to m/s^2 and how it was chosen: given, stated by the header, or from the
     median norm (1 g or 9.81 m/s^2 at rest, and near it on average in motion); refused where
-    the norm in that unit cannot be gravity's."""
-
+    the norm in that unit cannot be gravity's, and where a given unit is not the header's."""
+    _given_against_header(path, "accelerometer", "acc-unit", unit, stated)
     norm = float(np.median(np.linalg.norm(acc, axis=1)))
     chosen = unit if unit != "auto" else stated
     how = "given" if unit != "auto" else "from the header"
@@ -566,9 +577,10 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     windows of further blocks (`more`: (acc, gyro, dt) each) pooled while the first cannot
     tell and no unit is given. A unit given or stated by the header that the data contradict
     is refused with the evidence; where the data cannot tell and no unit is given or stated,
-    the recording is refused."""
+    the recording is refused, and so is a given unit that is not the header's."""
     from ..gyro_unit import UNITS, verdict, window_misses
 
+    _given_against_header(path, "gyro", "gyro-unit", unit, stated)
     misses = window_misses(acc, gyro, dt)
     evidence, used = verdict(misses), len(dt)
     chosen = unit if unit != "auto" else stated
