@@ -17,9 +17,7 @@ from typing import Any
 import numpy as np
 
 from fusion_core import ESTIMATORS, native
-from fusion_core.registry import REGISTRY
-
-from .config import ESTIMATOR_KEYS
+from fusion_core.registry import KEYS, REGISTRY
 
 MIN_SAMPLES = 200_000
 PYTHON_SAMPLES = 20_000
@@ -66,7 +64,7 @@ def native_section(rec: dict[str, np.ndarray], repeats: int) -> dict[str, Any]:
     out: dict[str, Any] = {"available": True, "samples": n, "run_us_per_sample": {},
                            "python_run_us_per_sample": {}, "speedup_vs_python": {},
                            "no_twin_yet": []}
-    for key in ESTIMATOR_KEYS:
+    for key in KEYS:
         cls = ESTIMATORS[key]
         if not native.has_twin(cls()):
             out["no_twin_yet"].append(key)

@@ -22,7 +22,7 @@ from .common import (
     samples,
     time_interleaved,
 )
-from .config import ESTIMATOR_KEYS, BenchConfig
+from .config import BenchConfig, estimator_keys
 from .estimators import STREAM, step_factories, stream_factories
 from .fmu import build_fmus, fmu_steps
 from .long_file import estimate_section
@@ -81,6 +81,7 @@ def core_info() -> dict[str, Any]:
 
 def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
     """Run the sections named in config.sections; return the results (see benchmarks/__init__)."""
+    keys = estimator_keys()
     rec = recording(config.duration_s)
     data = samples(rec)
     n = len(data)
@@ -95,10 +96,10 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         "core": core_info(),
     }
     if "per_sample" in config.sections:
-        log(f"per-sample timing: {len(ESTIMATOR_KEYS)} estimators and the peers, {n} samples x "
+        log(f"per-sample timing: {len(keys)} estimators and the peers, {n} samples x "
             f"{config.repeats} passes, in turn")
-        factories = step_factories(ESTIMATOR_KEYS, data)
-        factories.update(stream_factories(ESTIMATOR_KEYS, data))
+        factories = step_factories(keys, data)
+        factories.update(stream_factories(keys, data))
         unavailable = {name: "not run (peers switched off)" for name in PEERS}
         if config.peers:
             peer_factories, unavailable = available_peers(rec)
@@ -108,11 +109,11 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         floor = detail.pop(FLOOR)
         results["per_sample_us"] = {
             key: (detail[key]["median_us"] if key in detail else None)
-            for key in (*ESTIMATOR_KEYS, *PEERS)
+            for key in (*keys, *PEERS)
         }
         results["per_sample_us_stream"] = {
             key: (detail[key + STREAM]["median_us"] if key + STREAM in detail else None)
-            for key in ESTIMATOR_KEYS
+            for key in keys
         }
         results["per_sample_detail"] = detail
         results["peers_unavailable"] = unavailable
@@ -129,7 +130,7 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
                 log("FMU step timing (fusion_core, fmpy API and low-level host in turn)")
                 fmu_data = np.column_stack(
                     [rec["acc_meas"], rec["gyro_meas"], rec["dt"]]).tolist()
-                timings = fmu_steps(ESTIMATOR_KEYS, fmu_dir, fmu_data, data, config.repeats)
+                timings = fmu_steps(keys, fmu_dir, fmu_data, data, config.repeats)
                 results["fmu_step_detail"] = timings
                 med = {k: {h: v[h]["median_us"] for h in v} for k, v in timings.items()}
                 results["fmu_step_us"] = {k: m["api"] for k, m in med.items()}
@@ -147,12 +148,12 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
                 fmu_data = np.column_stack(
                     [rec["acc_meas"], rec["gyro_meas"], rec["dt"]]).tolist()
                 native_fmus = native_fmu_section(
-                    ESTIMATOR_KEYS, Path(fmu_dir), fmu_data, config.repeats,
+                    keys, Path(fmu_dir), fmu_data, config.repeats,
                     config.testbench_s.get(1000.0, 1.0), config.testbench_repeats, log)
             if "testbench" in config.sections:
                 log("testbench throughput")
                 results["testbench"] = testbench_throughput(
-                    config.testbench_estimators, config.testbench_s, fmu_dir,
+                    estimator_keys(config.testbench_estimators), config.testbench_s, fmu_dir,
                     config.testbench_repeats)
     if "native" in config.sections:
         log("native batch runs (the C twin), the Python core and VQF's C++ batch")
@@ -167,7 +168,8 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
         results["campaign"] = campaign_section(config.campaign_seeds)
     if "scaling" in config.sections:
         log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
-        results["scaling"] = scaling(config.scaling_estimators, config.scaling_sizes, rec)
+        results["scaling"] = scaling(estimator_keys(config.scaling_estimators),
+                                     config.scaling_sizes, rec)
     if "estimate_2e6" in config.sections:
         log(f"imu-fusion estimate on a {config.long_rows}-row CSV, beside pyarrow's read of it")
         with tempfile.TemporaryDirectory(prefix="bench_long_") as tmp:

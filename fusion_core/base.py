@@ -89,6 +89,8 @@ MAX_ACC_NORM: Final = 1000.0 * G
 like a sample in free fall: far beyond any MEMS accelerometer's range (+-16 g for the MPU-6050,
 +-200 g for high-g parts such as the ADXL375), and too large to filter without overflow. The
 gyro of such a sample is still integrated."""
+NEVER_ESTIMATED: Final = "always 0"
+"""How the reason of a bias output the filter never estimates begins (Estimator.ZERO_BIAS)."""
 BACKENDS: Final = ("auto", "python", "native")
 """Estimator.run's backends."""
 _MIN_INIT_NORM2: Final = MIN_INIT_NORM * MIN_INIT_NORM
@@ -178,7 +180,7 @@ class SensorNoise(NamedTuple):
 
 
 class Estimator:
-    """Base class of the five estimators. See the module docstring."""
+    """Base class of the estimators. See the module docstring."""
 
     PARAMS: ClassVar[tuple[Param, ...]] = ()
     STATE: ClassVar[StateSpec] = {}
@@ -187,8 +189,9 @@ class Estimator:
     exact class has one; a subclass, which may change the Python methods, has none of its own."""
     HAS_POSITION: ClassVar[bool] = False
     ZERO_BIAS: ClassVar[dict[str, str]] = {}
-    """The bias outputs this filter leaves at 0 whatever it is given, each with the reason (its
-    FMU's variable descriptions say it); the others are estimated."""
+    """The bias outputs this filter may leave at 0, each with the reason (its FMU's variable
+    descriptions say it): one it never estimates begins with NEVER_ESTIMATED, one that stays 0
+    until something observes it says what; the others are estimated."""
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = ()
     """The gyro axes (0 x, 1 y, 2 z) whose bias the filter learns while it moves, not only at
     rest: those the contract scores the bias error of."""
@@ -198,6 +201,11 @@ class Estimator:
     The noise-derived ones come from `imu-fusion noise`, the rest detector's thresholds and the
     pre-filter's time constant are VQF's published values: fitting those too on a handful of
     recordings fits the recordings' motions, not the sensor."""
+    GYRO_ONLY: ClassVar[dict[str, float] | None] = None
+    """Parameter values with which only the gyro moves roll and pitch, on samples whose
+    accelerometer reads 3 g (the accelerometer's corrections off or gated out): what the tests
+    of the integration rule run; None where the class has no such setting (the tests run its
+    paper's filter instead)."""
     COMMON: ClassVar[tuple[Param, ...]] = COMMON_PARAMS
     """The parameters every estimator shares (a paper's reference filter, which knows no gyro
     range, leaves gyro_range out: fusion_core.papers)."""

@@ -106,6 +106,7 @@ class ComplementaryFilter(Estimator):
     TWIN: ClassVar[str | None] = "fc_cf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = ()
     SCANNED: ClassVar[tuple[str, ...]] = ("tau",)
+    GYRO_ONLY: ClassVar[dict[str, float] | None] = {"acc_lowpass": 0.0, "gate_high": 2.0}
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "meas": MEASURE_CHECK, "q_att": UNIT, "bias": REAL,
         "rest": REST,

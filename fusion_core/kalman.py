@@ -242,6 +242,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     TWIN: ClassVar[str | None] = "fc_kf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1)
     SCANNED: ClassVar[tuple[str, ...]] = ("Q_bias",)
+    GYRO_ONLY: ClassVar[dict[str, float] | None] = {"acc_lowpass": 0.0, "rest_time": 0.0,
+                                                    "gate_high": 2.0}
     ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": Z_BIAS_REST_ONLY}
     STATE: ClassVar[StateSpec] = {
         "roll": ANGLE, "pitch": HALF_ANGLE, "bias_x": REAL, "bias_y": REAL, "P_roll": COV,

@@ -70,8 +70,10 @@ class Entry:
 
     key: str
     cls: type[Estimator]
-    reference: type[Estimator]
-    """The seed paper's filter (fusion_core.papers)."""
+    reference: type[Estimator] | None
+    """The seed paper's filter (fusion_core.papers), or None where the class is itself its
+    paper's filter at its paper's values: the paper preset then runs the class with the papers'
+    rules (presets.PAPER_RULES)."""
     title: str
     """What it is, for help strings and tables."""
     cites: str
@@ -95,6 +97,12 @@ class Entry:
     def twin(self) -> str | None:
         """The C twin's prefix (fusion_core/native), or None."""
         return self.cls.TWIN
+
+    @property
+    def paper_class(self) -> type[Estimator]:
+        """The class the paper preset ("filter": "paper") runs: the reference, or the class
+        itself where the entry has none."""
+        return self.reference or self.cls
 
     @property
     def fmu(self) -> str:
@@ -156,10 +164,12 @@ FMU_NAMES: dict[str, str] = {e.key: e.fmu for e in REGISTRY}
 """key -> FMU model name."""
 
 
-REFERENCES: dict[str, type[Estimator]] = {e.key: e.reference for e in REGISTRY}
-"""key -> reference class (the seed paper's filter)."""
+REFERENCES: dict[str, type[Estimator]] = {e.key: e.reference for e in REGISTRY
+                                           if e.reference is not None}
+"""key -> reference class (the seed paper's filter), for the entries that have one."""
 ENTRY: dict[str, Entry] = {e.key: e for e in REGISTRY}
-CLASSES: tuple[type[Estimator], ...] = tuple(c for e in REGISTRY for c in (e.cls, e.reference))
+CLASSES: tuple[type[Estimator], ...] = tuple(c for e in REGISTRY for c in (e.cls, e.reference)
+                                             if c is not None)
 """Every estimator class, recommended and reference (each has a C twin)."""
 
 
@@ -173,7 +183,7 @@ def estimator_class(key: str, params: dict[str, Any] | None = None) -> type[Esti
         raise ValueError(f"{key}: {FILTER}={choice!r} is not allowed: expected "
                          f"{' or '.join(repr(f) for f in FILTERS)}")
     entry = ENTRY[key]
-    return entry.reference if choice == FILTERS[1] else entry.cls
+    return entry.paper_class if choice == FILTERS[1] else entry.cls
 
 
 def create(key: str, params: dict[str, Any] | None = None) -> Estimator:

@@ -162,6 +162,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     TWIN: ClassVar[str | None] = "fc_ukf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1, 2)
     SCANNED: ClassVar[tuple[str, ...]] = ("bias_psd",)
+    GYRO_ONLY: ClassVar[dict[str, float] | None] = {"acc_lowpass": 0.0, "rest_time": 0.0}
     STATE: ClassVar[StateSpec] = {
         "x": Segments(((UNIT, 3), (REAL, 3))), "P": COV, "meas": MEASURE_CHECK, "rest": REST,
     }

@@ -89,13 +89,16 @@ def error_budget(estimators: list[str], scenarios: list[str], seeds: int,
     rows = []
     for scenario in scenarios:
         for est in estimators:
+            limit = accuracy_limits(est, scenario)
+            if limit is None:  # no bound to budget against
+                continue
             params = dict(preset.get(est, {}))
             rmse = {}
             for name, off in VARIANTS.items():
                 rmse[name] = _rmse(est, scenario, seeds, {**sensor, **off}, params)
                 if progress:
                     progress()
-            rows.append(BudgetRow(est, scenario, accuracy_limits(est, scenario), rmse["full"],
+            rows.append(BudgetRow(est, scenario, limit, rmse["full"],
                                   {n: rmse[n] for n in SOURCES}, rmse["motion only"]))
     return rows
 

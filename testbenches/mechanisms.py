@@ -257,7 +257,7 @@ def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
     with the mechanism off."""
     from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
-    from .contract import accuracy_limits
+    from .contract import bound
     from .parts import HOW, part_rmse, share_within
 
     def passing(key: str, params: dict[str, float]) -> tuple[set[str], dict[str, float]]:
@@ -266,7 +266,7 @@ def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
         if progress:
             progress()
         return ({s for (_, _, s), v in rmse.items()
-                 if share_within(v, accuracy_limits(key, s)) >= HOW[False][1]},
+                 if share_within(v, bound(key, s)) >= HOW[False][1]},
                 {s: float(np.mean(v)) for (_, _, s), v in rmse.items()})
 
     base = {key: passing(key, {}) for key in dict.fromkeys(k for k, _ in worth)}

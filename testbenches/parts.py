@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from .contract import Check, accuracy_limits, compute_metrics
+from .contract import Check, accuracy_limits, bound, compute_metrics
 
 PARTS = 20
 """Sensor parts (seeds) each accuracy check is stated over."""
@@ -82,8 +82,10 @@ def parts_checks(rmse: dict[tuple[bool, str, str], np.ndarray]) -> list[Check]:
     parts within the bound against the rule's share."""
     checks = []
     for (calibrated, estimator, scenario), values in rmse.items():
+        if accuracy_limits(estimator, scenario) is None:  # nothing to check it against
+            continue
         label, needed = HOW[calibrated]
-        lim = accuracy_limits(estimator, scenario)
+        lim = bound(estimator, scenario)
         within = share_within(values, lim)
         median = np.median(values, axis=0)
         checks.append(Check(
@@ -99,9 +101,10 @@ def parts_table(rmse: dict[tuple[bool, str, str], np.ndarray]) -> str:
     the share of parts within it, the median part's and the worst part's roll/pitch RMSE."""
     rows = ["| estimator | scenario | bound [deg] | as delivered: within | median | worst | "
             "calibrated first: within | median | worst |", "|---|---|---|---|---|---|---|---|---|"]
-    keys = sorted({(e, s) for _, e, s in rmse}, key=lambda k: (k[1], k[0]))
+    keys = sorted({(e, s) for _, e, s in rmse if accuracy_limits(e, s) is not None},
+                  key=lambda k: (k[1], k[0]))
     for estimator, scenario in keys:
-        lim = accuracy_limits(estimator, scenario)
+        lim = bound(estimator, scenario)
         cells = [estimator, scenario, f"{lim[0]:.3g} / {lim[1]:.3g}"]
         for calibrated in (False, True):
             v = rmse[(calibrated, estimator, scenario)]

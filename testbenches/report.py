@@ -46,11 +46,12 @@ def contract_table(result: ContractResult) -> str:
     for r in result.runs:
         m = r.metrics
         lim = contract.accuracy_limits(r.estimator, r.scenario)
+        shown = f"{lim[0]:>5.2f}/{lim[1]:<5.2f}" if lim is not None else f"{'(none)':^11}"
         failed = [c.name for c in r.checks if not c.passed]
         verdict = "PASS" if not failed else "FAIL: " + ", ".join(failed)
         lines.append(
             f"{r.estimator:<9} {r.scenario:<18} {r.seed:>4} {m['rmse_roll_deg']:>10.3f} "
-            f"{m['rmse_pitch_deg']:>10.3f} {lim[0]:>5.2f}/{lim[1]:<5.2f} {m['max_err_deg']:>8.2f} "
+            f"{m['rmse_pitch_deg']:>10.3f} {shown} {m['max_err_deg']:>8.2f} "
             f"{m['step_p99_us']:>7.0f}  {verdict}"
         )
     if result.checks:

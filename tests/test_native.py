@@ -260,8 +260,11 @@ def test_the_memcheck_host_checks_every_twin_of_the_registry() -> None:
     header = memcheck_twins(host)
     from fusion_core.registry import CLASSES
 
-    for cls in CLASSES:
-        assert f"CHECK_TWIN({cls.TWIN}, VARIANT_{cls.TWIN})" in header, cls.__name__
+    twins = {cls.TWIN for cls in CLASSES}
+    for twin in twins:
+        assert f"CHECK_TWIN({twin}, " in header, twin
+    # a variant is optional; one for a twin the registry no longer has is stale
+    assert set(re.findall(r"#define VARIANT_(\w+)", host)) <= twins
 
 
 @pytest.mark.heavy

@@ -13,8 +13,8 @@ from helpers import KEYS, make
 
 from fusion_core import DEG, ESTIMATORS, G
 from fusion_core.papers.mgcf import SCHEDULES, scheduled_w0
-from fusion_core.presets import PRESETS, load_preset, preset_params
-from fusion_core.registry import REFERENCES, create
+from fusion_core.presets import PAPER_RULES, PRESETS, load_preset, preset_params
+from fusion_core.registry import ENTRY, FILTER, create
 
 
 @pytest.mark.parametrize("key", KEYS)
@@ -26,8 +26,9 @@ def test_the_defaults_are_the_recommended_preset(key: str) -> None:
 @pytest.mark.parametrize("key", KEYS)
 def test_the_paper_preset_runs_the_papers_filter_at_its_values(key: str) -> None:
     paper = make(key, **preset_params("paper", key))
-    assert type(paper) is REFERENCES[key]
-    assert paper.params == REFERENCES[key]().params  # the paper's values are its defaults
+    assert type(paper) is ENTRY[key].paper_class  # the reference, else the class itself
+    # the paper's values are its defaults, with the papers' rules
+    assert paper.params == {**type(paper)().params, **PAPER_RULES}
     assert paper.params["gyro_sampling"] == "mean"  # the papers' rectangle rule
     assert paper.params["sensor_delay"] == 0.0
 
@@ -77,13 +78,15 @@ def test_the_simulation_schedule_is_duong_quocs_section_4_1(rho: float, w0: floa
     assert scheduled_w0(rho, SCHEDULES["simulation"]) == w0
 
 
-ONLY_GYRO = {"cf": {"acc_lowpass": 0.0, "gate_high": 2.0},
-             "mgcf": {"filter": "paper"},
-             "kf": {"acc_lowpass": 0.0, "rest_time": 0.0, "gate_high": 2.0},
-             "ukf": {"acc_lowpass": 0.0, "rest_time": 0.0}, "poskf": {"filter": "paper"}}
-"""Options that would let the accelerometer in: off, and cf's and kf's gate closed above 2 g,
-so that only the gyro moves roll (the papers' mgcf gates a norm of 3 g out, their position
-filter's attitude is its tilt stage's)."""
+def only_gyro(key: str) -> dict[str, object]:
+    """The options with which only the gyro moves roll (Estimator.GYRO_ONLY: the recommended
+    class's, else its paper's filter's)."""
+    options = ENTRY[key].cls.GYRO_ONLY
+    if options is not None:
+        return dict(options)
+    paper = ENTRY[key].paper_class.GYRO_ONLY
+    assert paper is not None, f"{key}: neither class declares GYRO_ONLY"
+    return {FILTER: "paper", **paper}
 
 
 @pytest.mark.parametrize("key", KEYS)
@@ -105,11 +108,11 @@ def test_the_sampling_property_chooses_the_integration_rule(key: str) -> None:
         else:  # the mean of the ramp over each interval (t_{k-1}, t_k]
             gyro[1:, 0] = 0.5 * (rate[1:] + rate[:-1])
             expected = 0.5 * (t[-1]) + t[-1] ** 2
-        est = make(key, gyro_sampling=sampling, **ONLY_GYRO[key])
+        est = make(key, gyro_sampling=sampling, **only_gyro(key))
         out = est.run(acc, gyro, h)
         assert out["roll"][-1] == pytest.approx(expected, abs=2e-4), (key, sampling)
         wrong = make(key, gyro_sampling="mean" if sampling == "point" else "point",
-                     **ONLY_GYRO[key])
+                     **only_gyro(key))
         assert abs(wrong.run(acc, gyro, h)["roll"][-1] - expected) > 1e-3, (key, sampling)
 
 

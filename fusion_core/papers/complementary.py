@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import ClassVar, Final
 
-from ..base import ESTIMATE, Estimator, tuple_new
+from ..base import ESTIMATE, NEVER_ESTIMATED, Estimator, tuple_new
 from ..kinematics import (
     HALF_PI,
     PI,
@@ -50,7 +50,7 @@ class PaperComplementaryFilter(Estimator):
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_cf"
     ZERO_BIAS: ClassVar[dict[str, str]] = {
-        f"bias_{a}": "always 0: this filter has no gyro-bias state" for a in "xyz"}
+        f"bias_{a}": f"{NEVER_ESTIMATED}: this filter has no gyro-bias state" for a in "xyz"}
     STATE: ClassVar[StateSpec] = {"roll": ANGLE, "pitch": HALF_ANGLE}
 
     def _configure(self) -> None:

@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import ClassVar, Final
 
-from ..base import ESTIMATE, Estimator, tuple_new
+from ..base import ESTIMATE, NEVER_ESTIMATED, Estimator, tuple_new
 from ..kinematics import (
     HALF_PI,
     PI,
@@ -170,8 +170,8 @@ class RollPitchAxes:
         )
 
 
-NO_Z_BIAS: Final = ("always 0: the papers' filter has no bias state about z, which no "
-                    "accelerometer tilt observes")
+NO_Z_BIAS: Final = (f"{NEVER_ESTIMATED}: the papers' filter has no bias state about z, which "
+                    "no accelerometer tilt observes")
 """Why bias_z of the papers' per-axis Kalman filter (and of their position filter, whose
 attitude is that filter's) is 0 (Estimator.ZERO_BIAS)."""
 

@@ -136,6 +136,7 @@ class PaperGainScheduledFilter(Estimator):
     PARAMS = PAPER_MGCF_PARAMS
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_mgcf"
+    GYRO_ONLY: ClassVar[dict[str, float] | None] = {}  # its schedule takes 3 g out
     STATE: ClassVar[StateSpec] = {"q": UNIT, "bias": REAL, "w0_now": NONNEG}
 
     def _configure(self) -> None:

@@ -232,6 +232,7 @@ class PaperPositionKalmanFilter(AxisFiltersState, Estimator):
     )
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_poskf"
+    GYRO_ONLY: ClassVar[dict[str, float] | None] = {}  # its tilt stage's gate takes 3 g out
     ZERO_BIAS: ClassVar[dict[str, str]] = {"bias_z": NO_Z_BIAS}
     STATE: ClassVar[StateSpec] = {"yaw": ANGLE, "states": REAL, "P": COV, "tilt_state": NESTED}
 

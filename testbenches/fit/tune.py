@@ -70,7 +70,8 @@ def tunable(key: str, names: Sequence[str] | None = None,
             cls: type[Estimator] | None = None) -> list[Param]:
     """The parameters to fit of estimator key's class cls (the recommended one unless given):
     the named ones (["all"]: every tunable float parameter of the class's PARAMS, not the sample
-    rules or the mounting), by default the class's SCANNED (for a paper's filter: all); ValueError
+    rules or the mounting), by default the class's SCANNED (where it scans none, as a paper's
+    filter: all); ValueError
     naming an unknown or untunable one."""
     cls = cls or ESTIMATORS[key]
     specs = cls.param_specs()
@@ -78,8 +79,8 @@ def tunable(key: str, names: Sequence[str] | None = None,
                if p.tunable and isinstance(p.default, float) and p.choices is None]
     if names is not None and list(names) == ["all"]:
         return allowed
-    if not names:
-        names = cls.SCANNED if cls is ESTIMATORS[key] else [p.name for p in allowed]
+    if not names:  # a paper's filter, or a class at its paper's values, scans nothing: all
+        names = (cls.SCANNED if cls is ESTIMATORS[key] else ()) or [p.name for p in allowed]
     out = []
     for name in names:
         if name not in specs:

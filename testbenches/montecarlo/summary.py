@@ -61,8 +61,9 @@ def summarise(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
             x = np.array([r[metric] for r in ok], dtype=float)
             x = x[np.isfinite(x)]
             entry[metric] = {name: _stat(x, name) for name in STATISTICS} if len(x) else None
-        lim_roll, lim_pitch = accuracy_limits(estimator, scenario)
-        if ok:
+        limits = accuracy_limits(estimator, scenario)
+        if ok and limits is not None:
+            lim_roll, lim_pitch = limits
             roll = np.array([r["rmse_roll_deg"] for r in ok])
             pitch = np.array([r["rmse_pitch_deg"] for r in ok])
             within = float(np.mean((roll <= lim_roll) & (pitch <= lim_pitch)))
