@@ -588,9 +588,10 @@ def slow_roll_table(ctx: dict[str, Path]) -> str:
     return table()
 
 
-def estimators_table(ctx: dict[str, Path]) -> str:
+def estimators_table(ctx: dict[str, Path], pages: str = "") -> str:
     """README: every estimator of the registry, its classes (the FMU is named after the
-    recommended one), its papers and equations and the gyro biases it learns."""
+    recommended one), its papers and equations and the gyro biases it learns; with pages (the
+    folder of the estimators' pages, relative to the page), each key links to its page."""
     from fusion_core.base import NEVER_ESTIMATED
     from fusion_core.registry import REGISTRY
 
@@ -606,7 +607,8 @@ def estimators_table(ctx: dict[str, Path]) -> str:
         also = " (also position, velocity)" if e.cls.HAS_POSITION else ""
         paper = (f"`{e.reference.__name__}`" if e.reference is not None
                  else "the same class at its paper's values")
-        rows.append(f"| `{e.key}` | `{e.fmu}`{also} | {paper} | {e.cites} | {learned} |")
+        key = f"[`{e.key}`]({pages}{e.key}.md)" if pages else f"`{e.key}`"
+        rows.append(f"| {key} | `{e.fmu}`{also} | {paper} | {e.cites} | {learned} |")
     return "\n".join(rows)
 
 
@@ -986,6 +988,8 @@ FIGURES: tuple[Figure, ...] = (
     Figure("readme-estimators", "README.md", "fusion_core.registry (python -c 'from "
            "testbenches.docs_figures import estimators_table; print(estimators_table({}))')",
            estimators_table),
+    Figure("estimators-index", "docs/estimators/index.md", "fusion_core.registry (as "
+           "readme-estimators)", functools.partial(estimators_table, pages="./")),
     Figure("readme-contract", "README.md", "make run (imu-fusion run --fmu-dir dist)",
            readme_contract, needs=("fmus",)),
     Figure("contract-parts", "docs/results/contract.md", "imu-fusion run (its checks over 20 "
