@@ -6,10 +6,10 @@ peer_runs). Each returns the estimated up direction in the sensor frame, [N, 3].
   and Magnetic Disturbance Rejection". Information Fusion 91:187-204, 2023. The `vqf` package's
   causal filter (`VQF.updateBatch`, its defaults), 6D quaternion `quat6D`. Not `offlineVQF`,
   which also looks at future samples.
-- Madgwick: S. Madgwick, A. Harrison, R. Vaidyanathan. "Estimation of IMU and MARG orientation
-  using a gradient descent algorithm". ICORR 2011. `ahrs.filters.Madgwick`, IMU form, its default
-  gain 0.033.
-- Mahony: R. Mahony, T. Hamel, J.-M. Pflimlin. "Nonlinear complementary filters on the special
+- ahrs-madgwick: S. Madgwick, A. Harrison, R. Vaidyanathan. "Estimation of IMU and MARG
+  orientation using a gradient descent algorithm". ICORR 2011. `ahrs.filters.Madgwick`, IMU
+  form, its default gain 0.033.
+- ahrs-mahony: R. Mahony, T. Hamel, J.-M. Pflimlin. "Nonlinear complementary filters on the special
   orthogonal group". IEEE TAC 53(5), 2008. `ahrs.filters.Mahony`, IMU form, its defaults
   k_P = 1, k_I = 0.3.
 
@@ -118,10 +118,12 @@ def run_mahony(acc: np.ndarray, gyro: np.ndarray, rate: float) -> np.ndarray:
 
 PEERS: dict[str, Callable[[np.ndarray, np.ndarray, float], np.ndarray]] = {
     "vqf": run_vqf,
-    "madgwick": run_madgwick,
-    "mahony": run_mahony,
+    "ahrs-madgwick": run_madgwick,
+    "ahrs-mahony": run_mahony,
 }
-"""Peer name -> run(acc [N, 3], gyro [N, 3], rate [Hz]) -> up direction [N, 3]."""
+"""Peer name -> run(acc [N, 3], gyro [N, 3], rate [Hz]) -> up direction [N, 3]. A peer is named
+after the package it runs where the filter's name could be an estimator's key (fusion_core's
+registry has a madgwick of its own); tests/test_peers.py holds the names apart."""
 
 AHEAD_PEERS: dict[str, Callable[[np.ndarray, np.ndarray, float, float], np.ndarray]] = {
     "vqf-ahead": run_vqf_ahead,
@@ -131,8 +133,8 @@ AHEAD_PEERS: dict[str, Callable[[np.ndarray, np.ndarray, float, float], np.ndarr
 
 def check_peers(names: list[str]) -> None:
     """Raise PeerUnavailable (with the pip command) unless every named peer can be imported."""
-    modules = {"vqf": "vqf", "vqf-ahead": "vqf", "madgwick": "ahrs.filters",
-               "mahony": "ahrs.filters"}
+    modules = {"vqf": "vqf", "vqf-ahead": "vqf", "ahrs-madgwick": "ahrs.filters",
+               "ahrs-mahony": "ahrs.filters"}
     for name in names:
         _import(modules[name], f"the {name} peer")
 

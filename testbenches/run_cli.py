@@ -27,6 +27,7 @@ from .options import (
     with_calibration,
 )
 from .parts import CALIBRATED_SHARE, PARTS
+from .peers import PEERS
 
 CALIBRATED_PCT = f"{100 * CALIBRATED_SHARE:g}"
 
@@ -77,7 +78,7 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     run.add_argument("--peers", default="", metavar="LIST",
                      help="also run public filters on the same samples and score them against "
                      "the same bounds, for reference (not in the verdict): all or a comma list "
-                     "of vqf, madgwick, mahony (the bench extra: pip install -e '.[bench]')")
+                     f"of {', '.join(PEERS)} (the bench extra: pip install -e '.[bench]')")
     run.set_defaults(func=cmd_run)
 
 

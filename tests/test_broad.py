@@ -298,7 +298,7 @@ def test_cli_runs_the_peers_on_the_same_trial(tmp_path: Path) -> None:
     assert main(["broad", str(path), "--estimator", "mgcf", "--peers", "--no-plots",
                  "--out", str(out)]) == 0
     means = json.loads((out / "report.json").read_text())["mean_inclination_rmse_deg"]
-    assert set(means) == {"mgcf", "vqf", "madgwick", "mahony", "vqf-ahead"}
+    assert set(means) == {"mgcf", "vqf", "ahrs-madgwick", "ahrs-mahony", "vqf-ahead"}
     assert means["vqf"] < 2.0, means  # VQF on an undisturbed slow trial
     assert means["vqf-ahead"] != means["vqf"], means  # turned ahead over the trial's 2.4 ms
 
