@@ -20,6 +20,7 @@ from typing import Any, NamedTuple
 from .base import Estimator
 from .complementary import ComplementaryFilter
 from .kalman import AngleBiasKalmanFilter
+from .madgwick import MadgwickFilter
 from .mgcf import GainScheduledComplementaryFilter
 from .papers import (
     PaperComplementaryFilter,
@@ -151,6 +152,15 @@ REGISTRY: tuple[Entry, ...] = (
           "Cahyadi, Firmansyah, eq. 20-29; tilt from the Gui, Tang, Mukhopadhyay (2015) "
           "[angle, bias] Kalman filter. One IMU sample per doStep.",
           paper_row=CCF_ROW, bench=Bench(step_us=10.0, native_us=0.4, vqf_ratio=1.5)),
+    Entry("madgwick", MadgwickFilter, None,
+          title="Madgwick's gradient-descent filter (Madgwick et al. 2011)",
+          cites="Madgwick, Harrison, Vaidyanathan 2011; Madgwick 2010 eq. 12-13, 25-26, 33-34",
+          attitude_filter=False,
+          fmu_text="Madgwick's gradient-descent orientation filter, IMU form, for roll and pitch: "
+          "S. Madgwick, A. Harrison, R. Vaidyanathan (2011); Madgwick (2010), eq. 12-13, 25-26, "
+          "33-34, at its paper's gain beta = 0.033 rad/s. One IMU sample per doStep; no "
+          "gyro-bias state.",
+          paper_row=None, bench=Bench(step_us=0.5, native_us=0.1, vqf_ratio=0.5)),
 )
 """Every estimator, in the order of the tables."""
 

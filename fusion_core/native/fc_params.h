@@ -1007,6 +1007,85 @@ static inline void fc_paper_poskf_params_default(fc_paper_poskf_params *p)
     p->sensor_delay = 0.0;
 }
 
+/* ----- MadgwickFilter (fc_madgwick) ----------------------------------------- */
+
+#define FC_MADGWICK_GYRO_SAMPLING_POINT 0
+#define FC_MADGWICK_GYRO_SAMPLING_MEAN 1
+
+typedef struct fc_madgwick_params {
+    fc_real beta;          /* [0.0, 10000.0] [rad/s] */
+    int gyro_sampling;     /* one of 'point', 'mean' */
+    fc_real max_dt;        /* (0.0, 1000000.0] [s] */
+    fc_real max_rate;      /* (0.0, 10000.0] [rad/s] */
+    fc_real mount_roll;    /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_pitch;   /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real mount_yaw;     /* [-3.141592653589793, 3.141592653589793] [rad] */
+    fc_real acc_cal_xx;    /* [0.8, 1.25] */
+    fc_real acc_cal_xy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_xz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_yy;    /* [0.8, 1.25] */
+    fc_real acc_cal_yz;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zx;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zy;    /* [-0.2, 0.2] */
+    fc_real acc_cal_zz;    /* [0.8, 1.25] */
+    fc_real acc_off_x;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_y;     /* [-100.0, 100.0] [m/s2] */
+    fc_real acc_off_z;     /* [-100.0, 100.0] [m/s2] */
+    fc_real gyro_cal_xx;   /* [0.8, 1.25] */
+    fc_real gyro_cal_xy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_xz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_yy;   /* [0.8, 1.25] */
+    fc_real gyro_cal_yz;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zx;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zy;   /* [-0.2, 0.2] */
+    fc_real gyro_cal_zz;   /* [0.8, 1.25] */
+    fc_real gyro_off_x;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_y;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_off_z;    /* [-10.0, 10.0] [rad/s] */
+    fc_real gyro_range;    /* [0.001, 10000.0] [rad/s] */
+    fc_real sensor_delay;  /* [0.0, 0.1] [s] */
+} fc_madgwick_params;
+
+/* The defaults: MadgwickFilter.PARAMS. */
+static inline void fc_madgwick_params_default(fc_madgwick_params *p)
+{
+    p->beta = 0.033;
+    p->gyro_sampling = FC_MADGWICK_GYRO_SAMPLING_POINT;
+    p->max_dt = 1.0;
+    p->max_rate = 1000.0;
+    p->mount_roll = 0.0;
+    p->mount_pitch = 0.0;
+    p->mount_yaw = 0.0;
+    p->acc_cal_xx = 1.0;
+    p->acc_cal_xy = 0.0;
+    p->acc_cal_xz = 0.0;
+    p->acc_cal_yx = 0.0;
+    p->acc_cal_yy = 1.0;
+    p->acc_cal_yz = 0.0;
+    p->acc_cal_zx = 0.0;
+    p->acc_cal_zy = 0.0;
+    p->acc_cal_zz = 1.0;
+    p->acc_off_x = 0.0;
+    p->acc_off_y = 0.0;
+    p->acc_off_z = 0.0;
+    p->gyro_cal_xx = 1.0;
+    p->gyro_cal_xy = 0.0;
+    p->gyro_cal_xz = 0.0;
+    p->gyro_cal_yx = 0.0;
+    p->gyro_cal_yy = 1.0;
+    p->gyro_cal_yz = 0.0;
+    p->gyro_cal_zx = 0.0;
+    p->gyro_cal_zy = 0.0;
+    p->gyro_cal_zz = 1.0;
+    p->gyro_off_x = 0.0;
+    p->gyro_off_y = 0.0;
+    p->gyro_off_z = 0.0;
+    p->gyro_range = 34.90658503988659;
+    p->sensor_delay = 0.0;
+}
+
 /* ----- ImuSensorModel (fc_sensor) ------------------------------------------- */
 
 #define FC_SENSOR_GYRO_SAMPLING_POINT 0

@@ -17,6 +17,7 @@ extern const fc_layout FC_KF_LAYOUT;
 extern const fc_layout FC_PAPER_KF_LAYOUT;
 extern const fc_layout FC_UKF_LAYOUT;
 extern const fc_layout FC_PAPER_UKF_LAYOUT;
+extern const fc_layout FC_MADGWICK_LAYOUT;
 extern const fc_layout FC_PAPER_POSKF_LAYOUT;
 extern const fc_layout FC_POSKF_LAYOUT;
 extern const fc_layout FC_SENSOR_LAYOUT;

@@ -10,6 +10,7 @@
 
 #include "fc_cf.h"
 #include "fc_kf.h"
+#include "fc_madgwick.h"
 #include "fc_mgcf.h"
 #include "fc_paper_cf.h"
 #include "fc_paper_kf.h"
@@ -143,6 +144,15 @@ static const fc_field PAPER_UKF_FIELDS[] = {
 };
 const fc_layout FC_PAPER_UKF_LAYOUT = {"fc_paper_ukf", PAPER_UKF_FIELDS, (int)(sizeof PAPER_UKF_FIELDS / sizeof PAPER_UKF_FIELDS[0])};
 
+static const fc_field MADGWICK_FIELDS[] = {
+    {"base.initialized", offsetof(fc_madgwick, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
+    {"base.n_samples", offsetof(fc_madgwick, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.n_rejected", offsetof(fc_madgwick, base.n_rejected), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
+    {"base.gyro_prev", offsetof(fc_madgwick, base.gyro_prev), FC_DOUBLE, 3, FC_CHECK_REAL, 0.0},
+    {"q", offsetof(fc_madgwick, q), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
+};
+const fc_layout FC_MADGWICK_LAYOUT = {"fc_madgwick", MADGWICK_FIELDS, (int)(sizeof MADGWICK_FIELDS / sizeof MADGWICK_FIELDS[0])};
+
 static const fc_field PAPER_POSKF_FIELDS[] = {
     {"base.initialized", offsetof(fc_paper_poskf, base.initialized), FC_INT, 1, FC_CHECK_FLAG, 0.0},
     {"base.n_samples", offsetof(fc_paper_poskf, base.n_samples), FC_LONG, 1, FC_CHECK_COUNT, 0.0},
@@ -235,7 +245,7 @@ const fc_layout FC_SENSOR_LAYOUT = {"fc_sensor", SENSOR_FIELDS, (int)(sizeof SEN
 
 const fc_layout *fc_state_layout(const char *twin)
 {
-    const fc_layout *all[] = {&FC_CF_LAYOUT, &FC_PAPER_CF_LAYOUT, &FC_MGCF_LAYOUT, &FC_PAPER_MGCF_LAYOUT, &FC_KF_LAYOUT, &FC_PAPER_KF_LAYOUT, &FC_UKF_LAYOUT, &FC_PAPER_UKF_LAYOUT, &FC_PAPER_POSKF_LAYOUT, &FC_POSKF_LAYOUT, &FC_SENSOR_LAYOUT};
+    const fc_layout *all[] = {&FC_CF_LAYOUT, &FC_PAPER_CF_LAYOUT, &FC_MGCF_LAYOUT, &FC_PAPER_MGCF_LAYOUT, &FC_KF_LAYOUT, &FC_PAPER_KF_LAYOUT, &FC_UKF_LAYOUT, &FC_PAPER_UKF_LAYOUT, &FC_MADGWICK_LAYOUT, &FC_PAPER_POSKF_LAYOUT, &FC_POSKF_LAYOUT, &FC_SENSOR_LAYOUT};
     size_t i;
     for (i = 0; twin && i < sizeof all / sizeof all[0]; i++) {
         if (strcmp(all[i]->twin, twin) == 0) {
