@@ -164,23 +164,55 @@ REGISTRY: tuple[Entry, ...] = (
 )
 """Every estimator, in the order of the tables."""
 
-ESTIMATORS: dict[str, type[Estimator]] = {e.key: e.cls for e in REGISTRY}
+ESTIMATORS: dict[str, type[Estimator]] = {}
 """key -> class."""
-KEYS: tuple[str, ...] = tuple(ESTIMATORS)
+KEYS: tuple[str, ...] = ()
 """Every estimator's key."""
-ATTITUDE_FILTERS: tuple[str, ...] = tuple(e.key for e in REGISTRY if e.attitude_filter)
+ATTITUDE_FILTERS: tuple[str, ...] = ()
 """The keys of the attitude filters with a measured vector of their own."""
-FMU_NAMES: dict[str, str] = {e.key: e.fmu for e in REGISTRY}
+FMU_NAMES: dict[str, str] = {}
 """key -> FMU model name."""
-
-
-REFERENCES: dict[str, type[Estimator]] = {e.key: e.reference for e in REGISTRY
-                                           if e.reference is not None}
+REFERENCES: dict[str, type[Estimator]] = {}
 """key -> reference class (the seed paper's filter), for the entries that have one."""
-ENTRY: dict[str, Entry] = {e.key: e for e in REGISTRY}
-CLASSES: tuple[type[Estimator], ...] = tuple(c for e in REGISTRY for c in (e.cls, e.reference)
-                                             if c is not None)
+ENTRY: dict[str, Entry] = {}
+CLASSES: tuple[type[Estimator], ...] = ()
 """Every estimator class, recommended and reference (each has a C twin)."""
+
+
+def _derive() -> None:
+    """The tables above, from REGISTRY: at import and after register (the dicts in place)."""
+    global KEYS, ATTITUDE_FILTERS, CLASSES
+    ESTIMATORS.clear()
+    ESTIMATORS.update({e.key: e.cls for e in REGISTRY})
+    FMU_NAMES.clear()
+    FMU_NAMES.update({e.key: e.fmu for e in REGISTRY})
+    REFERENCES.clear()
+    REFERENCES.update({e.key: e.reference for e in REGISTRY if e.reference is not None})
+    ENTRY.clear()
+    ENTRY.update({e.key: e for e in REGISTRY})
+    KEYS = tuple(ESTIMATORS)
+    ATTITUDE_FILTERS = tuple(e.key for e in REGISTRY if e.attitude_filter)
+    CLASSES = tuple(c for e in REGISTRY for c in (e.cls, e.reference) if c is not None)
+
+
+_derive()
+
+
+def register(entry: Entry) -> None:
+    """Add an estimator to REGISTRY and to every table derived from it: for a test, or an
+    estimator kept outside the project, before any other module of the project is imported
+    (presets, the commands, the FMU builders and the testbenches take their lists from the
+    registry when they are imported; fusion_core.REGISTRY, bound when the package was imported,
+    keeps the tuple it had). ValueError for a key, FMU name or class already registered."""
+    global REGISTRY
+    taken = [what for what, clash in (("key", entry.key in ENTRY),
+                                      ("FMU name", entry.fmu in FMU_NAMES.values()),
+                                      ("class", entry.cls in CLASSES)) if clash]
+    if taken:
+        raise ValueError(f"estimator {entry.key!r} ({entry.cls.__name__}): its "
+                         f"{' and '.join(taken)} is already registered")
+    REGISTRY = (*REGISTRY, entry)
+    _derive()
 
 
 def estimator_class(key: str, params: dict[str, Any] | None = None) -> type[Estimator]:
@@ -219,4 +251,4 @@ def keys_help() -> str:
 
 __all__ = ["ATTITUDE_FILTERS", "CCF_ROW", "CLASSES", "ESTIMATORS", "FILTER", "FILTERS", "FMU_NAMES",
            "KEYS", "REFERENCES", "REGISTRY", "Bench", "Entry", "PaperRow", "create",
-           "estimator_class", "key_of", "keys_help"]
+           "estimator_class", "key_of", "keys_help", "register"]
