@@ -96,10 +96,10 @@ def test_after_garbage_a_clean_static_tilt_brings_the_error_back_under_1_deg(key
 def test_after_absurd_but_accepted_samples_the_error_is_back_under_1_deg_within_40_s(key: str
                                                                                    ) -> None:
     """1 s of samples that pass every rule but are absurd (rates up to 300 rad/s, specific force
-    up to 100 g) throws the attitude tens of degrees off; then a clean static tilt brings the
-    error under 1 deg for good within RECOVERY_BOUND_S (testbenches.recovery, whose table
+    up to 100 g) throws the attitude more than ten degrees off; then a clean static tilt brings
+    the error under 1 deg for good within RECOVERY_BOUND_S (testbenches.recovery, whose table
     docs/results/robustness.md shows)."""
     got = absurd_then_tilt(key)
     assert got["rejected"] == 0.0
-    assert got["thrown_deg"] > 20.0  # the garbage did throw it off
+    assert got["thrown_deg"] > 10.0  # the garbage did throw it off, ten times the bound
     assert got["back_after_s"] <= RECOVERY_BOUND_S, got
