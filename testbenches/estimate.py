@@ -53,9 +53,12 @@ OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", 
            "pos": ("pos_x", "pos_y", "pos_z"), "vel": ("vel_x", "vel_y", "vel_z"),
            "rejected": ("rejected",)}
 """The output groups --outputs chooses from, and their columns."""
-PLOT_POINTS = 5000
-"""The plot keeps at most about twice this many samples per line (every kth, k doubling): a
-few per pixel column of the figure."""
+PLOT_POINTS = 1000
+"""The plot keeps at most about twice this many samples per line (every kth, k doubling): about
+two per pixel column of the figure (9 in at 110 dpi); more only cost drawing time."""
+IN_FLIGHT = 2
+"""Blocks read ahead of the slowest estimator at most: what bounds memory while each estimator
+works through the blocks at its own pace (_Lanes)."""
 
 G_STANDARD = 9.80665
 DEG = np.pi / 180.0
@@ -351,6 +354,101 @@ class _VqfRun:
         self.trace.add(row0, {"t": t, "up": up})
 
 
+class _Lanes:
+    """Every task (an estimator's or VQF's run) takes the blocks in order, each at its own pace:
+    no task waits for the others at the end of a block. As many worker threads as the machine
+    has cores take whichever task has a block waiting and is not running (the C twins run
+    without the GIL, so the cores stay busy; one thread per task would hold a malloc arena and
+    a block's outputs each). Blocks are handed out as read, at most IN_FLIGHT held at once
+    (submit waits); `done(n)` is called once every task has finished a block of n rows. The
+    first exception of a task is raised by submit or close."""
+
+    def __init__(self, tasks: list[Any], done: Callable[[int], None]) -> None:
+        import collections
+        import os
+        import queue
+        import threading
+
+        self._done, self._lock = done, threading.Lock()
+        self._idle = threading.Condition(self._lock)  # notified when no block is left
+        self._slots = threading.Semaphore(IN_FLIGHT)
+        self._left: dict[int, list[int]] = {}  # block id -> [tasks still on it, rows]
+        self._error: BaseException | None = None
+        self._pending: list[collections.deque[Any]] = [collections.deque() for _ in tasks]
+        self._busy = [False] * len(tasks)  # running, or waiting in the ready queue
+        self._tasks = tasks
+        self._ready: queue.Queue[int | None] = queue.Queue()
+        self._next = 0
+        self._workers = [threading.Thread(target=self._work, daemon=True)
+                         for _ in range(max(1, min(len(tasks), os.cpu_count() or 1)))]
+        for worker in self._workers:
+            worker.start()
+
+    def _work(self) -> None:
+        while (i := self._ready.get()) is not None:
+            with self._lock:
+                block_id, args = self._pending[i].popleft()
+            if self._error is None:
+                try:
+                    self._tasks[i].block(*args)
+                except BaseException as err:  # raised in the caller
+                    with self._lock:
+                        self._error = self._error or err
+            del args  # a worker holds no block between tasks
+            with self._lock:
+                if self._pending[i]:
+                    self._ready.put(i)  # its next block
+                else:
+                    self._busy[i] = False
+            self._finished(block_id)
+
+    def _finished(self, block_id: int) -> None:
+        with self._lock:
+            left = self._left[block_id]
+            left[0] -= 1
+            if left[0] > 0:
+                return
+            del self._left[block_id]
+            if not self._left:
+                self._idle.notify_all()
+        self._slots.release()
+        if self._error is None:
+            self._done(left[1])
+
+    def submit(self, rows: int, *args: Any) -> None:
+        """One block (rows long) to every task: task.block(*args)."""
+        self._slots.acquire()
+        self._raise()
+        with self._lock:
+            self._left[self._next] = [len(self._tasks), rows]
+            for i, pending in enumerate(self._pending):
+                pending.append((self._next, args))
+                if not self._busy[i]:
+                    self._busy[i] = True
+                    self._ready.put(i)
+        self._next += 1
+
+    def close(self, quiet: bool = False) -> None:
+        """Wait for every task to finish its blocks; raise the first exception of any (quiet:
+        none, the caller is raising its own)."""
+        if quiet:
+            with self._lock:
+                self._error = self._error or RuntimeError("stopped")  # the rest is skipped
+        with self._idle:  # every block done (the workers put tasks' next blocks in the queue)
+            while self._left:
+                self._idle.wait()
+        for _ in self._workers:
+            self._ready.put(None)
+        for worker in self._workers:
+            worker.join()
+        if not quiet:
+            self._raise()
+
+    def _raise(self) -> None:
+        if self._error is not None:
+            raise self._error
+
+
 def _read_ahead(blocks: Any) -> Any:
     """The blocks of an iterator, the next one read by a thread of its own while the caller
     works on the last (the reader's exceptions raised in the caller, in order)."""
@@ -454,12 +552,9 @@ def cmd_estimate(args: argparse.Namespace) -> int:
 
 def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | None,
                 runs: list[Any], vqf_params: dict[str, Any]) -> tuple[Any, dict[str, Any]]:
-    """Every block through every estimator (in parallel: the C twin runs without the GIL) and
-    VQF where there is a reference (on the samples as `vqf_params` condition them); what was
-    read, found and scored."""
-    import os
-    from concurrent.futures import ThreadPoolExecutor
-
+    """Every block through every estimator (in parallel, each at its own pace: _Lanes) and VQF
+    where there is a reference (on the samples as `vqf_params` condition them); what was read,
+    found and scored."""
     from .fit.recording import RecordingError
 
     world_up, notes, vqf = None, [], None
@@ -467,36 +562,42 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
     first_t = last_t = float("nan")
     truth = Thinned()
     duration = 0.0
-    workers = max(1, min(len(runs) + 1, os.cpu_count() or 1))
-    with ThreadPoolExecutor(workers) as pool, _progress(source) as bar:
-        for rec, t in _read_ahead(source.blocks()):
-            if reference is not None:
-                if n == 0 and reference.span[1] < t[0]:
-                    raise RecordingError(reference.overlap_error(float(t[0]), float("nan")))
-                rec.up_ref, rec.ref_quat = reference.at(t)
-                rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
-            if n == 0:
-                world_up, note = find_world_up(rec, args.reference or args.recording)
-                notes += [note] if note else []
-                if rec.up_ref is not None and not args.no_vqf:
-                    vqf = _VqfRun(source.rate, vqf_params)
-            if world_up is not None and rec.ref_quat is not None:
-                rec.up_ref = about_world_up(rec.ref_quat, world_up)
-            if rec.up_ref is not None:  # scored where every estimator and VQF took the sample
-                rec.counts = rec.counted & rec.valid
-                scored += int(rec.counts.sum())
-                truth.add(n, {"t": t, "up": rec.up_ref})
-            tasks = [*runs, *([vqf] if vqf is not None else [])]
-            done = [pool.submit(r.block, rec, t, n, args.every) for r in tasks]
-            for job in done:
-                job.result()
-            if n == 0:
-                first_t = float(t[0])
-            last_t = float(t[-1])
-            duration += float(np.nansum(rec.dt[1:] if n == 0 else rec.dt))
-            missing += int((~rec.valid).sum())
-            n += len(t)
-            bar.update(len(t))
+    lanes = None
+    try:
+        with _progress(source) as bar:
+            for rec, t in _read_ahead(source.blocks()):
+                if reference is not None:
+                    if n == 0 and reference.span[1] < t[0]:
+                        raise RecordingError(reference.overlap_error(float(t[0]),
+                                                                     float("nan")))
+                    rec.up_ref, rec.ref_quat = reference.at(t)
+                    rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
+                if n == 0:
+                    world_up, note = find_world_up(rec, args.reference or args.recording)
+                    notes += [note] if note else []
+                    if rec.up_ref is not None and not args.no_vqf:
+                        vqf = _VqfRun(source.rate, vqf_params)
+                if world_up is not None and rec.ref_quat is not None:
+                    rec.up_ref = about_world_up(rec.ref_quat, world_up)
+                if rec.up_ref is not None:  # scored where every estimator and VQF took it
+                    rec.counts = rec.counted & rec.valid
+                    scored += int(rec.counts.sum())
+                    truth.add(n, {"t": t, "up": rec.up_ref})
+                if lanes is None:  # VQF's lane is known after the first block's reference
+                    lanes = _Lanes([*runs, *([vqf] if vqf is not None else [])], bar.update)
+                lanes.submit(len(t), rec, t, n, args.every)  # rec is not changed after this
+                if n == 0:
+                    first_t = float(t[0])
+                last_t = float(t[-1])
+                duration += float(np.nansum(rec.dt[1:] if n == 0 else rec.dt))
+                missing += int((~rec.valid).sum())
+                n += len(t)
+            if lanes is not None:
+                lanes.close()
+    except BaseException:
+        if lanes is not None:  # the estimators stop before their outputs are discarded
+            lanes.close(quiet=True)
+        raise
     if reference is not None and scored == 0:
         lo, hi = reference.span
         if hi < first_t or lo > last_t:

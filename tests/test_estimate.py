@@ -384,3 +384,48 @@ def test_a_quaternion_reference_of_another_sensor_is_refused(tmp_path, capsys):
     assert main(["estimate", str(EXAMPLE), "--reference", str(path), "--out", str(tmp_path),
                  "--no-plots"]) == 2
     assert "no vertical of the reference's world frame explains" in capsys.readouterr().err
+
+
+def test_each_estimator_takes_the_blocks_in_order_at_its_own_pace():
+    """estimate's _Lanes: every task sees every block in order, a fast task does not wait for
+    a slow one at the end of a block, no more than IN_FLIGHT blocks are held, done() follows
+    the slowest, and a task's exception is raised in the caller."""
+    import time
+
+    from testbenches import estimate
+
+    class Task:
+        def __init__(self, pause):
+            self.pause, self.seen, self.times = pause, [], []
+
+        def block(self, k):
+            time.sleep(self.pause)
+            self.seen.append(k)
+            self.times.append(time.perf_counter())
+
+    fast, slow, done = Task(0.0), Task(0.02), []
+    lanes = estimate._Lanes([fast, slow], done.append)
+    held = []
+    for k in range(10):
+        lanes.submit(k + 1, k)
+        held.append(k + 1 - len(done))
+    lanes.close()
+    assert fast.seen == slow.seen == list(range(10))
+    assert fast.times[-1] < slow.times[-2]  # the fast one ran ahead
+    assert max(held) <= estimate.IN_FLIGHT
+    assert done == [k + 1 for k in range(10)]
+
+    class Failing(Task):
+        def block(self, k):
+            if k == 2:
+                raise ValueError("disk full")
+            super().block(k)
+
+    failing = Failing(0.0)
+    lanes = estimate._Lanes([Task(0.0), failing], lambda n: None)
+    with pytest.raises(ValueError, match="disk full"):
+        for k in range(10):
+            lanes.submit(1, k)
+        lanes.close()
+    lanes.close(quiet=True)
+    assert failing.seen == [0, 1]
