@@ -140,7 +140,7 @@ def run_contract(
         from .parts import part_rmse, parts_checks
 
         out.checks += parts_checks(part_rmse(estimators, scenarios, preset or {}, sensor or {},
-                                             parts, params, parts_progress))
+                                             parts, params, parts_progress, bounded_only=True))
     return out
 
 

@@ -234,7 +234,7 @@ def parts_table(ctx: dict[str, Path]) -> str:
     from . import parts
 
     rmse = parts.part_rmse(list(KEYS), list(ESTIMATION_SCENARIOS), load_preset("recommended"),
-                           sensor_preset("realistic"))
+                           sensor_preset("realistic"), bounded_only=True)
     return parts.parts_table(rmse)
 
 

@@ -11,6 +11,7 @@ from typing import Any
 
 from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
+from .contract import accuracy_limits
 from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .master import MASTERS
 from .options import (
@@ -123,7 +124,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     fmu_dir = kind_dir(args.fmu_dir, args.kind)
     print(f"FMUs: {fmu_dir}", file=sys.stderr)
     parts = 0 if args.no_contract else args.parts
-    n_parts = 2 * parts * len(estimators) * len(scenarios)
+    bounded = sum(accuracy_limits(e, s) is not None for e in estimators for s in scenarios)
+    n_parts = 2 * parts * bounded  # the pairs with a bound are run over parts
     with tqdm(total=len(jobs) + n_parts, unit="run", file=sys.stderr) as bar:
         def progress(job: object) -> None:
             bar.set_postfix_str(f"{job.estimator} {job.scenario}")  # type: ignore[attr-defined]
