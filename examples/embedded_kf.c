@@ -12,7 +12,7 @@ int main(void)
     fc_kf kf;                    /* all the filter's state: no globals, no malloc */
     fc_kf_params p;
     fc_kf_params_default(&p);    /* the recommended values */
-    p.gyro_sampling = FC_KF_GYRO_SAMPLING_MEAN;  /* an integrating IMU */
+    p.input.gyro_sampling = FC_GYRO_SAMPLING_MEAN;  /* an integrating IMU */
     fc_kf_init(&kf, &p);
     for (int i = 0; i < 500; i++) {              /* 5 s at 100 Hz, tilted 10 deg in roll */
         double acc[3] = {0.0, 9.80665 * sin(0.1745), 9.80665 * cos(0.1745)};

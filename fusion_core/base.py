@@ -1,7 +1,11 @@
 """The step API that every estimator shares: parameters, input checks, run, state.
 
-A subclass declares PARAMS (its tuning parameters) and STATE (the attributes that make up its
-internal state, each with the check a restored value must pass: fusion_core.state), and
+The input stage every estimator shares is declared here once: its parameters (COMMON_PARAMS:
+the gyro sampling rule, the sample limits, mounting, calibration, gyro range, sensor delay) and
+its work on each sample (Estimator._prepare; the C twin's fc_base_configure and
+fc_base_prepare). A subclass declares PARAMS (its own filter's parameters only) and STATE (the
+attributes that make up its internal state, each with the check a restored value must pass:
+fusion_core.state), and
 implements `_reset()`, `_init(...)`, `_estimate()` and `_update(ax, ay, az, gx, gy, gz, dt)`, or
 instead of `_update` the hot-path form `_advance(ax, ay, az, gx, gy, gz, dt)`, which also
 returns the estimate (one call less per sample). Everything else (validation, the first-sample
@@ -16,10 +20,13 @@ from typing import Any, ClassVar, Final, NamedTuple
 
 import numpy as np
 
+from .building_blocks.sampling import GYRO_SAMPLING_PARAM
 from .calibration import CALIBRATION_PARAMS, check_calibration, matrices
 from .kinematics import roll_pitch_ahead
+from .linalg import Mat9, mat_vec, vec_sub
 from .state import BASE_STATE, NESTED, StateSpec, check_field
 from .types import (
+    ABSENT,
     GYRO_RANGE_DEFAULT,
     RUN_CHUNK,
     Estimate,
@@ -51,6 +58,7 @@ MOUNTING_PARAMS: tuple[Param, ...] = tuple(
 down, turned on its side) is given as the rotation that takes its axes to the filter's, so that
 every estimator sees the body frame of docs/interface.md."""
 COMMON_PARAMS: tuple[Param, ...] = (
+    GYRO_SAMPLING_PARAM,
     Param(
         "max_dt", 1.0, "Longest accepted time between samples; a longer dt is rejected",
         unit="s", low=0.0, low_open=True, tunable=True,
@@ -95,13 +103,8 @@ BACKENDS: Final = ("auto", "python", "native")
 """Estimator.run's backends."""
 _MIN_INIT_NORM2: Final = MIN_INIT_NORM * MIN_INIT_NORM
 _MAX_ACC_NORM2: Final = MAX_ACC_NORM * MAX_ACC_NORM
-tuple_new: Final = tuple.__new__
-ESTIMATE: Final = Estimate
-"""`tuple_new(ESTIMATE, (roll, pitch, bias, None, None))` is `Estimate(roll, pitch, bias)`
-without the NamedTuple's Python-level __new__: the hot paths build their estimate this way."""
 
 
-Mat9 = tuple[float, float, float, float, float, float, float, float, float]
 IDENTITY: Final[Mat9] = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 ZERO3: Final = (0.0, 0.0, 0.0)
 
@@ -262,8 +265,8 @@ class Estimator:
         self._calibrated: bool = (self._acc_cal != IDENTITY or self._gyro_cal != IDENTITY
                                   or self._acc_off != ZERO3 or self._gyro_off != ZERO3)
         self._delay = float(values["sensor_delay"])
-        # without gyro_range (COMMON) no sample is at a rail
-        self._rail = float(values.get("gyro_range", math.inf)) * (1.0 - RAIL_MARGIN)
+        self._trapezoid: bool = values["gyro_sampling"] == "point"
+        self._rail = float(values.get("gyro_range", ABSENT["gyro_range"])) * (1.0 - RAIL_MARGIN)
         self._configure()
 
     def _check_params(self, values: dict[str, Any]) -> None:
@@ -339,41 +342,10 @@ class Estimator:
             raise InvalidSample(
                 f"sample is not three accelerations, three rates and dt: {err}"
             ) from None
-        # Fast path of check_sample (written out here, the hot path): one finite test on the
-        # sum; _check_values says what is wrong only when this test fails.
-        w2 = gx * gx + gy * gy + gz * gz
-        total = ax + ay + az + w2 + dt  # not finite if an input is NaN or inf (or huge)
-        if not (
-            total - total == 0.0  # isfinite(total) without a call: inf - inf, NaN - NaN are NaN
-            and w2 <= self._max_rate2
-            and 0.0 < dt <= self._max_dt
-        ):
-            self._check_values(ax, ay, az, gx, gy, gz, dt)
-        rail = self._rail  # on the sensor's own axes, before the mounting (gyro_range)
-        self.clipped = not (-rail < gx < rail and -rail < gy < rail and -rail < gz < rail)
-        if self._calibrated:  # the part's calibration (fusion_core.calibration)
-            c0, c1, c2, c3, c4, c5, c6, c7, c8 = self._acc_cal
-            ox, oy, oz = self._acc_off
-            ax, ay, az = ax - ox, ay - oy, az - oz
-            ax, ay, az = (c0 * ax + c1 * ay + c2 * az, c3 * ax + c4 * ay + c5 * az,
-                          c6 * ax + c7 * ay + c8 * az)
-            c0, c1, c2, c3, c4, c5, c6, c7, c8 = self._gyro_cal
-            ox, oy, oz = self._gyro_off
-            gx, gy, gz = gx - ox, gy - oy, gz - oz
-            gx, gy, gz = (c0 * gx + c1 * gy + c2 * gz, c3 * gx + c4 * gy + c5 * gz,
-                          c6 * gx + c7 * gy + c8 * gz)
-        if self._mounted:  # into the filter frame (MOUNTING_PARAMS)
-            m00, m01, m02, m10, m11, m12, m20, m21, m22 = self._mounting
-            ax, ay, az = (m00 * ax + m01 * ay + m02 * az, m10 * ax + m11 * ay + m12 * az,
-                          m20 * ax + m21 * ay + m22 * az)
-            gx, gy, gz = (m00 * gx + m01 * gy + m02 * gz, m10 * gx + m11 * gy + m12 * gz,
-                          m20 * gx + m21 * gy + m22 * gz)
-        norm2 = ax * ax + ay * ay + az * az
-        if not norm2 <= _MAX_ACC_NORM2:  # (also an overflow to inf) no reading at all
-            ax = ay = az = norm2 = 0.0
+        ax, ay, az, gx, gy, gz = self._prepare(ax, ay, az, gx, gy, gz, dt)
         if self.initialized:
             last = self._advance(ax, ay, az, gx, gy, gz, dt)
-        elif norm2 >= _MIN_INIT_NORM2:
+        elif ax * ax + ay * ay + az * az >= _MIN_INIT_NORM2:
             self._init(ax, ay, az, gx, gy, gz)
             self.initialized = True
             last = self._estimate()
@@ -385,6 +357,36 @@ class Estimator:
         self.last = last
         self.n_samples += 1
         return last
+
+    def _prepare(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> tuple[float, float, float, float, float, float]:
+        """The input stage every estimator shares (its parameters are COMMON_PARAMS; its C twin
+        is fc_base_prepare), on one sample as the sensor gave it: the sample rules (InvalidSample
+        where it is rejected, the state untouched), whether the gyro is at its rail
+        (self.clipped, on the sensor's own axes), the part's calibration (calibrated = cal
+        (raw - off), fusion_core.calibration), the mounting into the filter frame, and an
+        accelerometer reading beyond MAX_ACC_NORM taken as none. Returns the sample as the
+        filter sees it."""
+        # One test covers every value: check_sample says what is wrong only when it fails (a
+        # finite sample whose sum merely overflowed, e.g. acc = 1e308, passes there).
+        w2 = gx * gx + gy * gy + gz * gz
+        if not (math.isfinite(ax + ay + az + w2 + dt) and w2 <= self._max_rate2
+                and 0.0 < dt <= self._max_dt):
+            self.check_sample((ax, ay, az), (gx, gy, gz), dt)
+        rail = self._rail
+        self.clipped = not (-rail < gx < rail and -rail < gy < rail and -rail < gz < rail)
+        acc, gyro = (ax, ay, az), (gx, gy, gz)
+        if self._calibrated:
+            acc = mat_vec(self._acc_cal, vec_sub(acc, self._acc_off))
+            gyro = mat_vec(self._gyro_cal, vec_sub(gyro, self._gyro_off))
+        if self._mounted:
+            acc = mat_vec(self._mounting, acc)
+            gyro = mat_vec(self._mounting, gyro)
+        ax, ay, az = acc
+        if not ax * ax + ay * ay + az * az <= _MAX_ACC_NORM2:  # (or an overflow to inf)
+            ax = ay = az = 0.0
+        return ax, ay, az, gyro[0], gyro[1], gyro[2]
 
     def stream(self) -> Any:
         """This estimator stepped through its C twin: a fusion_core.native.Stream whose
@@ -417,13 +419,6 @@ class Estimator:
         self.gyro_prev is still the previous sample's rate here."""
         self._update(ax, ay, az, gx, gy, gz, dt)
         return self._estimate()
-
-    def _check_values(
-        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
-    ) -> None:
-        # The details of the fast test in step(): raises InvalidSample saying what is wrong.
-        # (a finite sample whose sum merely overflowed, e.g. acc = 1e308, passes)
-        self.check_sample((ax, ay, az), (gx, gy, gz), dt)
 
     def run(
         self,

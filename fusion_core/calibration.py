@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final
 
+from .linalg import Mat9
 from .types import Param
 
 AXES: Final = ("x", "y", "z")
@@ -95,7 +96,6 @@ CALIBRATION_PARAMS: Final[tuple[Param, ...]] = _params("acc") + _params("gyro")
 """The calibration every estimator applies to its input (identity and zero by default)."""
 SPECS: Final[dict[str, Param]] = {p.name: p for p in CALIBRATION_PARAMS}
 
-Mat9 = tuple[float, float, float, float, float, float, float, float, float]
 Vec3 = tuple[float, float, float]
 IDENTITY: Final[Mat9] = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 

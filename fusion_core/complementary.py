@@ -7,12 +7,11 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
+from .base import Estimator, SensorNoise
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
     COMPLEMENTARY_ADAPTIVE_PARAMS,
-    GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     REST_START,
     ZERO3,
@@ -98,7 +97,6 @@ class ComplementaryFilter(Estimator):
         *ACC_GATE_PARAMS,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
-        GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
         STRETCH_PARAM,
@@ -123,7 +121,6 @@ class ComplementaryFilter(Estimator):
         p = self._params
         self._tau = float(p["tau"])
         self._gate_low2, self._gate_high2 = gate_bounds2(p)
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
         self._rest = (float(p["rest_time"]), float(p["rest_gyro"]), float(p["rest_acc"]),
                       float(p["rest_bias_bound"]))
@@ -194,7 +191,7 @@ class ComplementaryFilter(Estimator):
             self.q_att = corrected_quat(q, up, roll, pitch, dr, dp)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-        return tuple_new(ESTIMATE, (roll, pitch, bias, None, None))
+        return Estimate(roll, pitch, bias)
 
     def _estimate(self) -> Estimate:
         return Estimate(self.roll, self.pitch, self.bias)

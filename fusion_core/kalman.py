@@ -10,7 +10,7 @@ import dataclasses
 from math import cos, sin, sqrt
 from typing import ClassVar, Final
 
-from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
+from .base import Estimator, SensorNoise
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
@@ -19,7 +19,6 @@ from .building_blocks import (
     BIAS_INNOVATION_PARAM,
     FACE_SWITCH_COS,
     FACES,
-    GYRO_SAMPLING_PARAM,
     MAX_CORRECTION_TIME_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
@@ -33,8 +32,6 @@ from .building_blocks import (
     corrected_quat,
     first_rest,
     gate_bounds2,
-    mat_t_vec,
-    mat_vec,
     nearest_face,
     quat_from_roll_pitch,
     rest_mean_share,
@@ -56,6 +53,7 @@ from .kinematics import (
     up_terms,
     wrap_angle,
 )
+from .linalg import mat_t_vec, mat_vec
 from .measured_vector import (
     BAND_PARAM,
     MEASURE_CHECK,
@@ -234,7 +232,6 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         ),
         BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
-        GYRO_SAMPLING_PARAM,
         BAND_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
@@ -267,7 +264,6 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self._r = float(p["R_measure"])
         self.r_step = self._r  # this step's measurement variance (the measured vector's noise)
         self._gate2 = gate_bounds2(p)
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
         # the zero-rate update's constants, read together
         self._rest_cfg = (
@@ -344,9 +340,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             self._switch_face()
         if self.face:
             return self._estimate()
-        return tuple_new(
-            ESTIMATE, (self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z), None, None)
-        )
+        return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z))
 
     def _update(  # type: ignore[override]
         self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float,

@@ -1,13 +1,36 @@
-"""Small dense linear algebra in plain floats, for the filters' covariances: a symmetric
-matrix kept as its lower triangle row by row ("packed"), Cholesky factors written out for the
-sizes the filters use, and a Jacobi eigen-decomposition for a covariance that rounding made
-indefinite. Plain Python floats and written-out operations, so that the C twins
-(fusion_core/native) do the same operations in the same order and agree bit for bit."""
+"""Small dense linear algebra in plain floats: 3-vectors and 3x3 matrices (row by row), and for
+the filters' covariances a symmetric matrix kept as its lower triangle row by row ("packed"),
+Cholesky factors written out for the sizes the filters use, and a Jacobi eigen-decomposition
+for a covariance that rounding made indefinite. Plain Python floats and written-out operations,
+so that the C twins (fusion_core/native) do the same operations in the same order and agree bit
+for bit."""
 
 from __future__ import annotations
 
 import math
 from typing import Final
+
+Vec3 = tuple[float, float, float]
+Mat9 = tuple[float, float, float, float, float, float, float, float, float]
+
+
+def vec_sub(a: Vec3, b: Vec3) -> Vec3:
+    """a - b."""
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def mat_vec(m: Mat9, v: Vec3) -> Vec3:
+    """m v for a 3x3 matrix m given row by row."""
+    x, y, z = v
+    return (m[0] * x + m[1] * y + m[2] * z, m[3] * x + m[4] * y + m[5] * z,
+            m[6] * x + m[7] * y + m[8] * z)
+
+
+def mat_t_vec(m: Mat9, v: Vec3) -> Vec3:
+    """m^T v for a 3x3 matrix m given row by row."""
+    x, y, z = v
+    return (m[0] * x + m[3] * y + m[6] * z, m[1] * x + m[4] * y + m[7] * z,
+            m[2] * x + m[5] * y + m[8] * z)
 
 
 def packed_size(t: tuple[float, ...]) -> int:

@@ -16,7 +16,6 @@ import math
 from typing import ClassVar, Final
 
 from .base import NEVER_ESTIMATED, Estimator
-from .building_blocks import GYRO_SAMPLING_PARAM
 from .kinematics import accel_roll_pitch, quat_from_roll_pitch_yaw, quat_roll_pitch
 from .state import UNIT, StateSpec
 from .types import Estimate, Param
@@ -59,7 +58,7 @@ class MadgwickFilter(Estimator):
     sample at its rail (gyro_range marks such samples, which it integrates as any).
     """
 
-    PARAMS = (BETA_PARAM, GYRO_SAMPLING_PARAM)
+    PARAMS = (BETA_PARAM,)
     TWIN: ClassVar[str | None] = "fc_madgwick"
     GYRO_ONLY: ClassVar[dict[str, float] | None] = {"beta": 0.0}
     ZERO_BIAS: ClassVar[dict[str, str]] = {
@@ -70,7 +69,6 @@ class MadgwickFilter(Estimator):
     def _configure(self) -> None:
         p = self._params
         self._beta = float(p["beta"])
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)

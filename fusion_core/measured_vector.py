@@ -69,13 +69,13 @@ from typing import Final, NamedTuple
 
 from .building_blocks import (
     PREFILTER_FULL,
-    Mat9,
     Vec3,
     adaptive_prefilter_time,
     lowpass_specific_force,
     on_the_mark,
 )
 from .kinematics import rotation_back_matrix
+from .linalg import Mat9
 from .state import NONNEG, REAL, Segments
 from .types import G, Param
 

@@ -10,11 +10,10 @@ import dataclasses
 import math
 from typing import ClassVar
 
-from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
+from .base import Estimator, SensorNoise
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
     COMPLEMENTARY_ADAPTIVE_PARAMS,
-    GYRO_SAMPLING_PARAM,
     REST_PARAMS,
     REST_START,
     SLOWEST_CORRECTION,
@@ -104,7 +103,6 @@ class GainScheduledComplementaryFilter(Estimator):
               low=0.0, high=1000.0),
         MGCF_ACC_LOWPASS,
         *REST_PARAMS,
-        GYRO_SAMPLING_PARAM,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
     )
     TWIN: ClassVar[str | None] = "fc_mgcf"
@@ -125,7 +123,6 @@ class GainScheduledComplementaryFilter(Estimator):
         p = self._params
         self._w0 = float(p["w0"])
         self._two_zeta = 2.0 * float(p["zeta"])
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._acc_tau = float(p["acc_lowpass"])
         self._rest_time = float(p["rest_time"])
         self._rest_gyro = float(p["rest_gyro"])
@@ -193,7 +190,7 @@ class GainScheduledComplementaryFilter(Estimator):
         if aligning and w0 > 0.0:  # the vector still fills (measured_vector): the mean's tilt
             self.q = q = quat_from_roll_pitch(*accel_roll_pitch(ax, ay, az))
             roll, pitch = quat_roll_pitch(*q)
-            return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
+            return Estimate(roll, pitch, self.bias)
         bx, by, bz = self.bias
         kp = self._two_zeta * w0
         # the adaptive noise: 1/Kp follows building_blocks.correction_time
@@ -209,7 +206,7 @@ class GainScheduledComplementaryFilter(Estimator):
                                norm, w0, kp, dt, self._trapezoid, learn)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)
-        return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
+        return Estimate(roll, pitch, self.bias)
 
     def _estimate(self) -> Estimate:
         roll, pitch = quat_roll_pitch(*self.q)

@@ -11,8 +11,8 @@ import dataclasses
 from math import nan, sqrt
 from typing import Any, ClassVar, Final
 
-from .base import ESTIMATE, Estimator, SensorNoise, tuple_new
-from .building_blocks import GYRO_SAMPLING_PARAM, zero_rate_psd_param
+from .base import Estimator, SensorNoise
+from .building_blocks import zero_rate_psd_param
 from .kalman import Z_BIAS_REST_ONLY, AngleBiasKalmanFilter
 from .kinematics import PI, accel_roll_pitch, roll_pitch_sines, wrap_angle
 from .papers.kalman import PAPER_KF_PARAMS, PaperKalmanFilter
@@ -41,8 +41,7 @@ so the bound is met up to 8 kHz. A fixed bound lets the C twin keep the queue in
 without allocating."""
 
 TILT_PARAMS: Final[tuple[Param, ...]] = tuple(
-    {"R_loop_time": dataclasses.replace(p, default=0.0),
-     "gyro_sampling": GYRO_SAMPLING_PARAM}.get(p.name, p)
+    dataclasses.replace(p, default=0.0) if p.name == "R_loop_time" else p
     for p in PAPER_KF_PARAMS
 )
 """The tilt stage's parameters (a PaperKalmanFilter, passed through): the papers' Q and R. It
@@ -156,14 +155,13 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         tilt_params = {k: p[k] for k in TILT_PARAM_NAMES}
         if not hasattr(self, "tilt"):
             self.tilt = PaperKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
-                                          **tilt_params)
+                                          gyro_sampling=p["gyro_sampling"], **tilt_params)
             # the attitude outputs: the recommended kf on the same samples
             self.att = AngleBiasKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
                                              gyro_sampling=p["gyro_sampling"])
         else:
             for k, v in tilt_params.items():
-                if k != "gyro_sampling":
-                    self.tilt.set_param(k, v)
+                self.tilt.set_param(k, v)
             for f in (self.tilt, self.att):
                 f.set_param("max_dt", p["max_dt"])
                 f.set_param("max_rate", p["max_rate"])
@@ -345,4 +343,4 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
     def _estimate(self) -> Estimate:
         x = self._x
         a = self.att.last  # the attitude kf's own output (in the sensor frame)
-        return tuple_new(ESTIMATE, (a[0], a[1], a[2], (x[0], x[3], x[6]), (x[1], x[4], x[7])))
+        return Estimate(a[0], a[1], a[2], (x[0], x[3], x[6]), (x[1], x[4], x[7]))

@@ -27,6 +27,9 @@ RUN_CHUNK: Final = 1024
 GYRO_RANGE_DEFAULT: Final = 2000.0 * DEG
 """Default gyro_range [rad/s]: +-2000 deg/s, the widest setting of the MPU-6050 class of consumer
 MEMS gyros (the realistic sensor model's range)."""
+ABSENT: Final[dict[str, float]] = {"gyro_range": math.inf}
+"""What a shared parameter (base.COMMON_PARAMS) a class leaves out amounts to: without gyro_range
+(the papers' filters know no gyro range) no sample is at a rail."""
 
 
 class Estimate(NamedTuple):

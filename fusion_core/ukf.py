@@ -15,7 +15,6 @@ from .building_blocks import (
     ADAPTIVE_NOISE_PARAMS,
     BIAS_GATE_PARAM,
     BIAS_INNOVATION_PARAM,
-    GYRO_SAMPLING_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
     REST_START,
@@ -149,7 +148,6 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         ),
         *SIGMA_PARAMS,
         *ADAPTIVE_NOISE_PARAMS,
-        GYRO_SAMPLING_PARAM,
         ACC_LOWPASS_PARAM,
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
@@ -192,7 +190,6 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                           float(p["acc_lowpass_stretch"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
         gate = float(p["bias_innovation"])
         # cos of the largest innovation angle the bias learns from (-2: every one)

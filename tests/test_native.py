@@ -16,9 +16,11 @@ from helpers import make, state_numbers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fusion_core import ESTIMATORS, InvalidSample, native, synthetic
+from fusion_core import ESTIMATORS, InvalidSample, native, registry, synthetic
 from fusion_core.calibration import Calibration
+from fusion_core.native.estimators import param_struct
 from fusion_core.presets import PRESETS, preset_params
+from fusion_core.types import ABSENT
 
 REPO = Path(__file__).resolve().parents[1]
 NATIVE = REPO / "fusion_core" / "native"
@@ -140,16 +142,22 @@ def test_available_and_reason_agree() -> None:
 
 
 @needs_twin
-@pytest.mark.parametrize("key", TWIN_KEYS)
-def test_the_c_defaults_are_the_python_defaults(key: str) -> None:
+@pytest.mark.parametrize("cls", [c for c in registry.CLASSES if c.TWIN is not None],
+                         ids=lambda c: c.TWIN)
+def test_the_c_defaults_are_the_python_defaults(cls: type) -> None:
+    """Every twin's T_params_default (fc_params.h) gives its class's defaults, and a shared
+    parameter the class leaves out (a paper filter's gyro_range) at base.ABSENT's value."""
     lib, ffi = native.lib_and_ffi()
-    prefix = ESTIMATORS[key].TWIN
+    prefix = cls.TWIN
     twin = ffi.new(f"{prefix} *")
     getattr(lib, f"{prefix}_init")(twin, ffi.NULL)
-    for name, spec in ESTIMATORS[key].param_specs().items():
-        c_value = getattr(twin.params, name)
+    for name, spec in cls.param_specs().items():
+        c_value = getattr(param_struct(twin.params, cls, name), name)
         expected = spec.choices.index(spec.default) if spec.choices else spec.default
         assert c_value == expected, name
+    for name, value in ABSENT.items():  # a shared parameter the class leaves out
+        if name not in cls.param_specs():
+            assert getattr(twin.params.input, name) == value, name
 
 
 @needs_twin

@@ -1,5 +1,6 @@
-"""MkDocs hook: `<!-- params: KEY -->` in a page becomes the table of that estimator's
-parameters, read from its class when the site is built (so the table is never stale), and the
+"""MkDocs hook: `<!-- params: KEY -->` in a page becomes the table of that estimator's own
+parameters (`<!-- params: input -->`: the input stage's, which every estimator shares), read
+from its class when the site is built (so the table is never stale), and the
 navigation's Estimators section lists every estimator of the registry, estimators/<key>.md
 after the overview (titled by the page's heading)."""
 
@@ -26,11 +27,15 @@ def _range(spec: Any) -> str:
 
 
 def params_table(key: str) -> str:
-    """The markdown table of estimator key's parameters (the recommended class)."""
+    """The markdown table of estimator key's own parameters (the recommended class's PARAMS),
+    or for "input" those of the input stage every estimator shares (base.COMMON_PARAMS)."""
     from fusion_core import registry
+    from fusion_core.base import COMMON_PARAMS
 
+    specs = COMMON_PARAMS if key == "input" else registry.estimator_class(key).PARAMS
     rows = ["| parameter | default | unit | allowed | description |", "|---|---|---|---|---|"]
-    for name, spec in registry.estimator_class(key).param_specs().items():
+    for spec in specs:
+        name = spec.name
         default = f"{spec.default:.6g}" if isinstance(spec.default, float) else repr(spec.default)
         rows.append(f"| `{name}` | `{_cell(default)}` | {_cell(spec.unit or '')} | "
                     f"{_cell(_range(spec))} | {_cell(spec.description or '')} |")

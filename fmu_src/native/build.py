@@ -113,6 +113,7 @@ class NativeModel:
     kind: str
     prefix: str = ""
     params: tuple = ()  # the fusion_core Params that fill the twin's params struct
+    shared: frozenset[str] = frozenset()  # those of them in its `input` (fc_input_params)
     source: Path | None = None  # the model's C file, if not models/<kind>.c
 
     @property
@@ -160,7 +161,8 @@ def native_model(name: str, preset: dict[str, dict[str, Any]] | None = None) -> 
         estimator, variables = estimator_table(key, (preset or {}).get(key, {}))
         params = tuple(estimator.param_specs().values())
         return NativeModel(name, model_description(ENTRY[key].fmu_text, estimator), variables,
-                           "estimator", estimator.TWIN or "", params)
+                           "estimator", estimator.TWIN or "", params,
+                           frozenset(p.name for p in estimator.COMMON))
     if not (MODELS_DIR / script_name(name)).is_file():
         raise ValueError(f"{name} has no native model")
     cls = getattr(importlib.import_module(f"fmu_src.models.{script_name(name)[:-3]}"), name)
@@ -192,14 +194,15 @@ def _variable_row(v: Variable) -> str:
             f"{int(low_open)}, {int(high_open)}}},")
 
 
-def _param_assignment(p) -> str:
+def _param_assignment(p, shared: frozenset[str]) -> str:
+    field = f"input.{p.name}" if p.name in shared else p.name
     if p.choices is not None:
-        return f"    p->{p.name} = (int)v[VR_{p.name}] - 1;"
+        return f"    p->{field} = (int)v[VR_{p.name}] - 1;"
     if isinstance(p.default, bool):
-        return f"    p->{p.name} = v[VR_{p.name}] != 0.0;"
+        return f"    p->{field} = v[VR_{p.name}] != 0.0;"
     if isinstance(p.default, int):
-        return f"    p->{p.name} = (long)v[VR_{p.name}];"
-    return f"    p->{p.name} = v[VR_{p.name}];"
+        return f"    p->{field} = (long)v[VR_{p.name}];"
+    return f"    p->{field} = v[VR_{p.name}];"
 
 
 def render_config(model: NativeModel) -> str:
@@ -254,10 +257,12 @@ def render_config(model: NativeModel) -> str:
     if model.params:
         struct = f"{model.prefix or 'fc_sensor'}_params"
         lines += [
-            f"/* The twin's {struct} from the parameter values. */",
+            f"/* The twin's {struct} from the parameter values (a field no variable sets, such",
+            " * as a paper filter's gyro_range, at its default). */",
             f"static void params_from_values({struct} *p, const double *v)",
             "{",
-            *(_param_assignment(p) for p in model.params),
+            f"    {struct}_default(p);",
+            *(_param_assignment(p, model.shared) for p in model.params),
             "}",
             "",
         ]

@@ -52,9 +52,6 @@ from .attitude import (
 from .faces import (
     FACE_SWITCH_COS,
     FACES,
-    Mat9,
-    mat_t_vec,
-    mat_vec,
     nearest_face,
 )
 from .gate import (
@@ -118,7 +115,6 @@ __all__ = [
     "REST_START",
     "SLOWEST_CORRECTION",
     "ZERO3",
-    "Mat9",
     "RestState",
     "Vec3",
     "adaptive_noise_constants",
@@ -133,8 +129,6 @@ __all__ = [
     "first_rest",
     "gate_bounds2",
     "lowpass_specific_force",
-    "mat_t_vec",
-    "mat_vec",
     "nearest_face",
     "on_the_mark",
     "quat_from_roll_pitch",

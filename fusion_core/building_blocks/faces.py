@@ -6,9 +6,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from .sampling import Vec3
-
-Mat9 = tuple[float, float, float, float, float, float, float, float, float]
+from ..linalg import Mat9
 
 FACES: Final[tuple[Mat9, ...]] = (
     (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),  # z up: the identity
@@ -38,17 +36,3 @@ def nearest_face(ux: float, uy: float, uz: float) -> int:
     if ax >= ay:
         return 2 if ux > 0.0 else 3
     return 4 if uy > 0.0 else 5
-
-
-def mat_vec(m: Mat9, v: Vec3) -> Vec3:
-    """m v for a 3x3 matrix m given row by row."""
-    x, y, z = v
-    return (m[0] * x + m[1] * y + m[2] * z, m[3] * x + m[4] * y + m[5] * z,
-            m[6] * x + m[7] * y + m[8] * z)
-
-
-def mat_t_vec(m: Mat9, v: Vec3) -> Vec3:
-    """m^T v for a 3x3 matrix m given row by row."""
-    x, y, z = v
-    return (m[0] * x + m[3] * y + m[6] * z, m[1] * x + m[4] * y + m[7] * z,
-            m[2] * x + m[5] * y + m[8] * z)

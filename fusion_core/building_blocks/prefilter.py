@@ -4,8 +4,8 @@ from it."""
 
 from __future__ import annotations
 
+from ..linalg import Mat9, mat_vec
 from ..types import Param
-from .faces import Mat9, mat_vec
 from .sampling import Vec3
 
 ACC_LOWPASS_PARAM = Param(

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..state import BASE_STATE as STATE_BASE
-from ..types import RUN_CHUNK, Estimate
+from ..types import ABSENT, RUN_CHUNK, Estimate
 from .library import available, lib_and_ffi
 
 FC_SKIPPED = 1
@@ -153,16 +153,34 @@ def _take_position(twin: Any, est: Any) -> None:
     est.aligned = bool(twin.aligned)
 
 
+def twin_params(ffi: Any, estimator: Any) -> Any:
+    """The estimator's parameter values as its twin's params struct (fc_params.h), made by ffi
+    (the double build's or a float one's): its own parameters by name, the input stage's in
+    params.input (fc_input_params), a choice as its index; a COMMON parameter the class leaves
+    out at base.ABSENT's value, as the generated T_params_default sets it."""
+    cls = type(estimator)
+    params = ffi.new(f"{cls.TWIN}_params *")
+    for name, value in ABSENT.items():
+        setattr(params.input, name, value)
+    for name, spec in estimator.param_specs().items():
+        value = estimator.params[name]
+        value = spec.choices.index(value) if spec.choices is not None else value
+        setattr(param_struct(params, cls, name), name, value)
+    return params
+
+
+def param_struct(params: Any, cls: Any, name: str) -> Any:
+    """The struct that holds parameter `name` of estimator class cls in its twin's params:
+    params for one of its own (cls.PARAMS), params.input for the input stage's."""
+    return params if any(p.name == name for p in cls.PARAMS) else params.input
+
+
 def new_twin(estimator: Any) -> Any:
     """A C twin holding the estimator's parameters and its whole state."""
     lib, ffi = lib_and_ffi()
     prefix = type(estimator).TWIN
     twin = ffi.new(f"{prefix} *")
-    params = ffi.new(f"{prefix}_params *")
-    specs = estimator.param_specs()
-    for name, value in estimator.params.items():
-        choices = specs[name].choices
-        setattr(params, name, choices.index(value) if choices is not None else value)
+    params = twin_params(ffi, estimator)
     getattr(lib, f"{prefix}_init")(twin, params)
     _fill(lib, twin, estimator)
     return twin

@@ -6,10 +6,9 @@
 void fc_cf_configure(fc_cf *f)
 {
     const fc_cf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
+    fc_base_configure(&f->base, &p->input);
     f->tau = p->tau;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
-    f->trapezoid = p->gyro_sampling == FC_CF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
     f->r_ref = fc_pow(p->acc_noise, 2.0);
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
@@ -65,7 +64,7 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
     fc_real bx = f->bias[0], by = f->bias[1], bz = f->bias[2];
     fc_real r = f->r_ref;
     int aligning = 0;
-    fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+    fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->base.trapezoid, phi);
     fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
     if (f->acc_tau > 0.0) {  /* the filter and its gate use the measured vector */
         if (clipped) {

@@ -781,45 +781,44 @@ void fc_mounting_matrix(fc_real roll, fc_real pitch, fc_real yaw, fc_real m[9])
     m[8] = cp * cr;
 }
 
-void fc_base_configure(fc_base *b, fc_real max_dt, fc_real max_rate, fc_real mount_roll,
-                       fc_real mount_pitch, fc_real mount_yaw, fc_real sensor_delay,
-                       fc_real gyro_range)
+static int differs(const fc_real *a, const fc_real *b, int n)
 {
-    static const fc_real identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-    b->max_dt = max_dt;
-    b->max_rate = max_rate;
-    b->delay = sensor_delay;
-    b->max_rate2 = fc_pow(max_rate, 2.0);
-    b->rail = gyro_range * (1.0 - RAIL_MARGIN);
-    b->clipped = 0;
-    fc_mounting_matrix(mount_roll, mount_pitch, mount_yaw, b->mounting);
-    b->mounted = 0;
-    for (int i = 0; i < 9; i++) {
-        if (b->mounting[i] != identity[i]) {
-            b->mounted = 1;
+    for (int i = 0; i < n; i++) {
+        if (a[i] != b[i]) {
+            return 1;
         }
     }
+    return 0;
 }
 
-void fc_base_calibrate(fc_base *b, const fc_real acc_cal[9], const fc_real acc_off[3],
-                       const fc_real gyro_cal[9], const fc_real gyro_off[3])
+void fc_base_configure(fc_base *b, const fc_input_params *in)
 {
     static const fc_real identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-    b->calibrated = 0;
-    for (int i = 0; i < 9; i++) {
-        b->acc_cal[i] = acc_cal[i];
-        b->gyro_cal[i] = gyro_cal[i];
-        if (acc_cal[i] != identity[i] || gyro_cal[i] != identity[i]) {
-            b->calibrated = 1;
-        }
-    }
-    for (int i = 0; i < 3; i++) {
-        b->acc_off[i] = acc_off[i];
-        b->gyro_off[i] = gyro_off[i];
-        if (acc_off[i] != 0.0 || gyro_off[i] != 0.0) {
-            b->calibrated = 1;
-        }
-    }
+    static const fc_real zero[3] = {0.0, 0.0, 0.0};
+    b->trapezoid = in->gyro_sampling == FC_GYRO_SAMPLING_POINT;
+    b->max_dt = in->max_dt;
+    b->max_rate = in->max_rate;
+    b->delay = in->sensor_delay;
+    b->max_rate2 = fc_pow(in->max_rate, 2.0);
+    b->rail = in->gyro_range * (1.0 - RAIL_MARGIN);
+    b->clipped = 0;
+    fc_mounting_matrix(in->mount_roll, in->mount_pitch, in->mount_yaw, b->mounting);
+    b->mounted = differs(b->mounting, identity, 9);
+    /* the part's calibration (fusion_core.calibration): calibrated = cal (raw - off) */
+    const fc_real acc_cal[9] = {in->acc_cal_xx, in->acc_cal_xy, in->acc_cal_xz,
+                                in->acc_cal_yx, in->acc_cal_yy, in->acc_cal_yz,
+                                in->acc_cal_zx, in->acc_cal_zy, in->acc_cal_zz};
+    const fc_real gyro_cal[9] = {in->gyro_cal_xx, in->gyro_cal_xy, in->gyro_cal_xz,
+                                 in->gyro_cal_yx, in->gyro_cal_yy, in->gyro_cal_yz,
+                                 in->gyro_cal_zx, in->gyro_cal_zy, in->gyro_cal_zz};
+    const fc_real acc_off[3] = {in->acc_off_x, in->acc_off_y, in->acc_off_z};
+    const fc_real gyro_off[3] = {in->gyro_off_x, in->gyro_off_y, in->gyro_off_z};
+    memcpy(b->acc_cal, acc_cal, sizeof acc_cal);
+    memcpy(b->gyro_cal, gyro_cal, sizeof gyro_cal);
+    memcpy(b->acc_off, acc_off, sizeof acc_off);
+    memcpy(b->gyro_off, gyro_off, sizeof gyro_off);
+    b->calibrated = differs(acc_cal, identity, 9) || differs(gyro_cal, identity, 9) ||
+                    differs(acc_off, zero, 3) || differs(gyro_off, zero, 3);
 }
 
 void fc_base_reset(fc_base *b)
@@ -835,7 +834,7 @@ fc_status fc_base_prepare(fc_base *b, fc_real acc[3], fc_real gyro[3], fc_real d
     fc_real ax = acc[0], ay = acc[1], az = acc[2], gx = gyro[0], gy = gyro[1], gz = gyro[2];
     fc_real w2 = gx * gx + gy * gy + gz * gz;
     fc_real total = ax + ay + az + w2 + dt;
-    if (!(total - total == 0.0 && w2 <= b->max_rate2 && 0.0 < dt && dt <= b->max_dt)) {
+    if (!(isfinite(total) && w2 <= b->max_rate2 && 0.0 < dt && dt <= b->max_dt)) {
         /* Estimator.check_sample: what is wrong (a finite sample whose sum overflowed passes) */
         if (!isfinite(ax) || !isfinite(ay) || !isfinite(az)) {
             return FC_BAD_ACC;

@@ -13,6 +13,7 @@
 
 #include <stddef.h>
 
+#include "fc_params.h"
 #include "fc_real.h"
 
 #define FC_G 9.80665            /* standard gravity [m/s^2] (fusion_core.types.G) */
@@ -61,6 +62,7 @@ typedef struct fc_base {
     fc_real acc_cal[9], acc_off[3], gyro_cal[9], gyro_off[3];  /* fusion_core.calibration */
     int calibrated;
     fc_real delay;  /* sensor_delay [s] */
+    int trapezoid;  /* gyro_sampling "point": the interval's rate linear between the samples */
     fc_real rail;   /* gyro_range (1 - RAIL_MARGIN): a gyro axis at or beyond it is at the rail */
     int clipped;   /* Estimator.clipped: whether this sample's gyro is at its rail */
 } fc_base;
@@ -218,31 +220,10 @@ void fc_mat_t_vec(const fc_real m[9], const fc_real v[3], fc_real out[3]);
 
 /* ----- base.py ----------------------------------------------------------------------------- */
 void fc_mounting_matrix(fc_real roll, fc_real pitch, fc_real yaw, fc_real m[9]);
-void fc_base_configure(fc_base *b, fc_real max_dt, fc_real max_rate, fc_real mount_roll,
-                       fc_real mount_pitch, fc_real mount_yaw, fc_real sensor_delay,
-                       fc_real gyro_range);
-/* The part's calibration (fusion_core.calibration): calibrated = cal (raw - off), applied by
- * fc_base_prepare before the mounting; the identity and zero: none. */
-void fc_base_calibrate(fc_base *b, const fc_real acc_cal[9], const fc_real acc_off[3],
-                       const fc_real gyro_cal[9], const fc_real gyro_off[3]);
-/* Estimator._set_params' shared part for any params struct p (every estimator's has COMMON's
- * fields): the sample rules, mounting, delay, the gyro's range (HUGE_VAL for a filter without
- * one: the papers') and the part's calibration. */
-#define FC_BASE_CONFIGURE(b, p, gyro_range)                                                   \
-    do {                                                                                      \
-        fc_base_configure((b), (p)->max_dt, (p)->max_rate, (p)->mount_roll, (p)->mount_pitch,  \
-                          (p)->mount_yaw, (p)->sensor_delay, (gyro_range));                   \
-        fc_base_calibrate(                                                                    \
-            (b),                                                                              \
-            (const fc_real[9]){(p)->acc_cal_xx, (p)->acc_cal_xy, (p)->acc_cal_xz,             \
-                               (p)->acc_cal_yx, (p)->acc_cal_yy, (p)->acc_cal_yz,             \
-                               (p)->acc_cal_zx, (p)->acc_cal_zy, (p)->acc_cal_zz},            \
-            (const fc_real[3]){(p)->acc_off_x, (p)->acc_off_y, (p)->acc_off_z},               \
-            (const fc_real[9]){(p)->gyro_cal_xx, (p)->gyro_cal_xy, (p)->gyro_cal_xz,          \
-                               (p)->gyro_cal_yx, (p)->gyro_cal_yy, (p)->gyro_cal_yz,          \
-                               (p)->gyro_cal_zx, (p)->gyro_cal_zy, (p)->gyro_cal_zz},         \
-            (const fc_real[3]){(p)->gyro_off_x, (p)->gyro_off_y, (p)->gyro_off_z});           \
-    } while (0)
+/* Estimator._set_params' shared part, the input stage's constants from its parameters
+ * (fc_input_params, base.COMMON_PARAMS): the gyro sampling rule, the sample rules, the part's
+ * calibration, the mounting, the gyro's range and the sensor's delay. */
+void fc_base_configure(fc_base *b, const fc_input_params *in);
 void fc_base_reset(fc_base *b);
 /* The sample rules of Estimator.step: checks the sample (a rejection leaves every state as it
  * was), applies the calibration, turns it into the filter frame (mounting) and takes an absurd
@@ -281,6 +262,36 @@ long fc_run_columns(const fc_ops *ops, void *self, fc_base *base, fc_estimate *l
                     const fc_real *acc, const fc_real *gyro, const fc_real *dt, fc_real *roll,
                     fc_real *pitch, fc_real *bias, fc_real *pos, fc_real *vel,
                     unsigned char *rejected);
+
+/* The functions every estimator T's twin has (fc_cf, ...; Estimator's life cycle), declared by
+ * its header with FC_DECLARE_ESTIMATOR(T):
+ * - T_init(f, params): params (NULL: the defaults) in, a filter waiting for its first sample out;
+ * - T_configure(f): take a change of f->params (the state is kept);
+ * - T_reset(f): forget every sample;
+ * - T_step(f, acc, gyro, dt, out): one sample, acc [m/s^2], gyro [rad/s], dt [s]; FC_OK or
+ *   FC_SKIPPED with *out the estimate (the last one when skipped); a rejection leaves the filter
+ *   and *out as they were;
+ * - T_run(f, n, acc, gyro, dt, out, rejected): n samples (acc, gyro row-major [n][3], dt [n]),
+ *   out[i] the estimate after sample i (the last one for a rejected sample, rejected[i] = 1,
+ *   counted in n_rejected); returns the number of rejected samples;
+ * - T_run_columns: T_run with the estimates written as columns (fc_run_columns);
+ * - T_estimate(f): the estimate of the state as it is;
+ * - T_restored(f): after a restore of the state fields (fc_state.h), recompute what follows
+ *   from them.
+ * fusion_core.native.library expands it for the cffi binding, which reads no macros. */
+#define FC_DECLARE_ESTIMATOR(T)                                                               \
+    void T##_init(T *f, const T##_params *params);                                            \
+    void T##_configure(T *f);                                                                 \
+    void T##_reset(T *f);                                                                     \
+    fc_status T##_step(T *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,         \
+                       fc_estimate *out);                                                     \
+    long T##_run(T *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,    \
+                 fc_estimate *out, unsigned char *rejected);                                  \
+    long T##_run_columns(T *f, long n, const fc_real *acc, const fc_real *gyro,               \
+                         const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,     \
+                         fc_real *pos, fc_real *vel, unsigned char *rejected);                \
+    fc_estimate T##_estimate(const T *f);                                                     \
+    void T##_restored(T *f)
 
 /* T_init(f, params) for an estimator T: params (NULL: the defaults) in, T_configure, T_reset. */
 #define FC_DEFINE_INIT(T)                                                                     \

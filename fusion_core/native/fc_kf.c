@@ -22,20 +22,19 @@ static void angle_only_gain(const fc_real P[4], fc_real r, fc_real K[2], fc_real
 void fc_kf_configure(fc_kf *f)
 {
     const fc_kf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
+    fc_base_configure(&f->base, &p->input);
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;
     f->r_step = f->r;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
-    f->trapezoid = p->gyro_sampling == FC_KF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, p->gyro_scale_std,
                          p->acc_lowpass_stretch, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
-    f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
+    f->rail_var = fc_pow(p->input.gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
     f->rest_acc = p->rest_acc;
@@ -206,7 +205,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
 {
     fc_real a[3] = {a_in[0], a_in[1], a_in[2]}, phi[3], terms[4], up[4];
     fc_real b[3] = {f->bias_x, f->bias_y, f->bias_z};
-    fc_body_rotation(prev, g, b, dt, f->trapezoid, phi);
+    fc_body_rotation(prev, g, b, dt, f->base.trapezoid, phi);
     fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
     propagate(f, g, dt, phi, terms, up);
     int clipped = f->base.clipped;  /* at the gyro's rail: the rate beyond it is unknown */

@@ -30,21 +30,9 @@ typedef struct fc_kf {
     fc_real longest2, rail_var;
     fc_real rest_time, rest_gyro, rest_acc, gyro_var, rest_bias_bound;
     fc_real bias_lo2, bias_hi2;
-    int trapezoid;
 } fc_kf;
 
-void fc_kf_init(fc_kf *f, const fc_kf_params *params);
-void fc_kf_configure(fc_kf *f);
-void fc_kf_reset(fc_kf *f);
-fc_status fc_kf_step(fc_kf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                     fc_estimate *out);
-long fc_kf_run(fc_kf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
-               fc_estimate *out, unsigned char *rejected);
-long fc_kf_run_columns(fc_kf *f, long n, const fc_real *acc, const fc_real *gyro,
-                       const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                       fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_kf_estimate(const fc_kf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_kf_restored(fc_kf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_kf);
 
 #endif /* FC_KF_H */

@@ -4,9 +4,8 @@
 void fc_madgwick_configure(fc_madgwick *f)
 {
     const fc_madgwick_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
+    fc_base_configure(&f->base, &p->input);
     f->beta = p->beta;
-    f->trapezoid = p->gyro_sampling == FC_MADGWICK_GYRO_SAMPLING_POINT;
 }
 
 fc_estimate fc_madgwick_estimate(const fc_madgwick *f)  /* _estimate: no bias state */
@@ -39,7 +38,7 @@ static void advance(fc_madgwick *f, const fc_real a[3], const fc_real g[3], fc_r
 {
     fc_real w = f->q[0], x = f->q[1], y = f->q[2], z = f->q[3];
     fc_real gx = g[0], gy = g[1], gz = g[2];
-    if (f->trapezoid) {  /* the rate's mean over the interval, linear between the samples */
+    if (f->base.trapezoid) {  /* the rate's mean over the interval, linear between the samples */
         const fc_real *p = f->base.gyro_prev;
         gx = 0.5 * (p[0] + gx);
         gy = 0.5 * (p[1] + gy);
@@ -50,7 +49,7 @@ static void advance(fc_madgwick *f, const fc_real a[3], const fc_real g[3], fc_r
     fc_real dx = 0.5 * (w * gx + y * gz - z * gy);
     fc_real dy = 0.5 * (w * gy - x * gz + z * gx);
     fc_real dz = 0.5 * (w * gz + x * gy - y * gx);
-    if (f->trapezoid) {  /* the gradient taken at this sample's time: q turned first */
+    if (f->base.trapezoid) {  /* the gradient taken at this sample's time: q turned first */
         w = w + dw * dt;
         x = x + dx * dt;
         y = y + dy * dt;

@@ -14,21 +14,9 @@ typedef struct fc_madgwick {
     fc_estimate last;
     /* derived from params (MadgwickFilter._configure) */
     fc_real beta;
-    int trapezoid;
 } fc_madgwick;
 
-void fc_madgwick_init(fc_madgwick *f, const fc_madgwick_params *params);
-void fc_madgwick_configure(fc_madgwick *f);
-void fc_madgwick_reset(fc_madgwick *f);
-fc_status fc_madgwick_step(fc_madgwick *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                           fc_estimate *out);
-long fc_madgwick_run(fc_madgwick *f, long n, const fc_real *acc, const fc_real *gyro,
-                     const fc_real *dt, fc_estimate *out, unsigned char *rejected);
-long fc_madgwick_run_columns(fc_madgwick *f, long n, const fc_real *acc, const fc_real *gyro,
-                             const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                             fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_madgwick_estimate(const fc_madgwick *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_madgwick_restored(fc_madgwick *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_madgwick);
 
 #endif /* FC_MADGWICK_H */

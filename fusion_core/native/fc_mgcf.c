@@ -9,10 +9,9 @@
 void fc_mgcf_configure(fc_mgcf *f)
 {
     const fc_mgcf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
+    fc_base_configure(&f->base, &p->input);
     f->w0 = p->w0;
     f->two_zeta = 2.0 * p->zeta;
-    f->trapezoid = p->gyro_sampling == FC_MGCF_GYRO_SAMPLING_POINT;
     f->acc_tau = p->acc_lowpass;
     f->rest_time = p->rest_time;
     f->rest_gyro = p->rest_gyro;
@@ -72,7 +71,7 @@ static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_re
     }
     if (f->acc_tau > 0.0) {
         fc_real phi[3], terms[4];
-        fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->trapezoid, phi);
+        fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->base.trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);
         if (clipped) {
             fc_measure_clipped(f->meas);
@@ -108,7 +107,7 @@ static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_re
     int learn = !clipped && (f->acc_tau == 0.0 || fc_measure_settled(f->meas, &f->measure));
     const fc_real af[3] = {ax, ay, az};
     fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, af, norm, w0, kp, dt,
-                          f->trapezoid, learn);
+                          f->base.trapezoid, learn);
 }
 
 FC_DEFINE_STEP_AND_RUN(fc_mgcf)

@@ -21,21 +21,9 @@ typedef struct fc_mgcf {
     fc_real w0, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
     fc_real r_ref, q_rotation, dist_tau, longest;  /* _adaptive */
     fc_meas_constants measure;  /* _measure */
-    int trapezoid;
 } fc_mgcf;
 
-void fc_mgcf_init(fc_mgcf *f, const fc_mgcf_params *params);
-void fc_mgcf_configure(fc_mgcf *f);
-void fc_mgcf_reset(fc_mgcf *f);
-fc_status fc_mgcf_step(fc_mgcf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                       fc_estimate *out);
-long fc_mgcf_run(fc_mgcf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
-                 fc_estimate *out, unsigned char *rejected);
-long fc_mgcf_run_columns(fc_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
-                         const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                         fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_mgcf_estimate(const fc_mgcf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_mgcf_restored(fc_mgcf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_mgcf);
 
 #endif /* FC_MGCF_H */

@@ -7,10 +7,9 @@
 void fc_paper_cf_configure(fc_paper_cf *f)
 {
     const fc_paper_cf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
+    fc_base_configure(&f->base, &p->input);
     f->tau = p->tau;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
-    f->trapezoid = p->gyro_sampling == FC_PAPER_CF_GYRO_SAMPLING_POINT;
 }
 
 fc_estimate fc_paper_cf_estimate(const fc_paper_cf *f)  /* _estimate: no bias state */
@@ -41,7 +40,7 @@ static void first_sample(fc_paper_cf *f, const fc_real a[3], const fc_real g[3])
 static void advance(fc_paper_cf *f, const fc_real a[3], const fc_real g[3], fc_real dt)
 {
     fc_real roll, pitch;
-    if (f->trapezoid) {
+    if (f->base.trapezoid) {
         const fc_real *w0 = f->base.gyro_prev;
         fc_heun_euler_step(f->roll, f->pitch, w0[0], w0[1], w0[2], g[0], g[1], g[2], dt, NULL,
                            &roll, &pitch);

@@ -14,21 +14,9 @@ typedef struct fc_paper_cf {
     fc_estimate last;
     /* derived from params (PaperComplementaryFilter._configure) */
     fc_real tau, gate_low2, gate_high2;
-    int trapezoid;
 } fc_paper_cf;
 
-void fc_paper_cf_init(fc_paper_cf *f, const fc_paper_cf_params *params);
-void fc_paper_cf_configure(fc_paper_cf *f);
-void fc_paper_cf_reset(fc_paper_cf *f);
-fc_status fc_paper_cf_step(fc_paper_cf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                           fc_estimate *out);
-long fc_paper_cf_run(fc_paper_cf *f, long n, const fc_real *acc, const fc_real *gyro,
-                     const fc_real *dt, fc_estimate *out, unsigned char *rejected);
-long fc_paper_cf_run_columns(fc_paper_cf *f, long n, const fc_real *acc, const fc_real *gyro,
-                             const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                             fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_paper_cf_estimate(const fc_paper_cf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_paper_cf_restored(fc_paper_cf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_paper_cf);
 
 #endif /* FC_PAPER_CF_H */

@@ -6,14 +6,13 @@
 void fc_paper_kf_configure(fc_paper_kf *f)
 {
     const fc_paper_kf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
+    fc_base_configure(&f->base, &p->input);
     f->q_angle = p->Q_angle;
     f->q_bias = p->Q_bias;
     f->r = p->R_measure;
     f->r_loop = f->r * p->R_loop_time;
     f->r_step = f->r;
     fc_gate_bounds2(p->gate_low, p->gate_high, &f->gate_low2, &f->gate_high2);
-    f->trapezoid = p->gyro_sampling == FC_PAPER_KF_GYRO_SAMPLING_POINT;
 }
 
 fc_estimate fc_paper_kf_estimate(const fc_paper_kf *f)  /* _estimate */
@@ -52,7 +51,7 @@ void fc_paper_kf_propagate(fc_paper_kf *f, const fc_real prev[3], const fc_real 
                            const fc_real sc[4])
 {
     fc_real bx = f->bias_x, by = f->bias_y, roll, pitch;
-    if (f->trapezoid) {
+    if (f->base.trapezoid) {
         fc_heun_euler_step(f->roll, f->pitch, prev[0] - bx, prev[1] - by, prev[2], g[0] - bx,
                            g[1] - by, g[2], dt, sc, &roll, &pitch);
     } else {

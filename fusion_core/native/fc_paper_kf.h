@@ -20,22 +20,10 @@ typedef struct fc_paper_kf {
     fc_real r_step;  /* this step's measurement variance (R_loop_time) */
     /* derived from params (PaperKalmanFilter._configure) */
     fc_real q_angle, q_bias, r, r_loop, gate_low2, gate_high2;
-    int trapezoid;
 } fc_paper_kf;
 
-void fc_paper_kf_init(fc_paper_kf *f, const fc_paper_kf_params *params);
-void fc_paper_kf_configure(fc_paper_kf *f);
-void fc_paper_kf_reset(fc_paper_kf *f);
-fc_status fc_paper_kf_step(fc_paper_kf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                           fc_estimate *out);
-long fc_paper_kf_run(fc_paper_kf *f, long n, const fc_real *acc, const fc_real *gyro,
-                     const fc_real *dt, fc_estimate *out, unsigned char *rejected);
-long fc_paper_kf_run_columns(fc_paper_kf *f, long n, const fc_real *acc, const fc_real *gyro,
-                             const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                             fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_paper_kf_estimate(const fc_paper_kf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_paper_kf_restored(fc_paper_kf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_paper_kf);
 
 /* The tilt stage: the steps of one sample, for a filter that drives them (the position filters;
  * PaperKalmanFilter's methods of the same names). */

@@ -81,10 +81,9 @@ void fc_paper_mgcf_pi_step(fc_real q[4], fc_real bias[3], const fc_real prev[3],
 void fc_paper_mgcf_configure(fc_paper_mgcf *f)
 {
     const fc_paper_mgcf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
+    fc_base_configure(&f->base, &p->input);
     f->w0_fixed = p->w0;
     f->two_zeta = 2.0 * p->zeta;
-    f->trapezoid = p->gyro_sampling == FC_PAPER_MGCF_GYRO_SAMPLING_POINT;
 }
 
 fc_estimate fc_paper_mgcf_quat_estimate(const fc_real q[4], const fc_real bias[3])
@@ -135,7 +134,7 @@ static void advance(fc_paper_mgcf *f, const fc_real a[3], const fc_real g[3], fc
     }
     f->w0_now = w0;
     fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, a, norm, w0, f->two_zeta * w0, dt,
-                          f->trapezoid, 1);
+                          f->base.trapezoid, 1);
 }
 
 FC_DEFINE_STEP_AND_RUN(fc_paper_mgcf)

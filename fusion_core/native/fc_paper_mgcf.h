@@ -17,24 +17,12 @@ typedef struct fc_paper_mgcf {
     fc_estimate last;
     /* derived from params (PaperGainScheduledFilter._configure) */
     fc_real w0_fixed, two_zeta;
-    int trapezoid;
 } fc_paper_mgcf;
 
-void fc_paper_mgcf_init(fc_paper_mgcf *f, const fc_paper_mgcf_params *params);
-void fc_paper_mgcf_configure(fc_paper_mgcf *f);
-void fc_paper_mgcf_reset(fc_paper_mgcf *f);
-fc_status fc_paper_mgcf_step(fc_paper_mgcf *f, const fc_real acc[3], const fc_real gyro[3],
-                             fc_real dt, fc_estimate *out);
-long fc_paper_mgcf_run(fc_paper_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
-                       const fc_real *dt, fc_estimate *out, unsigned char *rejected);
-long fc_paper_mgcf_run_columns(fc_paper_mgcf *f, long n, const fc_real *acc, const fc_real *gyro,
-                               const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                               fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_paper_mgcf_estimate(const fc_paper_mgcf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_paper_mgcf);
 /* The estimate of a quaternion's roll and pitch and a gyro bias (both mgcfs' _estimate). */
 fc_estimate fc_paper_mgcf_quat_estimate(const fc_real q[4], const fc_real bias[3]);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_paper_mgcf_restored(fc_paper_mgcf *f);
 
 /* quat_first_order: q + dt/2 q (x) (0, w), renormalised, in place (Mahony's reference code; the
  * recommended filter integrates mean samples with it too). */

@@ -170,15 +170,15 @@ static void tilt_params(const fc_paper_poskf_params *p, fc_paper_kf_params *tp)
     tp->R_loop_time = p->R_loop_time;
     tp->gate_low = p->gate_low;
     tp->gate_high = p->gate_high;
-    tp->gyro_sampling = p->gyro_sampling;
-    tp->max_dt = p->max_dt;
-    tp->max_rate = p->max_rate;
+    tp->input.gyro_sampling = p->input.gyro_sampling;
+    tp->input.max_dt = p->input.max_dt;
+    tp->input.max_rate = p->input.max_rate;
 }
 
 void fc_paper_poskf_configure(fc_paper_poskf *f)
 {
     const fc_paper_poskf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
+    fc_base_configure(&f->base, &p->input);
     tilt_params(p, &f->tilt.params);
     fc_paper_kf_configure(&f->tilt);
     f->acc_var_density = p->acc_psd;
@@ -228,8 +228,8 @@ void fc_paper_poskf_restored(fc_paper_poskf *f)  /* the tilt stage's last estima
 
 static void first_sample(fc_paper_poskf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
-    fc_paper_poskf_first_axis_states(&f->tilt, a, g, f->params.max_dt, f->acc_var_density, f->x,
-                                     f->P);
+    fc_paper_poskf_first_axis_states(&f->tilt, a, g, f->params.input.max_dt, f->acc_var_density,
+                                     f->x, f->P);
 }
 
 static void advance(fc_paper_poskf *f, const fc_real a[3], const fc_real g[3], fc_real dt)

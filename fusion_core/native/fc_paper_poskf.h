@@ -23,21 +23,10 @@ typedef struct fc_paper_poskf {
     fc_real Q[6], R, Q_dt;
 } fc_paper_poskf;
 
-void fc_paper_poskf_init(fc_paper_poskf *f, const fc_paper_poskf_params *params);
-void fc_paper_poskf_configure(fc_paper_poskf *f);
-void fc_paper_poskf_reset(fc_paper_poskf *f);
-fc_status fc_paper_poskf_step(fc_paper_poskf *f, const fc_real acc[3], const fc_real gyro[3],
-                              fc_real dt, fc_estimate *out);
-long fc_paper_poskf_run(fc_paper_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
-                        const fc_real *dt, fc_estimate *out, unsigned char *rejected);
-long fc_paper_poskf_run_columns(fc_paper_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
-                                const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                                fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_paper_poskf_estimate(const fc_paper_poskf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_paper_poskf);
 /* The position and velocity of the [p, v, a] axis states x (x, y, z axes in turn) into e. */
 void fc_paper_poskf_put_axes(const fc_real x[9], fc_estimate *e);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_paper_poskf_restored(fc_paper_poskf *f);
 
 /* The equations (papers/position.py's functions of the same names): Q of one axis for a form
  * (FC_PAPER_POSKF_QR_FORM_*, upper triangle); one sample of the three [p, v, a] filters, with

@@ -498,14 +498,13 @@ void fc_paper_ukf_measurement_update(const fc_ukf_prediction *pred, const fc_rea
 void fc_paper_ukf_configure(fc_paper_ukf *f)
 {
     const fc_paper_ukf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, HUGE_VAL);
+    fc_base_configure(&f->base, &p->input);
     fc_paper_ukf_unscented_constants(p->alpha, p->beta, p->kappa, &f->gamma, &f->w, &f->w_mu);
     f->q_gyro = p->gyro_psd;
     f->q_bias = p->bias_psd;
     f->r_acc = fc_pow(p->acc_noise, 2.0);
     f->r_norm = fc_pow(p->norm_noise, 2.0);
     f->gate = p->acc_gate;
-    f->trapezoid = p->gyro_sampling == FC_PAPER_UKF_GYRO_SAMPLING_POINT;
 }
 
 fc_estimate fc_paper_ukf_gravity_estimate(const fc_real x[6])
@@ -558,7 +557,7 @@ static void advance(fc_paper_ukf *f, const fc_real a[3], const fc_real g[3], fc_
     int update = fc_fabs(norm / FC_G - 1.0) < f->gate && norm > 0.0;  /* rho < acc_gate */
     int norm_row = update && f->r_norm > 0.0;  /* the pseudo-measurement |X|^2 = 1 */
     fc_real terms[6];
-    fc_paper_ukf_rotation_terms(f->base.gyro_prev, g, dt, f->trapezoid, terms);
+    fc_paper_ukf_rotation_terms(f->base.gyro_prev, g, dt, f->base.trapezoid, terms);
     fc_ukf_prediction pred;
     fc_paper_ukf_sigma_predict(f->x, f->P, terms, dt, f->gamma, f->w, f->w_mu, norm_row, &pred);
     fc_real X0 = pred.X[0], X1 = pred.X[1], X2 = pred.X[2];

@@ -18,22 +18,10 @@ typedef struct fc_paper_ukf {
     fc_estimate last;
     /* derived from params (PaperUnscentedKalmanFilter._configure) */
     fc_real gamma, w, w_mu, q_gyro, q_bias, r_acc, r_norm, gate;
-    int trapezoid;
 } fc_paper_ukf;
 
-void fc_paper_ukf_init(fc_paper_ukf *f, const fc_paper_ukf_params *params);
-void fc_paper_ukf_configure(fc_paper_ukf *f);
-void fc_paper_ukf_reset(fc_paper_ukf *f);
-fc_status fc_paper_ukf_step(fc_paper_ukf *f, const fc_real acc[3], const fc_real gyro[3],
-                            fc_real dt, fc_estimate *out);
-long fc_paper_ukf_run(fc_paper_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
-                      const fc_real *dt, fc_estimate *out, unsigned char *rejected);
-long fc_paper_ukf_run_columns(fc_paper_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
-                              const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                              fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_paper_ukf_estimate(const fc_paper_ukf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_paper_ukf_restored(fc_paper_ukf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_paper_ukf);
 
 /* papers/ukf.py's Prediction: the unscented transform of one sample's process model. */
 typedef struct fc_ukf_prediction {

@@ -9,7 +9,7 @@
 void fc_poskf_configure(fc_poskf *f)
 {
     const fc_poskf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
+    fc_base_configure(&f->base, &p->input);
     /* the tilt stage: the papers' kf with the TILT_PARAMS given */
     fc_paper_kf_params tp;
     fc_paper_kf_params_default(&tp);
@@ -19,17 +19,17 @@ void fc_poskf_configure(fc_poskf *f)
     tp.R_loop_time = p->R_loop_time;
     tp.gate_low = p->gate_low;
     tp.gate_high = p->gate_high;
-    tp.gyro_sampling = p->gyro_sampling;
-    tp.max_dt = p->max_dt;
-    tp.max_rate = p->max_rate;
+    tp.input.gyro_sampling = p->input.gyro_sampling;
+    tp.input.max_dt = p->input.max_dt;
+    tp.input.max_rate = p->input.max_rate;
     f->tilt.params = tp;
     fc_paper_kf_configure(&f->tilt);
     /* the attitude output: the recommended kf */
     fc_kf_params ap;
     fc_kf_params_default(&ap);
-    ap.gyro_sampling = p->gyro_sampling;
-    ap.max_dt = p->max_dt;
-    ap.max_rate = p->max_rate;
+    ap.input.gyro_sampling = p->input.gyro_sampling;
+    ap.input.max_dt = p->input.max_dt;
+    ap.input.max_rate = p->input.max_rate;
     f->att.params = ap;
     fc_kf_configure(&f->att);
     f->acc_var_density = p->acc_psd;
@@ -75,9 +75,9 @@ void fc_poskf_restored(fc_poskf *f)  /* the nested filters' last estimates too (
 
 static void first_sample(fc_poskf *f, const fc_real a[3], const fc_real g[3])  /* _init */
 {
-    fc_paper_poskf_first_axis_states(&f->tilt, a, g, f->params.max_dt, f->acc_var_density, f->x,
-                                     f->P);
-    fc_kf_step(&f->att, a, g, f->params.max_dt, NULL);
+    fc_paper_poskf_first_axis_states(&f->tilt, a, g, f->params.input.max_dt, f->acc_var_density,
+                                     f->x, f->P);
+    fc_kf_step(&f->att, a, g, f->params.input.max_dt, NULL);
     memcpy(f->f_mean, a, sizeof f->f_mean);
 }
 

@@ -35,18 +35,7 @@ typedef struct fc_poskf {
     fc_real sines[6];
 } fc_poskf;
 
-void fc_poskf_init(fc_poskf *f, const fc_poskf_params *params);
-void fc_poskf_configure(fc_poskf *f);
-void fc_poskf_reset(fc_poskf *f);
-fc_status fc_poskf_step(fc_poskf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                        fc_estimate *out);
-long fc_poskf_run(fc_poskf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
-                  fc_estimate *out, unsigned char *rejected);
-long fc_poskf_run_columns(fc_poskf *f, long n, const fc_real *acc, const fc_real *gyro,
-                          const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                          fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_poskf_estimate(const fc_poskf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_poskf_restored(fc_poskf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_poskf);
 
 #endif /* FC_POSKF_H */

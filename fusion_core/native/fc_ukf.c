@@ -9,7 +9,7 @@
 void fc_ukf_configure(fc_ukf *f)
 {
     const fc_ukf_params *p = &f->params;
-    FC_BASE_CONFIGURE(&f->base, p, p->gyro_range);
+    fc_base_configure(&f->base, &p->input);
     fc_paper_ukf_unscented_constants(p->alpha, p->beta, p->kappa, &f->gamma, &f->w, &f->w_mu);
     f->q_gyro = p->gyro_psd;
     f->q_bias = p->bias_psd;
@@ -19,8 +19,7 @@ void fc_ukf_configure(fc_ukf *f)
     fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc,
                          p->gyro_scale_std, p->acc_lowpass_stretch, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
-    f->rail_var = fc_pow(p->gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
-    f->trapezoid = p->gyro_sampling == FC_UKF_GYRO_SAMPLING_POINT;
+    f->rail_var = fc_pow(p->input.gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
     f->cos_innovation = p->bias_innovation < FC_PI ? fc_cos(p->bias_innovation) : -2.0;
 }
@@ -151,7 +150,7 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
 {
     fc_real b[3] = {f->x[3], f->x[4], f->x[5]};
     fc_real terms[6];
-    fc_paper_ukf_rotation_terms(f->base.gyro_prev, g, dt, f->trapezoid, terms);
+    fc_paper_ukf_rotation_terms(f->base.gyro_prev, g, dt, f->base.trapezoid, terms);
     fc_ukf_prediction pred;
     fc_paper_ukf_sigma_predict(f->x, f->P, terms, dt, f->gamma, f->w, f->w_mu, 0, &pred);
     fc_real X0 = pred.X[0], X1 = pred.X[1], X2 = pred.X[2];
@@ -206,7 +205,7 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
     int clipped = f->base.clipped;
     if (p->acc_lowpass > 0.0) {  /* _update: the real-sensor options */
         fc_real phi[3], terms[4], b[3] = {f->x[3], f->x[4], f->x[5]};
-        fc_body_rotation(f->base.gyro_prev, g, b, dt, f->trapezoid, phi);
+        fc_body_rotation(f->base.gyro_prev, g, b, dt, f->base.trapezoid, phi);
         fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for the low-passes */
         int filling;
         if (clipped) {

@@ -26,21 +26,9 @@ typedef struct fc_ukf {
     fc_meas_constants measure;  /* UnscentedKalmanFilter._measure */
     fc_real longest2, rail_var;
     fc_real bias_lo2, bias_hi2, cos_innovation;
-    int trapezoid;
 } fc_ukf;
 
-void fc_ukf_init(fc_ukf *f, const fc_ukf_params *params);
-void fc_ukf_configure(fc_ukf *f);
-void fc_ukf_reset(fc_ukf *f);
-fc_status fc_ukf_step(fc_ukf *f, const fc_real acc[3], const fc_real gyro[3], fc_real dt,
-                      fc_estimate *out);
-long fc_ukf_run(fc_ukf *f, long n, const fc_real *acc, const fc_real *gyro, const fc_real *dt,
-                fc_estimate *out, unsigned char *rejected);
-long fc_ukf_run_columns(fc_ukf *f, long n, const fc_real *acc, const fc_real *gyro,
-                        const fc_real *dt, fc_real *roll, fc_real *pitch, fc_real *bias,
-                        fc_real *pos, fc_real *vel, unsigned char *rejected);
-fc_estimate fc_ukf_estimate(const fc_ukf *f);
-/* After a restore of the state fields (fc_state.h): recompute what follows from them. */
-void fc_ukf_restored(fc_ukf *f);
+/* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
+FC_DECLARE_ESTIMATOR(fc_ukf);
 
 #endif /* FC_UKF_H */

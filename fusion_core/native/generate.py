@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from fusion_core.base import Estimator
+from fusion_core.base import COMMON_PARAMS, Estimator
 from fusion_core.position import PENDING_MAX
 from fusion_core.registry import CLASSES
 from fusion_core.sensor import SENSOR_PARAMS, ImuSensorModel
@@ -36,7 +36,7 @@ from fusion_core.state import (
     count,
     index,
 )
-from fusion_core.types import Param
+from fusion_core.types import ABSENT, Param
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "fc_params.h"
@@ -68,8 +68,16 @@ def c_type(p: Param) -> str:
     return "long" if isinstance(p.default, int) else "fc_real"
 
 
+SHARED: dict[str, Param] = {p.name: p for p in COMMON_PARAMS if p.choices is not None}
+"""The enumerations every estimator shares (base.COMMON_PARAMS): their choices are #defined once,
+FC_GYRO_SAMPLING_POINT, for fc_core's shared stage and every twin."""
+
+
 def choice_name(prefix: str, p: Param, choice: str) -> str:
-    """The #define of one choice of an enumeration parameter: FC_KF_PROPAGATION_QUATERNION."""
+    """The #define of one choice of an enumeration parameter: FC_KF_PROPAGATION_QUATERNION, or
+    FC_GYRO_SAMPLING_POINT for one every estimator shares (SHARED)."""
+    if prefix != "fc_sensor" and p.name in SHARED:
+        prefix = "fc"
     return f"{prefix.upper()}_{p.name.upper()}_{choice.upper()}"
 
 
@@ -89,31 +97,63 @@ def comment(p: Param) -> str:
     return f"{p.allowed()}{unit}"
 
 
+def struct_lines(struct: str, specs: list[Param], extra: tuple[str, str] | None = None
+                 ) -> list[str]:
+    """typedef struct struct {...} struct; with a field per parameter, its allowed values beside
+    it, and extra, a (declaration, comment) field after them."""
+    decls = [(f"    {c_type(p)} {p.name};", comment(p)) for p in specs]
+    if extra is not None:
+        decls.append((f"    {extra[0]};", extra[1]))
+    width = max(len(d) for d, _ in decls)
+    return [f"typedef struct {struct} {{", *(f"{d:<{width}}  /* {c} */" for d, c in decls),
+            f"}} {struct};", ""]
+
+
+def input_block() -> list[str]:
+    """fc_input_params, the parameters of the input stage every estimator shares
+    (base.COMMON_PARAMS: fc_base_configure), with their defaults."""
+    out = ["/* ----- the input stage every estimator shares (base.COMMON_PARAMS) " + "-" * 12
+           + " */", ""]
+    for p in SHARED.values():
+        for i, choice in enumerate(p.choices or ()):
+            out.append(f"#define {choice_name('fc', p, choice)} {i}")
+    out += ["", *struct_lines("fc_input_params", list(COMMON_PARAMS))]
+    out += ["/* The defaults: base.COMMON_PARAMS. */",
+            "static inline void fc_input_params_default(fc_input_params *p)", "{",
+            *(f"    p->{p.name} = {c_value('fc', p)};" for p in COMMON_PARAMS), "}", ""]
+    return out
+
+
 def estimator_block(prefix: str) -> list[str]:
+    """prefix's params struct: a field per parameter of its own (the class's PARAMS) and, for an
+    estimator, its input stage's in `input`, at the class's defaults (a COMMON parameter the
+    class leaves out at base.ABSENT's value)."""
     if prefix == "fc_sensor":
-        name, specs = ImuSensorModel.__name__, list(SENSOR_PARAMS)
+        name, own, common = ImuSensorModel.__name__, list(SENSOR_PARAMS), None
     else:
         cls = TWINS[prefix]
-        name, specs = cls.__name__, list(cls.param_specs().values())
+        name, own, common = cls.__name__, list(cls.PARAMS), {p.name: p for p in cls.COMMON}
     out = [f"/* ----- {name} ({prefix}) " + "-" * (80 - len(name) - len(prefix) - 14) + " */", ""]
-    for p in specs:
-        if p.choices is not None:
-            for i, choice in enumerate(p.choices):
-                out.append(f"#define {choice_name(prefix, p, choice)} {i}")
-    if any(p.choices for p in specs):
+    for p in own:
+        for i, choice in enumerate(p.choices or ()):
+            out.append(f"#define {choice_name(prefix, p, choice)} {i}")
+    if any(p.choices for p in own):
         out.append("")
-    out.append(f"typedef struct {prefix}_params {{")
-    width = max(len(f"    {c_type(p)} {p.name};") for p in specs)
-    for p in specs:
-        decl = f"    {c_type(p)} {p.name};"
-        out.append(f"{decl:<{width}}  /* {comment(p)} */")
-    out.append(f"}} {prefix}_params;")
-    out.append("")
-    out.append(f"/* The defaults: {name}.PARAMS. */")
+    extra = None if common is None else ("fc_input_params input", "the input stage's")
+    out += struct_lines(f"{prefix}_params", own, extra)
+    out.append(f"/* The defaults: {name}'s. */")
     out.append(f"static inline void {prefix}_params_default({prefix}_params *p)")
     out.append("{")
-    for p in specs:
+    for p in own:
         out.append(f"    p->{p.name} = {c_value(prefix, p)};")
+    if common is not None:
+        out.append("    fc_input_params_default(&p->input);")
+        for q in COMMON_PARAMS:
+            if q.name not in common:
+                out.append(f"    p->input.{q.name} = {c_double(ABSENT[q.name])};  "
+                           f"/* {name} has no {q.name} */")
+            elif common[q.name].default != q.default:
+                out.append(f"    p->input.{q.name} = {c_value(prefix, common[q.name])};")
     out.append("}")
     out.append("")
     return out
@@ -126,7 +166,9 @@ def render() -> str:
         " * GENERATED by `python -m fusion_core.native.generate` from the estimators' PARAMS",
         " * tables, the one source of truth: do not edit by hand. Each field is a parameter of",
         " * the same name; an enumeration is an int whose values are the #defines above its",
-        " * struct, in the Python choices' order.",
+        " * struct, in the Python choices' order. An estimator's struct holds its own parameters",
+        " * (its class's PARAMS) and, in `input`, those of the input stage every estimator shares",
+        " * (fc_input_params: base.COMMON_PARAMS).",
         " */",
         "#ifndef FC_PARAMS_H",
         "#define FC_PARAMS_H",
@@ -139,6 +181,7 @@ def render() -> str:
         f"#define FC_POSKF_PENDING_MAX {PENDING_MAX}  /* position.PENDING_MAX */",
         "",
     ]
+    lines += input_block()
     for prefix in PREFIX:
         lines += estimator_block(prefix)
     lines += ["#endif /* FC_PARAMS_H */", ""]

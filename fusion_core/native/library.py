@@ -197,10 +197,13 @@ def stream_reason() -> str | None:
 def cdef(real: str = "double") -> str:
     """The headers as cffi declarations: comments, include guards, #includes, macros and the
     static inline default functions left out; integer #defines kept (lib.NAME), and written
-    into the declarations that use them (array sizes). real: the twins' real type (fc_real.h;
-    the binding is the double build, testbenches.embedded also loads a float one)."""
+    into the declarations that use them (array sizes); a declaring macro used at the top level
+    of a header (FC_DECLARE_ESTIMATOR(fc_kf);) expanded into its declarations. real: the twins'
+    real type (fc_real.h; the binding is the double build, testbenches.embedded also loads a
+    float one)."""
     out: list[str] = [f"typedef {real} fc_real;"]
     defines: dict[str, str] = {}
+    macros: dict[str, tuple[str, str]] = {}  # NAME -> (its parameter, its body)
     for name in HEADERS:
         text = re.sub(r"/\*.*?\*/", "", (HERE / name).read_text(), flags=re.S)
         text = text.replace("\\\n", " ")  # a macro's continued lines into one
@@ -208,12 +211,22 @@ def cdef(real: str = "double") -> str:
         for line in text.splitlines():
             line = line.rstrip()
             define = re.match(r"#define (\w+) (-?\d+)(?:\s.*)?$", line)
+            macro = re.match(r"#define (\w+)\((\w+)\)\s+(.*)$", line)
+            use = re.match(r"(\w+)\((\w+)\);$", line)
             if define:  # a constant the binding reads too (lib.NAME)
                 defines[define.group(1)] = define.group(2)
                 out.append(f"#define {define.group(1)} {define.group(2)}")
-            elif line.startswith("#"):
                 continue
-            elif defines:
+            if macro:
+                macros[macro.group(1)] = (macro.group(2), macro.group(3))
+                continue
+            if line.startswith("#"):
+                continue
+            if use and use.group(1) in macros:
+                param, body = macros[use.group(1)]
+                arg = use.group(2)
+                line = re.sub(rf"\b{param}\b", arg, body.replace(f"{param}##", arg)) + ";"
+            if defines:
                 line = re.sub(r"\b(" + "|".join(defines) + r")\b",
                               lambda m: defines[m.group(1)], line)
             out.append(line)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import ClassVar, Final
 
-from ..base import ESTIMATE, NEVER_ESTIMATED, Estimator, tuple_new
+from ..base import NEVER_ESTIMATED, Estimator
 from ..kinematics import (
     HALF_PI,
     PI,
@@ -23,7 +23,7 @@ from ..kinematics import (
 )
 from ..state import ANGLE, HALF_ANGLE, StateSpec
 from ..types import Estimate, G, Param
-from .common import PAPER_COMMON, PAPER_GATE, PAPER_SAMPLING
+from .common import PAPER_COMMON, PAPER_GATE
 
 NO_BIAS: Final = (0.0, 0.0, 0.0)
 """The bias outputs: the papers' complementary filter has no bias state."""
@@ -46,7 +46,7 @@ class PaperComplementaryFilter(Estimator):
     bias state, and its bias outputs are 0.
     """
 
-    PARAMS = (TAU_PARAM, *PAPER_GATE, PAPER_SAMPLING)
+    PARAMS = (TAU_PARAM, *PAPER_GATE)
     COMMON = PAPER_COMMON
     TWIN: ClassVar[str | None] = "fc_paper_cf"
     ZERO_BIAS: ClassVar[dict[str, str]] = {
@@ -58,7 +58,6 @@ class PaperComplementaryFilter(Estimator):
         self._tau = float(p["tau"])
         self._gate_low2 = (p["gate_low"] * G) ** 2
         self._gate_high2 = (p["gate_high"] * G) ** 2
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -83,10 +82,10 @@ class PaperComplementaryFilter(Estimator):
             pitch += k * (acc_pitch - pitch)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-        return tuple_new(ESTIMATE, (roll, pitch, NO_BIAS, None, None))
+        return Estimate(roll, pitch, NO_BIAS)
 
     def _estimate(self) -> Estimate:
-        return tuple_new(ESTIMATE, (self.roll, self.pitch, NO_BIAS, None, None))
+        return Estimate(self.roll, self.pitch, NO_BIAS)
 
 
 __all__ = ["PaperComplementaryFilter"]

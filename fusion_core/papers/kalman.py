@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import ClassVar, Final
 
-from ..base import ESTIMATE, NEVER_ESTIMATED, Estimator, tuple_new
+from ..base import NEVER_ESTIMATED, Estimator
 from ..kinematics import (
     HALF_PI,
     PI,
@@ -35,7 +35,7 @@ from ..kinematics import (
 )
 from ..state import ANGLE, COV, HALF_ANGLE, REAL, StateSpec
 from ..types import DEG, Estimate, G, Param
-from .common import PAPER_COMMON, PAPER_GATE, PAPER_SAMPLING, Vec3
+from .common import PAPER_COMMON, PAPER_GATE, Vec3
 
 DEG2: Final = DEG * DEG
 Cov = tuple[float, float, float, float]
@@ -100,7 +100,6 @@ PAPER_KF_PARAMS: Final[tuple[Param, ...]] = (
           "R_measure is each sample's variance)",
           unit="s", low=0.0),
     *PAPER_GATE,
-    PAPER_SAMPLING,
 )
 """The parameters of PaperKalmanFilter, at the papers' values."""
 
@@ -213,7 +212,6 @@ class PaperKalmanFilter(RollPitchAxes, Estimator):
         self._r_loop = self._r * float(p["R_loop_time"])  # R dt, the same at every rate
         self.r_step = self._r  # this step's measurement variance (propagate sets it)
         self._gate2 = ((p["gate_low"] * G) ** 2, (p["gate_high"] * G) ** 2)
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -235,8 +233,7 @@ class PaperKalmanFilter(RollPitchAxes, Estimator):
         self.propagate(self.gyro_prev, (gx, gy, gz), dt)
         if self.accel_trusted(ax * ax + ay * ay + az * az):
             self.correct(ax, ay, az)
-        return tuple_new(ESTIMATE, (self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0),
-                                    None, None))
+        return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0))
 
     # ----- the tilt stage: the steps one sample takes, for a filter that drives them ---------
     def propagate(self, prev: Vec3, g: Vec3, dt: float,
@@ -277,8 +274,7 @@ class PaperKalmanFilter(RollPitchAxes, Estimator):
         self.n_samples += 1
 
     def _estimate(self) -> Estimate:
-        return tuple_new(ESTIMATE, (self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0),
-                                    None, None))
+        return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, 0.0))
 
 
 __all__ = ["PaperKalmanFilter", "RollPitchAxes", "bias_update", "measurement_gain",

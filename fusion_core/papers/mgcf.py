@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from typing import ClassVar, Final
 
-from ..base import ESTIMATE, Estimator, tuple_new
+from ..base import Estimator
 from ..kinematics import (
     accel_roll_pitch,
     quat_from_roll_pitch_yaw,
@@ -31,7 +31,7 @@ from ..kinematics import (
 )
 from ..state import NONNEG, REAL, UNIT, StateSpec
 from ..types import Estimate, G, Param
-from .common import PAPER_COMMON, PAPER_SAMPLING, Vec3
+from .common import PAPER_COMMON, Vec3
 
 Quat = tuple[float, float, float, float]
 
@@ -110,7 +110,6 @@ PAPER_MGCF_PARAMS: Final[tuple[Param, ...]] = (
           "0.05 rad/s)", unit="rad/s", low=0.0),
     Param("zeta", 2.0, "Damping ratio of the PI correction, Kp = 2 zeta w0 (Duong Quoc et al.: 2)",
           low=0.0, high=1000.0),
-    PAPER_SAMPLING,
 )
 
 
@@ -144,7 +143,6 @@ class PaperGainScheduledFilter(Estimator):
         self._table = SCHEDULES.get(p["schedule"])
         self._w0_fixed = float(p["w0"])
         self._two_zeta = 2.0 * float(p["zeta"])
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
 
     def _reset(self) -> None:
         self.q: Quat = (1.0, 0.0, 0.0, 0.0)
@@ -169,11 +167,11 @@ class PaperGainScheduledFilter(Estimator):
             self._two_zeta * w0, dt, self._trapezoid, True)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)
-        return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
+        return Estimate(roll, pitch, self.bias)
 
     def _estimate(self) -> Estimate:
         roll, pitch = quat_roll_pitch(*self.q)
-        return tuple_new(ESTIMATE, (roll, pitch, self.bias, None, None))
+        return Estimate(roll, pitch, self.bias)
 
 
 __all__ = ["SCHEDULES", "PaperGainScheduledFilter", "pi_step", "quat_first_order",

@@ -23,7 +23,7 @@ from __future__ import annotations
 from math import cos, sin
 from typing import Any, ClassVar, Final
 
-from ..base import ESTIMATE, Estimator, tuple_new
+from ..base import Estimator
 from ..kinematics import PI, roll_pitch_sines, wrap_angle
 from ..state import ANGLE, COV, NESTED, REAL, StateSpec
 from ..types import MPU6050_ACC_DENSITY, Estimate, G, Param
@@ -241,11 +241,10 @@ class PaperPositionKalmanFilter(AxisFiltersState, Estimator):
         tilt_params = {k: p[k] for k in TILT_PARAM_NAMES}
         if not hasattr(self, "tilt"):
             self.tilt = PaperKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
-                                          **tilt_params)
+                                          gyro_sampling=p["gyro_sampling"], **tilt_params)
         else:
             for k, v in tilt_params.items():
-                if k != "gyro_sampling":
-                    self.tilt.set_param(k, v)
+                self.tilt.set_param(k, v)
             self.tilt.set_param("max_dt", p["max_dt"])
             self.tilt.set_param("max_rate", p["max_rate"])
         self._acc_var_density = float(p["acc_psd"])
@@ -294,8 +293,8 @@ class PaperPositionKalmanFilter(AxisFiltersState, Estimator):
     def _estimate(self) -> Estimate:
         x = self._x
         t = self.tilt
-        return tuple_new(ESTIMATE, (t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0),
-                                    (x[0], x[3], x[6]), (x[1], x[4], x[7])))
+        return Estimate(t.roll, t.pitch, (t.bias_x, t.bias_y, 0.0), (x[0], x[3], x[6]),
+                        (x[1], x[4], x[7]))
 
 
 def first_axis_states(tilt: PaperKalmanFilter, ax: float, ay: float, az: float, gx: float,

@@ -49,7 +49,7 @@ from __future__ import annotations
 import math
 from typing import ClassVar, Final, NamedTuple
 
-from ..base import ESTIMATE, Estimator, tuple_new
+from ..base import Estimator
 from ..kinematics import accel_roll_pitch, rotate_back
 from ..linalg import (
     cholesky4,
@@ -61,7 +61,7 @@ from ..linalg import (
 )
 from ..state import COV, REAL, UNIT, Segments, StateSpec
 from ..types import DEG, MPU6050_GYRO_DENSITY, Estimate, G, Param
-from .common import PAPER_COMMON, PAPER_SAMPLING, Vec3
+from .common import PAPER_COMMON, Vec3
 
 N_STATE: Final = 6  # X (3), gyro bias b (3)
 UpdateResult = tuple[float, float, float, float, float, float, tuple[float, ...]]
@@ -268,7 +268,6 @@ PAPER_UKF_PARAMS: Final[tuple[Param, ...]] = (
     Param("init_bias_std", 1.0 * DEG, "Initial standard deviation of each gyro-bias state",
           unit="rad/s", low=0.0, low_open=True, tunable=False, display_unit="deg/s"),
     *SIGMA_PARAMS,
-    PAPER_SAMPLING,
 )
 """The parameters of PaperUnscentedKalmanFilter. The paper gives no noise values: these are
 ours for its simulated MPU-6050 at 100 Hz (the datasheet's gyro density, acc_noise 0.06 with an
@@ -294,7 +293,7 @@ class GravityDirectionState:
     def _estimate(self) -> Estimate:
         X1, X2, X3, bx, by, bz = self.x
         roll, pitch = accel_roll_pitch(X1, X2, X3)  # X is a resting accelerometer's direction
-        return tuple_new(ESTIMATE, (roll, pitch, (bx, by, bz), None, None))
+        return Estimate(roll, pitch, (bx, by, bz))
 
 
 class PaperUnscentedKalmanFilter(GravityDirectionState, Estimator):
@@ -328,7 +327,6 @@ class PaperUnscentedKalmanFilter(GravityDirectionState, Estimator):
         self._r_acc = float(p["acc_noise"]) ** 2
         self._r_norm = float(p["norm_noise"]) ** 2
         self._gate = float(p["acc_gate"])
-        self._trapezoid: bool = p["gyro_sampling"] == "point"
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]

@@ -50,17 +50,13 @@ class FloatTwin:
     def run(self, key: str, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
             params: dict[str, Any] | None = None) -> np.ndarray:
         """[N, 11] estimates (roll, pitch, bias, pos, vel) of the float build."""
+        from fusion_core.native.estimators import twin_params
         from fusion_core.registry import create
 
         ffi, lib = self.ffi, self.lib
-        prefix = f"fc_{key}"
-        p = ffi.new(f"{prefix}_params *")
         est = create(key, params or {})  # the values, checked as the double build's are
-        for name, spec in est.param_specs().items():
-            value = est.params[name]
-            if spec.choices is not None:
-                value = spec.choices.index(value)
-            setattr(p, name, value)
+        prefix = type(est).TWIN
+        p = twin_params(ffi, est)
         f = ffi.new(f"{prefix} *")
         getattr(lib, f"{prefix}_init")(f, p)
         n = len(acc)

@@ -12,12 +12,12 @@
 #include "memcheck_twins.h"
 
 /* the second variant of a twin: another branch of its code */
-#define VARIANT_fc_cf p.gyro_sampling = FC_CF_GYRO_SAMPLING_MEAN
+#define VARIANT_fc_cf p.input.gyro_sampling = FC_GYRO_SAMPLING_MEAN
 #define VARIANT_fc_kf p.acc_lowpass = 0.0
-#define VARIANT_fc_mgcf p.gyro_sampling = FC_MGCF_GYRO_SAMPLING_MEAN
+#define VARIANT_fc_mgcf p.input.gyro_sampling = FC_GYRO_SAMPLING_MEAN
 #define VARIANT_fc_ukf (p.alpha = 0.3, p.beta = 0.0) /* a negative central weight */
 #define VARIANT_fc_poskf p.zupt_window = 0.0
-#define VARIANT_fc_paper_cf p.gyro_sampling = FC_PAPER_CF_GYRO_SAMPLING_POINT
+#define VARIANT_fc_paper_cf p.input.gyro_sampling = FC_GYRO_SAMPLING_POINT
 #define VARIANT_fc_paper_kf p.R_loop_time = 0.0
 #define VARIANT_fc_paper_mgcf p.schedule = FC_PAPER_MGCF_SCHEDULE_FIXED
 #define VARIANT_fc_paper_ukf (p.alpha = 0.3, p.beta = 0.0, p.norm_noise = 0.0)
