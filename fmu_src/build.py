@@ -17,10 +17,12 @@ Python sources.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import tempfile
 import traceback
 from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -178,9 +180,11 @@ def build_all(
     results = []
     if kind != "native":
         results += [_build_and_check(name, out_dir, entries) for name in names]
-    if kind != "pythonfmu":
-        results += [_build_native_and_check(name, version, out_dir, entries, preset)
-                    for version in ("fmi2", "fmi3") for name in names]
+    if kind != "pythonfmu":  # the compiler runs in processes of its own: one thread per core
+        jobs = [(name, version) for version in ("fmi2", "fmi3") for name in names]
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+            results += pool.map(
+                lambda job: _build_native_and_check(*job, out_dir, entries, preset), jobs)
     return results
 
 

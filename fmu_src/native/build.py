@@ -18,6 +18,7 @@ names, and a model's three kinds of FMU can be swapped without touching a connec
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 import math
 import os
@@ -448,22 +449,61 @@ def stage_sources(model: NativeModel, version: str, folder: Path) -> list[str]:
     return compiled
 
 
-def compile_binary(cc: str, sources: Path, files: Sequence[str], target: Path,
-                   windows: bool = False) -> None:
-    """Compile the FMU's sources into target (a shared library); RuntimeError with the
-    compiler's last lines when it fails."""
-    target.parent.mkdir(parents=True, exist_ok=True)
-    flags = [*CFLAGS, *([] if windows else ["-fPIC"]), *(["-static-libgcc"] if windows else [])]
-    cmd = [cc, *flags, "-I", str(sources), "-o", str(target),
-           *(str(sources / f) for f in files), "-lm"]
+def object_cache() -> Path:
+    """Where compiled objects are kept by content (beside the C twin's library: build/ in a
+    checkout), so that the sources every FMU shares (the FMI plumbing, the twins) are compiled
+    once for all FMUs, presets and builds, and only a model's own configured file each time."""
+    from fusion_core.native.library import cache_dir
+
+    return cache_dir().parent / "fmu-objects"
+
+
+def _run(cmd: list[str], what: str) -> None:
+    """Run a compiler command: RuntimeError with its last lines where it fails, a
+    CompilerWarning with what it said where it warns."""
     proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-15:])
-        raise RuntimeError(f"compiling {target.name} failed ({' '.join(cmd)}):\n{tail}")
+        raise RuntimeError(f"compiling {what} failed ({' '.join(cmd)}):\n{tail}")
     said = (proc.stdout + proc.stderr).strip()
     if said:
-        warnings.warn(f"compiling {target.name} gave warnings:\n{said}", CompilerWarning,
-                      stacklevel=2)
+        warnings.warn(f"compiling {what} gave warnings:\n{said}", CompilerWarning, stacklevel=3)
+
+
+def _object(cc: str, flags: Sequence[str], sources: Path, name: str, what: str) -> Path:
+    """sources/name compiled (cc -c) into the object cache, unless an object of the same
+    compiler, flags, source and headers is there already. Its key holds every header of the
+    staged folder (config.h, the one file that differs between FMUs, only where the source
+    names it), so that a change to any of them compiles again."""
+    text = (sources / name).read_bytes()
+    h = hashlib.sha256("\0".join((cc, *flags, name)).encode() + b"\0" + text)
+    for header in sorted(sources.glob("*.h")):
+        if header.name != "config.h" or b'"config.h"' in text:
+            h.update(header.name.encode() + b"\0" + header.read_bytes())
+    obj = object_cache() / f"{h.hexdigest()[:32]}.o"
+    if not obj.is_file():
+        obj.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(suffix=".o", dir=obj.parent)
+        os.close(fd)
+        try:
+            _run([cc, *flags, "-I", str(sources), "-c", "-o", tmp, str(sources / name)],
+                 f"{name} of {what}")
+            os.replace(tmp, obj)  # atomic: a parallel build never links half an object
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    return obj
+
+
+def compile_binary(cc: str, sources: Path, files: Sequence[str], target: Path,
+                   windows: bool = False) -> None:
+    """Compile the FMU's sources into target (a shared library), each through the object
+    cache, and link them; RuntimeError with the compiler's last lines when it fails."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    flags = [*(f for f in CFLAGS if f != "-shared"), *([] if windows else ["-fPIC"])]
+    objects = [_object(cc, flags, sources, f, target.name) for f in files]
+    _run([cc, "-shared", *(["-static-libgcc"] if windows else []), "-o", str(target),
+          *(str(o) for o in objects), "-lm"], target.name)
 
 
 def build_native(model: NativeModel, version: str, out_dir: Path,
