@@ -33,6 +33,9 @@ TINY = dict(
 )
 
 
+pytestmark = pytest.mark.xdist_group("bench")  # bench_json is made once, on one worker
+
+
 @pytest.fixture(scope="module")
 def bench_json(built_fmus, tmp_path_factory: pytest.TempPathFactory) -> dict:
     """`python -m benchmarks --quick` with the quick settings shrunk to TINY, through main()."""

@@ -50,9 +50,17 @@ SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "campai
 battery ten times: minutes (`make test-slow`)."""
 
 
+SHARED_RUNS = {"battery": ("readme-battery", *(f.name for f in figs.FIGURES
+                                               if f.name.startswith("battery-")))}
+"""Figures made from one run their process keeps (docs_figures' cached battery), each set on
+one worker (`--dist loadgroup`) so that the run is made once."""
+
+
 def _marks(name: str) -> list[pytest.MarkDecorator]:
     marks = [pytest.mark.heavy] if name in HEAVY else []
     marks += [pytest.mark.slow] if name in SLOW else []
+    marks += [pytest.mark.xdist_group(group) for group, names in SHARED_RUNS.items()
+              if name in names]
     if "fmus" in BY_NAME[name].needs:  # built for the session: `make test-fast` leaves it out
         marks.append(pytest.mark.fmu)
     return marks

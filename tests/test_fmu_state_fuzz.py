@@ -31,7 +31,7 @@ from fmu_src.names import model_names
 from fmu_src.native.build import native_model, stage_sources
 from fusion_core.native import compiler
 
-STATES = 20_000
+STATES = 8_000
 """Mutated states per model and standard in `make test`."""
 SLOW_STATES = 100_000
 """Mutated states per model and standard in `make test-slow`."""
