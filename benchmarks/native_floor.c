@@ -4,10 +4,11 @@
 #include "config.h"
 #include "fmu_model.h"
 
-static void setup(void *data, double *values)
+static void setup(void *data, double *values, double t)
 {
     (void)data;
     (void)values;
+    (void)t;
 }
 
 static void tune(void *data, const double *values)
