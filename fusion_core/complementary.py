@@ -81,11 +81,7 @@ class ComplementaryFilter(Estimator):
       up to max_correction_time. A gyro sample at its rail (gyro_range) measures no bias at rest
       and restarts the measured vector.
 
-    tau = 1 s: a gyro bias b the rest updates have not seen leaves an error b tau (0.5 deg at
-    0.5 deg/s, an uncalibrated MEMS gyro), while a shorter tau lets the measured vector's
-    residual acceleration through; a longer one would suit recordings that start at rest (whose
-    bias the rest updates know) and fail a gyro they have not seen. max_correction_time 3 s:
-    this filter learns its bias only at rest, and a bias b costs b tau.
+    Why the defaults are so: docs/estimators/cf.md, "The defaults".
     """
 
     PARAMS = (

@@ -173,33 +173,11 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
       bias_innovation (a larger one is a gross attitude error, not a bias drift) and the
       measured vector is settled; otherwise the biases are consider states (angle_only_gain).
 
-    Start: the first valid sample sets the angles from the accelerometer and the biases to 0;
-    P = diag(R_measure + ((|a| - g) / g)^2, init_bias_std^2): the angles as sure as one
-    accelerometer sample, less so as far as its norm shows linear acceleration, the bias as its
-    prior (with a small, physical Q_bias a zero prior would keep the bias from ever moving).
-    While the measured vector fills (its first acc_lowpass, a mean of the turned samples so far)
-    the angles are its tilt, as the complementary filters' are: a first sample taken in a moving
-    hand is off by its linear acceleration, and corrected with the noise of a settled vector it
-    stays so for tens of seconds (tests/test_start_alignment.py holds a hand-held start near
-    VQF's). Their variance is then the vector's: one sample's averaged
-    over the fill, the disturbance that reaches it, and the turn a bias error b gives it over
-    its samples' mean age (b age), whose covariance with the bias is -age P_bias, as the
-    propagation's is -t P_bias (without it an uncalibrated gyro's first corrections after the
-    fill move the bias by the vector's own turn: docs/guide/own-sensor.md, parts that never
-    rest). At the first rest the angles are the rest's tilt and their
-    variance that of its mean (building_blocks.rest_mean_share), with no covariance with a bias
-    they were not measured with; a vector still filling then leaves them.
-
-    The defaults, from sensor physics: Q_angle = the gyro's noise PSD and R_measure = the
-    variance of one accelerometer sample's tilt (RECOMMENDED_R), whose correction time constant
-    sqrt(R dt / Q_angle) is seconds at 100-300 Hz (the papers' values, tuned at 30 Hz, give
-    fractions of a second); gyro_psd (the zero-rate update) the same PSD; init_bias_std
-    RECOMMENDED_INIT_BIAS_STD; max_correction_time KALMAN_MAX_CORRECTION_TIME. Q_bias is small
-    (1e-8 deg^2/s^3): the accelerometer's error after the pre-filter is coloured (residual
-    linear acceleration), and a bias random walk sized from the gyro's drift lets it steer the
-    bias in motion within seconds; the rest updates measure the bias instead. What physics
-    leaves open (acc_lowpass, slow_band_time) is chosen by cross-validation over groups of
-    recordings (`python -m testbenches broad DIR --cv`, whose report gives the figures).
+    Start: the first valid sample sets the angles from the accelerometer and the biases to 0,
+    with P = diag(R_measure + ((|a| - g) / g)^2, init_bias_std^2); while the measured vector
+    fills, the angles are its tilt, and at the first rest the rest's. The defaults follow from
+    the sensor's noise (noise_params). Why each is so: docs/estimators/kf.md, "Start" and "The
+    defaults".
     """
 
     PARAMS = (

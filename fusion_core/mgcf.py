@@ -88,10 +88,7 @@ class GainScheduledComplementaryFilter(Estimator):
     - no bias is learned from a gyro sample at its rail (gyro_range) nor from a measured vector
       that still holds its turns.
 
-    w0 = 0.02 rad/s, zeta = 10: Kp = 0.4 rad/s, a 2.5 s correction time constant as in the
-    paper's top band (w0 = 0.1, zeta = 2), and Ki = 4e-4 s^-2 instead of 0.01: the bias comes
-    from the rest updates, and an integral with a 10 s time constant turns every systematic
-    accelerometer error in motion into bias.
+    Why the defaults are so: docs/estimators/mgcf.md, "The defaults".
     """
 
     PARAMS = (

@@ -12,7 +12,7 @@ differences:
 Every formula is written once and evaluated two ways: on an array of times with numpy
 (`Trajectory.truth`, recordings and tests) and on one float time with plain math
 (`Trajectory.truth_at`, the plant FMU's one evaluation per step, where numpy's per-call overhead
-on one-element arrays made it some 30 times slower). A formula sees the difference only through
+on one-element arrays would dominate). A formula sees the difference only through
 `Ops` (sin, cos, clip, where, zeros_like); + - * / are IEEE operations in both, and no formula
 raises a time-dependent value to a power (on CPUs with AVX-512 numpy computes array powers with
 a vectorised pow whose last bit differs from libm's). So both paths give the same floats wherever

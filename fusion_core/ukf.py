@@ -109,16 +109,9 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     a bias error gave its samples, and at the first rest the rest's mean direction with that
     mean's variance and no covariance with the bias, as in the kf (kalman.AngleBiasKalmanFilter;
     measured_covariance).
-    No unit-norm pseudo-measurement (the paper's |X|^2 = 1 row): X is renormalised after every
-    update, so |X|^2 = 1 tells the filter nothing about X, but the unscented transform of |X|^2
-    reacts to the sigma points' spread (points X +- gamma s with s across X lie gamma^2 |s|^2 off
-    the sphere) and the update reads that spread as information and takes it out of P_XX: the
-    filter then holds X more certain than it is and explains its innovations by its bias states
-    (tests/test_adaptive_noise.py shows it on the vibration scenario).
-    The defaults, from sensor physics: gyro_psd and zaru_psd = the gyro's measured noise PSD,
-    acc_noise = the accelerometer's measured sample noise over g (the measurement is the
-    pre-filtered vector, so no allowance for linear acceleration is added), bias_psd the gyro's
-    drift over a recording of minutes, the rest updates doing the rest.
+    No unit-norm pseudo-measurement (the paper's |X|^2 = 1 row; why: docs/estimators/ukf.md).
+    The defaults follow from the sensor's noise (noise_params): docs/estimators/ukf.md, "The
+    defaults".
     Output: roll = atan2(X2, X3), pitch = atan2(-X1, sqrt(X2^2 + X3^2)); bias = b.
     """
 

@@ -28,7 +28,10 @@ def test_the_site_builds_strict(tmp_path: Path) -> None:
     for page in ("index.html", "estimators/ukf/index.html", "interface/index.html"):
         assert (tmp_path / page).is_file(), page
     ukf = (tmp_path / "estimators/ukf/index.html").read_text()
-    assert "gyro_range" in ukf and "PaperUnscentedKalmanFilter" in ukf  # the tables were made
+    assert "bias_psd" in ukf and "PaperUnscentedKalmanFilter" in ukf  # the tables were made
+    assert "gyro_range" not in ukf.split("The recommended filter")[0]  # the filter's own only
+    shared = (tmp_path / "estimators/index.html").read_text()
+    assert "gyro_range" in shared and "sensor_delay" in shared  # the input stage's, once
     home = (tmp_path / "index.html").read_text()
     assert 'id="quickstart"' in home and 'href="results/broad/"' in home  # the README, relinked
 

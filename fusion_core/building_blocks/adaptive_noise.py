@@ -134,10 +134,9 @@ constant, which overflows beyond 1e154 s (a Kp of a subnormal w0)."""
 
 PREFILTER_FULL: Final = 4.0
 """adaptive_prefilter_time reaches the full pre-filter where the disturbance's power is this many
-times the white noise's (its RMS twice the noise's). 1 to 8 give the same BROAD mean and the same
-testbench verdicts; below 4 the pre-filter switches within so narrow a band of disturbance that a
-noise-free run's RMSE moves by up to 30 % with the sample times (contract T2), from 4 on by at
-most 5 %."""
+times the white noise's (its RMS twice the noise's): a band of disturbance wide enough that the
+pre-filter does not switch on the rounding of the sample times of a noise-free run (contract
+T2); docs/estimators/index.md, "Numerical choices beyond the papers", says how it was chosen."""
 
 
 def adaptive_prefilter_time(tau: float, dist: float, noise: float) -> float:
