@@ -39,18 +39,37 @@ testbench extra, and say so where it is missing.
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
-
-from fmu_src.cli import add_build_parser
-
-from .estimate import add_estimate_parser
 
 TESTBENCH_COMMANDS = ("run", "export-ssp", "broad", "noise", "tune", "campaign", "battery",
                       "mechanisms", "budget", "crosscheck", "calibrate", "engines")
 """The commands that need the testbench extra."""
+COMMANDS: dict[str, str] = {
+    "estimate": "testbenches.estimate:add_estimate_parser",
+    "build-fmus": "fmu_src.cli:add_build_parser",
+    "run": "testbenches.run_cli:add_run_parser",
+    "export-ssp": "testbenches.ssp:add_ssp_parser",
+    "broad": "testbenches.broad.cli:add_broad_parser",
+    "noise": "testbenches.fit.cli:add_fit_parsers",
+    "tune": "testbenches.fit.cli:add_fit_parsers",
+    "campaign": "testbenches.montecarlo.cli:add_campaign_parser",
+    "battery": "testbenches.battery:add_battery_parser",
+    "mechanisms": "testbenches.mechanisms:add_mechanisms_parser",
+    "budget": "testbenches.budget:add_budget_parser",
+    "crosscheck": "testbenches.crosscheck:add_crosscheck_parser",
+    "calibrate": "testbenches.calibrate.cli:add_calibrate_parser",
+    "engines": "testbenches.engines:add_engines_parser",
+    "docs": "testbenches.docs_figures:add_docs_parser",
+}
+"""Each command and the function that adds its parser (one may add two), in the order the help
+lists them: a command line that names its command imports that command's module only (the
+others' imports cost half a second), the help and an unknown command every one."""
 
 
-def _parser(prog: str) -> argparse.ArgumentParser:
+def _parser(prog: str, command: str | None = None) -> argparse.ArgumentParser:
+    """The command line's parser: with command (one of COMMANDS) only that command's parser,
+    else every command's (those of the testbench extra where it is installed)."""
     # The commands are listed once, by argparse from each one's help; the module docstring's
     # last paragraph says what they need.
     parser = argparse.ArgumentParser(
@@ -59,30 +78,16 @@ def _parser(prog: str) -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    add_estimate_parser(sub)
-    add_build_parser(sub)
     from . import missing_modules
 
-    if not missing_modules():
-        from .battery import add_battery_parser
-        from .broad.cli import add_broad_parser
-        from .budget import add_budget_parser
-        from .calibrate.cli import add_calibrate_parser
-        from .crosscheck import add_crosscheck_parser
-        from .docs_figures import add_docs_parser
-        from .engines import add_engines_parser
-        from .fit.cli import add_fit_parsers
-        from .mechanisms import add_mechanisms_parser
-        from .montecarlo.cli import add_campaign_parser
-        from .run_cli import add_run_parser
-        from .ssp import add_ssp_parser
-
-        for add in (add_run_parser, add_ssp_parser, add_broad_parser, add_fit_parsers,
-                    add_campaign_parser, add_battery_parser, add_mechanisms_parser,
-                    add_budget_parser,
-                    add_crosscheck_parser, add_calibrate_parser, add_engines_parser,
-                    add_docs_parser):
-            add(sub)
+    if command is not None:
+        names = [command]
+    else:
+        lacking = missing_modules()
+        names = [n for n in COMMANDS if not (lacking and n in TESTBENCH_COMMANDS)]
+    for where in dict.fromkeys(COMMANDS[n] for n in names):  # each adding function once
+        module, function = where.split(":")
+        getattr(importlib.import_module(module), function)(sub)
     return parser
 
 
@@ -104,7 +109,7 @@ def main(argv: list[str] | None = None, prog: str = "imu-fusion") -> int:
         print(f"{prog} {argv[0]} needs the testbench extra ({INSTALL_HINT}); not installed: "
               f"{', '.join(missing_modules())}", file=sys.stderr)
         return 2
-    args = _parser(prog).parse_args(argv)
+    args = _parser(prog, argv[0] if argv and argv[0] in COMMANDS else None).parse_args(argv)
     try:
         return int(args.func(args))
     except (ValueError, FileNotFoundError, ConnectionError) as err:

@@ -87,3 +87,22 @@ def test_the_command_line_says_its_version_and_lists_each_command_once() -> None
     text = parser.format_help()
     assert text.count("estimate  ") == 1 and "--version" in text
     assert _version() != "(not installed)"
+
+
+def test_a_named_command_imports_its_own_module_only() -> None:
+    """testbenches.cli.COMMANDS is every command of the full parser, and the command line of
+    one command builds that command's parser without importing the others'."""
+    import argparse
+
+    from testbenches.cli import COMMANDS, _parser
+
+    full = _parser("imu-fusion")
+    sub = next(a for a in full._actions if isinstance(a, argparse._SubParsersAction))
+    assert list(sub.choices) == list(COMMANDS)
+    code = ("import sys; from testbenches.cli import _parser; "
+            "p = _parser('imu-fusion', 'estimate'); "
+            "print(sorted(m for m in ('testbenches.run_cli', 'testbenches.broad.cli', "
+            "'testbenches.docs_figures', 'fmu_src.cli') if m in sys.modules))")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True,
+                          text=True, check=True)
+    assert proc.stdout.strip() == "[]", proc.stdout

@@ -45,9 +45,12 @@ HEAVY = ("engines-table", "contract-parts", "readme-contract", "embedded-table",
          *(f.name for f in figs.FIGURES if f.name.startswith("battery-")))
 """Figures whose command runs for tens of seconds (`make test-fast` leaves them out)."""
 SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "campaigns-makefile",
-        "readme-broad", "mechanisms-table", "broad-groups", "broad-cv")
-"""Figures of 200 parts calibrated first, `make campaign`'s 17,500 runs, BROAD's trials or the
-battery ten times: minutes (`make test-slow`)."""
+        "readme-broad", "mechanisms-table", "broad-groups", "broad-cv", "readme-battery",
+        *(f.name for f in figs.FIGURES if f.name.startswith("battery-")
+          and f.name != "battery-classes"))
+"""Figures of 200 parts calibrated first, `make campaign`'s 17,500 runs, BROAD's trials, the
+battery's campaign (13 motion classes x 3 sensor classes x 20 parts) or the battery ten times:
+minutes (`make test-slow`)."""
 
 
 SHARED_RUNS = {"battery": ("readme-battery", *(f.name for f in figs.FIGURES
