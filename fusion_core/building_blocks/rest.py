@@ -34,7 +34,6 @@ class RestState(NamedTuple):
     rz: float
 
 
-_new = tuple.__new__
 REST_START: Final = RestState(*(0.0,) * 14)
 """The rest detector's state before the first sample."""
 
@@ -168,7 +167,7 @@ def rest_mean_share(dt: float) -> float:
 def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
     """The rest detector's state at the first sample: its means start at that sample, quiet time
     0, the bias not measured yet."""
-    return _new(RestState, (gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az, gx, gy, gz))
+    return RestState(gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az, gx, gy, gz)
 
 
 def rest_step(
@@ -209,8 +208,8 @@ def rest_step(
         ox, oy, oz = fx, fy, fz
         rx, ry, rz = wx, wy, wz
     quiet = on_the_mark(on_the_mark(quiet + dt, dt, REST_MEAN_TAU), dt, rest_time) if still else 0.0
-    return _new(RestState, (wx, wy, wz, fx, fy, fz, quiet,
-                            (1.0 if quiet >= rest_time else measured), ox, oy, oz, rx, ry, rz))
+    return RestState(wx, wy, wz, fx, fy, fz, quiet, 1.0 if quiet >= rest_time else measured,
+                     ox, oy, oz, rx, ry, rz)
 
 
 def first_rest(measured_before: float, rest: RestState) -> bool:
