@@ -64,8 +64,8 @@ pre-filter, BROAD's largest are a few degrees in the fast trials). An innovation
 degrees means the attitude itself is grossly off (after a stretch of absurd samples, a knock,
 a restart in motion); the filters' linear model of the angle-bias coupling does not hold there,
 and learning from it winds the bias up to tens or hundreds of deg/s, which then takes minutes to
-unwind (measured after 1 s of absurd but accepted samples: kf not back under 1 deg within 120 s;
-with the gate, 14 s). The angle is corrected as always; only the bias waits."""
+unwind. The angle is corrected as always; only the bias waits (the recovery from absurd but
+accepted samples: `python -m testbenches.recovery`, docs/results/robustness.md)."""
 
 BIAS_INNOVATION_PARAM = Param(
     "bias_innovation", BIAS_INNOVATION,

@@ -30,9 +30,9 @@ started averages to (velocity change) / (time), so a low-pass with a time consta
 removes most of it, without the lag that a body-frame low-pass has while the sensor turns. Here
 the filtered vector is kept in body axes and turned with the gyro's rotation increment each
 sample (a world-fixed vector seen from the body), which is the same filter. Each paper's filter is
-then unchanged: it takes the filtered vector where it took the raw sample. Measured on BROAD's
-real recordings (testbenches/broad): the fast-translation trials, whose raw accelerometer
-swings between 0.02 g and 5 g, drop from tens of degrees to below 1 deg of inclination error."""
+then unchanged: it takes the filtered vector where it took the raw sample. BROAD's
+fast-translation trials, whose raw accelerometer swings between 0.02 g and 5 g, show what it
+does (`imu-fusion broad DIR`; docs/results/broad.md)."""
 
 
 def lowpass_specific_force(f: Vec3, turn: Mat9, a: Vec3, k: float) -> Vec3:
