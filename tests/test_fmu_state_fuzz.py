@@ -28,7 +28,7 @@ import pytest
 from conftest import REPO
 
 from fmu_src.names import model_names
-from fmu_src.native.build import _object, native_model, stage_sources
+from fmu_src.native.build import cached_object, native_model, stage_sources
 from fusion_core.native import compiler
 
 STATES = 8_000
@@ -67,7 +67,7 @@ def _fuzz(cc: str, name: str, version: str, folder: Path, mode: str, states: int
              f"-DFUZZ_KIND_{_kind(name)}"]
     # each source through the native build's object cache: what the models share (the FMI
     # plumbing, the twins) is compiled once per standard and kind of model, not per FMU
-    objects = [str(_object(cc, flags, sources, f, exe.name))
+    objects = [str(cached_object(cc, flags, sources, f, exe.name))
                for f in (FUZZ_HOST.name, *files)]
     link = [cc, *(SANITIZE if mode == "asan" else ()), "-o", str(exe), *objects, "-lm"]
     built = subprocess.run(link, capture_output=True, text=True, check=False)

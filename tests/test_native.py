@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from fusion_core import ESTIMATORS, InvalidSample, native, registry, synthetic
 from fusion_core.calibration import Calibration
-from fusion_core.native.estimators import param_struct
+from fusion_core.native.estimators import param_field, param_struct
 from fusion_core.presets import PRESETS, preset_params
 from fusion_core.types import ABSENT
 
@@ -152,7 +152,8 @@ def test_the_c_defaults_are_the_python_defaults(cls: type) -> None:
     twin = ffi.new(f"{prefix} *")
     getattr(lib, f"{prefix}_init")(twin, ffi.NULL)
     for name, spec in cls.param_specs().items():
-        c_value = getattr(param_struct(twin.params, cls, name), name)
+        *path, field = param_field(cls, name).split(".")
+        c_value = getattr(param_struct(twin.params, path), field)
         expected = spec.choices.index(spec.default) if spec.choices else spec.default
         assert c_value == expected, name
     for name, value in ABSENT.items():  # a shared parameter the class leaves out

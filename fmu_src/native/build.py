@@ -114,7 +114,7 @@ class NativeModel:
     kind: str
     prefix: str = ""
     params: tuple = ()  # the fusion_core Params that fill the twin's params struct
-    shared: frozenset[str] = frozenset()  # those of them in its `input` (fc_input_params)
+    fields: tuple[str, ...] = ()  # where each of them goes in the struct (default: its name)
     source: Path | None = None  # the model's C file, if not models/<kind>.c
 
     @property
@@ -152,6 +152,7 @@ def native_model(name: str, preset: dict[str, dict[str, Any]] | None = None) -> 
     """The NativeModel of the FMU called name (fmu_src.names: an estimator of the registry,
     with the estimator class and start values of the preset's entry for it, None: the
     recommended ones, fusion_core.presets.load_preset; or the plant or the sensor)."""
+    from fusion_core.native.estimators import param_field
     from fusion_core.registry import ENTRY
     from fusion_core.sensor import SENSOR_PARAMS
 
@@ -163,7 +164,7 @@ def native_model(name: str, preset: dict[str, dict[str, Any]] | None = None) -> 
         params = tuple(estimator.param_specs().values())
         return NativeModel(name, model_description(ENTRY[key].fmu_text, estimator), variables,
                            "estimator", estimator.TWIN or "", params,
-                           frozenset(p.name for p in estimator.COMMON))
+                           tuple(param_field(estimator, p.name) for p in params))
     if not (MODELS_DIR / script_name(name)).is_file():
         raise ValueError(f"{name} has no native model")
     cls = getattr(importlib.import_module(f"fmu_src.models.{script_name(name)[:-3]}"), name)
@@ -195,8 +196,7 @@ def _variable_row(v: Variable) -> str:
             f"{int(low_open)}, {int(high_open)}}},")
 
 
-def _param_assignment(p, shared: frozenset[str]) -> str:
-    field = f"input.{p.name}" if p.name in shared else p.name
+def _param_assignment(p, field: str) -> str:
     if p.choices is not None:
         return f"    p->{field} = (int)v[VR_{p.name}] - 1;"
     if isinstance(p.default, bool):
@@ -263,7 +263,8 @@ def render_config(model: NativeModel) -> str:
             f"static void params_from_values({struct} *p, const double *v)",
             "{",
             f"    {struct}_default(p);",
-            *(_param_assignment(p, model.shared) for p in model.params),
+            *(_param_assignment(p, field) for p, field in
+              zip(model.params, model.fields or [p.name for p in model.params], strict=True)),
             "}",
             "",
         ]
@@ -470,7 +471,7 @@ def _run(cmd: list[str], what: str) -> None:
         warnings.warn(f"compiling {what} gave warnings:\n{said}", CompilerWarning, stacklevel=3)
 
 
-def _object(cc: str, flags: Sequence[str], sources: Path, name: str, what: str) -> Path:
+def cached_object(cc: str, flags: Sequence[str], sources: Path, name: str, what: str) -> Path:
     """sources/name compiled (cc -c) into the object cache, unless an object of the same
     compiler, flags, source and headers is there already. Its key holds every header of the
     staged folder (config.h, the one file that differs between FMUs, only where the source
@@ -501,7 +502,7 @@ def compile_binary(cc: str, sources: Path, files: Sequence[str], target: Path,
     cache, and link them; RuntimeError with the compiler's last lines when it fails."""
     target.parent.mkdir(parents=True, exist_ok=True)
     flags = [*(f for f in CFLAGS if f != "-shared"), *([] if windows else ["-fPIC"])]
-    objects = [_object(cc, flags, sources, f, target.name) for f in files]
+    objects = [cached_object(cc, flags, sources, f, target.name) for f in files]
     _run([cc, "-shared", *(["-static-libgcc"] if windows else []), "-o", str(target),
           *(str(o) for o in objects), "-lm"], target.name)
 

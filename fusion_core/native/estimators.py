@@ -165,14 +165,24 @@ def twin_params(ffi: Any, estimator: Any) -> Any:
     for name, spec in estimator.param_specs().items():
         value = estimator.params[name]
         value = spec.choices.index(value) if spec.choices is not None else value
-        setattr(param_struct(params, cls, name), name, value)
+        *path, field = param_field(cls, name).split(".")
+        setattr(param_struct(params, path), field, value)
     return params
 
 
-def param_struct(params: Any, cls: Any, name: str) -> Any:
-    """The struct that holds parameter `name` of estimator class cls in its twin's params:
-    params for one of its own (cls.PARAMS), params.input for the input stage's."""
-    return params if any(p.name == name for p in cls.PARAMS) else params.input
+def param_field(cls: Any, name: str) -> str:
+    """The field of parameter `name` of estimator class cls in its twin's params struct
+    (fc_params.h): `name` for one of its own (cls.PARAMS), `input.name` for one of the input
+    stage every estimator shares (fc_input_params). The native FMUs' config.h and the binding
+    both fill the struct by it."""
+    return name if any(p.name == name for p in cls.PARAMS) else f"input.{name}"
+
+
+def param_struct(params: Any, path: list[str]) -> Any:
+    """The struct within params that path (param_field's dotted prefix) names."""
+    for part in path:
+        params = getattr(params, part)
+    return params
 
 
 def new_twin(estimator: Any) -> Any:

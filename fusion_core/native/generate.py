@@ -74,10 +74,8 @@ FC_GYRO_SAMPLING_POINT, for fc_core's shared stage and every twin."""
 
 
 def choice_name(prefix: str, p: Param, choice: str) -> str:
-    """The #define of one choice of an enumeration parameter: FC_KF_PROPAGATION_QUATERNION, or
-    FC_GYRO_SAMPLING_POINT for one every estimator shares (SHARED)."""
-    if prefix != "fc_sensor" and p.name in SHARED:
-        prefix = "fc"
+    """The #define of one choice of an enumeration parameter: FC_KF_PROPAGATION_QUATERNION, or,
+    with the prefix "fc", FC_GYRO_SAMPLING_POINT for one every estimator shares (SHARED)."""
     return f"{prefix.upper()}_{p.name.upper()}_{choice.upper()}"
 
 
@@ -153,7 +151,7 @@ def estimator_block(prefix: str) -> list[str]:
                 out.append(f"    p->input.{q.name} = {c_double(ABSENT[q.name])};  "
                            f"/* {name} has no {q.name} */")
             elif common[q.name].default != q.default:
-                out.append(f"    p->input.{q.name} = {c_value(prefix, common[q.name])};")
+                out.append(f"    p->input.{q.name} = {c_value('fc', common[q.name])};")
     out.append("}")
     out.append("")
     return out
