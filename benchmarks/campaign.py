@@ -4,7 +4,8 @@ samples_per_s: simulated IMU samples per second over a whole campaign (plant -> 
 estimator through the native core, every run's samples counted, the LocalCluster's start and
 the Parquet writes included) on this machine's cores (WORKERS); samples_per_s_1_worker the
 same campaign on one worker; scaling their ratio (target >= 1.7 on two cores). Each is the
-fastest of CAMPAIGN_PASSES campaigns, the two worker counts taking turns.
+fastest of CAMPAIGN_PASSES campaigns (BenchConfig.campaign_passes), the two worker counts taking
+turns.
 overhead_seconds (and _1_worker): the campaign's time less its runs' own (their rows' seconds,
 summed, over the workers): the cluster's start and stop, the workers' first imports, the last
 batches' imbalance, which a longer campaign spreads over more runs; runs_scaling: the runs' own
@@ -30,6 +31,8 @@ from typing import Any
 
 from fusion_core.registry import KEYS
 
+from .config import CAMPAIGN_PASSES
+
 SAMPLES_PER_S_TARGET = 5e6
 SCALING_TARGET = 1.7
 WORKERS = 2
@@ -37,9 +40,6 @@ WORKERS = 2
 ESTIMATORS = KEYS
 SCENARIOS = ("moderate_dynamics", "vibration")
 PASSES = 3
-CAMPAIGN_PASSES = 2
-"""Campaigns per worker count, interleaved (2, 1, 2, 1 workers); the fastest of each counts."""
-
 
 def _throughput(workers: int, seeds: int) -> tuple[float, int, float, float]:
     from testbenches.montecarlo.plan import parse_variation, plan
@@ -89,7 +89,7 @@ def _per_sample_us() -> tuple[float, float]:
     return statistics.mean(est_us), statistics.mean(sensor_us) / len(ESTIMATORS)
 
 
-def campaign_section(seeds: int) -> dict[str, Any]:
+def campaign_section(seeds: int, passes: int = CAMPAIGN_PASSES) -> dict[str, Any]:
     """The campaign section of bench.json (see the module docstring)."""
     try:
         import distributed  # noqa: F401
@@ -97,9 +97,9 @@ def campaign_section(seeds: int) -> dict[str, Any]:
         return {"available": False, "reason": f"ImportError: {err}"}
     # interleaved, the fastest of each: a shared VM's neighbours come and go within a minute,
     # and two back-to-back campaigns can see different machines
-    passes = [(_throughput(WORKERS, seeds), _throughput(1, seeds)) for _ in range(CAMPAIGN_PASSES)]
-    two, runs, seconds, run_s = max((p[0] for p in passes), key=lambda m: m[0])
-    one, _, seconds_1, run_s_1 = max((p[1] for p in passes), key=lambda m: m[0])
+    made = [(_throughput(WORKERS, seeds), _throughput(1, seeds)) for _ in range(passes)]
+    two, runs, seconds, run_s = max((p[0] for p in made), key=lambda m: m[0])
+    one, _, seconds_1, run_s_1 = max((p[1] for p in made), key=lambda m: m[0])
     est_us, sensor_us = _per_sample_us()
     return {"available": True, "runs": runs, "samples_per_s": two, "seconds": seconds,
             "samples_per_s_1_worker": one, "seconds_1_worker": seconds_1, "scaling": two / one,

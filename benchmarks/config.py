@@ -5,6 +5,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+MIN_SAMPLES = 200_000
+"""The native section's batch runs (the C twin, VQF's C++ batch): at least this many samples."""
+PYTHON_SAMPLES = 20_000
+"""The native section's Python core: this many samples."""
+CAMPAIGN_PASSES = 2
+"""Campaigns per worker count, interleaved (2, 1, 2, 1 workers); the fastest of each counts."""
+
 EVERY_ESTIMATOR: tuple[str, ...] = ()
 """A config's list of estimators that names none: every estimator of fusion_core.registry
 (estimator_keys). The registry is read when the suite runs, not here: the command line chooses
@@ -26,7 +33,9 @@ class BenchConfig:
     repeats: timed passes over it (the medians are reported); fmu_dir: prebuilt FMUs (None:
     build them into a temporary folder with build_fmu.py); testbench_s: simulated seconds per
     testbench rate, for each of testbench_estimators; scaling_sizes: sample counts of the `run`
-    scaling test; peers: time the peer filters too; sections: which parts to run (all).
+    scaling test; peers: time the peer filters too; sections: which parts to run (all);
+    native_samples, python_samples: the native section's batch lengths (the C twin and VQF, the
+    Python core); campaign_passes: campaigns per worker count in the campaign section.
     """
 
     duration_s: float = 60.0
@@ -42,6 +51,9 @@ class BenchConfig:
     sections: tuple[str, ...] = ("per_sample", "fmu", "testbench", "native", "campaign",
                                  "scaling", "estimate_2e6")
     campaign_seeds: int = 300
+    campaign_passes: int = CAMPAIGN_PASSES
+    native_samples: int = MIN_SAMPLES
+    python_samples: int = PYTHON_SAMPLES
     quick: bool = False
 
     @classmethod

@@ -1,11 +1,11 @@
 """The `native` section: fusion_core's C twin against the Python core and VQF's C++ batch.
 
 run_us_per_sample: Estimator.run(backend="native") over the recording repeated to at least
-MIN_SAMPLES samples (the C batch run, chunked by the binding), per sample, median of the passes;
-python_run_us_per_sample: run(backend="python") over a slice of PYTHON_SAMPLES, the core this
-process imported (the Python reference); speedup_vs_python their
-ratio; vqf_batch_us_per_sample: VQF's C++ updateBatch on the same samples (the fastest public
-6D filter's own batch loop), when the vqf package is installed.
+MIN_SAMPLES samples (BenchConfig.native_samples; the C batch run, chunked by the binding), per
+sample, median of the passes; python_run_us_per_sample: run(backend="python") over a slice of
+PYTHON_SAMPLES (BenchConfig.python_samples), the core this process imported (the Python
+reference); speedup_vs_python their ratio; vqf_batch_us_per_sample: VQF's C++ updateBatch on the
+same samples (the fastest public 6D filter's own batch loop), when the vqf package is installed.
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ import numpy as np
 from fusion_core import ESTIMATORS, native
 from fusion_core.registry import KEYS, REGISTRY
 
-MIN_SAMPLES = 200_000
-PYTHON_SAMPLES = 20_000
+from .config import MIN_SAMPLES, PYTHON_SAMPLES
+
 NATIVE_TARGETS_US = {e.key: e.bench.native_us for e in REGISTRY}
 """Per-sample targets of the native batch run [us] (the registry's Bench)."""
 VQF_RATIO_TARGETS = {e.key: e.bench.vqf_ratio for e in REGISTRY}
@@ -44,22 +44,25 @@ def tiled(rec: dict[str, np.ndarray], n: int) -> tuple[np.ndarray, np.ndarray, n
             np.ascontiguousarray(rec["gyro_meas"][idx]), np.ascontiguousarray(rec["dt"][idx]))
 
 
-def vqf_batch_us(rec: dict[str, np.ndarray], repeats: int) -> float | str:
-    """VQF's updateBatch per sample [us], or why it could not run."""
+def vqf_batch_us(rec: dict[str, np.ndarray], repeats: int, samples: int = MIN_SAMPLES
+                 ) -> float | str:
+    """VQF's updateBatch per sample [us] over the recording repeated to `samples`, or why it
+    could not run."""
     try:
         from vqf import VQF
     except ImportError as err:
         return f"ImportError: {err}"
-    acc, gyro, dt = tiled(rec, MIN_SAMPLES)
+    acc, gyro, dt = tiled(rec, samples)
     seconds = _median_seconds(lambda: VQF(float(dt[0])).updateBatch(gyro, acc), repeats)
     return seconds / len(dt) * 1e6
 
 
-def native_section(rec: dict[str, np.ndarray], repeats: int) -> dict[str, Any]:
+def native_section(rec: dict[str, np.ndarray], repeats: int, samples: int = MIN_SAMPLES,
+                   python_samples: int = PYTHON_SAMPLES) -> dict[str, Any]:
     """The native section of bench.json (see the module docstring)."""
     if not native.available():
         return {"available": False, "reason": native.reason()}
-    acc, gyro, dt = tiled(rec, max(MIN_SAMPLES, len(rec["dt"])))
+    acc, gyro, dt = tiled(rec, max(samples, len(rec["dt"])))
     n = len(dt)
     out: dict[str, Any] = {"available": True, "samples": n, "run_us_per_sample": {},
                            "python_run_us_per_sample": {}, "speedup_vs_python": {},
@@ -72,14 +75,14 @@ def native_section(rec: dict[str, np.ndarray], repeats: int) -> dict[str, Any]:
         cls().run(acc[:100], gyro[:100], dt[:100], backend="native")  # first-call costs
         c = _median_seconds(lambda cls=cls: cls().run(acc, gyro, dt, backend="native"),
                             repeats) / n * 1e6
-        m = PYTHON_SAMPLES
+        m = python_samples
         py = _median_seconds(
             lambda cls=cls, m=m: cls().run(acc[:m], gyro[:m], dt[:m], backend="python"),
             max(1, repeats // 2)) / m * 1e6
         out["run_us_per_sample"][key] = c
         out["python_run_us_per_sample"][key] = py
         out["speedup_vs_python"][key] = py / c
-    vqf = vqf_batch_us(rec, repeats)
+    vqf = vqf_batch_us(rec, repeats, samples)
     out["vqf_batch_us_per_sample"] = vqf if isinstance(vqf, float) else None
     if not isinstance(vqf, float):
         out["vqf_unavailable"] = vqf

@@ -157,7 +157,8 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
                     config.testbench_repeats)
     if "native" in config.sections:
         log("native batch runs (the C twin), the Python core and VQF's C++ batch")
-        results["native"] = native_section(rec, config.repeats)
+        results["native"] = native_section(rec, config.repeats, config.native_samples,
+                                           config.python_samples)
         results["native"].update(native_fmus)
         host, twin = native_fmus.get("c_host_step_us", {}), results["native"].get(
             "run_us_per_sample", {})
@@ -165,7 +166,7 @@ def run_benchmarks(config: BenchConfig, log: Any = print) -> dict[str, Any]:
             key: host["fmi2"][key] / twin[key] for key in twin if key in host.get("fmi2", {})}
     if "campaign" in config.sections:
         log("campaign throughput on a local Dask cluster (2 workers, then 1)")
-        results["campaign"] = campaign_section(config.campaign_seeds)
+        results["campaign"] = campaign_section(config.campaign_seeds, config.campaign_passes)
     if "scaling" in config.sections:
         log(f"scaling of run(): N = {', '.join(f'{s:g}' for s in config.scaling_sizes)}")
         results["scaling"] = scaling(estimator_keys(config.scaling_estimators),

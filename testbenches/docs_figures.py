@@ -845,16 +845,9 @@ def scale_parts_table(ctx: dict[str, Path]) -> str:
 def embedded_table(ctx: dict[str, Path]) -> str:
     """`make embedded`'s table: each twin on the Cortex-M7 (double) and the Cortex-M4F (float)
     under QEMU, on moderate_dynamics through the realistic sensor (BROAD_DIR unset)."""
-    import json
-    from unittest import mock
+    from .embedded.cli import report_without_broad
 
-    from .embedded.cli import main as embedded_main
-
-    with tempfile.TemporaryDirectory() as tmp, mock.patch.dict(os.environ, clear=False) as env:
-        env.pop("BROAD_DIR", None)
-        with contextlib.redirect_stdout(io.StringIO()):
-            embedded_main(out=Path(tmp))
-        report = json.loads(Path(tmp, "report.json").read_text())
+    report, _ = report_without_broad()
     double = report["cortex-m7-double"]["estimators"]
     single = report["cortex-m4f-float"]["estimators"]
     rows = ["| | Cortex-M7, double: largest difference from the desktop | instructions per "

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes.util
+import functools
 import time
 from collections.abc import Mapping
 from pathlib import Path
@@ -285,6 +286,27 @@ def velocity_error(r: TestbenchResult, at_s: float = 10.0) -> float:
                                  for a in "xyz"]))
 
 
+@functools.cache
+def engine_runs(fmu_dir: Path, scenario: str, seed: int, key: str
+                ) -> tuple[tuple[str, int, TestbenchResult, float], ...]:
+    """The estimator's chain under the project's own Jacobi master (on the native FMI 2.0 FMUs)
+    and in every engine and FMI version that can run here: (engine, FMI version, result, CPU
+    seconds), the own master first. Made once per process: the engines table and the checks of
+    the same runs take them instead of simulating again."""
+    from .master import run_testbench
+
+    t0 = time.process_time()
+    own = run_testbench(key, scenario, seed, master="jacobi", fmu_dir=fmu_dir / "native" / "fmi2")
+    runs = [("own Jacobi master", 2, own, time.process_time() - t0)]
+    for engine, versions in ENGINES.items():
+        if engine_reason(engine):
+            continue
+        for fmi in versions:
+            r = run_engine(engine, key, scenario, seed, fmi=fmi, fmu_dir=fmu_dir)
+            runs.append((engine, fmi, r, r.cpu_s))
+    return tuple(runs)
+
+
 def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TABLE_SCENARIO,
                 seed: int = 0, estimators: list[str] | None = None
                 ) -> list[dict[str, Any]]:
@@ -293,21 +315,10 @@ def engine_rows(fmu_dir: Path | str = DEFAULT_FMU_DIR, scenario: str = ENGINE_TA
     difference from the project's Jacobi master, the position filter's velocity error at 10 s
     and the speed in simulated seconds per CPU second. Engines that cannot run here are left
     out (engine_reason says why)."""
-    from .master import run_testbench
-
-    folder = Path(fmu_dir) / "native" / "fmi2"
     rows = []
     for key in estimators or list(ESTIMATOR_FMUS):
-        t0 = time.process_time()
-        own = run_testbench(key, scenario, seed, master="jacobi", fmu_dir=folder)
-        own_cpu = time.process_time() - t0
-        runs = [("own Jacobi master", 2, own, own_cpu)]
-        for engine, versions in ENGINES.items():
-            if engine_reason(engine):
-                continue
-            for fmi in versions:
-                r = run_engine(engine, key, scenario, seed, fmi=fmi, fmu_dir=fmu_dir)
-                runs.append((engine, fmi, r, r.cpu_s))
+        runs = engine_runs(Path(fmu_dir), scenario, seed, key)
+        own = runs[0][2]
         for name, fmi, r, cpu in runs:
             rows.append({
                 "engine": name, "fmi": fmi, "estimator": key,

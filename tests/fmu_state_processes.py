@@ -30,12 +30,15 @@ def _value(fmu: NativeFmu, name: str, value: Any) -> Any:
 
 
 def _outputs(fmu: NativeFmu) -> list[float]:
-    return [float(fmu.get(n)) for n, v in fmu.vars.items() if v.causality == "output"]
+    """Every output: the Real ones in one call, then the others."""
+    outputs = [n for n, v in fmu.vars.items() if v.causality == "output"]
+    real = [n for n in outputs if fmu.vars[n].type in ("Real", "Float64")]
+    return fmu.get_reals(real) + [float(fmu.get(n)) for n in outputs if n not in real]
 
 
 def _step(fmu: NativeFmu, job: dict[str, Any], k: int) -> None:
-    inputs = {name: values[k] for name, values in job["inputs"].items()}
-    fmu.step(0.01 * k, 0.01, **inputs)
+    fmu.set_reals({name: values[k] for name, values in job["inputs"].items()})
+    fmu.fmu.doStep(currentCommunicationPoint=0.01 * k, communicationStepSize=0.01)
 
 
 def save(job: dict[str, Any], folder: Path) -> None:

@@ -111,6 +111,17 @@ class NativeFmu:
             return self.fmu.getInt32([v.valueReference])[0]
         return self.fmu.getInteger([v.valueReference])[0]
 
+    def get_reals(self, names: list[str]) -> list[float]:
+        """The Real (Float64) variables names, in one call."""
+        vrs = [self.vars[n].valueReference for n in names]
+        return list((self.fmu.getFloat64 if self.version == "fmi3" else self.fmu.getReal)(vrs))
+
+    def set_reals(self, values: dict[str, float]) -> None:
+        """The Real (Float64) variables of values, in one call."""
+        vrs = [self.vars[n].valueReference for n in values]
+        (self.fmu.setFloat64 if self.version == "fmi3" else self.fmu.setReal)(
+            vrs, [float(v) for v in values.values()])
+
     def step(self, t: float, h: float, **inputs: float) -> None:
         for name, value in inputs.items():
             self.set(name, value)

@@ -29,6 +29,9 @@ TINY = dict(
     scaling_sizes=(300, 600),
     scaling_estimators=("cf",),
     campaign_seeds=4,  # 40 runs a campaign: the section's fields, not its figures
+    campaign_passes=1,
+    native_samples=2000,
+    python_samples=200,
     long_rows=3000,
 )
 

@@ -53,10 +53,17 @@ battery's campaign (13 motion classes x 3 sensor classes x 20 parts) or the batt
 minutes (`make test-slow`)."""
 
 
-SHARED_RUNS = {"battery": ("readme-battery", *(f.name for f in figs.FIGURES
-                                               if f.name.startswith("battery-")))}
-"""Figures made from one run their process keeps (docs_figures' cached battery), each set on
-one worker (`--dist loadgroup`) so that the run is made once."""
+SHARED_RUNS = {
+    "battery": ("readme-battery", *(f.name for f in figs.FIGURES
+                                    if f.name.startswith("battery-"))),
+    "contract-parts": ("readme-contract", "contract-parts", "campaigns-scenarios"),
+    "embedded": ("embedded-table",),
+    "engines": ("engines-table",),
+}
+"""Figures made from runs their process keeps (docs_figures' cached battery, the parts' runs
+of testbenches.parts, the embedded report of testbenches.embedded.cli, the engines' runs of
+testbenches.engines), each set on one worker
+(`--dist loadgroup`, with the tests of the same group) so that the runs are made once."""
 
 
 def _marks(name: str) -> list[pytest.MarkDecorator]:

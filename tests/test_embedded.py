@@ -3,7 +3,6 @@ stays close to them (float), and the command says what to install where the tool
 
 from __future__ import annotations
 
-import json
 import shutil
 
 import numpy as np
@@ -25,11 +24,11 @@ def test_missing_tools_are_named_with_their_packages(monkeypatch, capsys, tmp_pa
 
 
 @pytest.mark.heavy
+@pytest.mark.xdist_group("embedded")  # the docs' embedded table takes the same run
 @pytest.mark.skipif(bool(TOOLS), reason=f"not installed: {', '.join(TOOLS)} "
                     f"(apt-get install {build.PACKAGES})")
-def test_the_twins_on_a_microcontroller(tmp_path, capsys) -> None:
-    assert cli.main(out=tmp_path) == 0
-    report = json.loads((tmp_path / "report.json").read_text())
+def test_the_twins_on_a_microcontroller() -> None:
+    report, said = cli.report_without_broad()
     double, single = report["cortex-m7-double"], report["cortex-m4f-float"]
     for key in build.ESTIMATORS:
         # newlib's libm against glibc's is the only difference a double build may have
@@ -44,7 +43,7 @@ def test_the_twins_on_a_microcontroller(tmp_path, capsys) -> None:
         assert double["libm"][name]["differing"] == 0, name
     long_run = report["float_accuracy"]["long_run"]
     assert all(v["finite"] and v["last_tenth_max_diff_deg"] < 0.05 for v in long_run.values())
-    assert "largest roll error after 5 s" in capsys.readouterr().out
+    assert "largest roll error after 5 s" in said
 
 
 @pytest.mark.heavy  # every contract scenario through the float twins

@@ -36,25 +36,19 @@ def _skip_without(engine: str) -> None:
         pytest.skip(why)
 
 
-@pytest.fixture(scope="module")
-def jacobi_runs(built_fmus) -> dict[str, object]:
-    """The project's Jacobi master on the native FMI 2.0 FMUs, per estimator."""
-    folder = built_fmus.native("fmi2", "ImuPlant").parent
-    return {key: run_testbench(key, "moderate_dynamics", 0, master="jacobi", fmu_dir=folder)
-            for key in KEYS}
-
-
 @pytest.mark.heavy
+@pytest.mark.xdist_group("engines")  # the docs' engines table takes the same runs
 @pytest.mark.parametrize(("engine", "fmi"), RUNS, ids=[f"{e}-fmi{v}" for e, v in RUNS])
 @pytest.mark.parametrize("key", KEYS)
 def test_the_chain_in_the_engine_holds_the_contract_and_equals_the_jacobi_master(
-        built_fmus, jacobi_runs, engine, fmi, key):
+        built_fmus, engine, fmi, key):
     _skip_without(engine)
-    fmu_dir = built_fmus.directory
-    r = engines.run_engine(engine, key, "moderate_dynamics", 0, fmi=fmi, fmu_dir=fmu_dir)
+    built_fmus.native("fmi3", "ImuPlant")  # both standards' native FMUs built
+    runs = engines.engine_runs(built_fmus.directory, "moderate_dynamics", 0, key)
+    own = runs[0][2]  # the project's Jacobi master on the native FMI 2.0 FMUs
+    r = next(run for name, version, run, _ in runs if (name, version) == (engine, fmi))
     failed = [c.line() for c in r.checks if not c.passed]
     assert not failed, failed
-    own = jacobi_runs[key]
     for name, trace in r.estimate.items():
         assert np.array_equal(trace, own.estimate[name]), name  # bit for bit
     assert r.invalid_samples == own.invalid_samples == 1  # the sensor's start: no sample

@@ -5,7 +5,12 @@ and written to build/embedded/report.json."""
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import io
 import json
+import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -52,3 +57,26 @@ def main(argv: list[str] | None = None, out: Path | None = None) -> int:
                                                    indent=1))
     print(f"wrote {folder / 'report.json'}")
     return 0
+
+
+@functools.lru_cache(maxsize=1)
+def report_without_broad() -> tuple[dict[str, Any], str]:
+    """main's report.json and what it printed, with BROAD_DIR unset (so the same on every
+    machine), made once per process: the docs' table and the checks of the same run take it
+    instead of building and running QEMU again. Raises where the tools are missing."""
+    missing = missing_tools()
+    if missing:
+        raise RuntimeError(f"make embedded: {', '.join(missing)} not found "
+                           f"(apt-get install {PACKAGES})")
+    saved = os.environ.pop("BROAD_DIR", None)
+    try:
+        with tempfile.TemporaryDirectory() as tmp, \
+                contextlib.redirect_stdout(io.StringIO()) as said:
+            status = main(out=Path(tmp))
+            report = json.loads(Path(tmp, "report.json").read_text())
+    finally:
+        if saved is not None:
+            os.environ["BROAD_DIR"] = saved
+    if status != 0:
+        raise RuntimeError(f"make embedded ended with {status}:\n{said.getvalue()}")
+    return report, said.getvalue()
