@@ -292,7 +292,7 @@ class Thinned:
                make: Callable[[np.ndarray], dict[str, np.ndarray]]) -> None:
         """A block of n rows from row row0 whose series `make` gives at the block's indices
         it is passed: only the rows kept are computed."""
-        at = np.flatnonzero(np.arange(row0, row0 + n) % self.k == 0)
+        at = np.arange(-row0 % self.k, n, self.k)  # the block's rows r with r % k == 0
         self.rows = np.concatenate([self.rows, row0 + at])
         for name, v in make(at).items():
             old = self.values.get(name)

@@ -53,18 +53,19 @@ def part_rmse(estimators: Sequence[str], scenarios: Sequence[str], preset: dict[
     out: dict[tuple[bool, str, str], np.ndarray] = {}
     for calibrated in calibrated_first:
         for scenario in scenarios:
-            for estimator in estimators:
-                if bounded_only and accuracy_limits(estimator, scenario) is None:
-                    continue
-                rows = []
-                for seed in range(parts):
+            keys = [e for e in estimators
+                    if not bounded_only or accuracy_limits(e, scenario) is not None]
+            rows: dict[str, list[tuple[float, float]]] = {e: [] for e in keys}
+            for seed in range(parts):  # a part's samples made once for every estimator
+                for estimator in keys:
                     run = Run("part", estimator, scenario, seed, None, sensor,
                               {**preset.get(estimator, {}), **(params or {})}, {},
                               calibrate_first=calibrated)
-                    rows.append(_part(run, simulate))
+                    rows[estimator].append(_part(run, simulate))
                     if progress:
                         progress()
-                out[(calibrated, estimator, scenario)] = np.array(rows)
+            for estimator in keys:
+                out[(calibrated, estimator, scenario)] = np.array(rows[estimator])
     return out
 
 

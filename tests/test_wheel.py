@@ -101,10 +101,11 @@ def test_installed_without_a_compiler_the_twin_runs_and_native_fmus_build(
         dists: Path, tmp_path: Path) -> None:
     (wheel,) = dists.glob("*.whl")
     env_dir = tmp_path / "venv"
-    venv.create(env_dir, with_pip=True)
+    venv.create(env_dir, with_pip=False)  # this environment's pip installs into it (--python)
     bin_dir = env_dir / "bin"
-    proc = subprocess.run([str(bin_dir / "python"), "-m", "pip", "install", "--quiet",
-                           str(wheel), "fmpy"], capture_output=True, text=True, check=False)
+    proc = subprocess.run([sys.executable, "-m", "pip", "--python", str(bin_dir / "python"),
+                           "install", "--quiet", str(wheel), "fmpy"],
+                          capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr[-3000:]
     env = _without_compiler(bin_dir) | {"HOME": str(tmp_path),
                                         "FUSION_CORE_NATIVE_CACHE": str(tmp_path / "cache")}

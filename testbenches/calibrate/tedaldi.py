@@ -98,6 +98,9 @@ def _standard_uncertainty(jac: np.ndarray, fun: np.ndarray, p: int) -> np.ndarra
     return np.sqrt(np.maximum(np.diag(cov), 0.0))
 
 
+_IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+
+
 def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     w1, x1, y1, z1 = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
     w2, x2, y2, z2 = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
@@ -151,10 +154,11 @@ class _Integrator:
     def predict(self, matrix: np.ndarray, bias: np.ndarray) -> np.ndarray:
         steps = ((self.mid - bias) @ matrix.T) * self.dt[..., None]
         dq = _rotvec_quat(steps)
-        q = np.tile([1.0, 0.0, 0.0, 0.0], (self.turns, 1))
-        for k in range(dq.shape[1]):
-            q = _quat_mul(q, dq[:, k])
-        return _rotate_back(q, self.up_from)
+        while dq.shape[1] > 1:  # the product dq_0 dq_1 ... in pairs, in order: log2(n) levels
+            if dq.shape[1] % 2:
+                dq = np.concatenate([dq, np.broadcast_to(_IDENTITY, (self.turns, 1, 4))], axis=1)
+            dq = _quat_mul(dq[:, 0::2], dq[:, 1::2])
+        return _rotate_back(dq[:, 0], self.up_from)
 
     def angles(self, matrix: np.ndarray, bias: np.ndarray) -> np.ndarray:
         pred = self.predict(matrix, bias)
