@@ -290,7 +290,7 @@ def calibrated_parts_table(ctx: dict[str, Path]) -> str:
     pair = lambda v: f"{v[0]:.3f} / {v[1]:.3f}"  # noqa: E731
     rows = ["| roll / pitch RMSE [deg] | half the row | calibrated first: mean | median | "
             "within | as delivered: mean | within |", "|---|---|---|---|---|---|---|"]
-    for key in ("ukf", "mgcf", "kf", "cf", "poskf", "vqf"):
+    for key in runs:  # the estimators with a paper row, then VQF
         half = _half_row("ukf" if key == "vqf" else key)
         cal, raw = runs[key][True], runs[key][False]
         name = "VQF, the same samples calibrated alike" if key == "vqf" else key
@@ -316,6 +316,14 @@ def readme_calibrated_part(ctx: dict[str, Path]) -> str:
             "--calibrate-first`; [docs/results/calibration.md](docs/results/calibration.md)).")
 
 
+def _attitude_filters() -> list[str]:
+    """The attitude filters with a measured vector of their own (the registry's
+    attitude_filter), in its order."""
+    from fusion_core.registry import REGISTRY
+
+    return [e.key for e in REGISTRY if e.attitude_filter]
+
+
 def _stats(v: np.ndarray) -> tuple[str, str, str]:
     mean, median, p95 = v.mean(axis=0), np.median(v, axis=0), np.percentile(v, 95, axis=0)
     return tuple(f"{a[0]:.2f} / {a[1]:.2f}" for a in (mean, median, p95))  # type: ignore[return-value]
@@ -332,7 +340,7 @@ def campaigns_parts_table(ctx: dict[str, Path]) -> str:
             "its row | within half the UKF's row |", "|---|---|---|---|---|---|"]
     share = DEFAULTS_MODERATE_SHARE  # the defaults' target (tests/test_paper_rows.py)
     half = (share * PAPER_MODERATE["ukf"][0], share * PAPER_MODERATE["ukf"][1])
-    for key in ("cf", "mgcf", "kf", "ukf", "vqf"):
+    for key in (*_attitude_filters(), "vqf"):
         v = runs[key][False]
         if key == "vqf":
             rows.append("| VQF (peer) | " + " | ".join(_stats(v)) + f" | - | "
@@ -480,7 +488,7 @@ def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
     from .parts import part_rmse, vqf_rmse
 
     sensor = {**sensor_preset("realistic"), "calibration": "none"}
-    keys = ["cf", "mgcf", "kf", "ukf"]
+    keys = _attitude_filters()
     preset = load_preset("recommended")
     pair = lambda v: f"{v[0]:.2g}/{v[1]:.2g}"  # noqa: E731
     vqf_rule = part_rmse(keys, ["static_tilted"], preset, sensor, UNCALIBRATED_PARTS,
