@@ -19,6 +19,7 @@ from .building_blocks import (
     BIAS_INNOVATION_PARAM,
     FACE_SWITCH_COS,
     FACES,
+    GROSS_INNOVATION_PARAM,
     MAX_CORRECTION_TIME_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
@@ -171,7 +172,10 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
       vector (its slow band: measured_vector.gate_norm2; without the vector the raw sample's) is
       within bias_gate of g (Duong Quoc et al.'s real-sensor cutoff), both innovations are within
       bias_innovation (a larger one is a gross attitude error, not a bias drift) and the
-      measured vector is settled; otherwise the biases are consider states (angle_only_gain).
+      measured vector is settled; otherwise the biases are consider states (angle_only_gain);
+    - a gross innovation (beyond gross_innovation, more than a held linear acceleration can
+      tilt the measured vector by): the attitude is off by at least that much, so the angle's
+      variance is raised to the innovation squared before the update (raised_angle_variance).
 
     Start: the first valid sample sets the angles from the accelerometer and the biases to 0,
     with P = diag(R_measure + ((|a| - g) / g)^2, init_bias_std^2); while the measured vector
@@ -210,6 +214,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         ),
         BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
+        GROSS_INNOVATION_PARAM,
         BAND_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
@@ -259,6 +264,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
         self._bias_innovation = float(p["bias_innovation"])
+        self._gross_innovation = float(p["gross_innovation"])
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -456,6 +462,11 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         gate = self._bias_innovation
         if not (-gate <= y_roll <= gate and -gate <= y_pitch <= gate):
             learn_bias = False  # grossly off: the angle only (bias_innovation)
+        gross = self._gross_innovation
+        if not -gross <= y_roll <= gross:  # off by more than y: its variance at least y^2
+            self.P_roll = raised_angle_variance(self.P_roll, y_roll * y_roll)
+        if not -gross <= y_pitch <= gross:
+            self.P_pitch = raised_angle_variance(self.P_pitch, y_pitch * y_pitch)
         self.correct_innovation(y_roll, y_pitch, learn_bias)
         return (moved_roll + self.gain_roll[0] * y_roll,
                 moved_pitch + self.gain_pitch[0] * y_pitch)
@@ -510,6 +521,13 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             roll, pitch = accel_roll_pitch(*up)
             return Estimate(roll, pitch, mat_t_vec(C, (self.bias_x, self.bias_y, self.bias_z)))
         return Estimate(self.roll, self.pitch, (self.bias_x, self.bias_y, self.bias_z))
+
+
+def raised_angle_variance(P: tuple[float, float, float, float], var: float
+                          ) -> tuple[float, float, float, float]:
+    """An axis's covariance [P00, P01, P10, P11] with its angle's variance at least var
+    (gross_innovation)."""
+    return (var, P[1], P[2], P[3]) if var > P[0] else P
 
 
 def turn_axis(C2: tuple[float, ...], C: tuple[float, ...], k: int, j: int) -> float:

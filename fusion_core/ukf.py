@@ -15,6 +15,7 @@ from .building_blocks import (
     ADAPTIVE_NOISE_PARAMS,
     BIAS_GATE_PARAM,
     BIAS_INNOVATION_PARAM,
+    GROSS_INNOVATION_PARAM,
     REAL_GYRO_DENSITY,
     REST_PARAMS,
     REST_START,
@@ -60,6 +61,16 @@ ACC_GATE: Final = 1.0
 """The update is skipped while the measured vector's norm is off g by a whole g or more
 (||f|/g - 1| >= 1): a vector of 2 g is no gravity direction, and one near 0 (free fall) none
 either."""
+
+
+def raised_direction_variance(P: tuple[float, ...], var: float) -> tuple[float, ...]:
+    """The packed lower triangle P of [X, b] with each of X's variances at least var
+    (gross_innovation; the kf's raised_angle_variance)."""
+    out = list(P)
+    for k in (0, 2, 5):  # packed_index(i, i), i = 0..2
+        if var > out[k]:
+            out[k] = var
+    return tuple(out)
 
 
 def measured_covariance(P: tuple[float, ...], X: tuple[float, float, float], var: float,
@@ -146,6 +157,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         zero_rate_psd_param("zaru_psd"),
         BIAS_GATE_PARAM,
         BIAS_INNOVATION_PARAM,
+        GROSS_INNOVATION_PARAM,
         BAND_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
@@ -187,6 +199,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         gate = float(p["bias_innovation"])
         # cos of the largest innovation angle the bias learns from (-2: every one)
         self._cos_innovation = math.cos(gate) if gate < math.pi else -2.0
+        gross = float(p["gross_innovation"])
+        self._cos_gross = math.cos(gross) if gross < math.pi else -2.0  # -2: never
 
     def _reset(self) -> None:
         self.x = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -332,8 +346,12 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
             X0, X1, X2, n = ax, ay, az, norm
             P = measured_covariance(P, (X0 / n, X1 / n, X2 / n), *fill)
         elif gate:
-            if ax * X0 + ay * X1 + az * X2 < self._cos_innovation * norm * n:
+            dot = ax * X0 + ay * X1 + az * X2
+            if dot < self._cos_innovation * norm * n:
                 learn_bias = False  # grossly off: X only (bias_innovation)
+            if dot < self._cos_gross * norm * n:  # off by more than gross_innovation: X's
+                # variance at least the squared distance of the two directions
+                P = raised_direction_variance(P, 2.0 - 2.0 * (dot / (norm * n)))
             if r is None:
                 r = self._r_acc
             else:  # the longest correction time: r at most q T^2 / dt (max_correction_time)

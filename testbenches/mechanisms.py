@@ -2,10 +2,10 @@
 worth on recordings it was not chosen on.
 
 A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the longer vector, the
-scale-error process noise, rest detection and its turn-on rule, the bias gates, the
-accelerometer gate) on by default is switched off by the parameter values that turn it off,
-everything else at the recommended values, and the filter is scored with and without it two
-ways:
+scale-error process noise, rest detection and its turn-on rule, the bias gates, the variance
+after a gross innovation, the accelerometer gate) on by default is switched off by the parameter
+values that turn it off, everything else at the recommended values, and the filter is scored
+with and without it two ways:
 
 - **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
   on three folds' trials, by the rule `broad --cv` chooses grid points with (the smallest regret
@@ -101,6 +101,8 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("bias_gates", "both gates on bias learning at once (bias_gate 0, bias_innovation "
               "pi): each covers much of what the other does", {"bias_gate": 0.0,
                                                                 "bias_innovation": math.pi}),
+    Mechanism("gross_innovation", "the angle's variance raised to a tilt innovation beyond 30 "
+              "deg, an attitude grossly off (gross_innovation pi)", {"gross_innovation": math.pi}),
     Mechanism("acc_gate", "no correction from a sample whose norm is outside gate_low-gate_high "
               "g (gate_low 0, gate_high 1000)", {"gate_low": 0.0, "gate_high": 1000.0}),
 )

@@ -6,7 +6,8 @@ below answers one of them the same way in every estimator:
 
 - sampling: the gyro sampling rule (GYRO_SAMPLING_PARAM): point samples or interval means;
 - gate: the accelerometer-magnitude gate (ACC_GATE_PARAMS), skipping the correction when |a| is
-  far from g, and the gates of the bias learning (BIAS_GATE_PARAM, BIAS_INNOVATION_PARAM);
+  far from g, the gates of the bias learning (BIAS_GATE_PARAM, BIAS_INNOVATION_PARAM) and the
+  angle's variance after a gross innovation (GROSS_INNOVATION_PARAM);
 - prefilter: the accelerometer pre-filter (ACC_LOWPASS_PARAM, lowpass_specific_force): the
   specific force low-passed in a frame that turns with the gyro, so linear acceleration averages
   out (Laidig & Seel 2023, VQF);
@@ -60,6 +61,8 @@ from .gate import (
     BIAS_GATE_PARAM,
     BIAS_INNOVATION,
     BIAS_INNOVATION_PARAM,
+    GROSS_INNOVATION,
+    GROSS_INNOVATION_PARAM,
     bias_band2,
     gate_bounds2,
 )
@@ -104,6 +107,8 @@ __all__ = [
     "CONSTANT_NOISE",
     "FACES",
     "FACE_SWITCH_COS",
+    "GROSS_INNOVATION",
+    "GROSS_INNOVATION_PARAM",
     "GYRO_SAMPLING_PARAM",
     "MAX_CORRECTION_TIME_PARAM",
     "PREFILTER_FULL",

@@ -76,6 +76,27 @@ BIAS_INNOVATION_PARAM = Param(
 )
 
 
+GROSS_INNOVATION: Final = 30.0 * DEG
+"""Recommended gross_innovation. A linear acceleration a held longer than the measured vector's
+averaging tilts it by atan(a / g) at most: 30 deg needs 0.58 g held for seconds, more than a
+hand or a vehicle holds (a car's hardest braking is about 1 g for a moment, its turns a few
+tenths of a g). An innovation beyond it says that the attitude itself is off (after a stretch of
+absurd samples, a knock, a restart in motion), not that the specific force carries an
+acceleration; the filter's angle variance, small after a long clean run, would then take the
+correction time of a filter that trusts its gyro (up to max_correction_time) to come back. The
+variance is raised to the innovation squared, the error it at least has, and the accelerometer
+takes the attitude back at the pace its measurement noise allows
+(`python -m testbenches.recovery`, the battery's glitching part)."""
+
+GROSS_INNOVATION_PARAM = Param(
+    "gross_innovation", GROSS_INNOVATION,
+    "Tilt innovation beyond which the attitude is taken as grossly off: the angle's variance is "
+    "raised to the innovation squared, so that the accelerometer corrects it at once; pi = never "
+    "(the papers)",
+    unit="rad", low=0.0, low_open=True, high=math.pi, display_unit="deg",
+)
+
+
 def bias_band2(gate: float) -> tuple[float, float]:
     """BIAS_GATE_PARAM as bounds on the raw sample's squared norm: the bias learns while
     lo < |a|^2 < hi (any sample when the gate is 0, off)."""

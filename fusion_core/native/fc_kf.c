@@ -140,6 +140,14 @@ static void correct_innovation(fc_kf *f, fc_real y_roll, fc_real y_pitch, int le
     }
 }
 
+/* raised_angle_variance: an axis's angle variance at least var (gross_innovation) */
+static void raised_angle_variance(fc_real P[4], fc_real var)
+{
+    if (var > P[0]) {
+        P[0] = var;
+    }
+}
+
 /* correct: the accelerometer's roll and pitch against up (propagate's); turn: what a zero-rate
  * update moved the angles by, in, and that plus the correction, out (q's turn) */
 static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias,
@@ -152,6 +160,13 @@ static void correct(fc_kf *f, fc_real ax, fc_real ay, fc_real az, int learn_bias
     fc_real gate = f->params.bias_innovation;
     if (!(-gate <= y_roll && y_roll <= gate && -gate <= y_pitch && y_pitch <= gate)) {
         learn_bias = 0;  /* grossly off: the angle only (bias_innovation) */
+    }
+    fc_real gross = f->params.gross_innovation;
+    if (!(-gross <= y_roll && y_roll <= gross)) {  /* off by more than y: variance >= y^2 */
+        raised_angle_variance(f->P_roll, y_roll * y_roll);
+    }
+    if (!(-gross <= y_pitch && y_pitch <= gross)) {
+        raised_angle_variance(f->P_pitch, y_pitch * y_pitch);
     }
     correct_innovation(f, y_roll, y_pitch, learn_bias);
     turn[0] = moved_roll + f->gain_roll[0] * y_roll;

@@ -234,6 +234,7 @@ typedef struct fc_kf_params {
     fc_real init_bias_std;        /* (0.0, 10000.0] [rad/s] */
     fc_real bias_gate;            /* [0.0, 1000.0] */
     fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
+    fc_real gross_innovation;     /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
@@ -260,6 +261,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->init_bias_std = 0.005235987755982988;
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;
+    p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
@@ -313,6 +315,7 @@ typedef struct fc_ukf_params {
     fc_real zaru_psd;             /* (0.0, 1.0] [rad2/s] */
     fc_real bias_gate;            /* [0.0, 1000.0] */
     fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
+    fc_real gross_innovation;     /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
@@ -340,6 +343,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->zaru_psd = 1.949551486634935e-08;
     p->bias_gate = 0.05;
     p->bias_innovation = 0.17453292519943295;
+    p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;

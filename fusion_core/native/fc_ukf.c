@@ -22,6 +22,7 @@ void fc_ukf_configure(fc_ukf *f)
     f->rail_var = fc_pow(p->input.gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
     f->cos_innovation = p->bias_innovation < FC_PI ? fc_cos(p->bias_innovation) : -2.0;
+    f->cos_gross = p->gross_innovation < FC_PI ? fc_cos(p->gross_innovation) : -2.0;
 }
 
 fc_estimate fc_ukf_estimate(const fc_ukf *f)
@@ -113,6 +114,17 @@ static void zero_rate_update(fc_ukf *f, const fc_real z[3], fc_real r)
     f->x[5] = x[5];
 }
 
+/* raised_direction_variance: each of X's variances at least var (gross_innovation) */
+static void raised_direction_variance(fc_real P[21], fc_real var)
+{
+    static const int diagonal[3] = {0, 2, 5};
+    for (int k = 0; k < 3; k++) {
+        if (var > P[diagonal[k]]) {
+            P[diagonal[k]] = var;
+        }
+    }
+}
+
 /* measured_covariance: P once X is taken from a measured vector of variance var per axis whose
  * samples the gyro turned over age [s] on average: P_XX = var I + age^2 [X]x P_bb [X]x^T,
  * P_Xb = -age [X]x P_bb, P_bb kept (packed lower triangle of [X, b]) */
@@ -177,8 +189,13 @@ static void filter_update(fc_ukf *f, fc_real ax, fc_real ay, fc_real az, const f
         const fc_real h_new[3] = {x[0] / n, x[1] / n, x[2] / n};
         measured_covariance(P, h_new, fill[0], fill[1]);
     } else if (gate) {
-        if (ax * X0 + ay * X1 + az * X2 < f->cos_innovation * norm * n) {
+        fc_real dot = ax * X0 + ay * X1 + az * X2;
+        if (dot < f->cos_innovation * norm * n) {
             learn_bias = 0;  /* grossly off: X only (bias_innovation) */
+        }
+        if (dot < f->cos_gross * norm * n) {  /* off by more than gross_innovation: X's
+                                               * variance at least the two directions' distance^2 */
+            raised_direction_variance(P, 2.0 - 2.0 * (dot / (norm * n)));
         }
         if (capped) {  /* the longest correction time: r at most q T^2 / dt */
             fc_real cap = q_gyro * f->longest2 / dt;

@@ -25,7 +25,7 @@ typedef struct fc_ukf {
     fc_real q_rotation, dist_tau;  /* UnscentedKalmanFilter._adaptive */
     fc_meas_constants measure;  /* UnscentedKalmanFilter._measure */
     fc_real longest2, rail_var;
-    fc_real bias_lo2, bias_hi2, cos_innovation;
+    fc_real bias_lo2, bias_hi2, cos_innovation, cos_gross;
 } fc_ukf;
 
 /* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
