@@ -295,9 +295,9 @@ def glitched(sample: dict[str, np.ndarray], sensor: SensorClass, start: float, s
 
 def filter_keys() -> list[str]:
     """The registry's attitude filters (the position filter's attitude is a kf's)."""
-    from fusion_core.registry import REGISTRY
+    from fusion_core import registry
 
-    return [e.key for e in REGISTRY if e.attitude_filter]
+    return list(registry.ATTITUDE_FILTERS)
 
 
 def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:

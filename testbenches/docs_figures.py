@@ -316,14 +316,6 @@ def readme_calibrated_part(ctx: dict[str, Path]) -> str:
             "--calibrate-first`; [docs/results/calibration.md](docs/results/calibration.md)).")
 
 
-def _attitude_filters() -> list[str]:
-    """The attitude filters with a measured vector of their own (the registry's
-    attitude_filter), in its order."""
-    from fusion_core.registry import REGISTRY
-
-    return [e.key for e in REGISTRY if e.attitude_filter]
-
-
 def _stats(v: np.ndarray) -> tuple[str, str, str]:
     mean, median, p95 = v.mean(axis=0), np.median(v, axis=0), np.percentile(v, 95, axis=0)
     return tuple(f"{a[0]:.2f} / {a[1]:.2f}" for a in (mean, median, p95))  # type: ignore[return-value]
@@ -333,6 +325,8 @@ def campaigns_parts_table(ctx: dict[str, Path]) -> str:
     """docs/guide/campaigns.md: moderate_dynamics over CALIBRATED_PARTS parts as delivered,
     each estimator beside VQF, and the share within its row and within the defaults' target
     (half the UKF's row)."""
+    from fusion_core import registry
+
     from .contract import DEFAULTS_MODERATE_SHARE, PAPER_MODERATE
 
     runs = _calibrated_parts()
@@ -340,7 +334,7 @@ def campaigns_parts_table(ctx: dict[str, Path]) -> str:
             "its row | within half the UKF's row |", "|---|---|---|---|---|---|"]
     share = DEFAULTS_MODERATE_SHARE  # the defaults' target (tests/test_paper_rows.py)
     half = (share * PAPER_MODERATE["ukf"][0], share * PAPER_MODERATE["ukf"][1])
-    for key in (*_attitude_filters(), "vqf"):
+    for key in (*registry.ATTITUDE_FILTERS, "vqf"):
         v = runs[key][False]
         if key == "vqf":
             rows.append("| VQF (peer) | " + " | ".join(_stats(v)) + f" | - | "
@@ -482,13 +476,14 @@ def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
     """docs/guide/own-sensor.md: static_tilted on UNCALIBRATED_PARTS parts whose gyro and
     accelerometer were not calibrated at start-up (the sensor's `calibration` none), each filter
     with VQF's rest rule (rest_bias_bound 0) and with the default; mean roll/pitch RMSE."""
+    from fusion_core import registry
     from fusion_core.presets import load_preset
     from fusion_core.sensor import sensor_preset
 
     from .parts import part_rmse, vqf_rmse
 
     sensor = {**sensor_preset("realistic"), "calibration": "none"}
-    keys = _attitude_filters()
+    keys = list(registry.ATTITUDE_FILTERS)
     preset = load_preset("recommended")
     pair = lambda v: f"{v[0]:.2g}/{v[1]:.2g}"  # noqa: E731
     vqf_rule = part_rmse(keys, ["static_tilted"], preset, sensor, UNCALIBRATED_PARTS,

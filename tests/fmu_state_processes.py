@@ -37,8 +37,7 @@ def _outputs(fmu: NativeFmu) -> list[float]:
 
 
 def _step(fmu: NativeFmu, job: dict[str, Any], k: int) -> None:
-    fmu.set_reals({name: values[k] for name, values in job["inputs"].items()})
-    fmu.fmu.doStep(currentCommunicationPoint=0.01 * k, communicationStepSize=0.01)
+    fmu.step(0.01 * k, 0.01, **{name: values[k] for name, values in job["inputs"].items()})
 
 
 def save(job: dict[str, Any], folder: Path) -> None:

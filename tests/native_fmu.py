@@ -123,8 +123,13 @@ class NativeFmu:
             vrs, [float(v) for v in values.values()])
 
     def step(self, t: float, h: float, **inputs: float) -> None:
+        """Set the inputs (the Real ones in one call) and step from t by h."""
+        real = {n: v for n, v in inputs.items() if self.vars[n].type in ("Real", "Float64")}
+        if real:
+            self.set_reals(real)
         for name, value in inputs.items():
-            self.set(name, value)
+            if name not in real:
+                self.set(name, value)
         self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
 
     def save(self) -> Any:
