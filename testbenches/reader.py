@@ -23,6 +23,7 @@ other formats count rows from 1.
 from __future__ import annotations
 
 import csv
+import itertools
 import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -92,10 +93,26 @@ class TableSource:
     _where: Callable[[int], str]
     attrs: dict[str, float] = field(default_factory=dict)
 
+    _kept: Any = field(default=None, repr=False, compare=False)
+    """(columns, rows, first block, the read after it) of first_block, for blocks to go on."""
+
     def blocks(self, columns: list[int], rows: int = BLOCK_ROWS) -> Iterator[np.ndarray]:
         """The chosen columns as float64 [n, len(columns)], `rows` rows at a time (the last
-        block shorter), from the first row; TableError where a row cannot be read."""
+        block shorter), from the first row; TableError where a row cannot be read. The first
+        call after first_block with its columns and rows goes on with that read."""
+        kept = self._kept
+        if kept is not None and kept[0] == list(columns) and kept[1] == rows:
+            self._kept = None
+            return itertools.chain([kept[2]], kept[3])
         return self._read(columns, rows)
+
+    def first_block(self, columns: list[int], rows: int = BLOCK_ROWS) -> np.ndarray | None:
+        """blocks(columns, rows)'s first block (None for an empty table), its read kept open so
+        that the recording's read that follows does not parse those rows again."""
+        read = self._read(columns, rows)
+        first = next(read, None)
+        self._kept = None if first is None else (list(columns), rows, first, read)
+        return first
 
     def read(self, columns: list[int]) -> np.ndarray:
         """Every row of the chosen columns [N, len(columns)]."""

@@ -17,6 +17,15 @@ FORMATS = {"csv": ".csv", "parquet": ".parquet", "hdf5": ".h5"}
 """Output format -> file suffix."""
 
 
+def _float64_array(values: np.ndarray) -> Any:
+    """A pyarrow float64 array over the values' memory (copied only where not contiguous):
+    pyarrow's own conversion imports pandas on its first call, half a second of a command."""
+    import pyarrow as pa
+
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    return pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)])
+
+
 class TableWriter:
     """Columns `names` (float64) appended a block at a time to `path` in `fmt`."""
 
@@ -28,6 +37,7 @@ class TableWriter:
         self.rows = 0
         self._sink: Any = None
         self._writer: Any = None
+        self._schema: Any = None
         if fmt == "csv":
             self._sink = self.partial.open("wb")
             self._sink.write((",".join(self.names) + "\n").encode())
@@ -37,16 +47,18 @@ class TableWriter:
             except ImportError:  # numpy writes the same digits, slower
                 self._writer = None
             else:
-                schema = pa.schema([(n, pa.float64()) for n in self.names])
+                self._schema = pa.schema([(n, pa.float64()) for n in self.names])
                 self._writer = pc.CSVWriter(
-                    self._sink, schema, write_options=pc.WriteOptions(include_header=False))
+                    self._sink, self._schema, write_options=pc.WriteOptions(include_header=False))
         elif fmt == "parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq
 
-            schema = pa.schema([(n, pa.float64()) for n in self.names])
+            # never null (a missing estimate is NaN), so no definition levels are written;
             # a dictionary of doubles that seldom repeat costs 5x the write and saves nothing
-            self._writer = pq.ParquetWriter(self.partial, schema, use_dictionary=False)
+            self._schema = pa.schema([pa.field(n, pa.float64(), nullable=False)
+                                      for n in self.names])
+            self._writer = pq.ParquetWriter(self.partial, self._schema, use_dictionary=False)
         else:
             import h5py
 
@@ -70,8 +82,8 @@ class TableWriter:
         else:
             import pyarrow as pa
 
-            batch = pa.record_batch([pa.array(np.asarray(c, dtype=float)) for c in columns],
-                                    names=self.names)
+            batch = pa.RecordBatch.from_arrays([_float64_array(c) for c in columns],
+                                               schema=self._schema)
             self._writer.write_batch(batch)
         self.rows += n
 

@@ -49,6 +49,47 @@ def test_blocks_of_any_size_give_what_the_whole_file_gives(tmp_path):
     assert t[12] < t_whole[13] < t_whole[14] < t[15]
 
 
+@pytest.mark.parametrize("kind", ["csv", "parquet"])
+def test_the_read_after_the_first_block_goes_on_from_it(tmp_path, kind):
+    """The units are decided on the first block; the recording's read then goes on from it
+    rather than parsing it again, and gives what a fresh read gives; a later read starts
+    from the first row again."""
+    from testbenches.reader import open_table
+
+    ex = _example()
+    data = np.column_stack([ex["time"], ex["acc"], ex["gyro"]])
+    path = tmp_path / f"rec.{kind}"
+    if kind == "csv":
+        np.savetxt(path, data, delimiter=",", header="time,ax,ay,az,gx,gy,gz", comments="")
+    else:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        pq.write_table(pa.table({n: data[:, i] for i, n in enumerate(
+            ["time", "ax", "ay", "az", "gx", "gy", "gz"])}), path)
+    table = open_table(path)
+    columns = [0, 2, 5]
+    fresh = table.read(columns)
+    parsed = []  # the rows each read of the file yields
+    read = table._read
+
+    def counted(cols, rows):
+        for block in read(cols, rows):
+            parsed.append(len(block))
+            yield block
+
+    table._read = counted
+    first = table.first_block(columns, 64)
+    assert first is not None and np.array_equal(first, fresh[:64])
+    other = list(table.blocks(columns, 32))  # other block rows: a read of its own
+    assert np.array_equal(np.concatenate(other), fresh) and sum(parsed) == 64 + len(fresh)
+    went_on = list(table.blocks(columns, 64))
+    assert np.array_equal(np.concatenate(went_on), fresh) and len(went_on[0]) == 64
+    assert sum(parsed) == 2 * len(fresh)  # the first block was not read again
+    assert np.array_equal(np.concatenate(list(table.blocks(columns, 64))), fresh)
+    assert sum(parsed) == 3 * len(fresh)
+
+
 def test_a_time_that_goes_back_in_a_later_block_names_its_line(tmp_path):
     ex = _example()
     t = ex["time"].copy()
@@ -205,3 +246,15 @@ def test_the_c_twin_loads_once_for_threads_that_ask_at_once():
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=300, cwd=REPO)
     assert proc.stdout.strip() == "8", proc.stdout + proc.stderr
+
+
+@pytest.mark.parametrize("fmt", ["csv", "parquet"])
+def test_estimate_reads_and_writes_without_importing_pandas(tmp_path, fmt):
+    """pyarrow's numpy conversions import pandas where it is installed, half a second of every
+    command: the reader and the writers go through buffers instead."""
+    code = ("import sys; from testbenches.cli import main; "
+            f"s = main(['estimate', {str(EXAMPLE)!r}, '--out', {str(tmp_path)!r}, '--format', "
+            f"{fmt!r}, '--no-plots']); print(s, 'pandas' in sys.modules)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=REPO, check=False)
+    assert proc.stdout.strip().splitlines()[-1] == "0 False", proc.stderr[-500:]

@@ -414,9 +414,11 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     names = list(found.index)
     wanted = [found.index[q] for q in names]
     try:
-        prefix_block = next(table.blocks(wanted, PREFIX_ROWS), np.empty((0, len(names))))
+        prefix_block = table.first_block(wanted, PREFIX_ROWS)
     except TableError as err:
         raise RecordingError(str(err)) from None
+    if prefix_block is None:
+        prefix_block = np.empty((0, len(names)))
     prefix = {q: prefix_block[:, k] for k, q in enumerate(names)}
     units = found.units
     n = len(prefix_block)
