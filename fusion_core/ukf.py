@@ -6,6 +6,7 @@ fusion_core.measured_vector around it (UnscentedKalmanFilter).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import ClassVar, Final
 
@@ -62,6 +63,13 @@ ACC_GATE: Final = 1.0
 (||f|/g - 1| >= 1): a vector of 2 g is no gravity direction, and one near 0 (free fall) none
 either."""
 
+UKF_BIAS_INNOVATION: Final = dataclasses.replace(BIAS_INNOVATION_PARAM, default=math.pi)
+"""The ukf's bias_innovation: pi, no limit (the papers). The kf's 10 deg gate keeps a gross
+attitude error from winding up the bias; in the ukf, with gross_innovation raising the
+direction's variance first, it lowers the error neither on BROAD's folds left out nor on the
+battery, so `imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays
+for a user's own value."""
+
 
 def raised_direction_variance(P: tuple[float, ...], var: float) -> tuple[float, ...]:
     """The packed lower triangle P of [X, b] with each of X's variances at least var
@@ -114,7 +122,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     it grows Q, no bias is learned), rest detection with a zero-rate update of the bias states
     (rest_time > 0), and the bias learned only while the slow band of the measured vector
     (measured_vector.gate_norm2; without the vector the raw sample) is within bias_gate of g,
-    the measured and the predicted gravity direction within bias_innovation and the measured
+    the measured and the predicted gravity direction within bias_innovation (no limit by
+    default: UKF_BIAS_INNOVATION) and the measured
     vector settled (else the biases are consider states). While the measured vector fills, X
     is its direction, with that vector's variance and the covariance with the bias of the turn
     a bias error gave its samples, and at the first rest the rest's mean direction with that
@@ -156,7 +165,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
         BIAS_GATE_PARAM,
-        BIAS_INNOVATION_PARAM,
+        UKF_BIAS_INNOVATION,
         GROSS_INNOVATION_PARAM,
         BAND_PARAM,
         STRETCH_PARAM,

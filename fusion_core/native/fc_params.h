@@ -342,7 +342,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->rest_bias_bound = 0.3490658503988659;
     p->zaru_psd = 1.949551486634935e-08;
     p->bias_gate = 0.05;
-    p->bias_innovation = 0.17453292519943295;
+    p->bias_innovation = 3.141592653589793;
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->acc_lowpass_stretch = 2.0;
