@@ -32,7 +32,9 @@ from .kinematics import (
     rotvec_terms,
 )
 from .measured_vector import (
+    BAND_PARAM,
     MEASURE_CHECK,
+    STRETCH_PARAM,
     measure_aligned,
     measure_clipped,
     measure_constants,
@@ -48,7 +50,8 @@ MGCF_ACC_LOWPASS = dataclasses.replace(ACC_LOWPASS_PARAM, default=1.0)
 """The mgcf's acc_lowpass: 1 s, not the 1.5 s of the others. Its integral term (Ki = w0^2)
 learns a bias from every error its correction passes, and a longer vector turned by a gyro with
 scale errors carries more of them: tests/test_paper_rows.py holds the defaults to half the
-paper's row on moderate_dynamics, which 1.5 s leaves in pitch, and the
+paper's row on moderate_dynamics, which 1.5 s leaves in pitch (the longer vector, which grows
+only where slow linear acceleration reaches it, leaves the row), and the
 cross-validation on BROAD chooses among the values that keep it (`python -m testbenches broad
 DIR --cv`; testbenches.broad.feasible)."""
 
@@ -76,6 +79,11 @@ class GainScheduledComplementaryFilter(Estimator):
       accelerometer low-passed in a frame that turns with the bias-corrected gyro (after Laidig
       & Seel 2023), so linear acceleration averages out instead of reading as tilt; over its
       first time constant it is the running mean of the turned samples, and q is its tilt;
+      it grows longer (up to acc_lowpass_stretch times) where the slow band (slow_band_time)
+      finds linear acceleration slower than it that the gyro's turn would not explain, once a
+      rest has measured the bias (measured_vector, item 4; a hand carrying the sensor back and
+      forth over seconds); the measurement noise stays the raw disturbance
+      (measured_vector.raw_noise), the slow band only decides the length;
     - rest detection (rest_time > 0; building_blocks.REST_PARAMS): at rest the gyro reads its
       own bias, and b follows the gyro with time constant rest_time (a zero-angular-rate update
       of the integral term; Mahony's integral alone needs minutes, and cannot see the bias about
@@ -101,6 +109,8 @@ class GainScheduledComplementaryFilter(Estimator):
         MGCF_ACC_LOWPASS,
         *REST_PARAMS,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
+        BAND_PARAM,
+        STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_mgcf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1, 2)
@@ -129,9 +139,12 @@ class GainScheduledComplementaryFilter(Estimator):
         # variance, the rotation term per (rad/s)^2, the disturbance's averaging time (0: off),
         # the white noise's share of the disturbance statistic, the longest correction time
         self._adaptive = complementary_adaptive(p, self._acc_tau)
-        # no slow band: the mgcf's noise is the raw disturbance (measured_vector.raw_noise)
-        self._measure = measure_constants(self._acc_tau, self._adaptive[2], 0.0,
-                                          self._adaptive[0], 0.0)
+        # the slow band only decides the longer vector (measured_vector item 4): the mgcf's
+        # noise is the raw disturbance (measured_vector.raw_noise)
+        self._measure = measure_constants(self._acc_tau, self._adaptive[2],
+                                          float(p["slow_band_time"]), self._adaptive[0],
+                                          float(p["gyro_scale_std"]),
+                                          float(p["acc_lowpass_stretch"]))
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)
@@ -167,7 +180,8 @@ class GainScheduledComplementaryFilter(Estimator):
             phi = body_rotation(self.gyro_prev, (gx, gy, gz), self.bias, dt, self._trapezoid)
             terms = rotvec_terms(*phi)
             m = measure_clipped(self.meas) if clipped else self.meas
-            self.meas, _, filling = measure_step(m, (ax, ay, az), phi, terms, dt, self._measure)
+            self.meas, _, filling = measure_step(m, (ax, ay, az), phi, terms, dt, self._measure,
+                                                 self.rest.measured > 0.0)
             f0, f1, f2 = self.meas.f
             r = raw_noise(self.meas, self._measure)
             return f0, f1, f2, r, filling

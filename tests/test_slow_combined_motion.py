@@ -6,8 +6,9 @@ A linear acceleration slower than acc_lowpass passes the measured vector whole, 
 band (a short low-pass against the full-length one) cannot see what both pass, so the filters
 trust a vector that is off. The vector grows longer where the slow band finds more linear
 acceleration than the gyro's turn explains, once a rest has measured the gyro bias
-(measured_vector, item 4): from a rest, as recordings usually start, every filter with a slow
-band is within VQF's RMSE plus 10 % (the rule of the shaking and gyro_clipping scenarios).
+(measured_vector, item 4): from a rest, as recordings usually start, cf, kf and ukf are within
+VQF's RMSE plus 10 % (the rule of the shaking and gyro_clipping scenarios); the mgcf, whose
+vector is shorter, is not yet.
 Started in motion the vector keeps its length, and the Kalman filters stay behind; that test
 fails the day they reach VQF + 10 % there.
 """
@@ -90,7 +91,13 @@ def test_the_kalman_filters_are_within_vqf_plus_ten_percent_on_slow_combined_mot
     assert mine <= 1.1 * vqf
 
 
-@pytest.mark.parametrize("key", ["cf", "kf", "ukf"])
+MGCF_NOT_MET = ("not met yet: the mgcf 2.25 deg (3.16 with the vector kept at acc_lowpass) "
+                "against VQF 1.69 (+10 %: 1.86); its vector is 1 s where the others' is 1.5 s, "
+                "so at twice its length it is still shorter than VQF's 3 s")
+
+
+@pytest.mark.parametrize("key", ["cf", pytest.param("mgcf", marks=pytest.mark.xfail(
+    strict=True, reason=MGCF_NOT_MET)), "kf", "ukf"])
 def test_from_a_rest_every_filter_with_a_slow_band_is_within_vqf_plus_ten_percent(key: str
                                                                                  ) -> None:
     """The same motion after 3 s at rest (VQF 1.69 deg): cf 1.77, kf and ukf 1.81 with the

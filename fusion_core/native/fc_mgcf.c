@@ -21,8 +21,10 @@ void fc_mgcf_configure(fc_mgcf *f)
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
-    /* no slow band: the mgcf's noise is the raw disturbance (fc_measure_raw_noise) */
-    fc_measure_constants(f->acc_tau, f->dist_tau, 0.0, f->r_ref, 0.0, 1.0, &f->measure);
+    /* the slow band only decides the longer vector: the mgcf's noise is the raw disturbance
+     * (fc_measure_raw_noise) */
+    fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
+                         p->acc_lowpass_stretch, &f->measure);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
@@ -76,7 +78,8 @@ static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_re
         if (clipped) {
             fc_measure_clipped(f->meas);
         }
-        fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, 0, &aligning);
+        fc_measure_step(f->meas, a_in, phi, terms, dt, &f->measure, f->rest[7] > 0.0,
+                        &aligning);
         ax = f->meas[FC_MEAS_F];
         ay = f->meas[FC_MEAS_F + 1];
         az = f->meas[FC_MEAS_F + 2];

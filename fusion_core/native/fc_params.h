@@ -169,6 +169,8 @@ typedef struct fc_mgcf_params {
     fc_real scale_time;           /* [0.0, 1000000.0] [s] */
     fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
+    fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_input_params input;        /* the input stage's */
 } fc_mgcf_params;
 
@@ -187,6 +189,8 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->scale_time = 0.5;
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
+    p->slow_band_time = 0.15;
+    p->acc_lowpass_stretch = 2.0;
     fc_input_params_default(&p->input);
 }
 
