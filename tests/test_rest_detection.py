@@ -53,7 +53,10 @@ def test_a_still_gyro_with_a_bias_beyond_rest_gyro_is_measured(key: str, backend
     measured = final_bias(key, backend, [bias], [20.0])
     assert measured == pytest.approx(bias, abs=0.01 * DEG)
     refused = final_bias(key, backend, [bias], [20.0], rest_bias_bound=0.0)
-    assert abs(refused[2]) < 0.5 * DEG  # about z the accelerometer sees nothing of it
+    # never measured: about z the accelerometer of a level sensor sees little of it (the ukf,
+    # whose direction the x and y biases tilt at first, learns a fifth of it; a rest would
+    # have measured it to 0.01 deg/s)
+    assert abs(refused[2] - bias[2]) > 0.5 * bias[2]
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
