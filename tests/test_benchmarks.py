@@ -68,6 +68,9 @@ def test_the_long_file_is_timed_beside_pyarrows_read_in_every_format(bench_json:
     names = {t["name"] for t in bench_json["targets"]}
     for fmt, run in long["runs"].items():
         assert run["seconds"] > 0 and run["peak_mb"] > 0
+        # each run beside a read timed just before it, on the machine as it then was
+        assert run["vs_pyarrow_read"] == pytest.approx(run["seconds"] / run["pyarrow_read_s"])
+        assert run["pyarrow_read_s"] >= long["pyarrow_read_s"]
         assert {f"estimate_2e6.{fmt}.vs_pyarrow_read", f"estimate_2e6.{fmt}.peak_mb"} <= names
 
 
