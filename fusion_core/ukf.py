@@ -75,7 +75,7 @@ def raised_direction_variance(P: tuple[float, ...], var: float) -> tuple[float, 
     """The packed lower triangle P of [X, b] with each of X's variances at least var
     (gross_innovation; the kf's raised_angle_variance)."""
     out = list(P)
-    for k in (0, 2, 5):  # packed_index(i, i), i = 0..2
+    for k in (packed_index(i, i) for i in range(3)):
         if var > out[k]:
             out[k] = var
     return tuple(out)

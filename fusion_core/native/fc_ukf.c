@@ -117,10 +117,10 @@ static void zero_rate_update(fc_ukf *f, const fc_real z[3], fc_real r)
 /* raised_direction_variance: each of X's variances at least var (gross_innovation) */
 static void raised_direction_variance(fc_real P[21], fc_real var)
 {
-    static const int diagonal[3] = {0, 2, 5};
-    for (int k = 0; k < 3; k++) {
-        if (var > P[diagonal[k]]) {
-            P[diagonal[k]] = var;
+    for (int i = 0; i < 3; i++) {
+        int k = fc_paper_ukf_packed(i, i);
+        if (var > P[k]) {
+            P[k] = var;
         }
     }
 }
