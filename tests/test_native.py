@@ -142,6 +142,33 @@ def test_available_and_reason_agree() -> None:
 
 
 @needs_twin
+def test_the_declarations_are_parsed_once_and_a_damaged_cache_is_made_again(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import cffi
+
+    from fusion_core.native.library import cdef, declarations
+
+    monkeypatch.setenv("FUSION_CORE_NATIVE_CACHE", str(tmp_path))
+    text = cdef()
+    first = declarations(text)
+    (kept,) = (tmp_path / "ffi").glob("_fc_ffi_*.py")
+    parsed = []
+    monkeypatch.setattr(cffi.FFI, "cdef", lambda self, t: parsed.append(t))
+    again = declarations(text)  # from the cache: nothing parsed
+    assert parsed == []
+    assert again.sizeof("fc_ukf") == first.sizeof("fc_ukf")
+    assert again.offsetof("fc_kf", "last") == first.offsetof("fc_kf", "last")
+    lib = again.dlopen(str(native.library_path()))
+    assert lib.FC_BAD_DT == native.lib_and_ffi()[0].FC_BAD_DT
+    kept.write_text("this is not python (")
+    monkeypatch.undo()
+    monkeypatch.setenv("FUSION_CORE_NATIVE_CACHE", str(tmp_path))
+    repaired = declarations(text)  # parsed again and written again
+    assert repaired.sizeof("fc_ukf") == first.sizeof("fc_ukf")
+    assert "this is not python" not in kept.read_text()
+
+
+@needs_twin
 @pytest.mark.parametrize("cls", [c for c in registry.CLASSES if c.TWIN is not None],
                          ids=lambda c: c.TWIN)
 def test_the_c_defaults_are_the_python_defaults(cls: type) -> None:

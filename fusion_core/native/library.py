@@ -233,6 +233,45 @@ def cdef(real: str = "double") -> str:
     return "\n".join(out)
 
 
+def declarations(text: str) -> Any:
+    """A cffi FFI declaring `text` (cdef()'s): parsed once per text and cffi version, then kept
+    in the cache as the Python module cffi's out-of-line ABI mode writes (the types as data),
+    which a process loads in milliseconds where pycparser takes a third of a second. Where the
+    cache cannot be written or read the text is parsed as before; cffi.CDefError and
+    cffi.FFIError say what in it is wrong."""
+    import importlib.util
+    import io
+
+    import cffi  # type: ignore[import-untyped]
+    from cffi.recompiler import make_py_source  # type: ignore[import-untyped]
+
+    key = hashlib.sha256(f"{cffi.__version__}\0{text}".encode()).hexdigest()[:16]
+    name = f"_fc_ffi_{key}"
+    path = cache_dir() / "ffi" / f"{name}.py"
+    if path.is_file():
+        try:
+            spec = importlib.util.spec_from_file_location(name, path)
+            assert spec is not None and spec.loader is not None
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            return module.ffi
+        except Exception:  # a damaged cache entry: parse, and write it again
+            pass
+    ffi = cffi.FFI()
+    ffi.cdef(text)
+    try:
+        source = io.StringIO()
+        make_py_source(ffi, name, source)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(suffix=".py", dir=path.parent)
+        with os.fdopen(fd, "w") as f:
+            f.write(source.getvalue())
+        os.replace(tmp, path)  # atomic: a process loading meanwhile sees the whole module
+    except OSError:
+        pass  # no cache: the next process parses too
+    return ffi
+
+
 def _load() -> None:
     global _lib, _ffi, _reason, _tried, _path
     try:
@@ -248,9 +287,8 @@ def _load_library() -> None:
     except ImportError as err:
         _reason = f"cffi is not installed ({err})"
         return
-    ffi = cffi.FFI()
     try:
-        ffi.cdef(cdef())
+        ffi = declarations(cdef())
     except (cffi.CDefError, cffi.FFIError) as err:
         _reason = str(err)
         return

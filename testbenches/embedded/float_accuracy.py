@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from fusion_core.native.library import CFLAGS, cdef, compiler
+from fusion_core.native.library import CFLAGS, cdef, compiler, declarations
 
 from .build import ESTIMATORS, OUT, desktop_table, realistic_samples, twin_sources
 
@@ -34,8 +34,6 @@ class FloatTwin:
     """The float build's estimators through cffi."""
 
     def __init__(self, folder: Path = OUT) -> None:
-        import cffi  # type: ignore[import-untyped]
-
         cc = compiler()
         if cc is None:
             raise RuntimeError("no C compiler found: the float build cannot be measured")
@@ -43,8 +41,7 @@ class FloatTwin:
         lib = folder / "libfusion_core_float.so"
         subprocess.run([cc, *CFLAGS, *REAL_FLAGS, "-o", str(lib), *map(str, twin_sources()),
                         "-lm"], check=True, capture_output=True, text=True)
-        self.ffi = cffi.FFI()
-        self.ffi.cdef(cdef("float"))
+        self.ffi = declarations(cdef("float"))
         self.lib = self.ffi.dlopen(str(lib))
 
     def run(self, key: str, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
