@@ -65,10 +65,19 @@ class UnitEvidence:
 def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
     if n <= 1:
         return x
-    c = np.cumsum(np.vstack([np.zeros((1, x.shape[1])), x]), axis=0)
-    out = (c[n:] - c[:-n]) / n
-    pad = np.repeat(out[:1], n - 1, axis=0)
-    return np.vstack([pad, out])
+    c = np.zeros((len(x) + 1, x.shape[1]))
+    np.cumsum(x, axis=0, out=c[1:])
+    out = np.empty_like(x)
+    np.divide(c[n:] - c[:-n], n, out=out[n - 1:])
+    out[:n - 1] = out[n - 1]
+    return out
+
+
+def median_period(dt: np.ndarray) -> float:
+    """The median of the periods that are numbers (np.nanmedian's, at a tenth of its time on a
+    long block); NaN where none is."""
+    numbers = dt[~np.isnan(dt)]
+    return float(np.median(numbers)) if len(numbers) else float("nan")
 
 
 def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str, np.ndarray]:
@@ -79,14 +88,15 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str
     acc, gyro, dt = (np.asarray(a, dtype=float) for a in (acc, gyro, dt))
     none = {unit: np.empty(0) for unit in UNITS}
     n = len(dt)
-    period = float(np.nanmedian(dt)) if n else 0.0
+    period = median_period(dt) if n else 0.0
     if not (n > 2 and period > 0.0):
         return none
     k = max(1, round(WINDOW_S / period))
     finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
-    acc = np.where(finite[:, None], acc, 0.0)
-    gyro = np.where(finite[:, None], gyro, 0.0)
-    dt = np.where(finite, dt, 0.0)
+    if not finite.all():
+        acc = np.where(finite[:, None], acc, 0.0)
+        gyro = np.where(finite[:, None], gyro, 0.0)
+        dt = np.where(finite, dt, 0.0)
     smooth = _moving_average(acc, max(1, round(LOWPASS_S / period)))
     norm = np.linalg.norm(smooth, axis=1)
     g = float(np.median(norm[finite])) if finite.any() else 0.0
@@ -95,23 +105,30 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str
     u = smooth / np.where(norm > 0.0, norm, 1.0)[:, None]
     quiet = finite & (np.abs(norm / g - 1.0) < QUIET_G)
     bad = np.concatenate([[0], np.cumsum(~finite)])
-    starts = np.arange(0, n - k)
+    m = n - k  # the windows start at samples 0 .. m-1 and end k samples later
+    usable = np.flatnonzero(quiet[:m] & quiet[k:n] & (bad[k + 1:n + 1] - bad[:m] == 0))
+    ux, uy, uz = (np.ascontiguousarray(u[:, i]) for i in range(3))
+    dot = (ux[usable] * ux[usable + k] + uy[usable] * uy[usable + k]
+           + uz[usable] * uz[usable + k])
+    seen = np.degrees(np.arccos(np.clip(dot, -1.0, 1.0)))
+    starts = usable[seen >= MIN_TURN_DEG]
+    if len(starts) > MAX_WINDOWS:  # evenly spread over the recording
+        starts = starts[np.linspace(0, len(starts) - 1, MAX_WINDOWS).astype(np.int64)]
     ends = starts + k
-    usable = quiet[starts] & quiet[ends] & (bad[ends + 1] - bad[starts] == 0)
-    starts, ends = starts[usable], ends[usable]
-    seen = np.degrees(np.arccos(np.clip(np.sum(u[starts] * u[ends], axis=1), -1.0, 1.0)))
-    counts = np.flatnonzero(seen >= MIN_TURN_DEG)
-    if len(counts) > MAX_WINDOWS:  # evenly spread over the recording
-        counts = counts[np.linspace(0, len(counts) - 1, MAX_WINDOWS).astype(np.int64)]
-    starts, ends = starts[counts], ends[counts]
+    # the readings within each window, component by component: [k, windows] each
+    steps = starts[None, :] + np.arange(1, k + 1)[:, None]
+    wx, wy, wz = (np.ascontiguousarray(gyro[:, i])[steps] for i in range(3))
+    h = dt[steps]
     misses: dict[str, np.ndarray] = {}
     for unit, scale in UNITS.items():
-        v = u[starts].copy()
-        for j in range(1, k + 1):  # du/dt = -omega x u, omega at the sample ending each step
-            w = gyro[starts + j] * scale
-            v = v - np.cross(w, v) * dt[starts + j][:, None]
-            v /= np.linalg.norm(v, axis=1, keepdims=True)
-        cos_miss = np.clip(np.sum(v * u[ends], axis=1), -1.0, 1.0)
+        vx, vy, vz = ux[starts], uy[starts], uz[starts]
+        for j in range(k):  # du/dt = -omega x u, omega at the sample ending each step
+            ax, ay, az = wx[j] * scale, wy[j] * scale, wz[j] * scale
+            vx, vy, vz = (vx - (ay * vz - az * vy) * h[j], vy - (az * vx - ax * vz) * h[j],
+                          vz - (ax * vy - ay * vx) * h[j])
+            length = np.sqrt(vx * vx + vy * vy + vz * vz)
+            vx, vy, vz = vx / length, vy / length, vz / length
+        cos_miss = np.clip(vx * ux[ends] + vy * uy[ends] + vz * uz[ends], -1.0, 1.0)
         misses[unit] = np.degrees(np.arccos(cos_miss))
     return misses
 

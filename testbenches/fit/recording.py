@@ -22,6 +22,7 @@ import numpy as np
 
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
+from ..gyro_unit import median_period
 from ..reader import TIME_SCALE
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
@@ -470,7 +471,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     gyro_scale, gyro_how, used = _gyro_scale(
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
         more if n == PREFIX_ROWS else None)
-    period = float(np.nanmedian(dt))
+    period = median_period(dt)
     if n == PREFIX_ROWS:  # the file may go on
         acc_how += f" over the first {n} samples"
         gyro_how += f" over the first {used} samples"
