@@ -514,14 +514,14 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     estimators = {key: create(key, estimator_params(args, preset[key])) for key in keys}
     names = {key: output_columns(args.outputs, est.HAS_POSITION)
              for key, est in estimators.items()}
+    if not args.no_plots:  # the plotting library loads while the recording opens, which
+        import threading  # leaves the second core idle (reading, units and rate are serial)
+
+        threading.Thread(target=_import_pyplot, daemon=True).start()
     source = source_from_args(args.recording, args)
     print(f"{args.recording}: {source.choices}")
     reference = Reference(args.reference) if args.reference is not None else None
     args.out.mkdir(parents=True, exist_ok=True)
-    if not args.no_plots:  # the plotting library loads while the estimators run
-        import threading
-
-        threading.Thread(target=_import_pyplot, daemon=True).start()
     runs: list[Any] = []
     try:
         for key, est in estimators.items():
