@@ -4,7 +4,8 @@ pyproject.toml holds the project's metadata; this file only adds a build step. A
 where a C compiler exists holds
 - fusion_core/native/libfusion_core.so (fusion_core.native.PREBUILT), loaded before any build,
   so that run(), stream() and the pythonfmu FMUs step through the twin on a machine without a
-  compiler;
+  compiler, and beside it its declarations as cffi's out-of-line module (_fc_ffi_<hash>.py,
+  fusion_core.native.library.write_declarations), loaded without parsing the headers;
 - fmu_src/native/prebuilt/<preset>/<fmi2|fmi3>/<Model>.fmu for the recommended and paper
   presets (fmu_src.native.prebuilt), which `imu-fusion build-fmus --kind native` copies where
   no compiler exists (a JSON preset's start values are compiled into the binary: it needs one).

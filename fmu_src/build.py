@@ -71,12 +71,15 @@ def _ship_native_library(core: Path) -> None:
     """Put the C twin's library, built for this platform, beside the FMU's fusion_core sources
     (fusion_core.native.PREBUILT), where it can be built: the FMU's estimators then step
     through it (fusion_core.native.Stepper); a host of another platform, or without cffi, runs
-    the Python core."""
+    the Python core. The declarations go beside it (write_declarations): an FMU's process then
+    loads them instead of parsing the headers, and writes nothing into the host's cache."""
     from fusion_core import native
+    from fusion_core.native.library import write_declarations
 
     if native.reason() is not None:
         return
     shutil.copy2(native.library_path(), core / "native" / native.PREBUILT.name)
+    write_declarations(core / "native")  # the headers' declarations, loaded without parsing
 
 
 def build(name: str, out_dir: Path, preset: Preset | None = None) -> Path:

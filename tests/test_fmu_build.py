@@ -18,6 +18,7 @@ import fusion_core
 from fmu_src.build import check
 from fmu_src.variables import items_in_description
 from fusion_core import native
+from fusion_core.native.library import cdef, declarations_name
 
 REPO = Path(__file__).resolve().parents[1]
 DEG = 180.0 / math.pi
@@ -88,6 +89,8 @@ def test_each_fmu_carries_the_c_twins_library_beside_the_sources(fmu_path):
         assert f"resources/fusion_core/{module}.py" in names
     assert "resources/fusion_core/native/fc_kf.c" in names
     assert f"resources/fusion_core/native/{native.PREBUILT.name}" in names
+    # and its declarations as cffi's module for these headers, loaded without parsing them
+    assert f"resources/fusion_core/native/{declarations_name(cdef())}.py" in names
     assert "cffi" in requirements
 
 

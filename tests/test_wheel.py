@@ -92,6 +92,8 @@ def test_the_wheel_carries_the_library_and_both_presets_native_fmus(dists: Path)
     assert "fusion_core/native/libfusion_core.so" in names
     assert "fusion_core/native/_fc_stream.abi3.so" in names  # stream()'s entry point
     assert "fusion_core/native/fc_kf.h" in names  # the binding's declarations
+    assert any(n.startswith("fusion_core/native/_fc_ffi_") and n.endswith(".py")
+               for n in names)  # ... as cffi's module, loaded without parsing them
     for preset in ("recommended", "paper"):
         for version in ("fmi2", "fmi3"):
             assert f"fmu_src/native/prebuilt/{preset}/{version}/UnscentedKalmanFilter.fmu" in names

@@ -56,6 +56,10 @@ def build_into(build_lib: Path) -> Iterator[str]:
     library.parent.mkdir(parents=True, exist_ok=True)
     shutil.copy2(native.build(), library)
     yield f"compiled {library.relative_to(build_lib)}"
+    from fusion_core.native.library import write_declarations
+
+    declared = write_declarations(library.parent)  # loaded without parsing the headers
+    yield f"declared {declared.relative_to(build_lib)}"
     from fusion_core.native.library import STREAM_PREBUILT, build_stream
 
     try:  # stream()'s compiled entry point needs the Python headers too

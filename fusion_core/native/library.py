@@ -3,6 +3,7 @@ and the cffi binding whose declarations are the headers' (fusion_core.native).""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import re
@@ -233,42 +234,77 @@ def cdef(real: str = "double") -> str:
     return "\n".join(out)
 
 
-def declarations(text: str) -> Any:
-    """A cffi FFI declaring `text` (cdef()'s): parsed once per text and cffi version, then kept
-    in the cache as the Python module cffi's out-of-line ABI mode writes (the types as data),
-    which a process loads in milliseconds where pycparser takes a third of a second. Where the
-    cache cannot be written or read the text is parsed as before; cffi.CDefError and
-    cffi.FFIError say what in it is wrong."""
-    import importlib.util
-    import io
-
+def declarations_name(text: str) -> str:
+    """The module name of cdef() text's declarations: its hash with cffi's version, so that a
+    module written for other headers or another cffi is never loaded."""
     import cffi  # type: ignore[import-untyped]
-    from cffi.recompiler import make_py_source  # type: ignore[import-untyped]
 
-    key = hashlib.sha256(f"{cffi.__version__}\0{text}".encode()).hexdigest()[:16]
-    name = f"_fc_ffi_{key}"
-    path = cache_dir() / "ffi" / f"{name}.py"
-    if path.is_file():
-        try:
-            spec = importlib.util.spec_from_file_location(name, path)
-            assert spec is not None and spec.loader is not None
-            module = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(module)
-            return module.ffi
-        except Exception:  # a damaged cache entry: parse, and write it again
-            pass
+    return "_fc_ffi_" + hashlib.sha256(f"{cffi.__version__}\0{text}".encode()).hexdigest()[:16]
+
+
+def _load_declarations(path: Path) -> Any:
+    """The FFI of a declarations module (write_declarations), or None where there is none or it
+    cannot be loaded (a damaged cache entry is parsed and written again)."""
+    import importlib.util
+
+    if not path.is_file():
+        return None
+    try:
+        spec = importlib.util.spec_from_file_location(path.stem, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module.ffi
+    except Exception:  # anything a damaged file raises
+        return None
+
+
+def write_declarations(folder: Path, text: str | None = None) -> Path:
+    """Write the declarations of cdef() text (default: the double build's) into folder as the
+    Python module cffi's out-of-line ABI mode makes of them (the types as data); its path. A
+    wheel and an FMU ship it beside the library, so that an installed package loads the
+    declarations without parsing them and writes nothing."""
+    import cffi
+
+    text = cdef() if text is None else text
     ffi = cffi.FFI()
     ffi.cdef(text)
-    try:
-        source = io.StringIO()
-        make_py_source(ffi, name, source)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=".py", dir=path.parent)
-        with os.fdopen(fd, "w") as f:
-            f.write(source.getvalue())
-        os.replace(tmp, path)  # atomic: a process loading meanwhile sees the whole module
-    except OSError:
-        pass  # no cache: the next process parses too
+    return _write_declarations(ffi, declarations_name(text), folder)
+
+
+def _write_declarations(ffi: Any, name: str, folder: Path) -> Path:
+    import io
+
+    from cffi.recompiler import make_py_source  # type: ignore[import-untyped]
+
+    source = io.StringIO()
+    make_py_source(ffi, name, source)
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".py", dir=folder)
+    with os.fdopen(fd, "w") as f:
+        f.write(source.getvalue())
+    path = folder / f"{name}.py"
+    os.replace(tmp, path)  # atomic: a process loading meanwhile sees the whole module
+    return path
+
+
+def declarations(text: str) -> Any:
+    """A cffi FFI declaring `text` (cdef()'s). Parsing them takes pycparser a third of a second,
+    so they are parsed once: loaded from the module shipped beside the sources (a wheel's, an
+    FMU's: write_declarations) or kept in the cache, else parsed and written to the cache (where
+    it cannot be written, parsed each time). cffi.CDefError and cffi.FFIError say what in the
+    text is wrong."""
+    import cffi
+
+    name = declarations_name(text)
+    for folder in (HERE, cache_dir() / "ffi"):
+        ffi = _load_declarations(folder / f"{name}.py")
+        if ffi is not None:
+            return ffi
+    ffi = cffi.FFI()
+    ffi.cdef(text)
+    with contextlib.suppress(OSError):  # no cache: the next process parses too
+        _write_declarations(ffi, name, cache_dir() / "ffi")
     return ffi
 
 
