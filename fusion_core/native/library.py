@@ -281,10 +281,14 @@ def _write_declarations(ffi: Any, name: str, folder: Path) -> Path:
     make_py_source(ffi, name, source)
     folder.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".py", dir=folder)
-    with os.fdopen(fd, "w") as f:
-        f.write(source.getvalue())
     path = folder / f"{name}.py"
-    os.replace(tmp, path)  # atomic: a process loading meanwhile sees the whole module
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(source.getvalue())
+        os.replace(tmp, path)  # atomic: a process loading meanwhile sees the whole module
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)  # no half-written file left behind
+        raise
     return path
 
 
