@@ -115,19 +115,20 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str
     if len(starts) > MAX_WINDOWS:  # evenly spread over the recording
         starts = starts[np.linspace(0, len(starts) - 1, MAX_WINDOWS).astype(np.int64)]
     ends = starts + k
-    # the readings within each window, component by component: [k, windows] each
-    steps = starts[None, :] + np.arange(1, k + 1)[:, None]
-    wx, wy, wz = (np.ascontiguousarray(gyro[:, i])[steps] for i in range(3))
-    h = dt[steps]
-    misses: dict[str, np.ndarray] = {}
-    for unit, scale in UNITS.items():
-        vx, vy, vz = ux[starts], uy[starts], uz[starts]
-        for j in range(k):  # du/dt = -omega x u, omega at the sample ending each step
-            ax, ay, az = wx[j] * scale, wy[j] * scale, wz[j] * scale
-            vx, vy, vz = (vx - (ay * vz - az * vy) * h[j], vy - (az * vx - ax * vz) * h[j],
-                          vz - (ax * vy - ay * vx) * h[j])
+    gx, gy, gz = (np.ascontiguousarray(gyro[:, i]) for i in range(3))
+    v = {unit: (ux[starts], uy[starts], uz[starts]) for unit in UNITS}
+    for j in range(1, k + 1):  # du/dt = -omega x u, omega at the sample ending each step
+        at = starts + j  # one step of every window at once: memory does not grow with k
+        wx, wy, wz, h = gx[at], gy[at], gz[at], dt[at]
+        for unit, scale in UNITS.items():
+            vx, vy, vz = v[unit]
+            ax, ay, az = wx * scale, wy * scale, wz * scale
+            vx, vy, vz = (vx - (ay * vz - az * vy) * h, vy - (az * vx - ax * vz) * h,
+                          vz - (ax * vy - ay * vx) * h)
             length = np.sqrt(vx * vx + vy * vy + vz * vz)
-            vx, vy, vz = vx / length, vy / length, vz / length
+            v[unit] = (vx / length, vy / length, vz / length)
+    misses: dict[str, np.ndarray] = {}
+    for unit, (vx, vy, vz) in v.items():
         cos_miss = np.clip(vx * ux[ends] + vy * uy[ends] + vz * uz[ends], -1.0, 1.0)
         misses[unit] = np.degrees(np.arccos(cos_miss))
     return misses
