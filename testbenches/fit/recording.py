@@ -437,7 +437,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         clock = _Clock("time", scale, first, path, table.where)
     elif "dt" in prefix:
         scale = TIME_SCALE.get(units.get("dt") or "s", 1.0)
-        clock = _Clock("dt", scale, float(np.nanmedian(prefix["dt"][1:])) * scale, path,
+        clock = _Clock("dt", scale, median_period(prefix["dt"][1:]) * scale, path,
                        table.where)
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
