@@ -39,6 +39,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     BAND_PARAM,
+    LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
     measure_aligned,
@@ -95,6 +96,7 @@ class ComplementaryFilter(Estimator):
         *REST_PARAMS,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
+        LEAK_PARAM,
         STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_cf"
@@ -127,7 +129,8 @@ class ComplementaryFilter(Estimator):
         self._measure = measure_constants(self._acc_tau, self._adaptive[2],
                                           float(p["slow_band_time"]), self._adaptive[0],
                                           float(p["gyro_scale_std"]),
-                                          float(p["acc_lowpass_stretch"]))
+                                          float(p["acc_lowpass_stretch"]),
+                                          float(p["slow_band_leak"]))
 
     def _reset(self) -> None:
         self.roll = 0.0

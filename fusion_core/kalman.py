@@ -57,6 +57,7 @@ from .kinematics import (
 from .linalg import mat_t_vec, mat_vec
 from .measured_vector import (
     BAND_PARAM,
+    LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
     fill_noise,
@@ -216,6 +217,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         BIAS_INNOVATION_PARAM,
         GROSS_INNOVATION_PARAM,
         BAND_PARAM,
+        LEAK_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
@@ -259,7 +261,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self._measure = measure_constants(self._acc_tau, self._adaptive[1],
                                           float(p["slow_band_time"]), self._r,
                                           float(p["gyro_scale_std"]),
-                                          float(p["acc_lowpass_stretch"]))
+                                          float(p["acc_lowpass_stretch"]),
+                                          float(p["slow_band_leak"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))

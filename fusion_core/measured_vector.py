@@ -5,7 +5,7 @@ An accelerometer sample is gravity plus the body's linear acceleration plus whit
 filters do not measure the raw sample; they measure a low-passed specific force that turns with
 the gyro (Laidig & Seel 2023, VQF: in an almost inertial frame gravity is constant and the linear
 acceleration of a body that ends where it started averages to its velocity change over time).
-Four things follow, and this module is each of them:
+Five things follow, and this module is each of them:
 
 1. The measured vector `f` is a second-order low-pass: two first-order stages of time constant
    acc_lowpass / 2 each, every stage turned by the gyro's rotation increment. A second-order
@@ -59,6 +59,21 @@ Four things follow, and this module is each of them:
    every BROAD trial. What each of these is worth out of sample: docs/results/mechanisms.md
    (`imu-fusion mechanisms`).
 
+5. The slow band's second-order low-pass still passes a fast disturbance at (w b)^-4 of its
+   power, b = slow_band_time: a running torso's 2.8 Hz bounce of 1.1 g reaches it at about 1.6 %
+   (0.9 m^2/s^4 of disturbance), while the vector (two stages of acc_lowpass / 2) passes 3e-5 of
+   it. Counted as disturbance, that leak makes a filter trust the accelerometer less in
+   exactly the motions whose fast content the vector removes. The band's two stages measure
+   the leak themselves: before the first stage the fast power is all there (`band_in`, the
+   mean square of a - s1), after it 1/(w b)^2 of it is left (`band_mid`, s1 - s), so after the
+   second it is band_mid^2 / band_in, at any frequency above the corner and without a value
+   to tune (LEAK_PARAM: the share taken off; 1, all of it). Near the corner the estimate falls
+   to a fraction of what passes, so the slow swing of a translation still counts (a 0.3 Hz sway
+   keeps more than 90 % of it, tests/test_adaptive_noise.py). The
+   leak's mean is taken off each sample before the statistic's peak follower, which still
+   catches its ripple (a tone along one axis swings between none and twice its mean): a bounce
+   then counts about half as much as before, not nothing.
+
 The statistic of the adaptive length (`dist`: the raw sample against the full-length reference)
 is the first-order pre-filter's, kept: it decides whether there is anything to average.
 """
@@ -97,6 +112,17 @@ BAND_PARAM: Final = Param(
 the swing of a translation or a combined motion. Chosen by cross-validation over BROAD's groups of
 trials (`python -m testbenches broad --cv`), with the synthetic shaking scenario as the check of
 the fast side."""
+LEAK_PARAM: Final = Param(
+    "slow_band_leak", 1.0,
+    "Share of the fast disturbance that leaks through the slow band (estimated from the power "
+    "before and between its two stages) taken off its statistic: shaking, running and waving "
+    "that the pre-filter removes then do not count as disturbance (0: the band's output as it "
+    "is)",
+    low=0.0, high=1.0,
+)
+"""Recommended 1: the estimate is the leak's mean (module docstring, item 5); nothing is fitted.
+`imu-fusion mechanisms` scores it against 0 (docs/results/mechanisms.md), and drops it from the
+mgcf (mgcf.MGCF_BAND_LEAK)."""
 STRETCH_PARAM: Final = Param(
     "acc_lowpass_stretch", 2.0,
     "The longest the measured vector may grow, as a multiple of acc_lowpass, once a rest has "
@@ -109,9 +135,9 @@ STRETCH_PARAM: Final = Param(
 combined motion from rest (tests/test_slow_combined_motion.py) comes within VQF + 10 %. The
 cross-validation over BROAD's motion folds (testbenches.broad.cv.CV_GRID holds 1, 1.5 and 2)
 chooses 1.5 or 2 without every fold, never 1. Module docstring, item 4."""
-MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 5)))
+MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 7)))
 """The state check of a Measure (fusion_core.state): six vectors, two mean squares, two
-times and a mean square rate."""
+times, a mean square rate and the slow band's two fast powers."""
 
 
 class Measure(NamedTuple):
@@ -139,6 +165,12 @@ class Measure(NamedTuple):
     rate2: float
     """Mean square rate [rad^2/s^2] over one stage (acc_lowpass / 2): what a longer vector would
     turn with (the stretch, module docstring item 4)."""
+    band_in: float
+    """Mean square of a - s1 [m^2/s^4] over disturbance_time: the fast power before the slow
+    band's first stage (module docstring, item 5)."""
+    band_mid: float
+    """Mean square of s1 - s [m^2/s^4] over disturbance_time: what of it the first stage lets
+    through."""
 
     def settled(self, c: MeasureConstants) -> bool:
         """Whether the vector holds no sample turned by a rotation the gyro did not measure (no
@@ -150,7 +182,7 @@ class Measure(NamedTuple):
 def measure_start(a: Vec3, c: MeasureConstants) -> Measure:
     """The state at a first sample a: every low-pass starts at it, no disturbance measured, and
     settled (no gyro sample at its rail yet: the vector holds no rotation the gyro missed)."""
-    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage, 0.0)
+    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage, 0.0, 0.0, 0.0)
 
 
 class MeasureConstants(NamedTuple):
@@ -173,15 +205,20 @@ class MeasureConstants(NamedTuple):
     explains (module docstring, item 2)."""
     stretch: float
     """acc_lowpass_stretch: the longest vector as a multiple of the full length (1: none)."""
+    leak: float
+    """slow_band_leak: the share of the slow band's estimated fast leak taken off its statistic
+    (0: none)."""
 
 
 def measure_constants(acc_lowpass: float, disturbance_time: float, band: float, r: float,
-                      gyro_scale_std: float, stretch: float = 1.0) -> MeasureConstants:
+                      gyro_scale_std: float, stretch: float = 1.0, leak: float = 0.0
+                      ) -> MeasureConstants:
     """The constants of measure_step from the parameters, one sample's tilt variance r, the
-    gyro's scale uncertainty (0: no turn discounted from the slow band) and the longest
-    vector's multiple of acc_lowpass (STRETCH_PARAM; 1: none)."""
+    gyro's scale uncertainty (0: no turn discounted from the slow band), the longest vector's
+    multiple of acc_lowpass (STRETCH_PARAM; 1: none) and the share of the slow band's fast leak
+    taken off its statistic (LEAK_PARAM; 0: none)."""
     return MeasureConstants(0.5 * acc_lowpass, disturbance_time, 3.0 * r * G * G, band, r,
-                            3.0 * gyro_scale_std * gyro_scale_std * G * G, stretch)
+                            3.0 * gyro_scale_std * gyro_scale_std * G * G, stretch, leak)
 
 
 def two_stage_noise(k: float) -> float:
@@ -208,7 +245,7 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     vector with its rotvec_terms; bias_measured: whether a rest has measured the gyro bias (the
     vector may then grow longer, item 4). Returns the new state (its f is the measured vector),
     the measurement noise r [rad^2] and whether the vector is still filling."""
-    f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2 = m
+    f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid = m
     stage = c.stage
     full = 2.0 * stage
     if settle < full:  # both times counted up to the full length (building_blocks.on_the_mark)
@@ -236,6 +273,14 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
             w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt)
             turn = c.turn * w2 * (lag * lag)
             inst = inst - turn if inst > turn else 0.0
+            if c.leak > 0.0:  # less the fast disturbance that leaks through the band (item 5)
+                k = dt / (c.dist_tau + dt)
+                h0, h1, h2 = a[0] - s1[0], a[1] - s1[1], a[2] - s1[2]
+                q0, q1, q2 = s1[0] - s[0], s1[1] - s[1], s1[2] - s[2]
+                band_in += k * (h0 * h0 + h1 * h1 + h2 * h2 - band_in)
+                band_mid += k * (q0 * q0 + q1 * q1 + q2 * q2 - band_mid)
+                leak = c.leak * band_mid * band_mid / band_in if band_in > 0.0 else 0.0
+                inst = inst - leak if inst > leak else 0.0
             rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
             slow += dt / (rise + dt) * (inst - slow)
             rate2 += dt / (stage + dt) * (w2 - rate2)
@@ -245,7 +290,8 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
                 if c.stretch > 1.0 and bias_measured and not filling:
                     tau = tau * stretched(c, excess, rate2, lag, full)
     f1, f = _lowpass2(f1, f, back, a, dt, tau)
-    return Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2), r, filling
+    return (Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid),
+            r, filling)
 
 
 def stretched(c: MeasureConstants, excess: float, rate2: float, lag: float, full: float
@@ -332,5 +378,5 @@ def measure_clipped(m: Measure) -> Measure:
 def measure_turned(m: Measure, turn) -> Measure:  # type: ignore[no-untyped-def]
     """The state with every vector turned by turn (a function of a vector: the kf's face
     switch)."""
-    return Measure(turn(m.f1), turn(m.f), turn(m.ref1), turn(m.ref), turn(m.s1), turn(m.s),
-                   m.dist, m.slow, m.fill, m.settle, m.rate2)
+    return m._replace(f1=turn(m.f1), f=turn(m.f), ref1=turn(m.ref1), ref=turn(m.ref),
+                      s1=turn(m.s1), s=turn(m.s))

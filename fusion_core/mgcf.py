@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import ClassVar
+from typing import ClassVar, Final
 
 from .base import Estimator, SensorNoise
 from .building_blocks import (
@@ -33,6 +33,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     BAND_PARAM,
+    LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
     measure_aligned,
@@ -55,6 +56,13 @@ only where slow linear acceleration reaches it, leaves the row), and the
 cross-validation on BROAD chooses among the values that keep it (`python -m testbenches broad
 DIR --cv`; testbenches.broad.feasible)."""
 
+
+MGCF_BAND_LEAK: Final = dataclasses.replace(LEAK_PARAM, default=0.0)
+"""The mgcf's slow_band_leak: 0, the slow band's output as it is. Its measurement noise is the
+raw disturbance, so the slow band only decides how long the vector grows; taking the fast leak
+off it lowers the error neither on BROAD's folds left out nor on the battery (0.998), and
+`imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays for a user's
+own value."""
 
 class GainScheduledComplementaryFilter(Estimator):
     """The recommended modified-gain complementary filter (Duong Quoc et al. eq. 7-13:
@@ -83,7 +91,8 @@ class GainScheduledComplementaryFilter(Estimator):
       finds linear acceleration slower than it that the gyro's turn would not explain, once a
       rest has measured the bias (measured_vector, item 4; a hand carrying the sensor back and
       forth over seconds); the measurement noise stays the raw disturbance
-      (measured_vector.raw_noise), the slow band only decides the length;
+      (measured_vector.raw_noise), the slow band only decides the length, without its fast
+      leak taken off (MGCF_BAND_LEAK);
     - rest detection (rest_time > 0; building_blocks.REST_PARAMS): at rest the gyro reads its
       own bias, and b follows the gyro with time constant rest_time (a zero-angular-rate update
       of the integral term; Mahony's integral alone needs minutes, and cannot see the bias about
@@ -110,6 +119,7 @@ class GainScheduledComplementaryFilter(Estimator):
         *REST_PARAMS,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
+        MGCF_BAND_LEAK,
         STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_mgcf"
@@ -144,7 +154,8 @@ class GainScheduledComplementaryFilter(Estimator):
         self._measure = measure_constants(self._acc_tau, self._adaptive[2],
                                           float(p["slow_band_time"]), self._adaptive[0],
                                           float(p["gyro_scale_std"]),
-                                          float(p["acc_lowpass_stretch"]))
+                                          float(p["acc_lowpass_stretch"]),
+                                          float(p["slow_band_leak"]))
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)

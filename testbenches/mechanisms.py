@@ -1,11 +1,11 @@
 """`imu-fusion mechanisms DIR`: what each mechanism of the recommended attitude filters is
 worth on recordings it was not chosen on.
 
-A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the longer vector, the
-scale-error process noise, rest detection and its turn-on rule, the bias gates, the variance
-after a gross innovation, the accelerometer gate) on by default is switched off by the parameter
-values that turn it off, everything else at the recommended values, and the filter is scored
-with and without it two ways:
+A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the fast leak taken
+off its slow band, the longer vector, the scale-error process noise, rest detection and its
+turn-on rule, the bias gates, the variance after a gross innovation, the accelerometer gate) on
+by default is switched off by the parameter values that turn it off, everything else at the
+recommended values, and the filter is scored with and without it two ways:
 
 - **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
   on three folds' trials, by the rule `broad --cv` chooses grid points with (the smallest regret
@@ -87,6 +87,8 @@ MECHANISMS: tuple[Mechanism, ...] = (
               {"acc_lowpass": 0.0, "disturbance_time": 0.0}),
     Mechanism("adaptive_noise", "measurement noise and pre-filter length that follow the "
               "measured linear acceleration (disturbance_time 0)", {"disturbance_time": 0.0}),
+    Mechanism("band_leak", "the fast disturbance that leaks through the slow band taken off "
+              "its statistic (slow_band_leak 0)", {"slow_band_leak": 0.0}),
     Mechanism("longer_vector", "the vector grows where slow linear acceleration reaches it "
               "(acc_lowpass_stretch 1)", {"acc_lowpass_stretch": 1.0}),
     Mechanism("scale_noise", "process noise for the gyro's scale error while it turns "

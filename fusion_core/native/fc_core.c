@@ -397,7 +397,8 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise)
 #define DISTURBANCE_ATTACK 0.05 /* measured_vector.DISTURBANCE_ATTACK [s] */
 
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_real gyro_scale_std, fc_real stretch, fc_meas_constants *c)
+                          fc_real gyro_scale_std, fc_real stretch, fc_real leak,
+                          fc_meas_constants *c)
 {
     c->stage = 0.5 * acc_lowpass;
     c->dist_tau = disturbance_time;
@@ -406,6 +407,7 @@ void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real
     c->r = r;
     c->turn = 3.0 * gyro_scale_std * gyro_scale_std * FC_G * FC_G;
     c->stretch = stretch;
+    c->leak = leak;
 }
 
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c)
@@ -413,7 +415,7 @@ void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas
     fc_measure_align(m, a);
     m[FC_MEAS_DIST] = m[FC_MEAS_SLOW] = m[FC_MEAS_FILL] = 0.0;
     m[FC_MEAS_SETTLE] = 2.0 * c->stage;
-    m[FC_MEAS_RATE2] = 0.0;
+    m[FC_MEAS_RATE2] = m[FC_MEAS_BAND_IN] = m[FC_MEAS_BAND_MID] = 0.0;
 }
 
 void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
@@ -491,6 +493,18 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             fc_real w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt);
             fc_real turn = c->turn * w2 * (lag * lag);
             inst = inst > turn ? inst - turn : 0.0;
+            if (c->leak > 0.0) {  /* less the fast disturbance that leaks through the band */
+                const fc_real *s1 = m + FC_MEAS_S1;
+                fc_real k = dt / (c->dist_tau + dt);
+                fc_real h0 = a[0] - s1[0], h1 = a[1] - s1[1], h2 = a[2] - s1[2];
+                fc_real q0 = s1[0] - s[0], q1 = s1[1] - s[1], q2 = s1[2] - s[2];
+                m[FC_MEAS_BAND_IN] += k * (h0 * h0 + h1 * h1 + h2 * h2 - m[FC_MEAS_BAND_IN]);
+                m[FC_MEAS_BAND_MID] += k * (q0 * q0 + q1 * q1 + q2 * q2 - m[FC_MEAS_BAND_MID]);
+                fc_real leak = m[FC_MEAS_BAND_IN] > 0.0
+                    ? c->leak * m[FC_MEAS_BAND_MID] * m[FC_MEAS_BAND_MID] / m[FC_MEAS_BAND_IN]
+                    : 0.0;
+                inst = inst > leak ? inst - leak : 0.0;
+            }
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
             m[FC_MEAS_RATE2] += dt / (stage + dt) * (w2 - m[FC_MEAS_RATE2]);

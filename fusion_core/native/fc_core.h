@@ -149,14 +149,16 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise);
 enum {
     FC_MEAS_F1 = 0, FC_MEAS_F = 3, FC_MEAS_REF1 = 6, FC_MEAS_REF = 9, FC_MEAS_S1 = 12,
     FC_MEAS_S = 15, FC_MEAS_DIST = 18, FC_MEAS_SLOW = 19, FC_MEAS_FILL = 20, FC_MEAS_SETTLE = 21,
-    FC_MEAS_RATE2 = 22, FC_MEAS_SIZE = 23
+    FC_MEAS_RATE2 = 22, FC_MEAS_BAND_IN = 23, FC_MEAS_BAND_MID = 24,
+    FC_MEAS_SIZE = 25
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {
-    fc_real stage, dist_tau, noise, band, r, turn, stretch;
+    fc_real stage, dist_tau, noise, band, r, turn, stretch, leak;
 } fc_meas_constants;
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_real gyro_scale_std, fc_real stretch, fc_meas_constants *c);
+                          fc_real gyro_scale_std, fc_real stretch, fc_real leak,
+                          fc_meas_constants *c);
 /* measure_start: every low-pass at a, no disturbance measured, settled */
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
 /* measure_step: one sample a (bias_measured: a rest has measured the gyro bias, the vector may

@@ -109,6 +109,7 @@ typedef struct fc_cf_params {
     fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_input_params input;        /* the input stage's */
 } fc_cf_params;
@@ -130,6 +131,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
+    p->slow_band_leak = 1.0;
     p->acc_lowpass_stretch = 2.0;
     fc_input_params_default(&p->input);
 }
@@ -170,6 +172,7 @@ typedef struct fc_mgcf_params {
     fc_real disturbance_time;     /* [0.0, 1000000.0] [s] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_input_params input;        /* the input stage's */
 } fc_mgcf_params;
@@ -190,6 +193,7 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
+    p->slow_band_leak = 0.0;
     p->acc_lowpass_stretch = 2.0;
     fc_input_params_default(&p->input);
 }
@@ -240,6 +244,7 @@ typedef struct fc_kf_params {
     fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
     fc_real gross_innovation;     /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_input_params input;        /* the input stage's */
@@ -267,6 +272,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->bias_innovation = 0.17453292519943295;
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
+    p->slow_band_leak = 1.0;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     fc_input_params_default(&p->input);
@@ -321,6 +327,7 @@ typedef struct fc_ukf_params {
     fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
     fc_real gross_innovation;     /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
+    fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_input_params input;        /* the input stage's */
@@ -349,6 +356,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->bias_innovation = 3.141592653589793;
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
+    p->slow_band_leak = 1.0;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     fc_input_params_default(&p->input);
