@@ -64,6 +64,7 @@ off it lowers the error neither on BROAD's folds left out nor on the battery (0.
 `imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays for a user's
 own value."""
 
+
 class GainScheduledComplementaryFilter(Estimator):
     """The recommended modified-gain complementary filter (Duong Quoc et al. eq. 7-13:
     quaternion PI after Mahony et al. 2008).
