@@ -191,7 +191,7 @@ def test_the_vector_keeps_its_length_until_a_rest_has_measured_the_bias() -> Non
     assert runs[0] == runs[1] != runs[2]
 
 
-def test_fast_disturbance_leaking_through_the_slow_band_counts_less_a_slow_sway_in_full() -> None:
+def test_a_fast_leak_through_the_slow_band_counts_less_a_slow_sway_still_counts() -> None:
     """measured_vector item 5: a running torso's bounce (1.1 g at 2.8 Hz along gravity), which
     the vector removes, leaks through the slow band; with the leak taken off (slow_band_leak 1)
     the measurement noise it adds falls by more than 40 % (the statistic's peak follower still
