@@ -260,7 +260,8 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     if c.dist_tau > 0.0:
         ref1, ref = _lowpass2(ref1, ref, back, a, dt, stage)
         e0, e1, e2 = a[0] - ref[0], a[1] - ref[1], a[2] - ref[2]
-        dist += dt / (c.dist_tau + dt) * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
+        k = dt / (c.dist_tau + dt)  # one step of a mean over disturbance_time
+        dist += k * (e0 * e0 + e1 * e1 + e2 * e2 - dist)
         if not filling:
             tau = stage * adaptive_prefilter_time(1.0, dist, c.noise)
         if c.band > 0.0:  # the slow band (band 0: not measured, r stays white: raw_noise's users)
@@ -274,7 +275,6 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
             turn = c.turn * w2 * (lag * lag)
             inst = inst - turn if inst > turn else 0.0
             if c.leak > 0.0:  # less the fast disturbance that leaks through the band (item 5)
-                k = dt / (c.dist_tau + dt)
                 h0, h1, h2 = a[0] - s1[0], a[1] - s1[1], a[2] - s1[2]
                 q0, q1, q2 = s1[0] - s[0], s1[1] - s[1], s1[2] - s[2]
                 band_in += k * (h0 * h0 + h1 * h1 + h2 * h2 - band_in)

@@ -477,8 +477,8 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
         fc_real *ref = m + FC_MEAS_REF, *s = m + FC_MEAS_S;
         lowpass2(m + FC_MEAS_REF1, ref, back, a, dt, stage);
         fc_real e0 = a[0] - ref[0], e1 = a[1] - ref[1], e2 = a[2] - ref[2];
-        m[FC_MEAS_DIST] += dt / (c->dist_tau + dt)
-                           * (e0 * e0 + e1 * e1 + e2 * e2 - m[FC_MEAS_DIST]);
+        fc_real k = dt / (c->dist_tau + dt);  /* one step of a mean over disturbance_time */
+        m[FC_MEAS_DIST] += k * (e0 * e0 + e1 * e1 + e2 * e2 - m[FC_MEAS_DIST]);
         if (!*filling) {
             tau = stage * fc_adaptive_prefilter_time(1.0, m[FC_MEAS_DIST], c->noise);
         }
@@ -495,7 +495,6 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             inst = inst > turn ? inst - turn : 0.0;
             if (c->leak > 0.0) {  /* less the fast disturbance that leaks through the band */
                 const fc_real *s1 = m + FC_MEAS_S1;
-                fc_real k = dt / (c->dist_tau + dt);
                 fc_real h0 = a[0] - s1[0], h1 = a[1] - s1[1], h2 = a[2] - s1[2];
                 fc_real q0 = s1[0] - s[0], q1 = s1[1] - s[1], q2 = s1[2] - s[2];
                 m[FC_MEAS_BAND_IN] += k * (h0 * h0 + h1 * h1 + h2 * h2 - m[FC_MEAS_BAND_IN]);
