@@ -39,6 +39,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     BAND_PARAM,
+    HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
@@ -97,6 +98,7 @@ class ComplementaryFilter(Estimator):
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
         LEAK_PARAM,
+        HELD_PARAM,
         STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_cf"
@@ -130,7 +132,8 @@ class ComplementaryFilter(Estimator):
                                           float(p["slow_band_time"]), self._adaptive[0],
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
-                                          float(p["slow_band_leak"]))
+                                          float(p["slow_band_leak"]),
+                                          float(p["held_acceleration"]))
 
     def _reset(self) -> None:
         self.roll = 0.0

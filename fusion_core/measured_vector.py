@@ -5,7 +5,7 @@ An accelerometer sample is gravity plus the body's linear acceleration plus whit
 filters do not measure the raw sample; they measure a low-passed specific force that turns with
 the gyro (Laidig & Seel 2023, VQF: in an almost inertial frame gravity is constant and the linear
 acceleration of a body that ends where it started averages to its velocity change over time).
-Five things follow, and this module is each of them:
+Six things follow, and this module is each of them:
 
 1. The measured vector `f` is a second-order low-pass: two first-order stages of time constant
    acc_lowpass / 2 each, every stage turned by the gyro's rotation increment. A second-order
@@ -73,6 +73,16 @@ Five things follow, and this module is each of them:
    leak's mean is taken off each sample before the statistic's peak follower, which still
    catches its ripple (a tone along one axis swings between none and twice its mean): a bounce
    then counts about half as much as before, not nothing.
+6. The statistic counts no more than a held linear acceleration can be (HELD_PARAM): one held
+   longer than the vector tilts it by atan(a / g), and beyond gross_innovation's 30 deg
+   (0.58 g held for seconds, more than a hand or a vehicle holds;
+   building_blocks.GROSS_INNOVATION) what reaches the slow band is no linear acceleration but
+   absurd samples, a knock or a restart. Counted in full, the statistic after such a burst
+   makes the vector's tilt uncertain by radians, and stays so for disturbance_time times the
+   logarithm of its size over the held level: just when the attitude the burst threw, its
+   variance raised to the innovation's (gross_innovation), needs the accelerometer to come
+   back. Capped, the measurement noise is at most tan^2 30 deg = 1/3 rad^2 over one sample's,
+   the most a held acceleration makes (tests/test_adaptive_noise.py).
 
 The statistic of the adaptive length (`dist`: the raw sample against the full-length reference)
 is the first-order pre-filter's, kept: it decides whether there is anything to average.
@@ -80,9 +90,11 @@ is the first-order pre-filter's, kept: it decides whether there is anything to a
 
 from __future__ import annotations
 
+import math
 from typing import Final, NamedTuple
 
 from .building_blocks import (
+    GROSS_INNOVATION,
     PREFILTER_FULL,
     Vec3,
     adaptive_prefilter_time,
@@ -123,6 +135,17 @@ LEAK_PARAM: Final = Param(
 """Recommended 1: the estimate is the leak's mean (module docstring, item 5); nothing is fitted.
 `imu-fusion mechanisms` scores it against 0 (docs/results/mechanisms.md), and drops it from the
 mgcf (mgcf.MGCF_BAND_LEAK)."""
+HELD_PARAM: Final = Param(
+    "held_acceleration", G * math.tan(GROSS_INNOVATION),
+    "The largest linear acceleration the slow band's statistic counts: more than a body holds "
+    "for seconds (absurd samples, a knock) raises the measurement noise no further, so that it "
+    "falls back as after a hard real move (0: no limit)",
+    unit="m/s2", low=0.0, high=1000.0,
+)
+"""Recommended g tan(30 deg) = 5.66 m/s^2 (0.58 g): the acceleration that tilts a held vector by
+gross_innovation's 30 deg (building_blocks.GROSS_INNOVATION), the largest tilt the filters take
+for linear acceleration rather than for an attitude grossly off; derived, not fitted. Module
+docstring, item 6."""
 STRETCH_PARAM: Final = Param(
     "acc_lowpass_stretch", 2.0,
     "The longest the measured vector may grow, as a multiple of acc_lowpass, once a rest has "
@@ -208,17 +231,22 @@ class MeasureConstants(NamedTuple):
     leak: float
     """slow_band_leak: the share of the slow band's estimated fast leak taken off its statistic
     (0: none)."""
+    held2: float
+    """held_acceleration squared [m^2/s^4]: the most the slow band's statistic counts (0: no
+    limit)."""
 
 
 def measure_constants(acc_lowpass: float, disturbance_time: float, band: float, r: float,
-                      gyro_scale_std: float, stretch: float = 1.0, leak: float = 0.0
-                      ) -> MeasureConstants:
+                      gyro_scale_std: float, stretch: float = 1.0, leak: float = 0.0,
+                      held: float = 0.0) -> MeasureConstants:
     """The constants of measure_step from the parameters, one sample's tilt variance r, the
     gyro's scale uncertainty (0: no turn discounted from the slow band), the longest vector's
-    multiple of acc_lowpass (STRETCH_PARAM; 1: none) and the share of the slow band's fast leak
-    taken off its statistic (LEAK_PARAM; 0: none)."""
+    multiple of acc_lowpass (STRETCH_PARAM; 1: none), the share of the slow band's fast leak
+    taken off its statistic (LEAK_PARAM; 0: none) and the largest linear acceleration it counts
+    (HELD_PARAM; 0: no limit)."""
     return MeasureConstants(0.5 * acc_lowpass, disturbance_time, 3.0 * r * G * G, band, r,
-                            3.0 * gyro_scale_std * gyro_scale_std * G * G, stretch, leak)
+                            3.0 * gyro_scale_std * gyro_scale_std * G * G, stretch, leak,
+                            held * held)
 
 
 def two_stage_noise(k: float) -> float:
@@ -281,6 +309,8 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
                 band_mid += k * (q0 * q0 + q1 * q1 + q2 * q2 - band_mid)
                 leak = c.leak * band_mid * band_mid / band_in if band_in > 0.0 else 0.0
                 inst = inst - leak if inst > leak else 0.0
+            if c.held2 > 0.0 and inst > c.held2:  # no more than a held acceleration (item 6)
+                inst = c.held2
             rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
             slow += dt / (rise + dt) * (inst - slow)
             rate2 += dt / (stage + dt) * (w2 - rate2)

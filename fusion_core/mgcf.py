@@ -33,6 +33,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     BAND_PARAM,
+    HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
@@ -64,6 +65,13 @@ off it lowers the error neither on BROAD's folds left out nor on the battery (0.
 `imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays for a user's
 own value."""
 
+MGCF_HELD: Final = dataclasses.replace(HELD_PARAM, default=0.0)
+"""The mgcf's held_acceleration: 0, no limit. The cap bounds the slow band's statistic, the
+measurement noise of the other filters; the mgcf's is the raw disturbance, which it does not
+touch, so here the cap would only decide how long the vector grows, and the vector reaches its
+longest at a slow band far below the cap (measured_vector.stretched) unless the sensor turns
+faster than any real motion; the parameter stays for a user's own value."""
+
 
 class GainScheduledComplementaryFilter(Estimator):
     """The recommended modified-gain complementary filter (Duong Quoc et al. eq. 7-13:
@@ -93,7 +101,7 @@ class GainScheduledComplementaryFilter(Estimator):
       rest has measured the bias (measured_vector, item 4; a hand carrying the sensor back and
       forth over seconds); the measurement noise stays the raw disturbance
       (measured_vector.raw_noise), the slow band only decides the length, without its fast
-      leak taken off (MGCF_BAND_LEAK);
+      leak taken off (MGCF_BAND_LEAK) and without a cap (MGCF_HELD);
     - rest detection (rest_time > 0; building_blocks.REST_PARAMS): at rest the gyro reads its
       own bias, and b follows the gyro with time constant rest_time (a zero-angular-rate update
       of the integral term; Mahony's integral alone needs minutes, and cannot see the bias about
@@ -121,6 +129,7 @@ class GainScheduledComplementaryFilter(Estimator):
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
         MGCF_BAND_LEAK,
+        MGCF_HELD,
         STRETCH_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_mgcf"
@@ -156,7 +165,8 @@ class GainScheduledComplementaryFilter(Estimator):
                                           float(p["slow_band_time"]), self._adaptive[0],
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
-                                          float(p["slow_band_leak"]))
+                                          float(p["slow_band_leak"]),
+                                          float(p["held_acceleration"]))
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)

@@ -35,6 +35,7 @@ from .kinematics import rotvec_terms
 from .linalg import cholesky3, packed_diagonal, packed_index
 from .measured_vector import (
     BAND_PARAM,
+    HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
@@ -170,6 +171,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         GROSS_INNOVATION_PARAM,
         BAND_PARAM,
         LEAK_PARAM,
+        HELD_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
@@ -204,7 +206,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                           float(p["slow_band_time"]), self._r_acc,
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
-                                          float(p["slow_band_leak"]))
+                                          float(p["slow_band_leak"]),
+                                          float(p["held_acceleration"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))

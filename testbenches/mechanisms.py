@@ -2,8 +2,9 @@
 worth on recordings it was not chosen on.
 
 A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the fast leak taken
-off its slow band, the longer vector, the scale-error process noise, rest detection and its
-turn-on rule, the bias gates, the variance after a gross innovation, the accelerometer gate) on
+off its slow band and the band's cap at a held acceleration, the longer vector, the
+scale-error process noise, rest detection and its turn-on rule, the bias gates, the variance
+after a gross innovation, the accelerometer gate) on
 by default is switched off by the parameter values that turn it off, everything else at the
 recommended values, and the filter is scored with and without it two ways:
 
@@ -89,6 +90,9 @@ MECHANISMS: tuple[Mechanism, ...] = (
               "measured linear acceleration (disturbance_time 0)", {"disturbance_time": 0.0}),
     Mechanism("band_leak", "the fast disturbance that leaks through the slow band taken off "
               "its statistic (slow_band_leak 0)", {"slow_band_leak": 0.0}),
+    Mechanism("held_acceleration", "the slow band's statistic counts no more than a held "
+              "linear acceleration, g tan 30 deg (held_acceleration 0)",
+              {"held_acceleration": 0.0}),
     Mechanism("longer_vector", "the vector grows where slow linear acceleration reaches it "
               "(acc_lowpass_stretch 1)", {"acc_lowpass_stretch": 1.0}),
     Mechanism("scale_noise", "process noise for the gyro's scale error while it turns "

@@ -218,3 +218,54 @@ def test_a_fast_leak_through_the_slow_band_counts_less_a_slow_sway_still_counts(
 
     assert added(1.0, 1.1 * G, 2.8) < 0.6 * added(0.0, 1.1 * G, 2.8)
     assert added(1.0, 2.0, 0.3) > 0.9 * added(0.0, 2.0, 0.3)
+
+
+def test_absurd_samples_count_no_more_than_a_held_acceleration_a_real_move_in_full() -> None:
+    """measured_vector item 6: after a second of absurd samples (uniform within an MPU-6050's
+    16 g range, as the battery's glitching part has them) the measurement noise is at most a
+    held acceleration's, tan^2 30 deg = 1/3 rad^2 over one sample's (held_acceleration
+    g tan 30 deg), where uncapped it reaches more than five times that, and falls under
+    0.1 rad^2 more than half a second sooner; a real slow move (a 0.3 Hz sway of 3 m/s^2, well
+    under the cap) gives the same noise to the bit."""
+    import numpy as np
+
+    from fusion_core.building_blocks import GROSS_INNOVATION
+    from fusion_core.kinematics import rotvec_terms
+    from fusion_core.measured_vector import (
+        HELD_PARAM,
+        measure_constants,
+        measure_start,
+        measure_step,
+    )
+    from fusion_core.types import G
+
+    assert HELD_PARAM.default == G * math.tan(GROSS_INNOVATION)
+    dt, r, zero = 0.01, 0.005**2, (0.0, 0.0, 0.0)
+    terms = rotvec_terms(*zero)
+    absurd = np.random.default_rng(0).uniform(-0.9, 0.9, (100, 3)) * 16.0 * G
+
+    def noise(held: float, sample) -> np.ndarray:
+        c = measure_constants(1.5, 1.0, 0.15, r, 0.005, 1.0, 1.0, held)
+        m = measure_start((0.0, 0.0, G), c)
+        rs = []
+        for k in range(1, 3000):
+            m, r_k, _ = measure_step(m, sample(k), zero, terms, dt, c)
+            rs.append(r_k)
+        return np.array(rs)
+
+    def glitch(k: int) -> tuple[float, float, float]:
+        return tuple(absurd[k - 1000]) if 1000 <= k < 1100 else (0.0, 0.0, G)
+
+    def under(rs: np.ndarray, level: float) -> float:
+        """Seconds after the glitch until the noise stays under level."""
+        return (np.nonzero(rs > level)[0].max() + 1 - 1100) * dt
+
+    capped, full = noise(HELD_PARAM.default, glitch), noise(0.0, glitch)
+    held = math.tan(GROSS_INNOVATION) ** 2
+    assert capped.max() <= r + held * (1.0 + 1e-12) < full.max() / 5.0
+    assert under(capped, 0.1) < under(full, 0.1) - 0.5
+
+    def sway(k: int) -> tuple[float, float, float]:
+        return (3.0 * math.sin(2.0 * math.pi * 0.3 * k * dt), 0.0, G)
+
+    assert list(noise(HELD_PARAM.default, sway)) == list(noise(0.0, sway))

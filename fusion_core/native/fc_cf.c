@@ -15,7 +15,8 @@ void fc_cf_configure(fc_cf *f)
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     f->longest = p->max_correction_time;
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
-                         p->acc_lowpass_stretch, p->slow_band_leak, &f->measure);
+                         p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
+                         &f->measure);
 }
 
 fc_estimate fc_cf_estimate(const fc_cf *f)

@@ -397,7 +397,7 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise)
 #define DISTURBANCE_ATTACK 0.05 /* measured_vector.DISTURBANCE_ATTACK [s] */
 
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_real gyro_scale_std, fc_real stretch, fc_real leak,
+                          fc_real gyro_scale_std, fc_real stretch, fc_real leak, fc_real held,
                           fc_meas_constants *c)
 {
     c->stage = 0.5 * acc_lowpass;
@@ -408,6 +408,7 @@ void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real
     c->turn = 3.0 * gyro_scale_std * gyro_scale_std * FC_G * FC_G;
     c->stretch = stretch;
     c->leak = leak;
+    c->held2 = held * held;
 }
 
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c)
@@ -503,6 +504,9 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
                     ? c->leak * m[FC_MEAS_BAND_MID] * m[FC_MEAS_BAND_MID] / m[FC_MEAS_BAND_IN]
                     : 0.0;
                 inst = inst > leak ? inst - leak : 0.0;
+            }
+            if (c->held2 > 0.0 && inst > c->held2) {  /* no more than a held acceleration */
+                inst = c->held2;
             }
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);

@@ -154,10 +154,10 @@ enum {
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {
-    fc_real stage, dist_tau, noise, band, r, turn, stretch, leak;
+    fc_real stage, dist_tau, noise, band, r, turn, stretch, leak, held2;
 } fc_meas_constants;
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
-                          fc_real gyro_scale_std, fc_real stretch, fc_real leak,
+                          fc_real gyro_scale_std, fc_real stretch, fc_real leak, fc_real held,
                           fc_meas_constants *c);
 /* measure_start: every low-pass at a, no disturbance measured, settled */
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);

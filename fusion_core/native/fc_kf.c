@@ -32,7 +32,8 @@ void fc_kf_configure(fc_kf *f)
     fc_adaptive_noise_constants(p->gyro_scale_std, p->scale_time, p->disturbance_time,
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, p->gyro_scale_std,
-                         p->acc_lowpass_stretch, p->slow_band_leak, &f->measure);
+                         p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
+                         &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
     f->rail_var = fc_pow(p->input.gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->rest_time = p->rest_time;

@@ -24,7 +24,8 @@ void fc_mgcf_configure(fc_mgcf *f)
     /* the slow band only decides the longer vector: the mgcf's noise is the raw disturbance
      * (fc_measure_raw_noise) */
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
-                         p->acc_lowpass_stretch, p->slow_band_leak, &f->measure);
+                         p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
+                         &f->measure);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)

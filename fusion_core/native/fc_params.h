@@ -110,6 +110,7 @@ typedef struct fc_cf_params {
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
+    fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_input_params input;        /* the input stage's */
 } fc_cf_params;
@@ -132,6 +133,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
+    p->held_acceleration = 5.6618720173484425;
     p->acc_lowpass_stretch = 2.0;
     fc_input_params_default(&p->input);
 }
@@ -173,6 +175,7 @@ typedef struct fc_mgcf_params {
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
+    fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_input_params input;        /* the input stage's */
 } fc_mgcf_params;
@@ -194,6 +197,7 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 0.0;
+    p->held_acceleration = 0.0;
     p->acc_lowpass_stretch = 2.0;
     fc_input_params_default(&p->input);
 }
@@ -245,6 +249,7 @@ typedef struct fc_kf_params {
     fc_real gross_innovation;     /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
+    fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_input_params input;        /* the input stage's */
@@ -273,6 +278,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
+    p->held_acceleration = 5.6618720173484425;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     fc_input_params_default(&p->input);
@@ -328,6 +334,7 @@ typedef struct fc_ukf_params {
     fc_real gross_innovation;     /* (0.0, 3.141592653589793] [rad] */
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
+    fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_input_params input;        /* the input stage's */
@@ -357,6 +364,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
+    p->held_acceleration = 5.6618720173484425;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     fc_input_params_default(&p->input);
