@@ -366,13 +366,38 @@ Results = dict[str, dict[str, dict[str, list[float]]]]
 
 def run_battery(motions: Sequence[str], sensors: Sequence[str], parts: int = PARTS,
                 scheduler: str | None = "local", workers: int = 2,
-                progress: Callable[[], None] | None = None) -> Results:
+                progress: Callable[[], None] | None = None,
+                overrides: dict[str, dict[str, Any]] | None = None) -> Results:
     """Every motion x sensor class on `parts` parts, each (motion, class) a Dask task on the
     cluster `scheduler` names (runner.connect), or with None one after the other in this
-    process (the same numbers: every run is seeded)."""
-    variants = run_variants({"": {}}, motions, sensors, parts, scheduler, workers, progress,
-                            filter_keys(), vqf=True)
+    process (the same numbers: every run is seeded); overrides: filter -> parameter values on
+    top of the class's (filter_overrides)."""
+    variants = run_variants({"": overrides or {}}, motions, sensors, parts, scheduler, workers,
+                            progress, filter_keys(), vqf=True)
     return variants[""]
+
+
+def filter_overrides(params: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """`--param` values for each attitude filter that has the parameter (a filter without it
+    keeps its own), each checked on top of every sensor class's values. A name that no filter
+    has, or a value out of its range, is a ValueError that says what is allowed."""
+    from fusion_core.registry import create, estimator_class
+
+    keys = filter_keys()
+    names = {key: {q.name for q in estimator_class(key).PARAMS} for key in keys}
+    unknown = sorted(set(params) - set().union(*names.values()))
+    if unknown:
+        known = ", ".join(sorted(set().union(*names.values())))
+        raise ValueError(f"--param {', '.join(unknown)}: no attitude filter has it; they have "
+                         f"{known}")
+    out = {key: {n: v for n, v in params.items() if n in names[key]} for key in keys}
+    for key, values in out.items():
+        for sensor in SENSOR_CLASSES.values():
+            try:
+                create(key, {**filter_params(sensor)[key], **values})
+            except ValueError as err:
+                raise ValueError(f"--param, {key}: {err}") from None
+    return {key: values for key, values in out.items() if values}
 
 
 def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequence[str],
@@ -504,7 +529,7 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
 
     p = sub.add_parser(
         "battery", help="every attitude filter beside VQF on a battery of motions x parts of "
-        "three sensor classes", description=__doc__.split("\n\n")[0])
+        "several sensor classes", description=__doc__.split("\n\n")[0])
     p.add_argument("--motion", default="all", help=f"all, or some of {', '.join(MOTIONS)}")
     p.add_argument("--sensor", default="all",
                    help=f"all, or some of {', '.join(SENSOR_CLASSES)}")
@@ -514,6 +539,10 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
     p.add_argument("--out", type=Path, default=Path("reports/battery"),
                    help="where battery.json, battery.md, one page per motion and the plot go")
     p.add_argument("--no-plots", action="store_true", help="no battery.png")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="a parameter value for every attitude filter that has it (repeatable), "
+                   "on top of each sensor class's values: what a value is worth beside VQF, "
+                   "e.g. --param scale_time=1")
     p.set_defaults(func=cmd_battery)
 
 
@@ -522,17 +551,19 @@ def cmd_battery(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from .options import choose
+    from .options import choose, parse_params
 
     motions = choose(args.motion, list(MOTIONS), "motion")
     sensors = choose(args.sensor, list(SENSOR_CLASSES), "sensor class")
+    params = parse_params(args.param)
+    overrides = filter_overrides(params)
     with tqdm(total=len(motions) * len(sensors), desc="battery", unit="cell",
               disable=None) as bar:
         results = run_battery(motions, sensors, args.parts, args.scheduler, args.workers,
-                              lambda: bar.update(1))
+                              lambda: bar.update(1), overrides)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "battery.json").write_text(json.dumps(
-        {"parts": args.parts, "settle_s": SETTLE_S,
+        {"parts": args.parts, "settle_s": SETTLE_S, "params": params,
          "motions": {m: MOTIONS[m].what for m in motions},
          "sensor_classes": {s: {"what": SENSOR_CLASSES[s].what, "rate": SENSOR_CLASSES[s].rate,
                                 "params": SENSOR_CLASSES[s].params,

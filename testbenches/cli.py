@@ -18,7 +18,7 @@
               on others (testbenches.fit).
   campaign    a Monte Carlo campaign of seeded runs on Dask, resumable, with percentiles and
               confidence intervals (testbenches.montecarlo).
-  battery     every attitude filter beside VQF on a battery of motions x parts of three
+  battery     every attitude filter beside VQF on a battery of motions x parts of several
               sensor classes (testbenches.battery).
   mechanisms  what each mechanism of the recommended attitude filters is worth out of sample
               (BROAD's motion folds and the battery; testbenches.mechanisms).

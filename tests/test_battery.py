@@ -145,3 +145,33 @@ def test_a_sensor_without_quantisation_adds_no_converter_noise() -> None:
     c = SensorClass("ideal_adc", "no converter", 100.0, {"bits": 0})
     std = battery.filter_params(c)["cf"]["acc_noise"] * G
     assert std == pytest.approx(math.sqrt(c.value("acc_psd") * c.rate))
+
+
+def test_a_param_reaches_every_filter_that_has_it_and_an_unknown_one_is_refused(tmp_path,
+                                                                               capsys) -> None:
+    """`battery --param`: a value goes to the filters that have the parameter (the Kalman
+    filters' gross_innovation, not the complementary filters'), changes their numbers and no
+    other's, and is written to battery.json; a name no filter has, or a value out of range, is
+    refused in one line before any run, saying what is allowed."""
+    pytest.importorskip("vqf")
+    from testbenches.cli import main
+
+    assert battery.filter_overrides({"gross_innovation": 0.3}) == {
+        "kf": {"gross_innovation": 0.3}, "ukf": {"gross_innovation": 0.3}}
+    with pytest.raises(ValueError, match=r"no attitude filter has it; they have .*scale_time"):
+        battery.filter_overrides({"gross_innovatoin": 0.3})
+    with pytest.raises(ValueError, match=r"--param, cf: .*scale_time"):
+        battery.filter_overrides({"scale_time": -1.0})
+    status = main(["battery", "--motion", "clipping", "--sensor", "mpu6050_glitch", "--parts", "1",
+                   "--out", str(tmp_path), "--no-plots", "--scheduler", "local",
+                   "--param", "gross_innovation=3.14159"])
+    assert status == 0
+    report = json.loads((tmp_path / "battery.json").read_text())
+    assert report["params"] == {"gross_innovation": 3.14159}
+    got = report["rmse_deg"]["clipping"]["mpu6050_glitch"]
+    default = battery.run_battery(["clipping"], ["mpu6050_glitch"], 1, scheduler=None)
+    default = default["clipping"]["mpu6050_glitch"]
+    assert got["kf"] != default["kf"] and got["ukf"] != default["ukf"]
+    assert (got["cf"], got["mgcf"], got["vqf"]) == (default["cf"], default["mgcf"], default["vqf"])
+    assert main(["battery", "--param", "nope=1", "--out", str(tmp_path)]) != 0
+    assert "no attitude filter has it" in capsys.readouterr().err

@@ -49,7 +49,7 @@ SLOW = ("calibrated-parts", "readme-calibrated-part", "campaigns-parts", "campai
         *(f.name for f in figs.FIGURES if f.name.startswith("battery-")
           and f.name != "battery-classes"))
 """Figures of 200 parts calibrated first, `make campaign`'s 17,500 runs, BROAD's trials, the
-battery's campaign (13 motion classes x 3 sensor classes x 20 parts) or the battery ten times:
+battery's campaign (every motion class x sensor class x 20 parts) or the battery ten times:
 minutes (`make test-slow`)."""
 
 
