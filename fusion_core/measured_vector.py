@@ -76,8 +76,11 @@ Six things follow, and this module is each of them:
 6. The statistic counts no more than a held linear acceleration can be (HELD_PARAM): one held
    longer than the vector tilts it by atan(a / g), and beyond gross_innovation's 30 deg
    (0.58 g held for seconds, more than a hand or a vehicle holds;
-   building_blocks.GROSS_INNOVATION) what reaches the slow band is no linear acceleration but
-   absurd samples, a knock or a restart. Counted in full, the statistic after such a burst
+   building_blocks.GROSS_INNOVATION) what reaches the slow band is mostly no linear
+   acceleration but absurd samples, a knock or a restart; a real one past it (a synthetic
+   scenario's seconds of 0.7 g) leaves the vector's tilt uncertain by 30 deg and more, and the
+   capped noise already gives the accelerometer that little weight. Counted in full, the
+   statistic after such a burst
    makes the vector's tilt uncertain by radians, and stays so for disturbance_time times the
    logarithm of its size over the held level: just when the attitude the burst threw, its
    variance raised to the innovation's (gross_innovation), needs the accelerometer to come
