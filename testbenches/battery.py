@@ -383,21 +383,22 @@ def filter_overrides(params: dict[str, Any]) -> dict[str, dict[str, Any]]:
     has, or a value out of its range, is a ValueError that says what is allowed."""
     from fusion_core.registry import create, estimator_class
 
-    keys = filter_keys()
-    names = {key: {q.name for q in estimator_class(key).PARAMS} for key in keys}
-    unknown = sorted(set(params) - set().union(*names.values()))
+    names = {key: {q.name for q in estimator_class(key).PARAMS} for key in filter_keys()}
+    known = set().union(*names.values())
+    unknown = sorted(set(params) - known)
     if unknown:
-        known = ", ".join(sorted(set().union(*names.values())))
         raise ValueError(f"--param {', '.join(unknown)}: no attitude filter has it; they have "
-                         f"{known}")
-    out = {key: {n: v for n, v in params.items() if n in names[key]} for key in keys}
-    for key, values in out.items():
-        for sensor in SENSOR_CLASSES.values():
+                         f"{', '.join(sorted(known))}")
+    out = {key: {n: v for n, v in params.items() if n in have} for key, have in names.items()}
+    out = {key: values for key, values in out.items() if values}
+    for sensor in SENSOR_CLASSES.values():
+        base = filter_params(sensor)
+        for key, values in out.items():
             try:
-                create(key, {**filter_params(sensor)[key], **values})
+                create(key, {**base[key], **values})
             except ValueError as err:
                 raise ValueError(f"--param, {key}: {err}") from None
-    return {key: values for key, values in out.items() if values}
+    return out
 
 
 def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequence[str],
