@@ -13,7 +13,11 @@ starts with and SETTLE_S more.
 
 Each filter is given what a user of that sensor gives it: the parameters that follow from the
 sensor's noise and range (fusion_core.presets.noise_preset, what `imu-fusion noise` writes for a
-static recording), the rest at their recommended values. VQF takes no noise parameters.
+static recording), the rest at their recommended values. VQF takes no noise parameters. With
+`known_scale` (`--known-scale`) each filter's gyro_scale_std is also the class's own spread of
+gyro scale factors, as a user sets it from the part's datasheet (docs/guide/own-sensor.md):
+what knowing it is worth, class by class, beside the recommended value every class gets
+otherwise.
 
 The truth comes from the trajectory (fusion_core.synthetic), the samples from the sensor model's
 C twin (fusion_core.sensor), the filters from theirs: a run is deterministic, and the battery is
@@ -300,11 +304,13 @@ def filter_keys() -> list[str]:
     return list(registry.ATTITUDE_FILTERS)
 
 
-def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:
+def filter_params(sensor: SensorClass, known_scale: bool = False) -> dict[str, dict[str, Any]]:
     """Each filter's parameters for a sensor of this class: the recommended values with what
     follows from its noise, range and the gyro bias its parts start with (presets.noise_preset:
     what its calibration leaves, sensor.CALIBRATION), one sample's accelerometer noise taken at
-    the class's rate with its quantisation."""
+    the class's rate with its quantisation; with known_scale, gyro_scale_std is the class's
+    spread of gyro scale factors (the sensor model's gyro_scale_std, 1 sigma), where a filter
+    has the parameter."""
     from fusion_core.presets import noise_preset
     from fusion_core.sensor import CALIBRATION
 
@@ -315,14 +321,21 @@ def filter_params(sensor: SensorClass) -> dict[str, dict[str, Any]]:
     gyro_bias_std = max(CALIBRATION[sensor.value("calibration")][0])
     preset = noise_preset(math.sqrt(sensor.value("gyro_psd")), acc_density, acc_sample_std,
                           sensor.value("gyro_range"), gyro_bias_std)
-    return {key: preset[key] for key in filter_keys()}
+    out = {key: dict(preset[key]) for key in filter_keys()}
+    if known_scale:
+        from fusion_core.registry import estimator_class
+
+        for key, params in out.items():
+            if any(p.name == "gyro_scale_std" for p in estimator_class(key).PARAMS):
+                params["gyro_scale_std"] = float(sensor.value("gyro_scale_std"))
+    return out
 
 
 def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
-              overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True
-              ) -> dict[str, float]:
-    """One part's inclination RMSE [deg] per filter (its parameters with `overrides[key]` over
-    them) and, with vqf, VQF's on one motion."""
+              overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True,
+              known_scale: bool = False) -> dict[str, float]:
+    """One part's inclination RMSE [deg] per filter (its parameters, filter_params with
+    known_scale, with `overrides[key]` over them) and, with vqf, VQF's on one motion."""
     from fusion_core.registry import create
     from fusion_core.sensor import ImuSensorModel
 
@@ -338,7 +351,7 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
     sample = glitched(sample, s, m.rest + GLITCH_AFTER_S, seed)
     true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
     scored = t >= m.rest + SETTLE_S
-    params = filter_params(s)
+    params = filter_params(s, known_scale)
 
     def rmse(up: np.ndarray) -> float:
         return inclination_rmse_deg(up, true_up, scored)
@@ -354,9 +367,10 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
 
 
 def _cell(motion: str, sensor: str, parts: int, filters: Sequence[str],
-          overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True
-          ) -> dict[str, list[float]]:
-    rows = [part_rmse(motion, sensor, seed, filters, overrides, vqf) for seed in range(parts)]
+          overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True,
+          known_scale: bool = False) -> dict[str, list[float]]:
+    rows = [part_rmse(motion, sensor, seed, filters, overrides, vqf, known_scale)
+            for seed in range(parts)]
     return {key: [r[key] for r in rows] for key in rows[0]}
 
 
@@ -367,13 +381,14 @@ Results = dict[str, dict[str, dict[str, list[float]]]]
 def run_battery(motions: Sequence[str], sensors: Sequence[str], parts: int = PARTS,
                 scheduler: str | None = "local", workers: int = 2,
                 progress: Callable[[], None] | None = None,
-                overrides: dict[str, dict[str, Any]] | None = None) -> Results:
+                overrides: dict[str, dict[str, Any]] | None = None,
+                known_scale: bool = False) -> Results:
     """Every motion x sensor class on `parts` parts, each (motion, class) a Dask task on the
     cluster `scheduler` names (runner.connect), or with None one after the other in this
     process (the same numbers: every run is seeded); overrides: filter -> parameter values on
-    top of the class's (filter_overrides)."""
+    top of the class's (filter_overrides); known_scale: filter_params'."""
     variants = run_variants({"": overrides or {}}, motions, sensors, parts, scheduler, workers,
-                            progress, filter_keys(), vqf=True)
+                            progress, filter_keys(), vqf=True, known_scale=known_scale)
     return variants[""]
 
 
@@ -404,16 +419,16 @@ def filter_overrides(params: dict[str, Any]) -> dict[str, dict[str, Any]]:
 def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequence[str],
                  sensors: Sequence[str], parts: int = PARTS, scheduler: str | None = "local",
                  workers: int = 2, progress: Callable[[], None] | None = None,
-                 filters: Sequence[str] | None = None, vqf: bool = False
-                 ) -> dict[str, Results]:
+                 filters: Sequence[str] | None = None, vqf: bool = False,
+                 known_scale: bool = False) -> dict[str, Results]:
     """The battery once per variant (name -> filter -> parameter overrides) on one cluster:
-    each (variant, motion, class) a task."""
+    each (variant, motion, class) a task; known_scale: filter_params'."""
     filters = list(filters or filter_keys())
     cells = [(v, m, s) for v in variants for m in motions for s in sensors]
     out: dict[str, Results] = {v: {m: {} for m in motions} for v in variants}
     if scheduler is None:
         for v, m, s in cells:
-            out[v][m][s] = _cell(m, s, parts, filters, variants[v], vqf)
+            out[v][m][s] = _cell(m, s, parts, filters, variants[v], vqf, known_scale)
             if progress:
                 progress()
         return out
@@ -423,7 +438,8 @@ def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequen
 
     client, cluster = connect(scheduler, workers)
     try:
-        futures = {client.submit(_cell, m, s, parts, filters, variants[v], vqf, pure=False):
+        futures = {client.submit(_cell, m, s, parts, filters, variants[v], vqf, known_scale,
+                                 pure=False):
                    (v, m, s) for v, m, s in cells}
         for future in as_completed(futures):
             v, m, s = futures[future]
@@ -544,6 +560,10 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
                    help="a parameter value for every attitude filter that has it (repeatable), "
                    "on top of each sensor class's values: what a value is worth beside VQF, "
                    "e.g. --param scale_time=1")
+    p.add_argument("--known-scale", action="store_true",
+                   help="give each filter the sensor class's own spread of gyro scale factors "
+                   "as gyro_scale_std, as a user sets it from the part's datasheet (default: "
+                   "the recommended value for every class)")
     p.set_defaults(func=cmd_battery)
 
 
@@ -561,14 +581,16 @@ def cmd_battery(args: argparse.Namespace) -> int:
     with tqdm(total=len(motions) * len(sensors), desc="battery", unit="cell",
               disable=None) as bar:
         results = run_battery(motions, sensors, args.parts, args.scheduler, args.workers,
-                              lambda: bar.update(1), overrides)
+                              lambda: bar.update(1), overrides, args.known_scale)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "battery.json").write_text(json.dumps(
         {"parts": args.parts, "settle_s": SETTLE_S, "params": params,
+         "known_scale": args.known_scale,
          "motions": {m: MOTIONS[m].what for m in motions},
          "sensor_classes": {s: {"what": SENSOR_CLASSES[s].what, "rate": SENSOR_CLASSES[s].rate,
                                 "params": SENSOR_CLASSES[s].params,
-                                "filter_params": filter_params(SENSOR_CLASSES[s])}
+                                "filter_params": filter_params(SENSOR_CLASSES[s],
+                                                               args.known_scale)}
                             for s in sensors},
          "rmse_deg": results}, indent=1))
     overview = overview_table(results)
