@@ -27,11 +27,16 @@ Six things follow, and this module is each of them:
    motion does, in full, since a filter that assumes white measurement noise cannot average a
    disturbance that stays for seconds. While the sensor turns, the two low-passes also part
    because the gyro that turns them is off by a fraction of the rate (its scale-factor error
-   and two cross-axis sensitivities: sigma = sqrt(3) gyro_scale_std, each of that std): by
-   g sigma |w| times the difference of their delays. That is no linear acceleration, and the
-   process noise already holds it (ADAPTIVE_NOISE_PARAMS' rotation term), so the statistic
-   leaves it out: counted as disturbance, it slows the correction in exactly the rotations
-   where a gyro's scale error asks for a faster one (the realistic sensor's high_dynamics).
+   and two cross-axis sensitivities: sigma = sqrt(3) gyro_scale_std, each of that std): each
+   holds samples turned by the gyro since they came, so each is off by sigma times the angle
+   the sensor turned since its samples, weighted as it weighs them (its lag, `lag_ref` and
+   `lag_s`: a rotation vector low-passed as the samples are), and the two part by g sigma
+   times the difference of their lags. At a steady rate w that is |w| times the difference of
+   their delays; a swing that turns back within the vector's length parts them by less, as
+   far as it turned back. That is no linear acceleration, and the process noise already holds
+   it (ADAPTIVE_NOISE_PARAMS' rotation term), so the statistic leaves it out: counted as
+   disturbance, it slows the correction in exactly the rotations where a gyro's scale error
+   asks for a faster one (the realistic sensor's high_dynamics).
    The statistic rises within DISTURBANCE_ATTACK (a disturbance that starts counts before a filter
    learns a gyro bias from it) and decays over disturbance_time.
 3. A gyro sample at its rail (the sensor's gyro_range, base.Estimator) is no measurement of the
@@ -105,10 +110,12 @@ from .building_blocks import (
     on_the_mark,
 )
 from .kinematics import rotation_back_matrix
-from .linalg import Mat9
+from .linalg import Mat9, mat_vec
 from .state import NONNEG, REAL, Segments
 from .types import G, Param
 
+ZERO: Final = (0.0, 0.0, 0.0)
+"""No lag: a low-pass whose samples all came at this attitude."""
 DISTURBANCE_ATTACK: Final = 0.05
 """Time constant [s] with which the slow-band statistic rises. A disturbance that starts (the
 onset of a move, a burst of linear acceleration) must count in the measurement noise before a
@@ -161,9 +168,9 @@ STRETCH_PARAM: Final = Param(
 combined motion from rest (tests/test_slow_combined_motion.py) comes within VQF + 10 %. The
 cross-validation over BROAD's motion folds (testbenches.broad.cv.CV_GRID holds 1, 1.5 and 2)
 chooses 1.5 or 2 without every fold, never 1. Module docstring, item 4."""
-MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 7)))
+MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 7), (REAL, 12)))
 """The state check of a Measure (fusion_core.state): six vectors, two mean squares, two
-times, a mean square rate and the slow band's two fast powers."""
+times, a mean square rate, the slow band's two fast powers and four lag angles."""
 
 
 class Measure(NamedTuple):
@@ -197,6 +204,13 @@ class Measure(NamedTuple):
     band_mid: float
     """Mean square of s1 - s [m^2/s^4] over disturbance_time: what of it the first stage lets
     through."""
+    lag_ref1: Vec3
+    lag_ref: Vec3
+    """The reference's lag [rad]: the rotation vector the sensor turned since the samples each
+    of its stages holds, weighted as the stage weighs them (module docstring, item 2)."""
+    lag_s1: Vec3
+    lag_s: Vec3
+    """The slow band's lag [rad], the same for its stages."""
 
     def settled(self, c: MeasureConstants) -> bool:
         """Whether the vector holds no sample turned by a rotation the gyro did not measure (no
@@ -208,7 +222,8 @@ class Measure(NamedTuple):
 def measure_start(a: Vec3, c: MeasureConstants) -> Measure:
     """The state at a first sample a: every low-pass starts at it, no disturbance measured, and
     settled (no gyro sample at its rail yet: the vector holds no rotation the gyro missed)."""
-    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage, 0.0, 0.0, 0.0)
+    return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage, 0.0, 0.0, 0.0, ZERO, ZERO,
+                   ZERO, ZERO)
 
 
 class MeasureConstants(NamedTuple):
@@ -227,8 +242,8 @@ class MeasureConstants(NamedTuple):
     """One sample's tilt variance [rad^2], the white part of the measurement noise."""
     turn: float
     """(g sigma)^2 [m^2/s^4] with sigma = sqrt(3) gyro_scale_std, the gyro's rate error as a
-    fraction of the rate: the slow band's share per (rad/s)^2 and s^2 of lag that a turn
-    explains (module docstring, item 2)."""
+    fraction of the rate: the slow band's share per rad^2 of lag between its two low-passes
+    that a turn explains (module docstring, item 2)."""
     stretch: float
     """acc_lowpass_stretch: the longest vector as a multiple of the full length (1: none)."""
     leak: float
@@ -269,6 +284,19 @@ def _lowpass2(s1: Vec3, s: Vec3, back: Mat9, a: Vec3, dt: float, tau: float
     return s1, lowpass_specific_force(s, back, s1, k)
 
 
+def _lag2(l1: Vec3, lag: Vec3, back: Mat9, phi: Vec3, k: float) -> tuple[Vec3, Vec3]:
+    """One step of the lags of a second-order low-pass's two stages (each of gain k): every
+    sample a stage holds has turned by phi more (the lags turned with the body by back, as the
+    stages' vectors are), and the new sample comes with none (the first stage's input) or with
+    the first stage's lag (the second's)."""
+    j = 1.0 - k
+    a0, a1, a2 = mat_vec(back, l1)
+    l1 = (j * (a0 + phi[0]), j * (a1 + phi[1]), j * (a2 + phi[2]))
+    b0, b1, b2 = mat_vec(back, lag)
+    return l1, (j * (b0 + phi[0]) + k * l1[0], j * (b1 + phi[1]) + k * l1[1],
+                j * (b2 + phi[2]) + k * l1[2])
+
+
 def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, float, float],
                  dt: float, c: MeasureConstants, bias_measured: bool = False
                  ) -> tuple[Measure, float, bool]:
@@ -276,7 +304,8 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     vector with its rotvec_terms; bias_measured: whether a rest has measured the gyro bias (the
     vector may then grow longer, item 4). Returns the new state (its f is the measured vector),
     the measurement noise r [rad^2] and whether the vector is still filling."""
-    f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid = m
+    (f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid, lag_ref1,
+     lag_ref, lag_s1, lag_s) = m
     stage = c.stage
     full = 2.0 * stage
     if settle < full:  # both times counted up to the full length (building_blocks.on_the_mark)
@@ -299,11 +328,12 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
             s1, s = _lowpass2(s1, s, back, a, dt, c.band)
             e0, e1, e2 = s[0] - ref[0], s[1] - ref[1], s[2] - ref[2]
             inst = e0 * e0 + e1 * e1 + e2 * e2
-            # less what the gyro's rate error turns the two apart by: sigma |w| times the
-            # difference of their delays (two stages each: 2 stage and 2 band)
-            lag = 2.0 * (stage - c.band)
-            w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt)
-            turn = c.turn * w2 * (lag * lag)
+            # less what the gyro's rate error turns the two apart by: sigma times the
+            # difference of their lags (item 2)
+            lag_ref1, lag_ref = _lag2(lag_ref1, lag_ref, back, phi, dt / (stage + dt))
+            lag_s1, lag_s = _lag2(lag_s1, lag_s, back, phi, dt / (c.band + dt))
+            d0, d1, d2 = lag_ref[0] - lag_s[0], lag_ref[1] - lag_s[1], lag_ref[2] - lag_s[2]
+            turn = c.turn * (d0 * d0 + d1 * d1 + d2 * d2)
             inst = inst - turn if inst > turn else 0.0
             if c.leak > 0.0:  # less the fast disturbance that leaks through the band (item 5)
                 h0, h1, h2 = a[0] - s1[0], a[1] - s1[1], a[2] - s1[2]
@@ -316,15 +346,16 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
                 inst = c.held2
             rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
             slow += dt / (rise + dt) * (inst - slow)
+            w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt)
             rate2 += dt / (stage + dt) * (w2 - rate2)
             excess = slow - c.noise * two_stage_noise(dt / (c.band + dt))
             if excess > 0.0:
                 r += excess / (G * G)
                 if c.stretch > 1.0 and bias_measured and not filling:
-                    tau = tau * stretched(c, excess, rate2, lag, full)
+                    tau = tau * stretched(c, excess, rate2, 2.0 * (stage - c.band), full)
     f1, f = _lowpass2(f1, f, back, a, dt, tau)
-    return (Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid),
-            r, filling)
+    return (Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid,
+                    lag_ref1, lag_ref, lag_s1, lag_s), r, filling)
 
 
 def stretched(c: MeasureConstants, excess: float, rate2: float, lag: float, full: float
@@ -389,9 +420,10 @@ def raw_noise(m: Measure, c: MeasureConstants) -> float:
 
 
 def measure_aligned(m: Measure, f: Vec3) -> Measure:
-    """The state with every low-pass at f (a rest alignment: the rest's mean specific force),
-    the statistics kept."""
-    return m._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f)
+    """The state with every low-pass at f (a rest alignment: the rest's mean specific force)
+    and no lag, the statistics kept."""
+    return m._replace(f1=f, f=f, ref1=f, ref=f, s1=f, s=f, lag_ref1=ZERO, lag_ref=ZERO,
+                      lag_s1=ZERO, lag_s=ZERO)
 
 
 def measure_restarted(m: Measure, f: Vec3) -> Measure:
@@ -410,6 +442,7 @@ def measure_clipped(m: Measure) -> Measure:
 
 def measure_turned(m: Measure, turn) -> Measure:  # type: ignore[no-untyped-def]
     """The state with every vector turned by turn (a function of a vector: the kf's face
-    switch)."""
+    switch), the lags too."""
     return m._replace(f1=turn(m.f1), f=turn(m.f), ref1=turn(m.ref1), ref=turn(m.ref),
-                      s1=turn(m.s1), s=turn(m.s))
+                      s1=turn(m.s1), s=turn(m.s), lag_ref1=turn(m.lag_ref1),
+                      lag_ref=turn(m.lag_ref), lag_s1=turn(m.lag_s1), lag_s=turn(m.lag_s))

@@ -125,6 +125,43 @@ def test_the_slow_band_leaves_out_what_a_gyro_s_rate_error_turns_the_vectors_apa
     assert noise(gyro_scale_std, 0.0, 2.0) == noise(0.0, 0.0, 2.0) > 100.0 * r  # in full
 
 
+def test_a_swing_that_turns_back_is_discounted_by_what_it_turned_not_by_its_rate() -> None:
+    """A hand turning the sensor +-60 deg at 0.5 Hz about x: the swing turns back within the
+    vector's length, so the two low-passes part by the difference of their lags (the angle
+    turned since their samples, measured_vector item 2), far less than the peak rate times
+    their delays' difference. With a gyro 1 % off (sigma sqrt(3) x 1 %) that parting is left
+    out and the noise stays at one sample's; with an exact gyro and a 0.15 Hz sway of 1 m/s^2
+    along x (no rotation moves it) the sway still counts in full, where a discount by the rate
+    takes a third of it away."""
+    from fusion_core.kinematics import rotvec_terms
+    from fusion_core.measured_vector import measure_constants, measure_start, measure_step
+    from fusion_core.types import G
+
+    dt, r, gyro_scale_std = 0.01, 0.005**2, 0.01
+    amp, freq = math.radians(60.0), 0.5
+
+    def noise(discount: float, error: float, sway: float) -> float:
+        c = measure_constants(1.5, 1.0, 0.15, r, discount)
+        m = measure_start((0.0, 0.0, G), c)
+        settled = []
+        for k in range(1, 3000):
+            t = k * dt
+            angle = amp * math.sin(2.0 * math.pi * freq * t)
+            rate = amp * 2.0 * math.pi * freq * math.cos(2.0 * math.pi * freq * (t - 0.5 * dt))
+            a = (sway * math.sin(2.0 * math.pi * 0.15 * t), G * math.sin(angle),
+                 G * math.cos(angle))
+            phi = (rate * error * dt, 0.0, 0.0)
+            m, r_k, _ = measure_step(m, a, phi, rotvec_terms(*phi), dt, c)
+            if t > 10.0:  # the vectors full and the statistic settled
+                settled.append(r_k)
+        return sum(settled) / len(settled)
+
+    off = 1.0 + math.sqrt(3.0) * gyro_scale_std
+    assert noise(0.0, off, 0.0) > 5.0 * r  # the turn taken for disturbance
+    assert noise(gyro_scale_std, off, 0.0) < 1.1 * r  # left out
+    assert noise(gyro_scale_std, 1.0, 1.0) > 0.95 * noise(0.0, 1.0, 1.0) > 100.0 * r
+
+
 def test_the_vector_grows_longer_for_slow_linear_acceleration_but_not_for_a_turn() -> None:
     """measured_vector.stretched: a 0.15 Hz sway of 1 m/s^2 (periods longer than the 1.5 s
     vector) with no rotation stretches the vector to its longest, and the vector's tilt error

@@ -426,6 +426,9 @@ void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
         m[v + 1] = f[1];
         m[v + 2] = f[2];
     }
+    for (int v = FC_MEAS_LAG_REF1; v < FC_MEAS_SIZE; v++) {  /* no lag */
+        m[v] = 0.0;
+    }
 }
 
 static fc_real two_stage_noise(fc_real k)
@@ -441,6 +444,23 @@ static void lowpass2(fc_real *s1, fc_real *s, const fc_real back[9], const fc_re
     fc_real k = dt / (tau + dt);
     fc_lowpass_specific_force(s1, back, a, k);
     fc_lowpass_specific_force(s, back, s1, k);
+}
+
+/* lag2: one step of the lags of a second-order low-pass's two stages (each of gain k): every
+ * sample a stage holds has turned by phi more (the lags turned with the body by back), and the
+ * new sample comes with none (the first stage's input) or with the first stage's lag */
+static void lag2(fc_real l1[3], fc_real lag[3], const fc_real back[9], const fc_real phi[3],
+                 fc_real k)
+{
+    fc_real j = 1.0 - k, t[3];
+    fc_mat_vec(back, l1, t);
+    l1[0] = j * (t[0] + phi[0]);
+    l1[1] = j * (t[1] + phi[1]);
+    l1[2] = j * (t[2] + phi[2]);
+    fc_mat_vec(back, lag, t);
+    lag[0] = j * (t[0] + phi[0]) + k * l1[0];
+    lag[1] = j * (t[1] + phi[1]) + k * l1[1];
+    lag[2] = j * (t[2] + phi[2]) + k * l1[2];
 }
 
 /* stretched: the vector's length as a multiple of the full length, 1 to c->stretch */
@@ -489,10 +509,14 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             e1 = s[1] - ref[1];
             e2 = s[2] - ref[2];
             fc_real inst = e0 * e0 + e1 * e1 + e2 * e2;
-            /* less what the gyro's rate error turns the two apart by */
-            fc_real lag = 2.0 * (stage - c->band);
-            fc_real w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt);
-            fc_real turn = c->turn * w2 * (lag * lag);
+            /* less what the gyro's rate error turns the two apart by: sigma times the
+             * difference of their lags */
+            lag2(m + FC_MEAS_LAG_REF1, m + FC_MEAS_LAG_REF, back, phi, dt / (stage + dt));
+            lag2(m + FC_MEAS_LAG_S1, m + FC_MEAS_LAG_S, back, phi, dt / (c->band + dt));
+            fc_real d0 = m[FC_MEAS_LAG_REF] - m[FC_MEAS_LAG_S];
+            fc_real d1 = m[FC_MEAS_LAG_REF + 1] - m[FC_MEAS_LAG_S + 1];
+            fc_real d2 = m[FC_MEAS_LAG_REF + 2] - m[FC_MEAS_LAG_S + 2];
+            fc_real turn = c->turn * (d0 * d0 + d1 * d1 + d2 * d2);
             inst = inst > turn ? inst - turn : 0.0;
             if (c->leak > 0.0) {  /* less the fast disturbance that leaks through the band */
                 const fc_real *s1 = m + FC_MEAS_S1;
@@ -510,12 +534,14 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             }
             fc_real rise = inst > m[FC_MEAS_SLOW] ? DISTURBANCE_ATTACK : c->dist_tau;
             m[FC_MEAS_SLOW] += dt / (rise + dt) * (inst - m[FC_MEAS_SLOW]);
+            fc_real w2 = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]) / (dt * dt);
             m[FC_MEAS_RATE2] += dt / (stage + dt) * (w2 - m[FC_MEAS_RATE2]);
             fc_real excess = m[FC_MEAS_SLOW] - c->noise * two_stage_noise(dt / (c->band + dt));
             if (excess > 0.0) {
                 r += excess / (FC_G * FC_G);
                 if (c->stretch > 1.0 && bias_measured && !*filling) {  /* stretched */
-                    tau = tau * stretched(c, excess, m[FC_MEAS_RATE2], lag, full);
+                    tau = tau * stretched(c, excess, m[FC_MEAS_RATE2], 2.0 * (stage - c->band),
+                                          full);
                 }
             }
         }

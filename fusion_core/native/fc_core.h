@@ -149,8 +149,9 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise);
 enum {
     FC_MEAS_F1 = 0, FC_MEAS_F = 3, FC_MEAS_REF1 = 6, FC_MEAS_REF = 9, FC_MEAS_S1 = 12,
     FC_MEAS_S = 15, FC_MEAS_DIST = 18, FC_MEAS_SLOW = 19, FC_MEAS_FILL = 20, FC_MEAS_SETTLE = 21,
-    FC_MEAS_RATE2 = 22, FC_MEAS_BAND_IN = 23, FC_MEAS_BAND_MID = 24,
-    FC_MEAS_SIZE = 25
+    FC_MEAS_RATE2 = 22, FC_MEAS_BAND_IN = 23, FC_MEAS_BAND_MID = 24, FC_MEAS_LAG_REF1 = 25,
+    FC_MEAS_LAG_REF = 28, FC_MEAS_LAG_S1 = 31, FC_MEAS_LAG_S = 34,
+    FC_MEAS_SIZE = 37
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {

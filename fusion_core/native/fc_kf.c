@@ -320,6 +320,11 @@ static void switch_face(fc_kf *f)
         TURN(f->meas + v, turned);
         memcpy(f->meas + v, turned, sizeof turned);
     }
+    for (int v = FC_MEAS_LAG_REF1; v < FC_MEAS_SIZE; v += 3) {  /* the lags */
+        fc_real turned[3];
+        TURN(f->meas + v, turned);
+        memcpy(f->meas + v, turned, sizeof turned);
+    }
     for (int v = 0; v < FC_REST_SIZE; v += v == 3 ? 5 : 3) {  /* rates, means, start's mean */
         fc_real turned[3];
         TURN(f->rest + v, turned);
