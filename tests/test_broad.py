@@ -431,12 +431,13 @@ def test_cv_grid_refuses_a_bad_entry_before_any_run(
 
 def test_the_contract_constraint_names_the_first_check_a_point_fails() -> None:
     """The defaults keep the contract's per-run accuracy bounds (make run); the kf with a 2 s
-    measured vector turns too slowly for the roll sweep's bound, and the reason says so."""
+    measured vector still fills when high_dynamics' first move starts and leaves its pitch
+    bound, and the reason says so."""
     from testbenches.broad.feasible import contract_failure
 
     assert contract_failure("kf", {}) is None
     why = contract_failure("kf", {"acc_lowpass": 2.0})
-    assert why is not None and why.startswith("roll_sweep: FAIL accuracy roll RMSE")
+    assert why is not None and why.startswith("high_dynamics: FAIL accuracy pitch RMSE")
 
 
 def test_the_constraint_keeps_the_share_of_the_papers_row_the_defaults_owe() -> None:
