@@ -315,12 +315,8 @@ static void switch_face(fc_kf *f)
     f->bias_x = b2[0];
     f->bias_y = b2[1];
     f->bias_z = b2[2];
-    for (int v = 0; v < FC_MEAS_DIST; v += 3) {
-        fc_real turned[3];
-        TURN(f->meas + v, turned);
-        memcpy(f->meas + v, turned, sizeof turned);
-    }
-    for (int v = FC_MEAS_LAG_REF1; v < FC_MEAS_SIZE; v += 3) {  /* the lags */
+    /* the measured vector's vectors, then its lags (the statistics between them are scalars) */
+    for (int v = 0; v < FC_MEAS_SIZE; v = v + 3 == FC_MEAS_DIST ? FC_MEAS_LAG_REF1 : v + 3) {
         fc_real turned[3];
         TURN(f->meas + v, turned);
         memcpy(f->meas + v, turned, sizeof turned);
