@@ -63,6 +63,7 @@ from .measured_vector import (
     STRETCH_PARAM,
     fill_noise,
     gate_norm2,
+    held_norm2,
     measure_clipped,
     measure_constants,
     measure_restarted,
@@ -172,9 +173,14 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
       grows by it, no bias is learned from the sample and the measured vector starts again;
     - the bias learns from the accelerometer only while the norm of what reaches the measured
       vector (its slow band: measured_vector.gate_norm2; without the vector the raw sample's) is
-      within bias_gate of g (Duong Quoc et al.'s real-sensor cutoff), both innovations are within
-      bias_innovation (a larger one is a gross attitude error, not a bias drift) and the
-      measured vector is settled; otherwise the biases are consider states (angle_only_gain);
+      within bias_gate of g (Duong Quoc et al.'s real-sensor cutoff), so is the vector's own
+      (measured_vector.held_norm2: a disturbance the slow band has passed stays in the vector
+      for its length), both innovations are within bias_innovation (a larger one is a gross
+      attitude error, not a bias drift) and the measured vector is settled; otherwise the
+      biases are consider states (angle_only_gain). A bias learned wrong on a horizontal axis
+      and carried to z by a face switch would stay, as bias_z is observed only at rest (a
+      second of absurd samples during a slow roll: `imu-fusion battery --motion slow_rotation
+      --sensor mpu6050_glitch`);
     - a gross innovation (beyond gross_innovation, more than a held linear acceleration can
       tilt the measured vector by): the attitude is off by at least that much, so the angle's
       variance is raised to the innovation squared before the update (raised_angle_variance).
@@ -370,11 +376,13 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             r = base + (r - self._measure.r)
             cap = self.q_step * self._longest2 / dt
             self.r_step = r if r < cap else (cap if cap > base else base)
-            # the bias gate on what reaches the vector (gate_norm2); no bias from a vector that
-            # is filling (a mean of the first samples, of a motion's start as likely as of rest)
-            # or holds turns the gyro did not measure (gyro_range)
+            # the bias gate on what reaches the vector (gate_norm2) and on what it still holds
+            # (held_norm2); no bias from a vector that is filling (a mean of the first samples,
+            # of a motion's start as likely as of rest) or holds turns the gyro did not measure
+            # (gyro_range)
             n2 = gate_norm2(self.meas, self._measure, raw2)
-            learn_bias = (lo < n2 < hi and not clipped and not filling
+            v2 = held_norm2(self.meas, self._measure, n2)
+            learn_bias = (lo < n2 < hi and lo < v2 < hi and not clipped and not filling
                           and self.meas.settled(self._measure))
             ax, ay, az = self.meas.f
         else:  # the raw sample (bias_gate); never a sample at the rail

@@ -409,6 +409,20 @@ def gate_norm2(m: Measure, c: MeasureConstants, raw2: float) -> float:
     return raw2
 
 
+def held_norm2(m: Measure, c: MeasureConstants, n2: float) -> float:
+    """The squared norm [m^2/s^4] of the measured vector itself where the slow band is measured
+    (gate_norm2's n2 is the slow band's), else n2. After a disturbance the slow band is back
+    within a fraction of a second while the vector holds it for its length: a filter whose
+    attitude followed the vector then drifts back to gravity as the vector refills, a drift an
+    update would take for a bias. A bias gate that judges this norm as well waits for the
+    vector to let the disturbance go (the kf, whose z bias a face switch may carry such a bias
+    into and which observes it only at rest: kalman.AngleBiasKalmanFilter)."""
+    if c.dist_tau > 0.0 and c.band > 0.0:
+        f0, f1, f2 = m.f
+        return f0 * f0 + f1 * f1 + f2 * f2
+    return n2
+
+
 def raw_noise(m: Measure, c: MeasureConstants) -> float:
     """The measurement noise [rad^2] sized by the raw sample's disturbance (`dist`, all of the
     linear acceleration against the full-length reference, fast or slow) instead of the slow band

@@ -331,16 +331,11 @@ def filter_params(sensor: SensorClass, known_scale: bool = False) -> dict[str, d
     return out
 
 
-def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
-              overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True,
-              known_scale: bool = False) -> dict[str, float]:
-    """One part's inclination RMSE [deg] per filter (its parameters, filter_params with
-    known_scale, with `overrides[key]` over them) and, with vqf, VQF's on one motion."""
-    from fusion_core.registry import create
+def part_samples(motion: str, sensor: str, seed: int
+                 ) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """One part's recording of one motion: the times [s], the truth (Trajectory.truth) and the
+    samples (ImuSensorModel.run with the part's seed, glitched where its class glitches)."""
     from fusion_core.sensor import ImuSensorModel
-
-    from .broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
-    from .peers import PEERS
 
     m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
     n = round((m.rest + m.duration) * s.rate) + 1
@@ -348,7 +343,21 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
     truth = m.trajectory().truth(t)
     sample = ImuSensorModel(**{**s.params, "seed": seed}).run(truth["omega"], truth["f"],
                                                               1.0 / s.rate)
-    sample = glitched(sample, s, m.rest + GLITCH_AFTER_S, seed)
+    return t, truth, glitched(sample, s, m.rest + GLITCH_AFTER_S, seed)
+
+
+def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
+              overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True,
+              known_scale: bool = False) -> dict[str, float]:
+    """One part's inclination RMSE [deg] per filter (its parameters, filter_params with
+    known_scale, with `overrides[key]` over them) and, with vqf, VQF's on one motion."""
+    from fusion_core.registry import create
+
+    from .broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
+    from .peers import PEERS
+
+    m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
+    t, truth, sample = part_samples(motion, sensor, seed)
     true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
     scored = t >= m.rest + SETTLE_S
     params = filter_params(s, known_scale)

@@ -573,6 +573,16 @@ fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_const
     return raw2;
 }
 
+fc_real fc_measure_held_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
+                              fc_real n2)
+{
+    if (c->dist_tau > 0.0 && c->band > 0.0) {
+        const fc_real *f = m + FC_MEAS_F;
+        return f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
+    }
+    return n2;
+}
+
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)
 {
     fc_real excess = m[FC_MEAS_DIST] - c->noise;

@@ -177,6 +177,9 @@ int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c
 /* gate_norm2: the squared norm a bias gate judges (the slow band's, else raw2) */
 fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
                               fc_real raw2);
+/* held_norm2: the squared norm of the vector itself where the slow band is measured, else n2 */
+fc_real fc_measure_held_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
+                              fc_real n2);
 /* raw_noise */
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* measure_restarted: aligned at f, the slow band from nothing */

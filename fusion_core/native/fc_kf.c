@@ -263,10 +263,13 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         r_meas = r;
         fc_real cap = f->q_step * f->longest2 / dt;
         f->r_step = r < cap ? r : (cap > base ? cap : base);
-        /* the bias gate on what reaches the vector (gate_norm2); no bias from a vector that is
-         * filling or holds turns the gyro did not measure */
+        /* the bias gate on what reaches the vector (gate_norm2) and on what it still holds
+         * (held_norm2); no bias from a vector that is filling or holds turns the gyro did not
+         * measure */
         fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
-        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && !clipped && !filling
+        fc_real v2 = fc_measure_held_norm2(f->meas, &f->measure, n2);
+        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && f->bias_lo2 < v2
+                     && v2 < f->bias_hi2 && !clipped && !filling
                      && fc_measure_settled(f->meas, &f->measure);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
     } else {  /* the raw sample (bias_gate); never a sample at the rail */
