@@ -26,9 +26,12 @@ Otherwise a mechanism keeps its place where BROAD and the battery's mean both sa
 error, or where neither does but one of the battery's cells or the contract's scenarios needs it
 (MOTION_CLASS_GAIN); where nothing does, it is a candidate to drop; else the table says which
 way each points. Mechanisms can cover for each other (the two bias gates): one switched off at
-a time shows what the other leaves, and `bias_gates` switches both. The grid values of the
-other parameters were chosen with every mechanism on, which favours keeping: a mechanism that
-does not earn its place even so does not earn it.
+a time shows what the other leaves, and `bias_gates` switches both.
+
+The grid values of the other parameters were chosen with every mechanism on. Dropping one
+changes what the folds choose as well, so a candidate to drop is scored once more with the grid
+chosen again per fold without it, as `broad --cv` chooses it (grid_worth), and stays where
+BROAD's folds so chosen are worse without it.
 """
 
 from __future__ import annotations
@@ -144,6 +147,10 @@ class Worth:
     contract_best: tuple[str, float] = ("", math.nan)
     """The contract's scenario where it helps most: (scenario, mean RMSE over the parts
     without / with): the contract's scenarios are a battery of motions too."""
+    grid_cv: tuple[float, float] | None = None
+    """For a candidate to drop (would_drop): BROAD's cross-validated mean [deg] with the grid
+    parameters chosen again per fold (testbenches.broad.cv), without it and with it (None:
+    not a candidate, or BROAD's folds not measured so)."""
 
     def broad_gain(self) -> float:
         """Cross-validated mean of always dropping it minus that of deciding per fold [deg]."""
@@ -170,7 +177,17 @@ class Worth:
         scenario, ratio = self.contract_best
         if ratio >= MOTION_CLASS_GAIN:
             return f"keeps its place for the contract's {scenario} ({ratio:.2f}x without)"
+        if self.grid_cv is not None:
+            off, on = self.grid_cv
+            if (off - on) / off > TIE:
+                return ("keeps its place: with the grid chosen again, BROAD's folds need it "
+                        f"({off:.3f} without)")
         return "drop: no gain out of sample"
+
+    def would_drop(self) -> bool:
+        """Whether the verdict at the recommended grid point drops it: the candidates whose
+        grid is chosen again (grid_worth) before they are dropped."""
+        return self.grid_cv is None and self.verdict().startswith("drop")
 
 
 def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
@@ -258,6 +275,28 @@ def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: st
         w.battery_best = (cell, ratios[cell])
 
 
+def grid_worth(worth: dict[tuple[str, str], Worth], trials: Sequence[Any],
+               groups: Sequence[Sequence[str]],
+               progress: Callable[[str], None] | None = None) -> None:
+    """Fill grid_cv of every candidate to drop: `broad --cv`'s cross-validation of the grid
+    parameters (CV_GRID, among the points that keep the contract, by the smallest regret) with
+    the filter as it is and with the mechanism off. At the recommended point a mechanism may
+    look level while the choices the folds make without it are worse: the slow band's fast
+    leak keeps the band's statistic from counting a bounce, and without it the folds that
+    never saw a disturbed trial take a longer band."""
+    from .broad.cv import cross_validate
+
+    on: dict[str, float] = {}
+    for (key, name), w in worth.items():
+        if not w.would_drop():
+            continue
+        if key not in on:
+            on[key] = cross_validate(trials, groups, [key], progress=progress).cv_means()[key]
+        off = cross_validate(trials, groups, [key], progress=progress,
+                             base=BY_NAME[name].off).cv_means()[key]
+        w.grid_cv = (off, on[key])
+
+
 def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
                    progress: Callable[[], None] | None = None) -> None:
     """Fill each Worth's contract_lost: the contract's accuracy checks over `parts` parts (as
@@ -291,17 +330,19 @@ def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
     keep it, the cross-validated gain, the battery's ratio and the verdict."""
     rows = ["| estimator | mechanism | BROAD with | without | folds keeping it | CV gain [deg] "
             "| battery without / with | cell it helps most | cell it costs most | contract checks "
-            "lost without | verdict |",
-            "|---|---|---|---|---|---|---|---|---|---|---|"]
+            "lost without | grid chosen again: CV without / with [deg] | verdict |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (key, name), w in worth.items():
         lost = "-" if w.contract_lost is None else (", ".join(w.contract_lost) or "none")
         worst, best = ((f"{c} {r:.2f}" if math.isfinite(r) else "-")
                        for c, r in (w.battery_worst, w.battery_best))
         ratio = f"{w.battery_ratio:.3f}" if math.isfinite(w.battery_ratio) else "-"
+        grid = "-" if w.grid_cv is None else f"{w.grid_cv[0]:.3f} / {w.grid_cv[1]:.3f}"
         rows.append(
             f"| {key} | {name} | {np.mean(list(w.broad_on.values())):.3f} | "
             f"{np.mean(list(w.broad_off.values())):.3f} | {len(w.kept_in)} of 4 | "
-            f"{w.broad_gain():+.3f} | {ratio} | {best} | {worst} | {lost} | {w.verdict()} |")
+            f"{w.broad_gain():+.3f} | {ratio} | {best} | {worst} | {lost} | {grid} | "
+            f"{w.verdict()} |")
     return "\n".join(rows)
 
 
@@ -368,6 +409,10 @@ def measure(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimators: 
         cells = (1 + len({m for _, m in worth})) * len(MOTIONS) * len(SENSOR_CLASSES)
         with stage(cells, "battery", "cell") as b:
             battery_worth(worth, parts, scheduler, workers, step(b))
+    candidates = {k for (k, _), w in worth.items() if w.would_drop()}
+    runs = len(trials) * (len(candidates) + sum(w.would_drop() for w in worth.values()))
+    with stage(runs, "BROAD's grid", "trial") as b:
+        grid_worth(worth, trials, groups, (lambda _: b.update()) if b is not None else None)
     return worth
 
 
@@ -402,7 +447,8 @@ def cmd_mechanisms(args: argparse.Namespace) -> int:
                    "battery_worst_cell": list(w.battery_worst),
                    "battery_best_cell": list(w.battery_best),
                    "contract_checks_lost": w.contract_lost,
-                   "contract_best": list(w.contract_best), "verdict": w.verdict()}
+                   "contract_best": list(w.contract_best),
+                   "grid_cv_without_with_deg": w.grid_cv, "verdict": w.verdict()}
                   for w in worth.values()]}, indent=1))
     print(f"written: {args.out}/mechanisms.md, mechanisms.json")
     return 0

@@ -64,14 +64,23 @@ def test_the_verdict_needs_both_ways_of_scoring() -> None:
     assert level.verdict().startswith("keeps its place: the contract needs it")
 
 
-@pytest.mark.skipif(not all(p.is_file() for p in TRIALS),
-                    reason=f"no BROAD trials in {DATA} (set BROAD_DIR)")
-def test_the_command_on_two_slices(tmp_path: Path, capsys) -> None:
-    pytest.importorskip("h5py")
+def test_a_drop_waits_for_the_grid_chosen_again_without_it() -> None:
+    """Level at the recommended point, the fast leak would go; with the grid chosen again per
+    fold it stays where the folds choose worse points without it, and goes where they do not."""
+    on = {"a1": 1.0, "b1": 1.0}
+    w = Worth("kf", "band_leak", on, dict(on), [], dict(on), battery_ratio=1.001)
+    assert w.would_drop() and w.verdict().startswith("drop")
+    w.grid_cv = (0.515, 0.497)
+    assert not w.would_drop()
+    assert w.verdict().startswith("keeps its place: with the grid chosen again")
+    w.grid_cv = (0.4975, 0.497)  # within the tie: the simpler filter
+    assert w.verdict().startswith("drop")
+
+
+def _slices(tmp_path: Path) -> list[str]:
     import h5py
 
     from testbenches.broad.data import load_trial
-    from testbenches.cli import main
 
     files = []
     for source in TRIALS:
@@ -82,6 +91,37 @@ def test_the_command_on_two_slices(tmp_path: Path, capsys) -> None:
             f["opt_quat"], f["movement"] = trial.opt_quat, trial.movement
             f.attrs["sampling_rate"] = trial.rate
         files.append(str(path))
+    return files
+
+
+@pytest.mark.skipif(not all(p.is_file() for p in TRIALS),
+                    reason=f"no BROAD trials in {DATA} (set BROAD_DIR)")
+def test_the_grid_is_chosen_again_with_the_mechanism_off(tmp_path: Path) -> None:
+    """cross_validate's base reaches every run, over the grid point's own values: with the
+    pre-filter off, each point of a grid of acc_lowpass runs the filter without it."""
+    pytest.importorskip("h5py")
+    from testbenches.broad.cv import _rmse, cross_validate
+    from testbenches.broad.run import run_fusion_core
+    from testbenches.mechanisms import BY_NAME, load_trials
+
+    trials, groups = load_trials([Path(f) for f in _slices(tmp_path)])
+    off = BY_NAME["prefilter"].off
+    grid = {"acc_lowpass": [1.0, 2.0]}
+    cv = cross_validate(trials, groups, ["kf"], grid=grid, constraint=None, base=off)
+    e = cv.estimators["kf"]
+    for j, trial in enumerate(trials):
+        r = run_fusion_core("kf", off, trial)
+        assert e.errors[0, j] == e.errors[1, j] == _rmse(trial, r["roll"], r["pitch"])
+        assert e.in_sample[trial.name] == e.errors[0, j]
+
+
+@pytest.mark.skipif(not all(p.is_file() for p in TRIALS),
+                    reason=f"no BROAD trials in {DATA} (set BROAD_DIR)")
+def test_the_command_on_two_slices(tmp_path: Path, capsys) -> None:
+    pytest.importorskip("h5py")
+    from testbenches.cli import main
+
+    files = _slices(tmp_path)
     out = tmp_path / "m"
     assert main(["mechanisms", *files, "--estimator", "kf", "--mechanism", "prefilter,rest",
                  "--parts", "0", "--out", str(out)]) == 0

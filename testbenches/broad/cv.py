@@ -199,6 +199,7 @@ def cross_validate(
     grid: Grid | None = None,
     constraint: Callable[[str, dict[str, float]], str | None] | None = contract_failure,
     choice: str = "regret",
+    base: dict[str, float] | None = None,
 ) -> CvResult:
     """The cross-validation of every estimator's grid parameters over the trials (groups: each
     trial's BROAD groups). peers: name -> f(acc, gyro, rate, delay) giving the up direction,
@@ -209,7 +210,8 @@ def cross_validate(
     leaves that one out. constraint(key, point): why the point may not be chosen, or None
     (testbenches.broad.feasible.contract_failure: the contract's per-run accuracy bounds; None:
     every point may be); a fold, and the scan, choose the best point it allows by choice
-    (CHOICES: "regret" or "mean")."""
+    (CHOICES: "regret" or "mean"). base: parameters every run takes, over the point's and
+    the defaults' (a mechanism switched off: testbenches.mechanisms)."""
     if choice not in CHOICES:
         raise ValueError(f"choice {choice!r}: allowed {', '.join(CHOICES)}")
     measured = measured or {}
@@ -231,19 +233,19 @@ def cross_validate(
                   for values in itertools.product(*(grid[k] for k in keys))]
         defaults = {k: float(specs[k].default) for k in keys}
         cv = EstimatorCv(key, defaults, grid=points, errors=np.zeros((len(points), len(trials))))
-        at_default = points.index(defaults) if defaults in points else None
+        at_default = points.index(defaults) if defaults in points and not base else None
         for j, trial in enumerate(trials):
             for i, point in enumerate(points):
-                r = run_fusion_core(key, point, trial)
+                r = run_fusion_core(key, {**point, **(base or {})}, trial)
                 cv.errors[i, j] = _rmse(trial, r["roll"], r["pitch"])
             if at_default is None:  # defaults off the grid: run them too
-                r = run_fusion_core(key, {}, trial)
+                r = run_fusion_core(key, dict(base or {}), trial)
                 cv.in_sample[trial.name] = _rmse(trial, r["roll"], r["pitch"])
             else:
                 cv.in_sample[trial.name] = float(cv.errors[at_default, j])
             if progress is not None:
                 progress(f"{key} {trial.name[:28]}")
-        allowed = _Allowed(key, points, constraint)
+        allowed = _Allowed(key, [{**p, **(base or {})} for p in points], constraint)
         columns = {f: [j for j, n in enumerate(names) if folds[n] == f] for f in present}
 
         cv.scan_choice = points[_choose(cv, list(columns.values()), allowed, choice)]
