@@ -403,10 +403,7 @@ def gate_norm2(m: Measure, c: MeasureConstants, raw2: float) -> float:
     contract's shaking and high_dynamics over parts show the difference (`python -m
     testbenches run --scenario shaking,high_dynamics --seeds 20 --estimator kf,ukf
     --no-contract`)."""
-    if c.dist_tau > 0.0 and c.band > 0.0:
-        s0, s1, s2 = m.s
-        return s0 * s0 + s1 * s1 + s2 * s2
-    return raw2
+    return _band_norm2(m.s, c, raw2)
 
 
 def held_norm2(m: Measure, c: MeasureConstants, n2: float) -> float:
@@ -417,10 +414,15 @@ def held_norm2(m: Measure, c: MeasureConstants, n2: float) -> float:
     update would take for a bias. A bias gate that judges this norm as well waits for the
     vector to let the disturbance go (the kf, whose z bias a face switch may carry such a bias
     into and which observes it only at rest: kalman.AngleBiasKalmanFilter)."""
+    return _band_norm2(m.f, c, n2)
+
+
+def _band_norm2(v: Vec3, c: MeasureConstants, otherwise: float) -> float:
+    """|v|^2 where the slow band is measured (the statistics on), else `otherwise`."""
     if c.dist_tau > 0.0 and c.band > 0.0:
-        f0, f1, f2 = m.f
-        return f0 * f0 + f1 * f1 + f2 * f2
-    return n2
+        v0, v1, v2 = v
+        return v0 * v0 + v1 * v1 + v2 * v2
+    return otherwise
 
 
 def raw_noise(m: Measure, c: MeasureConstants) -> float:

@@ -563,24 +563,28 @@ int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c
     return m[FC_MEAS_SETTLE] >= 2.0 * c->stage;
 }
 
+/* band_norm2: the squared norm of the vector at m + at where the slow band is measured, else
+ * otherwise */
+static fc_real band_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c, int at,
+                          fc_real otherwise)
+{
+    if (c->dist_tau > 0.0 && c->band > 0.0) {
+        const fc_real *v = m + at;
+        return v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    }
+    return otherwise;
+}
+
 fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
                               fc_real raw2)
 {
-    if (c->dist_tau > 0.0 && c->band > 0.0) {
-        const fc_real *s = m + FC_MEAS_S;
-        return s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
-    }
-    return raw2;
+    return band_norm2(m, c, FC_MEAS_S, raw2);
 }
 
 fc_real fc_measure_held_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
                               fc_real n2)
 {
-    if (c->dist_tau > 0.0 && c->band > 0.0) {
-        const fc_real *f = m + FC_MEAS_F;
-        return f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
-    }
-    return n2;
+    return band_norm2(m, c, FC_MEAS_F, n2);
 }
 
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)
