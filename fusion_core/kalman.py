@@ -61,9 +61,9 @@ from .measured_vector import (
     LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
+    band_measured,
     fill_noise,
     gate_norm2,
-    held_norm2,
     measure_clipped,
     measure_constants,
     measure_restarted,
@@ -174,8 +174,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
     - the bias learns from the accelerometer only while the norm of what reaches the measured
       vector (its slow band: measured_vector.gate_norm2; without the vector the raw sample's) is
       within bias_gate of g (Duong Quoc et al.'s real-sensor cutoff), so is the vector's own
-      (measured_vector.held_norm2: a disturbance the slow band has passed stays in the vector
-      for its length), both innovations are within bias_innovation (a larger one is a gross
+      where the slow band is measured (a disturbance the slow band has passed stays in the
+      vector for its length), both innovations are within bias_innovation (a larger one is a gross
       attitude error, not a bias drift) and the measured vector is settled; otherwise the
       biases are consider states (angle_only_gain). A bias learned wrong on a horizontal axis
       and carried to z by a face switch would stay, as bias_z is observed only at rest (a
@@ -376,18 +376,22 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             r = base + (r - self._measure.r)
             cap = self.q_step * self._longest2 / dt
             self.r_step = r if r < cap else (cap if cap > base else base)
-            # the bias gate on what reaches the vector (gate_norm2) and on what it still holds
-            # (held_norm2); no bias from a vector that is filling (a mean of the first samples,
-            # of a motion's start as likely as of rest) or holds turns the gyro did not measure
-            # (gyro_range)
-            n2 = gate_norm2(self.meas, self._measure, raw2)
-            v2 = held_norm2(self.meas, self._measure, n2)
-            learn_bias = (lo < n2 < hi and lo < v2 < hi and not clipped and not filling
-                          and self.meas.settled(self._measure))
             ax, ay, az = self.meas.f
+            a2 = ax * ax + ay * ay + az * az
+            # the bias gate on what reaches the vector (gate_norm2) and, where that is the slow
+            # band, on what the vector still holds, its own norm: after a disturbance the slow
+            # band is back within a fraction of a second while the vector holds it for its
+            # length, and the attitude that followed the vector drifts back to gravity as it
+            # refills, a drift an update would take for a bias. No bias from a vector that is
+            # filling (a mean of the first samples, of a motion's start as likely as of rest) or
+            # holds turns the gyro did not measure (gyro_range)
+            n2 = gate_norm2(self.meas, self._measure, raw2)
+            learn_bias = (lo < n2 < hi and (lo < a2 < hi or not band_measured(self._measure))
+                          and not clipped and not filling and self.meas.settled(self._measure))
         else:  # the raw sample (bias_gate); never a sample at the rail
+            a2 = raw2
             learn_bias = lo < raw2 < hi and not clipped
-        if self.accel_trusted(ax * ax + ay * ay + az * az):
+        if self.accel_trusted(a2):
             if not filling:
                 turn = self.correct(ax, ay, az, learn_bias, up, turn)
             elif not rested:  # (a first rest's mean, which no gyro error turned, stands)

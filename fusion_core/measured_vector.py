@@ -403,26 +403,15 @@ def gate_norm2(m: Measure, c: MeasureConstants, raw2: float) -> float:
     contract's shaking and high_dynamics over parts show the difference (`python -m
     testbenches run --scenario shaking,high_dynamics --seeds 20 --estimator kf,ukf
     --no-contract`)."""
-    return _band_norm2(m.s, c, raw2)
+    if band_measured(c):
+        s0, s1, s2 = m.s
+        return s0 * s0 + s1 * s1 + s2 * s2
+    return raw2
 
 
-def held_norm2(m: Measure, c: MeasureConstants, n2: float) -> float:
-    """The squared norm [m^2/s^4] of the measured vector itself where the slow band is measured
-    (gate_norm2's n2 is the slow band's), else n2. After a disturbance the slow band is back
-    within a fraction of a second while the vector holds it for its length: a filter whose
-    attitude followed the vector then drifts back to gravity as the vector refills, a drift an
-    update would take for a bias. A bias gate that judges this norm as well waits for the
-    vector to let the disturbance go (the kf, whose z bias a face switch may carry such a bias
-    into and which observes it only at rest: kalman.AngleBiasKalmanFilter)."""
-    return _band_norm2(m.f, c, n2)
-
-
-def _band_norm2(v: Vec3, c: MeasureConstants, otherwise: float) -> float:
-    """|v|^2 where the slow band is measured (the statistics on), else `otherwise`."""
-    if c.dist_tau > 0.0 and c.band > 0.0:
-        v0, v1, v2 = v
-        return v0 * v0 + v1 * v1 + v2 * v2
-    return otherwise
+def band_measured(c: MeasureConstants) -> bool:
+    """Whether the slow band is measured (slow_band_time > 0, the statistics on)."""
+    return c.dist_tau > 0.0 and c.band > 0.0
 
 
 def raw_noise(m: Measure, c: MeasureConstants) -> float:

@@ -563,28 +563,19 @@ int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c
     return m[FC_MEAS_SETTLE] >= 2.0 * c->stage;
 }
 
-/* band_norm2: the squared norm of the vector at m + at where the slow band is measured, else
- * otherwise */
-static fc_real band_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c, int at,
-                          fc_real otherwise)
+int fc_measure_band_measured(const fc_meas_constants *c)
 {
-    if (c->dist_tau > 0.0 && c->band > 0.0) {
-        const fc_real *v = m + at;
-        return v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-    }
-    return otherwise;
+    return c->dist_tau > 0.0 && c->band > 0.0;
 }
 
 fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
                               fc_real raw2)
 {
-    return band_norm2(m, c, FC_MEAS_S, raw2);
-}
-
-fc_real fc_measure_held_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
-                              fc_real n2)
-{
-    return band_norm2(m, c, FC_MEAS_F, n2);
+    if (fc_measure_band_measured(c)) {
+        const fc_real *s = m + FC_MEAS_S;
+        return s[0] * s[0] + s[1] * s[1] + s[2] * s[2];
+    }
+    return raw2;
 }
 
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)

@@ -174,12 +174,11 @@ void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,
                            const fc_meas_constants *c, fc_real *var, fc_real *age);
 /* Measure.settled */
 int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
+/* band_measured: whether the slow band is measured (the statistics on) */
+int fc_measure_band_measured(const fc_meas_constants *c);
 /* gate_norm2: the squared norm a bias gate judges (the slow band's, else raw2) */
 fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
                               fc_real raw2);
-/* held_norm2: the squared norm of the vector itself where the slow band is measured, else n2 */
-fc_real fc_measure_held_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
-                              fc_real n2);
 /* raw_noise */
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
 /* measure_restarted: aligned at f, the slow band from nothing */

@@ -250,6 +250,7 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         turn[1] = f->pitch - pred_pitch;
     }
     fc_real r_meas = f->r;
+    fc_real a2;  /* the squared norm of what the update measures */
     if (f->acc_tau > 0.0) {
         if (clipped) {
             fc_measure_clipped(f->meas);
@@ -263,20 +264,21 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         r_meas = r;
         fc_real cap = f->q_step * f->longest2 / dt;
         f->r_step = r < cap ? r : (cap > base ? cap : base);
-        /* the bias gate on what reaches the vector (gate_norm2) and on what it still holds
-         * (held_norm2); no bias from a vector that is filling or holds turns the gyro did not
-         * measure */
-        fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
-        fc_real v2 = fc_measure_held_norm2(f->meas, &f->measure, n2);
-        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2 && f->bias_lo2 < v2
-                     && v2 < f->bias_hi2 && !clipped && !filling
-                     && fc_measure_settled(f->meas, &f->measure);
         memcpy(a, f->meas + FC_MEAS_F, sizeof a);
+        a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        /* the bias gate on what reaches the vector (gate_norm2) and, where that is the slow
+         * band, on what the vector still holds, its own norm; no bias from a vector that is
+         * filling or holds turns the gyro did not measure */
+        fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
+        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2
+                     && ((f->bias_lo2 < a2 && a2 < f->bias_hi2)
+                         || !fc_measure_band_measured(&f->measure))
+                     && !clipped && !filling && fc_measure_settled(f->meas, &f->measure);
     } else {  /* the raw sample (bias_gate); never a sample at the rail */
+        a2 = raw2;
         learn_bias = f->bias_lo2 < raw2 && raw2 < f->bias_hi2 && !clipped;
     }
-    fc_real n2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    if (f->gate_low2 <= n2 && n2 <= f->gate_high2) {
+    if (f->gate_low2 <= a2 && a2 <= f->gate_high2) {
         if (!filling) {
             correct(f, a[0], a[1], a[2], learn_bias, up, turn);
         } else if (!rested) {  /* (a first rest's mean, which no gyro error turned, stands) */
