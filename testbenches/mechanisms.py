@@ -5,8 +5,10 @@ A mechanism (MECHANISMS: the accelerometer pre-filter, its adaptive noise, the f
 off its slow band and the band's cap at a held acceleration, the longer vector, the
 scale-error process noise, rest detection and its turn-on rule, the bias gates, the variance
 after a gross innovation, the accelerometer gate) on
-by default is switched off by the parameter values that turn it off, everything else at the
-recommended values, and the filter is scored with and without it two ways:
+by default is switched off by the parameter values that turn it off, and one this test dropped
+from a filter's defaults is switched on again by the values the other filters recommend
+(Mechanism.on), everything else at the recommended values; the filter is scored with and
+without it three ways:
 
 - **BROAD, leave one motion fold out** (testbenches.broad.cv.FOLDS): whether to keep it is decided
   on three folds' trials, by the rule `broad --cv` chooses grid points with (the smallest regret
@@ -25,13 +27,18 @@ recommended values, and the filter is scored with and without it two ways:
 Otherwise a mechanism keeps its place where BROAD and the battery's mean both say it lowers the
 error, or where neither does but one of the battery's cells or the contract's scenarios needs it
 (MOTION_CLASS_GAIN); where nothing does, it is a candidate to drop; else the table says which
-way each points. Mechanisms can cover for each other (the two bias gates): one switched off at
-a time shows what the other leaves, and `bias_gates` switches both.
+way each points. A dropped mechanism is judged by the same rules with it switched on: where
+they would keep it, it is a candidate to come back. Mechanisms can cover for each other (the two
+bias gates): one switched off at a time shows what the other leaves, and `bias_gates` switches
+both.
 
-The grid values of the other parameters were chosen with every mechanism on. Dropping one
-changes what the folds choose as well, so a candidate to drop is scored once more with the grid
-chosen again per fold without it, as `broad --cv` chooses it (grid_worth), and stays where
-BROAD's folds so chosen are worse without it.
+The grid values of the other parameters were chosen with the mechanisms as they are. Dropping
+one, or taking a dropped one back, changes what the folds choose as well, so a candidate to
+change is scored once more with the grid chosen again per fold, without it and with it, as
+`broad --cv` chooses it (grid_worth): cross-validated and nested-cross-validated. A filter's
+set of mechanisms changes only where both agree: a mechanism on stays where either finds the
+folds so chosen worse without it, and a dropped one comes back only where both find them
+better with it.
 """
 
 from __future__ import annotations
@@ -39,11 +46,15 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from fusion_core.building_blocks.gate import BIAS_GATE, BIAS_INNOVATION
+from fusion_core.measured_vector import HELD_PARAM, LEAK_PARAM
+from fusion_core.papers.common import PAPER_GATE
 
 TIE = 0.005
 """Relative differences below this count as level (half a percent of the error)."""
@@ -55,11 +66,13 @@ many times the error with it: a mechanism made for one kind of motion."""
 
 @dataclass(frozen=True)
 class Mechanism:
-    """A mechanism of the recommended filters and the parameter values that switch it off."""
+    """A mechanism of the recommended filters, the parameter values that switch it off and
+    those that switch it on again in a filter whose defaults dropped it (none: never dropped)."""
 
     name: str
     what: str
     off: dict[str, float]
+    on: dict[str, float] = field(default_factory=dict)
 
     def _at_off(self, key: str) -> list[bool] | None:
         """For each parameter that switches it off, whether estimator `key`'s default is
@@ -84,6 +97,16 @@ class Mechanism:
         at_off = self._at_off(key)
         return at_off is not None and all(at_off)
 
+    def switch(self, key: str) -> dict[str, float] | None:
+        """The parameter values that change estimator `key`'s mechanism: `off` where its
+        defaults have it on, `on` where they dropped it, None where it is not scored (neither,
+        or dropped with no `on`)."""
+        if self.applies(key):
+            return self.off
+        if self.dropped(key) and self.on:
+            return self.on
+        return None
+
 
 MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("prefilter", "the accelerometer pre-filter in a frame turning with the gyro, with "
@@ -92,10 +115,11 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("adaptive_noise", "measurement noise and pre-filter length that follow the "
               "measured linear acceleration (disturbance_time 0)", {"disturbance_time": 0.0}),
     Mechanism("band_leak", "the fast disturbance that leaks through the slow band taken off "
-              "its statistic (slow_band_leak 0)", {"slow_band_leak": 0.0}),
+              "its statistic (slow_band_leak 0)", {"slow_band_leak": 0.0},
+              {"slow_band_leak": float(LEAK_PARAM.default)}),
     Mechanism("held_acceleration", "the slow band's statistic counts no more than a held "
               "linear acceleration, g tan 30 deg (held_acceleration 0)",
-              {"held_acceleration": 0.0}),
+              {"held_acceleration": 0.0}, {"held_acceleration": float(HELD_PARAM.default)}),
     Mechanism("longer_vector", "the vector grows where slow linear acceleration reaches it "
               "(acc_lowpass_stretch 1)", {"acc_lowpass_stretch": 1.0}),
     Mechanism("scale_noise", "process noise for the gyro's scale error while it turns "
@@ -104,28 +128,31 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("turn_on_rest", "before the first rest, a rest may start within the turn-on bias "
               "bound of the estimate (rest_bias_bound 0: VQF's rule)", {"rest_bias_bound": 0.0}),
     Mechanism("bias_gate", "no bias learning while linear acceleration reaches the vector "
-              "(bias_gate 0)", {"bias_gate": 0.0}),
+              "(bias_gate 0)", {"bias_gate": 0.0}, {"bias_gate": BIAS_GATE}),
     Mechanism("bias_innovation", "no bias learning from a tilt innovation beyond 10 deg "
-              "(bias_innovation pi)", {"bias_innovation": math.pi}),
+              "(bias_innovation pi)", {"bias_innovation": math.pi},
+              {"bias_innovation": BIAS_INNOVATION}),
     Mechanism("bias_gates", "both gates on bias learning at once (bias_gate 0, bias_innovation "
-              "pi): each covers much of what the other does", {"bias_gate": 0.0,
-                                                                "bias_innovation": math.pi}),
+              "pi): each covers much of what the other does",
+              {"bias_gate": 0.0, "bias_innovation": math.pi},
+              {"bias_gate": BIAS_GATE, "bias_innovation": BIAS_INNOVATION}),
     Mechanism("gross_innovation", "the angle's variance raised to a tilt innovation beyond 30 "
               "deg, an attitude grossly off (gross_innovation pi)", {"gross_innovation": math.pi}),
     Mechanism("acc_gate", "no correction from a sample whose norm is outside gate_low-gate_high "
-              "g (gate_low 0, gate_high 1000)", {"gate_low": 0.0, "gate_high": 1000.0}),
+              "g (gate_low 0, gate_high 1000)", {"gate_low": 0.0, "gate_high": 1000.0},
+              {p.name: float(p.default) for p in PAPER_GATE}),
 )
 """Every mechanism the recommended attitude filters have on top of their paper's filter that a
 parameter switches off, and those this test dropped (off by default, Mechanism.dropped; their
-parameters kept for a user's own values): the accelerometer gate of cf and kf
-(building_blocks.ACC_GATE_PARAMS)."""
+parameters kept for a user's own values, and `on` the values the other filters recommend, or
+the papers' 0.9-1.1 g for the accelerometer gate, papers.common.PAPER_GATE)."""
 BY_NAME = {m.name: m for m in MECHANISMS}
 
 
 @dataclass
 class Worth:
     """One mechanism of one estimator: BROAD with and without, the folds' decisions and the
-    battery's ratio."""
+    battery's ratio. Every figure is with it and without it, whichever the defaults have."""
 
     key: str
     mechanism: str
@@ -148,16 +175,23 @@ class Worth:
     """The contract's scenario where it helps most: (scenario, mean RMSE over the parts
     without / with): the contract's scenarios are a battery of motions too."""
     grid_cv: tuple[float, float] | None = None
-    """For a candidate to drop (would_drop): BROAD's cross-validated mean [deg] with the grid
-    parameters chosen again per fold (testbenches.broad.cv), without it and with it (None:
+    """For a candidate to change (would_change): BROAD's cross-validated mean [deg] with the
+    grid parameters chosen again per fold (testbenches.broad.cv), without it and with it (None:
     not a candidate, or BROAD's folds not measured so)."""
+    grid_nested: tuple[float, float] = (math.nan, math.nan)
+    """With grid_cv: the nested cross-validation's mean [deg] of the same runs, without it and
+    with it (NaN: fewer than three folds)."""
+    dropped: bool = False
+    """Whether the estimator's defaults have it off (Mechanism.dropped): `with` is then the
+    mechanism switched on again (Mechanism.on)."""
 
     def broad_gain(self) -> float:
         """Cross-validated mean of always dropping it minus that of deciding per fold [deg]."""
         return float(np.mean(list(self.broad_off.values()))
                      - np.mean(list(self.cv_decided.values())))
 
-    def verdict(self) -> str:
+    def _at_point(self) -> str:
+        """The verdict at the recommended grid point: keep, mixed or drop."""
         if self.contract_lost:
             n = len(self.contract_lost)
             return f"keeps its place: the contract needs it ({n} check{'s' if n != 1 else ''})"
@@ -177,17 +211,47 @@ class Worth:
         scenario, ratio = self.contract_best
         if ratio >= MOTION_CLASS_GAIN:
             return f"keeps its place for the contract's {scenario} ({ratio:.2f}x without)"
-        if self.grid_cv is not None:
-            off, on = self.grid_cv
-            if (off - on) / off > TIE:
-                return ("keeps its place: with the grid chosen again, BROAD's folds need it "
-                        f"({off:.3f} without)")
         return "drop: no gain out of sample"
 
-    def would_drop(self) -> bool:
-        """Whether the verdict at the recommended grid point drops it: the candidates whose
-        grid is chosen again (grid_worth) before they are dropped."""
-        return self.grid_cv is None and self.verdict().startswith("drop")
+    def _grid_helps(self) -> tuple[bool, bool]:
+        """Whether, with the grid chosen again, the cross-validated and the nested means are
+        lower with it than without by more than the tie."""
+        assert self.grid_cv is not None
+        return tuple(bool((off - on) / off > TIE)  # type: ignore[return-value]
+                     for off, on in (self.grid_cv, self.grid_nested))
+
+    def verdict(self) -> str:
+        """What the test does with it: the verdict at the recommended point, and for a
+        candidate to change, what the grid chosen again says (the set of mechanisms changes
+        only where the cross-validation and the nested one agree)."""
+        at_point = self._at_point()
+        if not self.dropped:
+            if at_point.startswith("drop") and self.grid_cv is not None and any(
+                    self._grid_helps()):
+                return "keeps its place: with the grid chosen again, BROAD's folds need it"
+            return at_point
+        if at_point.startswith("drop"):
+            return "stays dropped: no gain out of sample"
+        if at_point.startswith("mixed"):
+            return f"stays dropped: {at_point}"
+        would = at_point.replace("keeps its place", "it would keep a place", 1)
+        if self.grid_cv is None:
+            return f"would come back: at the recommended point {would}"
+        if all(self._grid_helps()):
+            return f"comes back: at the recommended point {would}, and with the grid chosen again"
+        return (f"stays dropped: at the recommended point {would}, but with the grid chosen "
+                "again the two cross-validations do not both gain")
+
+    def would_change(self) -> bool:
+        """Whether the verdict at the recommended grid point changes the defaults (drops a
+        mechanism on, or takes a dropped one back): the candidates whose grid is chosen again
+        (grid_worth) first."""
+        if self.grid_cv is not None:
+            return False
+        at_point = self._at_point()
+        if self.dropped:
+            return not at_point.startswith(("drop", "mixed"))
+        return at_point.startswith("drop")
 
 
 def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
@@ -212,8 +276,8 @@ def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
 def broad_worth(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimators: Sequence[str],
                 mechanisms: Sequence[Mechanism] = MECHANISMS,
                 progress: Callable[[], None] | None = None) -> dict[tuple[str, str], Worth]:
-    """Each (estimator, mechanism it has): its BROAD errors with and without and the folds'
-    decisions."""
+    """Each (estimator, mechanism it has or dropped, Mechanism.switch): its BROAD errors with
+    and without and the folds' decisions."""
     from .broad.cv import FOLDS, _rmse, fold_of
     from .broad.run import run_fusion_core
 
@@ -234,39 +298,43 @@ def broad_worth(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimato
 
     worth = {}
     for key in estimators:
-        on = errors(key, {})
+        as_is = errors(key, {})
         for m in mechanisms:
-            if not m.applies(key):
+            switch = m.switch(key)
+            if switch is None:
                 continue
-            off = errors(key, m.off)
+            dropped = not m.applies(key)
+            on, off = (errors(key, switch), as_is) if dropped else (as_is, errors(key, switch))
             kept, decided = [], {}
             for fold in present:
                 keep = decide(on, off, folds, [f for f in present if f != fold])
                 kept += [fold] if keep else []
                 decided.update({t: (on if keep else off)[t] for t in on if folds[t] == fold})
-            worth[(key, m.name)] = Worth(key, m.name, on, off, kept, decided)
+            worth[(key, m.name)] = Worth(key, m.name, on, off, kept, decided, dropped=dropped)
     return worth
 
 
 def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: str | None,
                   workers: int, progress: Callable[[], None] | None = None) -> None:
     """Fill each Worth's battery ratio: the battery with every filter at its defaults and once
-    per mechanism with it switched off in the filters that have it."""
+    per mechanism with it switched (Mechanism.switch: off where it is on, on where it was
+    dropped) in the filters that score it."""
     from .battery import MOTIONS, SENSOR_CLASSES, run_variants, stats
 
     keys = sorted({k for k, _ in worth}, key=list(dict.fromkeys(k for k, _ in worth)).index)
     names = list(dict.fromkeys(m for _, m in worth))
     variants: dict[str, dict[str, dict[str, Any]]] = {"": {}}
     for name in names:
-        variants[name] = {k: BY_NAME[name].off for k in keys if (k, name) in worth}
+        variants[name] = {k: BY_NAME[name].switch(k) or {} for k in keys if (k, name) in worth}
     results = run_variants(variants, list(MOTIONS), list(SENSOR_CLASSES), parts, scheduler,
                            workers, progress, keys)
     for (key, name), w in worth.items():
         ratios = {}
+        with_it, without = (name, "") if w.dropped else ("", name)
         for motion in MOTIONS:
             for sensor in SENSOR_CLASSES:
-                on = stats(results[""][motion][sensor][key])[0]
-                off = stats(results[name][motion][sensor][key])[0]
+                on = stats(results[with_it][motion][sensor][key])[0]
+                off = stats(results[without][motion][sensor][key])[0]
                 ratios[f"{motion}/{sensor}"] = off / on
         w.battery_ratio = float(np.exp(np.mean(np.log(list(ratios.values())))))
         cell = min(ratios, key=lambda c: ratios[c])
@@ -278,23 +346,28 @@ def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: st
 def grid_worth(worth: dict[tuple[str, str], Worth], trials: Sequence[Any],
                groups: Sequence[Sequence[str]],
                progress: Callable[[str], None] | None = None) -> None:
-    """Fill grid_cv of every candidate to drop: `broad --cv`'s cross-validation of the grid
-    parameters (CV_GRID, among the points that keep the contract, by the smallest regret) with
-    the filter as it is and with the mechanism off. At the recommended point a mechanism may
+    """Fill grid_cv and grid_nested of every candidate to change (Worth.would_change): `broad
+    --cv`'s cross-validation of the grid parameters (CV_GRID, among the points that keep the
+    contract, by the smallest regret) and its nested cross-validation, with the filter as it is
+    and with the mechanism switched (Mechanism.switch). At the recommended point a mechanism may
     look level while the choices the folds make without it are worse: the slow band's fast
     leak keeps the band's statistic from counting a bounce, and without it the folds that
     never saw a disturbed trial take a longer band."""
     from .broad.cv import cross_validate
 
-    on: dict[str, float] = {}
+    def means(key: str, base: dict[str, float] | None) -> tuple[float, float]:
+        e = cross_validate(trials, groups, [key], progress=progress, base=base).estimators[key]
+        return e.cv_mean(), e.nested_mean()
+
+    as_is: dict[str, tuple[float, float]] = {}
     for (key, name), w in worth.items():
-        if not w.would_drop():
+        if not w.would_change():
             continue
-        if key not in on:
-            on[key] = cross_validate(trials, groups, [key], progress=progress).cv_means()[key]
-        off = cross_validate(trials, groups, [key], progress=progress,
-                             base=BY_NAME[name].off).cv_means()[key]
-        w.grid_cv = (off, on[key])
+        if key not in as_is:
+            as_is[key] = means(key, None)
+        switched = means(key, BY_NAME[name].switch(key))
+        on, off = (switched, as_is[key]) if w.dropped else (as_is[key], switched)
+        w.grid_cv, w.grid_nested = (off[0], on[0]), (off[1], on[1])
 
 
 def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
@@ -318,28 +391,32 @@ def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
 
     base = {key: passing(key, {}) for key in dict.fromkeys(k for k, _ in worth)}
     for (key, name), w in worth.items():
-        passed, mean = passing(key, BY_NAME[name].off)
-        w.contract_lost = sorted(base[key][0] - passed)
-        w.contract_best = max(((s, mean[s] / base[key][1][s]) for s in mean
-                               if base[key][1][s] > 0.0), key=lambda c: c[1],
-                              default=("", math.nan))
+        switched = passing(key, BY_NAME[name].switch(key) or {})
+        (passed, on), (failed, off) = (switched, base[key]) if w.dropped else (base[key],
+                                                                                switched)
+        w.contract_lost = sorted(passed - failed)
+        w.contract_best = max(((s, off[s] / on[s]) for s in off if on[s] > 0.0),
+                              key=lambda c: c[1], default=("", math.nan))
 
 
 def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
-    """Markdown: per estimator and mechanism, BROAD's means with and without, the folds that
-    keep it, the cross-validated gain, the battery's ratio and the verdict."""
+    """Markdown: per estimator and mechanism (those its defaults dropped marked so), BROAD's
+    means with and without, the folds that keep it, the cross-validated gain, the battery's
+    ratio, the contract, the grid chosen again and the verdict."""
     rows = ["| estimator | mechanism | BROAD with | without | folds keeping it | CV gain [deg] "
             "| battery without / with | cell it helps most | cell it costs most | contract checks "
-            "lost without | grid chosen again: CV without / with [deg] | verdict |",
+            "lost without | grid chosen again: CV without / with; nested [deg] | verdict |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for (key, name), w in worth.items():
         lost = "-" if w.contract_lost is None else (", ".join(w.contract_lost) or "none")
         worst, best = ((f"{c} {r:.2f}" if math.isfinite(r) else "-")
                        for c, r in (w.battery_worst, w.battery_best))
         ratio = f"{w.battery_ratio:.3f}" if math.isfinite(w.battery_ratio) else "-"
-        grid = "-" if w.grid_cv is None else f"{w.grid_cv[0]:.3f} / {w.grid_cv[1]:.3f}"
+        grid = "-" if w.grid_cv is None else "; ".join(
+            f"{off:.3f} / {on:.3f}" for off, on in (w.grid_cv, w.grid_nested))
+        label = f"{name} (dropped)" if w.dropped else name
         rows.append(
-            f"| {key} | {name} | {np.mean(list(w.broad_on.values())):.3f} | "
+            f"| {key} | {label} | {np.mean(list(w.broad_on.values())):.3f} | "
             f"{np.mean(list(w.broad_off.values())):.3f} | {len(w.kept_in)} of 4 | "
             f"{w.broad_gain():+.3f} | {ratio} | {best} | {worst} | {lost} | {grid} | "
             f"{w.verdict()} |")
@@ -398,7 +475,8 @@ def measure(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimators: 
     def step(b: Any) -> Callable[[], None] | None:
         return b.update if b is not None else None
 
-    runs = sum(len(trials) * (1 + sum(m.applies(k) for m in mechanisms)) for k in estimators)
+    runs = sum(len(trials) * (1 + sum(m.switch(k) is not None for m in mechanisms))
+               for k in estimators)
     with stage(runs, "BROAD", "run") as b:
         worth = broad_worth(trials, groups, estimators, mechanisms, step(b))
     if parts > 0:
@@ -409,8 +487,8 @@ def measure(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimators: 
         cells = (1 + len({m for _, m in worth})) * len(MOTIONS) * len(SENSOR_CLASSES)
         with stage(cells, "battery", "cell") as b:
             battery_worth(worth, parts, scheduler, workers, step(b))
-    candidates = {k for (k, _), w in worth.items() if w.would_drop()}
-    runs = len(trials) * (len(candidates) + sum(w.would_drop() for w in worth.values()))
+    candidates = {k for (k, _), w in worth.items() if w.would_change()}
+    runs = len(trials) * (len(candidates) + sum(w.would_change() for w in worth.values()))
     with stage(runs, "BROAD's grid", "trial") as b:
         grid_worth(worth, trials, groups, (lambda _: b.update()) if b is not None else None)
     return worth
@@ -448,7 +526,9 @@ def cmd_mechanisms(args: argparse.Namespace) -> int:
                    "battery_best_cell": list(w.battery_best),
                    "contract_checks_lost": w.contract_lost,
                    "contract_best": list(w.contract_best),
-                   "grid_cv_without_with_deg": w.grid_cv, "verdict": w.verdict()}
+                   "grid_cv_without_with_deg": w.grid_cv,
+                   "grid_nested_without_with_deg": w.grid_nested if w.grid_cv else None,
+                   "dropped": w.dropped, "verdict": w.verdict()}
                   for w in worth.values()]}, indent=1))
     print(f"written: {args.out}/mechanisms.md, mechanisms.json")
     return 0

@@ -28,6 +28,10 @@ def test_each_switch_is_a_change_the_filters_that_have_it_accept(mechanism) -> N
         on = [p for p, v in mechanism.off.items() if specs[p].default != v]
         assert len(on) == (len(mechanism.off) if mechanism.applies(key) else 0)
         create(key, dict(mechanism.off))  # a valid parameter set
+        if mechanism.dropped(key):  # switched on again: every value changes, and is valid
+            switch = mechanism.switch(key)
+            assert switch and all(specs[p].default != v for p, v in switch.items())
+            create(key, dict(switch))
 
 
 FOLDS = {"a1": "slow", "a2": "slow", "b1": "fast", "c1": "trans", "d1": "dist"}
@@ -69,12 +73,32 @@ def test_a_drop_waits_for_the_grid_chosen_again_without_it() -> None:
     fold it stays where the folds choose worse points without it, and goes where they do not."""
     on = {"a1": 1.0, "b1": 1.0}
     w = Worth("kf", "band_leak", on, dict(on), [], dict(on), battery_ratio=1.001)
-    assert w.would_drop() and w.verdict().startswith("drop")
-    w.grid_cv = (0.515, 0.497)
-    assert not w.would_drop()
+    assert w.would_change() and w.verdict().startswith("drop")
+    w.grid_cv, w.grid_nested = (0.515, 0.497), (0.4975, 0.497)
+    assert not w.would_change()
     assert w.verdict().startswith("keeps its place: with the grid chosen again")
-    w.grid_cv = (0.4975, 0.497)  # within the tie: the simpler filter
+    w.grid_cv, w.grid_nested = (0.4975, 0.497), (0.521, 0.507)  # the nested one needs it
+    assert w.verdict().startswith("keeps its place: with the grid chosen again")
+    w.grid_nested = (0.4975, 0.497)  # both within the tie: the simpler filter
     assert w.verdict().startswith("drop")
+
+
+def test_a_dropped_mechanism_comes_back_only_where_both_cross_validations_agree() -> None:
+    """Scored with it switched on again: level, it stays dropped; where it would keep a place
+    at the recommended point, the grid is chosen again with it, and it comes back only if the
+    cross-validated and the nested means both gain (the mgcf's fast leak: 0.508 against 0.536
+    cross-validated, 0.548 against 0.537 nested)."""
+    as_is = {"a1": 1.0, "b1": 1.0}
+    w = Worth("mgcf", "band_leak", dict(as_is), dict(as_is), [], dict(as_is),
+              battery_ratio=1.001, dropped=True)
+    assert not w.would_change() and w.verdict() == "stays dropped: no gain out of sample"
+    w.battery_best = ("disturbed/better", 1.2)  # made for one kind of motion
+    assert w.would_change() and w.verdict().startswith("would come back")
+    w.grid_cv, w.grid_nested = (0.536, 0.508), (0.537, 0.548)
+    assert not w.would_change() and w.verdict().startswith("stays dropped: at the recommended")
+    w.grid_nested = (0.548, 0.537)
+    assert w.verdict().startswith(
+        "comes back: at the recommended point it would keep a place for disturbed/better")
 
 
 def _slices(tmp_path: Path) -> list[str]:
