@@ -246,12 +246,7 @@ class Worth:
         """Whether the verdict at the recommended grid point changes the defaults (drops a
         mechanism on, or takes a dropped one back): the candidates whose grid is chosen again
         (grid_worth) first."""
-        if self.grid_cv is not None:
-            return False
-        at_point = self._at_point()
-        if self.dropped:
-            return not at_point.startswith(("drop", "mixed"))
-        return at_point.startswith("drop")
+        return self.grid_cv is None and self.verdict().startswith(("drop", "would come back"))
 
 
 def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
