@@ -955,6 +955,35 @@ def mechanisms_count(ctx: dict[str, Path]) -> str:
     return "\n".join(rows)
 
 
+RUNNING_SWITCHES = {"as recommended": {}, "acc_lowpass_stretch=1": {"acc_lowpass_stretch": 1.0},
+                    "held_acceleration=0.1": {"held_acceleration": 0.1}}
+"""The running page's switches (`imu-fusion battery --param NAME=VALUE`): the longer vector
+off, and the slow band's statistic capped at 0.1 m/s2."""
+
+
+def battery_running_switches(ctx: dict[str, Path]) -> str:
+    """docs/results/battery/running.md: kf and ukf over VQF (mean RMSE over the parts) on the
+    running torso and the pendulum, as recommended and with each of RUNNING_SWITCHES: what the
+    slow band's statistic costs where it counts a fast bounce, and what a lower cap on it costs
+    where the vector holds a slow swing."""
+    from .battery import PARTS, filter_overrides, run_variants, stats
+
+    motions, sensors = ("running", "pendulum"), ("mpu6050", "worse")
+    variants = {name: filter_overrides(values) for name, values in RUNNING_SWITCHES.items()}
+    results = run_variants(variants, motions, sensors, PARTS, scheduler=None,
+                           filters=["kf", "ukf"], vqf=True)
+    rows = ["| motion / sensor class | VQF [deg] | "
+            + " | ".join(f"kf / ukf over VQF, {name}" for name in variants) + " |",
+            "|---|---|" + "---|" * len(variants)]
+    for m in motions:
+        for s in sensors:
+            vqf = stats(results["as recommended"][m][s]["vqf"])[0]
+            cells = [" / ".join(f"{stats(results[v][m][s][k])[0] / vqf:.2f}" for k in ("kf", "ukf"))
+                     for v in variants]
+            rows.append(f"| {m} / {s} | {vqf:.3f} | " + " | ".join(cells) + " |")
+    return "\n".join(rows)
+
+
 def _battery_figures() -> tuple[Figure, ...]:
     from .battery import MOTIONS
 
@@ -968,7 +997,11 @@ def _battery_figures() -> tuple[Figure, ...]:
         Figure("battery-picture", "docs/results/battery/index.md", command, battery_picture,
                "docs/results/battery/battery.png", ("vqf",)),
         *(Figure(f"battery-{m}", f"docs/results/battery/{m}.md", f"{command} --motion {m}",
-                 _battery_motion(m), needs=("vqf",)) for m in MOTIONS))
+                 _battery_motion(m), needs=("vqf",)) for m in MOTIONS),
+        Figure("battery-running-switches", "docs/results/battery/running.md",
+               f"{command} --motion running,pendulum --sensor mpu6050,worse --param "
+               "acc_lowpass_stretch=1 (or held_acceleration=0.1)", battery_running_switches,
+               needs=("vqf",)))
 
 
 FIGURES: tuple[Figure, ...] = (
