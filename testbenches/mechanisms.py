@@ -48,7 +48,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -56,6 +56,7 @@ from fusion_core.building_blocks.gate import BIAS_GATE, BIAS_INNOVATION
 from fusion_core.measured_vector import HELD_PARAM, LEAK_PARAM
 from fusion_core.papers.common import PAPER_GATE
 
+T = TypeVar("T")
 TIE = 0.005
 """Relative differences below this count as level (half a percent of the error)."""
 MOTION_CLASS_GAIN = 1.1
@@ -217,8 +218,8 @@ class Worth:
         """Whether, with the grid chosen again, the cross-validated and the nested means are
         lower with it than without by more than the tie."""
         assert self.grid_cv is not None
-        return tuple(bool((off - on) / off > TIE)  # type: ignore[return-value]
-                     for off, on in (self.grid_cv, self.grid_nested))
+        (cv_off, cv_on), (nested_off, nested_on) = self.grid_cv, self.grid_nested
+        return (cv_off - cv_on) / cv_off > TIE, (nested_off - nested_on) / nested_off > TIE
 
     def verdict(self) -> str:
         """What the test does with it: the verdict at the recommended point, and for a
@@ -247,6 +248,12 @@ class Worth:
         mechanism on, or takes a dropped one back): the candidates whose grid is chosen again
         (grid_worth) first."""
         return self.grid_cv is None and self.verdict().startswith(("drop", "would come back"))
+
+
+def with_without(dropped: bool, as_is: T, switched: T) -> tuple[T, T]:
+    """A figure of the filter as it is and one with the mechanism switched, as (with it,
+    without it): the switched one is "with" where the defaults dropped the mechanism."""
+    return (switched, as_is) if dropped else (as_is, switched)
 
 
 def decide(on: dict[str, float], off: dict[str, float], folds: dict[str, str],
@@ -299,7 +306,7 @@ def broad_worth(trials: Sequence[Any], groups: Sequence[Sequence[str]], estimato
             if switch is None:
                 continue
             dropped = not m.applies(key)
-            on, off = (errors(key, switch), as_is) if dropped else (as_is, errors(key, switch))
+            on, off = with_without(dropped, as_is, errors(key, switch))
             kept, decided = [], {}
             for fold in present:
                 keep = decide(on, off, folds, [f for f in present if f != fold])
@@ -325,7 +332,7 @@ def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: st
                            workers, progress, keys)
     for (key, name), w in worth.items():
         ratios = {}
-        with_it, without = (name, "") if w.dropped else ("", name)
+        with_it, without = with_without(w.dropped, "", name)
         for motion in MOTIONS:
             for sensor in SENSOR_CLASSES:
                 on = stats(results[with_it][motion][sensor][key])[0]
@@ -361,7 +368,7 @@ def grid_worth(worth: dict[tuple[str, str], Worth], trials: Sequence[Any],
         if key not in as_is:
             as_is[key] = means(key, None)
         switched = means(key, BY_NAME[name].switch(key))
-        on, off = (switched, as_is[key]) if w.dropped else (as_is[key], switched)
+        on, off = with_without(w.dropped, as_is[key], switched)
         w.grid_cv, w.grid_nested = (off[0], on[0]), (off[1], on[1])
 
 
@@ -387,8 +394,7 @@ def contract_worth(worth: dict[tuple[str, str], Worth], parts: int,
     base = {key: passing(key, {}) for key in dict.fromkeys(k for k, _ in worth)}
     for (key, name), w in worth.items():
         switched = passing(key, BY_NAME[name].switch(key) or {})
-        (passed, on), (failed, off) = (switched, base[key]) if w.dropped else (base[key],
-                                                                                switched)
+        (passed, on), (failed, off) = with_without(w.dropped, base[key], switched)
         w.contract_lost = sorted(passed - failed)
         w.contract_best = max(((s, off[s] / on[s]) for s in off if on[s] > 0.0),
                               key=lambda c: c[1], default=("", math.nan))

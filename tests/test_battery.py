@@ -131,17 +131,16 @@ def test_a_second_of_absurd_samples_leaves_the_kf_no_bias_it_cannot_unlearn() ->
     vector's own norm waits until the vector has let the disturbance go (here 2.0 deg; the UKF,
     which observes its three biases from the tilt, 0.1)."""
     from fusion_core.registry import create
-    from testbenches.broad.metric import gravity_from_roll_pitch
+    from testbenches.broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
 
+    params = battery.filter_params(SENSOR_CLASSES["mpu6050_glitch"])["kf"]
     late = []
     for seed in range(10):
         t, truth, sample = battery.part_samples("slow_rotation", "mpu6050_glitch", seed)
-        params = battery.filter_params(SENSOR_CLASSES["mpu6050_glitch"])["kf"]
         o = create("kf", params).run(sample["acc"], sample["gyro"], sample["dt"])
-        up = gravity_from_roll_pitch(o["roll"], o["pitch"])
-        true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
-        error = np.degrees(np.arccos(np.clip(np.sum(up * true_up, axis=1), -1.0, 1.0)))
-        late.append(float(np.sqrt(np.mean(error[t >= 60.0] ** 2))))
+        late.append(inclination_rmse_deg(gravity_from_roll_pitch(o["roll"], o["pitch"]),
+                                         gravity_from_roll_pitch(truth["roll"], truth["pitch"]),
+                                         t >= 60.0))
     assert np.mean(late) < 3.0
 
 
