@@ -518,6 +518,31 @@ def overview_table(results: Results) -> str:
     return "\n".join(rows)
 
 
+def known_scale_table(recommended: Results, known: Results) -> str:
+    """Markdown: per motion and sensor class the worse of kf's and ukf's mean RMSE over VQF's,
+    as recommended and with the class's own gyro_scale_std (`--known-scale`), and a line that
+    counts the cells where the best of ours is ahead of VQF and where kf and ukf are within
+    5 % of it, both ways."""
+    sensors = list(next(iter(recommended.values())))
+    spread = [f"{s} ({100.0 * SENSOR_CLASSES[s].value('gyro_scale_std'):g} %)" for s in sensors]
+    rows = ["| motion | " + " | ".join(spread) + " |", "|---|" + "---|" * len(sensors)]
+    counts = {"recommended": [0, 0], "known": [0, 0]}
+    for motion, by_sensor in recommended.items():
+        cells = []
+        for s in sensors:
+            pair = verdicts(by_sensor[s]), verdicts(known[motion][s])
+            for name, v in zip(counts, pair, strict=True):
+                counts[name][0] += v["best_vs_vqf"] < 1.0
+                counts[name][1] += v["kf_ukf_vs_vqf"] <= 1.05
+            cells.append(f"{pair[0]['kf_ukf_vs_vqf']:.2f} -> {pair[1]['kf_ukf_vs_vqf']:.2f}")
+        rows.append(f"| {motion} | " + " | ".join(cells) + " |")
+    total = len(recommended) * len(sensors)
+    (a0, w0), (a1, w1) = counts.values()
+    return ("\n".join(rows) + f"\n\nOf {total} cells, the best of ours is ahead of VQF in {a0} "
+            f"as recommended and {a1} with the class's spread; kf and ukf are within 5 % of it "
+            f"in {w0} and {w1}.")
+
+
 def plot(results: Results, path: Path) -> None:
     """Per sensor class, each motion's best filter and kf/ukf against VQF (ratio of mean
     inclination RMSE: below 1 is ahead)."""

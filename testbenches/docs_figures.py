@@ -890,6 +890,20 @@ def battery_overview(ctx: dict[str, Path]) -> str:
     return overview_table(_battery())
 
 
+@functools.lru_cache(maxsize=1)
+def _battery_known_scale() -> Any:
+    from .battery import MOTIONS, PARTS, SENSOR_CLASSES, run_battery
+
+    return run_battery(list(MOTIONS), list(SENSOR_CLASSES), PARTS, scheduler=None,
+                       known_scale=True)
+
+
+def battery_known_scale(ctx: dict[str, Path]) -> str:
+    from .battery import known_scale_table
+
+    return known_scale_table(_battery(), _battery_known_scale())
+
+
 def battery_picture(ctx: dict[str, Path], path: Path) -> None:
     from .battery import plot
 
@@ -994,6 +1008,8 @@ def _battery_figures() -> tuple[Figure, ...]:
         Figure("readme-battery", "README.md", command, readme_battery, needs=("vqf",)),
         Figure("battery-overview", "docs/results/battery/index.md", command, battery_overview,
                needs=("vqf",)),
+        Figure("battery-known-scale", "docs/results/battery/index.md",
+               f"{command}; {command} --known-scale", battery_known_scale, needs=("vqf",)),
         Figure("battery-picture", "docs/results/battery/index.md", command, battery_picture,
                "docs/results/battery/battery.png", ("vqf",)),
         *(Figure(f"battery-{m}", f"docs/results/battery/{m}.md", f"{command} --motion {m}",

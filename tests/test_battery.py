@@ -225,3 +225,19 @@ def test_a_param_reaches_every_filter_that_has_it_and_an_unknown_one_is_refused(
     assert (got["cf"], got["mgcf"], got["vqf"]) == (default["cf"], default["mgcf"], default["vqf"])
     assert main(["battery", "--param", "nope=1", "--out", str(tmp_path)]) != 0
     assert "no attitude filter has it" in capsys.readouterr().err
+
+
+def test_the_known_scale_table_compares_each_cell_and_counts_both_ways() -> None:
+    """Each cell: the worse of kf's and ukf's mean over VQF's, as recommended -> known; the last
+    line counts the aims' cells both ways (a tie with VQF is not ahead, 1.05 is within)."""
+    def cell(kf: float, ukf: float, cf: float) -> dict[str, list[float]]:
+        return {"cf": [cf, cf], "kf": [kf, kf], "ukf": [ukf, ukf], "vqf": [1.0, 1.0]}
+
+    recommended = {"running": {"better": cell(1.2, 1.1, 1.0), "worse": cell(1.05, 1.0, 0.9)}}
+    known = {"running": {"better": cell(0.9, 0.95, 1.0), "worse": cell(1.5, 1.4, 1.3)}}
+    text = battery.known_scale_table(recommended, known)
+    head, _rule, row, _, counts = text.split("\n")
+    assert head == "| motion | better (0.2 %) | worse (2 %) |"
+    assert row == "| running | 1.20 -> 0.95 | 1.05 -> 1.50 |"
+    assert counts == ("Of 2 cells, the best of ours is ahead of VQF in 1 as recommended and 1 "
+                      "with the class's spread; kf and ukf are within 5 % of it in 1 and 1.")
