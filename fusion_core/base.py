@@ -23,7 +23,7 @@ import numpy as np
 from .building_blocks.sampling import GYRO_SAMPLING_PARAM
 from .calibration import CALIBRATION_PARAMS, check_calibration, matrices
 from .kinematics import roll_pitch_ahead
-from .linalg import Mat9, mat_vec, vec_sub
+from .linalg import Mat9, Vec3, mat_vec, vec_sub
 from .state import BASE_STATE, NESTED, StateSpec, check_field
 from .types import (
     ABSENT,
@@ -343,6 +343,22 @@ class Estimator:
                 f"sample is not three accelerations, three rates and dt: {err}"
             ) from None
         ax, ay, az, gx, gy, gz = self._prepare(ax, ay, az, gx, gy, gz, dt)
+        return self._take(ax, ay, az, gx, gy, gz, dt)
+
+    def step_prepared(self, acc: Vec3, gyro: Vec3, dt: float, clipped: bool) -> Estimate:
+        """One sample that a filter holding this one has already checked and conditioned with
+        the same limits (its _prepare: the position filter's attitude kf), with its rail flag:
+        judged on the sensor's own axes against the sensor's gyro_range, which the conditioned
+        sample no longer shows (a mounting mixes the axes) and which this filter's own
+        parameters need not hold. The rest of step."""
+        self.clipped = clipped
+        return self._take(acc[0], acc[1], acc[2], gyro[0], gyro[1], gyro[2], dt)
+
+    def _take(
+        self, ax: float, ay: float, az: float, gx: float, gy: float, gz: float, dt: float
+    ) -> Estimate:
+        """step after the input stage: the first valid sample initialises, the others advance;
+        the estimate (turned ahead over sensor_delay) kept as last and returned."""
         if self.initialized:
             last = self._advance(ax, ay, az, gx, gy, gz, dt)
         elif ax * ax + ay * ay + az * az >= _MIN_INIT_NORM2:

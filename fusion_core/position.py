@@ -81,7 +81,9 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
     The filter starts at position 0 and velocity 0 (the platform at rest, as in the paper).
 
     Outputs pos, vel [m, m/s] plus roll, pitch and bias, these from the recommended
-    AngleBiasKalmanFilter run on the same samples: the tilt stage is right for levelling the
+    AngleBiasKalmanFilter run on the same samples with the same gyro_range, its rail judged on
+    the sensor's own axes (Estimator.step_prepared), so that they are the kf's for the same
+    sensor: the tilt stage is right for levelling the
     accelerometer between rests (it never takes linear acceleration for tilt), but in continuous
     motion it is gyro-only integration, and an attitude output must be as good as the best
     attitude filter here. The recommended acc_psd and gyro_psd are the noise densities measured
@@ -156,9 +158,11 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         if not hasattr(self, "tilt"):
             self.tilt = PaperKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
                                           gyro_sampling=p["gyro_sampling"], **tilt_params)
-            # the attitude outputs: the recommended kf on the same samples
+            # the attitude outputs: the recommended kf on the same samples, with the gyro range
+            # (the rail flag it takes with each sample is this filter's: step_prepared)
             self.att = AngleBiasKalmanFilter(max_dt=p["max_dt"], max_rate=p["max_rate"],
-                                             gyro_sampling=p["gyro_sampling"])
+                                             gyro_sampling=p["gyro_sampling"],
+                                             gyro_range=p["gyro_range"])
         else:
             for k, v in tilt_params.items():
                 self.tilt.set_param(k, v)
@@ -226,7 +230,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         max_dt = self._params["max_dt"]
         self._x, self._P = first_axis_states(self.tilt, ax, ay, az, gx, gy, gz, max_dt,
                                              self._acc_var_density)
-        self.att.step((ax, ay, az), (gx, gy, gz), max_dt)
+        self.att.step_prepared((ax, ay, az), (gx, gy, gz), max_dt, self.clipped)
         self.f_mean = (ax, ay, az)
 
     def _slow_enough(self) -> bool:
@@ -304,7 +308,7 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
         if stationary:
             tilt.correct_bias(gx, gy, self._gyro_var_density / dt)
         tilt.took_sample((gx, gy, gz))
-        att = self.att.step((ax, ay, az), (gx, gy, gz), dt)
+        att = self.att.step_prepared((ax, ay, az), (gx, gy, gz), dt, self.clipped)
         if not self.aligned:
             # Until its first confirmed rest the tilt stage levels with the attitude filter's
             # roll and pitch, which align over the first samples and are corrected in motion:

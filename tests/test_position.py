@@ -125,3 +125,31 @@ def test_one_false_level_first_sample_fades_from_the_position_filters_levelling(
     assert vel_err["false start"] <= 1.5, vel_err
     assert vel_err["false start"] <= vel_err["plain"] + 0.5, vel_err
     assert att_err.max() < np.radians(1.0)
+
+
+@pytest.mark.parametrize("backend", ["python", "native"])
+def test_the_position_filters_attitude_is_the_kfs_with_the_same_sensor_rail_included(
+        backend: str) -> None:
+    """The poskf's roll, pitch and bias are the recommended kf's on the same samples with the
+    same sensor properties: a gyro of +-1000 deg/s clipping in a hand's swings, a mounting that
+    mixes its axes and a gyro calibration. The attitude kf inside takes the samples as the
+    position filter conditioned them, with its rail flag judged on the sensor's own axes: with
+    its own default range of 2000 deg/s it would miss every rail here."""
+    from fusion_core import native
+    from testbenches.battery import SENSOR_CLASSES, part_samples
+
+    if backend == "native" and not native.available():
+        pytest.skip("no C twin (no C compiler)")
+    _, _, sample = part_samples("clipping", "worse", 0)
+    sensor = {"gyro_range": SENSOR_CLASSES["worse"].value("gyro_range"), "mount_roll": 0.3,
+              "mount_yaw": 0.5, "gyro_cal_xx": 1.01, "gyro_cal_xy": 0.004, "gyro_cal_zz": 0.99}
+    wide = {k: v for k, v in sensor.items() if k != "gyro_range"}
+    runs = {name: make(key, **params).run(sample["acc"], sample["gyro"], sample["dt"],
+                                          backend=backend)
+            for name, key, params in (("kf", "kf", sensor), ("poskf", "poskf", sensor),
+                                      ("kf at 2000 deg/s", "kf", wide))}
+    at_rail = np.abs(sample["gyro"]) >= 0.999 * sensor["gyro_range"]
+    assert at_rail.any(axis=1).sum() > 100
+    for name in ("roll", "pitch", "bias"):
+        np.testing.assert_array_equal(runs["poskf"][name], runs["kf"][name])
+    assert not np.array_equal(runs["kf"]["roll"], runs["kf at 2000 deg/s"]["roll"])

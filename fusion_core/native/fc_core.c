@@ -933,14 +933,10 @@ void fc_base_output(const fc_base *b, fc_estimate *e)
     }
 }
 
-fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
-                  const fc_real acc[3], const fc_real gyro[3], fc_real dt, fc_estimate *out)
+/* fc_step after the input stage (Estimator._take): a, g the sample as the filter sees it */
+static inline fc_status take(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                             const fc_real a[3], const fc_real g[3], fc_real dt, fc_estimate *out)
 {
-    fc_real a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
-    fc_status status = fc_base_prepare(base, a, g, dt);
-    if (status != FC_OK) {
-        return status;
-    }
     if (base->initialized) {
         ops->advance(self, a, g, dt);
     } else if (fc_base_can_init(a)) {
@@ -952,7 +948,7 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
         }
         return FC_SKIPPED;
     }
-    memcpy(base->gyro_prev, g, sizeof g);
+    memcpy(base->gyro_prev, g, 3 * sizeof g[0]);
     ops->estimate(self, last);
     fc_base_output(base, last);
     base->n_samples += 1;
@@ -960,6 +956,25 @@ fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *las
         *out = *last;
     }
     return FC_OK;
+}
+
+fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                  const fc_real acc[3], const fc_real gyro[3], fc_real dt, fc_estimate *out)
+{
+    fc_real a[3] = {acc[0], acc[1], acc[2]}, g[3] = {gyro[0], gyro[1], gyro[2]};
+    fc_status status = fc_base_prepare(base, a, g, dt);
+    if (status != FC_OK) {
+        return status;
+    }
+    return take(ops, self, base, last, a, g, dt, out);
+}
+
+fc_status fc_step_prepared(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                           const fc_real a[3], const fc_real g[3], fc_real dt, int clipped,
+                           fc_estimate *out)
+{
+    base->clipped = clipped;
+    return take(ops, self, base, last, a, g, dt, out);
 }
 
 /* one sample of a batch run: fc_step, a rejection counted; returns whether it was rejected

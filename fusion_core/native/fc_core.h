@@ -254,6 +254,11 @@ typedef struct fc_ops {
  * rejection leaves everything as it was. */
 fc_status fc_step(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
                   const fc_real acc[3], const fc_real gyro[3], fc_real dt, fc_estimate *out);
+/* Estimator.step_prepared: a sample a filter holding this one has already checked and conditioned
+ * (fc_base_prepare with the same limits), with its rail flag clipped; the rest of fc_step. */
+fc_status fc_step_prepared(const fc_ops *ops, void *self, fc_base *base, fc_estimate *last,
+                           const fc_real a[3], const fc_real g[3], fc_real dt, int clipped,
+                           fc_estimate *out);
 /* Estimator.run for any estimator: n samples (acc, gyro [n][3] row-major, dt [n]), out[i] the
  * estimate after sample i, the last one for a rejected sample (rejected[i] = 1, counted in
  * n_rejected). Returns the number of rejected samples. */

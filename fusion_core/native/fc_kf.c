@@ -373,3 +373,9 @@ static void advance(fc_kf *f, const fc_real a_in[3], const fc_real g_in[3], fc_r
 }
 
 FC_DEFINE_STEP_AND_RUN(fc_kf)
+
+fc_status fc_kf_step_prepared(fc_kf *f, const fc_real a[3], const fc_real g[3], fc_real dt,
+                              int clipped, fc_estimate *out)
+{
+    return fc_step_prepared(&OPS, f, &f->base, &f->last, a, g, dt, clipped, out);
+}

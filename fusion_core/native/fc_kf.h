@@ -34,5 +34,9 @@ typedef struct fc_kf {
 
 /* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */
 FC_DECLARE_ESTIMATOR(fc_kf);
+/* Estimator.step_prepared (fc_step_prepared): the position filter's attitude kf takes the samples
+ * the position filter has checked and conditioned, with its rail flag */
+fc_status fc_kf_step_prepared(fc_kf *f, const fc_real a[3], const fc_real g[3], fc_real dt,
+                              int clipped, fc_estimate *out);
 
 #endif /* FC_KF_H */

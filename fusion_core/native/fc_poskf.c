@@ -30,6 +30,7 @@ void fc_poskf_configure(fc_poskf *f)
     ap.input.gyro_sampling = p->input.gyro_sampling;
     ap.input.max_dt = p->input.max_dt;
     ap.input.max_rate = p->input.max_rate;
+    ap.input.gyro_range = p->input.gyro_range;
     f->att.params = ap;
     fc_kf_configure(&f->att);
     f->acc_var_density = p->acc_psd;
@@ -77,7 +78,7 @@ static void first_sample(fc_poskf *f, const fc_real a[3], const fc_real g[3])  /
 {
     fc_paper_poskf_first_axis_states(&f->tilt, a, g, f->params.input.max_dt, f->acc_var_density,
                                      f->x, f->P);
-    fc_kf_step(&f->att, a, g, f->params.input.max_dt, NULL);
+    fc_kf_step_prepared(&f->att, a, g, f->params.input.max_dt, f->base.clipped, NULL);
     memcpy(f->f_mean, a, sizeof f->f_mean);
 }
 
@@ -167,7 +168,7 @@ static void advance(fc_poskf *f, const fc_real a[3], const fc_real g[3], fc_real
         fc_paper_kf_correct_bias(tilt, gx, gy, f->gyro_var_density / dt);
     }
     fc_paper_kf_took_sample(tilt, g);
-    fc_kf_step(&f->att, a, g, dt, NULL);
+    fc_kf_step_prepared(&f->att, a, g, dt, f->base.clipped, NULL);
     if (!f->aligned) {  /* until the first confirmed rest: the attitude filter's levelling */
         tilt->roll = f->att.last.roll;
         tilt->pitch = f->att.last.pitch;
