@@ -61,6 +61,17 @@ class UnitEvidence:
         return (f"over {self.windows} windows of {WINDOW_S} s, gravity's turn is missed by "
                 f"{misses} (median)")
 
+    def undecided(self) -> str:
+        """Why the data tell no unit: too few windows turn gravity (a recording at rest), or
+        the windows that turn it do not point to one unit (a gyro at its rail for much of
+        them, columns that are not the gyro's, linear acceleration in most windows)."""
+        if self.windows < MIN_WINDOWS:
+            return (f"{self.windows} windows of {WINDOW_S} s turn gravity by {MIN_TURN_DEG:g} "
+                    f"deg or more, {MIN_WINDOWS} are needed: too little motion")
+        return (f"{self.describe()}: within {MIN_RATIO:g} times of each other, so neither "
+                "unit explains the turn, as where the gyro sits at its rail, the columns are not "
+                "the gyro's or linear acceleration fills the windows")
+
 
 def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
     if n <= 1:

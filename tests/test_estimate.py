@@ -267,9 +267,27 @@ def test_a_recording_that_cannot_tell_its_gyro_unit_is_refused_unless_told(tmp_p
     path = tmp_path / "quiet.csv"
     _still(path, 0.0, deg=False)
     assert main(["estimate", str(path), "--out", str(tmp_path), "--no-plots"]) == 2
-    assert "give --gyro-unit rad/s or deg/s" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "too little motion" in err and "give --gyro-unit rad/s or deg/s" in err
     assert main(["estimate", str(path), "--gyro-unit", "rad/s", "--estimator", "kf",
                  "--out", str(tmp_path), "--no-plots"]) == 0
+
+
+def test_a_gyro_at_its_rail_is_refused_with_the_misses_not_as_too_little_motion(tmp_path,
+                                                                               capsys):
+    """The example's gyro clipped at a fifth of its largest rate: the sensor turns in hundreds
+    of windows, but the clipped gyro explains gravity's turn in neither unit. The refusal says
+    so, with both misses; "too little motion" would send the user looking for the wrong fault."""
+    ex = _example()
+    rail = 0.2 * np.max(np.abs(ex["gyro"]))
+    path = tmp_path / "clipped.csv"
+    np.savetxt(path, np.column_stack([ex["time"], ex["acc"], np.clip(ex["gyro"], -rail, rail)]),
+               delimiter=",", header="time,ax,ay,az,gx,gy,gz", comments="")
+    assert main(["estimate", str(path), "--out", str(tmp_path), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "too little motion" not in err
+    assert "missed by rad/s:" in err and "neither unit explains the turn" in err
+    assert "give --gyro-unit rad/s or deg/s" in err
 
 
 def _reference(path: Path, time: np.ndarray, roll: np.ndarray, pitch: np.ndarray) -> None:

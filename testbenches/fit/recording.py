@@ -608,9 +608,8 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
             ", and the data agree)" if evidence.unit else ")"), used
     if evidence.unit is None:
         raise RecordingError(
-            f"{path}: the gyro's unit cannot be told from the data (the gyro turns gravity "
-            "measurably in neither rad/s nor deg/s: too little motion): give --gyro-unit rad/s "
-            "or deg/s")
+            f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
+            "give --gyro-unit rad/s or deg/s")
     return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
 
 
