@@ -871,11 +871,12 @@ def engines_table(ctx: dict[str, Path]) -> str:
     return engine_table(engine_rows(ctx["fmus"]), speed=False)
 
 
-@functools.lru_cache(maxsize=1)
-def _battery() -> Any:
+@functools.lru_cache(maxsize=2)
+def _battery(known_scale: bool = False) -> Any:
     from .battery import MOTIONS, PARTS, SENSOR_CLASSES, run_battery
 
-    return run_battery(list(MOTIONS), list(SENSOR_CLASSES), PARTS, scheduler=None)
+    return run_battery(list(MOTIONS), list(SENSOR_CLASSES), PARTS, scheduler=None,
+                       known_scale=known_scale)
 
 
 def battery_classes() -> str:
@@ -890,18 +891,10 @@ def battery_overview(ctx: dict[str, Path]) -> str:
     return overview_table(_battery())
 
 
-@functools.lru_cache(maxsize=1)
-def _battery_known_scale() -> Any:
-    from .battery import MOTIONS, PARTS, SENSOR_CLASSES, run_battery
-
-    return run_battery(list(MOTIONS), list(SENSOR_CLASSES), PARTS, scheduler=None,
-                       known_scale=True)
-
-
 def battery_known_scale(ctx: dict[str, Path]) -> str:
     from .battery import known_scale_table
 
-    return known_scale_table(_battery(), _battery_known_scale())
+    return known_scale_table(_battery(), _battery(known_scale=True))
 
 
 def battery_picture(ctx: dict[str, Path], path: Path) -> None:
@@ -913,12 +906,11 @@ def battery_picture(ctx: dict[str, Path], path: Path) -> None:
 def readme_battery(ctx: dict[str, Path]) -> str:
     """The README's battery line: in how many cells (motion class x sensor class) the best of
     ours and kf, ukf are ahead of VQF, and where they are furthest behind."""
-    from .battery import PARTS, verdicts
+    from .battery import PARTS, aims_met, verdicts
 
     results = _battery()
     cells = {(m, s): verdicts(c) for m, by in results.items() for s, c in by.items()}
-    ahead = sum(v["best_vs_vqf"] < 1.0 for v in cells.values())
-    level = sum(v["kf_ukf_vs_vqf"] <= 1.05 for v in cells.values())
+    ahead, level = aims_met(results)
     worst = max(cells, key=lambda k: cells[k]["kf_ukf_vs_vqf"])
     sensors = len(next(iter(results.values())))
     return (f"- **A battery of motions and parts**: {len(results)} motion classes x {sensors} "
