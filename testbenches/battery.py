@@ -17,7 +17,10 @@ static recording), the rest at their recommended values. VQF takes no noise para
 `known_scale` (`--known-scale`) each filter's gyro_scale_std is also the class's own spread of
 gyro scale factors, as a user sets it from the part's datasheet (docs/guide/own-sensor.md):
 what knowing it is worth, class by class, beside the recommended value every class gets
-otherwise.
+otherwise. With `calibrated_first` (`--calibrated-first`) each part is calibrated first by the
+project's own calibration (testbenches.calibrate.part: the part's calibration session,
+Tedaldi's method, its matrices given to the filters), and VQF gets the same calibrated samples:
+what a calibration of the gyro's and the accelerometer's matrices is worth to each.
 
 The truth comes from the trajectory (fusion_core.synthetic), the samples from the sensor model's
 C twin (fusion_core.sensor), the filters from theirs: a run is deterministic, and the battery is
@@ -299,6 +302,24 @@ def glitched(sample: dict[str, np.ndarray], sensor: SensorClass, start: float, s
     return {**sample, "acc": acc, "gyro": gyro}
 
 
+@dataclass(frozen=True)
+class Setup:
+    """What the filters are given of each part beyond what follows from its class's noise and
+    range: its class's spread of gyro scale factors (known_scale, filter_params), its own
+    calibration (calibrated_first, part_rmse)."""
+
+    known_scale: bool = False
+    calibrated_first: bool = False
+
+    @property
+    def label(self) -> str:
+        """How the setup reads in a table's line: "with the class's spread", "calibrated first"
+        or both."""
+        said = [w for w, on in (("calibrated first", self.calibrated_first),
+                                ("with the class's spread", self.known_scale)) if on]
+        return ", ".join(said) or "as recommended"
+
+
 def filter_keys() -> list[str]:
     """The registry's attitude filters (the position filter's attitude is a kf's)."""
     from fusion_core import registry
@@ -350,37 +371,45 @@ def part_samples(motion: str, sensor: str, seed: int
 
 def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
               overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True,
-              known_scale: bool = False) -> dict[str, float]:
+              setup: Setup = Setup()) -> dict[str, float]:
     """One part's inclination RMSE [deg] per filter (its parameters, filter_params with
-    known_scale, with `overrides[key]` over them) and, with vqf, VQF's on one motion."""
+    setup.known_scale, with `overrides[key]` over them) and, with vqf, VQF's on one motion;
+    with setup.calibrated_first the part's calibration is every filter's (its matrices) and
+    VQF takes the samples it calibrates."""
     from fusion_core.registry import create
 
     from .broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
+    from .calibrate.part import part_calibration
+    from .estimate import conditioned
     from .peers import PEERS
 
     m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
     t, truth, sample = part_samples(motion, sensor, seed)
     true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
     scored = t >= m.rest + SETTLE_S
-    params = filter_params(s, known_scale)
+    params = filter_params(s, setup.known_scale)
+    calibration = part_calibration(s.params, seed) if setup.calibrated_first else {}
 
     def rmse(up: np.ndarray) -> float:
         return inclination_rmse_deg(up, true_up, scored)
 
     out = {}
     for key in filters:
-        o = create(key, {**params[key], **(overrides or {}).get(key, {})}).run(
+        o = create(key, {**params[key], **calibration, **(overrides or {}).get(key, {})}).run(
             sample["acc"], sample["gyro"], sample["dt"])
         out[key] = rmse(gravity_from_roll_pitch(o["roll"], o["pitch"]))
     if vqf:
-        out["vqf"] = rmse(PEERS["vqf"](sample["acc"], sample["gyro"], s.rate))
+        acc, gyro = sample["acc"], sample["gyro"]
+        if calibration:
+            acc, gyro = conditioned(acc, gyro, calibration)
+        out["vqf"] = rmse(PEERS["vqf"](acc, gyro, s.rate))
     return out
 
 
 def _cell(motion: str, sensor: str, parts: int, filters: Sequence[str],
           overrides: dict[str, dict[str, Any]] | None = None, vqf: bool = True,
-          known_scale: bool = False) -> dict[str, list[float]]:
-    rows = [part_rmse(motion, sensor, seed, filters, overrides, vqf, known_scale)
+          setup: Setup = Setup()) -> dict[str, list[float]]:
+    rows = [part_rmse(motion, sensor, seed, filters, overrides, vqf, setup)
             for seed in range(parts)]
     return {key: [r[key] for r in rows] for key in rows[0]}
 
@@ -393,13 +422,13 @@ def run_battery(motions: Sequence[str], sensors: Sequence[str], parts: int = PAR
                 scheduler: str | None = "local", workers: int = 2,
                 progress: Callable[[], None] | None = None,
                 overrides: dict[str, dict[str, Any]] | None = None,
-                known_scale: bool = False) -> Results:
+                setup: Setup = Setup()) -> Results:
     """Every motion x sensor class on `parts` parts, each (motion, class) a Dask task on the
     cluster `scheduler` names (runner.connect), or with None one after the other in this
     process (the same numbers: every run is seeded); overrides: filter -> parameter values on
-    top of the class's (filter_overrides); known_scale: filter_params'."""
+    top of the class's (filter_overrides); setup: what each part gives the filters (Setup)."""
     variants = run_variants({"": overrides or {}}, motions, sensors, parts, scheduler, workers,
-                            progress, filter_keys(), vqf=True, known_scale=known_scale)
+                            progress, filter_keys(), vqf=True, setup=setup)
     return variants[""]
 
 
@@ -431,15 +460,15 @@ def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequen
                  sensors: Sequence[str], parts: int = PARTS, scheduler: str | None = "local",
                  workers: int = 2, progress: Callable[[], None] | None = None,
                  filters: Sequence[str] | None = None, vqf: bool = False,
-                 known_scale: bool = False) -> dict[str, Results]:
+                 setup: Setup = Setup()) -> dict[str, Results]:
     """The battery once per variant (name -> filter -> parameter overrides) on one cluster:
-    each (variant, motion, class) a task; known_scale: filter_params'."""
+    each (variant, motion, class) a task; setup: part_rmse's."""
     filters = list(filters or filter_keys())
     cells = [(v, m, s) for v in variants for m in motions for s in sensors]
     out: dict[str, Results] = {v: {m: {} for m in motions} for v in variants}
     if scheduler is None:
         for v, m, s in cells:
-            out[v][m][s] = _cell(m, s, parts, filters, variants[v], vqf, known_scale)
+            out[v][m][s] = _cell(m, s, parts, filters, variants[v], vqf, setup)
             if progress:
                 progress()
         return out
@@ -449,7 +478,7 @@ def run_variants(variants: dict[str, dict[str, dict[str, Any]]], motions: Sequen
 
     client, cluster = connect(scheduler, workers)
     try:
-        futures = {client.submit(_cell, m, s, parts, filters, variants[v], vqf, known_scale,
+        futures = {client.submit(_cell, m, s, parts, filters, variants[v], vqf, setup,
                                  pure=False):
                    (v, m, s) for v, m, s in cells}
         for future in as_completed(futures):
@@ -528,23 +557,24 @@ def overview_table(results: Results) -> str:
     return "\n".join(rows)
 
 
-def known_scale_table(recommended: Results, known: Results) -> str:
+def setup_table(recommended: Results, other: Results, setup: Setup) -> str:
     """Markdown: per motion and sensor class the worse of kf's and ukf's mean RMSE over VQF's,
-    as recommended and with the class's own gyro_scale_std (`--known-scale`), and a line that
-    counts the cells where the best of ours is ahead of VQF and where kf and ukf are within
-    5 % of it, both ways."""
+    as recommended and as `setup` gives the parts (with known_scale the header gives each
+    class's spread of gyro scale factors), and a line that counts the cells where the best of
+    ours is ahead of VQF and where kf and ukf are within 5 % of it, both ways."""
     sensors = list(next(iter(recommended.values())))
-    spread = [f"{s} ({100.0 * SENSOR_CLASSES[s].value('gyro_scale_std'):g} %)" for s in sensors]
-    rows = ["| motion | " + " | ".join(spread) + " |", "|---|" + "---|" * len(sensors)]
+    head = [f"{s} ({100.0 * SENSOR_CLASSES[s].value('gyro_scale_std'):g} %)"
+            if setup.known_scale else s for s in sensors]
+    rows = ["| motion | " + " | ".join(head) + " |", "|---|" + "---|" * len(sensors)]
     for motion, by_sensor in recommended.items():
         cells = [f"{verdicts(by_sensor[s])['kf_ukf_vs_vqf']:.2f} -> "
-                 f"{verdicts(known[motion][s])['kf_ukf_vs_vqf']:.2f}" for s in sensors]
+                 f"{verdicts(other[motion][s])['kf_ukf_vs_vqf']:.2f}" for s in sensors]
         rows.append(f"| {motion} | " + " | ".join(cells) + " |")
     total = len(recommended) * len(sensors)
-    (a0, w0), (a1, w1) = aims_met(recommended), aims_met(known)
+    (a0, w0), (a1, w1) = aims_met(recommended), aims_met(other)
     return ("\n".join(rows) + f"\n\nOf {total} cells, the best of ours is ahead of VQF in {a0} "
-            f"as recommended and {a1} with the class's spread; kf and ukf are within 5 % of it "
-            f"in {w0} and {w1}.")
+            f"as recommended and {a1} {setup.label}; kf and ukf are within 5 % of it in {w0} "
+            f"and {w1}.")
 
 
 def plot(results: Results, path: Path) -> None:
@@ -602,6 +632,10 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
                    help="give each filter the sensor class's own spread of gyro scale factors "
                    "as gyro_scale_std, as a user sets it from the part's datasheet (default: "
                    "the recommended value for every class)")
+    p.add_argument("--calibrated-first", action="store_true",
+                   help="calibrate each part first by the project's own calibration (its "
+                   "calibration session, Tedaldi's method): every filter gets its matrices, "
+                   "VQF the samples they calibrate (default: the parts as delivered)")
     p.set_defaults(func=cmd_battery)
 
 
@@ -618,12 +652,13 @@ def cmd_battery(args: argparse.Namespace) -> int:
     overrides = filter_overrides(params)
     with tqdm(total=len(motions) * len(sensors), desc="battery", unit="cell",
               disable=None) as bar:
+        setup = Setup(args.known_scale, args.calibrated_first)
         results = run_battery(motions, sensors, args.parts, args.scheduler, args.workers,
-                              lambda: bar.update(1), overrides, args.known_scale)
+                              lambda: bar.update(1), overrides, setup)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "battery.json").write_text(json.dumps(
         {"parts": args.parts, "settle_s": SETTLE_S, "params": params,
-         "known_scale": args.known_scale,
+         "known_scale": args.known_scale, "calibrated_first": args.calibrated_first,
          "motions": {m: MOTIONS[m].what for m in motions},
          "sensor_classes": {s: {"what": SENSOR_CLASSES[s].what, "rate": SENSOR_CLASSES[s].rate,
                                 "params": SENSOR_CLASSES[s].params,

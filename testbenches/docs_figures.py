@@ -871,12 +871,12 @@ def engines_table(ctx: dict[str, Path]) -> str:
     return engine_table(engine_rows(ctx["fmus"]), speed=False)
 
 
-@functools.lru_cache(maxsize=2)
-def _battery(known_scale: bool = False) -> Any:
-    from .battery import MOTIONS, PARTS, SENSOR_CLASSES, run_battery
+@functools.lru_cache(maxsize=3)
+def _battery(known_scale: bool = False, calibrated_first: bool = False) -> Any:
+    from .battery import MOTIONS, PARTS, SENSOR_CLASSES, Setup, run_battery
 
     return run_battery(list(MOTIONS), list(SENSOR_CLASSES), PARTS, scheduler=None,
-                       known_scale=known_scale)
+                       setup=Setup(known_scale, calibrated_first))
 
 
 def battery_classes() -> str:
@@ -892,9 +892,15 @@ def battery_overview(ctx: dict[str, Path]) -> str:
 
 
 def battery_known_scale(ctx: dict[str, Path]) -> str:
-    from .battery import known_scale_table
+    from .battery import Setup, setup_table
 
-    return known_scale_table(_battery(), _battery(known_scale=True))
+    return setup_table(_battery(), _battery(known_scale=True), Setup(known_scale=True))
+
+
+def battery_calibrated_first(ctx: dict[str, Path]) -> str:
+    from .battery import Setup, setup_table
+
+    return setup_table(_battery(), _battery(calibrated_first=True), Setup(calibrated_first=True))
 
 
 def battery_picture(ctx: dict[str, Path], path: Path) -> None:
@@ -1002,6 +1008,9 @@ def _battery_figures() -> tuple[Figure, ...]:
                needs=("vqf",)),
         Figure("battery-known-scale", "docs/results/battery/index.md",
                f"{command}; {command} --known-scale", battery_known_scale, needs=("vqf",)),
+        Figure("battery-calibrated-first", "docs/results/battery/index.md",
+               f"{command}; {command} --calibrated-first", battery_calibrated_first,
+               needs=("vqf",)),
         Figure("battery-picture", "docs/results/battery/index.md", command, battery_picture,
                "docs/results/battery/battery.png", ("vqf",)),
         *(Figure(f"battery-{m}", f"docs/results/battery/{m}.md", f"{command} --motion {m}",

@@ -100,7 +100,7 @@ def test_a_worse_parts_known_scale_lets_the_kf_follow_a_runner() -> None:
     for seed in range(3):
         default = battery.part_rmse("running", "worse", seed, ["kf"], vqf=False)["kf"]
         known = battery.part_rmse("running", "worse", seed, ["kf"], vqf=False,
-                                  known_scale=True)["kf"]
+                                  setup=battery.Setup(known_scale=True))["kf"]
         assert known < 0.9 * default
 
 
@@ -235,9 +235,46 @@ def test_the_known_scale_table_compares_each_cell_and_counts_both_ways() -> None
 
     recommended = {"running": {"better": cell(1.2, 1.1, 1.0), "worse": cell(1.05, 1.0, 0.9)}}
     known = {"running": {"better": cell(0.9, 0.95, 1.0), "worse": cell(1.5, 1.4, 1.3)}}
-    text = battery.known_scale_table(recommended, known)
+    text = battery.setup_table(recommended, known, battery.Setup(known_scale=True))
     head, _rule, row, _, counts = text.split("\n")
     assert head == "| motion | better (0.2 %) | worse (2 %) |"
     assert row == "| running | 1.20 -> 0.95 | 1.05 -> 1.50 |"
     assert counts == ("Of 2 cells, the best of ours is ahead of VQF in 1 as recommended and 1 "
                       "with the class's spread; kf and ukf are within 5 % of it in 1 and 1.")
+    text = battery.setup_table(recommended, known, battery.Setup(calibrated_first=True))
+    head, _rule, row, _, counts = text.split("\n")
+    assert head == "| motion | better | worse |"
+    assert counts.startswith("Of 2 cells, the best of ours is ahead of VQF in 1 as recommended "
+                             "and 1 calibrated first;")
+
+
+def test_a_part_calibrated_first_gives_every_filter_and_vqf_its_calibration() -> None:
+    """Calibrated first, the filters run with the part's own calibration (the calibrate
+    command's matrices, testbenches.calibrate.part) and VQF on the samples that calibration
+    conditions: the same numbers as running each by hand that way. The worse part's gyro
+    matrix (2 % scale, 1.3 % cross-axis errors) is most of a runner's error, in ours and in
+    VQF alike."""
+    from fusion_core.registry import create
+    from testbenches.broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
+    from testbenches.calibrate.part import part_calibration
+    from testbenches.estimate import conditioned
+    from testbenches.peers import PEERS
+
+    pytest.importorskip("vqf")
+    motion, sensor, seed = "running", "worse", 1
+    setup = battery.Setup(calibrated_first=True)
+    got = battery.part_rmse(motion, sensor, seed, ["kf"], setup=setup)
+    raw = battery.part_rmse(motion, sensor, seed, ["kf"])
+    s, m = battery.SENSOR_CLASSES[sensor], battery.MOTIONS[motion]
+    t, truth, sample = battery.part_samples(motion, sensor, seed)
+    calibration = part_calibration(s.params, seed)
+    assert any(k.startswith("gyro_") for k in calibration)
+    up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
+    scored = t >= m.rest + battery.SETTLE_S
+    out = create("kf", {**battery.filter_params(s)["kf"], **calibration}).run(
+        sample["acc"], sample["gyro"], sample["dt"])
+    assert got["kf"] == inclination_rmse_deg(gravity_from_roll_pitch(out["roll"], out["pitch"]),
+                                             up, scored)
+    acc, gyro = conditioned(sample["acc"], sample["gyro"], calibration)
+    assert got["vqf"] == inclination_rmse_deg(PEERS["vqf"](acc, gyro, s.rate), up, scored)
+    assert got["kf"] < 0.6 * raw["kf"] and got["vqf"] < 0.8 * raw["vqf"]
