@@ -891,16 +891,14 @@ def battery_overview(ctx: dict[str, Path]) -> str:
     return overview_table(_battery())
 
 
-def battery_known_scale(ctx: dict[str, Path]) -> str:
-    from .battery import Setup, setup_table
+def _battery_versus(flag: str) -> Callable[[dict[str, Path]], str]:
+    """The table of every cell as recommended beside the battery with one Setup flag on."""
+    def make(ctx: dict[str, Path]) -> str:
+        from .battery import Setup, setup_table
 
-    return setup_table(_battery(), _battery(known_scale=True), Setup(known_scale=True))
+        return setup_table(_battery(), _battery(**{flag: True}), Setup(**{flag: True}))
 
-
-def battery_calibrated_first(ctx: dict[str, Path]) -> str:
-    from .battery import Setup, setup_table
-
-    return setup_table(_battery(), _battery(calibrated_first=True), Setup(calibrated_first=True))
+    return make
 
 
 def battery_picture(ctx: dict[str, Path], path: Path) -> None:
@@ -1011,11 +1009,9 @@ def _battery_figures() -> tuple[Figure, ...]:
                readme_battery, needs=("vqf",)),
         Figure("battery-overview", "docs/results/battery/index.md", command, battery_overview,
                needs=("vqf",)),
-        Figure("battery-known-scale", "docs/results/battery/index.md",
-               f"{command}; {command} --known-scale", battery_known_scale, needs=("vqf",)),
-        Figure("battery-calibrated-first", "docs/results/battery/index.md",
-               f"{command}; {command} --calibrated-first", battery_calibrated_first,
-               needs=("vqf",)),
+        *(Figure(f"battery-{flag.replace('_', '-')}", "docs/results/battery/index.md",
+                 f"{command}; {command} --{flag.replace('_', '-')}", _battery_versus(flag),
+                 needs=("vqf",)) for flag in ("known_scale", "calibrated_first")),
         Figure("battery-picture", "docs/results/battery/index.md", command, battery_picture,
                "docs/results/battery/battery.png", ("vqf",)),
         *(Figure(f"battery-{m}", f"docs/results/battery/{m}.md", f"{command} --motion {m}",
