@@ -5,22 +5,28 @@ mechanisms of building_blocks and fusion_core.measured_vector around it (Complem
 
 from __future__ import annotations
 
+from math import sqrt
 from typing import ClassVar
 
 from .base import Estimator, SensorNoise
 from .building_blocks import (
     ACC_GATE_PARAMS,
     ACC_LOWPASS_PARAM,
+    BIAS_GATE_PARAM,
+    BIAS_INNOVATION_PARAM,
     COMPLEMENTARY_ADAPTIVE_PARAMS,
+    MOTION_BIAS_PARAM,
     REST_PARAMS,
     REST_START,
     ZERO3,
+    bias_band2,
     body_rotation,
     complementary_adaptive,
     complementary_rest,
     corrected_quat,
     correction_time,
     gate_bounds2,
+    motion_bias_ki,
     quat_from_roll_pitch,
     rest_start,
     tilt_innovation,
@@ -48,6 +54,7 @@ from .measured_vector import (
     measure_constants,
     measure_start,
     measure_step,
+    within_bias_band,
 )
 from .state import ANGLE, HALF_ANGLE, REAL, REST, UNIT, StateSpec
 from .types import Estimate, G, Param
@@ -81,7 +88,12 @@ class ComplementaryFilter(Estimator):
       uncertainty against the measured vector's noise (building_blocks.correction_time):
       shorter while the sensor turns with a clean accelerometer, longer while it accelerates,
       up to max_correction_time. A gyro sample at its rail (gyro_range) measures no bias at rest
-      and restarts the measured vector.
+      and restarts the measured vector;
+    - bias learning in motion until the first rest (motion_bias_gain > 0;
+      building_blocks.motion_bias): b <- b - Ki e dt, e = f/|f| x v the tilt innovation as a
+      body rate (Mahony's, v the estimated gravity direction), Ki from the correction time the
+      disturbance sets (motion_bias_ki), where the kf's bias learns (bias_gate,
+      bias_innovation, a settled vector, no sample at the rail).
 
     Why the defaults are so: docs/estimators/cf.md, "The defaults".
     """
@@ -100,6 +112,9 @@ class ComplementaryFilter(Estimator):
         LEAK_PARAM,
         HELD_PARAM,
         STRETCH_PARAM,
+        MOTION_BIAS_PARAM,
+        BIAS_GATE_PARAM,
+        BIAS_INNOVATION_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_cf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = ()
@@ -134,6 +149,9 @@ class ComplementaryFilter(Estimator):
                                           float(p["acc_lowpass_stretch"]),
                                           float(p["slow_band_leak"]),
                                           float(p["held_acceleration"]))
+        self._motion_gain = float(p["motion_bias_gain"])
+        self._bias_band2 = bias_band2(float(p["bias_gate"]))
+        self._bias_innovation = float(p["bias_innovation"])
 
     def _reset(self) -> None:
         self.roll = 0.0
@@ -169,6 +187,7 @@ class ComplementaryFilter(Estimator):
         aligning = False
         phi = body_rotation(self.gyro_prev, (gx, gy, gz), bias, dt, self._trapezoid)
         terms = rotvec_terms(*phi)  # once, for the pre-filter and the propagation
+        raw2 = ax * ax + ay * ay + az * az
         if self._acc_tau > 0.0:  # the filter and its gate use the measured vector
             m = measure_clipped(self.meas) if clipped else self.meas
             self.meas, r, aligning = measure_step(m, (ax, ay, az), phi, terms, dt,
@@ -187,13 +206,39 @@ class ComplementaryFilter(Estimator):
                 tau = correction_time(tau, r / r_ref, q_rotation, wx * wx + wy * wy + wz * wz,
                                       r_ref, dt, longest)
             k = 1.0 if aligning else dt / (tau + dt)  # 1 - a, Gui et al. eq. 2
+            if self._learns_in_motion(ax, ay, az, raw2, y_roll, y_pitch, aligning, clipped):
+                tau_d = self._tau  # the disturbance's correction time, without the rotation's
+                if r != r_ref:
+                    tau_d = correction_time(tau_d, r / r_ref, 0.0, 0.0, r_ref, dt, longest)
+                ki_dt = motion_bias_ki(tau_d, self._motion_gain, dt, 0.5 * self._acc_tau) * dt
+                # Mahony's e = f/|f| x v, v the estimated gravity direction (up_terms): the
+                # innovation as a body rate at any attitude
+                inv = 1.0 / sqrt(ax * ax + ay * ay + az * az)
+                nx, ny, nz = ax * inv, ay * inv, az * inv
+                vx, vy, vz = -up[2], up[0], up[1]
+                ex, ey, ez = ny * vz - nz * vy, nz * vx - nx * vz, nx * vy - ny * vx
+                self.bias = (bx - ki_dt * ex, by - ki_dt * ey, bz - ki_dt * ez)
             dr, dp = k * y_roll, k * y_pitch
             roll += dr
             pitch += dp
             self.q_att = corrected_quat(q, up, roll, pitch, dr, dp)
         self.roll = roll = roll if -PI <= roll <= PI else wrap_angle(roll)
         self.pitch = pitch = pitch if -HALF_PI <= pitch <= HALF_PI else clamp_pitch(pitch)
-        return Estimate(roll, pitch, bias)
+        return Estimate(roll, pitch, self.bias)
+
+    def _learns_in_motion(self, ax: float, ay: float, az: float, raw2: float, y_roll: float,
+                          y_pitch: float, aligning: bool, clipped: bool) -> bool:
+        """Whether this correction teaches the bias (building_blocks.motion_bias): before the
+        first rest, on a settled measured vector (ax, ay, az; raw2 the raw sample's squared
+        norm) within the bias gates, no sample at the rail."""
+        if not (self._motion_gain > 0.0 and self._acc_tau > 0.0 and self.rest.measured <= 0.0
+                and not aligning and not clipped and self.meas.settled(self._measure)):
+            return False
+        gate = self._bias_innovation
+        if not (-gate <= y_roll <= gate and -gate <= y_pitch <= gate):
+            return False
+        a2 = ax * ax + ay * ay + az * az
+        return a2 > 0.0 and within_bias_band(self.meas, self._measure, self._bias_band2, a2, raw2)
 
     def _estimate(self) -> Estimate:
         return Estimate(self.roll, self.pitch, self.bias)

@@ -61,15 +61,14 @@ from .measured_vector import (
     LEAK_PARAM,
     MEASURE_CHECK,
     STRETCH_PARAM,
-    band_measured,
     fill_noise,
-    gate_norm2,
     measure_clipped,
     measure_constants,
     measure_restarted,
     measure_start,
     measure_step,
     measure_turned,
+    within_bias_band,
 )
 from .papers.kalman import RollPitchAxes
 from .state import ANGLE, COV, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec, index
@@ -385,8 +384,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             # refills, a drift an update would take for a bias. No bias from a vector that is
             # filling (a mean of the first samples, of a motion's start as likely as of rest) or
             # holds turns the gyro did not measure (gyro_range)
-            n2 = gate_norm2(self.meas, self._measure, raw2)
-            learn_bias = (lo < n2 < hi and (lo < a2 < hi or not band_measured(self._measure))
+            learn_bias = (within_bias_band(self.meas, self._measure, (lo, hi), a2, raw2)
                           and not clipped and not filling and self.meas.settled(self._measure))
         else:  # the raw sample (bias_gate); never a sample at the rail
             a2 = raw2

@@ -409,6 +409,17 @@ def gate_norm2(m: Measure, c: MeasureConstants, raw2: float) -> float:
     return raw2
 
 
+def within_bias_band(m: Measure, c: MeasureConstants, band2: tuple[float, float], a2: float,
+                     raw2: float) -> bool:
+    """Whether a bias may be learned from this sample by the bias gate band2 = (lo, hi), squared
+    norms [m^2/s^4]: what reaches the measured vector (gate_norm2; raw2 the raw sample's squared
+    norm) within it and, where that is the slow band, what the vector still holds (a2, its own
+    squared norm) too."""
+    lo, hi = band2
+    n2 = gate_norm2(m, c, raw2)
+    return lo < n2 < hi and (lo < a2 < hi or not band_measured(c))
+
+
 def band_measured(c: MeasureConstants) -> bool:
     """Whether the slow band is measured (slow_band_time > 0, the statistics on)."""
     return c.dist_tau > 0.0 and c.band > 0.0

@@ -13,15 +13,19 @@ from typing import ClassVar, Final
 from .base import Estimator, SensorNoise
 from .building_blocks import (
     ACC_LOWPASS_PARAM,
+    BIAS_GATE_PARAM,
     COMPLEMENTARY_ADAPTIVE_PARAMS,
+    MOTION_BIAS_PARAM,
     REST_PARAMS,
     REST_START,
     SLOWEST_CORRECTION,
     ZERO3,
+    bias_band2,
     body_rotation,
     complementary_adaptive,
     complementary_rest,
     correction_time,
+    motion_bias_ki,
     quat_from_roll_pitch,
     rest_start,
 )
@@ -43,6 +47,7 @@ from .measured_vector import (
     measure_start,
     measure_step,
     raw_noise,
+    within_bias_band,
 )
 from .papers.mgcf import pi_step
 from .state import NONNEG, REAL, REST, UNIT, StateSpec
@@ -112,7 +117,11 @@ class GainScheduledComplementaryFilter(Estimator):
       building_blocks.correction_time (Ki as it is): Kp grows while the sensor turns with a
       clean accelerometer and falls while it accelerates, to 1/max_correction_time;
     - no bias is learned from a gyro sample at its rail (gyro_range) nor from a measured vector
-      that still holds its turns.
+      that still holds its turns;
+    - bias learning in motion until the first rest (motion_bias_gain > 0;
+      building_blocks.motion_bias): Ki is at least motion_bias_ki of the correction time the
+      disturbance sets, where the kf's bias learns (bias_gate on what reaches the vector): the
+      paper's w0^2 alone takes minutes to learn what a start-up calibration left.
 
     Why the defaults are so: docs/estimators/mgcf.md, "The defaults".
     """
@@ -131,6 +140,8 @@ class GainScheduledComplementaryFilter(Estimator):
         MGCF_BAND_LEAK,
         MGCF_HELD,
         STRETCH_PARAM,
+        MOTION_BIAS_PARAM,
+        BIAS_GATE_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_mgcf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = (0, 1, 2)
@@ -167,6 +178,8 @@ class GainScheduledComplementaryFilter(Estimator):
                                           float(p["acc_lowpass_stretch"]),
                                           float(p["slow_band_leak"]),
                                           float(p["held_acceleration"]))
+        self._motion_gain = float(p["motion_bias_gain"])
+        self._bias_band2 = bias_band2(float(p["bias_gate"]))
 
     def _reset(self) -> None:
         self.q = (1.0, 0.0, 0.0, 0.0)
@@ -214,6 +227,7 @@ class GainScheduledComplementaryFilter(Estimator):
     ) -> Estimate:
         r_ref, q_rotation, _, longest = self._adaptive
         r = r_ref
+        raw2 = ax * ax + ay * ay + az * az
         ax, ay, az, r, aligning = self._real_sensor_options(ax, ay, az, gx, gy, gz, dt)
         norm = math.sqrt(ax * ax + ay * ay + az * az)
         w0 = self._w0
@@ -235,11 +249,29 @@ class GainScheduledComplementaryFilter(Estimator):
         # the integral term learns nothing from a gyro sample at its rail, nor from a vector
         # still holding its turns
         learn = not self.clipped and (self._acc_tau == 0.0 or self.meas.settled(self._measure))
+        w_i = w0  # Ki = w_i^2: the paper's, or more until the first rest (motion_bias)
+        kp0 = self._two_zeta * w0
+        if learn and kp0 * SLOWEST_CORRECTION > 1.0 and self._learns_in_motion(ax, ay, az, raw2):
+            tau_d = 1.0 / kp0  # the disturbance's correction time
+            if r != r_ref:
+                tau_d = correction_time(tau_d, r / r_ref, 0.0, 0.0, r_ref, dt, longest)
+            ki = motion_bias_ki(tau_d, self._motion_gain, dt, 0.5 * self._acc_tau)
+            if ki > w0 * w0:
+                w_i = math.sqrt(ki)
         q, self.bias = pi_step(self.q, self.bias, self.gyro_prev, (gx, gy, gz), (ax, ay, az),
-                               norm, w0, kp, dt, self._trapezoid, learn)
+                               norm, w_i, kp, dt, self._trapezoid, learn)
         self.q = q
         roll, pitch = quat_roll_pitch(*q)
         return Estimate(roll, pitch, self.bias)
+
+    def _learns_in_motion(self, ax: float, ay: float, az: float, raw2: float) -> bool:
+        """Whether the integral term learns at motion_bias_ki (building_blocks.motion_bias):
+        before the first rest, with the measured vector (ax, ay, az; raw2 the raw sample's
+        squared norm) within the bias gate, as the kf's bias learns."""
+        if not (self._motion_gain > 0.0 and self._acc_tau > 0.0 and self.rest.measured <= 0.0):
+            return False
+        a2 = ax * ax + ay * ay + az * az
+        return within_bias_band(self.meas, self._measure, self._bias_band2, a2, raw2)
 
     def _estimate(self) -> Estimate:
         roll, pitch = quat_roll_pitch(*self.q)

@@ -490,8 +490,9 @@ def uncalibrated_rest_table(ctx: dict[str, Path]) -> str:
                          {"rest_bias_bound": 0.0}, calibrated_first=(False,))
     default = part_rmse(keys, ["static_tilted"], preset, sensor, UNCALIBRATED_PARTS,
                         calibrated_first=(False,))
-    how = {"cf": "only at rest, aligning at the first", "mgcf": "only at rest, aligning at the "
-           "first", "kf": "also from the accelerometer", "ukf": "also from the accelerometer"}
+    before = "from the accelerometer until the first rest, aligning there; then at rest"
+    how = {"cf": before, "mgcf": before, "kf": "also from the accelerometer",
+           "ukf": "also from the accelerometer"}
     rows = ["| filter | `rest_bias_bound` 0 (VQF's rule) | default (20 deg/s) | how it learns "
             "its bias |", "|---|---|---|---|"]
     for key in keys:

@@ -128,6 +128,8 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("rest", "rest detection and its zero-rate update (rest_time 0)", {"rest_time": 0.0}),
     Mechanism("turn_on_rest", "before the first rest, a rest may start within the turn-on bias "
               "bound of the estimate (rest_bias_bound 0: VQF's rule)", {"rest_bias_bound": 0.0}),
+    Mechanism("motion_bias", "the complementary filters' bias learned in motion until the "
+              "first rest (motion_bias_gain 0)", {"motion_bias_gain": 0.0}),
     Mechanism("bias_gate", "no bias learning while linear acceleration reaches the vector "
               "(bias_gate 0)", {"bias_gate": 0.0}, {"bias_gate": BIAS_GATE}),
     Mechanism("bias_innovation", "no bias learning from a tilt innovation beyond 10 deg "

@@ -13,6 +13,8 @@ below answers one of them the same way in every estimator:
   out (Laidig & Seel 2023, VQF);
 - rest: rest detection for a zero-angular-rate bias update (REST_PARAMS, RestState, rest_step;
   VQF's detector);
+- motion_bias: the complementary filters' bias learned in motion until the first rest
+  (MOTION_BIAS_PARAM, motion_bias_ki; Mahony et al.'s integral term);
 - adaptive_noise: more process noise while the sensor turns (the gyro's scale-factor error),
   more measurement noise while it accelerates (the linear acceleration the pre-filter has not
   removed, fusion_core.measured_vector), the raw sample where it measures none; correction_time
@@ -66,6 +68,11 @@ from .gate import (
     bias_band2,
     gate_bounds2,
 )
+from .motion_bias import (
+    MOTION_BIAS_GAIN,
+    MOTION_BIAS_PARAM,
+    motion_bias_ki,
+)
 from .prefilter import (
     ACC_LOWPASS_PARAM,
     lowpass_specific_force,
@@ -111,6 +118,8 @@ __all__ = [
     "GROSS_INNOVATION_PARAM",
     "GYRO_SAMPLING_PARAM",
     "MAX_CORRECTION_TIME_PARAM",
+    "MOTION_BIAS_GAIN",
+    "MOTION_BIAS_PARAM",
     "PREFILTER_FULL",
     "REAL_GYRO_DENSITY",
     "RECOMMENDED_GYRO_SCALE_STD",
@@ -134,6 +143,7 @@ __all__ = [
     "first_rest",
     "gate_bounds2",
     "lowpass_specific_force",
+    "motion_bias_ki",
     "nearest_face",
     "on_the_mark",
     "quat_from_roll_pitch",

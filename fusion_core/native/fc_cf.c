@@ -17,6 +17,7 @@ void fc_cf_configure(fc_cf *f)
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
                          p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
                          &f->measure);
+    fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
 }
 
 fc_estimate fc_cf_estimate(const fc_cf *f)
@@ -48,6 +49,25 @@ static void first_sample(fc_cf *f, const fc_real a[3], const fc_real g[3])  /* _
     fc_rest_start(f->rest, g, a);
 }
 
+/* _learns_in_motion: before the first rest, a settled vector a (raw2 the raw sample's squared
+ * norm) within the bias gates, no sample at the rail (building_blocks.motion_bias) */
+static int learns_in_motion(const fc_cf *f, const fc_real a[3], fc_real raw2, fc_real y_roll,
+                            fc_real y_pitch, int aligning, int clipped)
+{
+    const fc_cf_params *p = &f->params;
+    if (!(p->motion_bias_gain > 0.0 && f->acc_tau > 0.0 && f->rest[7] <= 0.0 && !aligning
+          && !clipped && fc_measure_settled(f->meas, &f->measure))) {
+        return 0;
+    }
+    fc_real gate = p->bias_innovation;
+    if (!(-gate <= y_roll && y_roll <= gate && -gate <= y_pitch && y_pitch <= gate)) {
+        return 0;
+    }
+    fc_real a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    return a2 > 0.0 && fc_measure_within_bias_band(f->meas, &f->measure, f->bias_lo2,
+                                                   f->bias_hi2, a2, raw2);
+}
+
 static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real dt)  /* _advance */
 {
     const fc_cf_params *p = &f->params;
@@ -67,6 +87,7 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
     int aligning = 0;
     fc_body_rotation(f->base.gyro_prev, g, f->bias, dt, f->base.trapezoid, phi);
     fc_rotvec_terms(phi[0], phi[1], phi[2], terms);  /* once, for both rotations */
+    fc_real raw2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     if (f->acc_tau > 0.0) {  /* the filter and its gate use the measured vector */
         if (clipped) {
             fc_measure_clipped(f->meas);
@@ -89,6 +110,21 @@ static void advance(fc_cf *f, const fc_real a_in[3], const fc_real g[3], fc_real
                                      wx * wx + wy * wy + wz * wz, f->r_ref, dt, f->longest);
         }
         fc_real k = aligning ? 1.0 : dt / (tau + dt);  /* 1 - a, Gui et al. eq. 2 */
+        if (learns_in_motion(f, a, raw2, y_roll, y_pitch, aligning, clipped)) {
+            fc_real tau_d = f->tau;  /* the disturbance's correction time, without the rotation's */
+            if (r != f->r_ref) {
+                tau_d = fc_correction_time(tau_d, r / f->r_ref, 0.0, 0.0, f->r_ref, dt, f->longest);
+            }
+            fc_real ki_dt = fc_motion_bias_ki(tau_d, p->motion_bias_gain, dt, 0.5 * f->acc_tau) * dt;
+            /* Mahony's e = f/|f| x v, v the estimated gravity direction (up_terms) */
+            fc_real inv = 1.0 / fc_sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            fc_real nx = a[0] * inv, ny = a[1] * inv, nz = a[2] * inv;
+            fc_real vx = -up[2], vy = up[0], vz = up[1];
+            fc_real ex = ny * vz - nz * vy, ey = nz * vx - nx * vz, ez = nx * vy - ny * vx;
+            f->bias[0] = bx - ki_dt * ex;
+            f->bias[1] = by - ki_dt * ey;
+            f->bias[2] = bz - ki_dt * ez;
+        }
         fc_real dr = k * y_roll, dp = k * y_pitch;
         roll += dr;
         pitch += dp;

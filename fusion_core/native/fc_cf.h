@@ -21,6 +21,7 @@ typedef struct fc_cf {
     fc_real tau, gate_low2, gate_high2, acc_tau;
     fc_real r_ref, q_rotation, dist_tau, longest;  /* ComplementaryFilter._adaptive */
     fc_meas_constants measure;  /* ComplementaryFilter._measure */
+    fc_real bias_lo2, bias_hi2;  /* ComplementaryFilter._bias_band2 */
 } fc_cf;
 
 /* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */

@@ -578,6 +578,13 @@ fc_real fc_measure_gate_norm2(const fc_real m[FC_MEAS_SIZE], const fc_meas_const
     return raw2;
 }
 
+int fc_measure_within_bias_band(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
+                                fc_real lo2, fc_real hi2, fc_real a2, fc_real raw2)
+{
+    fc_real n2 = fc_measure_gate_norm2(m, c, raw2);
+    return lo2 < n2 && n2 < hi2 && ((lo2 < a2 && a2 < hi2) || !fc_measure_band_measured(c));
+}
+
 fc_real fc_measure_raw_noise(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c)
 {
     fc_real excess = m[FC_MEAS_DIST] - c->noise;
@@ -752,6 +759,20 @@ int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_
         fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time, rest[6] - rest_time);
     }
     return 0;
+}
+
+/* motion_bias_ki: Ki of the PI loop whose proportional gain is 1 / tau, gain / tau^2, with tau
+ * no shorter than one sample dt nor than one stage of the measured vector's low-pass
+ * (building_blocks.motion_bias) */
+fc_real fc_motion_bias_ki(fc_real tau, fc_real gain, fc_real dt, fc_real stage)
+{
+    if (tau < dt) {
+        tau = dt;
+    }
+    if (tau < stage) {
+        tau = stage;
+    }
+    return gain / (tau * tau);
 }
 
 void fc_bias_band2(fc_real gate, fc_real *lo, fc_real *hi)

@@ -174,6 +174,10 @@ void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,
                            const fc_meas_constants *c, fc_real *var, fc_real *age);
 /* Measure.settled */
 int fc_measure_settled(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c);
+/* within_bias_band: whether a bias may be learned by the gate (lo2, hi2): gate_norm2 within it
+ * and, where that is the slow band, the vector's own squared norm a2 too */
+int fc_measure_within_bias_band(const fc_real m[FC_MEAS_SIZE], const fc_meas_constants *c,
+                                fc_real lo2, fc_real hi2, fc_real a2, fc_real raw2);
 /* band_measured: whether the slow band is measured (the statistics on) */
 int fc_measure_band_measured(const fc_meas_constants *c);
 /* gate_norm2: the squared norm a bias gate judges (the slow band's, else raw2) */
@@ -219,6 +223,7 @@ int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_
                           fc_real rest_acc, fc_real bound, fc_real *roll, fc_real *pitch,
                           fc_real f[3]);
 void fc_bias_band2(fc_real gate, fc_real *lo, fc_real *hi);
+fc_real fc_motion_bias_ki(fc_real tau, fc_real gain, fc_real dt, fc_real stage);
 int fc_nearest_face(fc_real ux, fc_real uy, fc_real uz);
 void fc_mat_vec(const fc_real m[9], const fc_real v[3], fc_real out[3]);
 void fc_mat_t_vec(const fc_real m[9], const fc_real v[3], fc_real out[3]);

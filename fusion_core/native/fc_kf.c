@@ -269,10 +269,8 @@ static void update(fc_kf *f, const fc_real a_in[3], const fc_real g[3], fc_real 
         /* the bias gate on what reaches the vector (gate_norm2) and, where that is the slow
          * band, on what the vector still holds, its own norm; no bias from a vector that is
          * filling or holds turns the gyro did not measure */
-        fc_real n2 = fc_measure_gate_norm2(f->meas, &f->measure, raw2);
-        learn_bias = f->bias_lo2 < n2 && n2 < f->bias_hi2
-                     && ((f->bias_lo2 < a2 && a2 < f->bias_hi2)
-                         || !fc_measure_band_measured(&f->measure))
+        learn_bias = fc_measure_within_bias_band(f->meas, &f->measure, f->bias_lo2, f->bias_hi2,
+                                                 a2, raw2)
                      && !clipped && !filling && fc_measure_settled(f->meas, &f->measure);
     } else {  /* the raw sample (bias_gate); never a sample at the rail */
         a2 = raw2;

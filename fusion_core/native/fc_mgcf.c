@@ -26,6 +26,8 @@ void fc_mgcf_configure(fc_mgcf *f)
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
                          p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
                          &f->measure);
+    f->motion_gain = p->motion_bias_gain;
+    fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
 }
 
 fc_estimate fc_mgcf_estimate(const fc_mgcf *f)
@@ -58,11 +60,23 @@ static void first_sample(fc_mgcf *f, const fc_real a[3], const fc_real g[3])  /*
     fc_rest_start(f->rest, g, a);
 }
 
+/* _learns_in_motion: before the first rest, the vector a (raw2 the raw sample's squared norm)
+ * within the bias gate (building_blocks.motion_bias) */
+static int learns_in_motion(const fc_mgcf *f, const fc_real a[3], fc_real raw2)
+{
+    if (!(f->motion_gain > 0.0 && f->acc_tau > 0.0 && f->rest[7] <= 0.0)) {
+        return 0;
+    }
+    fc_real a2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    return fc_measure_within_bias_band(f->meas, &f->measure, f->bias_lo2, f->bias_hi2, a2, raw2);
+}
+
 static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_real dt)
 {
     fc_real ax = a_in[0], ay = a_in[1], az = a_in[2];
     fc_real gx = g[0], gy = g[1], gz = g[2];
     fc_real r = f->r_ref;
+    fc_real raw2 = ax * ax + ay * ay + az * az;
     int aligning = 0;
     int clipped = f->base.clipped;
     fc_real roll, pitch, fa[3];  /* _real_sensor_options */
@@ -110,7 +124,19 @@ static void advance(fc_mgcf *f, const fc_real a_in[3], const fc_real g[3], fc_re
      * still holding its turns */
     int learn = !clipped && (f->acc_tau == 0.0 || fc_measure_settled(f->meas, &f->measure));
     const fc_real af[3] = {ax, ay, az};
-    fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, af, norm, w0, kp, dt,
+    fc_real w_i = w0;  /* Ki = w_i^2: the paper's, or more until the first rest (motion_bias) */
+    fc_real kp0 = f->two_zeta * w0;
+    if (learn && kp0 * FC_SLOWEST_CORRECTION > 1.0 && learns_in_motion(f, af, raw2)) {
+        fc_real tau_d = 1.0 / kp0;  /* the disturbance's correction time */
+        if (r != f->r_ref) {
+            tau_d = fc_correction_time(tau_d, r / f->r_ref, 0.0, 0.0, f->r_ref, dt, f->longest);
+        }
+        fc_real ki = fc_motion_bias_ki(tau_d, f->motion_gain, dt, 0.5 * f->acc_tau);
+        if (ki > w0 * w0) {
+            w_i = fc_sqrt(ki);
+        }
+    }
+    fc_paper_mgcf_pi_step(f->q, f->bias, f->base.gyro_prev, g, af, norm, w_i, kp, dt,
                           f->base.trapezoid, learn);
 }
 

@@ -21,6 +21,7 @@ typedef struct fc_mgcf {
     fc_real w0, two_zeta, acc_tau, rest_time, rest_gyro, rest_acc, rest_bias_bound;
     fc_real r_ref, q_rotation, dist_tau, longest;  /* _adaptive */
     fc_meas_constants measure;  /* _measure */
+    fc_real motion_gain, bias_lo2, bias_hi2;  /* _motion_gain, _bias_band2 */
 } fc_mgcf;
 
 /* init, configure, reset, step, run, run_columns, estimate, restored (fc_core.h) */

@@ -112,6 +112,9 @@ typedef struct fc_cf_params {
     fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
+    fc_real motion_bias_gain;     /* [0.0, 1.0] */
+    fc_real bias_gate;            /* [0.0, 1000.0] */
+    fc_real bias_innovation;      /* (0.0, 3.141592653589793] [rad] */
     fc_input_params input;        /* the input stage's */
 } fc_cf_params;
 
@@ -135,6 +138,9 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->slow_band_leak = 1.0;
     p->held_acceleration = 5.6618720173484425;
     p->acc_lowpass_stretch = 2.0;
+    p->motion_bias_gain = 0.5;
+    p->bias_gate = 0.05;
+    p->bias_innovation = 0.17453292519943295;
     fc_input_params_default(&p->input);
 }
 
@@ -177,6 +183,8 @@ typedef struct fc_mgcf_params {
     fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
+    fc_real motion_bias_gain;     /* [0.0, 1.0] */
+    fc_real bias_gate;            /* [0.0, 1000.0] */
     fc_input_params input;        /* the input stage's */
 } fc_mgcf_params;
 
@@ -199,6 +207,8 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->slow_band_leak = 0.0;
     p->held_acceleration = 0.0;
     p->acc_lowpass_stretch = 2.0;
+    p->motion_bias_gain = 0.5;
+    p->bias_gate = 0.05;
     fc_input_params_default(&p->input);
 }
 
