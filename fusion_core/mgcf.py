@@ -56,11 +56,10 @@ from .types import Estimate, G, Param
 MGCF_ACC_LOWPASS = dataclasses.replace(ACC_LOWPASS_PARAM, default=1.0)
 """The mgcf's acc_lowpass: 1 s, not the 1.5 s of the others. Its integral term (Ki = w0^2)
 learns a bias from every error its correction passes, and a longer vector turned by a gyro with
-scale errors carries more of them: tests/test_paper_rows.py holds the defaults to half the
-paper's row on moderate_dynamics, which 1.5 s leaves in pitch (the longer vector, which grows
-only where slow linear acceleration reaches it, leaves the row), and the
-cross-validation on BROAD chooses among the values that keep it (`python -m testbenches broad
-DIR --cv`; testbenches.broad.feasible)."""
+scale errors carries more of them. The cross-validation on BROAD chooses 1 s in every fold
+(`python -m testbenches broad DIR --cv`), among the values that keep the contract's bounds and
+half the paper's row on moderate_dynamics (testbenches.broad.feasible; tests/test_paper_rows.py).
+Without the bias learning in motion (motion_bias_gain 0), 1.5 s leaves that row in pitch."""
 
 
 MGCF_BAND_LEAK: Final = dataclasses.replace(LEAK_PARAM, default=0.0)

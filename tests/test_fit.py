@@ -156,7 +156,7 @@ def _tilt_recording(seed: int) -> Recording:
 
 def test_tune_never_ends_worse_than_its_start_and_keeps_the_bounds():
     fit_set, check = [_tilt_recording(1)], [_tilt_recording(2)]
-    start = {"w0": 0.5}  # far too stiff: the fit must find better
+    start = {"w0": 2.0}  # far too stiff: the fit must find better
     result = tune("mgcf", fit_set, check, start, ["w0", "zeta"], max_evaluations=40)
     assert result.fit_rmse_deg <= result.start_fit_rmse_deg
     assert result.fit_rmse_deg < 0.8 * result.start_fit_rmse_deg
