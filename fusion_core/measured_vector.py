@@ -143,8 +143,7 @@ LEAK_PARAM: Final = Param(
     low=0.0, high=1.0,
 )
 """Recommended 1: the estimate is the leak's mean (module docstring, item 5); nothing is fitted.
-`imu-fusion mechanisms` scores it against 0 (docs/results/mechanisms.md), and drops it from the
-mgcf (mgcf.MGCF_BAND_LEAK)."""
+`imu-fusion mechanisms` scores it against 0 (docs/results/mechanisms.md)."""
 HELD_PARAM: Final = Param(
     "held_acceleration", G * math.tan(GROSS_INNOVATION),
     "The largest linear acceleration the slow band's statistic counts: more than a body holds "

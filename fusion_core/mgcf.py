@@ -62,13 +62,6 @@ half the paper's row on moderate_dynamics (testbenches.broad.feasible; tests/tes
 Without the bias learning in motion (motion_bias_gain 0), 1.5 s leaves that row in pitch."""
 
 
-MGCF_BAND_LEAK: Final = dataclasses.replace(LEAK_PARAM, default=0.0)
-"""The mgcf's slow_band_leak: 0, the slow band's output as it is. Its measurement noise is the
-raw disturbance, so the slow band only decides how long the vector grows; taking the fast leak
-off it lowers the error neither on BROAD's folds left out nor on the battery (0.998), and
-`imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays for a user's
-own value."""
-
 MGCF_HELD: Final = dataclasses.replace(HELD_PARAM, default=0.0)
 """The mgcf's held_acceleration: 0, no limit. The cap bounds the slow band's statistic, the
 measurement noise of the other filters; the mgcf's is the raw disturbance, which it does not
@@ -104,8 +97,8 @@ class GainScheduledComplementaryFilter(Estimator):
       finds linear acceleration slower than it that the gyro's turn would not explain, once a
       rest has measured the bias (measured_vector, item 4; a hand carrying the sensor back and
       forth over seconds); the measurement noise stays the raw disturbance
-      (measured_vector.raw_noise), the slow band only decides the length, without its fast
-      leak taken off (MGCF_BAND_LEAK) and without a cap (MGCF_HELD);
+      (measured_vector.raw_noise), the slow band only decides the length, with its fast leak
+      taken off (slow_band_leak) and without a cap (MGCF_HELD);
     - rest detection (rest_time > 0; building_blocks.REST_PARAMS): at rest the gyro reads its
       own bias, and b follows the gyro with time constant rest_time (a zero-angular-rate update
       of the integral term; Mahony's integral alone needs minutes, and cannot see the bias about
@@ -136,7 +129,7 @@ class GainScheduledComplementaryFilter(Estimator):
         *REST_PARAMS,
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
-        MGCF_BAND_LEAK,
+        LEAK_PARAM,
         MGCF_HELD,
         STRETCH_PARAM,
         MOTION_BIAS_PARAM,

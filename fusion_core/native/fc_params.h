@@ -140,7 +140,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->acc_lowpass_stretch = 2.0;
     p->motion_bias_gain = 0.5;
     p->bias_gate = 0.05;
-    p->bias_innovation = 0.17453292519943295;
+    p->bias_innovation = 3.141592653589793;
     fc_input_params_default(&p->input);
 }
 
@@ -204,7 +204,7 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->disturbance_time = 1.0;
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
-    p->slow_band_leak = 0.0;
+    p->slow_band_leak = 1.0;
     p->held_acceleration = 0.0;
     p->acc_lowpass_stretch = 2.0;
     p->motion_bias_gain = 0.5;
