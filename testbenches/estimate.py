@@ -10,9 +10,11 @@ encoding and a unit stated in a column's name ("Gyroscope X (deg/s)") are read o
 (testbenches.reader). Units are given (--acc-unit g|m/s2, --gyro-unit rad/s|deg/s), stated by
 the header, or found from the data: the accelerometer's from its norm (1 in g, 9.81 in m/s^2),
 the gyro's as the unit in which its turn explains the accelerometer's turn of gravity
-(testbenches.gyro_unit). A given or stated gyro unit the data contradict is refused with the
-evidence, and so is a recording whose data cannot tell the unit where none is given. A sample
-without a number in every column is rejected and counted by the estimators, not the file.
+(testbenches.gyro_unit), the time's (--time-unit s|ms|us|ns) as the unit in which its steps
+are an IMU's rate, the data deciding where two are (testbenches.time_unit). A given or stated
+unit the data contradict is refused with the evidence, and so is a recording whose data cannot
+tell the unit where none is given. A sample without a number in every column is rejected and
+counted by the estimators, not the file.
 
 A reference, roll and pitch [rad] or a quaternion q_w, q_x, q_y, q_z (sensor to a z-up frame),
 in the recording or in a file of its own (--reference, matched by time), gives the inclination
@@ -105,18 +107,20 @@ class Reference:
     """A reference file (time with roll, pitch or q_w..q_z), read whole (a reference is a
     recording's companion, not its bulk), matched to a recording's times by `at`."""
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, recording_time_unit: str = "s") -> None:
         from .fit.recording import RecordingError
 
         cols, found = read_columns(path)
         if "time" not in cols:
-            raise RecordingError(f"{path}: a reference needs a time column [s]; it has "
+            raise RecordingError(f"{path}: a reference needs a time column; it has "
                                  f"{', '.join(found.header)}")
         up, quat = reference_up(cols, path)
         if up is None:
             raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, "
                                  f"q_y, q_z; it has {', '.join(found.header)}")
-        t = cols["time"] * TIME_SCALE.get(found.units.get("time") or "s", 1.0)
+        self.time_unit = reference_time_unit(path, cols["time"], found.units.get("time"),
+                                             recording_time_unit)
+        t = cols["time"] * TIME_SCALE[self.time_unit]
         keep = np.isfinite(t) & np.all(np.isfinite(up), axis=1)
         if not keep.any():
             raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
@@ -134,10 +138,12 @@ class Reference:
         return float(self.t.min()), float(self.t.max())
 
     def overlap_error(self, first: float, last: float) -> str:
+        """Why the reference does not overlap a recording from `first` to `last` [s] (last NaN:
+        the recording's start only is known, and the reference ends before it)."""
         lo, hi = self.span
+        seen = f"{first:.6g} to {last:.6g} s" if np.isfinite(last) else f"from {first:.6g} s"
         return (f"{self.path}: the reference's time ({lo:.6g} to {hi:.6g} s) does not overlap "
-                f"the recording's ({first:.6g} to {last:.6g} s): both must count from the same "
-                "instant")
+                f"the recording's ({seen}): both must count from the same instant")
 
     def at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         """The up direction [n, 3] at the times t (linear between the reference's samples; NaN
@@ -150,6 +156,34 @@ class Reference:
                                               right=np.nan) for i in range(4)])
             q_at /= np.linalg.norm(q_at, axis=1, keepdims=True)
         return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
+
+
+def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording: str) -> str:
+    """The unit of a reference's time column: the one its header states, else the one in which
+    its steps are a rate a reference is sampled at (testbenches.time_unit.RATE_RANGE), and
+    where two are, the recording's (both count from one instant in one unit as a rule, and the
+    overlap is checked after); RecordingError where neither serves."""
+    from .fit.recording import RecordingError
+    from .time_unit import candidates, rate_in
+
+    if stated is not None:
+        if stated not in TIME_SCALE:
+            raise RecordingError(f"{path}: the reference's time column states the unit "
+                                 f"{stated!r}, not one of {', '.join(TIME_SCALE)}")
+        return stated
+    finite = t[np.isfinite(t)]
+    steps = np.diff(finite)
+    rising = steps[steps > 0.0]
+    step = float(np.median(rising)) if len(rising) else float("nan")
+    found = candidates(step)
+    if len(found) == 1:
+        return found[0]
+    if recording in found or not (np.isfinite(step) and step > 0.0):
+        return recording
+    rates = ", ".join(f"{rate_in(step, u):.4g} Hz in {u}" for u in found) or "none"
+    raise RecordingError(f"{path}: the reference's time column states no unit, and its median "
+                         f"step {step:.6g} is {rates}, none of them the recording's unit "
+                         f"({recording}): state it in the header, as time (ms)")
 
 
 WORLD_UP_SPREAD_DEG = 10.0
@@ -520,7 +554,8 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         threading.Thread(target=_import_pyplot, daemon=True).start()
     source = source_from_args(args.recording, args)
     print(f"{args.recording}: {source.choices}")
-    reference = Reference(args.reference) if args.reference is not None else None
+    reference = (Reference(args.reference, source.time_unit) if args.reference is not None
+                 else None)
     args.out.mkdir(parents=True, exist_ok=True)
     runs: list[Any] = []
     try:

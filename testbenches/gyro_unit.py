@@ -74,6 +74,9 @@ class UnitEvidence:
 
 
 def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
+    """The mean of each row and the n - 1 before it (the first rows: the first full mean); n
+    at most the rows there are."""
+    n = min(n, len(x))
     if n <= 1:
         return x
     c = np.zeros((len(x) + 1, x.shape[1]))

@@ -29,7 +29,11 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
     calibrate, noise, tune; testbenches.fit.recording.load_recording)."""
     parser.add_argument("--rate", type=positive_float, default=None,
                         help="sample rate [Hz] where the file has no time or dt column")
-    parser.add_argument("--time-column", default=None, help="the time column's name [s]")
+    parser.add_argument("--time-column", default=None, help="the time column's name")
+    parser.add_argument("--time-unit", choices=("auto", "s", "ms", "us", "ns"), default="auto",
+                        help="the unit of the time (or dt) column (auto: the header's, else the "
+                        "one in which its steps are an IMU's sample rate, the data deciding "
+                        "where two are)")
     parser.add_argument("--column", action="append", default=[], metavar="QUANTITY=NAME",
                         help="the column of a quantity (acc_x..gyro_z, time, dt, roll, pitch, "
                         "q_w..q_z) where its name is none the reader knows (repeatable)")

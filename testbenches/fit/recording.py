@@ -23,7 +23,6 @@ import numpy as np
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
-from ..reader import TIME_SCALE
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -127,7 +126,8 @@ ALIASES: dict[str, tuple[str, ...]] = {
     "gyro_x": ("gyro_x", "gx", "gyrx", "gyr_x", "gyro_x_dps", "gyroscope_x", "wx", "g_x"),
     "gyro_y": ("gyro_y", "gy", "gyry", "gyr_y", "gyro_y_dps", "gyroscope_y", "wy", "g_y"),
     "gyro_z": ("gyro_z", "gz", "gyrz", "gyr_z", "gyro_z_dps", "gyroscope_z", "wz", "g_z"),
-    "time": ("time", "t", "timestamp", "time_s"),
+    "time": ("time", "t", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
+             "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns"),
 }
 """Column names a recording may use (case and spaces ignored), per quantity."""
 G_STANDARD = 9.80665
@@ -208,8 +208,18 @@ def find_columns(table: Any, time_column: str | None = None,
         if i is not None:
             found.index[quantity] = i
             found.source[quantity] = table.header[i]
-            found.units[quantity] = table.units[i]
+            found.units[quantity] = table.units[i] or _unit_in_name(quantity, table.names[i])
     return found
+
+
+def _unit_in_name(quantity: str, name: str) -> str | None:
+    """The unit a time or dt column's name ends with (time_ms, timestamp_ns), else None."""
+    from ..reader import TIME_SCALE
+
+    if quantity not in ("time", "dt"):
+        return None
+    *_, suffix = _norm_name(name).rpartition("_")
+    return suffix if suffix in TIME_SCALE and _norm_name(name) != suffix else None
 
 
 def open_table(path: Path) -> Any:
@@ -334,6 +344,8 @@ class RecordingSource:
     choices: str
     rows: int | None
     _blocks: Any
+    time_unit: str = "s"
+    """The unit of the file's time column (s where the times come from a rate or the format)."""
 
     def blocks(self, rows: int | None = None) -> Iterator[tuple[Recording, np.ndarray]]:
         """(Recording, time [s]) of each block of samples, from the first; RecordingError where
@@ -390,7 +402,8 @@ def _broad_source(path: Path, trial: Any) -> RecordingSource:
 
 def open_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
                    acc_unit: str = "auto", gyro_unit: str = "auto",
-                   columns: dict[str, str] | None = None) -> RecordingSource:
+                   columns: dict[str, str] | None = None,
+                   time_unit: str = "auto") -> RecordingSource:
     """The recording opened for reading in blocks (RecordingSource), its units, columns and
     rate decided from its first PREFIX_ROWS samples: given, stated by the file, or from the
     data (which must not contradict what is given or stated); RecordingError saying what is
@@ -426,19 +439,32 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     if n < 2:
         raise RecordingError(f"{path}: {n} sample(s); a recording needs many")
     rate = rate or table.attrs.get("rate")
-    if "time" in prefix:
-        scale = TIME_SCALE.get(units.get("time") or "s", 1.0)
-        t = prefix["time"] * scale
-        valid = np.flatnonzero(np.isfinite(t))
-        if len(valid) < 2:
-            raise RecordingError(f"{path}: fewer than two samples with a time")
-        steps = np.diff(t[valid])
-        first = float(np.median(steps)) if np.all(steps > 0.0) else float("nan")
-        clock = _Clock("time", scale, first, path, table.where)
-    elif "dt" in prefix:
-        scale = TIME_SCALE.get(units.get("dt") or "s", 1.0)
-        clock = _Clock("dt", scale, median_period(prefix["dt"][1:]) * scale, path,
-                       table.where)
+    acc, gyro = _vectors(prefix)  # as read: the time unit's evidence needs their directions only
+    t_unit, time_how = "s", ""
+    if time_unit != "auto" and not ("time" in prefix or "dt" in prefix):
+        raise RecordingError(f"{path}: --time-unit {time_unit} is given, but the recording has "
+                             "no time or dt column for it (leave it out)")
+    if "time" in prefix or "dt" in prefix:
+        kind = "time" if "time" in prefix else "dt"
+        raw = prefix[kind]
+        if kind == "time":
+            valid = np.flatnonzero(np.isfinite(raw))
+            if len(valid) < 2:
+                raise RecordingError(f"{path}: fewer than two samples with a time")
+            steps = np.diff(raw[valid])
+            rising = steps[steps > 0.0]
+            step = float(np.median(rising)) if len(rising) else float("nan")
+            increasing = bool(np.all(steps > 0.0))
+        else:
+            step, increasing = median_period(raw[1:]), True
+
+        def clock_in(scale: float) -> _Clock:
+            first = step * scale if increasing else float("nan")
+            return _Clock(kind, scale, first, path, table.where)
+
+        t_unit, scale, time_how = _time_scale(path, kind, step, time_unit, units.get(kind),
+                                              lambda s: clock_in(s)(raw, 0, n)[0], acc, gyro)
+        clock = clock_in(scale)
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
     else:
@@ -450,10 +476,10 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                              "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
     dt, _ = replace(clock)(prefix.get(clock.kind), 0, n)
-    acc, gyro = _vectors(prefix)
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
-        raise RecordingError(f"{path}: no sample holds numbers in every column")
+        raise RecordingError(f"{path}: no sample holds numbers in every column"
+                             + _split_rows(acc, gyro))
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
                                     _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
 
@@ -477,7 +503,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         gyro_how += f" over the first {used} samples"
     where = ", ".join(f"{q}={found.source[q]!r}" for q in (*IMU_AXES, "time", "dt")
                       if q in found.source)
-    choices = (f"acc in {acc_how}; gyro in {gyro_how}" + (f"; columns {where}" if where else "")
+    choices = (f"acc in {acc_how}; gyro in {gyro_how}" + (f"; {time_how}" if time_how else "")
+               + (f"; columns {where}" if where else "")
                + ("" if table.kind == "text" else f"; read as {table.kind}"))
     name = path.stem
 
@@ -496,7 +523,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             row0 += len(block)
             yield rec, t
 
-    return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks)
+    return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit)
 
 
 def _vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -522,7 +549,7 @@ def source_from_args(path: Path, args: argparse.Namespace) -> RecordingSource:
     """open_recording with the options add_recording_options defines."""
     return open_recording(path, rate=args.rate, time_column=args.time_column,
                           acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
-                          columns=parse_columns(args.column))
+                          columns=parse_columns(args.column), time_unit=args.time_unit)
 
 
 def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
@@ -541,6 +568,56 @@ def _given_against_header(path: Path, sensor: str, option: str, unit: str,
             f"{path}: --{option} {unit} contradicts the header, which states {stated} for the "
             f"{sensor}: leave --{option} out to take the header's, or rename the columns where "
             "the header is wrong")
+
+
+def _split_rows(acc: np.ndarray, gyro: np.ndarray) -> str:
+    """Where the accelerometer and the gyro are on rows of their own (a logger that writes
+    each sensor's readings as they come): what would serve; else nothing."""
+    only_acc = int(np.sum(np.all(np.isfinite(acc), 1) & ~np.any(np.isfinite(gyro), 1)))
+    only_gyro = int(np.sum(np.all(np.isfinite(gyro), 1) & ~np.any(np.isfinite(acc), 1)))
+    if only_acc and only_gyro:
+        return (f": the accelerometer and the gyro are on rows of their own ({only_acc} rows "
+                f"hold only the accelerometer, {only_gyro} only the gyro); one row per sample "
+                "with both serves (each gyro row joined to the accelerometer row nearest in "
+                "time)")
+    return ""
+
+
+def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | None,
+                dt_of: Any, acc: np.ndarray, gyro: np.ndarray) -> tuple[str, float, str]:
+    """The unit of the time or dt column (kind), its factor to seconds and how it was chosen:
+    given, stated by the header, or from its median step (numbers as read) and where two units
+    give IMU rates from the data (testbenches.time_unit; dt_of(scale): each sample's dt [s] in a
+    unit of that factor). A step that is no IMU rate in the unit given or stated is refused
+    with the rate it would be, and so is a given unit that is not the header's."""
+    from ..time_unit import RATE_RANGE, TIME_UNITS, TimeUnit, candidates, rate_in, time_unit
+
+    _given_against_header(path, kind, "time-unit", unit, stated)
+    chosen = unit if unit != "auto" else stated
+    if chosen is not None:
+        how = "given" if unit != "auto" else "from the header"
+        if chosen not in TIME_UNITS:
+            raise RecordingError(f"{path}: the {kind} column's unit {chosen!r} is not one of "
+                                 f"{', '.join(TIME_UNITS)}")
+        if np.isfinite(step) and step > 0.0 and chosen not in candidates(step):
+            fits = candidates(step)
+            serve = "check the column"
+            if fits:
+                serve = (f"in {' or '.join(fits)} it is "
+                         + ", ".join(f"{rate_in(step, u):.4g} Hz" for u in fits) + ": "
+                         + ("give --time-unit " + " or ".join(fits) if unit != "auto"
+                            else "correct the unit in the header"))
+            raise RecordingError(
+                f"{path}: the {kind} column's median step {step:.6g} is "
+                f"{rate_in(step, chosen):.4g} Hz in {chosen} ({how}), a rate no IMU is "
+                f"sampled at ({RATE_RANGE[0]:g} to {RATE_RANGE[1]:g} Hz); {serve}")
+        return chosen, TIME_UNITS[chosen], f"{kind} in {chosen} ({how})"
+    if not (np.isfinite(step) and step > 0.0):  # a time that does not increase: the clock
+        return "s", 1.0, f"{kind} in s"           # names where, in the file's own numbers
+    found = time_unit(kind, step, dt_of, acc, gyro)
+    if not isinstance(found, TimeUnit):
+        raise RecordingError(f"{path}: {found}")
+    return found.unit, found.scale, f"{kind} in {found.unit} ({found.how})"
 
 
 def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None

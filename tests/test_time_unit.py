@@ -1,0 +1,136 @@
+"""A time column in whatever unit a logger wrote it: milliseconds and nanoseconds as loggers
+write them without a unit, the data deciding where two units give IMU rates, a recording that
+cannot tell refused with the candidates, a given or stated unit whose rate no IMU has refused,
+a reference in the recording's unit, and the accelerometer and gyro on rows of their own."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from testbenches.cli import main
+from testbenches.fit.recording import RecordingError, open_recording
+from testbenches.time_unit import RATE_RANGE, candidates
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLE = REPO / "examples" / "tilt_motion.csv"
+TRUTH = REPO / "examples" / "tilt_motion_truth.csv"
+HEADER = "ax,ay,az,gx,gy,gz"
+
+
+def _example(every: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """The example's time [s] and its six IMU columns (every `every`th sample)."""
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)[::every]
+    return data[:, 0], data[:, 1:7]
+
+
+def _write(path: Path, time_name: str, t: np.ndarray, imu: np.ndarray) -> Path:
+    np.savetxt(path, np.column_stack([t, imu]), delimiter=",", header=f"{time_name},{HEADER}",
+               comments="", fmt="%.10g")
+    return path
+
+
+def _read(path: Path, **options: str) -> tuple[object, np.ndarray, np.ndarray]:
+    source = open_recording(path, **options)
+    rec, t = source.load()
+    return source, rec, t
+
+
+@pytest.mark.parametrize(("unit", "factor"), [("ms", 1e3), ("us", 1e6), ("ns", 1e9)])
+def test_time_stamps_in_ms_us_or_ns_without_a_unit_are_read_as_such(tmp_path, unit, factor):
+    """A logger's millis(), micros() or event times: the steps are an IMU's rate in one unit
+    only, so the recording reads as the same one in seconds, and the choices say why."""
+    t, imu = _example()
+    seconds, rec_s, t_s = _read(_write(tmp_path / "s.csv", "time", t, imu))
+    source, rec, got_t = _read(_write(tmp_path / f"{unit}.csv", "timestamp",
+                                      np.round(t * factor), imu))
+    assert source.rate == pytest.approx(100.0) and source.time_unit == unit
+    assert f"time in {unit} (from its steps: a median step of" in source.choices
+    np.testing.assert_allclose(got_t, t_s, atol=1e-9)
+    np.testing.assert_allclose(rec.dt[1:], rec_s.dt[1:], atol=1e-9)
+    assert seconds.time_unit == "s" and "time in s (from its steps" in seconds.choices
+
+
+def test_a_dt_column_and_a_name_may_carry_the_unit(tmp_path):
+    """dt in ms without a unit is found as the time is; time_ms states its unit by name."""
+    t, imu = _example()
+    source, _, _ = _read(_write(tmp_path / "dt.csv", "dt", np.full(len(t), 10.0), imu))
+    assert source.rate == pytest.approx(100.0) and "dt in ms" in source.choices
+    source, _, _ = _read(_write(tmp_path / "named.csv", "time_ms", t * 1e3, imu))
+    assert source.time_unit == "ms" and "time in ms (from the header)" in source.choices
+
+
+def test_where_two_units_give_imu_rates_the_data_decide(tmp_path):
+    """A step of 0.05 is 20 Hz in s or 20 kHz in ms: in ms the gyro's turn is a thousand times
+    too small in either gyro unit, in s one unit explains gravity's turn."""
+    t, imu = _example(every=5)
+    assert candidates(0.05) == ["s", "ms"]
+    source, _, _ = _read(_write(tmp_path / "slow.csv", "time", t, imu))
+    assert source.time_unit == "s" and source.rate == pytest.approx(20.0)
+    assert "time in s (from the data: a median step of 0.05 is 20 Hz in s" in source.choices
+
+
+def test_a_still_recording_with_two_candidate_units_is_refused_with_both(tmp_path):
+    """At rest nothing turns, so nothing tells 20 Hz in s from 20 kHz in ms: refused, naming
+    both, and --time-unit serves."""
+    n = 400
+    rng = np.random.default_rng(1)
+    imu = np.column_stack([rng.normal(0, 0.02, (n, 2)), 9.81 + rng.normal(0, 0.02, n),
+                           rng.normal(0, 0.001, (n, 3))])
+    path = _write(tmp_path / "still.csv", "time", np.arange(n) * 0.05, imu)
+    with pytest.raises(RecordingError, match=r"20 Hz in s or 2e\+04 Hz in ms.*--time-unit s or "
+                       r"ms"):
+        open_recording(path, gyro_unit="rad/s")
+    source = open_recording(path, gyro_unit="rad/s", time_unit="s")
+    assert source.rate == pytest.approx(20.0) and "time in s (given)" in source.choices
+
+
+def test_a_unit_whose_rate_no_imu_has_is_refused(tmp_path):
+    """A given unit, or one the header states, that makes a step of 10 ms 0.1 Hz: refused with
+    the unit that fits (every sample would otherwise be rejected as dt > max_dt)."""
+    t, imu = _example()
+    path = _write(tmp_path / "ms.csv", "time", t * 1e3, imu)
+    with pytest.raises(RecordingError, match=r"0.1 Hz in s \(given\).*in ms it is 100 Hz: give "
+                       r"--time-unit ms"):
+        open_recording(path, time_unit="s")
+    stated = _write(tmp_path / "stated.csv", "time (s)", t * 1e3, imu)
+    with pytest.raises(RecordingError, match=r"\(from the header\).*correct the unit in the "
+                       "header"):
+        open_recording(stated)
+    with pytest.raises(RecordingError, match="--time-unit ms contradicts the header"):
+        open_recording(stated, time_unit="ms")
+    assert RATE_RANGE[0] > 1.0  # max_dt: a slower rate's every sample is rejected
+
+
+def test_a_reference_in_the_recordings_unit_is_matched(tmp_path, capsys):
+    """Recording and reference both in ms without a unit: the scores are those of the same
+    files in seconds."""
+    t, imu = _example()
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)[:, :3]
+    for name, factor in (("s", 1.0), ("ms", 1e3)):
+        rec = _write(tmp_path / f"rec_{name}.csv", "time", t * factor, imu)
+        ref = tmp_path / f"ref_{name}.csv"
+        np.savetxt(ref, np.column_stack([truth[:, 0] * factor, truth[:, 1:]]), delimiter=",",
+                   header="time,roll,pitch", comments="", fmt="%.10g")
+        assert main(["estimate", str(rec), "--reference", str(ref), "--estimator", "kf",
+                     "--out", str(tmp_path / name), "--no-plots", "--no-vqf"]) == 0
+    said = capsys.readouterr().out
+    rows = [line.split()[2] for line in said.splitlines() if line.startswith("kf ")]
+    assert len(rows) == 2 and rows[0] == rows[1]
+
+
+def test_accelerometer_and_gyro_on_rows_of_their_own_are_refused_with_why(tmp_path, capsys):
+    """A logger that writes each sensor's reading as it comes leaves no row with both: the
+    refusal says so and what would serve."""
+    t, imu = _example()
+    rows = np.full((2 * len(t), 7), np.nan)
+    rows[0::2, 0], rows[0::2, 1:4] = t, imu[:, :3]
+    rows[1::2, 0], rows[1::2, 4:7] = t + 0.004, imu[:, 3:]
+    path = _write(tmp_path / "interleaved.csv", "time", rows[:, 0], rows[:, 1:])
+    assert main(["estimate", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "on rows of their own (1000 rows hold only the accelerometer, 1000 only the gyro)" \
+        in err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
