@@ -48,7 +48,7 @@ from .options import (
     positive_int,
     with_calibration,
 )
-from .reader import TIME_SCALE
+from .reader import DATETIME, TIME_SCALE
 from .table_out import FORMATS, TableWriter
 
 OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", "bias_z"),
@@ -166,6 +166,8 @@ def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording
     from .fit.recording import RecordingError
     from .time_unit import candidates, rate_in
 
+    if stated == DATETIME:  # read as seconds since 1970
+        return "s"
     if stated is not None:
         if stated not in TIME_SCALE:
             raise RecordingError(f"{path}: the reference's time column states the unit "

@@ -8,6 +8,8 @@ any length is read in bounded memory:
   the header row are found from the file's start; pyarrow's CSV reader parses it, and where it
   cannot (text where a number belongs, a row of the wrong length, padded cells) the file is read
   by Python's csv module, which names the file's line, the column and the value;
+- a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
+  then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - Parquet: its columns (a timestamp column as seconds);
 - HDF5 (that is not a BROAD trial) and MATLAB .mat (v5, or v7.3 which is HDF5): the top level's
   one-dimensional datasets or variables of one length are columns, and an [N, 3] one (acc, gyro)
@@ -49,6 +51,10 @@ UNIT_ALIASES: dict[str, str] = {
 }
 """Units a header may state, by their spellings (lower case, spaces removed)."""
 TIME_SCALE = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+"""The units of a time or dt column and their factor to seconds."""
+DATETIME = "datetime"
+"""The unit of a column of dates and times (ISO 8601 text, a Parquet timestamp), which the
+reader gives as seconds since 1970."""
 
 _NAME_UNIT = re.compile(r"^(.*?)\s*[\(\[]\s*([^\)\]]*?)\s*[\)\]]\s*$")
 
@@ -152,6 +158,37 @@ class _TextLayout:
     header: list[str]
     decimal_comma: bool
     padded: bool  # cells with spaces around the number: Python's float reads those
+    datetimes: dict[int, bool] = field(default_factory=dict)
+    """Columns of ISO 8601 date-times (read as seconds since 1970): index -> with a zone."""
+
+
+_ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
+                       r"\s*(Z|[+-]\d{2}(?::?\d{2})?)?$")
+"""An ISO 8601 date and time as loggers write it: "2024-05-01T12:00:00.010", a space for the T,
+a decimal comma, a zone (Z, +02:00, +0200) or none."""
+
+
+def seconds_of(text: str) -> float | None:
+    """Seconds since 1970-01-01 UTC of an ISO 8601 date and time (_ISO_DATETIME; without a zone
+    taken as UTC, as both a recording and its reference are read), None where the text is
+    none."""
+    import datetime as dt
+
+    m = _ISO_DATETIME.match(text.strip())
+    if m is None:
+        return None
+    year, month, day, hour, minute, second = (int(g) for g in m.groups()[:6])
+    fraction, zone = m.group(7), m.group(8)
+    try:
+        t = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.timezone.utc)
+    except ValueError:
+        return None
+    offset = 0
+    if zone and zone != "Z":
+        digits = zone[1:].replace(":", "")
+        offset = (int(digits[:2]) * 60 + int(digits[2:4] or 0)) * (1 if zone[0] == "+" else -1)
+    whole = t.timestamp() - 60.0 * offset
+    return whole + (int(fraction) / 10 ** len(fraction) if fraction else 0.0)
 
 
 def _sniff(path: Path) -> _TextLayout:
@@ -188,12 +225,21 @@ def _sniff(path: Path) -> _TextLayout:
     decimal_comma = (delimiter == ";" and any("," in c for c in cells)
                      and not any("." in c for c in cells))
     padded = any(c != c.strip() for c in cells)
-    return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded)
+    rows = [next(csv.reader([line], delimiter=delimiter)) for _, line in numbered[1:50]]
+    datetimes = {}
+    for j in range(len(header)):
+        column = [row[j].strip() for row in rows if len(row) == len(header) and row[j].strip()]
+        found = [_ISO_DATETIME.match(c) for c in column]
+        if column and all(found):
+            datetimes[j] = all(m.group(8) for m in found if m)  # with a zone
+    return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
+                       datetimes)
 
 
 def _text(path: Path) -> TableSource:
     layout = _sniff(path)
-    names, units = zip(*(split_unit(h) for h in layout.header), strict=True)
+    names, stated = zip(*(split_unit(h) for h in layout.header), strict=True)
+    units = [(DATETIME if j in layout.datetimes else u) for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         if layout.padded or not _has_pyarrow():
@@ -240,6 +286,17 @@ def _float64(column: Any) -> np.ndarray:
     return x
 
 
+def _seconds(column: Any) -> np.ndarray:
+    """A pyarrow timestamp array [ns] as seconds since 1970, its nulls NaN."""
+    import pyarrow as pa
+
+    ns = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
+    seconds = np.asarray(ns, dtype=float) * 1e-9
+    if column.null_count:
+        seconds[np.asarray(column.is_null().to_numpy(zero_copy_only=False))] = np.nan
+    return seconds
+
+
 def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
                   ) -> Iterator[np.ndarray]:
     import pyarrow as pa
@@ -247,6 +304,8 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
 
     keys = [f"c{i}" for i in range(len(layout.header))]
     wanted = [keys[i] for i in columns]
+    types = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
+             if i in layout.datetimes else pa.float64() for i in columns}
     try:
         reader = pc.open_csv(
             path,
@@ -255,13 +314,14 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
                                         else "latin1", block_size=1 << 22),
             parse_options=pc.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
             convert_options=pc.ConvertOptions(
-                column_types=dict.fromkeys(wanted, pa.float64()), include_columns=wanted,
+                column_types=types, include_columns=wanted,
                 decimal_point="," if layout.decimal_comma else "."))
         pending: list[np.ndarray] = []
         held = 0
         for batch in reader:
-            part = np.column_stack([_float64(batch.column(k)) for k in wanted]) if wanted \
-                else np.empty((batch.num_rows, 0))
+            part = np.column_stack([_float64(batch.column(k)) if types[k] == pa.float64()
+                                    else _seconds(batch.column(k)) for k in wanted]) \
+                if wanted else np.empty((batch.num_rows, 0))
             pending.append(part)
             held += len(part)
             while held >= rows:
@@ -306,8 +366,8 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
                              f"{width} columns")
         if k < skip:
             continue
-        block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma)
-                      for j in columns])
+        block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
+                              j in layout.datetimes) for j in columns])
         if len(block) == rows:
             yield np.array(block, dtype=float).reshape(len(block), len(columns))
             block = []
@@ -315,12 +375,20 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
         yield np.array(block, dtype=float).reshape(len(block), len(columns))
 
 
-def _number(cell: str, path: Path, line: int, column: str, decimal_comma: bool) -> float:
+def _number(cell: str, path: Path, line: int, column: str, decimal_comma: bool,
+            datetime: bool = False) -> float:
     text = cell.strip()
-    if decimal_comma:
-        text = text.replace(",", ".")
     if not text:
         return float("nan")  # a missing value: that sample is rejected and counted
+    if datetime:  # seconds since 1970
+        seconds = seconds_of(text)
+        if seconds is None:
+            raise TableError(f"{path}, line {line}, column {column!r}: {text[:40]!r} is not a "
+                             "date and time as the column's others are (2024-05-01T12:00:00.010"
+                             ", a zone or none; an empty cell marks a missing value)")
+        return seconds
+    if decimal_comma:
+        text = text.replace(",", ".")
     try:
         return float(text)
     except ValueError:
@@ -343,6 +411,8 @@ def _parquet(path: Path) -> TableSource:
     header = list(schema.names)
     named = [_unit_of(f.name, (f.metadata or {}).get(b"unit", (f.metadata or {}).get(b"units")))
              for f in schema]
+    named = [(n, DATETIME if pa.types.is_timestamp(f.type) else u)
+             for (n, u), f in zip(named, schema, strict=True)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         wanted = [header[i] for i in columns]
@@ -360,7 +430,7 @@ def _arrow_float(column: Any, path: Path, name: str) -> np.ndarray:
 
     kind = column.type
     if pa.types.is_timestamp(kind) or pa.types.is_duration(kind):
-        scale = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}[kind.unit]
+        scale = TIME_SCALE[kind.unit]
         ints = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
         return np.asarray(ints, dtype=float) * scale
     if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
@@ -467,6 +537,7 @@ def _mat(path: Path) -> TableSource:
 
 __all__ = [
     "BLOCK_ROWS",
+    "DATETIME",
     "TIME_SCALE",
     "UNIT_ALIASES",
     "TableError",

@@ -1,7 +1,8 @@
 """A time column in whatever unit a logger wrote it: milliseconds and nanoseconds as loggers
 write them without a unit, the data deciding where two units give IMU rates, a recording that
 cannot tell refused with the candidates, a given or stated unit whose rate no IMU has refused,
-a reference in the recording's unit, and the accelerometer and gyro on rows of their own."""
+a reference in the recording's unit, dates and times, the column names of ROS, phones and
+microcontrollers, and the accelerometer and gyro on rows of their own."""
 
 from __future__ import annotations
 
@@ -134,3 +135,64 @@ def test_accelerometer_and_gyro_on_rows_of_their_own_are_refused_with_why(tmp_pa
     assert "on rows of their own (1000 rows hold only the accelerometer, 1000 only the gyro)" \
         in err
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+def _iso(t: np.ndarray, zone: str = "", sep: str = "T") -> list[str]:
+    start = np.datetime64("2024-05-01T12:00:00", "us")
+    return [str(start + np.timedelta64(round(v * 1e6), "us")).replace("T", sep) + zone
+            for v in t]
+
+
+def test_dates_and_times_are_seconds_since_1970_beside_a_reference_in_them(tmp_path, capsys):
+    """ISO 8601 time stamps (a space for the T, with a zone or without, then UTC; a reference
+    with Z): the score is that of the same files in seconds, and a cell that is no date and
+    time is refused by its line."""
+    t, imu = _example()
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)[:, :3]
+    rec = tmp_path / "dated.csv"
+    stamps = _iso(t, sep=" ")
+    stamps[1::2] = [s + "+00:00" for s in stamps[1::2]]  # mixed: Python's reader takes them
+    rec.write_text("timestamp," + HEADER + "\n" + "".join(
+        f"{s}," + ",".join(f"{v:.10g}" for v in row) + "\n"
+        for s, row in zip(stamps, imu, strict=True)))
+    ref = tmp_path / "ref.csv"
+    ref.write_text("time,roll,pitch\n" + "".join(
+        f"{s},{r:.17g},{p:.17g}\n"
+        for s, r, p in zip(_iso(truth[:, 0], "Z"), truth[:, 1], truth[:, 2], strict=True)))
+    plain = _write(tmp_path / "plain.csv", "time", t, imu)
+    plain_ref = tmp_path / "plain_ref.csv"
+    np.savetxt(plain_ref, truth, delimiter=",", header="time,roll,pitch", comments="",
+               fmt="%.17g")
+    for r, f in ((rec, ref), (plain, plain_ref)):
+        assert main(["estimate", str(r), "--reference", str(f), "--estimator", "kf", "--out",
+                     str(tmp_path / r.stem), "--no-plots", "--no-vqf"]) == 0
+    said = capsys.readouterr().out
+    assert "time from its dates and times (seconds since 1970, UTC)" in said
+    rows = [line.split()[2] for line in said.splitlines() if line.startswith("kf ")]
+    assert len(rows) == 2 and rows[0] == rows[1]
+    lines = rec.read_text().splitlines()
+    lines[300] = "noon" + lines[300][lines[300].index(","):]
+    rec.write_text("\n".join(lines) + "\n")
+    with pytest.raises(RecordingError, match=r"line 301, column 'timestamp': 'noon' is not a "
+                       "date and time"):
+        open_recording(rec).load()
+
+
+@pytest.mark.parametrize("header", [
+    "%time,field.linear_acceleration.x,field.linear_acceleration.y,field.linear_acceleration.z,"
+    "field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z",  # ROS topic
+    "Time,AccX,AccY,AccZ,GyroX,GyroY,GyroZ",
+    "timeStamp,accelX,accelY,accelZ,rotationRateX,rotationRateY,rotationRateZ",
+    "timestamp,accelerometerAccelerationX,accelerometerAccelerationY,"
+    "accelerometerAccelerationZ,gyro_x,gyro_y,gyro_z",  # iOS SensorLog
+])
+def test_the_names_loggers_give_their_columns_are_found(tmp_path, header):
+    """The column names of a ROS topic's CSV, microcontroller sketches and phone apps."""
+    t, imu = _example()
+    path = tmp_path / "named.csv"
+    np.savetxt(path, np.column_stack([t, imu]), delimiter=",", header=header, comments="",
+               fmt="%.10g")
+    source = open_recording(path)
+    names = header.split(",")
+    assert source.rate == pytest.approx(100.0)
+    assert f"acc_x={names[1]!r}" in source.choices and f"gyro_z={names[6]!r}" in source.choices

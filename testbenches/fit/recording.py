@@ -13,6 +13,7 @@ finds their rest segment (the start, before `movement` begins).
 from __future__ import annotations
 
 import argparse
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -119,24 +120,44 @@ def rest(rec: Recording) -> Recording:
     return rec.slice(0, first)
 
 
+ACC_STEMS = ("acc", "accel", "accelerometer", "acceleration", "linear_acceleration",
+             "accelerometer_acceleration")
+"""Names of the accelerometer's columns before the axis (acc_x, accelX, linear_acceleration.x
+as ROS writes it, accelerometerAccelerationX as iOS's SensorLog). Not a phone's linear or user
+acceleration, which leaves gravity out (its median norm is then no gravity's, and refused)."""
+GYRO_STEMS = ("gyro", "gyr", "gyroscope", "angular_velocity", "rotation_rate", "omega")
+"""Names of the gyro's columns before the axis (gyro_x, gyroX, angular_velocity.x)."""
+
+
+def _axis_names(stems: tuple[str, ...], axis: str, short: tuple[str, ...]) -> tuple[str, ...]:
+    return (*(n for stem in stems for n in (f"{stem}_{axis}", f"{stem}{axis}")),
+            *(f"{s}{axis}" for s in short))
+
+
 ALIASES: dict[str, tuple[str, ...]] = {
-    "acc_x": ("acc_x", "ax", "accx", "acc_x_g", "acc_x_ms2", "accelerometer_x", "a_x"),
-    "acc_y": ("acc_y", "ay", "accy", "acc_y_g", "acc_y_ms2", "accelerometer_y", "a_y"),
-    "acc_z": ("acc_z", "az", "accz", "acc_z_g", "acc_z_ms2", "accelerometer_z", "a_z"),
-    "gyro_x": ("gyro_x", "gx", "gyrx", "gyr_x", "gyro_x_dps", "gyroscope_x", "wx", "g_x"),
-    "gyro_y": ("gyro_y", "gy", "gyry", "gyr_y", "gyro_y_dps", "gyroscope_y", "wy", "g_y"),
-    "gyro_z": ("gyro_z", "gz", "gyrz", "gyr_z", "gyro_z_dps", "gyroscope_z", "wz", "g_z"),
+    **{f"acc_{a}": (*_axis_names(ACC_STEMS, a, ("a", "a_")), f"acc_{a}_g", f"acc_{a}_ms2")
+       for a in "xyz"},
+    **{f"gyro_{a}": (*_axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_")), f"gyro_{a}_dps")
+       for a in "xyz"},
     "time": ("time", "t", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
-             "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns"),
+             "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
+             "header_stamp"),
 }
-"""Column names a recording may use (case and spaces ignored), per quantity."""
+"""Column names a recording may use per quantity, as _norm_name makes them (case ignored;
+spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out)."""
 G_STANDARD = 9.80665
 
 
 # ----- reading ---------------------------------------------------------------------------------
 
 def _norm_name(name: str) -> str:
-    return name.strip().lower().replace(" ", "_").replace("-", "_")
+    """A column name as ALIASES spell them: "Gyroscope X" -> "gyroscope_x", "rotationRateX" ->
+    "rotation_rate_x", ROS's "field.angular_velocity.x" -> "angular_velocity_x", "%time" ->
+    "time"."""
+    name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name.strip()).lower().lstrip("%")
+    for sep in (" ", "-", "."):
+        name = name.replace(sep, "_")
+    return name.removeprefix("field_")
 
 
 def _find(names: list[str], quantity: str, given: str | None = None) -> int | None:
@@ -590,8 +611,14 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     give IMU rates from the data (testbenches.time_unit; dt_of(scale): each sample's dt [s] in a
     unit of that factor). A step that is no IMU rate in the unit given or stated is refused
     with the rate it would be, and so is a given unit that is not the header's."""
+    from ..reader import DATETIME
     from ..time_unit import RATE_RANGE, TIME_UNITS, TimeUnit, candidates, rate_in, time_unit
 
+    if stated == DATETIME:
+        if unit != "auto":
+            raise RecordingError(f"{path}: --time-unit {unit} is given, but the {kind} column "
+                                 "holds dates and times, which are read as such (leave it out)")
+        return "s", 1.0, f"{kind} from its dates and times (seconds since 1970, UTC)"
     _given_against_header(path, kind, "time-unit", unit, stated)
     chosen = unit if unit != "auto" else stated
     if chosen is not None:
