@@ -35,6 +35,14 @@ from typing import Any
 import numpy as np
 
 DELIMITERS = ",;\t|"
+COMMENTS = ("#", "//")
+"""A line that starts with one of these before the header is a comment (numpy.savetxt writes
+its header as "# time,acc_x,...", which is taken as the header where the rows follow it). Not
+"%": a ROS topic's CSV header starts "%time"."""
+HEADER_CHECK = 20
+"""The header must split into as many cells as this many lines after it."""
+PREAMBLE_LINES = 30
+"""The header is looked for among the first this many lines that are not comments."""
 BLOCK_ROWS = 1 << 18
 """Rows per block: a few MB per column, few enough Python round trips per million rows."""
 SNIFF_BYTES = 1 << 16
@@ -99,6 +107,9 @@ class TableSource:
     _where: Callable[[int], str]
     attrs: dict[str, float] = field(default_factory=dict)
 
+    note: str = ""
+    """What the reader did that a user should know (lines before the header skipped)."""
+
     _kept: Any = field(default=None, repr=False, compare=False)
     """(columns, rows, first block, the read after it) of first_block, for blocks to go on."""
 
@@ -160,6 +171,8 @@ class _TextLayout:
     padded: bool  # cells with spaces around the number: Python's float reads those
     datetimes: dict[int, bool] = field(default_factory=dict)
     """Columns of ISO 8601 date-times (read as seconds since 1970): index -> with a zone."""
+    skipped: str = ""
+    """The lines before the header that are not the table ("lines 1-3"; "" for none)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -208,32 +221,90 @@ def _sniff(path: Path) -> _TextLayout:
     numbered = [(i + 1, line) for i, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise TableError(f"{path}: empty file")
-    first = [line for _, line in numbered[:20]]
-    delimiter, best_cells = None, 1
-    for d in DELIMITERS:
-        counts = [len(next(csv.reader([line], delimiter=d))) for line in first]
-        if len(set(counts)) == 1 and counts[0] > best_cells:
-            delimiter, best_cells = d, counts[0]
-    if delimiter is None:
-        raise TableError(f"{path}: no delimiter splits the header and the first rows alike "
-                         f"(tried comma, semicolon, tab and bar); line {numbered[0][0]} reads "
-                         f"{first[0][:80]!r}")
-    header_line, header_text = numbered[0]
+    found = _find_header(numbered)
+    if found is None:
+        first = numbered[0]
+        raise TableError(f"{path}: no delimiter splits a header and the rows after it alike "
+                         f"(tried comma, semicolon, tab and bar); line {first[0]} reads "
+                         f"{first[1][:80]!r}")
+    delimiter, start = found
+    header_line, header_text = numbered[start]
+    preamble = numbered[:start]
+    if _all_numbers(header_text, delimiter):  # no header row, or one written as a comment
+        commented = [(no, _comment(line)) for no, line in preamble if _comment(line)]
+        named = commented[-1] if commented else None
+        if named is not None and _cells(named[1], delimiter) == _cells(header_text, delimiter):
+            header_line, header_text = named
+            preamble = [(no, line) for no, line in preamble if no < header_line]
+        elif len(commented) < len(preamble):  # rows before these that split otherwise
+            first = numbered[0]
+            raise TableError(f"{path}: no delimiter splits a header and the rows after it alike "
+                             f"(tried comma, semicolon, tab and bar); line {first[0]} reads "
+                             f"{first[1][:80]!r}")
+        else:
+            raise TableError(f"{path}, line {header_line}: numbers where a header row naming "
+                             "the columns belongs (time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z "
+                             "or the like): add one")
     header = [c.strip() for c in next(csv.reader([header_text], delimiter=delimiter))]
-    cells = [c for _, line in numbered[1:50]
-             for c in next(csv.reader([line], delimiter=delimiter)) if c.strip()]
+    rows = [next(csv.reader([line], delimiter=delimiter))
+            for no, line in numbered if no > header_line][:49]
+    cells = [c for row in rows for c in row if c.strip()]
     decimal_comma = (delimiter == ";" and any("," in c for c in cells)
                      and not any("." in c for c in cells))
     padded = any(c != c.strip() for c in cells)
-    rows = [next(csv.reader([line], delimiter=delimiter)) for _, line in numbered[1:50]]
     datetimes = {}
     for j in range(len(header)):
         column = [row[j].strip() for row in rows if len(row) == len(header) and row[j].strip()]
-        found = [_ISO_DATETIME.match(c) for c in column]
-        if column and all(found):
-            datetimes[j] = all(m.group(8) for m in found if m)  # with a zone
+        matches = [_ISO_DATETIME.match(c) for c in column]
+        if column and all(matches):
+            datetimes[j] = all(m.group(8) for m in matches if m)  # with a zone
+    skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
+               else f"line {preamble[0][0]}") if preamble else ""
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
-                       datetimes)
+                       datetimes, skipped)
+
+
+def _comment(line: str) -> str:
+    """A comment line's text after its mark ("" for a line that is no comment)."""
+    text = line.lstrip()
+    mark = next((c for c in COMMENTS if text.startswith(c)), None)
+    if mark is None:
+        return ""
+    return text[len(mark):] or " "
+
+
+def _cells(line: str, delimiter: str) -> int:
+    return len(next(csv.reader([line], delimiter=delimiter)))
+
+
+def _all_numbers(line: str, delimiter: str) -> bool:
+    def number(cell: str) -> bool:
+        try:
+            float(cell.strip().replace(",", "."))
+        except ValueError:
+            return bool(_ISO_DATETIME.match(cell.strip()))
+        return True
+
+    return all(number(c) for c in next(csv.reader([line], delimiter=delimiter)))
+
+
+def _find_header(numbered: list[tuple[int, str]]) -> tuple[str, int] | None:
+    """(delimiter, index into numbered) of the header: the first line that, with the
+    HEADER_CHECK lines after it, one delimiter splits into as many cells, more than one (the
+    most cells where several do). Lines before it are a logger's preamble (a comment, a device
+    name, the settings) and are skipped."""
+    content = [k for k, (_, line) in enumerate(numbered) if not _comment(line)]
+    for i, start in enumerate(content[:PREAMBLE_LINES]):
+        window = [numbered[k][1] for k in content[i:i + HEADER_CHECK + 1]]
+        best: tuple[str, int] | None = None
+        cells = 1
+        for d in DELIMITERS:
+            counts = {_cells(line, d) for line in window}
+            if len(counts) == 1 and (n := counts.pop()) > cells:
+                best, cells = (d, start), n
+        if best is not None:
+            return best
+    return None
 
 
 def _text(path: Path) -> TableSource:
@@ -256,8 +327,10 @@ def _text(path: Path) -> TableSource:
     def where(row: int) -> str:
         return f"line {_line_of_row(path, layout, row)}"
 
+    note = (f"the header on line {layout.header_line}, {layout.skipped} before it skipped"
+            if layout.skipped else "")
     return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
-                       where)
+                       where, note=note)
 
 
 class _ArrowFailed(Exception):
@@ -362,8 +435,9 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
     block: list[list[float]] = []
     for k, (line, row) in enumerate(_rows(path, layout)):
         if len(row) != width:
-            raise TableError(f"{path}, line {line}: {len(row)} values where the header has "
-                             f"{width} columns")
+            text = layout.delimiter.join(row)
+            raise TableError(f"{path}, line {line}: {len(row)} value(s) where the header has "
+                             f"{width} columns ({text[:60]!r})")
         if k < skip:
             continue
         block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,

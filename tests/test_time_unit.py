@@ -1,8 +1,7 @@
 """A time column in whatever unit a logger wrote it: milliseconds and nanoseconds as loggers
 write them without a unit, the data deciding where two units give IMU rates, a recording that
 cannot tell refused with the candidates, a given or stated unit whose rate no IMU has refused,
-a reference in the recording's unit, dates and times, the column names of ROS, phones and
-microcontrollers, and the accelerometer and gyro on rows of their own."""
+a reference in the recording's unit, and dates and times."""
 
 from __future__ import annotations
 
@@ -122,21 +121,6 @@ def test_a_reference_in_the_recordings_unit_is_matched(tmp_path, capsys):
     assert len(rows) == 2 and rows[0] == rows[1]
 
 
-def test_accelerometer_and_gyro_on_rows_of_their_own_are_refused_with_why(tmp_path, capsys):
-    """A logger that writes each sensor's reading as it comes leaves no row with both: the
-    refusal says so and what would serve."""
-    t, imu = _example()
-    rows = np.full((2 * len(t), 7), np.nan)
-    rows[0::2, 0], rows[0::2, 1:4] = t, imu[:, :3]
-    rows[1::2, 0], rows[1::2, 4:7] = t + 0.004, imu[:, 3:]
-    path = _write(tmp_path / "interleaved.csv", "time", rows[:, 0], rows[:, 1:])
-    assert main(["estimate", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 2
-    err = capsys.readouterr().err
-    assert "on rows of their own (1000 rows hold only the accelerometer, 1000 only the gyro)" \
-        in err
-    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
-
-
 def _iso(t: np.ndarray, zone: str = "", sep: str = "T") -> list[str]:
     start = np.datetime64("2024-05-01T12:00:00", "us")
     return [str(start + np.timedelta64(round(v * 1e6), "us")).replace("T", sep) + zone
@@ -176,23 +160,3 @@ def test_dates_and_times_are_seconds_since_1970_beside_a_reference_in_them(tmp_p
     with pytest.raises(RecordingError, match=r"line 301, column 'timestamp': 'noon' is not a "
                        "date and time"):
         open_recording(rec).load()
-
-
-@pytest.mark.parametrize("header", [
-    "%time,field.linear_acceleration.x,field.linear_acceleration.y,field.linear_acceleration.z,"
-    "field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z",  # ROS topic
-    "Time,AccX,AccY,AccZ,GyroX,GyroY,GyroZ",
-    "timeStamp,accelX,accelY,accelZ,rotationRateX,rotationRateY,rotationRateZ",
-    "timestamp,accelerometerAccelerationX,accelerometerAccelerationY,"
-    "accelerometerAccelerationZ,gyro_x,gyro_y,gyro_z",  # iOS SensorLog
-])
-def test_the_names_loggers_give_their_columns_are_found(tmp_path, header):
-    """The column names of a ROS topic's CSV, microcontroller sketches and phone apps."""
-    t, imu = _example()
-    path = tmp_path / "named.csv"
-    np.savetxt(path, np.column_stack([t, imu]), delimiter=",", header=header, comments="",
-               fmt="%.10g")
-    source = open_recording(path)
-    names = header.split(",")
-    assert source.rate == pytest.approx(100.0)
-    assert f"acc_x={names[1]!r}" in source.choices and f"gyro_z={names[6]!r}" in source.choices

@@ -526,6 +526,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                       if q in found.source)
     choices = (f"acc in {acc_how}; gyro in {gyro_how}" + (f"; {time_how}" if time_how else "")
                + (f"; columns {where}" if where else "")
+               + (f"; {table.note}" if table.note else "")
                + ("" if table.kind == "text" else f"; read as {table.kind}"))
     name = path.stem
 

@@ -1,0 +1,109 @@
+"""Files as loggers write them: the column names of ROS, phone apps and microcontroller
+sketches, a preamble or comments before the header, numpy's commented header, no header at all,
+a line after the table, and the accelerometer and gyro on rows of their own."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from testbenches.cli import main
+from testbenches.fit.recording import RecordingError, open_recording
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLE = REPO / "examples" / "tilt_motion.csv"
+HEADER = "ax,ay,az,gx,gy,gz"
+
+
+def _example() -> tuple[np.ndarray, np.ndarray]:
+    """The example's time [s] and its six IMU columns."""
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+    return data[:, 0], data[:, 1:7]
+
+
+def _write(path: Path, time_name: str, t: np.ndarray, imu: np.ndarray) -> Path:
+    np.savetxt(path, np.column_stack([t, imu]), delimiter=",", header=f"{time_name},{HEADER}",
+               comments="", fmt="%.10g")
+    return path
+
+
+@pytest.mark.parametrize("header", [
+    "%time,field.linear_acceleration.x,field.linear_acceleration.y,field.linear_acceleration.z,"
+    "field.angular_velocity.x,field.angular_velocity.y,field.angular_velocity.z",  # ROS topic
+    "Time,AccX,AccY,AccZ,GyroX,GyroY,GyroZ",
+    "timeStamp,accelX,accelY,accelZ,rotationRateX,rotationRateY,rotationRateZ",
+    "timestamp,accelerometerAccelerationX,accelerometerAccelerationY,"
+    "accelerometerAccelerationZ,gyro_x,gyro_y,gyro_z",  # iOS SensorLog
+])
+def test_the_names_loggers_give_their_columns_are_found(tmp_path, header):
+    """The column names of a ROS topic's CSV, microcontroller sketches and phone apps."""
+    t, imu = _example()
+    path = tmp_path / "named.csv"
+    np.savetxt(path, np.column_stack([t, imu]), delimiter=",", header=header, comments="",
+               fmt="%.10g")
+    source = open_recording(path)
+    names = header.split(",")
+    assert source.rate == pytest.approx(100.0)
+    assert f"acc_x={names[1]!r}" in source.choices and f"gyro_z={names[6]!r}" in source.choices
+
+
+@pytest.mark.parametrize("before", [
+    "# Logged by MyLogger v1.2\n# sensor: MPU6050 at 100 Hz\n#\n",
+    "Device,MPU6050\nRate,100\n\n",
+    "// firmware 2.1\nstarted 2024-05-01 12:00\n",
+])
+def test_lines_before_the_header_are_skipped_and_said(tmp_path, before):
+    """A logger's preamble (comments, a device and its settings as key,value rows, free
+    text): the table starts at the first line whose cells the rows after it share, and the
+    choices say which lines were skipped; the samples are those of the plain file."""
+    plain = open_recording(EXAMPLE).load()[0]
+    path = tmp_path / "preamble.csv"
+    path.write_text(before + EXAMPLE.read_text())
+    source = open_recording(path)
+    rec, _ = source.load()
+    header_line = before.count("\n") + 1
+    assert f"the header on line {header_line}, line" in source.choices
+    np.testing.assert_array_equal(rec.acc, plain.acc)
+    np.testing.assert_array_equal(rec.dt, plain.dt)
+
+
+def test_numpys_commented_header_is_the_header_and_a_file_without_one_is_refused(tmp_path):
+    """np.savetxt(header=...) writes "# time,acc_x,...": that is the header where its cells are
+    the rows'. Without any header the first row's numbers are no names: refused, saying so."""
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+    path = tmp_path / "saved.csv"
+    np.savetxt(path, data, delimiter=",", header=EXAMPLE.read_text().splitlines()[0])
+    assert path.read_text().startswith("# time,")
+    rec, _ = open_recording(path).load()
+    np.testing.assert_array_equal(rec.acc, open_recording(EXAMPLE).load()[0].acc)
+    bare = tmp_path / "bare.csv"
+    np.savetxt(bare, data, delimiter=",")
+    with pytest.raises(RecordingError, match="line 1: numbers where a header row naming the "
+                       "columns belongs"):
+        open_recording(bare)
+
+
+def test_a_line_after_the_table_is_refused_by_its_line_and_text(tmp_path):
+    """A summary line a logger appends ("END OF LOG") is no sample: refused naming it."""
+    path = tmp_path / "trailer.csv"
+    path.write_text(EXAMPLE.read_text() + "END OF LOG\n")
+    with pytest.raises(RecordingError, match=r"line 1002: 1 value\(s\) where the header has 8 "
+                       r"columns \('END OF LOG'\)"):
+        open_recording(path).load()
+
+
+def test_accelerometer_and_gyro_on_rows_of_their_own_are_refused_with_why(tmp_path, capsys):
+    """A logger that writes each sensor's reading as it comes leaves no row with both: the
+    refusal says so and what would serve."""
+    t, imu = _example()
+    rows = np.full((2 * len(t), 7), np.nan)
+    rows[0::2, 0], rows[0::2, 1:4] = t, imu[:, :3]
+    rows[1::2, 0], rows[1::2, 4:7] = t + 0.004, imu[:, 3:]
+    path = _write(tmp_path / "interleaved.csv", "time", rows[:, 0], rows[:, 1:])
+    assert main(["estimate", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 2
+    err = capsys.readouterr().err
+    assert "on rows of their own (1000 rows hold only the accelerometer, 1000 only the gyro)" \
+        in err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
