@@ -160,3 +160,26 @@ def test_dates_and_times_are_seconds_since_1970_beside_a_reference_in_them(tmp_p
     with pytest.raises(RecordingError, match=r"line 301, column 'timestamp': 'noon' is not a "
                        "date and time"):
         open_recording(rec).load()
+
+
+def test_a_microcontrollers_counter_that_starts_again_goes_on(tmp_path):
+    """micros() is 32 bits and starts again every 71.6 minutes: a fall by 2^32 us to one
+    period is the counter going on, in the first block or a later one, and the read says so;
+    a time that really goes back is still refused by its line."""
+    t, imu = _example()
+    _, _, t_plain = _read(_write(tmp_path / "s.csv", "time", t, imu))
+    ticks = (2**32 - 5_000_000 + np.round(t * 1e6).astype(np.int64)) % 2**32
+    path = _write(tmp_path / "micros.csv", "micros", ticks, imu)
+    source = open_recording(path)
+    assert source.time_unit == "us" and "time in us (from the header)" in source.choices
+    for rows in (None, 64):  # the wrap inside the first block, then between blocks
+        parts = list(source.blocks(rows=rows))
+        got = np.concatenate([tt for _, tt in parts])
+        np.testing.assert_allclose(got - got[0], t_plain - t_plain[0], atol=1e-9)
+        dt = np.concatenate([p.dt for p, _ in parts])
+        assert np.all(np.isfinite(dt)) and np.allclose(dt[1:], 0.01, atol=1e-9)
+    rec, _ = source.load()
+    assert "counter started again 1 time(s)" in rec.described
+    ticks[300:] -= 3_000_000  # back by 3 s before the wrap: no wrap
+    with pytest.raises(RecordingError, match="does not increase"):
+        open_recording(_write(tmp_path / "back.csv", "micros", ticks % 2**32, imu)).load()

@@ -15,7 +15,7 @@ from __future__ import annotations
 import argparse
 import re
 from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +24,7 @@ import numpy as np
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
+from ..reader import TIME_SCALE
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -141,7 +142,7 @@ ALIASES: dict[str, tuple[str, ...]] = {
        for a in "xyz"},
     "time": ("time", "t", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
              "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
-             "header_stamp"),
+             "header_stamp", "millis", "micros"),
 }
 """Column names a recording may use per quantity, as _norm_name makes them (case ignored;
 spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out)."""
@@ -234,13 +235,15 @@ def find_columns(table: Any, time_column: str | None = None,
 
 
 def _unit_in_name(quantity: str, name: str) -> str | None:
-    """The unit a time or dt column's name ends with (time_ms, timestamp_ns), else None."""
-    from ..reader import TIME_SCALE
-
+    """The unit a time or dt column's name states (time_ms, timestamp_ns, micros), else None."""
     if quantity not in ("time", "dt"):
         return None
-    *_, suffix = _norm_name(name).rpartition("_")
-    return suffix if suffix in TIME_SCALE and _norm_name(name) != suffix else None
+    normed = _norm_name(name)
+    counters = {"millis": "ms", "micros": "us"}  # a sketch's millis() and micros()
+    if normed in counters:
+        return counters[normed]
+    *_, suffix = normed.rpartition("_")
+    return suffix if suffix in TIME_SCALE and normed != suffix else None
 
 
 def open_table(path: Path) -> Any:
@@ -300,6 +303,11 @@ class _Clock:
     last_t: float | None = None
     last_row: int = -1
     total: float = 0.0
+    wrap: float = 0.0
+    """Where the time is a microcontroller's 32-bit counter (ms or us), its modulus [s]: a fall
+    by about that much is the counter starting again, not time going back (0: none)."""
+    offset: float = 0.0
+    wraps: int = 0
 
     def __call__(self, raw: np.ndarray | None, row0: int, n: int
                  ) -> tuple[np.ndarray, np.ndarray]:
@@ -320,6 +328,8 @@ class _Clock:
         """A sample's dt is the time since the last sample with a time (a sample without one
         gets dt NaN, which the estimators reject, and as its time that last time plus the
         nominal period per sample since)."""
+        if self.wrap > 0.0:
+            t = self._unwrapped(t)
         valid = np.flatnonzero(np.isfinite(t))
         dt = np.full(len(t), np.nan)
         times = t[valid]
@@ -351,6 +361,39 @@ class _Clock:
             self.last_t, self.last_row = float(times[-1]), int(rows[-1])
         return dt, np.where(np.isfinite(t), t, at)
 
+    def _unwrapped(self, t: np.ndarray) -> np.ndarray:
+        """The times [s] with the counter's wraps taken out (self.wrap): a step that falls by
+        the modulus less at most WRAP_STEPS periods is the counter going on."""
+        t = t + self.offset
+        valid = np.isfinite(t)
+        times = t[valid]
+        if not len(times):
+            return t
+        last = self.last_t if self.last_t is not None else times[0]
+        wrapped = wraps(np.diff(np.concatenate([[last], times])), self.wrap, self.first_dt)
+        if wrapped.any():
+            t = t.copy()
+            t[valid] = times + np.cumsum(wrapped) * self.wrap
+            self.offset += float(np.sum(wrapped)) * self.wrap
+            self.wraps += int(np.sum(wrapped))
+        return t
+
+
+COUNTER_WRAP = 2.0 ** 32
+"""A microcontroller's time counter (millis(), micros()) is 32 bits: micros() starts again
+every 71.6 minutes."""
+COUNTER_SCALES = (TIME_SCALE["ms"], TIME_SCALE["us"])
+"""The units such a counter counts in (a factor to seconds each)."""
+WRAP_STEPS = 10.0
+"""A fall of the time by the counter's modulus less at most this many periods is a wrap."""
+
+
+def wraps(steps: np.ndarray, modulus: float, period: float) -> np.ndarray:
+    """Which steps of a time are its counter starting again: a fall that the modulus turns
+    into a step of at most WRAP_STEPS periods."""
+    up = steps + modulus
+    return (steps < 0.0) & (up > 0.0) & (up <= WRAP_STEPS * period)
+
 
 @dataclass
 class RecordingSource:
@@ -367,6 +410,8 @@ class RecordingSource:
     _blocks: Any
     time_unit: str = "s"
     """The unit of the file's time column (s where the times come from a rate or the format)."""
+    read_notes: dict[str, int] = field(default_factory=dict)
+    """What the last read found ("wraps": how often the time's counter started again)."""
 
     def blocks(self, rows: int | None = None) -> Iterator[tuple[Recording, np.ndarray]]:
         """(Recording, time [s]) of each block of samples, from the first; RecordingError where
@@ -390,10 +435,13 @@ class RecordingSource:
     def summary(self, n: int, duration: float, missing: int, choices: bool = True) -> str:
         """What was read: the count and length, the choices (unless told not to), the samples
         without numbers."""
+        wrapped = self.read_notes.get("wraps", 0)
         return (f"{n} samples, {duration:.4g} s at {self.rate:.4g} Hz"
                 + (f"; {self.choices}" if choices else "")
                 + (f"; {missing} sample(s) without a number in every column, which the "
-                   "estimators reject and count" if missing else ""))
+                   "estimators reject and count" if missing else "")
+                + (f"; the time's 32-bit counter started again {wrapped} time(s), taken as "
+                   "going on" if wrapped else ""))
 
 
 def concatenate(parts: list[Recording]) -> Recording:
@@ -467,25 +515,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                              "no time or dt column for it (leave it out)")
     if "time" in prefix or "dt" in prefix:
         kind = "time" if "time" in prefix else "dt"
-        raw = prefix[kind]
-        if kind == "time":
-            valid = np.flatnonzero(np.isfinite(raw))
-            if len(valid) < 2:
-                raise RecordingError(f"{path}: fewer than two samples with a time")
-            steps = np.diff(raw[valid])
-            rising = steps[steps > 0.0]
-            step = float(np.median(rising)) if len(rising) else float("nan")
-            increasing = bool(np.all(steps > 0.0))
-        else:
-            step, increasing = median_period(raw[1:]), True
-
-        def clock_in(scale: float) -> _Clock:
-            first = step * scale if increasing else float("nan")
-            return _Clock(kind, scale, first, path, table.where)
-
-        t_unit, scale, time_how = _time_scale(path, kind, step, time_unit, units.get(kind),
-                                              lambda s: clock_in(s)(raw, 0, n)[0], acc, gyro)
-        clock = clock_in(scale)
+        clock, t_unit, time_how = _time_clock(path, kind, prefix[kind], time_unit,
+                                              units.get(kind), acc, gyro, table.where)
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
     else:
@@ -530,6 +561,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                + ("" if table.kind == "text" else f"; read as {table.kind}"))
     name = path.stem
 
+    read_notes: dict[str, int] = {}
+
     def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
         run_clock = replace(clock)
         row0 = 0
@@ -543,9 +576,41 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts)
             rec.ref_quat = ref_quat
             row0 += len(block)
+            read_notes["wraps"] = run_clock.wraps
             yield rec, t
 
-    return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit)
+    return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit,
+                           read_notes)
+
+
+def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str | None,
+                acc: np.ndarray, gyro: np.ndarray, where: Any) -> tuple[_Clock, str, str]:
+    """The clock of a time or dt column from its first samples `raw` (numbers as read), its
+    unit and how that was chosen (_time_scale; acc, gyro as read are the evidence where the
+    steps leave two units). A time of integers below 2^32 in ms or us is a microcontroller's
+    counter, whose wraps (wraps) count as going on."""
+    if kind == "time":
+        valid = np.flatnonzero(np.isfinite(raw))
+        if len(valid) < 2:
+            raise RecordingError(f"{path}: fewer than two samples with a time")
+        values = raw[valid]
+        steps = np.diff(values)
+        rising = steps[steps > 0.0]
+        step = float(np.median(rising)) if len(rising) else float("nan")
+        counter = bool(np.all((values == np.round(values)) & (values >= 0.0)
+                              & (values < COUNTER_WRAP)))
+        increasing = bool(np.all((steps > 0.0) | (counter & wraps(steps, COUNTER_WRAP, step))))
+    else:
+        step, increasing, counter = median_period(raw[1:]), True, False
+
+    def clock_in(scale: float) -> _Clock:
+        first = step * scale if increasing else float("nan")
+        wrap = COUNTER_WRAP * scale if counter and scale in COUNTER_SCALES else 0.0
+        return _Clock(kind, scale, first, path, where, wrap=wrap)
+
+    t_unit, scale, how = _time_scale(path, kind, step, unit, stated,
+                                     lambda s: clock_in(s)(raw, 0, len(raw))[0], acc, gyro)
+    return clock_in(scale), t_unit, how
 
 
 def _vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
