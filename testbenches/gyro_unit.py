@@ -5,15 +5,16 @@ A sensor that turns sees gravity turn the other way in its own frame: du/dt = -o
 unit vector u of gravity in the sensor's frame. So over a short window the accelerometer's
 direction at its end is predicted from its direction at the start and the gyro's readings taken
 in a unit: in the right unit the prediction meets the measured direction to within the noise and
-the linear acceleration; in a unit 57.3 times off it misses by the turn itself. A rate about the
-vertical turns nothing gravity shows, in either unit, and is neither evidence for nor against.
+the linear acceleration; in a unit 57.3 (rad/s against deg/s) or 1000 times off (deg/s against
+mdps, as ST's sensors give it) it misses by the turn itself. A rate about the vertical turns
+nothing gravity shows, in any unit, and is neither evidence for nor against.
 
-Only windows in which the accelerometer sees gravity turn count: there the wrong unit misses by
-about the turn itself (57 times too little) or by 56 times it (too much), while the right one
-misses by the noise, the linear acceleration and the gyro's bias over the window. A window at
-rest is no evidence: a gyro bias, which turns nothing, would there favour whichever unit makes
-the readings smallest. So a recording without turns (a still one) is undecided, and the caller
-asks for the unit.
+Only windows in which the accelerometer sees gravity turn count: there a wrong unit misses by
+about the turn itself (a turn many times too small) or by many times it (too large), while the
+right one misses by the noise, the linear acceleration and the gyro's bias over the window. A
+window at rest is no evidence: a gyro bias, which turns nothing, would there favour whichever
+unit makes the readings smallest. So a recording without turns (a still one) is undecided, and
+the caller asks for the unit.
 """
 
 from __future__ import annotations
@@ -22,8 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0}
+UNITS = {"rad/s": 1.0, "deg/s": np.pi / 180.0, "mdps": np.pi / 180.0e3}
 """The candidate units and their factor to rad/s."""
+PRIMARY = ("rad/s", "deg/s")
+MILLI = "mdps"
+"""The units verdict weighs first, and the one it weighs where neither of those explains the
+turn."""
 WINDOW_S = 0.25
 """Window over which the gyro's turn is compared with gravity's [s]: long enough that a turn of
 a few deg/s moves gravity by more than the accelerometer's noise after the low-pass, short
@@ -44,7 +49,7 @@ MAX_WINDOWS = 20000
 windows start at every sample and overlap, and a median over this many is as sure as over all
 of a long recording's (the comparison is most of the time a long file takes to open)."""
 MIN_RATIO = 3.0
-"""The other unit's miss must be at least this many times the chosen one's."""
+"""Every other unit's miss must be at least this many times the chosen one's."""
 
 
 @dataclass(frozen=True)
@@ -68,9 +73,10 @@ class UnitEvidence:
         if self.windows < MIN_WINDOWS:
             return (f"{self.windows} windows of {WINDOW_S} s turn gravity by {MIN_TURN_DEG:g} "
                     f"deg or more, {MIN_WINDOWS} are needed: too little motion")
-        return (f"{self.describe()}: within {MIN_RATIO:g} times of each other, so neither "
-                "unit explains the turn, as where the gyro sits at its rail, the columns are not "
-                "the gyro's or linear acceleration fills the windows")
+        return (f"{self.describe()}: the two smallest within {MIN_RATIO:g} times of each "
+                "other, so no unit explains the turn, as where the gyro sits at its rail, the "
+                "columns are not the gyro's (raw counts of its converter) or linear "
+                "acceleration fills the windows")
 
 
 def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
@@ -149,14 +155,21 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str
 
 
 def verdict(misses: dict[str, np.ndarray]) -> UnitEvidence:
-    """The unit the windows' misses point to: the one whose median miss is at least MIN_RATIO
-    times smaller than the other's, over at least MIN_WINDOWS windows (else undecided)."""
+    """The unit the windows' misses point to, over at least MIN_WINDOWS windows (else
+    undecided): of rad/s and deg/s the one whose median miss is at least MIN_RATIO times
+    smaller than the other's; where neither is, mdps where its miss is that much smaller than
+    both. A unit too small reads as no turn and misses by the turn itself, one too large by
+    more: so deg/s is told from rad/s, 57 times larger, as before mdps was a candidate, and mdps
+    comes in only where both of those fail (a gyro in mdps turns 1000 times too far in deg/s),
+    not where deg/s merely misses by more than a third of the turn."""
     windows = len(next(iter(misses.values())))
     median = {unit: float(np.median(m)) if windows else float("nan")
               for unit, m in misses.items()}
     unit = None
     if windows >= MIN_WINDOWS:
-        best, other = sorted(UNITS, key=lambda x: median[x])
+        best, other = sorted(PRIMARY, key=lambda x: median[x])
         if median[other] >= MIN_RATIO * max(median[best], 1e-3):
             unit = best
+        elif min(median[u] for u in PRIMARY) >= MIN_RATIO * max(median[MILLI], 1e-3):
+            unit = MILLI
     return UnitEvidence(median, windows, unit)

@@ -37,9 +37,10 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--column", action="append", default=[], metavar="QUANTITY=NAME",
                         help="the column of a quantity (acc_x..gyro_z, time, dt, roll, pitch, "
                         "q_w..q_z) where its name is none the reader knows (repeatable)")
-    parser.add_argument("--acc-unit", choices=("auto", "m/s2", "g"), default="auto",
+    parser.add_argument("--acc-unit", choices=("auto", "m/s2", "g", "mg"), default="auto",
                         help="the accelerometer's unit (auto: the header's, else from its norm)")
-    parser.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s"), default="auto",
+    parser.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s", "mdps"),
+                        default="auto",
                         help="the gyro's unit (auto: the header's, else the unit in which the "
                         "gyro's turn explains the accelerometer's turn of gravity; a given or "
                         "stated unit the data contradict is refused)")

@@ -51,7 +51,8 @@ SNIFF_BYTES = 1 << 16
 UNIT_ALIASES: dict[str, str] = {
     "rad/s": "rad/s", "rads": "rad/s", "rad/sec": "rad/s", "rps": "rad/s",
     "deg/s": "deg/s", "°/s": "deg/s", "dps": "deg/s", "deg/sec": "deg/s", "degs": "deg/s",
-    "g": "g", "gee": "g",
+    "mdps": "mdps", "mdeg/s": "mdps", "m°/s": "mdps",
+    "g": "g", "gee": "g", "mg": "mg", "milli-g": "mg",
     "m/s2": "m/s2", "m/s^2": "m/s2", "m/s²": "m/s2", "ms^-2": "m/s2", "ms-2": "m/s2",
     "m.s-2": "m/s2", "mps2": "m/s2",
     "s": "s", "sec": "s", "seconds": "s", "ms": "ms", "us": "us", "µs": "us", "ns": "ns",

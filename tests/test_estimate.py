@@ -75,7 +75,7 @@ def test_an_hdf5_recording_with_a_rate(tmp_path):
     ("time,ax,ay,az,gx,gy,gz\n0,0,0,9.8,0,0,0\n0.02,0,0,9.8,0,0,0\n0.01,0,0,9.8,0,0,0\n",
      "line 4: the time 0.01 s does not increase from 0.02 s on line 3"),
     ("time,ax,ay,az,gx,gy,gz\n0,0,0,98,0,0,0\n0.01,0,0,98,0,0,0\n",
-     "neither about 1 (g) nor about 9.81"),
+     "neither about 1 (g), 9.81 (m/s2) nor 1000 (mg)"),
     ("ax,ay,az,gx,gy,gz\n0,0,9.8,0,0,0\n0,0,9.8,0,0,0\n", "give the sample rate"),
     ("time,ax,ay,az,gx,gy,gz\n0,0,0,9.8,0,0,x\n0.01,0,0,9.8,0,0,0\n",
      "line 2, column 'gz': 'x' is not a number"),
@@ -228,7 +228,7 @@ def test_a_still_recording_in_deg_s_with_a_bias_is_not_read_as_rad_s(tmp_path, c
     _still(path, 0.3, deg=True)
     assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
                  "--no-plots"]) == 2
-    assert "give --gyro-unit rad/s or deg/s" in capsys.readouterr().err
+    assert "give --gyro-unit rad/s, deg/s or mdps" in capsys.readouterr().err
     assert main(["estimate", str(path), "--gyro-unit", "deg/s", "--estimator", "kf",
                  "--out", str(tmp_path), "--no-plots"]) == 0
     assert np.max(np.abs(np.degrees(_kf_roll(tmp_path, "still")) - 9.74)) < 1.0
@@ -268,7 +268,7 @@ def test_a_recording_that_cannot_tell_its_gyro_unit_is_refused_unless_told(tmp_p
     _still(path, 0.0, deg=False)
     assert main(["estimate", str(path), "--out", str(tmp_path), "--no-plots"]) == 2
     err = capsys.readouterr().err
-    assert "too little motion" in err and "give --gyro-unit rad/s or deg/s" in err
+    assert "too little motion" in err and "give --gyro-unit rad/s, deg/s or mdps" in err
     assert main(["estimate", str(path), "--gyro-unit", "rad/s", "--estimator", "kf",
                  "--out", str(tmp_path), "--no-plots"]) == 0
 
@@ -286,8 +286,8 @@ def test_a_gyro_at_its_rail_is_refused_with_the_misses_not_as_too_little_motion(
     assert main(["estimate", str(path), "--out", str(tmp_path), "--no-plots"]) == 2
     err = capsys.readouterr().err
     assert "too little motion" not in err
-    assert "missed by rad/s:" in err and "neither unit explains the turn" in err
-    assert "give --gyro-unit rad/s or deg/s" in err
+    assert "missed by rad/s:" in err and "no unit explains the turn" in err
+    assert "give --gyro-unit rad/s, deg/s or mdps" in err
 
 
 def _reference(path: Path, time: np.ndarray, roll: np.ndarray, pitch: np.ndarray) -> None:

@@ -107,3 +107,27 @@ def test_accelerometer_and_gyro_on_rows_of_their_own_are_refused_with_why(tmp_pa
     assert "on rows of their own (1000 rows hold only the accelerometer, 1000 only the gyro)" \
         in err
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+def test_milli_g_and_milli_deg_per_s_are_found_and_raw_counts_refused_with_why(tmp_path):
+    """ST's sensors give mg and mdps: found from the norm and from the turn, the samples those
+    of the example in SI. Raw counts (16384 per g) are no unit: refused, saying what they are."""
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+    g = 9.80665
+    plain = open_recording(EXAMPLE).load()[0]
+    milli = tmp_path / "milli.csv"
+    np.savetxt(milli, np.column_stack([data[:, 0], data[:, 1:4] / g * 1e3,
+                                       np.degrees(data[:, 4:7]) * 1e3]),
+               delimiter=",", header="time," + HEADER, comments="", fmt="%.17g")
+    source = open_recording(milli)
+    rec, _ = source.load()
+    assert "acc in mg (from its median norm" in source.choices
+    assert "gyro in mdps (from the data" in source.choices
+    np.testing.assert_allclose(rec.acc, plain.acc, rtol=1e-12)
+    np.testing.assert_allclose(rec.gyro, plain.gyro, rtol=1e-12, atol=1e-15)
+    counts = tmp_path / "counts.csv"
+    np.savetxt(counts, np.column_stack([data[:, 0], np.round(data[:, 1:4] / g * 16384),
+                                        np.round(np.degrees(data[:, 4:7]) * 131)]),
+               delimiter=",", header="time," + HEADER, comments="", fmt="%.10g")
+    with pytest.raises(RecordingError, match="about 16384, a MEMS part's raw counts per g"):
+        open_recording(counts)

@@ -713,6 +713,26 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     return found.unit, found.scale, f"{kind} in {found.unit} ({found.how})"
 
 
+ACC_UNITS = {"m/s2": 1.0, "g": G_STANDARD, "mg": G_STANDARD / 1000.0}
+"""The accelerometer's units and their factor to m/s^2."""
+ACC_NORMS = {"g": (0.5, 2.0), "m/s2": (5.0, 20.0), "mg": (500.0, 2000.0)}
+"""The median norm of the accelerometer (gravity, at rest and on average in motion) that each
+unit gives, as numbers read; they do not overlap."""
+COUNTS_PER_G = (256, 2048, 4096, 8192, 16384)
+"""Raw accelerometer counts per g of common MEMS parts at their ranges (an ADXL345's 256; an
+MPU-6050's or ICM's 16384 to 2048 at +-2 to 16 g); a norm of 1000 or so is mg."""
+
+
+def _counts_hint(norm: float) -> str:
+    """Where a median norm is about a common part's counts per g: what the numbers are."""
+    near = [c for c in COUNTS_PER_G if abs(norm / c - 1.0) < 0.15]
+    if not near:
+        return ""
+    return (f"that is about {near[0]}, a MEMS part's raw counts per g (an MPU-6050 gives "
+            "16384 at +-2 g, 2048 at +-16 g): divide the accelerometer's columns by its counts "
+            "per g and give them in g, or ")
+
+
 def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
                ) -> tuple[float, str]:
     """The factor to m/s^2 and how it was chosen: given, stated by the header, or from the
@@ -723,19 +743,17 @@ def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
     chosen = unit if unit != "auto" else stated
     how = "given" if unit != "auto" else "from the header"
     if chosen is None:
-        if 0.5 < norm < 2.0:
-            chosen = "g"
-        elif 5.0 < norm < 20.0:
-            chosen = "m/s2"
-        else:
+        chosen = next((u for u, (lo, hi) in ACC_NORMS.items() if lo < norm < hi), None)
+        if chosen is None:
             raise RecordingError(
-                f"{path}: the accelerometer's median norm is {norm:.4g}, neither about 1 (g) "
-                "nor about 9.81 (m/s2): give --acc-unit, or check the columns")
+                f"{path}: the accelerometer's median norm is {norm:.4g}, neither about 1 (g), "
+                f"9.81 (m/s2) nor 1000 (mg): {_counts_hint(norm)}give --acc-unit, or check the "
+                "columns")
         how = f"from its median norm {norm:.4g}"
-    scale = {"m/s2": 1.0, "g": G_STANDARD}.get(chosen)
+    scale = ACC_UNITS.get(chosen)
     if scale is None:
-        raise RecordingError(f"{path}: the accelerometer's unit {chosen!r} is not one of g, "
-                             "m/s2")
+        raise RecordingError(f"{path}: the accelerometer's unit {chosen!r} is not one of "
+                             f"{', '.join(ACC_UNITS)}")
     si = norm * scale
     if not 4.0 < si < 40.0:
         raise RecordingError(f"{path}: the accelerometer's median norm is {si:.4g} m/s2 in the "
@@ -767,8 +785,8 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     if chosen is not None:
         how = "given" if unit != "auto" else "from the header"
         if chosen not in UNITS:
-            raise RecordingError(f"{path}: the gyro's unit {chosen!r} is not one of rad/s, "
-                                 "deg/s")
+            raise RecordingError(f"{path}: the gyro's unit {chosen!r} is not one of "
+                                 f"{', '.join(UNITS)}")
         if evidence.unit is not None and evidence.unit != chosen:
             raise RecordingError(
                 f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
@@ -779,7 +797,7 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     if evidence.unit is None:
         raise RecordingError(
             f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
-            "give --gyro-unit rad/s or deg/s")
+            f"give --gyro-unit {', '.join(list(UNITS)[:-1])} or {list(UNITS)[-1]}")
     return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
 
 
