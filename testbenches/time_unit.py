@@ -11,9 +11,10 @@ and the rates IMUs are logged at span about as much, so the median step alone le
 for most files: a step of 10 is 100 Hz in ms (0.1 Hz in s, 100 kHz in us). Where it leaves two
 (a step of 0.05: 20 Hz in s or 20 kHz in ms) the data decide as they decide the gyro's unit: in
 the right time unit one gyro unit explains how the accelerometer sees gravity turn, while a
-time unit a thousand times off makes the integrated turn a thousand times off in either gyro
-unit, which neither explains. A recording without turns cannot tell, and is refused with the
-candidates.
+time unit a thousand times off makes the integrated turn a thousand times off, which no gyro
+unit explains (but mdps, a thousand times smaller than deg/s, in a time unit a thousand times
+too long: such a file fits both, and is refused). A recording without turns cannot tell, and is
+refused with the candidates.
 """
 
 from __future__ import annotations
@@ -59,9 +60,9 @@ def _rates(step: float, units: list[str]) -> str:
     return _listed([f"{rate_in(step, u):.4g} Hz in {u}" for u in units])
 
 
-def _listed(items: list[str], last: str = "or") -> str:
+def _listed(items: list[str]) -> str:
     """"a, b or c"."""
-    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} {last} {items[-1]}"
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
 
 
 def _why_not(e: UnitEvidence) -> str:
@@ -69,7 +70,7 @@ def _why_not(e: UnitEvidence) -> str:
     if e.windows < MIN_WINDOWS:
         return f"{e.windows} windows turn gravity, {MIN_WINDOWS} are needed"
     misses = ", ".join(f"{u}: {m:.3g} deg" for u, m in e.miss_deg.items())
-    return f"neither gyro unit explains gravity's turn (median miss {misses})"
+    return f"no gyro unit explains gravity's turn (median miss {misses})"
 
 
 def time_unit(column: str, step: float, dt_of: Callable[[float], np.ndarray], acc: np.ndarray,
@@ -100,6 +101,7 @@ def time_unit(column: str, step: float, dt_of: Callable[[float], np.ndarray], ac
                         f"{rate_in(step, u):.4g} Hz in {u}, where the gyro's turn explains "
                         f"gravity's; {others}")
     why = "; ".join(f"in {u}, {_why_not(evidence[u])}" for u in found) if not decided else (
-        "the gyro's turn explains gravity's in " + " and ".join(decided))
+        "the gyro's turn explains gravity's " + " and ".join(
+            f"in {u} (the gyro in {evidence[u].unit})" for u in decided))
     return (f"the {column} column states no unit, and its median step {step:.4g} is "
             f"{_rates(step, found)}; {why}: give --time-unit " + _listed(found))

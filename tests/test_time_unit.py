@@ -64,7 +64,7 @@ def test_a_dt_column_and_a_name_may_carry_the_unit(tmp_path):
 
 def test_where_two_units_give_imu_rates_the_data_decide(tmp_path):
     """A step of 0.05 is 20 Hz in s or 20 kHz in ms: in ms the gyro's turn is a thousand times
-    too small in either gyro unit, in s one unit explains gravity's turn."""
+    too small in any gyro unit, in s one unit explains gravity's turn."""
     t, imu = _example(every=5)
     assert candidates(0.05) == ["s", "ms"]
     source, _, _ = _read(_write(tmp_path / "slow.csv", "time", t, imu))
