@@ -25,6 +25,7 @@ other formats count rows from 1.
 from __future__ import annotations
 
 import csv
+import datetime as dt
 import itertools
 import re
 from collections.abc import Callable, Iterator
@@ -186,8 +187,6 @@ def seconds_of(text: str) -> float | None:
     """Seconds since 1970-01-01 UTC of an ISO 8601 date and time (_ISO_DATETIME; without a zone
     taken as UTC, as both a recording and its reference are read), None where the text is
     none."""
-    import datetime as dt
-
     m = _ISO_DATETIME.match(text.strip())
     if m is None:
         return None

@@ -57,11 +57,11 @@ def candidates(step: float) -> list[str]:
 
 
 def _rates(step: float, units: list[str]) -> str:
-    return _listed([f"{rate_in(step, u):.4g} Hz in {u}" for u in units])
+    return listed([f"{rate_in(step, u):.4g} Hz in {u}" for u in units])
 
 
-def _listed(items: list[str]) -> str:
-    """"a, b or c"."""
+def listed(items: list[str]) -> str:
+    """"a, b or c" (the units a message offers)."""
     return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
 
 
@@ -88,7 +88,7 @@ def time_unit(column: str, step: float, dt_of: Callable[[float], np.ndarray], ac
         u = found[0]
         return TimeUnit(u, TIME_UNITS[u], f"from its steps: a median step of {step:.4g} is "
                         f"{rate_in(step, u):.4g} Hz in {u}, and no IMU's rate in "
-                        + _listed([v for v in TIME_UNITS if v != u]))
+                        + listed([v for v in TIME_UNITS if v != u]))
     evidence: dict[str, UnitEvidence] = {}
     for u in found:
         evidence[u] = verdict(window_misses(acc, gyro, dt_of(TIME_UNITS[u])))
@@ -104,4 +104,4 @@ def time_unit(column: str, step: float, dt_of: Callable[[float], np.ndarray], ac
         "the gyro's turn explains gravity's " + " and ".join(
             f"in {u} (the gyro in {evidence[u].unit})" for u in decided))
     return (f"the {column} column states no unit, and its median step {step:.4g} is "
-            f"{_rates(step, found)}; {why}: give --time-unit " + _listed(found))
+            f"{_rates(step, found)}; {why}: give --time-unit " + listed(found))

@@ -678,7 +678,7 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     unit of that factor). A step that is no IMU rate in the unit given or stated is refused
     with the rate it would be, and so is a given unit that is not the header's."""
     from ..reader import DATETIME
-    from ..time_unit import RATE_RANGE, TIME_UNITS, TimeUnit, candidates, rate_in, time_unit
+    from ..time_unit import RATE_RANGE, TIME_UNITS, TimeUnit, candidates, listed, rate_in, time_unit
 
     if stated == DATETIME:
         if unit != "auto":
@@ -696,9 +696,9 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
             fits = candidates(step)
             serve = "check the column"
             if fits:
-                serve = (f"in {' or '.join(fits)} it is "
+                serve = (f"in {listed(fits)} it is "
                          + ", ".join(f"{rate_in(step, u):.4g} Hz" for u in fits) + ": "
-                         + ("give --time-unit " + " or ".join(fits) if unit != "auto"
+                         + ("give --time-unit " + listed(fits) if unit != "auto"
                             else "correct the unit in the header"))
             raise RecordingError(
                 f"{path}: the {kind} column's median step {step:.6g} is "
@@ -770,6 +770,7 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     is refused with the evidence; where the data cannot tell and no unit is given or stated,
     the recording is refused, and so is a given unit that is not the header's."""
     from ..gyro_unit import UNITS, verdict, window_misses
+    from ..time_unit import listed
 
     _given_against_header(path, "gyro", "gyro-unit", unit, stated)
     misses = window_misses(acc, gyro, dt)
@@ -797,7 +798,7 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     if evidence.unit is None:
         raise RecordingError(
             f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
-            f"give --gyro-unit {', '.join(list(UNITS)[:-1])} or {list(UNITS)[-1]}")
+            f"give --gyro-unit {listed(list(UNITS))}")
     return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
 
 
