@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from testbenches.cli import main
 from testbenches.fit.recording import RecordingError, open_recording
 
 REPO = Path(__file__).resolve().parents[1]
@@ -94,19 +93,34 @@ def test_a_line_after_the_table_is_refused_by_its_line_and_text(tmp_path):
         open_recording(path).load()
 
 
-def test_accelerometer_and_gyro_on_rows_of_their_own_are_refused_with_why(tmp_path, capsys):
-    """A logger that writes each sensor's reading as it comes leaves no row with both: the
-    refusal says so and what would serve."""
+def test_accelerometer_and_gyro_on_rows_of_their_own_are_joined(tmp_path):
+    """A logger that writes each sensor's reading as it comes (the gyro 4 ms after the
+    accelerometer): each gyro row is a sample with the accelerometer's latest row, so the
+    samples are the example's own, in blocks of any size. Without a time column nothing joins
+    them: refused, saying why."""
     t, imu = _example()
     rows = np.full((2 * len(t), 7), np.nan)
     rows[0::2, 0], rows[0::2, 1:4] = t, imu[:, :3]
     rows[1::2, 0], rows[1::2, 4:7] = t + 0.004, imu[:, 3:]
-    path = _write(tmp_path / "interleaved.csv", "time", rows[:, 0], rows[:, 1:])
-    assert main(["estimate", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 2
-    err = capsys.readouterr().err
-    assert "on rows of their own (1000 rows hold only the accelerometer, 1000 only the gyro)" \
-        in err
-    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    path = tmp_path / "interleaved.csv"
+    np.savetxt(path, rows, delimiter=",", header="time," + HEADER, comments="", fmt="%.17g")
+    plain = _write(tmp_path / "plain.csv", "time", t, imu)
+    want, _ = open_recording(plain).load()
+    source = open_recording(path)
+    assert "the accelerometer and the gyro on rows of their own" in source.choices
+    for size in (None, 7):
+        parts = list(source.blocks(rows=size))
+        for name in ("acc", "gyro"):
+            got = np.concatenate([getattr(p, name) for p, _ in parts])
+            np.testing.assert_array_equal(got, getattr(want, name))
+        np.testing.assert_allclose(np.concatenate([p.dt for p, _ in parts]), want.dt,
+                                   atol=1e-12)  # the 4 ms shift rounds the times apart
+        np.testing.assert_allclose(np.concatenate([tt for _, tt in parts]), t + 0.004)
+    no_time = tmp_path / "no_time.csv"
+    np.savetxt(no_time, rows[:, 1:], delimiter=",", header=HEADER, comments="", fmt="%.17g")
+    with pytest.raises(RecordingError, match=r"on rows of their own .* a time column joins "
+                       "them"):
+        open_recording(no_time, rate=100.0)
 
 
 def test_milli_g_and_milli_deg_per_s_are_found_and_raw_counts_refused_with_why(tmp_path):

@@ -508,7 +508,16 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     if n < 2:
         raise RecordingError(f"{path}: {n} sample(s); a recording needs many")
     rate = rate or table.attrs.get("rate")
-    acc, gyro = _vectors(prefix)  # as read: the time unit's evidence needs their directions only
+    split = _split_rows(*_vectors(prefix))
+    joiner = None
+    keep: Any = slice(None)  # the rows that are samples (all, unless split)
+    if split:
+        if "time" not in prefix:
+            raise RecordingError(f"{path}: {split}; a time column joins them, and this file "
+                                 "has none")
+        joiner = _JoinedRows
+        prefix, keep = joiner()(prefix)
+    acc, gyro = _vectors({q: v[keep] for q, v in prefix.items()})  # as read: the time unit's
     t_unit, time_how = "s", ""
     if time_unit != "auto" and not ("time" in prefix or "dt" in prefix):
         raise RecordingError(f"{path}: --time-unit {time_unit} is given, but the recording has "
@@ -516,7 +525,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     if "time" in prefix or "dt" in prefix:
         kind = "time" if "time" in prefix else "dt"
         clock, t_unit, time_how = _time_clock(path, kind, prefix[kind], time_unit,
-                                              units.get(kind), acc, gyro, table.where)
+                                              units.get(kind), acc, gyro, table.where, keep)
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
     else:
@@ -527,11 +536,10 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(f"{path}: no time or dt column{hint}: give the sample rate (--rate "
                              "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
-    dt, _ = replace(clock)(prefix.get(clock.kind), 0, n)
+    dt = replace(clock)(prefix.get(clock.kind), 0, n)[0][keep]
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
-        raise RecordingError(f"{path}: no sample holds numbers in every column"
-                             + _split_rows(acc, gyro))
+        raise RecordingError(f"{path}: no sample holds numbers in every column")
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
                                     _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
 
@@ -539,11 +547,13 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         """The blocks after the first, as read (for the gyro unit's evidence)."""
         evidence_clock = replace(clock)
         row0 = 0
+        join = joiner() if joiner else None
         for block in table.blocks(wanted, PREFIX_ROWS):
             cols = {q: block[:, k] for k, q in enumerate(names)}
+            cols, rows = join(cols) if join else (cols, slice(None))
             d, _ = evidence_clock(cols.get(clock.kind), row0, len(block))
             if row0 > 0:
-                yield (*_vectors(cols), d)
+                yield (*_vectors({q: v[rows] for q, v in cols.items()}), d[rows])
             row0 += len(block)
 
     gyro_scale, gyro_how, used = _gyro_scale(
@@ -555,6 +565,9 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         gyro_how += f" over the first {used} samples"
     where = ", ".join(f"{q}={found.source[q]!r}" for q in (*IMU_AXES, "time", "dt")
                       if q in found.source)
+    if split:
+        time_how += ("; the accelerometer and the gyro on rows of their own: each gyro row a "
+                     "sample, with the accelerometer's latest row before it")
     choices = (f"acc in {acc_how}; gyro in {gyro_how}" + (f"; {time_how}" if time_how else "")
                + (f"; columns {where}" if where else "")
                + (f"; {table.note}" if table.note else "")
@@ -566,16 +579,20 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
         run_clock = replace(clock)
         row0 = 0
+        join = joiner() if joiner else None
         for block in table.blocks(wanted, rows):
             cols = {q: block[:, k] for k, q in enumerate(names)}
+            cols, samples = join(cols) if join else (cols, slice(None))
             dt, t = run_clock(cols.get(run_clock.kind), row0, len(block))
+            row0 += len(block)
+            cols = {q: v[samples] for q, v in cols.items()}
+            dt, t = dt[samples], t[samples]
             acc, gyro = _vectors(cols)
             acc, gyro = acc * acc_scale, gyro * gyro_scale
             up, ref_quat = reference_up(cols, path)
             counts = None if up is None else np.all(np.isfinite(up), axis=1)
             rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts)
             rec.ref_quat = ref_quat
-            row0 += len(block)
             read_notes["wraps"] = run_clock.wraps
             yield rec, t
 
@@ -584,11 +601,12 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
 
 
 def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str | None,
-                acc: np.ndarray, gyro: np.ndarray, where: Any) -> tuple[_Clock, str, str]:
-    """The clock of a time or dt column from its first samples `raw` (numbers as read), its
-    unit and how that was chosen (_time_scale; acc, gyro as read are the evidence where the
-    steps leave two units). A time of integers below 2^32 in ms or us is a microcontroller's
-    counter, whose wraps (wraps) count as going on."""
+                acc: np.ndarray, gyro: np.ndarray, where: Any, keep: Any = slice(None)
+                ) -> tuple[_Clock, str, str]:
+    """The clock of a time or dt column from its first rows `raw` (numbers as read), its
+    unit and how that was chosen (_time_scale; acc, gyro as read, of the rows `keep` selects,
+    are the evidence where the steps leave two units). A time of integers below 2^32 in ms or
+    us is a microcontroller's counter, whose wraps (wraps) count as going on."""
     if kind == "time":
         valid = np.flatnonzero(np.isfinite(raw))
         if len(valid) < 2:
@@ -609,7 +627,8 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         return _Clock(kind, scale, first, path, where, wrap=wrap)
 
     t_unit, scale, how = _time_scale(path, kind, step, unit, stated,
-                                     lambda s: clock_in(s)(raw, 0, len(raw))[0], acc, gyro)
+                                     lambda s: clock_in(s)(raw, 0, len(raw))[0][keep], acc,
+                                     gyro)
     return clock_in(scale), t_unit, how
 
 
@@ -658,16 +677,47 @@ def _given_against_header(path: Path, sensor: str, option: str, unit: str,
 
 
 def _split_rows(acc: np.ndarray, gyro: np.ndarray) -> str:
-    """Where the accelerometer and the gyro are on rows of their own (a logger that writes
-    each sensor's readings as they come): what would serve; else nothing."""
+    """Where no row holds both the accelerometer and the gyro but rows hold each (a logger
+    that writes each sensor's readings as they come, or at its own rate): saying so; else
+    ""."""
+    if np.any(np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1)):
+        return ""
     only_acc = int(np.sum(np.all(np.isfinite(acc), 1) & ~np.any(np.isfinite(gyro), 1)))
     only_gyro = int(np.sum(np.all(np.isfinite(gyro), 1) & ~np.any(np.isfinite(acc), 1)))
     if only_acc and only_gyro:
-        return (f": the accelerometer and the gyro are on rows of their own ({only_acc} rows "
-                f"hold only the accelerometer, {only_gyro} only the gyro); one row per sample "
-                "with both serves (each gyro row joined to the accelerometer row nearest in "
-                "time)")
+        return (f"the accelerometer and the gyro are on rows of their own ({only_acc} rows "
+                f"hold only the accelerometer, {only_gyro} only the gyro)")
     return ""
+
+
+class _JoinedRows:
+    """The rows of a recording whose accelerometer and gyro are on rows of their own, as
+    samples: each gyro row is one (the gyro's readings are what is integrated, each over its
+    own dt), with the accelerometer's latest row at or before it (the estimators low-pass the
+    accelerometer over a second or more, so a reading a fraction of a period old is its
+    value). The accelerometer's rows are no samples: their time is NaN to the clock, which so
+    steps from gyro row to gyro row and still names a row by its line. One per read: the
+    latest accelerometer row carries across its blocks; gyro rows before any have none (NaN:
+    rejected and counted)."""
+
+    def __init__(self) -> None:
+        self.last = np.full(3, np.nan)
+
+    def __call__(self, cols: dict[str, np.ndarray]) -> tuple[dict[str, np.ndarray], np.ndarray]:
+        """The block's columns with each row's accelerometer filled and the accelerometer
+        rows' time NaN, and which rows are samples."""
+        acc, gyro = _vectors(cols)
+        own = np.all(np.isfinite(acc), 1)
+        acc_row = own & ~np.any(np.isfinite(gyro), 1)
+        latest = np.maximum.accumulate(np.where(acc_row, np.arange(len(acc)), -1))
+        filled = np.where((latest >= 0)[:, None], acc[np.maximum(latest, 0)], self.last)
+        filled = np.where((own & ~acc_row)[:, None], acc, filled)  # a row with both: its own
+        if acc_row.any():
+            self.last = acc[np.flatnonzero(acc_row)[-1]].copy()
+        out = dict(cols)
+        out.update({f"acc_{a}": filled[:, i] for i, a in enumerate("xyz")})
+        out["time"] = np.where(acc_row, np.nan, cols["time"])
+        return out, ~acc_row
 
 
 def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | None,
