@@ -164,7 +164,7 @@ def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording
     where two are, the recording's (both count from one instant in one unit as a rule, and the
     overlap is checked after); RecordingError where neither serves."""
     from .fit.recording import RecordingError
-    from .time_unit import candidates, rate_in
+    from .time_unit import candidates, median_step, rates
 
     if stated == DATETIME:  # read as seconds since 1970
         return "s"
@@ -173,18 +173,15 @@ def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording
             raise RecordingError(f"{path}: the reference's time column states the unit "
                                  f"{stated!r}, not one of {', '.join(TIME_SCALE)}")
         return stated
-    finite = t[np.isfinite(t)]
-    steps = np.diff(finite)
-    rising = steps[steps > 0.0]
-    step = float(np.median(rising)) if len(rising) else float("nan")
+    step = median_step(t)
     found = candidates(step)
     if len(found) == 1:
         return found[0]
     if recording in found or not (np.isfinite(step) and step > 0.0):
         return recording
-    rates = ", ".join(f"{rate_in(step, u):.4g} Hz in {u}" for u in found) or "none"
+    seen = rates(step, found) if found else "no rate a reference has in s, ms, us or ns"
     raise RecordingError(f"{path}: the reference's time column states no unit, and its median "
-                         f"step {step:.6g} is {rates}, none of them the recording's unit "
+                         f"step {step:.6g} is {seen}, none of them the recording's unit "
                          f"({recording}): state it in the header, as time (ms)")
 
 

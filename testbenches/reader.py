@@ -223,10 +223,7 @@ def _sniff(path: Path) -> _TextLayout:
         raise TableError(f"{path}: empty file")
     found = _find_header(numbered)
     if found is None:
-        first = numbered[0]
-        raise TableError(f"{path}: no delimiter splits a header and the rows after it alike "
-                         f"(tried comma, semicolon, tab and bar); line {first[0]} reads "
-                         f"{first[1][:80]!r}")
+        raise _no_table(path, numbered[0])
     delimiter, start = found
     header_line, header_text = numbered[start]
     preamble = numbered[:start]
@@ -237,10 +234,7 @@ def _sniff(path: Path) -> _TextLayout:
             header_line, header_text = named
             preamble = [(no, line) for no, line in preamble if no < header_line]
         elif len(commented) < len(preamble):  # rows before these that split otherwise
-            first = numbered[0]
-            raise TableError(f"{path}: no delimiter splits a header and the rows after it alike "
-                             f"(tried comma, semicolon, tab and bar); line {first[0]} reads "
-                             f"{first[1][:80]!r}")
+            raise _no_table(path, numbered[0])
         else:
             raise TableError(f"{path}, line {header_line}: numbers where a header row naming "
                              "the columns belongs (time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z "
@@ -262,6 +256,12 @@ def _sniff(path: Path) -> _TextLayout:
                else f"line {preamble[0][0]}") if preamble else ""
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                        datetimes, skipped)
+
+
+def _no_table(path: Path, first: tuple[int, str]) -> TableError:
+    line, text = first
+    return TableError(f"{path}: no delimiter splits a header and the rows after it alike (tried "
+                      f"comma, semicolon, tab and bar); line {line} reads {text[:80]!r}")
 
 
 def _comment(line: str) -> str:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .gyro_unit import MIN_WINDOWS, UnitEvidence, verdict, window_misses
-from .reader import TIME_SCALE as TIME_UNITS
+from .reader import TIME_SCALE
 
 RATE_RANGE = (2.0, 50_000.0)
 """The sample rates [Hz] an IMU recording may have, [low, high): from two samples a second,
@@ -43,9 +43,17 @@ class TimeUnit:
     how: str
 
 
+def median_step(t: np.ndarray) -> float:
+    """The median of a time column's rising steps (numbers as read; NaN where none rises): a
+    wrap or a glitch back leaves it as it is."""
+    steps = np.diff(t[np.isfinite(t)])
+    rising = steps[steps > 0.0]
+    return float(np.median(rising)) if len(rising) else float("nan")
+
+
 def rate_in(step: float, unit: str) -> float:
     """The sample rate [Hz] a median step of `step` (numbers as read) is in `unit`."""
-    return 1.0 / (step * TIME_UNITS[unit])
+    return 1.0 / (step * TIME_SCALE[unit])
 
 
 def candidates(step: float) -> list[str]:
@@ -53,10 +61,11 @@ def candidates(step: float) -> list[str]:
     low, high = RATE_RANGE
     if not (np.isfinite(step) and step > 0.0):
         return []
-    return [u for u in TIME_UNITS if low <= rate_in(step, u) < high]
+    return [u for u in TIME_SCALE if low <= rate_in(step, u) < high]
 
 
-def _rates(step: float, units: list[str]) -> str:
+def rates(step: float, units: list[str]) -> str:
+    """"100 Hz in ms or 1e+05 Hz in us"."""
     return listed([f"{rate_in(step, u):.4g} Hz in {u}" for u in units])
 
 
@@ -82,26 +91,26 @@ def time_unit(column: str, step: float, dt_of: Callable[[float], np.ndarray], ac
     found = candidates(step)
     if not found:
         return (f"the {column} column states no unit, and its median step {step:.4g} is a rate "
-                f"no IMU has in any of s, ms, us, ns ({_rates(step, list(TIME_UNITS))}): give "
+                f"no IMU has in any of s, ms, us, ns ({rates(step, list(TIME_SCALE))}): give "
                 "--time-unit, or --rate HZ")
     if len(found) == 1:
         u = found[0]
-        return TimeUnit(u, TIME_UNITS[u], f"from its steps: a median step of {step:.4g} is "
+        return TimeUnit(u, TIME_SCALE[u], f"from its steps: a median step of {step:.4g} is "
                         f"{rate_in(step, u):.4g} Hz in {u}, and no IMU's rate in "
-                        + listed([v for v in TIME_UNITS if v != u]))
+                        + listed([v for v in TIME_SCALE if v != u]))
     evidence: dict[str, UnitEvidence] = {}
     for u in found:
-        evidence[u] = verdict(window_misses(acc, gyro, dt_of(TIME_UNITS[u])))
+        evidence[u] = verdict(window_misses(acc, gyro, dt_of(TIME_SCALE[u])))
     decided = [u for u in found if evidence[u].unit is not None]
     if len(decided) == 1:
         u = decided[0]
         others = "; ".join(f"in {v} ({rate_in(step, v):.4g} Hz) {_why_not(evidence[v])}"
                            for v in found if v != u)
-        return TimeUnit(u, TIME_UNITS[u], f"from the data: a median step of {step:.4g} is "
+        return TimeUnit(u, TIME_SCALE[u], f"from the data: a median step of {step:.4g} is "
                         f"{rate_in(step, u):.4g} Hz in {u}, where the gyro's turn explains "
                         f"gravity's; {others}")
     why = "; ".join(f"in {u}, {_why_not(evidence[u])}" for u in found) if not decided else (
         "the gyro's turn explains gravity's " + " and ".join(
             f"in {u} (the gyro in {evidence[u].unit})" for u in decided))
     return (f"the {column} column states no unit, and its median step {step:.4g} is "
-            f"{_rates(step, found)}; {why}: give --time-unit " + listed(found))
+            f"{rates(step, found)}; {why}: give --time-unit " + listed(found))

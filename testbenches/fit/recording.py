@@ -25,6 +25,7 @@ from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
 from ..reader import TIME_SCALE
+from ..time_unit import median_step
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -517,7 +518,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                                  "has none")
         joiner = _JoinedRows
         prefix, keep = joiner()(prefix)
-    acc, gyro = _vectors({q: v[keep] for q, v in prefix.items()})  # as read: the time unit's
+    # the samples as read: the time unit's evidence needs their directions only
+    acc, gyro = _vectors({q: v[keep] for q, v in prefix.items()})
     t_unit, time_how = "s", ""
     if time_unit != "auto" and not ("time" in prefix or "dt" in prefix):
         raise RecordingError(f"{path}: --time-unit {time_unit} is given, but the recording has "
@@ -549,11 +551,9 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         row0 = 0
         join = joiner() if joiner else None
         for block in table.blocks(wanted, PREFIX_ROWS):
-            cols = {q: block[:, k] for k, q in enumerate(names)}
-            cols, rows = join(cols) if join else (cols, slice(None))
-            d, _ = evidence_clock(cols.get(clock.kind), row0, len(block))
+            cols, d, _ = _samples(block, names, join, evidence_clock, row0)
             if row0 > 0:
-                yield (*_vectors({q: v[rows] for q, v in cols.items()}), d[rows])
+                yield (*_vectors(cols), d)
             row0 += len(block)
 
     gyro_scale, gyro_how, used = _gyro_scale(
@@ -581,12 +581,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         row0 = 0
         join = joiner() if joiner else None
         for block in table.blocks(wanted, rows):
-            cols = {q: block[:, k] for k, q in enumerate(names)}
-            cols, samples = join(cols) if join else (cols, slice(None))
-            dt, t = run_clock(cols.get(run_clock.kind), row0, len(block))
+            cols, dt, t = _samples(block, names, join, run_clock, row0)
             row0 += len(block)
-            cols = {q: v[samples] for q, v in cols.items()}
-            dt, t = dt[samples], t[samples]
             acc, gyro = _vectors(cols)
             acc, gyro = acc * acc_scale, gyro * gyro_scale
             up, ref_quat = reference_up(cols, path)
@@ -598,6 +594,17 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
 
     return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit,
                            read_notes)
+
+
+def _samples(block: np.ndarray, names: list[str], join: Any, clock: _Clock, row0: int
+             ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
+    """A block's samples by quantity, their dt and times: joined first where the sensors are
+    on rows of their own (join: a _JoinedRows, or None), the clock run over every row so that
+    it names a row by the file's line."""
+    cols = {q: block[:, k] for k, q in enumerate(names)}
+    cols, rows = join(cols) if join else (cols, slice(None))
+    dt, t = clock(cols.get(clock.kind), row0, len(block))
+    return {q: v[rows] for q, v in cols.items()}, dt[rows], t[rows]
 
 
 def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str | None,
@@ -613,8 +620,7 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
             raise RecordingError(f"{path}: fewer than two samples with a time")
         values = raw[valid]
         steps = np.diff(values)
-        rising = steps[steps > 0.0]
-        step = float(np.median(rising)) if len(rising) else float("nan")
+        step = median_step(values)
         counter = bool(np.all((values == np.round(values)) & (values >= 0.0)
                               & (values < COUNTER_WRAP)))
         increasing = bool(np.all((steps > 0.0) | (counter & wraps(steps, COUNTER_WRAP, step))))
@@ -682,12 +688,17 @@ def _split_rows(acc: np.ndarray, gyro: np.ndarray) -> str:
     ""."""
     if np.any(np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1)):
         return ""
-    only_acc = int(np.sum(np.all(np.isfinite(acc), 1) & ~np.any(np.isfinite(gyro), 1)))
-    only_gyro = int(np.sum(np.all(np.isfinite(gyro), 1) & ~np.any(np.isfinite(acc), 1)))
+    only_acc = int(np.sum(_only(acc, gyro)))
+    only_gyro = int(np.sum(_only(gyro, acc)))
     if only_acc and only_gyro:
         return (f"the accelerometer and the gyro are on rows of their own ({only_acc} rows "
                 f"hold only the accelerometer, {only_gyro} only the gyro)")
     return ""
+
+
+def _only(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The rows that hold a's three axes and none of b's."""
+    return np.all(np.isfinite(a), 1) & ~np.any(np.isfinite(b), 1)
 
 
 class _JoinedRows:
@@ -708,7 +719,7 @@ class _JoinedRows:
         rows' time NaN, and which rows are samples."""
         acc, gyro = _vectors(cols)
         own = np.all(np.isfinite(acc), 1)
-        acc_row = own & ~np.any(np.isfinite(gyro), 1)
+        acc_row = _only(acc, gyro)
         latest = np.maximum.accumulate(np.where(acc_row, np.arange(len(acc)), -1))
         filled = np.where((latest >= 0)[:, None], acc[np.maximum(latest, 0)], self.last)
         filled = np.where((own & ~acc_row)[:, None], acc, filled)  # a row with both: its own
@@ -728,7 +739,7 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     unit of that factor). A step that is no IMU rate in the unit given or stated is refused
     with the rate it would be, and so is a given unit that is not the header's."""
     from ..reader import DATETIME
-    from ..time_unit import RATE_RANGE, TIME_UNITS, TimeUnit, candidates, listed, rate_in, time_unit
+    from ..time_unit import RATE_RANGE, TimeUnit, candidates, listed, rate_in, time_unit
 
     if stated == DATETIME:
         if unit != "auto":
@@ -739,9 +750,9 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     chosen = unit if unit != "auto" else stated
     if chosen is not None:
         how = "given" if unit != "auto" else "from the header"
-        if chosen not in TIME_UNITS:
+        if chosen not in TIME_SCALE:
             raise RecordingError(f"{path}: the {kind} column's unit {chosen!r} is not one of "
-                                 f"{', '.join(TIME_UNITS)}")
+                                 f"{', '.join(TIME_SCALE)}")
         if np.isfinite(step) and step > 0.0 and chosen not in candidates(step):
             fits = candidates(step)
             serve = "check the column"
@@ -754,7 +765,7 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
                 f"{path}: the {kind} column's median step {step:.6g} is "
                 f"{rate_in(step, chosen):.4g} Hz in {chosen} ({how}), a rate no IMU is "
                 f"sampled at ({RATE_RANGE[0]:g} to {RATE_RANGE[1]:g} Hz); {serve}")
-        return chosen, TIME_UNITS[chosen], f"{kind} in {chosen} ({how})"
+        return chosen, TIME_SCALE[chosen], f"{kind} in {chosen} ({how})"
     if not (np.isfinite(step) and step > 0.0):  # a time that does not increase: the clock
         return "s", 1.0, f"{kind} in s"           # names where, in the file's own numbers
     found = time_unit(kind, step, dt_of, acc, gyro)
