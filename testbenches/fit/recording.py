@@ -559,6 +559,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     gyro_scale, gyro_how, used = _gyro_scale(
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
         more if n == PREFIX_ROWS else None)
+    _holds_gravity(path, acc[finite] * acc_scale, gyro[finite] * gyro_scale, dt[finite],
+                   f"acc in {acc_how}; gyro in {gyro_how}")
     period = median_period(dt)
     if n == PREFIX_ROWS:  # the file may go on
         acc_how += f" over the first {n} samples"
@@ -861,6 +863,25 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
             f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
             f"give --gyro-unit {listed(list(UNITS))}")
     return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
+
+
+def _holds_gravity(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
+                   units: str) -> None:
+    """RecordingError where the accelerometer, in SI units with the gyro's, holds no gravity
+    (testbenches.gravity): a phone's linear acceleration, or units or axes taken wrongly."""
+    from ..gravity import WINDOW_S, held_gravity
+
+    found = held_gravity(acc, gyro, dt)
+    if found is None or found.held:
+        return
+    raise RecordingError(
+        f"{path}: the accelerometer holds no gravity as read: its samples, turned with the gyro "
+        f"and averaged over {WINDOW_S:g} s, keep {found.g:.3g} g (median of {found.windows} "
+        "windows) where gravity keeps 1 g. Its columns may hold a phone's linear or user "
+        "acceleration, from which gravity was taken out: give the accelerometer's own (total) "
+        "acceleration (Android's TYPE_ACCELEROMETER, Sensor Logger's TotalAcceleration, "
+        f"phyphox's acceleration with g); or the units ({units}) or the axes are not what they "
+        "are taken for")
 
 
 QUAT_NORM_TOLERANCE = 0.1
