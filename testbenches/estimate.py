@@ -41,6 +41,7 @@ import numpy as np
 
 from .fit.recording import read_columns, reference_up  # the one reader
 from .options import (
+    RECORDING_HELP,
     add_calibration,
     add_preset,
     add_recording_options,
@@ -71,7 +72,7 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
                        "HDF5, MAT)",
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.set_defaults(func=cmd_estimate)
-    p.add_argument("recording", type=Path, help="the recording: CSV, Parquet, HDF5 or MAT")
+    p.add_argument("recording", type=Path, help=f"the recording: {RECORDING_HELP}")
     p.add_argument("--estimator", default="all", help="all or a comma list of the estimators")
     add_preset(p)
     add_calibration(p)

@@ -112,6 +112,9 @@ class TableSource:
     note: str = ""
     """What the reader did that a user should know (lines before the header skipped)."""
 
+    owner: Any = field(default=None, repr=False, compare=False)
+    """What must live as long as the table (the unpacked files of a zip archive)."""
+
     _kept: Any = field(default=None, repr=False, compare=False)
     """(columns, rows, first block, the read after it) of first_block, for blocks to go on."""
 

@@ -30,7 +30,7 @@ import numpy as np
 from fusion_core.calibration import Calibration
 from fusion_core.types import G
 
-from ..options import add_recording_options, positive_float
+from ..options import RECORDING_HELP, add_recording_options, positive_float
 from . import ferraris as fer
 from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
 from .heldout import HeldOut, ferraris_held_out, tedaldi_held_out
@@ -42,8 +42,8 @@ def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: igno
     p = sub.add_parser("calibrate", help="a part's calibration from a session of static poses "
                        "and turns (calibration.json for --calibration)",
                        description=__doc__.split("\n\n")[0])
-    p.add_argument("recording", type=Path, help="the session: CSV (or HDF5) with acc_x..z, "
-                   "gyro_x..z and a time column (or --rate)")
+    p.add_argument("recording", type=Path, help=f"the session: {RECORDING_HELP}; with a time "
+                   "column (or --rate)")
     add_recording_options(p)
     p.add_argument("--sections", type=Path, default=None, metavar="FILE.json",
                    help="imucal's section list (x_p ... z_a, x_rot ... z_rot): Ferraris's "

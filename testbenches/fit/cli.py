@@ -11,6 +11,7 @@ from fusion_core import ESTIMATORS
 from fusion_core.registry import estimator_class
 
 from ..options import (
+    RECORDING_HELP,
     add_calibration,
     add_preset,
     add_recording_options,
@@ -26,9 +27,8 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
         "noise", help="noise densities of a static recording (Allan deviation), a preset for "
         "every estimator and the sensor FMU's parameters for that sensor")
     noise.set_defaults(func=cmd_noise)
-    noise.add_argument("file", type=Path, help="a static recording: CSV (acc_x..z [m/s2], "
-                       "gyro_x..z [rad/s], optional time or dt [s]) or a BROAD trial (its rest "
-                       "segment is used)")
+    noise.add_argument("file", type=Path, help=f"a static recording: {RECORDING_HELP}; or a "
+                       "BROAD trial (its rest segment is used)")
     add_recording_options(noise)
     noise.add_argument("--out", type=Path, default=Path("reports/noise"),
                        help="folder for noise.json, preset.json, sensor.json, allan.png")

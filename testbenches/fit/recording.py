@@ -13,7 +13,6 @@ finds their rest segment (the start, before `movement` begins).
 from __future__ import annotations
 
 import argparse
-import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -26,6 +25,7 @@ from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
 from ..reader import TIME_SCALE
 from ..time_unit import median_step
+from .columns import ALIASES, find_name, norm_name
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -122,56 +122,10 @@ def rest(rec: Recording) -> Recording:
     return rec.slice(0, first)
 
 
-ACC_STEMS = ("acc", "accel", "accelerometer", "acceleration", "linear_acceleration",
-             "accelerometer_acceleration")
-"""Names of the accelerometer's columns before the axis (acc_x, accelX, linear_acceleration.x
-as ROS writes it, accelerometerAccelerationX as iOS's SensorLog). Not a phone's linear or user
-acceleration, which leaves gravity out (its median norm is then no gravity's, and refused)."""
-GYRO_STEMS = ("gyro", "gyr", "gyroscope", "angular_velocity", "rotation_rate", "omega")
-"""Names of the gyro's columns before the axis (gyro_x, gyroX, angular_velocity.x)."""
-
-
-def _axis_names(stems: tuple[str, ...], axis: str, short: tuple[str, ...]) -> tuple[str, ...]:
-    return (*(n for stem in stems for n in (f"{stem}_{axis}", f"{stem}{axis}")),
-            *(f"{s}{axis}" for s in short))
-
-
-ALIASES: dict[str, tuple[str, ...]] = {
-    **{f"acc_{a}": (*_axis_names(ACC_STEMS, a, ("a", "a_")), f"acc_{a}_g", f"acc_{a}_ms2")
-       for a in "xyz"},
-    **{f"gyro_{a}": (*_axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_")), f"gyro_{a}_dps")
-       for a in "xyz"},
-    "time": ("time", "t", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
-             "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
-             "header_stamp", "millis", "micros"),
-}
-"""Column names a recording may use per quantity, as _norm_name makes them (case ignored;
-spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out)."""
 G_STANDARD = 9.80665
 
 
 # ----- reading ---------------------------------------------------------------------------------
-
-def _norm_name(name: str) -> str:
-    """A column name as ALIASES spell them: "Gyroscope X" -> "gyroscope_x", "rotationRateX" ->
-    "rotation_rate_x", ROS's "field.angular_velocity.x" -> "angular_velocity_x", "%time" ->
-    "time"."""
-    name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name.strip()).lower().lstrip("%")
-    for sep in (" ", "-", "."):
-        name = name.replace(sep, "_")
-    return name.removeprefix("field_")
-
-
-def _find(names: list[str], quantity: str, given: str | None = None) -> int | None:
-    """The column of a quantity: the one given (by its name as written, with or without its
-    unit), else the first of its aliases."""
-    normed = [_norm_name(n) for n in names]
-    wanted = (_norm_name(given),) if given else ALIASES[quantity]
-    for alias in wanted:
-        if alias in normed:
-            return normed.index(alias)
-    return None
-
 
 def parse_columns(specs: list[str]) -> dict[str, str]:
     """--column QUANTITY=NAME options as {quantity: column name}; RecordingError for a quantity
@@ -218,16 +172,16 @@ def find_columns(table: Any, time_column: str | None = None,
         name = given.get(quantity)
         i = None
         if name is not None:
-            i = _find(table.header, quantity, name)
+            i = find_name(table.header, quantity, name)
             if i is None:
-                i = _find(table.names, quantity, name)
+                i = find_name(table.names, quantity, name)
             if i is None:
                 raise RecordingError(f"{table.path}: no column {name!r} for {quantity}: the "
                                      f"header has {', '.join(table.header)}")
         elif quantity in ALIASES:
-            i = _find(table.names, quantity)
+            i = find_name(table.names, quantity)
         else:
-            i = _find(table.names, "time", quantity)
+            i = find_name(table.names, "time", quantity)
         if i is not None:
             found.index[quantity] = i
             found.source[quantity] = table.header[i]
@@ -239,7 +193,7 @@ def _unit_in_name(quantity: str, name: str) -> str | None:
     """The unit a time or dt column's name states (time_ms, timestamp_ns, micros), else None."""
     if quantity not in ("time", "dt"):
         return None
-    normed = _norm_name(name)
+    normed = norm_name(name)
     counters = {"millis": "ms", "micros": "us"}  # a sketch's millis() and micros()
     if normed in counters:
         return counters[normed]
@@ -479,15 +433,28 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     data (which must not contradict what is given or stated); RecordingError saying what is
     wrong."""
     from ..reader import TableError
+    from .sensor_files import is_sensor_files, open_sensor_files
 
-    if not path.is_file():
-        raise RecordingError(f"{path}: no such file")
-    if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
+    if is_sensor_files(path):  # a phone app's export: one file per sensor
+        others = sorted(set(columns or {}) - {"time"})
+        if others:
+            raise RecordingError(f"{path}: --column {others[0]}=... maps a file's column; the "
+                                 "files of a folder or archive are found by their names (the "
+                                 "time's column may be given)")
         try:
-            return _broad_source(path, load_trial(path))
-        except NotABroadTrial:
-            pass
-    table = open_table(path)
+            table = open_sensor_files(path, time_column or (columns or {}).get("time"))
+        except TableError as err:
+            raise RecordingError(str(err)) from None
+        time_column, columns = None, None
+    elif not path.is_file():
+        raise RecordingError(f"{path}: no such file")
+    else:
+        if path.suffix.lower() in (".hdf5", ".h5", ".mat"):
+            try:
+                return _broad_source(path, load_trial(path))
+            except NotABroadTrial:
+                pass
+        table = open_table(path)
     found = find_columns(table, time_column, columns)
     missing = [q for q in IMU_AXES if q not in found.index]
     if missing:
@@ -532,7 +499,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
     else:
         counters = [h for h, nm in zip(table.header, table.names, strict=True)
-                    if _norm_name(nm) in COUNTER_NAMES]
+                    if norm_name(nm) in COUNTER_NAMES]
         hint = (f" ({', '.join(map(repr, counters))} counts samples, which is no time)"
                 if counters else "")
         raise RecordingError(f"{path}: no time or dt column{hint}: give the sample rate (--rate "
@@ -808,10 +775,12 @@ def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
     if chosen is None:
         chosen = next((u for u, (lo, hi) in ACC_NORMS.items() if lo < norm < hi), None)
         if chosen is None:
+            low = (" (a phone's linear or user acceleration, from which gravity was taken out, "
+                   "reads so: give its total acceleration)" if norm < ACC_NORMS["g"][0] else "")
             raise RecordingError(
                 f"{path}: the accelerometer's median norm is {norm:.4g}, neither about 1 (g), "
-                f"9.81 (m/s2) nor 1000 (mg): {_counts_hint(norm)}give --acc-unit, or check the "
-                "columns")
+                f"9.81 (m/s2) nor 1000 (mg){low}: {_counts_hint(norm)}give --acc-unit, or check "
+                "the columns")
         how = f"from its median norm {norm:.4g}"
     scale = ACC_UNITS.get(chosen)
     if scale is None:
