@@ -42,6 +42,12 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
                         "q_w..q_z) where its name is none the reader knows (repeatable)")
     parser.add_argument("--acc-unit", choices=("auto", "m/s2", "g", "mg"), default="auto",
                         help="the accelerometer's unit (auto: the header's, else from its norm)")
+    parser.add_argument("--acc-sign", choices=("auto", "+1", "-1"), default="auto",
+                        help="+1: the accelerometer reads specific force, +1 g up at rest "
+                        "(Android, IMUs); -1: its negative, as iOS's Core Motion gives it (a "
+                        "phone flat on a table reads z = -1 g). auto: -1 for iOS SensorLog's "
+                        "columns, +1 elsewhere; a Sensor Logger export from iOS is refused "
+                        "until given (its 'Standardise Units & Frames' setting decides)")
     parser.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s", "mdps"),
                         default="auto",
                         help="the gyro's unit (auto: the header's, else the unit in which the "

@@ -112,6 +112,10 @@ class TableSource:
     note: str = ""
     """What the reader did that a user should know (lines before the header skipped)."""
 
+    platform: str = ""
+    """The platform a phone app's export says it was recorded on ("iOS", "Android"; "" where it
+    says none)."""
+
     owner: Any = field(default=None, repr=False, compare=False)
     """What must live as long as the table (the unpacked files of a zip archive)."""
 

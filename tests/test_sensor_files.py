@@ -138,3 +138,34 @@ def test_a_time_that_goes_back_or_files_of_two_clocks_are_refused_by_file_and_li
                header="time,x,y,z", comments="")
     with pytest.raises(RecordingError, match="must share one clock"):
         open_recording(late)
+
+
+def test_an_ios_export_is_refused_until_the_accelerometers_sign_is_given(tmp_path):
+    """iOS gives the negative of specific force unless the app turned it, and a negated
+    accelerometer reads as the phone upside down, its gyro explaining every turn: the data
+    cannot tell. Sensor Logger's metadata names the platform, not the setting."""
+    t, acc, gyro, _ = _part()
+    android = open_recording(_sensor_logger(tmp_path / "android", {
+        "TotalAcceleration": (t, acc), "Gyroscope": (t + 0.003, gyro)})).load()[0]
+    folder = _sensor_logger(tmp_path / "ios", {"TotalAcceleration": (t, -acc),
+                                               "Gyroscope": (t + 0.003, gyro)})
+    (folder / "Metadata.csv").write_text("version,device name,recording time,platform\n"
+                                         "3,iPhone,2023-10-28_13-52-24,ios\n")
+    with pytest.raises(RecordingError, match=r"recorded on iOS.*give --acc-sign -1"):
+        open_recording(folder)
+    source = open_recording(folder, acc_sign="-1")
+    assert "sign -1 (given)" in source.choices
+    np.testing.assert_array_equal(source.load()[0].acc, android.acc)
+
+
+def test_ios_sensorlogs_columns_are_core_motions_negative_in_g(tmp_path):
+    """SensorLog (iOS only) writes Core Motion's accelerometer: in g, -1 g up at rest."""
+    t, acc, gyro, _ = _part()
+    path = tmp_path / "sensorlog.csv"
+    np.savetxt(path, np.column_stack([t, -acc / G, gyro]), delimiter=",", comments="",
+               header="loggingTime(s),accelerometerAccelerationX(G),accelerometerAccelerationY(G),"
+               "accelerometerAccelerationZ(G),gyroRotationX(rad/s),gyroRotationY(rad/s),"
+               "gyroRotationZ(rad/s)", fmt="%.17g")
+    source = open_recording(path, time_column="loggingTime")
+    assert "sign -1 (iOS's Core Motion" in source.choices
+    np.testing.assert_allclose(source.load()[0].acc, acc, rtol=1e-12)

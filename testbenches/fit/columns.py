@@ -11,8 +11,10 @@ ACC_STEMS = ("acc", "accel", "accelerometer", "acceleration", "linear_accelerati
 """Names of the accelerometer's columns before the axis (acc_x, accelX, linear_acceleration.x
 as ROS writes it, accelerometerAccelerationX as iOS's SensorLog). Not a phone's linear or user
 acceleration, which leaves gravity out (its median norm is then no gravity's, and refused)."""
-GYRO_STEMS = ("gyro", "gyr", "gyroscope", "angular_velocity", "rotation_rate", "omega")
-"""Names of the gyro's columns before the axis (gyro_x, gyroX, angular_velocity.x)."""
+GYRO_STEMS = ("gyro", "gyr", "gyroscope", "angular_velocity", "rotation_rate", "omega",
+              "gyro_rotation")
+"""Names of the gyro's columns before the axis (gyro_x, gyroX, angular_velocity.x,
+gyroRotationX as iOS's SensorLog)."""
 
 
 def axis_names(stems: tuple[str, ...], axis: str, short: tuple[str, ...]) -> tuple[str, ...]:

@@ -427,7 +427,7 @@ def _broad_source(path: Path, trial: Any) -> RecordingSource:
 def open_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
                    acc_unit: str = "auto", gyro_unit: str = "auto",
                    columns: dict[str, str] | None = None,
-                   time_unit: str = "auto") -> RecordingSource:
+                   time_unit: str = "auto", acc_sign: str = "auto") -> RecordingSource:
     """The recording opened for reading in blocks (RecordingSource), its units, columns and
     rate decided from its first PREFIX_ROWS samples: given, stated by the file, or from the
     data (which must not contradict what is given or stated); RecordingError saying what is
@@ -511,6 +511,9 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(f"{path}: no sample holds numbers in every column")
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
                                     _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
+    sign, sign_how = _acc_sign(path, acc_sign, [table.names[found.index[f"acc_{a}"]]
+                                                for a in "xyz"], table.platform)
+    acc_scale, acc_how = sign * acc_scale, acc_how + sign_how
 
     def more() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """The blocks after the first, as read (for the gyro unit's evidence)."""
@@ -630,7 +633,8 @@ def source_from_args(path: Path, args: argparse.Namespace) -> RecordingSource:
     """open_recording with the options add_recording_options defines."""
     return open_recording(path, rate=args.rate, time_column=args.time_column,
                           acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
-                          columns=parse_columns(args.column), time_unit=args.time_unit)
+                          columns=parse_columns(args.column), time_unit=args.time_unit,
+                          acc_sign=args.acc_sign)
 
 
 def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
@@ -791,6 +795,34 @@ def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
         raise RecordingError(f"{path}: the accelerometer's median norm is {si:.4g} m/s2 in the "
                              f"unit {chosen} ({how}), which cannot be right (gravity is 9.81)")
     return scale, f"{chosen} ({how})"
+
+
+IOS_ACC_NAMES = ("accelerometer_acceleration",)
+"""Accelerometer column stems that only iOS apps write (SensorLog's accelerometerAccelerationX),
+whose values are Core Motion's: the negative of specific force, in g."""
+
+
+def _acc_sign(path: Path, given: str, names: list[str], platform: str) -> tuple[float, str]:
+    """The accelerometer's sign (+1: specific force; -1: its negative, iOS's Core Motion) and
+    how it was chosen, said where it is not +1 or was given; names: the accelerometer's columns'
+    names (without their units). A negated accelerometer reads as
+    the sensor turned upside down, and its gyro still explains every turn (a point reflection
+    commutes with rotations), so the data cannot tell: given, else the columns' names, else +1;
+    a phone app's export that says it was recorded on iOS, where the app's setting decides, is
+    refused until given."""
+    if given != "auto":
+        return float(given), "" if given == "+1" else ", sign -1 (given)"
+    if all(norm_name(name).startswith(IOS_ACC_NAMES) for name in names):
+        return -1.0, (", sign -1 (iOS's Core Motion: the columns are SensorLog's, which read "
+                      "-1 g up at rest)")
+    if platform == "iOS":
+        raise RecordingError(
+            f"{path}: recorded on iOS (its metadata says so), whose accelerometer reads the "
+            "negative of specific force (a phone flat on a table: z = -1 g) unless the app "
+            "turned it (Sensor Logger's 'Standardise Units & Frames'), and the export does not "
+            "say which: give --acc-sign -1 (the setting off, the app's default) or +1 (on). "
+            "Taken with the wrong sign the phone reads as upside down")
+    return 1.0, ""
 
 
 def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,

@@ -26,6 +26,7 @@ a recording's time is (Sensor Logger's `time` in ns, phyphox's `Time (s)`), or t
 
 from __future__ import annotations
 
+import csv
 import re
 import tempfile
 import zipfile
@@ -103,6 +104,29 @@ def _chosen(path: Path, names: list[str]) -> tuple[dict[str, str], list[str]]:
         chosen[sensor] = best[0]
         left += [n for _, n in ranked[1:]]
     return chosen, left
+
+
+PLATFORMS = {"ios": "iOS", "android": "Android"}
+"""The platforms a phone app's metadata may name (Sensor Logger's Metadata.csv, `platform`)."""
+
+
+def _platform(path: Path, names: list[str]) -> str:
+    """The platform the export's metadata file names ("" where none does)."""
+    for name in names:
+        if PurePosixPath(name).stem.lower() != "metadata":
+            continue
+        if path.is_dir():
+            text = (path / name).read_text(errors="replace")
+        else:
+            with zipfile.ZipFile(path) as z:
+                text = z.read(name).decode(errors="replace")
+        rows = list(csv.reader(text.splitlines()[:2]))
+        if len(rows) == 2:
+            cells = dict(zip((c.strip().lower() for c in rows[0]), rows[1], strict=False))
+            found = PLATFORMS.get(cells.get("platform", "").strip().lower())
+            if found:
+                return found
+    return ""
 
 
 def _axis(names: list[str], sensor: str, axis: str) -> int | None:
@@ -199,10 +223,11 @@ def open_sensor_files(path: Path, time_column: str | None = None) -> TableSource
 
     note = (f"one file per sensor: the accelerometer's {chosen['acc']}, the gyro's "
             f"{chosen['gyro']}" + (f" ({', '.join(left)} left)" if left else ""))
+    platform = _platform(path, names)
     kind = "a folder" if path.is_dir() else "a zip archive"
     return TableSource(path, header, [time_name, "acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y",
                                       "gyro_z"], units, kind, None, read, where, note=note,
-                       owner=owner)
+                       owner=owner, platform=platform)
 
 
 def _merged(parts: list[_SensorTable], rows: int
