@@ -3,7 +3,8 @@
 `open_table(path)` opens a file as named columns read in blocks of rows, so that a recording of
 any length is read in bounded memory:
 
-- delimited text (CSV and its kin): the encoding (UTF-8 with or without a byte-order mark, else
+- delimited text (CSV and its kin), also compressed (gzip, bz2 or xz: .csv.gz and the like,
+  told by the file's first bytes): the encoding (UTF-8 with or without a byte-order mark, else
   Latin-1), the delimiter (comma, semicolon, tab or bar; a decimal comma with semicolons) and
   the header row are found from the file's start; pyarrow's CSV reader parses it, and where it
   cannot (text where a number belongs, a row of the wrong length, padded cells) the file is read
@@ -11,6 +12,7 @@ any length is read in bounded memory:
 - a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - Parquet: its columns (a timestamp column as seconds);
+- a spreadsheet workbook or JSON is refused, saying to save or export it as CSV;
 - HDF5 (that is not a BROAD trial) and MATLAB .mat (v5, or v7.3 which is HDF5): the top level's
   one-dimensional datasets or variables of one length are columns, and an [N, 3] one (acc, gyro)
   is three (acc_x, acc_y, acc_z); a scalar `rate` (attribute or variable) is the sample rate.
@@ -26,12 +28,13 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import io
 import itertools
 import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
@@ -165,7 +168,37 @@ def open_table(path: str | Path) -> TableSource:
         return _hdf5(path)
     if suffix == ".mat":
         return _mat(path)
+    if magic.startswith(b"PK\x03\x04") or suffix in (".xlsx", ".xls", ".ods"):
+        raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "
+                         "table this reader takes: save the sheet as CSV (a zip archive of a "
+                         "phone app's files serves under a .zip name)")
+    if magic.lstrip()[:1] in (b"[", b"{") and suffix in (".json", ".jsonl", ".ndjson"):
+        raise TableError(f"{path}: JSON, which is no table this reader takes: export the "
+                         "recording as CSV (phone apps offer both)")
     return _text(path)
+
+
+COMPRESSIONS = {b"\x1f\x8b": "gzip", b"BZh": "bz2", b"\xfd7zXZ\x00": "xz"}
+"""A compressed text file's magic bytes and its compression: read as the text it holds."""
+ARROW_COMPRESSIONS = ("gzip", "bz2")
+"""Those pyarrow decompresses itself; the others Python's modules do."""
+
+
+def _compression(path: Path) -> str | None:
+    with path.open("rb") as f:
+        magic = f.read(6)
+    return next((kind for m, kind in COMPRESSIONS.items() if magic.startswith(m)), None)
+
+
+def _open_bytes(path: Path) -> IO[bytes]:
+    """The file's bytes, decompressed where it is compressed (COMPRESSIONS)."""
+    import bz2
+    import gzip
+    import lzma
+
+    kind = _compression(path)
+    opener = {"gzip": gzip.open, "bz2": bz2.open, "xz": lzma.open}.get(kind or "")
+    return opener(path, "rb") if opener else path.open("rb")  # type: ignore[return-value]
 
 
 # ----- delimited text --------------------------------------------------------------------------
@@ -212,7 +245,7 @@ def seconds_of(text: str) -> float | None:
 
 
 def _sniff(path: Path) -> _TextLayout:
-    with path.open("rb") as f:
+    with _open_bytes(path) as f:
         raw = f.read(SNIFF_BYTES)
     encoding = "utf-8"
     try:
@@ -386,9 +419,12 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
     wanted = [keys[i] for i in columns]
     types = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
              if i in layout.datetimes else pa.float64() for i in columns}
+    compression = _compression(path)
     try:
         reader = pc.open_csv(
-            path,
+            path if compression is None
+            else pa.input_stream(str(path), compression=compression)
+            if compression in ARROW_COMPRESSIONS else pa.PythonFile(_open_bytes(path), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.header_line,
                                         encoding="utf8" if layout.encoding == "utf-8"
                                         else "latin1", block_size=1 << 22),
@@ -417,8 +453,9 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
 
 def _rows(path: Path, layout: _TextLayout) -> Iterator[tuple[int, list[str]]]:
     """(line, cells) of every data row, blank lines skipped."""
-    with path.open(encoding="utf-8-sig" if layout.encoding == "utf-8" else layout.encoding,
-                   newline="") as f:
+    with io.TextIOWrapper(_open_bytes(path), newline="",
+                          encoding="utf-8-sig" if layout.encoding == "utf-8"
+                          else layout.encoding) as f:
         reader = csv.reader(f, delimiter=layout.delimiter)
         for row in reader:
             if reader.line_num <= layout.header_line or not row or not any(

@@ -145,3 +145,38 @@ def test_milli_g_and_milli_deg_per_s_are_found_and_raw_counts_refused_with_why(t
                delimiter=",", header="time," + HEADER, comments="", fmt="%.10g")
     with pytest.raises(RecordingError, match="about 16384, a MEMS part's raw counts per g"):
         open_recording(counts)
+
+
+@pytest.mark.parametrize("compress", ["gzip", "bz2", "lzma"])
+def test_a_compressed_file_reads_as_the_text_it_holds(tmp_path, compress):
+    """Datasets and long logs ship as .csv.gz (.bz2, .xz): the same samples to the bit, and a
+    bad cell still named by its line."""
+    import importlib
+
+    module = importlib.import_module(compress)
+    text = EXAMPLE.read_text()
+    path = tmp_path / "example.csv.z"
+    with module.open(path, "wt") as f:
+        f.write(text)
+    rec, _ = open_recording(path).load()
+    plain, _ = open_recording(EXAMPLE).load()
+    np.testing.assert_array_equal(rec.acc, plain.acc)
+    np.testing.assert_array_equal(rec.dt, plain.dt)
+    lines = text.splitlines()
+    cells = lines[500].split(",")
+    lines[500] = ",".join([cells[0], "abc", *cells[2:]])
+    with module.open(path, "wt") as f:
+        f.write("\n".join(lines))
+    with pytest.raises(RecordingError, match="line 501, column 'acc_x': 'abc' is not a number"):
+        open_recording(path).load()
+
+
+@pytest.mark.parametrize("name,content,serves", [
+    ("book.xlsx", b"PK\x03\x04 a workbook", "save the sheet as CSV"),
+    ("export.json", b'[{"sensor": "Accelerometer", "x": "0.1"}]', "export the recording as CSV"),
+])
+def test_a_workbook_or_json_is_refused_saying_what_serves(tmp_path, name, content, serves):
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(RecordingError, match=serves):
+        open_recording(path)
