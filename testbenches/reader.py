@@ -68,6 +68,10 @@ TIME_SCALE = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 DATETIME = "datetime"
 """The unit of a column of dates and times (ISO 8601 text, a Parquet timestamp), which the
 reader gives as seconds since 1970."""
+TIME_OF_DAY = "time of day"
+"""The unit of a column of times of day without a date ("12:00:00.010", as a logger with a
+real-time clock or a spreadsheet's time format writes them), which the reader gives as seconds
+since midnight."""
 
 _NAME_UNIT = re.compile(r"^(.*?)\s*[\(\[]\s*([^\)\]]*?)\s*[\)\]]\s*$")
 
@@ -213,6 +217,8 @@ class _TextLayout:
     padded: bool  # cells with spaces around the number: Python's float reads those
     datetimes: dict[int, bool] = field(default_factory=dict)
     """Columns of ISO 8601 date-times (read as seconds since 1970): index -> with a zone."""
+    times_of_day: set[int] = field(default_factory=set)
+    """Columns of times of day (read as seconds since midnight)."""
     skipped: str = ""
     """The lines before the header that are not the table ("lines 1-3"; "" for none)."""
 
@@ -221,6 +227,23 @@ _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})
                        r"\s*(Z|[+-]\d{2}(?::?\d{2})?)?$")
 """An ISO 8601 date and time as loggers write it: "2024-05-01T12:00:00.010", a space for the T,
 a decimal comma, a zone (Z, +02:00, +0200) or none."""
+
+
+_TIME_OF_DAY = re.compile(r"^(\d{1,2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?$")
+"""A time of day without a date: "12:00:00.010", a decimal comma, "9:05:00"."""
+
+
+def seconds_of_day(text: str) -> float | None:
+    """Seconds since midnight of a time of day (_TIME_OF_DAY), None where the text is none."""
+    m = _TIME_OF_DAY.match(text.strip())
+    if m is None:
+        return None
+    hour, minute, second = (int(g) for g in m.groups()[:3])
+    if hour > 23 or minute > 59 or second > 60:
+        return None
+    fraction = m.group(4)
+    return (3600.0 * hour + 60.0 * minute + second
+            + (int(fraction) / 10 ** len(fraction) if fraction else 0.0))
 
 
 def seconds_of(text: str) -> float | None:
@@ -286,16 +309,18 @@ def _sniff(path: Path) -> _TextLayout:
     decimal_comma = (delimiter == ";" and any("," in c for c in cells)
                      and not any("." in c for c in cells))
     padded = any(c != c.strip() for c in cells)
-    datetimes = {}
+    datetimes, times_of_day = {}, set()
     for j in range(len(header)):
         column = [row[j].strip() for row in rows if len(row) == len(header) and row[j].strip()]
         matches = [_ISO_DATETIME.match(c) for c in column]
         if column and all(matches):
             datetimes[j] = all(m.group(8) for m in matches if m)  # with a zone
+        elif column and all(seconds_of_day(c) is not None for c in column):
+            times_of_day.add(j)
     skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
                else f"line {preamble[0][0]}") if preamble else ""
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
-                       datetimes, skipped)
+                       datetimes, times_of_day, skipped)
 
 
 def _no_table(path: Path, first: tuple[int, str]) -> TableError:
@@ -322,7 +347,7 @@ def _all_numbers(line: str, delimiter: str) -> bool:
         try:
             float(cell.strip().replace(",", "."))
         except ValueError:
-            return bool(_ISO_DATETIME.match(cell.strip()))
+            return bool(_ISO_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip()))
         return True
 
     return all(number(c) for c in next(csv.reader([line], delimiter=delimiter)))
@@ -350,7 +375,8 @@ def _find_header(numbered: list[tuple[int, str]]) -> tuple[str, int] | None:
 def _text(path: Path) -> TableSource:
     layout = _sniff(path)
     names, stated = zip(*(split_unit(h) for h in layout.header), strict=True)
-    units = [(DATETIME if j in layout.datetimes else u) for j, u in enumerate(stated)]
+    units = [(DATETIME if j in layout.datetimes else TIME_OF_DAY if j in layout.times_of_day
+              else u) for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         if layout.padded or not _has_pyarrow():
@@ -418,7 +444,8 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
     keys = [f"c{i}" for i in range(len(layout.header))]
     wanted = [keys[i] for i in columns]
     types = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
-             if i in layout.datetimes else pa.float64() for i in columns}
+             if i in layout.datetimes else pa.time64("ns") if i in layout.times_of_day
+             else pa.float64() for i in columns}
     compression = _compression(path)
     try:
         reader = pc.open_csv(
@@ -485,7 +512,7 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
         if k < skip:
             continue
         block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
-                              j in layout.datetimes) for j in columns])
+                              _clock_of(layout, j)) for j in columns])
         if len(block) == rows:
             yield np.array(block, dtype=float).reshape(len(block), len(columns))
             block = []
@@ -493,17 +520,25 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
         yield np.array(block, dtype=float).reshape(len(block), len(columns))
 
 
+def _clock_of(layout: _TextLayout, j: int) -> str:
+    """What a column's cells are as time: DATETIME, TIME_OF_DAY or "" (numbers)."""
+    return (DATETIME if j in layout.datetimes else TIME_OF_DAY if j in layout.times_of_day
+            else "")
+
+
 def _number(cell: str, path: Path, line: int, column: str, decimal_comma: bool,
-            datetime: bool = False) -> float:
+            clock: str = "") -> float:
     text = cell.strip()
     if not text:
         return float("nan")  # a missing value: that sample is rejected and counted
-    if datetime:  # seconds since 1970
-        seconds = seconds_of(text)
+    if clock:  # seconds since 1970, or since midnight
+        seconds = (seconds_of if clock == DATETIME else seconds_of_day)(text)
         if seconds is None:
-            raise TableError(f"{path}, line {line}, column {column!r}: {text[:40]!r} is not a "
-                             "date and time as the column's others are (2024-05-01T12:00:00.010"
-                             ", a zone or none; an empty cell marks a missing value)")
+            like = ("a date and time as the column's others are (2024-05-01T12:00:00.010, a "
+                    "zone or none" if clock == DATETIME else
+                    "a time of day as the column's others are (12:00:00.010")
+            raise TableError(f"{path}, line {line}, column {column!r}: {text[:40]!r} is not "
+                             f"{like}; an empty cell marks a missing value)")
         return seconds
     if decimal_comma:
         text = text.replace(",", ".")
@@ -656,6 +691,7 @@ def _mat(path: Path) -> TableSource:
 __all__ = [
     "BLOCK_ROWS",
     "DATETIME",
+    "TIME_OF_DAY",
     "TIME_SCALE",
     "UNIT_ALIASES",
     "TableError",

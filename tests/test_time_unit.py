@@ -183,3 +183,29 @@ def test_a_microcontrollers_counter_that_starts_again_goes_on(tmp_path):
     ticks[300:] -= 3_000_000  # back by 3 s before the wrap: no wrap
     with pytest.raises(RecordingError, match="does not increase"):
         open_recording(_write(tmp_path / "back.csv", "micros", ticks % 2**32, imu)).load()
+
+
+@pytest.mark.parametrize("start", [12 * 3600.0, 86400.0 - 5.0])
+def test_a_time_of_day_reads_as_seconds_since_midnight_and_passes_midnight(tmp_path, start):
+    """A logger's real-time clock or a spreadsheet's time format: "12:00:00.010", no date. A
+    recording that passes midnight goes on (the read says so); a cell that is no time of day is
+    refused by its line, and a time unit given for it is refused."""
+    t, imu = _example()
+    day = (start + t) % 86400.0
+    stamps = [f"{int(s // 3600):02d}:{int(s % 3600 // 60):02d}:{s % 60:06.3f}" for s in day]
+    lines = ["time," + HEADER] + [f"{s}," + ",".join(f"{v:.10g}" for v in row)
+                                  for s, row in zip(stamps, imu, strict=True)]
+    path = tmp_path / "clock.csv"
+    path.write_text("\n".join(lines))
+    source, rec, _ = _read(path)
+    assert "time from its times of day" in source.choices and source.rate == pytest.approx(100.0)
+    np.testing.assert_allclose(rec.dt[1:], np.diff(t), atol=1e-9)
+    assert ("passed midnight 1 time(s)" in rec.described) == (start > 12 * 3600.0)
+    with pytest.raises(RecordingError, match="--time-unit s is given, but the time column holds "
+                                             "times of day"):
+        open_recording(path, time_unit="s")
+    lines[300] = "noon," + lines[300].split(",", 1)[1]
+    path.write_text("\n".join(lines))
+    with pytest.raises(RecordingError, match="line 301, column 'time': 'noon' is not a time of "
+                                             "day"):
+        _read(path)

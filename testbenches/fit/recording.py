@@ -23,7 +23,7 @@ import numpy as np
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
-from ..reader import TIME_SCALE
+from ..reader import TIME_OF_DAY, TIME_SCALE
 from ..time_unit import median_step
 from .columns import ALIASES, find_name, norm_name
 
@@ -334,6 +334,8 @@ class _Clock:
         return t
 
 
+DAY_S = 86400.0
+"""A time of day starts again at midnight: a fall by a day is the next day."""
 COUNTER_WRAP = 2.0 ** 32
 """A microcontroller's time counter (millis(), micros()) is 32 bits: micros() starts again
 every 71.6 minutes."""
@@ -391,12 +393,13 @@ class RecordingSource:
         """What was read: the count and length, the choices (unless told not to), the samples
         without numbers."""
         wrapped = self.read_notes.get("wraps", 0)
+        what = ("the time of day passed midnight" if self.time_unit == TIME_OF_DAY
+                else "the time's 32-bit counter started again")
         return (f"{n} samples, {duration:.4g} s at {self.rate:.4g} Hz"
                 + (f"; {self.choices}" if choices else "")
                 + (f"; {missing} sample(s) without a number in every column, which the "
                    "estimators reject and count" if missing else "")
-                + (f"; the time's 32-bit counter started again {wrapped} time(s), taken as "
-                   "going on" if wrapped else ""))
+                + (f"; {what} {wrapped} time(s), taken as going on" if wrapped else ""))
 
 
 def concatenate(parts: list[Recording]) -> Recording:
@@ -585,7 +588,9 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
     """The clock of a time or dt column from its first rows `raw` (numbers as read), its
     unit and how that was chosen (_time_scale; acc, gyro as read, of the rows `keep` selects,
     are the evidence where the steps leave two units). A time of integers below 2^32 in ms or
-    us is a microcontroller's counter, whose wraps (wraps) count as going on."""
+    us is a microcontroller's counter, and a time of day passes midnight: their wraps (wraps)
+    count as going on."""
+    day = stated == TIME_OF_DAY
     if kind == "time":
         valid = np.flatnonzero(np.isfinite(raw))
         if len(valid) < 2:
@@ -595,13 +600,15 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         step = median_step(values)
         counter = bool(np.all((values == np.round(values)) & (values >= 0.0)
                               & (values < COUNTER_WRAP)))
-        increasing = bool(np.all((steps > 0.0) | (counter & wraps(steps, COUNTER_WRAP, step))))
+        increasing = bool(np.all((steps > 0.0) | (counter & wraps(steps, COUNTER_WRAP, step))
+                                 | (day & wraps(steps, DAY_S, step))))
     else:
         step, increasing, counter = median_period(raw[1:]), True, False
 
     def clock_in(scale: float) -> _Clock:
         first = step * scale if increasing else float("nan")
-        wrap = COUNTER_WRAP * scale if counter and scale in COUNTER_SCALES else 0.0
+        wrap = (DAY_S if day else COUNTER_WRAP * scale if counter and scale in COUNTER_SCALES
+                else 0.0)
         return _Clock(kind, scale, first, path, where, wrap=wrap)
 
     t_unit, scale, how = _time_scale(path, kind, step, unit, stated,
@@ -714,10 +721,15 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     from ..reader import DATETIME
     from ..time_unit import RATE_RANGE, TimeUnit, candidates, listed, rate_in, time_unit
 
-    if stated == DATETIME:
+    if stated in (DATETIME, TIME_OF_DAY):
         if unit != "auto":
             raise RecordingError(f"{path}: --time-unit {unit} is given, but the {kind} column "
-                                 "holds dates and times, which are read as such (leave it out)")
+                                 f"holds {'dates and' if stated == DATETIME else 'times of day'}"
+                                 f"{' times' if stated == DATETIME else ''}, which are read as "
+                                 "such (leave it out)")
+        if stated == TIME_OF_DAY:
+            return TIME_OF_DAY, 1.0, (f"{kind} from its times of day (seconds since midnight; "
+                                      "a midnight passed taken as going on)")
         return "s", 1.0, f"{kind} from its dates and times (seconds since 1970, UTC)"
     _given_against_header(path, kind, "time-unit", unit, stated)
     chosen = unit if unit != "auto" else stated
