@@ -30,14 +30,16 @@ acceleration averages to a small part of g, short enough that an uncalibrated gy
 MEMS part's 20 deg/s at three sigma) turns gravity by little over it (VQF's accelerometer
 low-pass is as long)."""
 HELD_RANGE = (0.6, 1.5)
-"""Where the accelerometer holds gravity, the averaged samples keep about 1 g: 0.93 to 1.07 over
-BROAD's trials and the battery's motions and parts, raw MPU-6050 biases and clipping gyros
-included. A phone's linear acceleration keeps 0.3 g at most (a vehicle's sustained
-acceleration), mostly hundredths. Outside this range, in g, it is taken to hold none."""
+"""Where the accelerometer holds gravity, the averaged samples keep about 1 g, less what a gyro's
+scale errors and bias turn them by over a window and what linear acceleration adds (BROAD's
+trials and the battery's motions and parts, raw MPU-6050 biases and clipping gyros included,
+are within 0.1 g of it: tests/test_gravity.py). A linear acceleration alone keeps what a body
+holds for seconds: a vehicle's tenths of a g, a hand's hundredths. Outside this range, in g,
+the accelerometer is taken to hold no gravity."""
 CHECK_RATE_HZ = 200.0
 """Faster recordings are averaged in blocks down to about this rate first: the turn within a
 block is small, and the check costs a step per block."""
-MAX_WINDOWS = 64
+MAX_WINDOWS = 32
 """At most this many windows, spread over the samples given, are averaged."""
 
 
@@ -66,25 +68,26 @@ def held_gravity(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> HeldGravi
         return None
     period = float(np.median(dt[ok]))
     block = max(1, round(1.0 / (period * CHECK_RATE_HZ)))
-    n = len(dt) // block * block
-    if n == 0:
-        return None
-    count = ok[:n].reshape(-1, block).sum(1)
+    steps = max(2, round(WINDOW_S / (period * block)))  # blocks per window
+    n = len(dt)
+    if n < steps * block:  # shorter than a window: the whole as one
+        steps = n // block
+        if steps < 2:
+            return None
+    span = steps * block
+    starts = np.linspace(0, n - span, min(n // span, MAX_WINDOWS)).astype(int)
+    idx = starts[:, None] + np.arange(span)[None, :]  # only the windows' samples are read
+    w = len(starts)
+    good = ok[idx].reshape(w, steps, block)
+    count = good.sum(2)
 
     def mean(x: np.ndarray) -> np.ndarray:  # block means over the valid samples
-        x = np.where(ok[:n, None], x[:n], 0.0).reshape(-1, block, 3).sum(1)
-        return x / np.maximum(count, 1)[:, None]
+        x = np.where(good[..., None], x[idx].reshape(w, steps, block, 3), 0.0).sum(2)
+        return x / np.maximum(count, 1)[..., None]
 
     a, rate = mean(acc), mean(gyro)
-    step = np.where(ok[:n], dt[:n], 0.0).reshape(-1, block).sum(1)
+    step = np.where(good, dt[idx].reshape(w, steps, block), 0.0).sum(2)
     valid = count > 0
-    steps = max(2, round(WINDOW_S / (period * block)))
-    windows = len(a) // steps
-    if windows == 0:  # shorter than a window: the whole as one
-        steps, windows = len(a), 1
-    starts = np.linspace(0, len(a) - steps, min(windows, MAX_WINDOWS)).astype(int)
-    idx = starts[:, None] + np.arange(steps)[None, :]
-    a, rate, step, valid = a[idx], rate[idx], step[idx], valid[idx]
     turned = _turned_sum(a, rate * step[..., None], valid)
     enough = valid.sum(1) >= max(2, steps // 2)
     if not enough.any():
@@ -100,18 +103,16 @@ def _turned_sum(a: np.ndarray, phi: np.ndarray, valid: np.ndarray) -> np.ndarray
     w, k, _ = a.shape
     rot = np.broadcast_to(np.eye(3), (w, 3, 3)).copy()
     total = np.zeros((w, 3))
+    angle = np.linalg.norm(phi, axis=2)
+    axis = phi / np.where(angle > 1e-12, angle, 1.0)[..., None]
+    sin, one_cos = np.sin(angle), 1.0 - np.cos(angle)
+    skew = np.zeros((w, k, 3, 3))
+    x, y, z = axis[..., 0], axis[..., 1], axis[..., 2]
+    skew[..., 0, 1], skew[..., 0, 2], skew[..., 1, 2] = -z, y, -x
+    skew[..., 1, 0], skew[..., 2, 0], skew[..., 2, 1] = z, -y, x
+    inc = np.eye(3) + sin[..., None, None] * skew + one_cos[..., None, None] * (skew @ skew)
+    turned = np.where(valid[..., None], a, 0.0)[..., None]
     for j in range(k):
-        total += np.where(valid[:, j, None], np.einsum("wij,wj->wi", rot, a[:, j]), 0.0)
-        v = phi[:, j]
-        angle = np.linalg.norm(v, axis=1)
-        small = angle < 1e-12
-        axis = v / np.where(small, 1.0, angle)[:, None]
-        s, c = np.sin(angle), np.cos(angle)
-        x, y, z = axis[:, 0], axis[:, 1], axis[:, 2]
-        skew = np.zeros((w, 3, 3))
-        skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -z, y, -x
-        skew[:, 1, 0], skew[:, 2, 0], skew[:, 2, 1] = z, -y, x
-        inc = (np.eye(3) + s[:, None, None] * skew
-               + (1.0 - c)[:, None, None] * np.einsum("wij,wjk->wik", skew, skew))
-        rot = np.einsum("wij,wjk->wik", rot, inc)
+        total += (rot @ turned[:, j])[..., 0]
+        rot = rot @ inc[:, j]
     return total
