@@ -31,7 +31,9 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
     """How a recording is read: the options every command that reads one takes (estimate,
     calibrate, noise, tune; testbenches.fit.recording.load_recording)."""
     parser.add_argument("--rate", type=positive_float, default=None,
-                        help="sample rate [Hz] where the file has no time or dt column")
+                        help="sample rate [Hz]: where the file has no time or dt column, or to "
+                        "space the samples by it where its time cannot serve (a time coarser "
+                        "than the sampling repeats), the time column left")
     parser.add_argument("--time-column", default=None, help="the time column's name")
     parser.add_argument("--time-unit", choices=("auto", "s", "ms", "us", "ns"), default="auto",
                         help="the unit of the time (or dt) column (auto: the header's, else the "

@@ -209,3 +209,23 @@ def test_a_time_of_day_reads_as_seconds_since_midnight_and_passes_midnight(tmp_p
     with pytest.raises(RecordingError, match="line 301, column 'time': 'noon' is not a time of "
                                              "day"):
         _read(path)
+
+
+def test_a_repeated_time_is_refused_with_the_rate_and_a_given_rate_serves(tmp_path):
+    """A logger's millisecond stamps at 1.6 kHz repeat: the file was refused with no way to read
+    it but editing, since a time column took precedence over --rate. The refusal now says how
+    often the time repeats and the rate on average; --rate spaces the samples by the rate, the
+    time left, and says so."""
+    _, imu = _example()
+    stamps = np.floor(np.arange(len(imu)) / 1.6).astype(int)  # ms at 1.6 kHz
+    path = _write(tmp_path / "ms.csv", "time_ms", stamps, imu)
+    with pytest.raises(RecordingError, match=r"line 3: the time 0 s repeats the time 0 s on "
+                                             r"line 2 \(375 of the first 999 steps are 0.*"
+                                             r"give --rate 1601"):
+        open_recording(path, gyro_unit="rad/s")
+    source = open_recording(path, gyro_unit="rad/s", rate=1600.0)
+    assert "time from the rate given (1600 Hz), the file's time column left" in source.choices
+    rec, _ = source.load()
+    np.testing.assert_array_equal(rec.dt, np.full(len(imu), 1 / 1600.0))
+    with pytest.raises(RecordingError, match="--rate is given, but so is --time-unit"):
+        open_recording(path, rate=1600.0, time_unit="ms")

@@ -263,6 +263,9 @@ class _Clock:
     by about that much is the counter starting again, not time going back (0: none)."""
     offset: float = 0.0
     wraps: int = 0
+    repeats: str = ""
+    """What to say where a time repeats: how often it does over the first rows, and the rate
+    that would space the samples (a time coarser than the sampling)."""
 
     def __call__(self, raw: np.ndarray | None, row0: int, n: int
                  ) -> tuple[np.ndarray, np.ndarray]:
@@ -297,10 +300,13 @@ class _Clock:
         steps = np.diff(times_all)
         if not np.all(steps > 0.0):
             i = int(np.argmax(~(steps > 0.0)))
+            same = steps[i] == 0.0
             raise RecordingError(
                 f"{self.path}, {self.where(int(rows_all[i + 1]))}: the time "
-                f"{float(times_all[i + 1]):.6g} s does not increase from "
-                f"{float(times_all[i]):.6g} s on {self.where(int(rows_all[i]))}")
+                f"{float(times_all[i + 1]):.6g} s " + ("repeats" if same else "does not "
+                                                       "increase from")
+                + f" {'the time ' if same else ''}{float(times_all[i]):.6g} s on "
+                f"{self.where(int(rows_all[i]))}" + (self.repeats if same else ""))
         if self.last_t is not None:
             dt[valid] = steps
         elif len(valid):
@@ -478,6 +484,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     n = len(prefix_block)
     if n < 2:
         raise RecordingError(f"{path}: {n} sample(s); a recording needs many")
+    given_rate = rate
     rate = rate or table.attrs.get("rate")
     split = _split_rows(*_vectors(prefix))
     joiner = None
@@ -494,7 +501,18 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     if time_unit != "auto" and not ("time" in prefix or "dt" in prefix):
         raise RecordingError(f"{path}: --time-unit {time_unit} is given, but the recording has "
                              "no time or dt column for it (leave it out)")
-    if "time" in prefix or "dt" in prefix:
+    timed = "time" in prefix or "dt" in prefix
+    if timed and given_rate:  # the user's rate over the file's time (a time that cannot serve)
+        kind = "time" if "time" in prefix else "dt"
+        if split or time_unit != "auto":
+            raise RecordingError(
+                f"{path}: --rate is given, but " + ("the accelerometer and the gyro are on rows "
+                                                    "of their own, which their time joins"
+                                                    if split else "so is --time-unit")
+                + ": leave one of them out")
+        clock = _Clock("rate", 1.0, 1.0 / given_rate, path, table.where)
+        time_how = f"time from the rate given ({given_rate:g} Hz), the file's {kind} column left"
+    elif timed:
         kind = "time" if "time" in prefix else "dt"
         clock, t_unit, time_how = _time_clock(path, kind, prefix[kind], time_unit,
                                               units.get(kind), acc, gyro, table.where, keep)
@@ -591,6 +609,7 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
     us is a microcontroller's counter, and a time of day passes midnight: their wraps (wraps)
     count as going on."""
     day = stated == TIME_OF_DAY
+    zeros, span = 0, (0, 0.0)
     if kind == "time":
         valid = np.flatnonzero(np.isfinite(raw))
         if len(valid) < 2:
@@ -602,6 +621,7 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
                               & (values < COUNTER_WRAP)))
         increasing = bool(np.all((steps > 0.0) | (counter & wraps(steps, COUNTER_WRAP, step))
                                  | (day & wraps(steps, DAY_S, step))))
+        zeros, span = int(np.sum(steps == 0.0)), (len(values) - 1, float(values[-1] - values[0]))
     else:
         step, increasing, counter = median_period(raw[1:]), True, False
 
@@ -609,7 +629,14 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         first = step * scale if increasing else float("nan")
         wrap = (DAY_S if day else COUNTER_WRAP * scale if counter and scale in COUNTER_SCALES
                 else 0.0)
-        return _Clock(kind, scale, first, path, where, wrap=wrap)
+        repeats = ""
+        if zeros and span[1] > 0.0:
+            mean_rate = span[0] / (span[1] * scale)
+            repeats = (f" ({zeros} of the first {span[0]} steps are 0: rows written twice, or "
+                       "a time coarser than the samples' spacing, which is "
+                       f"{mean_rate:.4g} Hz on average; remove the rows, or give --rate "
+                       f"{mean_rate:.4g} to space the samples by a rate, the time left)")
+        return _Clock(kind, scale, first, path, where, wrap=wrap, repeats=repeats)
 
     t_unit, scale, how = _time_scale(path, kind, step, unit, stated,
                                      lambda s: clock_in(s)(raw, 0, len(raw))[0][keep], acc,
