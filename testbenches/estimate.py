@@ -610,6 +610,7 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                 if n == 0:
                     world_up, note = find_world_up(rec, args.reference or args.recording)
                     notes += [note] if note else []
+                    notes += [z_down] if (z_down := _z_down_note(rec, args)) else []
                     if rec.up_ref is not None and not args.no_vqf:
                         vqf = _VqfRun(source.rate, vqf_params)
                 if world_up is not None and rec.ref_quat is not None:
@@ -646,6 +647,30 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
     found = {"read": f"read {source.summary(n, duration, missing, choices=False)}", "notes": notes,
              "scored": scored, "trace": truth}
     return vqf, found
+
+
+Z_DOWN_COS = -0.9
+"""The accelerometer's mean direction over the first second with a z component below this (25
+deg from straight down) starts the sensor with its z axis down."""
+
+
+def _z_down_note(rec: Any, args: argparse.Namespace) -> str:
+    """Where the sensor starts with its z axis down and no mounting is given, what that means:
+    roll near +-180 deg is right in this project's z-up frame, and a recording in a z-down
+    frame (NED or FRD, as drone autopilots log it) reads as a level one turned over."""
+    if args.mounting:
+        return ""
+    first = rec.acc[:max(2, round(rec.rate))]
+    first = first[np.all(np.isfinite(first), axis=1)]
+    if not len(first):
+        return ""
+    mean = first.mean(axis=0)
+    norm = float(np.linalg.norm(mean))
+    if not (norm > 0.0 and mean[2] / norm < Z_DOWN_COS):
+        return ""
+    return ("the sensor starts with its z axis down (the accelerometer reads gravity along -z), "
+            "so roll is near +-180 deg; a recording in a z-down frame (NED or FRD, as PX4 and "
+            "ArduPilot log it) reads as level with --mounting 180,0,0")
 
 
 def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]

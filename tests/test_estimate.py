@@ -447,3 +447,24 @@ def test_each_estimator_takes_the_blocks_in_order_at_its_own_pace():
         lanes.close()
     lanes.close(quiet=True)
     assert failing.seen == [0, 1]
+
+
+def test_a_sensor_that_starts_z_down_is_said_and_a_mounting_turns_it(tmp_path, capsys):
+    """A drone autopilot logs its IMU in a z-down frame (FRD: level reads -g on z). Read in this
+    project's z-up frame its roll is near 180 deg and a z-up reference is 160 deg off: the
+    command says why; --mounting 180,0,0 reads it as the level example it is."""
+    ex = _example()
+    frd = tmp_path / "frd.csv"
+    flip = np.array([1.0, -1.0, -1.0])
+    np.savetxt(frd, np.column_stack([ex["time"], ex["acc"] * flip, ex["gyro"] * flip]),
+               delimiter=",", header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z",
+               comments="", fmt="%.17g")
+    args = ["estimate", str(frd), "--estimator", "kf", "--reference", str(TRUTH), "--no-plots"]
+    assert main([*args, "--out", str(tmp_path / "a")]) == 0
+    said = capsys.readouterr().out
+    assert "starts with its z axis down" in said and "--mounting 180,0,0" in said
+    assert main([*args, "--mounting", "180,0,0", "--out", str(tmp_path / "b")]) == 0
+    turned = capsys.readouterr().out
+    assert "z axis down" not in turned
+    rmse = float(next(r for r in turned.splitlines() if r.startswith("kf ")).split()[2])
+    assert rmse < 1.5
