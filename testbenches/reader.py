@@ -17,8 +17,11 @@ any length is read in bounded memory:
   one-dimensional datasets or variables of one length are columns, and an [N, 3] one (acc, gyro)
   is three (acc_x, acc_y, acc_z); a scalar `rate` (attribute or variable) is the sample rate.
 
-A unit stated in a column's name ("Gyroscope X (deg/s)", "acc_x [m/s^2]") or, in Parquet and
-HDF5, in the column's `unit` or `units` metadata, is read off it. Values become floats; an empty
+A header may span several rows (motion capture's: OptiTrack Motive names a rigid body's
+quaternion X, Y, Z, W under a row of "Rotation"): its names are its last row of text, each after
+the group the row above names ("Rotation X"). A unit stated in a column's name ("Gyroscope X
+(deg/s)", "acc_x [m/s^2]"), in a row of units under or over the names or, in Parquet and HDF5,
+in the column's `unit` or `units` metadata, is read off it. Values become floats; an empty
 cell, NaN or inf is kept as not-a-number (the estimators reject such a sample and count it, so
 one bad row does not refuse a file). Line numbers are the file's, counting the header as line 1;
 other formats count rows from 1.
@@ -221,6 +224,12 @@ class _TextLayout:
     """Columns of times of day (read as seconds since midnight)."""
     skipped: str = ""
     """The lines before the header that are not the table ("lines 1-3"; "" for none)."""
+    data_after: int = 0
+    """The line after which the data start (the header's, or a units row's under it)."""
+    units_row: list[str | None] = field(default_factory=list)
+    """Each column's unit from a row of units above or below the names (None: none)."""
+    stacked: str = ""
+    """The lines a header written on several rows spans ("lines 3-7"; "" for one row)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -290,12 +299,14 @@ def _sniff(path: Path) -> _TextLayout:
     delimiter, start = found
     header_line, header_text = numbered[start]
     preamble = numbered[:start]
+    commented = False
     if _all_numbers(header_text, delimiter):  # no header row, or one written as a comment
         commented = [(no, _comment(line)) for no, line in preamble if _comment(line)]
         named = commented[-1] if commented else None
         if named is not None and _cells(named[1], delimiter) == _cells(header_text, delimiter):
             header_line, header_text = named
             preamble = [(no, line) for no, line in preamble if no < header_line]
+            commented = True
         elif len(commented) < len(preamble):  # rows before these that split otherwise
             raise _no_table(path, numbered[0])
         else:
@@ -303,8 +314,12 @@ def _sniff(path: Path) -> _TextLayout:
                              "the columns belongs (time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z "
                              "or the like): add one")
     header = [c.strip() for c in next(csv.reader([header_text], delimiter=delimiter))]
+    data_after, units_row, stacked = header_line, [None] * len(header), ""
+    if not commented:
+        header, header_line, data_after, units_row, stacked = _stacked(numbered, start, header,
+                                                                       delimiter)
     rows = [next(csv.reader([line], delimiter=delimiter))
-            for no, line in numbered if no > header_line][:49]
+            for no, line in numbered if no > data_after][:49]
     cells = [c for row in rows for c in row if c.strip()]
     decimal_comma = (delimiter == ";" and any("," in c for c in cells)
                      and not any("." in c for c in cells))
@@ -320,7 +335,70 @@ def _sniff(path: Path) -> _TextLayout:
     skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
                else f"line {preamble[0][0]}") if preamble else ""
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
-                       datetimes, times_of_day, skipped)
+                       datetimes, times_of_day, skipped, data_after, units_row, stacked)
+
+
+def _cells_of(line: str, delimiter: str) -> list[str]:
+    return [c.strip() for c in next(csv.reader([line], delimiter=delimiter))]
+
+
+def _units_of(cells: list[str]) -> list[str | None] | None:
+    """A row of units (every cell empty or a unit UNIT_ALIASES knows, one at least) as each
+    column's unit; None for any other row."""
+    units = [UNIT_ALIASES.get(c.strip("()[] ").replace(" ", "").lower()) if c else None
+             for c in cells]
+    named = [c for c in cells if c]
+    if not named or any(u is None for c, u in zip(cells, units, strict=True) if c):
+        return None
+    return units
+
+
+def _text_row(line: str, delimiter: str) -> bool:
+    """Whether a line is a row of names (a header's): cells of text and empty ones, none a
+    number, a date and time or a time of day. A row of data with a bad cell is no such row:
+    the reader refuses it by its line."""
+    cells = [c for c in _cells_of(line, delimiter) if c]
+    return bool(cells) and not any(_all_numbers(c, delimiter) for c in cells)
+
+
+def _stacked(numbered: list[tuple[int, str]], at: int, header: list[str], delimiter: str
+             ) -> tuple[list[str], int, int, list[str | None], str]:
+    """A header written on several rows, as motion capture exports it (OptiTrack Motive: the
+    rigid body's name, then "Rotation" or "Position" over "X, Y, Z, W"; a row of units above
+    or below the names): (header, its line, the line after which the data start, each column's
+    unit from a units row (None: none), the lines the header spans as said). The header is the
+    last row of text before the data, each name after the group the row above it names; a row
+    of units is units, not names."""
+    width = len(header)
+    k, run = at, 0  # the last row of text before HEADER_CHECK rows of data in a row
+    for j in range(at + 1, min(len(numbered), at + PREAMBLE_LINES)):
+        if _cells(numbered[j][1], delimiter) != width:
+            break
+        if _text_row(numbered[j][1], delimiter):
+            k, run = j, 0
+        else:
+            run += 1
+            if run >= HEADER_CHECK:
+                break
+    units: list[str | None] = [None] * width
+    names_at = k
+    if k > at and (below := _units_of(_cells_of(numbered[k][1], delimiter))) is not None:
+        units, names_at = below, k - 1  # units under the names (Vicon's mm)
+    names = _cells_of(numbered[names_at][1], delimiter)
+    group: list[str] = [""] * width
+    for no in range(names_at - 1, at - 1, -1):  # the nearest row of text above, no units row
+        cells = _cells_of(numbered[no][1], delimiter)
+        above = _units_of(cells)
+        if above is not None:
+            units = [u or a for u, a in zip(units, above, strict=True)]
+        elif _text_row(numbered[no][1], delimiter):  # not an id row (Motive's 1, 1, ...)
+            group = cells
+            break
+    if k == at:
+        return header, numbered[at][0], numbered[at][0], units, ""
+    joined = [f"{g} {n}".strip() if g and g != n else n for g, n in zip(group, names, strict=True)]
+    first, last = numbered[at][0], numbered[k][0]
+    return joined, numbered[names_at][0], last, units, f"lines {first}-{last}"
 
 
 def _no_table(path: Path, first: tuple[int, str]) -> TableError:
@@ -376,7 +454,7 @@ def _text(path: Path) -> TableSource:
     layout = _sniff(path)
     names, stated = zip(*(split_unit(h) for h in layout.header), strict=True)
     units = [(DATETIME if j in layout.datetimes else TIME_OF_DAY if j in layout.times_of_day
-              else u) for j, u in enumerate(stated)]
+              else u or layout.units_row[j]) for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         if layout.padded or not _has_pyarrow():
@@ -393,8 +471,10 @@ def _text(path: Path) -> TableSource:
     def where(row: int) -> str:
         return f"line {_line_of_row(path, layout, row)}"
 
-    note = (f"the header on line {layout.header_line}, {layout.skipped} before it skipped"
-            if layout.skipped else "")
+    spans = layout.stacked or f"line {layout.header_line}"
+    note = (f"the header on {spans}" + (f", {layout.skipped} before it skipped"
+                                        if layout.skipped else "")
+            if layout.skipped or layout.stacked else "")
     return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
                        where, note=note)
 
@@ -452,7 +532,7 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
             path if compression is None
             else pa.input_stream(str(path), compression=compression)
             if compression in ARROW_COMPRESSIONS else pa.PythonFile(_open_bytes(path), mode="r"),
-            read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.header_line,
+            read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.data_after,
                                         encoding="utf8" if layout.encoding == "utf-8"
                                         else "latin1", block_size=1 << 22),
             parse_options=pc.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
@@ -485,7 +565,7 @@ def _rows(path: Path, layout: _TextLayout) -> Iterator[tuple[int, list[str]]]:
                           else layout.encoding) as f:
         reader = csv.reader(f, delimiter=layout.delimiter)
         for row in reader:
-            if reader.line_num <= layout.header_line or not row or not any(
+            if reader.line_num <= layout.data_after or not row or not any(
                     c.strip() for c in row):
                 continue
             yield reader.line_num, row

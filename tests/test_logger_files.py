@@ -180,3 +180,59 @@ def test_a_workbook_or_json_is_refused_saying_what_serves(tmp_path, name, conten
     path.write_bytes(content)
     with pytest.raises(RecordingError, match=serves):
         open_recording(path)
+
+
+def _motive(path: Path) -> Path:
+    """The example's truth as OptiTrack Motive exports a rigid body: a settings line, a blank
+    line, then the header on five rows (type, name, id, Rotation/Position over X, Y, Z, W), in
+    Motive's y-up world."""
+    truth = np.genfromtxt(REPO / "examples" / "tilt_motion_truth.csv", delimiter=",",
+                          names=True)
+    r, p = truth["roll"] / 2, truth["pitch"] / 2
+    qw, qx, qy, qz = (np.cos(r) * np.cos(p), np.sin(r) * np.cos(p), np.cos(r) * np.sin(p),
+                      -np.sin(r) * np.sin(p))
+    c, s = np.cos(-np.pi / 4), np.sin(-np.pi / 4)  # the z-up world turned -90 deg about x
+    quat = np.column_stack([c * qx + s * qw, c * qy - s * qz, c * qz + s * qy, c * qw - s * qx])
+    lines = ["Format Version,1.23,Take Name,Take 1,Capture Frame Rate,100.000000,Rotation Type,"
+             "Quaternion,Length Units,Meters,Coordinate Space,Global", "",
+             ",,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body",
+             ",,imu,imu,imu,imu,imu,imu,imu", ",,1,1,1,1,1,1,1",
+             ",,Rotation,Rotation,Rotation,Rotation,Position,Position,Position",
+             "Frame,Time (Seconds),X,Y,Z,W,X,Y,Z"]
+    lines += [f"{i},{t:.6f}," + ",".join(f"{v:.8f}" for v in q) + ",0.1,1.0,0.2"
+              for i, (t, q) in enumerate(zip(truth["time"], quat, strict=True))]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_a_motion_capture_export_with_its_header_on_rows_is_a_reference(tmp_path, capsys):
+    """OptiTrack Motive writes its header on five rows: the quaternion's columns are named X, Y,
+    Z, W under "Rotation". The stacked rows name them "Rotation X" ...; its y-up world is found
+    as any other; scored, it gives what the truth file gives."""
+    from testbenches.cli import main
+
+    scores = []
+    for reference in (REPO / "examples" / "tilt_motion_truth.csv", _motive(tmp_path / "m.csv")):
+        assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference",
+                     str(reference), "--no-plots", "--out", str(tmp_path)]) == 0
+        said = capsys.readouterr().out
+        scores.append(float(next(r for r in said.splitlines() if r.startswith("kf ")).split()[2]))
+    assert "world frame's up is +y" in said
+    assert scores[1] == pytest.approx(scores[0], abs=1e-3)
+
+
+@pytest.mark.parametrize("where", ["below", "above"])
+def test_a_row_of_units_beside_the_names_states_them(tmp_path, where):
+    """A logger's (or Vicon's) row of units under or over the names: the units, not a row of
+    data, and not part of the names."""
+    t, imu = _example()
+    names, units = "time," + HEADER, "s,g,g,g,deg/s,deg/s,deg/s"
+    rows = "\n".join(",".join(f"{v:.10g}" for v in row)
+                     for row in np.column_stack([t, imu[:, :3] / 9.80665, np.degrees(imu[:, 3:])]))
+    head = f"{names}\n{units}" if where == "below" else f"{units}\n{names}"
+    path = tmp_path / "units.csv"
+    path.write_text(f"{head}\n{rows}\n")
+    source = open_recording(path)
+    assert "acc in g (from the header)" in source.choices and "deg/s (from the header" in \
+        source.choices
+    np.testing.assert_allclose(source.load()[0].acc, imu[:, :3], rtol=1e-9)

@@ -30,9 +30,14 @@ ALIASES: dict[str, tuple[str, ...]] = {
     "time": ("time", "t", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
              "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
              "header_stamp", "millis", "micros"),
+    **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}")
+       for c in "wxyz"},
 }
 """Column names a recording may use per quantity, as norm_name makes them (case ignored;
-spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out)."""
+spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out). A reference
+quaternion's components (sensor to world) too, as motion capture names them ("Rotation W" in
+OptiTrack Motive's stacked header, testbenches.reader); not "orientation", which in a ROS Imu
+message is the device's own estimate, no reference."""
 
 
 def norm_name(name: str) -> str:

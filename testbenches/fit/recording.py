@@ -145,7 +145,7 @@ def parse_columns(specs: list[str]) -> dict[str, str]:
 COUNTER_NAMES = ("n_samples", "sample", "samples", "sample_index", "index", "idx", "counter",
                  "count", "frame", "n")
 """Column names of a sample counter: no time, and said so where the time is missing."""
-EXTRA_COLUMNS = ("dt", "roll", "pitch", "q_w", "q_x", "q_y", "q_z")
+EXTRA_COLUMNS = ("dt", "roll", "pitch")
 """Columns found by their own name only: the sampling and a reference."""
 
 
