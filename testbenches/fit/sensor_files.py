@@ -93,10 +93,12 @@ def _chosen(path: Path, names: list[str]) -> tuple[dict[str, str], list[str]]:
             why = (f" ({', '.join(gravity_free)}: named for an acceleration without gravity, "
                    "which the filters cannot use)" if gravity_free else "")
             held = ", ".join(names) or "no table"
+            serve = (f"; if {names[0]} holds both sensors, give that file itself (unpacked)"
+                     if len(names) == 1 else "")
             raise TableError(
                 f"{path}: no file named for the {label}{why}; it holds {held}. A phone app's "
                 "export holds one file per sensor, named for it (Accelerometer.csv or "
-                "TotalAcceleration.csv, Gyroscope.csv)")
+                f"TotalAcceleration.csv, Gyroscope.csv){serve}")
         best = [n for r, n in ranked if r == ranked[0][0]]
         if len(best) > 1:
             raise TableError(f"{path}: {', '.join(best)} are each named for the {label}: put "
