@@ -46,6 +46,9 @@ COMMENTS = ("#", "//")
 """A line that starts with one of these before the header is a comment (numpy.savetxt writes
 its header as "# time,acc_x,...", which is taken as the header where the rows follow it). Not
 "%": a ROS topic's CSV header starts "%time"."""
+MISSING_MARKS = ("null", "none", "na", "n/a", "-", "--")
+"""Cells loggers write for a missing value: a row of them is a row of data (each refused by its
+line, as text where a number belongs), not a header's row of names."""
 HEADER_CHECK = 20
 """The header must split into as many cells as this many lines after it."""
 PREAMBLE_LINES = 30
@@ -358,6 +361,8 @@ def _text_row(line: str, delimiter: str) -> bool:
     number, a date and time or a time of day. A row of data with a bad cell is no such row:
     the reader refuses it by its line."""
     cells = [c for c in _cells_of(line, delimiter) if c]
+    if all(c.lower() in MISSING_MARKS for c in cells):  # a row of missing values: data
+        return False
     return bool(cells) and not any(_all_numbers(c, delimiter) for c in cells)
 
 
