@@ -86,12 +86,17 @@ class TableError(ValueError):
     """A file that cannot be read as a table: where, what, and what would serve."""
 
 
+def unit_named(text: str) -> str | None:
+    """The unit a text names (UNIT_ALIASES: "deg/s", "Deg / s", "m/s^2"), None for none."""
+    return UNIT_ALIASES.get(text.replace(" ", "").lower())
+
+
 def split_unit(name: str) -> tuple[str, str | None]:
     """A header cell as (name, unit): "Gyroscope X (deg/s)" -> ("Gyroscope X", "deg/s"); a
     bracketed part that is no unit known here stays in the name."""
     m = _NAME_UNIT.match(name.strip())
     if m:
-        unit = UNIT_ALIASES.get(m.group(2).replace(" ", "").lower())
+        unit = unit_named(m.group(2))
         if unit is not None:
             return m.group(1).strip(), unit
     return name.strip(), None
@@ -101,8 +106,7 @@ def _unit_of(name: str, stated: Any) -> tuple[str, str | None]:
     """(name, unit) of a column whose metadata may state its unit (bytes or text)."""
     bare, unit = split_unit(name)
     if unit is None and stated is not None:
-        text = stated.decode() if isinstance(stated, bytes) else str(stated)
-        unit = UNIT_ALIASES.get(text.replace(" ", "").lower())
+        unit = unit_named(stated.decode() if isinstance(stated, bytes) else str(stated))
     return bare, unit
 
 
@@ -348,8 +352,7 @@ def _cells_of(line: str, delimiter: str) -> list[str]:
 def _units_of(cells: list[str]) -> list[str | None] | None:
     """A row of units (every cell empty or a unit UNIT_ALIASES knows, one at least) as each
     column's unit; None for any other row."""
-    units = [UNIT_ALIASES.get(c.strip("()[] ").replace(" ", "").lower()) if c else None
-             for c in cells]
+    units = [unit_named(c.strip("()[] ")) if c else None for c in cells]
     named = [c for c in cells if c]
     if not named or any(u is None for c, u in zip(cells, units, strict=True) if c):
         return None

@@ -50,11 +50,12 @@ def norm_name(name: str) -> str:
     return name.removeprefix("field_")
 
 
-def find_name(names: list[str], quantity: str, given: str | None = None) -> int | None:
+def find_name(names: list[str], quantity: str, given: str | None = None,
+              more: tuple[str, ...] = ()) -> int | None:
     """The column of a quantity: the one given (by its name as written, with or without its
-    unit), else the first of its aliases."""
+    unit), else the first of its aliases and then of `more`."""
     normed = [norm_name(n) for n in names]
-    wanted = (norm_name(given),) if given else ALIASES[quantity]
+    wanted = (norm_name(given),) if given else (*ALIASES[quantity], *more)
     for alias in wanted:
         if alias in normed:
             return normed.index(alias)

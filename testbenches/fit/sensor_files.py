@@ -131,14 +131,6 @@ def _platform(path: Path, names: list[str]) -> str:
     return ""
 
 
-def _axis(names: list[str], sensor: str, axis: str) -> int | None:
-    normed = [norm_name(n) for n in names]
-    for alias in (*ALIASES[f"{sensor}_{axis}"], axis, f"{axis}_axis"):
-        if alias in normed:
-            return normed.index(alias)
-    return None
-
-
 @dataclass
 class _SensorTable:
     """One sensor's file opened: its table, the columns of its time and three axes, and how it
@@ -151,7 +143,12 @@ class _SensorTable:
 
     def error(self, err: TableError) -> TableError:
         """The reader's error, naming the file as the user knows it."""
-        return TableError(str(err).replace(str(self.table.path), self.shown))
+        return _shown(err, self.table.path, self.shown)
+
+
+def _shown(err: TableError, file: Path, shown: str) -> TableError:
+    """A reader's error about `file` (an archive's member unpacked), naming it `shown`."""
+    return TableError(str(err).replace(str(file), shown))
 
 
 def _open_one(path: Path, member: str, file: Path, sensor: str,
@@ -160,7 +157,7 @@ def _open_one(path: Path, member: str, file: Path, sensor: str,
     try:
         table = open_table(file)
     except TableError as err:
-        raise TableError(str(err).replace(str(file), shown)) from None
+        raise _shown(err, file, shown) from None
     t = find_name(table.header, "time", time_column) if time_column else None
     if t is None:
         t = find_name(table.names, "time", time_column)
@@ -169,7 +166,7 @@ def _open_one(path: Path, member: str, file: Path, sensor: str,
         raise TableError(f"{shown}: no time column (the header has {', '.join(table.header)}): "
                          f"the {label}'s readings are joined to the other sensor's by their "
                          "times; name it with --time-column")
-    axes = [_axis(table.names, sensor, a) for a in "xyz"]
+    axes = [find_name(table.names, f"{sensor}_{a}", more=(a, f"{a}_axis")) for a in "xyz"]
     if None in axes:
         raise TableError(f"{shown}: no column for the {label}'s "
                          + ", ".join(a for a, i in zip("xyz", axes, strict=True) if i is None)
