@@ -46,9 +46,11 @@ COMMENTS = ("#", "//")
 """A line that starts with one of these before the header is a comment (numpy.savetxt writes
 its header as "# time,acc_x,...", which is taken as the header where the rows follow it). Not
 "%": a ROS topic's CSV header starts "%time"."""
-MISSING_MARKS = ("null", "none", "na", "n/a", "-", "--")
-"""Cells loggers write for a missing value: a row of them is a row of data (each refused by its
-line, as text where a number belongs), not a header's row of names."""
+MISSING_VALUES = ("", "#n/a", "#n/a n/a", "#na", "-1.#ind", "-1.#qnan", "-nan", "1.#ind",
+                  "1.#qnan", "n/a", "na", "null", "nan")
+"""Cells that mark a missing value, case ignored: pyarrow's CSV reader's own marks, which
+Python's reader takes as well. Its sample is rejected and counted; a row of them is a row of
+data, not a header's row of names."""
 HEADER_CHECK = 20
 """The header must split into as many cells as this many lines after it."""
 PREAMBLE_LINES = 30
@@ -364,7 +366,7 @@ def _text_row(line: str, delimiter: str) -> bool:
     number, a date and time or a time of day. A row of data with a bad cell is no such row:
     the reader refuses it by its line."""
     cells = [c for c in _cells_of(line, delimiter) if c]
-    if all(c.lower() in MISSING_MARKS for c in cells):  # a row of missing values: data
+    if all(c.lower() in MISSING_VALUES for c in cells):  # a row of missing values: data
         return False
     return bool(cells) and not any(_all_numbers(c, delimiter) for c in cells)
 
@@ -461,8 +463,7 @@ def _find_header(numbered: list[tuple[int, str]]) -> tuple[str, int] | None:
 def _text(path: Path) -> TableSource:
     layout = _sniff(path)
     names, stated = zip(*(split_unit(h) for h in layout.header), strict=True)
-    units = [(DATETIME if j in layout.datetimes else TIME_OF_DAY if j in layout.times_of_day
-              else u or layout.units_row[j]) for j, u in enumerate(stated)]
+    units = [_clock_of(layout, j) or u or layout.units_row[j] for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         if layout.padded or not _has_pyarrow():
@@ -617,7 +618,7 @@ def _clock_of(layout: _TextLayout, j: int) -> str:
 def _number(cell: str, path: Path, line: int, column: str, decimal_comma: bool,
             clock: str = "") -> float:
     text = cell.strip()
-    if not text:
+    if text.lower() in MISSING_VALUES:
         return float("nan")  # a missing value: that sample is rejected and counted
     if clock:  # seconds since 1970, or since midnight
         seconds = (seconds_of if clock == DATETIME else seconds_of_day)(text)

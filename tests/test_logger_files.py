@@ -236,3 +236,19 @@ def test_a_row_of_units_beside_the_names_states_them(tmp_path, where):
     assert "acc in g (from the header)" in source.choices and "deg/s (from the header" in \
         source.choices
     np.testing.assert_allclose(source.load()[0].acc, imu[:, :3], rtol=1e-9)
+
+
+@pytest.mark.parametrize("padded", [False, True])
+def test_missing_value_marks_are_missing_in_either_reader(tmp_path, padded):
+    """NULL, N/A and their kin mark a missing value: pyarrow's reader took them so, Python's
+    (which reads padded cells) refused them. Both reject and count the sample now."""
+    lines = EXAMPLE.read_text().splitlines()
+    pad = " " if padded else ""
+    for row, mark in ((5, "NULL"), (6, "N/A"), (7, "#N/A")):
+        cells = lines[row].split(",")
+        cells[2] = f"{pad}{mark}{pad}"
+        lines[row] = ",".join(cells)
+    path = tmp_path / "marks.csv"
+    path.write_text("\n".join(lines))
+    rec, _ = open_recording(path).load()
+    assert list(np.flatnonzero(~rec.valid)) == [4, 5, 6]
