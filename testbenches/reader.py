@@ -371,6 +371,10 @@ def _text_row(line: str, delimiter: str) -> bool:
     return bool(cells) and not any(_all_numbers(c, delimiter) for c in cells)
 
 
+_RULE = re.compile(r"^[-=_:+ ]+$")
+"""A cell of a rule drawn under a header (----, a Markdown table's |:---:|)."""
+
+
 def _stacked(numbered: list[tuple[int, str]], at: int, header: list[str], delimiter: str
              ) -> tuple[list[str], int, int, list[str | None], str]:
     """A header written on several rows, as motion capture exports it (OptiTrack Motive: the
@@ -391,15 +395,19 @@ def _stacked(numbered: list[tuple[int, str]], at: int, header: list[str], delimi
             if run >= HEADER_CHECK:
                 break
     units: list[str | None] = [None] * width
-    names_at = k
-    if k > at and (below := _units_of(_cells_of(numbered[k][1], delimiter))) is not None:
-        units, names_at = below, k - 1  # units under the names (Vicon's mm)
+    rows = [j for j in range(at, k + 1)  # a rule under the names (----, |---|) is no row
+            if not all(_RULE.match(c) for c in _cells_of(numbered[j][1], delimiter) if c)]
+    if not rows:
+        return header, numbered[at][0], numbered[at][0], units, ""
+    names_at = rows[-1]
+    if len(rows) > 1 and (below := _units_of(_cells_of(numbered[names_at][1], delimiter))):
+        units, names_at = below, rows[-2]  # units under the names (Vicon's mm)
     names = _cells_of(numbered[names_at][1], delimiter)
     group: list[str] = [""] * width
-    for no in range(names_at - 1, at - 1, -1):  # the nearest row of text above, no units row
+    for no in reversed([j for j in rows if j < names_at]):  # the nearest row of text above
         cells = _cells_of(numbered[no][1], delimiter)
         above = _units_of(cells)
-        if above is not None:
+        if above is not None:  # no units row
             units = [u or a for u, a in zip(units, above, strict=True)]
         elif _text_row(numbered[no][1], delimiter):  # not an id row (Motive's 1, 1, ...)
             group = cells

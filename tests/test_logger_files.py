@@ -252,3 +252,21 @@ def test_missing_value_marks_are_missing_in_either_reader(tmp_path, padded):
     path.write_text("\n".join(lines))
     rec, _ = open_recording(path).load()
     assert list(np.flatnonzero(~rec.valid)) == [4, 5, 6]
+
+
+@pytest.mark.parametrize("style", ["rule", "markdown"])
+def test_a_rule_under_the_header_is_no_row_of_names(tmp_path, style):
+    """A serial monitor's table (a row of dashes under the names) or a Markdown one (|---|)."""
+    t, imu = _example()
+    rows = np.column_stack([t, imu])
+    if style == "rule":
+        text = "time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z\n" + ",".join(["----"] * 7) + "\n"
+        text += "\n".join(",".join(f"{v:.10g}" for v in r) for r in rows)
+    else:
+        text = "| time | acc_x | acc_y | acc_z | gyro_x | gyro_y | gyro_z |\n" + \
+            "|" + ":---|" * 7 + "\n"
+        text += "\n".join("| " + " | ".join(f"{v:.10g}" for v in r) + " |" for r in rows)
+    path = tmp_path / "table.txt"
+    path.write_text(text + "\n")
+    rec, _ = open_recording(path).load()
+    np.testing.assert_allclose(rec.acc, imu[:, :3], rtol=1e-9)
