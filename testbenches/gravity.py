@@ -99,7 +99,8 @@ def held_gravity(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> HeldGravi
 def _turned_sum(a: np.ndarray, phi: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """The sum over each window's steps of a [w, k, 3] turned into the window's first frame,
     phi [w, k, 3] each step's rotation vector (the body's turn over it): R_0 = I, the sample
-    of step j is R_j a_j, R_{j+1} = R_j exp([phi_j]x) (Rodrigues)."""
+    of step j is R_j a_j, R_{j+1} = R_j exp([phi_j]x) (Rodrigues: scipy's Rotation would import
+    scipy.spatial, half a second of every command that opens a recording)."""
     w, k, _ = a.shape
     rot = np.broadcast_to(np.eye(3), (w, 3, 3)).copy()
     total = np.zeros((w, 3))

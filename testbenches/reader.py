@@ -368,7 +368,7 @@ def _text_row(line: str, delimiter: str) -> bool:
     cells = [c for c in _cells_of(line, delimiter) if c]
     if all(c.lower() in MISSING_VALUES for c in cells):  # a row of missing values: data
         return False
-    return bool(cells) and not any(_all_numbers(c, delimiter) for c in cells)
+    return bool(cells) and not any(_number_like(c) for c in cells)
 
 
 _RULE = re.compile(r"^[-=_:+ ]+$")
@@ -438,15 +438,17 @@ def _cells(line: str, delimiter: str) -> int:
     return len(next(csv.reader([line], delimiter=delimiter)))
 
 
-def _all_numbers(line: str, delimiter: str) -> bool:
-    def number(cell: str) -> bool:
-        try:
-            float(cell.strip().replace(",", "."))
-        except ValueError:
-            return bool(_ISO_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip()))
-        return True
+def _number_like(cell: str) -> bool:
+    """Whether a cell is a number (a decimal comma too), a date and time or a time of day."""
+    try:
+        float(cell.strip().replace(",", "."))
+    except ValueError:
+        return bool(_ISO_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip()))
+    return True
 
-    return all(number(c) for c in next(csv.reader([line], delimiter=delimiter)))
+
+def _all_numbers(line: str, delimiter: str) -> bool:
+    return all(_number_like(c) for c in next(csv.reader([line], delimiter=delimiter)))
 
 
 def _find_header(numbered: list[tuple[int, str]]) -> tuple[str, int] | None:

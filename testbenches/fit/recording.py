@@ -749,11 +749,10 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     from ..time_unit import RATE_RANGE, TimeUnit, candidates, listed, rate_in, time_unit
 
     if stated in (DATETIME, TIME_OF_DAY):
+        holds = "dates and times" if stated == DATETIME else "times of day"
         if unit != "auto":
             raise RecordingError(f"{path}: --time-unit {unit} is given, but the {kind} column "
-                                 f"holds {'dates and' if stated == DATETIME else 'times of day'}"
-                                 f"{' times' if stated == DATETIME else ''}, which are read as "
-                                 "such (leave it out)")
+                                 f"holds {holds}, which are read as such (leave it out)")
         if stated == TIME_OF_DAY:
             return TIME_OF_DAY, 1.0, (f"{kind} from its times of day (seconds since midnight; "
                                       "a midnight passed taken as going on)")
@@ -844,11 +843,10 @@ whose values are Core Motion's: the negative of specific force, in g."""
 def _acc_sign(path: Path, given: str, names: list[str], platform: str) -> tuple[float, str]:
     """The accelerometer's sign (+1: specific force; -1: its negative, iOS's Core Motion) and
     how it was chosen, said where it is not +1 or was given; names: the accelerometer's columns'
-    names (without their units). A negated accelerometer reads as
-    the sensor turned upside down, and its gyro still explains every turn (a point reflection
-    commutes with rotations), so the data cannot tell: given, else the columns' names, else +1;
-    a phone app's export that says it was recorded on iOS, where the app's setting decides, is
-    refused until given."""
+    names (without their units). A negated accelerometer reads as the sensor turned upside
+    down, and its gyro still explains every turn (a point reflection commutes with rotations),
+    so the data cannot tell: given, else the columns' names, else +1; a phone app's export that
+    says it was recorded on iOS, where the app's setting decides, is refused until given."""
     if given != "auto":
         return float(given), "" if given == "+1" else ", sign -1 (given)"
     if all(norm_name(name).startswith(IOS_ACC_NAMES) for name in names):

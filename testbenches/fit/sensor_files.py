@@ -139,7 +139,6 @@ class _SensorTable:
     table: TableSource
     columns: list[int]
     shown: str
-    sensor: str
 
     def error(self, err: TableError) -> TableError:
         """The reader's error, naming the file as the user knows it."""
@@ -172,7 +171,7 @@ def _open_one(path: Path, member: str, file: Path, sensor: str,
                          + ", ".join(a for a, i in zip("xyz", axes, strict=True) if i is None)
                          + f" axis (the header has {', '.join(table.header)}): name them x, y, "
                          "z")
-    return _SensorTable(table, [t, *axes], shown, sensor)  # type: ignore[list-item]
+    return _SensorTable(table, [t, *axes], shown)  # type: ignore[list-item]
 
 
 def open_sensor_files(path: Path, time_column: str | None = None) -> TableSource:
@@ -265,7 +264,7 @@ def _merged(parts: list[_SensorTable], rows: int
                 pending[i], keys[i], last[i] = block, key, float(key[-1])
         if all(len(q) == 0 for q in pending):
             break
-        if row0 == 0 and not out and first == [0, 0]:
+        if first == [0, 0]:  # nothing taken yet
             _overlap(parts, pending, keys)
         limit = min((keys[i][-1] for i in range(2) if not done[i] and len(keys[i])),
                     default=np.inf)
