@@ -68,9 +68,15 @@ UNIT_ALIASES: dict[str, str] = {
     "m/s2": "m/s2", "m/s^2": "m/s2", "m/s²": "m/s2", "ms^-2": "m/s2", "ms-2": "m/s2",
     "m.s-2": "m/s2", "mps2": "m/s2",
     "s": "s", "sec": "s", "seconds": "s", "ms": "ms", "us": "us", "µs": "us", "ns": "ns",
+    "m/(s^2)": "m/s2", "m/(s2)": "m/s2",
     "rad": "rad", "deg": "deg", "°": "deg", "1": "1",
 }
 """Units a header may state, by their spellings (lower case, spaces removed)."""
+OTHER_UNITS = frozenset({"mv", "v", "kpa", "pa", "hpa", "degreescelsius", "°c", "degc",
+                         "local_flux*", "ut", "µt", "gauss", "ga", "nounits", "%"})
+"""Units of a logger's other sensors (Shimmer's ECG in mV, its pressure in kPa, its temperature
+in degrees Celsius, its magnetometer in local_flux*, a counter's "no units"), spelled as
+UNIT_ALIASES' are: they make a row of units a row of units, and state nothing here."""
 TIME_SCALE = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 """The units of a time or dt column and their factor to seconds."""
 DATETIME = "datetime"
@@ -82,6 +88,8 @@ real-time clock or a spreadsheet's time format writes them), which the reader gi
 since midnight."""
 
 _NAME_UNIT = re.compile(r"^(.*?)\s*[\(\[]\s*([^\)\]]*?)\s*[\)\]]\s*$")
+_INDEX = re.compile(r"\w\[\d\]$")
+"""An index written onto a name, PX4's "gyro_rad[1]": an axis, not the unit "1" ("q_w [1]")."""
 
 
 class TableError(ValueError):
@@ -97,7 +105,7 @@ def split_unit(name: str) -> tuple[str, str | None]:
     """A header cell as (name, unit): "Gyroscope X (deg/s)" -> ("Gyroscope X", "deg/s"); a
     bracketed part that is no unit known here stays in the name."""
     m = _NAME_UNIT.match(name.strip())
-    if m:
+    if m and not _INDEX.search(name.strip()):
         unit = unit_named(m.group(2))
         if unit is not None:
             return m.group(1).strip(), unit
@@ -352,11 +360,15 @@ def _cells_of(line: str, delimiter: str) -> list[str]:
 
 
 def _units_of(cells: list[str]) -> list[str | None] | None:
-    """A row of units (every cell empty or a unit UNIT_ALIASES knows, one at least) as each
-    column's unit; None for any other row."""
-    units = [unit_named(c.strip("()[] ")) if c else None for c in cells]
-    named = [c for c in cells if c]
-    if not named or any(u is None for c, u in zip(cells, units, strict=True) if c):
+    """A row of units (every cell empty, in brackets or not, a unit UNIT_ALIASES knows or one
+    of OTHER_UNITS, one at least of UNIT_ALIASES') as each column's unit; None for any other
+    row."""
+    bare = [c[1:-1] if c[:1] in "([" and c[-1:] in ")]" else c for c in cells]
+    units = [unit_named(c) if c else None for c in bare]
+    other = [bool(c) and u is None and c.replace(" ", "").lower() in OTHER_UNITS
+             for c, u in zip(bare, units, strict=True)]
+    if not any(units) or any(c and u is None and not o
+                             for c, u, o in zip(bare, units, other, strict=True)):
         return None
     return units
 

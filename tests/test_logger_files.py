@@ -270,3 +270,93 @@ def test_a_rule_under_the_header_is_no_row_of_names(tmp_path, style):
     path.write_text(text + "\n")
     rec, _ = open_recording(path).load()
     np.testing.assert_allclose(rec.acc, imu[:, :3], rtol=1e-9)
+
+
+def _rows(path: Path, header: str, rows: list[str], before: str = "") -> Path:
+    path.write_text(before + header + "\n" + "\n".join(rows) + "\n")
+    return path
+
+
+def test_flight_logs_columns_with_an_index_and_a_unit_word_are_found(tmp_path):
+    """PX4's sensor_combined as ulog2csv writes it ("gyro_rad[0]", "accelerometer_m_s2[0]", the
+    time in us) and ArduPilot's IMU messages as mavlogdump writes them ("GyrX", "AccX" beside a
+    temperature "T" and the time "timestamp"): both read as the example's samples in their
+    z-down FRD frame, units from the names where they give them."""
+    t, imu = _example()
+    frd = imu * [1, -1, -1, 1, -1, -1]
+    cells = [[f"{v:.17g}" for v in r] for r in frd]
+    px4 = _rows(tmp_path / "sensor_combined.csv",
+                "timestamp,gyro_rad[0],gyro_rad[1],gyro_rad[2],gyro_integral_dt,"
+                "accelerometer_m_s2[0],accelerometer_m_s2[1],accelerometer_m_s2[2]",
+                [",".join([str(round(ti * 1e6)), *c[3:], "10000", *c[:3]])
+                 for ti, c in zip(t, cells, strict=True)])
+    ardupilot = _rows(tmp_path / "imu.csv", "timestamp,TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,T",
+                      [",".join([f"{ti:.17g}", str(round(ti * 1e6)), "0", *c[3:], *c[:3], "35.2"])
+                       for ti, c in zip(t, cells, strict=True)])
+    want = open_recording(EXAMPLE).load()[0]
+    for path in (px4, ardupilot):
+        source = open_recording(path)
+        assert "time='timestamp'" in source.choices
+        rec, _ = source.load()
+        np.testing.assert_array_equal(rec.acc, frd[:, :3])
+        np.testing.assert_array_equal(rec.gyro, frd[:, 3:])
+        np.testing.assert_allclose(rec.dt[1:], want.dt[1:], rtol=1e-6)
+    px4_choices = open_recording(px4).choices
+    assert "acc in m/s2 (from the header)" in px4_choices  # "m_s2" in the name
+    assert "gyro_x='gyro_rad[0]'" in px4_choices
+
+
+def test_a_device_prefix_and_a_units_row_of_other_sensors_are_read_through(tmp_path):
+    """Shimmer's export: Excel's "sep=" line, tab-separated quoted names that carry the device's
+    name and "_CAL", a row of units that also holds another sensor's (mV), a tab closing every
+    line."""
+    t, imu = _example()
+    names = ["Timestamp_CAL", "Accel_LN_X_CAL", "Accel_LN_Y_CAL", "Accel_LN_Z_CAL",
+             "Gyro_X_CAL", "Gyro_Y_CAL", "Gyro_Z_CAL", "ECG_CAL"]
+    units = ["ms", "m/(s^2)", "m/(s^2)", "m/(s^2)", "deg/s", "deg/s", "deg/s", "mV"]
+    rows = ["\t".join([f"{ti * 1e3:.3f}", *(f"{v:.17g}" for v in r[:3]),
+                       *(f"{np.degrees(v):.17g}" for v in r[3:]), "1.0", ""])
+            for ti, r in zip(t, imu, strict=True)]
+    path = _rows(tmp_path / "shimmer.csv",
+                 "\t".join(f'"Shimmer_A1B2_{n}"' for n in names) + "\t\n"
+                 + "\t".join(f'"{u}"' for u in units) + "\t", rows, before='"sep=\t"\n')
+    source = open_recording(path)
+    assert "gyro in deg/s (from the header" in source.choices
+    assert "acc_x='Shimmer_A1B2_Accel_LN_X_CAL'" in source.choices
+    rec, _ = source.load()
+    want = open_recording(EXAMPLE).load()[0]
+    np.testing.assert_allclose(rec.acc, want.acc, atol=1e-12)
+    np.testing.assert_allclose(rec.gyro, want.gyro, rtol=1e-12, atol=1e-15)
+
+
+def test_a_g_force_column_is_the_accelerometer_not_a_linear_acceleration(tmp_path):
+    """Physics Toolbox's "Multi Record": the g-force gFx beside ax, which leaves gravity out."""
+    t, imu = _example()
+    rows = [",".join([f"{ti:.17g}", *(f"{v / 9.80665:.17g}" for v in r[:3]), "0.01", "0.02", "0.03",
+                      *(f"{v:.17g}" for v in r[3:])]) for ti, r in zip(t, imu, strict=True)]
+    path = _rows(tmp_path / "toolbox.csv", "time,gFx,gFy,gFz,ax,ay,az,wx,wy,wz", rows)
+    source = open_recording(path)
+    assert "acc_x='gFx'" in source.choices and "acc in g" in source.choices
+    np.testing.assert_allclose(source.load()[0].acc, open_recording(EXAMPLE).load()[0].acc,
+                               rtol=1e-12)
+
+
+def test_a_clock_in_an_unstated_unit_is_named_and_an_index_is_no_unit(tmp_path):
+    """Xsens's SampleTimeFine counts ticks of 100 us (MT Manager) or 1 us (Movella DOT): the
+    refusal names it and what each is; given as us it is read. A unit "[1]" after a space
+    stays a unit, where "[1]" written onto a name is an axis."""
+    t, imu = _example()
+    rows = [",".join([str(i), str(round(ti * 1e6)), *(f"{v:.17g}" for v in r)])
+            for i, (ti, r) in enumerate(zip(t, imu, strict=True))]
+    path = _rows(tmp_path / "dot.csv", "PacketCounter,SampleTimeFine,Acc_X,Acc_Y,Acc_Z,Gyr_X,"
+                 "Gyr_Y,Gyr_Z", rows)
+    with pytest.raises(RecordingError, match=r"'PacketCounter' counts samples.*'SampleTimeFine' "
+                       r"is Xsens's clock, in ticks of 100 us .* 1 us"):
+        open_recording(path)
+    rec, _ = open_recording(path, time_column="SampleTimeFine", time_unit="us").load()
+    np.testing.assert_allclose(rec.dt[1:], open_recording(EXAMPLE).load()[0].dt[1:], rtol=1e-6)
+
+    from testbenches.reader import split_unit
+
+    assert split_unit("q_w [1]") == ("q_w", "1")
+    assert split_unit("gyro_rad[1]") == ("gyro_rad[1]", None)

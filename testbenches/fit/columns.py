@@ -7,10 +7,11 @@ from __future__ import annotations
 import re
 
 ACC_STEMS = ("acc", "accel", "accelerometer", "acceleration", "linear_acceleration",
-             "accelerometer_acceleration")
+             "accelerometer_acceleration", "accel_ln", "accel_wr")
 """Names of the accelerometer's columns before the axis (acc_x, accelX, linear_acceleration.x
 as ROS writes it, accelerometerAccelerationX as iOS's SensorLog). Not a phone's linear or user
-acceleration, which leaves gravity out (its median norm is then no gravity's, and refused)."""
+acceleration, which leaves gravity out (its median norm is then no gravity's, and refused).
+Shimmer's low-noise and wide-range accelerometers (Accel_LN_X, Accel_WR_X) in that order."""
 GYRO_STEMS = ("gyro", "gyr", "gyroscope", "angular_velocity", "rotation_rate", "omega",
               "gyro_rotation")
 """Names of the gyro's columns before the axis (gyro_x, gyroX, angular_velocity.x,
@@ -23,18 +24,21 @@ def axis_names(stems: tuple[str, ...], axis: str, short: tuple[str, ...]) -> tup
 
 
 ALIASES: dict[str, tuple[str, ...]] = {
-    **{f"acc_{a}": (*axis_names(ACC_STEMS, a, ("a", "a_")), f"acc_{a}_g", f"acc_{a}_ms2")
+    **{f"acc_{a}": (*axis_names(ACC_STEMS, a, ("g_f", "a", "a_")), f"acc_{a}_g", f"acc_{a}_ms2")
        for a in "xyz"},
     **{f"gyro_{a}": (*axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_")), f"gyro_{a}_dps")
        for a in "xyz"},
-    "time": ("time", "t", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
-             "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
-             "header_stamp", "millis", "micros"),
+    "time": ("time", "timestamp", "time_s", "time_ms", "time_us", "time_ns", "timestamp_s",
+             "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp", "timestamp_unix",
+             "header_stamp", "millis", "micros", "t"),
     **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}")
        for c in "wxyz"},
 }
 """Column names a recording may use per quantity, as norm_name makes them (case ignored;
-spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out). A reference
+spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out; an index
+[0], [1], [2] as the axis x, y, z), in the order they are taken: "t" last, as a flight log's
+"T" is its temperature beside a "timestamp". Physics Toolbox's g-force "gFx" is the
+accelerometer (its "ax" there leaves gravity out, and is refused for it). A reference
 quaternion's components (sensor to world) too, as motion capture names them ("Rotation W" in
 OptiTrack Motive's stacked header, testbenches.reader); not "orientation", which in a ROS Imu
 message is the device's own estimate, no reference."""
@@ -47,16 +51,71 @@ def norm_name(name: str) -> str:
     name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name.strip()).lower().lstrip("%")
     for sep in (" ", "-", "."):
         name = name.replace(sep, "_")
+    name = re.sub(r"\[([012])\]$", lambda m: "_" + "xyz"[int(m.group(1))], name)
     return name.removeprefix("field_")
+
+
+UNIT_TOKENS: dict[str, dict[str, str]] = {
+    "gyro": {"rad": "rad/s", "rad_s": "rad/s", "rads": "rad/s", "rps": "rad/s",
+             "dps": "deg/s", "deg_s": "deg/s", "degs": "deg/s", "mdps": "mdps"},
+    "acc": {"g": "g", "mg": "mg", "m_s2": "m/s2", "m_s_2": "m/s2", "ms2": "m/s2",
+            "mps2": "m/s2"},
+}
+"""Units a name may carry as a word of its own before or after the axis (PX4's "gyro_rad[0]",
+"accelerometer_m_s2[0]"; "gyro_x_dps"), per sensor, as norm_name spells them."""
+_WORDS = "|".join(sorted({t for tokens in UNIT_TOKENS.values() for t in tokens}, key=len,
+                         reverse=True))
+_UNIT_WORD = re.compile(rf"_({_WORDS})(?=(_[xyz])?$)")
+
+
+def _without_unit(name: str) -> tuple[str, str | None]:
+    """A normed name without a unit word (UNIT_TOKENS) and that word (None: none)."""
+    m = _UNIT_WORD.search(name)
+    return (name[:m.start()] + name[m.end():], m.group(1)) if m else (name, None)
+
+
+def unit_in_name(quantity: str, name: str) -> str | None:
+    """The unit an accelerometer's or gyro's column name carries as a word (UNIT_TOKENS), None
+    where it carries none or one of the other sensor's."""
+    sensor = quantity.partition("_")[0]
+    word = _without_unit(norm_name(name))[1]
+    return UNIT_TOKENS.get(sensor, {}).get(word) if word else None
+
+
+def _without_device(normed: list[str]) -> list[str]:
+    """Names without the device's prefix that every one of them shares and without a trailing
+    "_cal" (Shimmer's "Shimmer_A1B2_Gyro_X_CAL": "gyro_x"); as they are where they share
+    none."""
+    words = [n.split("_") for n in normed if n]
+    shared = 0  # the words every name starts with, one at least left to each
+    while (len(words) > 1 and all(len(w) > shared + 1 for w in words)
+           and len({w[shared] for w in words}) == 1):
+        shared += 1
+    prefix = "".join(f"{w}_" for w in words[0][:shared]) if shared else ""
+    return [n.removeprefix(prefix).removesuffix("_cal") for n in normed]
+
+
+def name_forms(names: list[str]) -> list[list[str]]:
+    """The names as norm_name spells them, then without a unit word (UNIT_TOKENS), then also
+    without a device's prefix and a "_cal" (_without_device): the forms find_name tries in
+    turn, so that a name as written is taken before one read into."""
+    normed = [norm_name(n) for n in names]
+    bare = [_without_unit(n)[0] for n in normed]
+    return [normed, bare, [_without_unit(n)[0] for n in _without_device(normed)]]
 
 
 def find_name(names: list[str], quantity: str, given: str | None = None,
               more: tuple[str, ...] = ()) -> int | None:
     """The column of a quantity: the one given (by its name as written, with or without its
-    unit), else the first of its aliases and then of `more`."""
-    normed = [norm_name(n) for n in names]
-    wanted = (norm_name(given),) if given else (*ALIASES[quantity], *more)
-    for alias in wanted:
-        if alias in normed:
-            return normed.index(alias)
+    unit), else the first of its aliases and then of `more` in the first of name_forms that
+    has one."""
+    if given:
+        forms = [[norm_name(n) for n in names]]
+        wanted: tuple[str, ...] = (norm_name(given),)
+    else:
+        forms, wanted = name_forms(names), (*ALIASES[quantity], *more)
+    for normed in forms:
+        for alias in wanted:
+            if alias in normed:
+                return normed.index(alias)
     return None

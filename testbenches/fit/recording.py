@@ -25,7 +25,7 @@ from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
 from ..reader import TIME_OF_DAY, TIME_SCALE
 from ..time_unit import median_step
-from .columns import ALIASES, find_name, norm_name
+from .columns import ALIASES, find_name, norm_name, unit_in_name
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -143,8 +143,12 @@ def parse_columns(specs: list[str]) -> dict[str, str]:
 
 
 COUNTER_NAMES = ("n_samples", "sample", "samples", "sample_index", "index", "idx", "counter",
-                 "count", "frame", "n")
+                 "count", "frame", "n", "packet_counter")
 """Column names of a sample counter: no time, and said so where the time is missing."""
+CLOCK_NAMES = {"sample_time_fine": "Xsens's clock, in ticks of 100 us in an MT Manager export "
+                                   "and of 1 us in a Movella DOT one (--time-unit us)"}
+"""Column names of a sensor's clock in a unit its file does not state and no step tells
+(time_unit: both are rates an IMU is sampled at): said where the time is missing, not taken."""
 EXTRA_COLUMNS = ("dt", "roll", "pitch")
 """Columns found by their own name only: the sampling and a reference."""
 
@@ -190,9 +194,11 @@ def find_columns(table: Any, time_column: str | None = None,
 
 
 def _unit_in_name(quantity: str, name: str) -> str | None:
-    """The unit a time or dt column's name states (time_ms, timestamp_ns, micros), else None."""
+    """The unit a column's name states: a time or dt column's (time_ms, timestamp_ns, micros),
+    an accelerometer's or gyro's as a word of its own (columns.unit_in_name: gyro_rad[0],
+    gyro_x_dps); else None."""
     if quantity not in ("time", "dt"):
-        return None
+        return unit_in_name(quantity, name)
     normed = norm_name(name)
     counters = {"millis": "ms", "micros": "us"}  # a sketch's millis() and micros()
     if normed in counters:
@@ -521,8 +527,12 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     else:
         counters = [h for h, nm in zip(table.header, table.names, strict=True)
                     if norm_name(nm) in COUNTER_NAMES]
-        hint = (f" ({', '.join(map(repr, counters))} counts samples, which is no time)"
-                if counters else "")
+        hints = ([f"{', '.join(map(repr, counters))} counts samples, which is no time"]
+                 if counters else [])
+        hints += [f"{h!r} is {CLOCK_NAMES[norm_name(nm)]}"
+                  for h, nm in zip(table.header, table.names, strict=True)
+                  if norm_name(nm) in CLOCK_NAMES]
+        hint = f" ({'; '.join(hints)})" if hints else ""
         raise RecordingError(f"{path}: no time or dt column{hint}: give the sample rate (--rate "
                              "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
