@@ -4,11 +4,12 @@
 any length is read in bounded memory:
 
 - delimited text (CSV and its kin), also compressed (gzip, bz2 or xz: .csv.gz and the like,
-  told by the file's first bytes): the encoding (UTF-8 with or without a byte-order mark, else
-  Latin-1), the delimiter (comma, semicolon, tab or bar; a decimal comma with semicolons) and
-  the header row are found from the file's start; pyarrow's CSV reader parses it, and where it
-  cannot (text where a number belongs, a row of the wrong length, padded cells) the file is read
-  by Python's csv module, which names the file's line, the column and the value;
+  told by the file's first bytes): the encoding (UTF-8 with or without a byte-order mark,
+  UTF-16 as Windows' "Unicode" exports write it, else Latin-1), the delimiter (comma,
+  semicolon, tab or bar; a decimal comma with semicolons) and the header row are found from the
+  file's start; pyarrow's CSV reader parses it, and where it cannot (text where a number
+  belongs, a row of the wrong length, padded cells) the file is read by Python's csv module,
+  which names the file's line, the column and the value;
 - a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - Parquet: its columns (a timestamp column as seconds);
@@ -293,15 +294,45 @@ def seconds_of(text: str) -> float | None:
     return whole + (int(fraction) / 10 ** len(fraction) if fraction else 0.0)
 
 
+def _utf16(raw: bytes) -> str | None:
+    """The UTF-16 codec a text's start is written in (Windows' "Unicode": Excel's Unicode Text,
+    PowerShell's redirection), by its byte-order mark or, without one, by the zero byte beside
+    every ASCII character; None for any other text."""
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        return "utf-16"
+    pairs = len(raw) // 2
+    if pairs < 8:
+        return None
+    if raw[1:2 * pairs:2].count(0) > 0.9 * pairs and raw[0:2 * pairs:2].count(0) == 0:
+        return "utf-16-le"
+    if raw[0:2 * pairs:2].count(0) > 0.9 * pairs and raw[1:2 * pairs:2].count(0) == 0:
+        return "utf-16-be"
+    return None
+
+
+def _decoded(raw: bytes, encoding: str, cut: bool) -> str:
+    """The text of a file's start in a UTF-16 codec, a character cut at its end left out."""
+    raw = raw[:len(raw) // 2 * 2]
+    try:
+        return raw.decode(encoding)
+    except UnicodeDecodeError:
+        if not cut:
+            raise
+        return raw[:-2].decode(encoding)  # half a surrogate pair
+
+
 def _sniff(path: Path) -> _TextLayout:
     with _open_bytes(path) as f:
         raw = f.read(SNIFF_BYTES)
     encoding = "utf-8"
     try:
-        text = raw.decode("utf-8-sig")
+        if (wide := _utf16(raw)) is not None:
+            encoding, text = wide, _decoded(raw, wide, len(raw) == SNIFF_BYTES)
+        else:
+            text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
-        if err.start >= len(raw) - 4 and len(raw) == SNIFF_BYTES:  # a character cut at the end
-            text = raw[:err.start].decode("utf-8-sig")
+        if encoding == "utf-8" and err.start >= len(raw) - 4 and len(raw) == SNIFF_BYTES:
+            text = raw[:err.start].decode("utf-8-sig")  # a character cut at the end
         else:
             encoding, text = "latin-1", raw.decode("latin-1")
     if len(raw) == SNIFF_BYTES:  # the last line may be cut
@@ -565,7 +596,7 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
             if compression in ARROW_COMPRESSIONS else pa.PythonFile(_open_bytes(path), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.data_after,
                                         encoding="utf8" if layout.encoding == "utf-8"
-                                        else "latin1", block_size=1 << 22),
+                                        else layout.encoding, block_size=1 << 22),
             parse_options=pc.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
             convert_options=pc.ConvertOptions(
                 column_types=types, include_columns=wanted,

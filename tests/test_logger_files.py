@@ -360,3 +360,30 @@ def test_a_clock_in_an_unstated_unit_is_named_and_an_index_is_no_unit(tmp_path):
 
     assert split_unit("q_w [1]") == ("q_w", "1")
     assert split_unit("gyro_rad[1]") == ("gyro_rad[1]", None)
+
+
+@pytest.mark.parametrize("codec,delimiter,compress", [
+    ("utf-16", "\t", False),  # Excel's "Unicode Text": a byte-order mark, tabs
+    ("utf-16-le", ",", False),  # no mark
+    ("utf-16-be", ",", True),  # gzip'd
+])
+def test_a_utf16_file_reads_as_the_text_it_holds(tmp_path, codec, delimiter, compress):
+    """Windows' "Unicode" (UTF-16, as Excel's Unicode Text and PowerShell's redirection write
+    it) reads as the UTF-8 file does, and a bad cell is still named by its line; read as bytes
+    its header was the characters between zero bytes."""
+    import gzip
+
+    text = EXAMPLE.read_text().replace(",", delimiter)
+    raw = text.encode(codec)
+    path = tmp_path / "unicode.txt"
+    path.write_bytes(gzip.compress(raw) if compress else raw)
+    rec, _ = open_recording(path).load()
+    want = open_recording(EXAMPLE).load()[0]
+    np.testing.assert_array_equal(rec.acc, want.acc)
+    np.testing.assert_array_equal(rec.dt, want.dt)
+    lines = text.splitlines(keepends=True)
+    lines[5] = lines[5].replace("0.0", "x.0", 1)
+    bad = tmp_path / "bad.txt"
+    bad.write_bytes("".join(lines).encode(codec))
+    with pytest.raises(RecordingError, match=r"line 6, column 'time': 'x\.04' is not a number"):
+        open_recording(bad).load()
