@@ -248,12 +248,21 @@ class _TextLayout:
     """Each column's unit from a row of units above or below the names (None: none)."""
     stacked: str = ""
     """The lines a header written on several rows spans ("lines 3-7"; "" for one row)."""
+    rate: tuple[float, int] | None = None
+    """The sample rate [Hz] a line before the header states, and that line (STATED_RATE)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
                        r"\s*(Z|[+-]\d{2}(?::?\d{2})?)?$")
 """An ISO 8601 date and time as loggers write it: "2024-05-01T12:00:00.010", a space for the T,
 a decimal comma, a zone (Z, +02:00, +0200) or none."""
+
+
+STATED_RATE = re.compile(r"\b(?:update|sample|sampling|output|data)[ _-]?(?:rate|frequency)"
+                         r"\W{0,3}?([0-9]+(?:[.,][0-9]+)?)\s*hz\b", re.IGNORECASE)
+"""A sample rate stated in a logger's preamble, with its unit: Xsens MT Manager's "// Update
+Rate: 100.0Hz", "# Sample rate = 200 Hz", "Sampling frequency,50,Hz" does not (the unit in a
+cell of its own). A file's time column governs where it has one; two statements are none."""
 
 
 _TIME_OF_DAY = re.compile(r"^(\d{1,2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?$")
@@ -382,8 +391,11 @@ def _sniff(path: Path) -> _TextLayout:
             times_of_day.add(j)
     skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
                else f"line {preamble[0][0]}") if preamble else ""
+    rates = [(float(m.group(1).replace(",", ".")), no) for no, line in preamble
+             if (m := STATED_RATE.search(line))]
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
-                       datetimes, times_of_day, skipped, data_after, units_row, stacked)
+                       datetimes, times_of_day, skipped, data_after, units_row, stacked,
+                       rates[0] if len(rates) == 1 and rates[0][0] > 0.0 else None)
 
 
 def _cells_of(line: str, delimiter: str) -> list[str]:
@@ -537,8 +549,9 @@ def _text(path: Path) -> TableSource:
     note = (f"the header on {spans}" + (f", {layout.skipped} before it skipped"
                                         if layout.skipped else "")
             if layout.skipped or layout.stacked else "")
+    attrs = {} if layout.rate is None else {"rate": layout.rate[0]}
     return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
-                       where, note=note)
+                       where, attrs, note=note)
 
 
 class _ArrowFailed(Exception):

@@ -387,3 +387,31 @@ def test_a_utf16_file_reads_as_the_text_it_holds(tmp_path, codec, delimiter, com
     bad.write_bytes("".join(lines).encode(codec))
     with pytest.raises(RecordingError, match=r"line 6, column 'time': 'x\.04' is not a number"):
         open_recording(bad).load()
+
+
+def test_a_rate_the_preamble_states_times_a_file_without_a_time_column(tmp_path):
+    """Xsens MT Manager's export: "// Update Rate: 100.0Hz" before a header of PacketCounter,
+    SampleTimeFine (ticks its file does not size) and the axes; the rate times the samples and
+    is said. Two rates stated, or none, leave the file without a time, refused as before; a
+    time column governs where there is one."""
+    _, imu = _example()
+    rows = ["\t".join([str(i), str(1000 + 100 * i), *(f"{v:.17g}" for v in r)])
+            for i, r in enumerate(imu)]
+    header = "PacketCounter\tSampleTimeFine\tAcc_X\tAcc_Y\tAcc_Z\tGyr_X\tGyr_Y\tGyr_Z"
+    path = _rows(tmp_path / "mt.txt", header, rows,
+                 before="// Start Time: Unknown\n// Update Rate: 100.0Hz\n// Filter Profile: "
+                        "General\n")
+    source = open_recording(path)
+    assert "time from the rate the file states (100 Hz)" in source.choices
+    rec, _ = source.load()
+    np.testing.assert_array_equal(rec.acc, open_recording(EXAMPLE).load()[0].acc)
+    np.testing.assert_allclose(rec.dt[1:], 0.01)
+    twice = _rows(tmp_path / "twice.txt", header, rows,
+                  before="// Update Rate: 100.0Hz\n// Sample rate: 50 Hz\n")
+    with pytest.raises(RecordingError, match="no time or dt column"):
+        open_recording(twice)
+    timed = tmp_path / "timed.csv"
+    timed.write_text("# sample rate: 50 Hz\n" + EXAMPLE.read_text())
+    assert "rate the file states" not in open_recording(timed).choices
+    np.testing.assert_array_equal(open_recording(timed).load()[0].dt,
+                                  open_recording(EXAMPLE).load()[0].dt)

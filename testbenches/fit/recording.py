@@ -524,6 +524,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                                               units.get(kind), acc, gyro, table.where, keep)
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
+        time_how = "" if given_rate else f"time from the rate the file states ({rate:g} Hz)"
     else:
         counters = [h for h, nm in zip(table.header, table.names, strict=True)
                     if norm_name(nm) in COUNTER_NAMES]
