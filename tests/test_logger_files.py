@@ -415,3 +415,18 @@ def test_a_rate_the_preamble_states_times_a_file_without_a_time_column(tmp_path)
     assert "rate the file states" not in open_recording(timed).choices
     np.testing.assert_array_equal(open_recording(timed).load()[0].dt,
                                   open_recording(EXAMPLE).load()[0].dt)
+
+
+@pytest.mark.parametrize("name,scale", [
+    ("Elapsed time (s)", 1.0),
+    ("Time since start in ms", 1e3),  # AndroSensor's
+    ("seconds_elapsed", 1.0),  # Sensor Logger's
+])
+def test_an_elapsed_time_is_the_time(tmp_path, name, scale):
+    """A time column named for the time since the start is the time, in its name's unit."""
+    t, imu = _example()
+    rows = [",".join([f"{ti * scale:.10g}", *(f"{v:.17g}" for v in r)])
+            for ti, r in zip(t, imu, strict=True)]
+    source = open_recording(_rows(tmp_path / "elapsed.csv", f"{name},{HEADER}", rows))
+    assert f"time={name!r}" in source.choices
+    np.testing.assert_allclose(source.load()[0].dt[1:], 0.01, rtol=1e-6)

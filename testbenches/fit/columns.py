@@ -30,7 +30,8 @@ ALIASES: dict[str, tuple[str, ...]] = {
        for a in "xyz"},
     "time": ("time", "timestamp", "time_s", "time_ms", "time_us", "time_ns", "timestamp_s",
              "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp", "timestamp_unix",
-             "header_stamp", "millis", "micros", "t"),
+             "header_stamp", "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
+             "seconds_elapsed", "time_since_start", "time_since_start_in_ms", "t"),
     **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}")
        for c in "wxyz"},
 }

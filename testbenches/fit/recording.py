@@ -200,9 +200,10 @@ def _unit_in_name(quantity: str, name: str) -> str | None:
     if quantity not in ("time", "dt"):
         return unit_in_name(quantity, name)
     normed = norm_name(name)
-    counters = {"millis": "ms", "micros": "us"}  # a sketch's millis() and micros()
-    if normed in counters:
-        return counters[normed]
+    named = {"millis": "ms", "micros": "us",  # a sketch's millis() and micros()
+             "seconds_elapsed": "s"}  # Sensor Logger's
+    if normed in named:
+        return named[normed]
     *_, suffix = normed.rpartition("_")
     return suffix if suffix in TIME_SCALE and normed != suffix else None
 
