@@ -430,3 +430,12 @@ def test_an_elapsed_time_is_the_time(tmp_path, name, scale):
     source = open_recording(_rows(tmp_path / "elapsed.csv", f"{name},{HEADER}", rows))
     assert f"time={name!r}" in source.choices
     np.testing.assert_allclose(source.load()[0].dt[1:], 0.01, rtol=1e-6)
+
+
+def test_a_name_the_header_gives_twice_is_refused_not_chosen(tmp_path):
+    """Two columns named acc_x (a second sensor's, or a gyro column misnamed): which one is
+    meant no rule can say, so the file is refused naming both, not read from the first."""
+    lines = EXAMPLE.read_text().splitlines()
+    path = _rows(tmp_path / "twice.csv", lines[0] + ",acc_x", [line + ",0" for line in lines[1:]])
+    with pytest.raises(RecordingError, match=r"names 'acc_x' 2 times \(columns 2, 9\)"):
+        open_recording(path)

@@ -190,6 +190,14 @@ def find_columns(table: Any, time_column: str | None = None,
             found.index[quantity] = i
             found.source[quantity] = table.header[i]
             found.units[quantity] = table.units[i] or _unit_in_name(quantity, table.names[i])
+    normed = [norm_name(n) for n in table.names]
+    for quantity, i in found.index.items():
+        same = [j for j, n in enumerate(normed) if n == normed[i]]
+        if len(same) > 1:  # which one is meant, no name can say
+            raise RecordingError(
+                f"{table.path}: the header names {table.header[i]!r} {len(same)} times (columns "
+                f"{', '.join(str(j + 1) for j in same)}), so {quantity} could be any of them: "
+                "rename them apart")
     return found
 
 
