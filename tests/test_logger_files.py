@@ -439,3 +439,21 @@ def test_a_name_the_header_gives_twice_is_refused_not_chosen(tmp_path):
     path = _rows(tmp_path / "twice.csv", lines[0] + ",acc_x", [line + ",0" for line in lines[1:]])
     with pytest.raises(RecordingError, match=r"names 'acc_x' 2 times \(columns 2, 9\)"):
         open_recording(path)
+
+
+def test_a_time_that_does_not_rise_gives_way_to_one_that_does(tmp_path):
+    """A logger's whole epoch seconds beside its milliseconds: the seconds repeat a hundred
+    times, the milliseconds rise, so they are the time, and the choices say why. Where no other
+    time rises the file is refused as before."""
+    t, imu = _example()
+    rows = [",".join([str(1_700_000_000 + int(ti)), f"{ti * 1e3:.0f}", *(f"{v:.17g}" for v in r)])
+            for ti, r in zip(t, imu, strict=True)]
+    path = _rows(tmp_path / "two.csv", f"timestamp,time_ms,{HEADER}", rows)
+    source = open_recording(path)
+    assert "'timestamp' does not rise from row to row, 'time_ms' does" in source.choices
+    assert "time='time_ms'" in source.choices
+    np.testing.assert_allclose(source.load()[0].dt[1:], 0.01, rtol=1e-9)
+    alone = _rows(tmp_path / "alone.csv", f"timestamp,note,{HEADER}",
+                  [",".join([row.split(",")[0], "0", *row.split(",")[2:]]) for row in rows])
+    with pytest.raises(RecordingError, match="repeats"):
+        open_recording(alone)

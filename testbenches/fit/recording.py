@@ -25,7 +25,7 @@ from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
 from ..reader import TIME_OF_DAY, TIME_SCALE
 from ..time_unit import median_step
-from .columns import ALIASES, find_name, norm_name, unit_in_name
+from .columns import ALIASES, find_name, name_forms, norm_name, unit_in_name
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -162,6 +162,13 @@ class Columns:
     source: dict[str, str]
     units: dict[str, str | None]
     header: list[str]
+    other_times: list[int] = field(default_factory=list)
+    """Further columns a time's name fits, where the time was not given (a logger's epoch
+    seconds beside its milliseconds): what serves where the one taken does not rise."""
+
+    def take_time(self, table: Any, i: int) -> None:
+        self.index["time"], self.source["time"] = i, table.header[i]
+        self.units["time"] = table.units[i] or _unit_in_name("time", table.names[i])
 
 
 def find_columns(table: Any, time_column: str | None = None,
@@ -190,6 +197,10 @@ def find_columns(table: Any, time_column: str | None = None,
             found.index[quantity] = i
             found.source[quantity] = table.header[i]
             found.units[quantity] = table.units[i] or _unit_in_name(quantity, table.names[i])
+    if "time" in found.index and "time" not in given:
+        taken = set(found.index.values())
+        found.other_times = [j for j, forms in enumerate(zip(*name_forms(table.names), strict=True))
+                             if j not in taken and set(forms) & set(ALIASES["time"])]
     normed = [norm_name(n) for n in table.names]
     for quantity, i in found.index.items():
         same = [j for j, n in enumerate(normed) if n == normed[i]]
@@ -489,12 +500,13 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     names = list(found.index)
     wanted = [found.index[q] for q in names]
     try:
-        prefix_block = table.first_block(wanted, PREFIX_ROWS)
+        prefix_block = table.first_block(wanted + found.other_times, PREFIX_ROWS)
     except TableError as err:
         raise RecordingError(str(err)) from None
     if prefix_block is None:
-        prefix_block = np.empty((0, len(names)))
+        prefix_block = np.empty((0, len(wanted) + len(found.other_times)))
     prefix = {q: prefix_block[:, k] for k, q in enumerate(names)}
+    other_times = {j: prefix_block[:, len(names) + k] for k, j in enumerate(found.other_times)}
     units = found.units
     n = len(prefix_block)
     if n < 2:
@@ -510,6 +522,15 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                                  "has none")
         joiner = _JoinedRows
         prefix, keep = joiner()(prefix)
+    time_taken = ""
+    if not split and "time" in prefix and not _rises(prefix["time"]):
+        rising = next((j for j, t in other_times.items() if _rises(t)), None)
+        if rising is not None:  # a time that repeats or goes back, where another rises
+            time_taken = (f"; {found.source['time']!r} does not rise from row to row, "
+                          f"{table.header[rising]!r} does")
+            found.take_time(table, rising)
+            prefix["time"] = other_times[rising]
+            wanted = [found.index[q] for q in names]
     # the samples as read: the time unit's evidence needs their directions only
     acc, gyro = _vectors({q: v[keep] for q, v in prefix.items()})
     t_unit, time_how = "s", ""
@@ -531,6 +552,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         kind = "time" if "time" in prefix else "dt"
         clock, t_unit, time_how = _time_clock(path, kind, prefix[kind], time_unit,
                                               units.get(kind), acc, gyro, table.where, keep)
+        time_how += time_taken
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
         time_how = "" if given_rate else f"time from the rate the file states ({rate:g} Hz)"
@@ -662,6 +684,12 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
                                      lambda s: clock_in(s)(raw, 0, len(raw))[0][keep], acc,
                                      gyro)
     return clock_in(scale), t_unit, how
+
+
+def _rises(t: np.ndarray) -> bool:
+    """Whether a time column's numbers rise from each row to the next (NaN rows left out)."""
+    values = t[np.isfinite(t)]
+    return len(values) > 1 and bool(np.all(np.diff(values) > 0.0))
 
 
 def _vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
