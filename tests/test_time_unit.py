@@ -229,3 +229,14 @@ def test_a_repeated_time_is_refused_with_the_rate_and_a_given_rate_serves(tmp_pa
     np.testing.assert_array_equal(rec.dt, np.full(len(imu), 1 / 1600.0))
     with pytest.raises(RecordingError, match="--rate is given, but so is --time-unit"):
         open_recording(path, rate=1600.0, time_unit="ms")
+
+
+def test_a_time_coarser_than_the_samples_is_sized_by_its_mean_step(tmp_path):
+    """Whole epoch seconds at 100 Hz rise by 1 a hundred rows apart: sized by that tick the
+    time was taken as ms and the refusal offered --rate 1.11e+05; by its mean step it is
+    seconds, and the rate offered is the samples' (111 Hz over the first 9 s: the last
+    second's rows count, not its span)."""
+    t, imu = _example()
+    path = _write(tmp_path / "epoch.csv", "timestamp", 1_700_000_000 + np.floor(t), imu)
+    with pytest.raises(RecordingError, match=r"the time 1\.7e\+09 s repeats .* give --rate 111 "):
+        open_recording(path)

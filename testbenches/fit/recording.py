@@ -680,7 +680,10 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
                        f"{mean_rate:.4g} to space the samples by a rate, the time left)")
         return _Clock(kind, scale, first, path, where, wrap=wrap, repeats=repeats)
 
-    t_unit, scale, how = _time_scale(path, kind, step, unit, stated,
+    # the unit from the mean step where the time repeats: a clock coarser than the samples
+    # rises by its tick, not by their spacing (whole epoch seconds at 100 Hz)
+    unit_step = span[1] / span[0] if zeros and span[1] > 0.0 else step
+    t_unit, scale, how = _time_scale(path, kind, unit_step, unit, stated,
                                      lambda s: clock_in(s)(raw, 0, len(raw))[0][keep], acc,
                                      gyro)
     return clock_in(scale), t_unit, how
