@@ -245,6 +245,8 @@ class Calibration:
     def read(cls, path: Path | str) -> Calibration:
         """calibration.json; ValueError (or FileNotFoundError) saying what is wrong."""
         path = Path(path)
+        if not path.is_file():
+            raise FileNotFoundError(f"calibration file {path}: no such file")
         try:
             doc = json.loads(path.read_text())
         except json.JSONDecodeError as err:

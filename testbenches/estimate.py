@@ -86,7 +86,8 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--sensor-delay", type=float, default=None,
                    help="how long the samples lag their time stamps [s] (outputs turned ahead)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="an estimator parameter for every chosen estimator (repeatable)")
+                   help="an estimator parameter, for every chosen estimator that has it "
+                   "(repeatable; a name none has is refused)")
     p.add_argument("--reference", type=Path, default=None,
                    help="a CSV of time with roll, pitch [rad] or q_w, q_x, q_y, q_z: the "
                    "reference, matched by time")
@@ -247,8 +248,10 @@ def about_world_up(q: np.ndarray, up: np.ndarray) -> np.ndarray:
 
 # ----- running ---------------------------------------------------------------------------------
 
-def estimator_params(args: argparse.Namespace, entry: dict[str, Any]) -> dict[str, Any]:
-    """A preset entry with the command's sensor options and --param on top."""
+def estimator_params(args: argparse.Namespace, entry: dict[str, Any],
+                     has: set[str] | None = None) -> dict[str, Any]:
+    """A preset entry with the command's sensor options and --param on top: of --param, the
+    names in `has` (the estimator's parameters; None: every name)."""
     from .fit.recording import RecordingError
 
     params = dict(entry)
@@ -263,8 +266,26 @@ def estimator_params(args: argparse.Namespace, entry: dict[str, Any]) -> dict[st
             raise RecordingError(f"--mounting {args.mounting!r}: expected ROLL,PITCH,YAW in "
                                  "deg, e.g. 0,90,0") from None
         params.update(mount_roll=roll, mount_pitch=pitch, mount_yaw=yaw)
-    params.update(parse_params(args.param))
+    params.update({name: value for name, value in parse_params(args.param).items()
+                   if has is None or name in has})
     return params
+
+
+def param_names(args: argparse.Namespace, keys: list[str]) -> dict[str, set[str]]:
+    """Each estimator's parameter names; a --param name none of them has is refused, naming
+    those they have (a name only some have, such as the Kalman filter's Q_angle, goes to
+    those)."""
+    from fusion_core.registry import estimator_class
+
+    from .fit.recording import RecordingError
+
+    names = {key: set(estimator_class(key).param_specs()) for key in keys}
+    known = set().union(*names.values())
+    unknown = sorted(set(parse_params(args.param)) - known)
+    if unknown:
+        raise RecordingError(f"--param {', '.join(unknown)}: no estimator run here has it; "
+                             f"they have {', '.join(sorted(known))}")
+    return names
 
 
 def output_columns(spec: str, position: bool) -> list[str]:
@@ -540,12 +561,16 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     from fusion_core.presets import load_preset
     from fusion_core.registry import KEYS, create
 
-    from .fit.recording import source_from_args
+    from .fit.recording import RecordingError, source_from_args
     from .options import choose
 
+    if args.out.exists() and not args.out.is_dir():
+        raise RecordingError(f"--out {args.out}: a file; the outputs go to a folder")
     keys = choose(args.estimator, list(KEYS), "estimator")
     preset = with_calibration(load_preset(args.preset), args.calibration)
-    estimators = {key: create(key, estimator_params(args, preset[key])) for key in keys}
+    has = param_names(args, keys)
+    estimators = {key: create(key, estimator_params(args, preset[key], has[key]))
+                  for key in keys}
     names = {key: output_columns(args.outputs, est.HAS_POSITION)
              for key, est in estimators.items()}
     if not args.no_plots:  # the plotting library loads while the recording opens, which
@@ -562,7 +587,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         for key, est in estimators.items():
             path = args.out / f"{source.name}_{key}{FORMATS[args.format]}"
             runs.append(_Run(key, est, path, args.format, names[key]))
-        vqf_params = estimator_params(args, preset[keys[0]])  # calibration and mounting
+        vqf_params = estimator_params(args, preset[keys[0]], has[keys[0]])  # calibration, mounting
         vqf, found = _run_blocks(args, source, reference, runs, vqf_params)
     except BaseException:
         for run in runs:

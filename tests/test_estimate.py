@@ -468,3 +468,42 @@ def test_a_sensor_that_starts_z_down_is_said_and_a_mounting_turns_it(tmp_path, c
     assert "z axis down" not in turned
     rmse = float(next(r for r in turned.splitlines() if r.startswith("kf ")).split()[2])
     assert rmse < 1.5
+
+
+@pytest.mark.parametrize("extra,says", [
+    (["--time-column", "acc_x"], "the column 'acc_x' is taken for both acc_x and time"),
+    (["--column", "gyro_x=acc_x"], "the column 'acc_x' is taken for both acc_x and gyro_x"),
+    (["--out", "FILE"], ": a file; the outputs go to a folder"),
+    (["--calibration", "MISSING"], "no such file"),
+    (["--param", "foo=1"], "--param foo: no estimator run here has it; they have Q_angle"),
+    (["--estimator", "cf", "--param", "Q_angle=1e-5"], "--param Q_angle: no estimator run here"),
+])
+def test_an_option_that_cannot_serve_gets_one_line(tmp_path, extra, says):
+    """A column given for a quantity another already takes (pyarrow's KeyError on the
+    doubled field, as a traceback), --out naming a file (FileExistsError), a calibration file
+    that is not there (an errno's text), a parameter no estimator run has: one line each."""
+    out = tmp_path / "FILE"
+    out.write_text("keep")
+    extra = [str(out) if e == "FILE" else str(tmp_path / "none.json") if e == "MISSING" else e
+             for e in extra]
+    args = ["--out", str(tmp_path / "out"), *extra] if "--out" not in extra else extra
+    proc = subprocess.run([sys.executable, "-m", "testbenches", "estimate", str(EXAMPLE),
+                           "--no-plots", *args], capture_output=True, text=True, timeout=120,
+                          cwd=REPO)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], proc.stderr
+    assert out.read_text() == "keep"
+
+
+def test_a_parameter_goes_to_the_estimators_that_have_it(tmp_path):
+    """--param Q_angle (the Kalman filters') with every estimator: the Kalman filters take it,
+    the others run as they would without it."""
+    assert main(["estimate", str(EXAMPLE), "--estimator", "cf,kf", "--param", "Q_angle=1e-3",
+                 "--out", str(tmp_path), "--no-plots"]) == 0
+    ex = _example()
+    dt = np.diff(ex["time"], prepend=ex["time"][0] - 0.01)
+    for key, params in (("cf", {}), ("kf", {"Q_angle": 1e-3})):
+        out = np.loadtxt(tmp_path / f"tilt_motion_{key}.csv", delimiter=",", skiprows=1)
+        np.testing.assert_array_equal(out[:, 1], create(key, params).run(
+            ex["acc"], ex["gyro"], dt)["roll"])

@@ -201,6 +201,15 @@ def find_columns(table: Any, time_column: str | None = None,
         taken = set(found.index.values())
         found.other_times = [j for j, forms in enumerate(zip(*name_forms(table.names), strict=True))
                              if j not in taken and set(forms) & set(ALIASES["time"])]
+    users: dict[int, list[str]] = {}
+    for quantity, i in found.index.items():
+        users.setdefault(i, []).append(quantity)
+    for i, quantities in users.items():
+        if len(quantities) > 1:  # a column given for one quantity that another's name fits
+            raise RecordingError(
+                f"{table.path}: the column {table.header[i]!r} is taken for both "
+                f"{' and '.join(quantities)}: each needs a column of its own (--column "
+                "QUANTITY=NAME, --time-column NAME)")
     normed = [norm_name(n) for n in table.names]
     for quantity, i in found.index.items():
         same = [j for j, n in enumerate(normed) if n == normed[i]]
