@@ -63,6 +63,9 @@ def run(args: argparse.Namespace) -> int:
     from .build import build_all, default_kind, format_table
     from .names import model_names
 
+    if args.out.exists() and not args.out.is_dir():
+        print(f"error: --out {args.out} is a file: the FMUs go to a folder", file=sys.stderr)
+        return 2
     kind = args.kind or default_kind()
     missing = [m for m in NEEDS[kind] if importlib.util.find_spec(m) is None]
     if missing:

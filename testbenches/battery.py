@@ -610,7 +610,7 @@ def plot(results: Results, path: Path) -> None:
 
 
 def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    from .options import add_cluster, positive_int
+    from .options import add_cluster, out_folder, positive_int
 
     p = sub.add_parser(
         "battery", help="every attitude filter beside VQF on a battery of motions x parts of "
@@ -621,7 +621,7 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
     p.add_argument("--parts", type=positive_int, default=PARTS,
                    help=f"parts (seeds) of each sensor class (default {PARTS})")
     add_cluster(p)
-    p.add_argument("--out", type=Path, default=Path("reports/battery"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/battery"),
                    help="where battery.json, battery.md, one page per motion and the plot go")
     p.add_argument("--no-plots", action="store_true", help="no battery.png")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",

@@ -28,7 +28,15 @@ from fusion_core.registry import keys_help
 from fusion_core.scenarios import ESTIMATION_SCENARIOS
 
 from .contract import accuracy_limits
-from .options import add_calibration, add_preset, add_sensor, choose, positive_int, with_calibration
+from .options import (
+    add_calibration,
+    add_preset,
+    add_sensor,
+    choose,
+    out_folder,
+    positive_int,
+    with_calibration,
+)
 
 SOURCES: dict[str, tuple[str, dict[str, Any]]] = {
     "gyro_scale": ("gyro scale-factor error", {"gyro_scale_std": 0.0}),
@@ -188,7 +196,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     add_preset(p)
     add_calibration(p)
     add_sensor(p)
-    p.add_argument("--out", type=Path, default=Path("reports/budget"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/budget"),
                    help="report folder (reports/budget)")
     p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
                    help="skip the bar chart")

@@ -267,12 +267,14 @@ def run_crosscheck(fmu_dir: Path, out: Path, log: Callable[[str], None] = print
 
 def add_crosscheck_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
     """The crosscheck subcommand."""
+    from .options import out_folder
+
     p = sub.add_parser("crosscheck", help="the native FMUs and their results in the FMI "
                        "Cross-Check layout, validated by fmpy",
                        description=" ".join(__doc__.split("\n\n")[0].split()))
     p.add_argument("--fmu-dir", type=Path, default=Path("dist"),
                    help="where build-fmus put the FMUs (native/fmi2 and native/fmi3 under it)")
-    p.add_argument("--out", type=Path, default=Path("reports/crosscheck"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/crosscheck"),
                    help="the cross-check tree (fmus/ and results/)")
     p.set_defaults(func=run)
 

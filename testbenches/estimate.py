@@ -45,6 +45,7 @@ from .options import (
     add_calibration,
     add_preset,
     add_recording_options,
+    out_folder,
     parse_params,
     positive_int,
     with_calibration,
@@ -91,7 +92,7 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--reference", type=Path, default=None,
                    help="a CSV of time with roll, pitch [rad] or q_w, q_x, q_y, q_z: the "
                    "reference, matched by time")
-    p.add_argument("--out", type=Path, default=Path("reports/estimate"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/estimate"),
                    help="output folder (reports/estimate)")
     p.add_argument("--format", choices=tuple(FORMATS), default="csv",
                    help="the outputs' format (csv)")
@@ -561,11 +562,9 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     from fusion_core.presets import load_preset
     from fusion_core.registry import KEYS, create
 
-    from .fit.recording import RecordingError, source_from_args
+    from .fit.recording import source_from_args
     from .options import choose
 
-    if args.out.exists() and not args.out.is_dir():
-        raise RecordingError(f"--out {args.out}: a file; the outputs go to a folder")
     keys = choose(args.estimator, list(KEYS), "estimator")
     preset = with_calibration(load_preset(args.preset), args.calibration)
     has = param_names(args, keys)

@@ -427,7 +427,7 @@ def worth_table(worth: dict[tuple[str, str], Worth]) -> str:
 
 
 def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    from .options import add_cluster
+    from .options import add_cluster, out_folder
 
     p = sub.add_parser(
         "mechanisms", help="what each mechanism of the recommended attitude filters is worth "
@@ -442,7 +442,7 @@ def add_mechanisms_parser(sub: argparse._SubParsersAction) -> None:  # type: ign
     p.add_argument("--trials-json", type=Path, default=None,
                    help="BROAD's trials.json (default: beside the files)")
     add_cluster(p)
-    p.add_argument("--out", type=Path, default=Path("reports/mechanisms"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/mechanisms"),
                    help="where mechanisms.json and mechanisms.md go")
     p.set_defaults(func=cmd_mechanisms)
 

@@ -130,6 +130,15 @@ def jitter_fraction(text: str) -> float:
     return _number(text, float, "a fraction in [0, 1)", lambda v: 0.0 <= v < 1.0)
 
 
+def out_folder(text: str) -> Path:
+    """argparse type: the folder a command writes to (--out), made where missing; a file of
+    that name is refused before anything runs (mkdir would raise on it after the work)."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file: the outputs go to a folder")
+    return path
+
+
 def _number(text: str, kind: type, allowed: str, ok: Callable[[Any], bool]) -> Any:
     try:
         value = kind(text)

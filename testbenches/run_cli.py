@@ -22,6 +22,7 @@ from .options import (
     jitter_fraction,
     load_sensor,
     non_negative_int,
+    out_folder,
     parse_params,
     positive_float,
     positive_int,
@@ -58,7 +59,8 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
                      help="communication-step jitter, fraction of the period (0)")
     run.add_argument("--duration", type=positive_float, default=None,
                      help="seconds per run instead of each scenario's own duration")
-    run.add_argument("--out", type=Path, default=Path("reports"), help="report folder (reports)")
+    run.add_argument("--out", type=out_folder, default=Path("reports"),
+                     help="report folder (reports)")
     run.add_argument("--fmu-dir", type=Path, default=DEFAULT_FMU_DIR, help="built FMUs (dist)")
     run.add_argument("--kind", choices=KINDS, default="auto",
                      help="FMUs to run: native (FMI 2.0 from the C twin, FMU_DIR/native/fmi2), "

@@ -58,3 +58,30 @@ def test_a_campaign_without_workers_is_refused_before_a_cluster_starts(tmp_path)
         execute([], tmp_path, "local", workers=0)
     with pytest.raises(ValueError, match="retries of at least 0"):
         execute([], tmp_path, "local", retries=-1)
+
+
+def test_every_commands_out_refuses_a_file_before_it_runs(tmp_path):
+    """--out is a folder in every command that writes one: a file of that name is refused by
+    the option (mkdir raised FileExistsError after the work, as a traceback), and the file is
+    left as it was."""
+    import argparse
+
+    from testbenches.cli import _parser
+
+    parser = _parser("imu-fusion")
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    with_out = [name for name, p in sub.choices.items()  # build-fmus: its own check, below
+                if name != "build-fmus" and any("--out" in a.option_strings for a in p._actions)]
+    assert {"estimate", "run", "broad", "noise", "tune", "calibrate", "battery", "campaign",
+            "mechanisms", "budget", "crosscheck"} <= set(with_out)
+    file = tmp_path / "taken"
+    file.write_text("keep")
+    for name in with_out:
+        out = next(a for a in sub.choices[name]._actions if "--out" in a.option_strings)
+        with pytest.raises(argparse.ArgumentTypeError, match="is a file: the outputs go to a "
+                           "folder"):
+            out.type(str(file))
+        assert out.type(str(tmp_path / "new")) == tmp_path / "new"
+    assert file.read_text() == "keep"
+    assert main(["build-fmus", "--out", str(file)]) == 2
+    assert file.read_text() == "keep"

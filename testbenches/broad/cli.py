@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from fusion_core.registry import keys_help
 
 from ..fmus import DEFAULT_FMU_DIR
-from ..options import add_calibration, add_preset, choose, positive_float
+from ..options import add_calibration, add_preset, choose, out_folder, positive_float
 
 if TYPE_CHECKING:
     from .cv import CvResult, Grid
@@ -54,7 +54,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "else the groups in the trial names)")
     p.add_argument("--head", type=positive_float, default=None, metavar="SECONDS",
                    help="use only the first SECONDS of every trial (a quick look)")
-    p.add_argument("--out", type=Path, default=Path("reports/broad"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/broad"),
                    help="report folder (reports/broad)")
     p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
                    help="skip the bar chart")

@@ -30,7 +30,7 @@ import numpy as np
 from fusion_core.calibration import Calibration
 from fusion_core.types import G
 
-from ..options import RECORDING_HELP, add_recording_options, positive_float
+from ..options import RECORDING_HELP, add_recording_options, out_folder, positive_float
 from . import ferraris as fer
 from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
 from .heldout import HeldOut, ferraris_held_out, tedaldi_held_out
@@ -52,7 +52,7 @@ def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: igno
                    help="the gyro's full-scale range [deg/s] (2000)")
     p.add_argument("--gravity", type=positive_float, default=G,
                    help=f"local gravity [m/s^2] ({G})")
-    p.add_argument("--out", type=Path, default=Path("calibration"),
+    p.add_argument("--out", type=out_folder, default=Path("calibration"),
                    help="output folder (calibration)")
     p.set_defaults(func=run)
 

@@ -16,6 +16,7 @@ from ..options import (
     add_preset,
     add_recording_options,
     non_negative_float,
+    out_folder,
     positive_float,
     positive_int,
     with_calibration,
@@ -30,7 +31,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     noise.add_argument("file", type=Path, help=f"a static recording: {RECORDING_HELP}; or a "
                        "BROAD trial (its rest segment is used)")
     add_recording_options(noise)
-    noise.add_argument("--out", type=Path, default=Path("reports/noise"),
+    noise.add_argument("--out", type=out_folder, default=Path("reports/noise"),
                        help="folder for noise.json, preset.json, sensor.json, allan.png")
     noise.add_argument("--gyro-range", type=positive_float, default=2000.0, metavar="DEG_S",
                        help="the gyro's full-scale range setting [deg/s] from its datasheet or "
@@ -69,7 +70,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     tune.add_argument("--fmu", action="store_true",
                       help="confirm the fitted preset through the estimator's FMU")
     tune.add_argument("--fmu-dir", type=Path, default=Path("dist"), help="built FMUs (dist)")
-    tune.add_argument("--out", type=Path, default=Path("reports/tune"),
+    tune.add_argument("--out", type=out_folder, default=Path("reports/tune"),
                       help="folder for preset.json, tune.json, tune.png")
     tune.add_argument("--no-plots", action="store_true", help="skip tune.png")
 

@@ -16,6 +16,7 @@ from ..options import (
     add_preset,
     add_sensor,
     non_negative_int,
+    out_folder,
     positive_float,
     positive_int,
     with_calibration,
@@ -57,7 +58,7 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fmu", action="store_true",
                    help="run the FMUs through fmpy (FMU-in-the-loop) instead of fusion_core")
     p.add_argument("--fmu-dir", type=Path, default=Path("dist"), help="built FMUs (dist)")
-    p.add_argument("--out", type=Path, default=Path("reports/campaign"),
+    p.add_argument("--out", type=out_folder, default=Path("reports/campaign"),
                    help="folder: runs/*.parquet, summary.json, summary.md, plots")
     p.add_argument("--no-plots", action="store_true", help="skip the plots")
 
