@@ -101,6 +101,8 @@ def load_preset(spec: str | Path) -> dict[str, dict[str, Any]]:
     path = Path(text)
     if not path.suffix == ".json":
         raise _unknown(text)
+    if not path.is_file():
+        raise ValueError(f"preset file {path}: no such file")
     try:
         data = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as err:

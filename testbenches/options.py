@@ -157,6 +157,8 @@ def load_sensor(spec: str | Path) -> dict[str, Any]:
     text = str(spec)
     if text in SENSOR_PRESETS or not text.endswith(".json"):
         return sensor_preset(text)
+    if not Path(text).is_file():
+        raise ValueError(f"sensor file {text}: no such file")
     try:
         params = json.loads(Path(text).read_text())
         ImuSensorModel(**params)

@@ -474,17 +474,19 @@ def test_a_sensor_that_starts_z_down_is_said_and_a_mounting_turns_it(tmp_path, c
     (["--time-column", "acc_x"], "the column 'acc_x' is taken for both acc_x and time"),
     (["--column", "gyro_x=acc_x"], "the column 'acc_x' is taken for both acc_x and gyro_x"),
     (["--out", "FILE"], "is a file: the outputs go to a folder"),  # argparse's, after usage
-    (["--calibration", "MISSING"], "no such file"),
+    (["--calibration", "MISSING"], "calibration file"),
+    (["--preset", "MISSING"], "preset file"),
     (["--param", "foo=1"], "--param foo: no estimator run here has it; they have Q_angle"),
     (["--estimator", "cf", "--param", "Q_angle=1e-5"], "--param Q_angle: no estimator run here"),
 ])
 def test_an_option_that_cannot_serve_gets_one_line(tmp_path, extra, says):
     """A column given for a quantity another already takes (pyarrow's KeyError on the
     doubled field, as a traceback), --out naming a file (FileExistsError: now refused by the
-    option's type, as argparse refuses, after the usage), a calibration file that is not there
-    (an errno's text), a parameter no estimator run has: one line each."""
+    option's type, as argparse refuses, after the usage), a calibration or preset file that is
+    not there (an errno's text), a parameter no estimator run has: one line each."""
     out = tmp_path / "FILE"
     out.write_text("keep")
+    missing = "MISSING" in extra
     extra = [str(out) if e == "FILE" else str(tmp_path / "none.json") if e == "MISSING" else e
              for e in extra]
     args = ["--out", str(tmp_path / "out"), *extra] if "--out" not in extra else extra
@@ -494,6 +496,7 @@ def test_an_option_that_cannot_serve_gets_one_line(tmp_path, extra, says):
     assert proc.returncode == 2, proc.stdout + proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert says in lines[-1] and "Traceback" not in proc.stderr, proc.stderr
+    assert "Errno" not in proc.stderr and (not missing or "no such file" in lines[-1])
     assert len(lines) == 1 or lines[0].startswith("usage:"), proc.stderr
     assert out.read_text() == "keep"
 

@@ -85,3 +85,11 @@ def test_every_commands_out_refuses_a_file_before_it_runs(tmp_path):
     assert file.read_text() == "keep"
     assert main(["build-fmus", "--out", str(file)]) == 2
     assert file.read_text() == "keep"
+
+
+def test_a_sensor_file_that_is_not_there_is_said_so(tmp_path):
+    """--sensor naming a JSON file that does not exist: "no such file", not an errno's text."""
+    from testbenches.options import load_sensor
+
+    with pytest.raises(ValueError, match=r"sensor file .*none\.json: no such file$"):
+        load_sensor(tmp_path / "none.json")
