@@ -16,9 +16,10 @@ unit the data contradict is refused with the evidence, and so is a recording who
 tell the unit where none is given. A sample without a number in every column is rejected and
 counted by the estimators, not the file.
 
-A reference, roll and pitch [rad] or a quaternion q_w, q_x, q_y, q_z (sensor to a z-up frame),
-in the recording or in a file of its own (--reference, matched by time), gives the inclination
-RMSE, beside VQF's on the same samples where the `vqf` package is installed.
+A reference, roll and pitch [rad, or deg where its header says so] or a quaternion q_w, q_x,
+q_y, q_z (sensor to a z-up frame), in the recording or in a file of its own (--reference,
+matched by time), gives the inclination RMSE, beside VQF's on the same samples where the `vqf`
+package is installed.
 
 It writes, per estimator, OUT/<recording>_<estimator>.csv (or .parquet, .h5 with --format):
 time, roll, pitch [rad], bias_x..z [rad/s], and for the position filter pos_x..z [m],
@@ -117,7 +118,7 @@ class Reference:
         if "time" not in cols:
             raise RecordingError(f"{path}: a reference needs a time column; it has "
                                  f"{', '.join(found.header)}")
-        up, quat = reference_up(cols, path)
+        up, quat = reference_up(cols, path, found.units)
         if up is None:
             raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, "
                                  f"q_y, q_z; it has {', '.join(found.header)}")

@@ -512,3 +512,26 @@ def test_a_parameter_goes_to_the_estimators_that_have_it(tmp_path):
         out = np.loadtxt(tmp_path / f"tilt_motion_{key}.csv", delimiter=",", skiprows=1)
         np.testing.assert_array_equal(out[:, 1], create(key, params).run(
             ex["acc"], ex["gyro"], dt)["roll"])
+
+
+def test_a_reference_whose_header_states_degrees_is_read_in_degrees(tmp_path, capsys):
+    """roll and pitch under "Roll (deg)", "Pitch (deg)": the same RMSE as the truth in rad (they
+    were refused as degrees though the header said so); a unit that is no angle is refused."""
+    truth = np.genfromtxt(TRUTH, delimiter=",", names=True)
+
+    def rmse(ref: Path) -> float:
+        assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference", str(ref),
+                     "--out", str(tmp_path / "out"), "--no-plots", "--no-vqf"]) == 0
+        line = next(r for r in capsys.readouterr().out.splitlines() if r.startswith("kf "))
+        return float(line.split()[2])
+
+    deg = tmp_path / "deg.csv"
+    np.savetxt(deg, np.column_stack([truth["time"], np.degrees(truth["roll"]),
+                                     np.degrees(truth["pitch"])]),
+               delimiter=",", header="time,Roll (deg),Pitch (deg)", comments="", fmt="%.17g")
+    assert rmse(deg) == pytest.approx(rmse(TRUTH), abs=1e-4)
+    bad = tmp_path / "bad.csv"
+    bad.write_text(deg.read_text().replace("Pitch (deg)", "Pitch (g)", 1))
+    assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference", str(bad),
+                 "--out", str(tmp_path / "out"), "--no-plots"]) == 2
+    assert "states the unit(s) deg, g for roll and pitch" in capsys.readouterr().err

@@ -629,7 +629,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             row0 += len(block)
             acc, gyro = _vectors(cols)
             acc, gyro = acc * acc_scale, gyro * gyro_scale
-            up, ref_quat = reference_up(cols, path)
+            up, ref_quat = reference_up(cols, path, units)
             counts = None if up is None else np.all(np.isfinite(up), axis=1)
             rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts)
             rec.ref_quat = ref_quat
@@ -987,12 +987,14 @@ QUAT_NORM_TOLERANCE = 0.1
 left out (and counted)."""
 
 
-def reference_up(cols: dict[str, np.ndarray], path: Path
+def reference_up(cols: dict[str, np.ndarray], path: Path,
+                 units: dict[str, str | None] | None = None
                  ) -> tuple[np.ndarray | None, np.ndarray | None]:
     """The up direction [N, 3] of the reference columns in the sensor frame, taking the
     reference's world frame as z-up, and for a quaternion reference the unit quaternions
     [N, 4] (rows of invalid ones NaN in both; None, None: no reference columns); RecordingError
-    where nothing in them can be an attitude or roll and pitch are not in rad."""
+    where nothing in them can be an attitude, or roll and pitch are in neither rad nor the deg
+    their header states (`units`, find_columns')."""
     from ..broad.metric import gravity_from_quat, gravity_from_roll_pitch
 
     if all(c in cols for c in ("q_w", "q_x", "q_y", "q_z")):
@@ -1007,11 +1009,18 @@ def reference_up(cols: dict[str, np.ndarray], path: Path
         unit[valid] = q[valid] / norm[valid, None]
         return gravity_from_quat(unit), unit
     if "roll" in cols and "pitch" in cols:
-        roll, pitch = cols["roll"], cols["pitch"]
+        stated = {(units or {}).get(c) for c in ("roll", "pitch")} - {None}
+        if len(stated) > 1 or not stated <= {"rad", "deg"}:
+            raise RecordingError(f"{path}: the reference's header states the unit(s) "
+                                 f"{', '.join(sorted(stated))} for roll and pitch: one of rad "
+                                 "or deg serves")
+        scale = np.pi / 180.0 if stated == {"deg"} else 1.0
+        roll, pitch = cols["roll"] * scale, cols["pitch"] * scale
         if np.nanmax(np.abs(roll)) > np.pi + 1e-6 or np.nanmax(np.abs(pitch)) > np.pi / 2 + 1e-6:
             raise RecordingError(
                 f"{path}: the reference's roll reaches {float(np.nanmax(np.abs(roll))):.4g} and "
                 f"its pitch {float(np.nanmax(np.abs(pitch))):.4g}, beyond pi and pi/2: they "
-                "are in degrees? a reference gives roll and pitch in rad")
+                "are in degrees? a reference gives roll and pitch in rad, or in deg where its "
+                "header says so (roll (deg))")
         return gravity_from_roll_pitch(roll, pitch), None
     return None, None
