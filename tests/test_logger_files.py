@@ -361,6 +361,11 @@ def test_a_clock_in_an_unstated_unit_is_named_and_an_index_is_no_unit(tmp_path):
     assert split_unit("q_w [1]") == ("q_w", "1")
     assert split_unit("gyro_rad[1]") == ("gyro_rad[1]", None)
 
+    from testbenches.fit.columns import norm_name
+
+    # a quaternion's index is no axis: PX4's q[0] is w, Eigen's and scipy's q[0] is x
+    assert norm_name("q[0]") == "q[0]" and norm_name("gyro_rad[0]") == "gyro_rad_x"
+
 
 @pytest.mark.parametrize("codec,delimiter,compress", [
     ("utf-16", "\t", False),  # Excel's "Unicode Text": a byte-order mark, tabs

@@ -37,7 +37,8 @@ ALIASES: dict[str, tuple[str, ...]] = {
 }
 """Column names a recording may use per quantity, as norm_name makes them (case ignored;
 spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out; an index
-[0], [1], [2] as the axis x, y, z), in the order they are taken: "t" last, as a flight log's
+[0], [1], [2] as the axis x, y, z, but a quaternion's, whose first may be w or x), in the
+order they are taken: "t" last, as a flight log's
 "T" is its temperature beside a "timestamp". Physics Toolbox's g-force "gFx" is the
 accelerometer (its "ax" there leaves gravity out, and is refused for it). A reference
 quaternion's components (sensor to world) too, as motion capture names them ("Rotation W" in
@@ -52,7 +53,8 @@ def norm_name(name: str) -> str:
     name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name.strip()).lower().lstrip("%")
     for sep in (" ", "-", "."):
         name = name.replace(sep, "_")
-    name = re.sub(r"\[([012])\]$", lambda m: "_" + "xyz"[int(m.group(1))], name)
+    if not re.search(r"(^|_)(q|quat|quaternion|rotation|orientation|attitude)\[", name):
+        name = re.sub(r"\[([012])\]$", lambda m: "_" + "xyz"[int(m.group(1))], name)
     return name.removeprefix("field_")
 
 
