@@ -100,13 +100,18 @@ def median_period(dt: np.ndarray) -> float:
     return float(np.median(numbers)) if len(numbers) else float("nan")
 
 
-def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str, np.ndarray]:
+def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
+                  readings: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
     """Each unit's miss [deg] in every window that counts, for `gyro` [N, 3] (numbers as read),
     `acc` [N, 3] (any unit: only its direction and its norm relative to the median are used)
     and `dt` [N] [s] (rows with a non-finite value are left out of every window that holds
-    them); the windows of a recording's blocks are pooled before the verdict."""
+    them); the windows of a recording's blocks are pooled before the verdict. `readings`, by
+    name, takes the gyro's rate in rad/s as a matrix times the numbers as read in place of
+    the units (gyro_axes: each signed order of its axes)."""
     acc, gyro, dt = (np.asarray(a, dtype=float) for a in (acc, gyro, dt))
-    none = {unit: np.empty(0) for unit in UNITS}
+    if readings is None:
+        readings = {unit: scale * np.eye(3) for unit, scale in UNITS.items()}
+    none = {name: np.empty(0) for name in readings}
     n = len(dt)
     period = median_period(dt) if n else 0.0
     if not (n > 2 and period > 0.0):
@@ -136,17 +141,18 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray) -> dict[str
         starts = starts[np.linspace(0, len(starts) - 1, MAX_WINDOWS).astype(np.int64)]
     ends = starts + k
     gx, gy, gz = (np.ascontiguousarray(gyro[:, i]) for i in range(3))
-    v = {unit: (ux[starts], uy[starts], uz[starts]) for unit in UNITS}
+    v = {name: (ux[starts], uy[starts], uz[starts]) for name in readings}
     for j in range(1, k + 1):  # du/dt = -omega x u, omega at the sample ending each step
         at = starts + j  # one step of every window at once: memory does not grow with k
-        wx, wy, wz, h = gx[at], gy[at], gz[at], dt[at]
-        for unit, scale in UNITS.items():
-            vx, vy, vz = v[unit]
-            ax, ay, az = wx * scale, wy * scale, wz * scale
+        w, h = (gx[at], gy[at], gz[at]), dt[at]
+        for name, m in readings.items():
+            vx, vy, vz = v[name]
+            ax, ay, az = (sum(m[r, c] * w[c] for c in range(3) if m[r, c] != 0.0)
+                          for r in range(3))
             vx, vy, vz = (vx - (ay * vz - az * vy) * h, vy - (az * vx - ax * vz) * h,
                           vz - (ax * vy - ay * vx) * h)
             length = np.sqrt(vx * vx + vy * vy + vz * vz)
-            v[unit] = (vx / length, vy / length, vz / length)
+            v[name] = (vx / length, vy / length, vz / length)
     misses: dict[str, np.ndarray] = {}
     for unit, (vx, vy, vz) in v.items():
         cos_miss = np.clip(vx * ux[ends] + vy * uy[ends] + vz * uz[ends], -1.0, 1.0)
@@ -173,3 +179,46 @@ def verdict(misses: dict[str, np.ndarray]) -> UnitEvidence:
         elif min(median[u] for u in PRIMARY) >= MIN_RATIO * max(median[MILLI], 1e-3):
             unit = MILLI
     return UnitEvidence(median, windows, unit)
+
+
+def _signed_orders() -> dict[str, np.ndarray]:
+    """Every signed order of three axes, by the way it reads ("x, -y, z": the gyro's own y
+    negated), the one as read first."""
+    import itertools
+
+    out = {}
+    for order in itertools.permutations(range(3)):
+        for signs in itertools.product((1.0, -1.0), repeat=3):
+            m = np.zeros((3, 3))
+            for row, (col, sign) in enumerate(zip(order, signs, strict=True)):
+                m[row, col] = sign
+            out[", ".join(("-" if sign < 0 else "") + "xyz"[col]
+                          for col, sign in zip(order, signs, strict=True))] = m
+    return out
+
+
+AS_READ = "x, y, z"
+
+
+def gyro_axes(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, scales: dict[str, float]
+              ) -> tuple[str, str, float, float] | None:
+    """Where the gyro's axes, as read, are not the accelerometer's: the signed order of them
+    (gyro_axes' "x, -y, z": its y negated) and the unit in which its turn explains the
+    accelerometer's turn of gravity at least MIN_RATIO times better than as read in any unit
+    of `scales` (name -> factor to rad/s), with the two median misses [deg]; None where the
+    axes as read serve as well, or too few windows turn gravity to tell. A sign flipped or two
+    axes swapped (a left-handed frame, axes remapped in the gyro but not the accelerometer)
+    leaves every unit missing by about the turn, as a wrong unit does."""
+    orders = _signed_orders()
+    readings = {f"{unit}|{name}": scale * m for unit, scale in scales.items()
+                for name, m in orders.items()}
+    misses = window_misses(acc, gyro, dt, readings)
+    if len(next(iter(misses.values()))) < MIN_WINDOWS:
+        return None
+    median = {name: float(np.median(m)) for name, m in misses.items()}
+    best = min(median, key=lambda name: median[name])
+    as_read = min(median[f"{unit}|{AS_READ}"] for unit in scales)
+    unit, order = best.split("|")
+    if order == AS_READ or as_read < MIN_RATIO * max(median[best], 1e-3):
+        return None
+    return order, unit, median[best], as_read

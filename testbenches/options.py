@@ -50,6 +50,10 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
                         "phone flat on a table reads z = -1 g). auto: -1 for iOS SensorLog's "
                         "columns, +1 elsewhere; a Sensor Logger export from iOS is refused "
                         "until given (its 'Standardise Units & Frames' setting decides)")
+    parser.add_argument("--gyro-axes", default="x,y,z", metavar="X,Y,Z",
+                        help="the gyro's axes in the accelerometer's, each with its sign, where "
+                        "its columns differ (x,-y,z: its y negated; y,x,-z); a gyro whose turn "
+                        "explains the accelerometer's only so is refused until given")
     parser.add_argument("--gyro-unit", choices=("auto", "rad/s", "deg/s", "mdps"),
                         default="auto",
                         help="the gyro's unit (auto: the header's, else the unit in which the "

@@ -58,10 +58,15 @@ def test_a_linear_acceleration_read_as_g_is_refused_though_the_gyro_unit_is_give
 
 
 def test_a_gyro_whose_axes_are_swapped_is_refused_though_its_unit_is_given(tmp_path):
+    """Its turn explains the accelerometer's only with x and y swapped: refused saying so
+    (before gravity is looked for), and read with --gyro-axes y,x,z as the part's samples."""
     t, _, s = battery.part_samples("handheld_fast", "mpu6050", 0)
     path = _write(tmp_path / "swapped.csv", t, s["acc"], s["gyro"][:, [1, 0, 2]])
-    with pytest.raises(RecordingError, match="the axes are not what they are taken for"):
+    with pytest.raises(RecordingError, match=r"the gyro's axes are not the accelerometer's: .* "
+                                             r"as \(y, x, z\) in rad/s .* --gyro-axes y,x,z"):
         open_recording(path, gyro_unit="rad/s")
+    rec, _ = open_recording(path, gyro_unit="rad/s", gyro_axes="y,x,z").load()
+    np.testing.assert_allclose(rec.gyro, s["gyro"], rtol=1e-7, atol=1e-9)  # written to 8 digits
 
 
 def test_every_shared_broad_trial_holds_gravity():

@@ -29,6 +29,8 @@ from .columns import ALIASES, find_name, name_forms, norm_name, unit_in_name
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
+AS_READ_AXES = "x,y,z"
+"""The gyro's axes as its columns give them (--gyro-axes)."""
 
 
 class RecordingError(ValueError):
@@ -471,10 +473,12 @@ def _broad_source(path: Path, trial: Any) -> RecordingSource:
 def open_recording(path: Path, *, rate: float | None = None, time_column: str | None = None,
                    acc_unit: str = "auto", gyro_unit: str = "auto",
                    columns: dict[str, str] | None = None,
-                   time_unit: str = "auto", acc_sign: str = "auto") -> RecordingSource:
+                   time_unit: str = "auto", acc_sign: str = "auto",
+                   gyro_axes: str = AS_READ_AXES) -> RecordingSource:
     """The recording opened for reading in blocks (RecordingSource), its units, columns and
     rate decided from its first PREFIX_ROWS samples: given, stated by the file, or from the
-    data (which must not contradict what is given or stated); RecordingError saying what is
+    data (which must not contradict what is given or stated); the gyro's axes in the
+    accelerometer's as `gyro_axes` orders them (parse_axes); RecordingError saying what is
     wrong."""
     from ..reader import TableError
     from .sensor_files import is_sensor_files, open_sensor_files
@@ -541,7 +545,13 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             prefix["time"] = other_times[rising]
             wanted = [found.index[q] for q in names]
     # the samples as read: the time unit's evidence needs their directions only
-    acc, gyro = _vectors({q: v[keep] for q, v in prefix.items()})
+    axes = parse_axes(gyro_axes)
+
+    def vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        acc, gyro = _vectors(cols)
+        return acc, gyro if axes is None else gyro @ axes.T
+
+    acc, gyro = vectors({q: v[keep] for q, v in prefix.items()})
     t_unit, time_how = "s", ""
     if time_unit != "auto" and not ("time" in prefix or "dt" in prefix):
         raise RecordingError(f"{path}: --time-unit {time_unit} is given, but the recording has "
@@ -595,12 +605,14 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         for block in table.blocks(wanted, PREFIX_ROWS):
             cols, d, _ = _samples(block, names, join, evidence_clock, row0)
             if row0 > 0:
-                yield (*_vectors(cols), d)
+                yield (*vectors(cols), d)
             row0 += len(block)
 
     gyro_scale, gyro_how, used = _gyro_scale(
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
         more if n == PREFIX_ROWS else None)
+    if axes is not None:
+        gyro_how += f"; its axes as the accelerometer's {', '.join(gyro_axes.split(','))} (given)"
     _holds_gravity(path, acc[finite] * acc_scale, gyro[finite] * gyro_scale, dt[finite],
                    f"acc in {acc_how}; gyro in {gyro_how}")
     period = median_period(dt)
@@ -627,7 +639,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         for block in table.blocks(wanted, rows):
             cols, dt, t = _samples(block, names, join, run_clock, row0)
             row0 += len(block)
-            acc, gyro = _vectors(cols)
+            acc, gyro = vectors(cols)
             acc, gyro = acc * acc_scale, gyro * gyro_scale
             up, ref_quat = reference_up(cols, path, units)
             counts = None if up is None else np.all(np.isfinite(up), axis=1)
@@ -728,7 +740,7 @@ def source_from_args(path: Path, args: argparse.Namespace) -> RecordingSource:
     return open_recording(path, rate=args.rate, time_column=args.time_column,
                           acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
                           columns=parse_columns(args.column), time_unit=args.time_unit,
-                          acc_sign=args.acc_sign)
+                          acc_sign=args.acc_sign, gyro_axes=args.gyro_axes)
 
 
 def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
@@ -922,6 +934,21 @@ def _acc_sign(path: Path, given: str, names: list[str], platform: str) -> tuple[
     return 1.0, ""
 
 
+def parse_axes(text: str) -> np.ndarray | None:
+    """The matrix that takes the gyro's readings, as read, into the accelerometer's axes, of a
+    signed order of its axes ("x,-y,z": its y negated; "y,x,z": x and y swapped); None for the
+    axes as read; RecordingError for anything else."""
+    cells = [c.strip().lower() for c in text.split(",")]
+    names = [c.lstrip("+-") for c in cells]
+    if len(cells) != 3 or sorted(names) != ["x", "y", "z"]:
+        raise RecordingError(f"--gyro-axes {text!r}: the gyro's x, y and z, each once, in the "
+                             "accelerometer's order, each with its sign: x,-y,z or y,x,-z")
+    m = np.zeros((3, 3))
+    for row, (cell, name) in enumerate(zip(cells, names, strict=True)):
+        m[row, "xyz".index(name)] = -1.0 if cell.startswith("-") else 1.0
+    return None if np.array_equal(m, np.eye(3)) else m
+
+
 def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
                 stated: str | None, more: Any = None) -> tuple[float, str, int]:
     """The factor to rad/s, how it was chosen and over how many samples: the unit in which the
@@ -930,7 +957,7 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
     tell and no unit is given. A unit given or stated by the header that the data contradict
     is refused with the evidence; where the data cannot tell and no unit is given or stated,
     the recording is refused, and so is a given unit that is not the header's."""
-    from ..gyro_unit import UNITS, verdict, window_misses
+    from ..gyro_unit import MIN_WINDOWS, UNITS, verdict, window_misses
     from ..time_unit import listed
 
     _given_against_header(path, "gyro", "gyro-unit", unit, stated)
@@ -944,6 +971,9 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
             evidence, used = verdict(misses), used + len(d)
             if evidence.unit is not None:
                 break
+    if evidence.unit is None and evidence.windows >= MIN_WINDOWS:  # turns no unit explains
+        _axes_as_read(path, acc, gyro, dt, {u: UNITS[u] for u in ((chosen,) if chosen in UNITS
+                                                                  else UNITS)})
     if chosen is not None:
         how = "given" if unit != "auto" else "from the header"
         if chosen not in UNITS:
@@ -961,6 +991,24 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
             f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
             f"give --gyro-unit {listed(list(UNITS))}")
     return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
+
+
+def _axes_as_read(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
+                  scales: dict[str, float]) -> None:
+    """RecordingError where the gyro's turn explains the accelerometer's only with its axes in
+    another signed order (testbenches.gyro_unit.gyro_axes), saying which."""
+    from ..gyro_unit import gyro_axes
+
+    found = gyro_axes(acc, gyro, dt, scales)
+    if found is None:
+        return
+    order, unit, best, as_read = found
+    raise RecordingError(
+        f"{path}: the gyro's axes are not the accelerometer's: its turn explains how the "
+        f"accelerometer sees gravity turn with its axes as ({order}) in {unit} (a median miss of "
+        f"{best:.3g} deg, against {as_read:.3g} deg as read): a sign or an order that differs "
+        "between the two (a left-handed frame, axes remapped in one sensor only); give "
+        f"--gyro-axes {order.replace(' ', '')}")
 
 
 def _holds_gravity(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
