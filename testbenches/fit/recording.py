@@ -168,9 +168,10 @@ class Columns:
     """Further columns a time's name fits, where the time was not given (a logger's epoch
     seconds beside its milliseconds): what serves where the one taken does not rise."""
 
-    def take_time(self, table: Any, i: int) -> None:
-        self.index["time"], self.source["time"] = i, table.header[i]
-        self.units["time"] = table.units[i] or _unit_in_name("time", table.names[i])
+    def take(self, table: Any, quantity: str, i: int) -> None:
+        """Column i of the table (testbenches.reader.TableSource) as the quantity's."""
+        self.index[quantity], self.source[quantity] = i, table.header[i]
+        self.units[quantity] = table.units[i] or _unit_in_name(quantity, table.names[i])
 
 
 def find_columns(table: Any, time_column: str | None = None,
@@ -196,9 +197,7 @@ def find_columns(table: Any, time_column: str | None = None,
         else:
             i = find_name(table.names, "time", quantity)
         if i is not None:
-            found.index[quantity] = i
-            found.source[quantity] = table.header[i]
-            found.units[quantity] = table.units[i] or _unit_in_name(quantity, table.names[i])
+            found.take(table, quantity, i)
     if "time" in found.index and "time" not in given:
         taken = set(found.index.values())
         found.other_times = [j for j, forms in enumerate(zip(*name_forms(table.names), strict=True))
@@ -483,6 +482,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     from ..reader import TableError
     from .sensor_files import is_sensor_files, open_sensor_files
 
+    axes = parse_axes(gyro_axes)
     if is_sensor_files(path):  # a phone app's export: one file per sensor
         others = sorted(set(columns or {}) - {"time"})
         if others:
@@ -541,12 +541,10 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         if rising is not None:  # a time that repeats or goes back, where another rises
             time_taken = (f"; {found.source['time']!r} does not rise from row to row, "
                           f"{table.header[rising]!r} does")
-            found.take_time(table, rising)
+            found.take(table, "time", rising)
             prefix["time"] = other_times[rising]
             wanted = [found.index[q] for q in names]
     # the samples as read: the time unit's evidence needs their directions only
-    axes = parse_axes(gyro_axes)
-
     def vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         acc, gyro = _vectors(cols)
         return acc, gyro if axes is None else gyro @ axes.T
@@ -612,7 +610,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
         more if n == PREFIX_ROWS else None)
     if axes is not None:
-        gyro_how += f"; its axes as the accelerometer's {', '.join(gyro_axes.split(','))} (given)"
+        gyro_how += ("; its axes as the accelerometer's "
+                     f"{', '.join(c.strip() for c in gyro_axes.split(','))} (given)")
     _holds_gravity(path, acc[finite] * acc_scale, gyro[finite] * gyro_scale, dt[finite],
                    f"acc in {acc_how}; gyro in {gyro_how}")
     period = median_period(dt)
