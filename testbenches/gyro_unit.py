@@ -15,6 +15,10 @@ right one misses by the noise, the linear acceleration and the gyro's bias over 
 window at rest is no evidence: a gyro bias, which turns nothing, would there favour whichever
 unit makes the readings smallest. So a recording without turns (a still one) is undecided, and
 the caller asks for the unit.
+
+The same prediction tells the gyro's axes from the accelerometer's (gyro_axes): with a sign
+flipped or two axes swapped between them, every unit misses by about the turn; the signed order
+of the gyro's axes that meets the accelerometer names what differs.
 """
 
 from __future__ import annotations
