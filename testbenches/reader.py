@@ -248,8 +248,8 @@ class _TextLayout:
     """Each column's unit from a row of units above or below the names (None: none)."""
     stacked: str = ""
     """The lines a header written on several rows spans ("lines 3-7"; "" for one row)."""
-    rate: tuple[float, int] | None = None
-    """The sample rate [Hz] a line before the header states, and that line (STATED_RATE)."""
+    rate: float | None = None
+    """The sample rate [Hz] a line before the header states (STATED_RATE)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -391,11 +391,11 @@ def _sniff(path: Path) -> _TextLayout:
             times_of_day.add(j)
     skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
                else f"line {preamble[0][0]}") if preamble else ""
-    rates = [(float(m.group(1).replace(",", ".")), no) for no, line in preamble
+    rates = [float(m.group(1).replace(",", ".")) for _, line in preamble
              if (m := STATED_RATE.search(line))]
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                        datetimes, times_of_day, skipped, data_after, units_row, stacked,
-                       rates[0] if len(rates) == 1 and rates[0][0] > 0.0 else None)
+                       rates[0] if len(rates) == 1 and rates[0] > 0.0 else None)
 
 
 def _cells_of(line: str, delimiter: str) -> list[str]:
@@ -549,7 +549,7 @@ def _text(path: Path) -> TableSource:
     note = (f"the header on {spans}" + (f", {layout.skipped} before it skipped"
                                         if layout.skipped else "")
             if layout.skipped or layout.stacked else "")
-    attrs = {} if layout.rate is None else {"rate": layout.rate[0]}
+    attrs = {} if layout.rate is None else {"rate": layout.rate}
     return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
                        where, attrs, note=note)
 
