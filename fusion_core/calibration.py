@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any, Final
 
 from .linalg import Mat9
-from .types import Param
+from .types import Param, read_json
 
 AXES: Final = ("x", "y", "z")
 SENSORS: Final = ("acc", "gyro")
@@ -244,13 +244,7 @@ class Calibration:
     @classmethod
     def read(cls, path: Path | str) -> Calibration:
         """calibration.json; ValueError (or FileNotFoundError) saying what is wrong."""
-        path = Path(path)
-        if not path.is_file():
-            raise FileNotFoundError(f"calibration file {path}: no such file")
-        try:
-            doc = json.loads(path.read_text())
-        except json.JSONDecodeError as err:
-            raise ValueError(f"{path}: not JSON ({err})") from None
+        doc = read_json(path, "calibration file")
         if not isinstance(doc, dict):
             raise ValueError(f"{path}: expected an object with acc_cal and gyro_cal")
         return cls.from_json(doc, str(path))

@@ -24,13 +24,12 @@ such files.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 from .base import SensorNoise
 from .registry import FILTER, KEYS, REGISTRY, create
-from .types import GYRO_RANGE_DEFAULT
+from .types import GYRO_RANGE_DEFAULT, read_json
 
 PAPER_RULES: dict[str, Any] = {"gyro_sampling": "mean", "sensor_delay": 0.0}
 """What every paper's filter keeps whatever the recording's sensor says: the rectangle rule, and
@@ -101,12 +100,7 @@ def load_preset(spec: str | Path) -> dict[str, dict[str, Any]]:
     path = Path(text)
     if not path.suffix == ".json":
         raise _unknown(text)
-    if not path.is_file():
-        raise ValueError(f"preset file {path}: no such file")
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as err:
-        raise ValueError(f"preset file {path}: {err}") from None
+    data = read_json(path, "preset file")
     if not isinstance(data, dict) or not all(isinstance(v, dict) for v in data.values()):
         raise ValueError(f"preset file {path}: expected an object of parameter objects per "
                          f"estimator, e.g. {{\"kf\": {{\"R_measure\": 0.0001}}}}")

@@ -1,4 +1,5 @@
-"""Shared types and constants of fusion_core: the estimate, the bad-sample error, parameter specs.
+"""Shared types and constants of fusion_core: the estimate, the bad-sample error, parameter specs,
+and the reading of a JSON file of parameters.
 
 Conventions (docs/interface.md): SI units; body frame x forward,
 y left, z up; the accelerometer measures specific force, so a sensor lying still and level reads
@@ -7,10 +8,12 @@ y left, z up; the accelerometer measures specific force, so a sensor lying still
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Final, NamedTuple
+from pathlib import Path
+from typing import Any, Final, NamedTuple
 
 G: Final = 9.80665
 """Standard gravity [m/s^2]; the accelerometer norm of a sensor at rest."""
@@ -173,3 +176,21 @@ def check_param_names(given: Iterable[str], specs: dict[str, Param], owner: str)
         f"unknown parameter(s) {', '.join(unknown)} for {owner}: allowed {', '.join(specs)}"
         + "".join(f"; {h}" for h in hints)
     )
+
+
+class MissingFile(FileNotFoundError, ValueError):
+    """A file of parameters that is not there: a FileNotFoundError, and a ValueError as every
+    other fault of such a file is, so that a caller catching either kind catches it."""
+
+
+def read_json(path: Path | str, what: str) -> Any:
+    """The JSON document of a file of parameters (a calibration, a preset, a sensor):
+    MissingFile where there is none, ValueError where it is no JSON, each naming `what`
+    ("calibration file") and the path."""
+    path = Path(path)
+    if not path.is_file():
+        raise MissingFile(f"{what} {path}: no such file")
+    try:
+        return json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise ValueError(f"{what} {path}: not JSON ({err})") from None

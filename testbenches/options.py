@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -157,16 +156,15 @@ def load_sensor(spec: str | Path) -> dict[str, Any]:
     """ImuSensor parameters by name (fusion_core.sensor.SENSOR_PRESETS: realistic, ideal) or
     from a JSON file of parameters; each is checked by building the sensor model."""
     from fusion_core.sensor import SENSOR_PRESETS, ImuSensorModel, sensor_preset
+    from fusion_core.types import read_json
 
     text = str(spec)
     if text in SENSOR_PRESETS or not text.endswith(".json"):
         return sensor_preset(text)
-    if not Path(text).is_file():
-        raise ValueError(f"sensor file {text}: no such file")
+    params = read_json(text, "sensor file")
     try:
-        params = json.loads(Path(text).read_text())
         ImuSensorModel(**params)
-    except (OSError, json.JSONDecodeError, TypeError, ValueError) as err:
+    except (TypeError, ValueError) as err:
         raise ValueError(f"sensor file {text}: {err}") from None
     return dict(params)
 
