@@ -508,7 +508,8 @@ class _Lanes:
 
 def _read_ahead(blocks: Any) -> Any:
     """The blocks of an iterator, the next one read by a thread of its own while the caller
-    works on the last (the reader's exceptions raised in the caller, in order)."""
+    works on the last (the reader's exceptions raised in the caller, in order); the thread has
+    ended when the caller's loop does, however it ends."""
     import queue
     import threading
 
@@ -540,8 +541,9 @@ def _read_ahead(blocks: Any) -> Any:
             if block is None:
                 return
             yield block
-    finally:
-        stop.set()
+    finally:  # the reader stops after its block in hand: no read is left running at exit,
+        stop.set()  # where a C++ reader's threads torn down mid-read abort the process
+        thread.join()
 
 
 class _NoBar(contextlib.nullcontext):  # type: ignore[type-arg]

@@ -449,6 +449,34 @@ def test_each_estimator_takes_the_blocks_in_order_at_its_own_pace():
     assert failing.seen == [0, 1]
 
 
+def test_the_reader_thread_has_ended_when_the_blocks_loop_does():
+    """estimate's _read_ahead: where the caller stops on an error (a reference that does not
+    overlap, found on the first block), the thread reading the next block has ended before the
+    error leaves: a reader still in pyarrow's C++ at the interpreter's exit aborted the process
+    (exit status 134, "terminate called without an active exception") instead of the one-line
+    refusal."""
+    import threading
+    import time
+
+    from testbenches import estimate
+
+    read = []
+
+    def blocks():
+        yield 0
+        time.sleep(0.3)  # the next block, still being read when the caller stops
+        read.append(1)
+        yield 1
+        read.append(2)
+
+    before = threading.active_count()
+    with pytest.raises(RuntimeError, match="stop"):
+        for _ in estimate._read_ahead(blocks()):
+            raise RuntimeError("stop")
+    assert read == [1]  # the block in hand was finished, no further one read
+    assert threading.active_count() == before
+
+
 def test_a_sensor_that_starts_z_down_is_said_and_a_mounting_turns_it(tmp_path, capsys):
     """A drone autopilot logs its IMU in a z-down frame (FRD: level reads -g on z). Read in this
     project's z-up frame its roll is near 180 deg and a z-up reference is 160 deg off: the
