@@ -62,8 +62,10 @@ SNIFF_BYTES = 1 << 16
 """How much of a text file's start the delimiter, encoding and header are found from."""
 
 UNIT_ALIASES: dict[str, str] = {
-    "rad/s": "rad/s", "rads": "rad/s", "rad/sec": "rad/s", "rps": "rad/s",
+    "rad/s": "rad/s", "rads": "rad/s", "rad/sec": "rad/s", "rps": "rad/s", "rads^-1": "rad/s",
+    "rads-1": "rad/s", "rad.s-1": "rad/s",
     "deg/s": "deg/s", "°/s": "deg/s", "dps": "deg/s", "deg/sec": "deg/s", "degs": "deg/s",
+    "degs^-1": "deg/s", "degs-1": "deg/s", "deg.s-1": "deg/s",
     "mdps": "mdps", "mdeg/s": "mdps", "m°/s": "mdps",
     "g": "g", "gee": "g", "mg": "mg", "milli-g": "mg",
     "m/s2": "m/s2", "m/s^2": "m/s2", "m/s²": "m/s2", "ms^-2": "m/s2", "ms-2": "m/s2",
@@ -103,10 +105,12 @@ def unit_named(text: str) -> str | None:
 
 
 def split_unit(name: str) -> tuple[str, str | None]:
-    """A header cell as (name, unit): "Gyroscope X (deg/s)" -> ("Gyroscope X", "deg/s"); a
-    bracketed part that is no unit known here stays in the name."""
+    """A header cell as (name, unit): "Gyroscope X (deg/s)" -> ("Gyroscope X", "deg/s"), "q_w []"
+    -> ("q_w", None); a bracketed part that is no unit known here stays in the name."""
     m = _NAME_UNIT.match(name.strip())
     if m and not _INDEX.search(name.strip()):
+        if not m.group(2):  # EuRoC's "q_RS_w []": no unit
+            return m.group(1).strip(), None
         unit = unit_named(m.group(2))
         if unit is not None:
             return m.group(1).strip(), unit

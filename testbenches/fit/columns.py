@@ -24,34 +24,47 @@ def axis_names(stems: tuple[str, ...], axis: str, short: tuple[str, ...]) -> tup
 
 
 ALIASES: dict[str, tuple[str, ...]] = {
-    **{f"acc_{a}": (*axis_names(ACC_STEMS, a, ("g_f", "a", "a_")), f"acc_{a}_g", f"acc_{a}_ms2")
-       for a in "xyz"},
-    **{f"gyro_{a}": (*axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_")), f"gyro_{a}_dps")
-       for a in "xyz"},
-    "time": ("time", "timestamp", "time_s", "time_ms", "time_us", "time_ns", "timestamp_s",
-             "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp", "timestamp_unix",
-             "header_stamp", "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
-             "seconds_elapsed", "time_since_start", "time_since_start_in_ms", "t"),
-    **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}")
-       for c in "wxyz"},
+    **{f"acc_{a}": (*axis_names(ACC_STEMS, a, ("g_f", "a", "a_", "a_rs_s_")), f"acc_{a}_g",
+                    f"acc_{a}_ms2") for a in "xyz"},
+    **{f"gyro_{a}": (*axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_", "w_rs_s_")),
+                     f"gyro_{a}_dps") for a in "xyz"},
+    "time": ("header_stamp", "time", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
+             "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
+             "timestamp_unix", "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
+             "seconds_elapsed", "time_since_start", "time_since_start_in_ms",
+             "gyro_timestamp_since_reboot", "accelerometer_timestamp_since_reboot",
+             "receive_time", "t"),
+    **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}",
+                  f"q_rs_{c}", f"transform_rotation_{c}", f"pose_orientation_{c}",
+                  f"pose_pose_orientation_{c}") for c in "wxyz"},
 }
-"""Column names a recording may use per quantity, as norm_name makes them (case ignored;
-spaces, hyphens and dots as underscores; a leading ROS "field." and "%" left out; an index
-[0], [1], [2] as the axis x, y, z, but a quaternion's, whose first may be w or x), in the
-order they are taken: "t" last, as a flight log's
-"T" is its temperature beside a "timestamp". Physics Toolbox's g-force "gFx" is the
-accelerometer (its "ax" there leaves gravity out, and is refused for it). A reference
+"""Column names a recording may use per quantity, as norm_name makes them (case ignored; spaces,
+hyphens, dots and slashes as underscores; a leading ROS "field.", "%", "#" and "_" left out; an
+index [0], [1], [2] as the axis x, y, z, but a quaternion's, whose first may be w or x), in the
+order they are taken: a ROS message's own stamp ("field.header.stamp") first, the time it was
+received last but one (rostopic's "%time", PlotJuggler's "__time": "receive_time"), which lags
+the sample by the transport's delay and bunches where messages arrive together; "t" last, as a
+flight log's "T" is its temperature beside a "timestamp". EuRoC's and TUM-VI's "w_RS_S_x" and
+"a_RS_S_x" (the rate and the specific force of the sensor frame S against the reference R, in
+S). SensorLog's (iOS) gyro's clock before its accelerometer's. Physics Toolbox's g-force "gFx"
+is the accelerometer (its "ax" there leaves gravity out, and is refused for it). A reference
 quaternion's components (sensor to world) too, as motion capture names them ("Rotation W" in
-OptiTrack Motive's stacked header, testbenches.reader); not "orientation", which in a ROS Imu
-message is the device's own estimate, no reference."""
+OptiTrack Motive's stacked header, testbenches.reader), EuRoC's ground truth ("q_RS_w") and
+ROS's messages a motion-capture system or an odometry publishes (TransformStamped's
+"transform.rotation", PoseStamped's "pose.orientation", Odometry's "pose.pose.orientation"); not
+"orientation" alone, which in a ROS Imu message is the device's own estimate, no reference."""
 
 
 def norm_name(name: str) -> str:
     """A column name as ALIASES spell them: "Gyroscope X" -> "gyroscope_x", "rotationRateX" ->
     "rotation_rate_x", ROS's "field.angular_velocity.x" -> "angular_velocity_x", "%time" ->
-    "time"."""
-    name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name.strip()).lower().lstrip("%")
-    for sep in (" ", "-", "."):
+    "receive_time" (PlotJuggler's "__time" too), "/imu/angular_velocity/x" ->
+    "imu_angular_velocity_x", EuRoC's "#timestamp" -> "timestamp"."""
+    name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", name.strip()).lower()
+    if name in ("%time", "__time"):  # ROS's receive time (rostopic, PlotJuggler)
+        return "receive_time"
+    name = name.lstrip("%#_/")
+    for sep in (" ", "-", ".", "/"):
         name = name.replace(sep, "_")
     if not re.search(r"(^|_)(q|quat|quaternion|rotation|orientation|attitude)\[", name):
         name = re.sub(r"\[([012])\]$", lambda m: "_" + "xyz"[int(m.group(1))], name)
@@ -98,20 +111,33 @@ def _without_device(normed: list[str]) -> list[str]:
     return [n.removeprefix(prefix).removesuffix("_cal") for n in normed]
 
 
+def _path_tails(names: list[str]) -> list[list[str]]:
+    """The names without the first 1, 2, ... parts of a path ("/imu/data/angular_velocity/x",
+    as PlotJuggler names a ROS topic's field: "data/angular_velocity/x", then
+    "angular_velocity/x"), as norm_name spells them; a name of fewer parts as it is."""
+    parts = [[p for p in n.split("/") if p] for n in names]
+    deepest = max((len(p) for p in parts if len(p) > 1), default=1)
+    return [[norm_name("/".join(p[k:])) if len(p) > k + 1 else norm_name(n)
+             for n, p in zip(names, parts, strict=True)] for k in range(1, deepest - 1)]
+
+
 def name_forms(names: list[str]) -> list[list[str]]:
     """The names as norm_name spells them, then without a unit word (UNIT_TOKENS), then also
-    without a device's prefix and a "_cal" (_without_device): the forms find_name tries in
-    turn, so that a name as written is taken before one read into."""
+    without a device's prefix and a "_cal" (_without_device), then without a path's first
+    parts (_path_tails, a topic's): the forms find_name tries in turn, so that a name as
+    written is taken before one read into."""
     normed = [norm_name(n) for n in names]
     bare = [_without_unit(n)[0] for n in normed]
-    return [normed, bare, [_without_unit(n)[0] for n in _without_device(normed)]]
+    return [normed, bare, [_without_unit(n)[0] for n in _without_device(normed)],
+            *([_without_unit(n)[0] for n in tails] for tails in _path_tails(names))]
 
 
-def find_name(names: list[str], quantity: str, given: str | None = None,
-              more: tuple[str, ...] = ()) -> int | None:
-    """The column of a quantity: the one given (by its name as written, with or without its
+def find_names(names: list[str], quantity: str, given: str | None = None,
+               more: tuple[str, ...] = ()) -> list[int]:
+    """The columns of a quantity: the one given (by its name as written, with or without its
     unit), else the first of its aliases and then of `more` in the first of name_forms that
-    has one."""
+    has one; every column that spells it so (two where a header names one twice, or two
+    topics the same field), none where none does."""
     if given:
         forms = [[norm_name(n) for n in names]]
         wanted: tuple[str, ...] = (norm_name(given),)
@@ -120,5 +146,12 @@ def find_name(names: list[str], quantity: str, given: str | None = None,
     for normed in forms:
         for alias in wanted:
             if alias in normed:
-                return normed.index(alias)
-    return None
+                return [j for j, n in enumerate(normed) if n == alias]
+    return []
+
+
+def find_name(names: list[str], quantity: str, given: str | None = None,
+              more: tuple[str, ...] = ()) -> int | None:
+    """The first of find_names, None for none."""
+    found = find_names(names, quantity, given, more)
+    return found[0] if found else None

@@ -25,7 +25,7 @@ from ..broad.metric import gravity_from_quat
 from ..gyro_unit import median_period
 from ..reader import TIME_OF_DAY, TIME_SCALE
 from ..time_unit import median_step
-from .columns import ALIASES, find_name, name_forms, norm_name, unit_in_name
+from .columns import ALIASES, find_names, name_forms, norm_name, unit_in_name
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
 QUAT_COLUMNS = ("q_w", "q_x", "q_y", "q_z")
@@ -182,22 +182,23 @@ def find_columns(table: Any, time_column: str | None = None,
     if time_column:
         given.setdefault("time", time_column)
     found = Columns({}, {}, {}, table.header)
+    alike: dict[str, list[int]] = {}  # quantity -> every column whose name fits as its does
     for quantity in (*ALIASES, *EXTRA_COLUMNS):
         name = given.get(quantity)
-        i = None
+        hits: list[int] = []
         if name is not None:
-            i = find_name(table.header, quantity, name)
-            if i is None:
-                i = find_name(table.names, quantity, name)
-            if i is None:
+            hits = (find_names(table.header, quantity, name)
+                    or find_names(table.names, quantity, name))
+            if not hits:
                 raise RecordingError(f"{table.path}: no column {name!r} for {quantity}: the "
                                      f"header has {', '.join(table.header)}")
         elif quantity in ALIASES:
-            i = find_name(table.names, quantity)
+            hits = find_names(table.names, quantity)
         else:
-            i = find_name(table.names, "time", quantity)
-        if i is not None:
-            found.take(table, quantity, i)
+            hits = find_names(table.names, "time", quantity)
+        if hits:
+            found.take(table, quantity, hits[0])
+            alike[quantity] = hits
     if "time" in found.index and "time" not in given:
         taken = set(found.index.values())
         found.other_times = [j for j, forms in enumerate(zip(*name_forms(table.names), strict=True))
@@ -211,14 +212,13 @@ def find_columns(table: Any, time_column: str | None = None,
                 f"{table.path}: the column {table.header[i]!r} is taken for both "
                 f"{' and '.join(quantities)}: each needs a column of its own (--column "
                 "QUANTITY=NAME, --time-column NAME)")
-    normed = [norm_name(n) for n in table.names]
-    for quantity, i in found.index.items():
-        same = [j for j, n in enumerate(normed) if n == normed[i]]
+    for quantity, same in alike.items():
         if len(same) > 1:  # which one is meant, no name can say
+            shown = ", ".join(f"{j + 1} {table.header[j]!r}" for j in same)
             raise RecordingError(
-                f"{table.path}: the header names {table.header[i]!r} {len(same)} times (columns "
-                f"{', '.join(str(j + 1) for j in same)}), so {quantity} could be any of them: "
-                "rename them apart")
+                f"{table.path}: {len(same)} columns' names fit {quantity} alike (columns "
+                f"{shown}), so it could be any of them: rename them apart or give the one "
+                f"meant (--column {quantity}=NAME)")
     return found
 
 
