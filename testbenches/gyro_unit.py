@@ -108,34 +108,31 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
                   readings: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
     """Each unit's miss [deg] in every window that counts, for `gyro` [N, 3] (numbers as read),
     `acc` [N, 3] (any unit: only its direction and its norm relative to the median are used)
-    and `dt` [N] [s] (rows with a non-finite value are left out of every window that holds
-    them); the windows of a recording's blocks are pooled before the verdict. `readings`, by
-    name, takes the gyro's rate in rad/s as a matrix times the numbers as read in place of
-    the units (gyro_axes: each signed order of its axes)."""
+    and `dt` [N] [s] (rows with a non-finite value are left out: they hold no sample, and the
+    next sample's dt spans them); the windows of a recording's blocks are pooled before the
+    verdict. `readings`, by name, takes the gyro's rate in rad/s as a matrix times the numbers
+    as read in place of the units (gyro_axes: each signed order of its axes)."""
     acc, gyro, dt = (np.asarray(a, dtype=float) for a in (acc, gyro, dt))
     if readings is None:
         readings = {unit: scale * np.eye(3) for unit, scale in UNITS.items()}
     none = {name: np.empty(0) for name in readings}
+    finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
+    if not finite.all():  # no sample: the dt of the next one spans it (fit.recording._Clock)
+        acc, gyro, dt = acc[finite], gyro[finite], dt[finite]
     n = len(dt)
     period = median_period(dt) if n else 0.0
     if not (n > 2 and period > 0.0):
         return none
     k = max(1, round(WINDOW_S / period))
-    finite = np.all(np.isfinite(acc), 1) & np.all(np.isfinite(gyro), 1) & np.isfinite(dt)
-    if not finite.all():
-        acc = np.where(finite[:, None], acc, 0.0)
-        gyro = np.where(finite[:, None], gyro, 0.0)
-        dt = np.where(finite, dt, 0.0)
     smooth = _moving_average(acc, max(1, round(LOWPASS_S / period)))
     norm = np.linalg.norm(smooth, axis=1)
-    g = float(np.median(norm[finite])) if finite.any() else 0.0
+    g = float(np.median(norm))
     if not g > 0.0 or n <= k:
         return none
     u = smooth / np.where(norm > 0.0, norm, 1.0)[:, None]
-    quiet = finite & (np.abs(norm / g - 1.0) < QUIET_G)
-    bad = np.concatenate([[0], np.cumsum(~finite)])
+    quiet = np.abs(norm / g - 1.0) < QUIET_G
     m = n - k  # the windows start at samples 0 .. m-1 and end k samples later
-    usable = np.flatnonzero(quiet[:m] & quiet[k:n] & (bad[k + 1:n + 1] - bad[:m] == 0))
+    usable = np.flatnonzero(quiet[:m] & quiet[k:n])
     ux, uy, uz = (np.ascontiguousarray(u[:, i]) for i in range(3))
     dot = (ux[usable] * ux[usable + k] + uy[usable] * uy[usable + k]
            + uz[usable] * uz[usable + k])

@@ -497,9 +497,10 @@ def _names_and_file(path: Path, header: list[str], columns: list[np.ndarray]) ->
 @pytest.mark.parametrize("kind", ["euroc", "plotjuggler", "sensorlog"])
 def test_robotics_datasets_and_topic_exports_are_read_as_written(tmp_path, kind):
     """EuRoC's and TUM-VI's imu0/data.csv ("#timestamp [ns]", "w_RS_S_x [rad s^-1]", "a_RS_S_x
-    [m s^-2]"), PlotJuggler's export of a ROS topic ("__time", "/imu/angular_velocity/x") and
-    iOS SensorLog's clocks ("gyroTimestamp_sinceReboot(s)" beside its accelerometer's): the
-    example's own samples, at its rate, each column named in the choices."""
+    [m s^-2]"), PlotJuggler's export of a ROS topic ("/imu/angular_velocity/x", timed by the
+    message's "/imu/header/stamp" before "__time") and iOS SensorLog's clocks
+    ("gyroTimestamp_sinceReboot(s)" beside its accelerometer's): the example's own samples, at
+    its rate, each column named in the choices."""
     t, imu = _example()
     acc, gyro = imu[:, :3], imu[:, 3:]
     if kind == "euroc":
@@ -513,7 +514,7 @@ def test_robotics_datasets_and_topic_exports_are_read_as_written(tmp_path, kind)
                   *(f"/imu/orientation/{c}" for c in "wxyz")]
         one, zero = np.ones_like(t), np.zeros_like(t)
         cols = [1.7e9 + t, gyro, 1.7e9 + t, acc, one, zero, zero, zero]
-        time = "__time"
+        time = "/imu/header/stamp"  # the message's own stamp before PlotJuggler's timeline
     else:
         header = ["loggingSample(N)", "accelerometerTimestamp_sinceReboot(s)",
                   *(f"accelerometerAcceleration{a}(G)" for a in "XYZ"),
@@ -602,3 +603,47 @@ def test_two_topics_with_the_same_field_are_refused_naming_both(tmp_path):
              for a in "xyz"}
     rec, _ = open_recording(path, columns=given).load()
     np.testing.assert_array_equal(rec.acc, imu[:, :3])
+
+
+@pytest.mark.parametrize("kind", ["time", "dt"])
+def test_rows_of_another_topic_take_no_time_from_the_samples(tmp_path, kind):
+    """A merged export (PlotJuggler's of several topics, a union of timetables) writes the
+    rows of another sensor between the IMU's, their IMU cells empty. Each such row is a sample
+    the estimators reject and count, and the next sample's dt spans it: the samples' dt are the
+    IMU's own (with dt from one row to the next, every IMU row lost the time since the other
+    topic's row, and the recording ran 12 deg off)."""
+    t, imu = _example()
+    other = t[:-1] + 0.0037  # a 2nd topic's row between each two IMU rows
+    times = np.concatenate([t, other])
+    order = np.argsort(times, kind="stable")
+    rows = np.full((len(times), 7), np.nan)
+    rows[:len(t), 1:] = imu
+    rows = rows[order]
+    if kind == "time":
+        rows[:, 0] = times[order]
+    else:
+        rows[:, 0] = np.diff(np.concatenate([[times[order][0] - 0.01], times[order]]))
+    path = tmp_path / "merged.csv"
+    np.savetxt(path, rows, delimiter=",", header=f"{kind},{HEADER}", comments="", fmt="%.17g")
+    source = open_recording(path, gyro_unit="rad/s" if kind == "dt" else "auto")
+    rec, _ = source.load()
+    assert source.rate == pytest.approx(100.0)
+    samples = rec.valid
+    assert samples.sum() == len(t)
+    np.testing.assert_allclose(rec.dt[samples][1:], np.diff(t), atol=1e-9)
+    assert "the next sample's dt spans them" in source.summary(len(rec.dt), 0.0,
+                                                              int((~samples).sum()))
+
+
+def test_a_sample_after_a_dropout_spans_it_at_a_given_rate(tmp_path):
+    """Timed by a rate, five rows a logger wrote without numbers are five sample periods: the
+    next sample's dt is six of them, so the gyro's turn over the gap is not lost."""
+    _, imu = _example()
+    imu = imu.copy()
+    imu[100:105] = np.nan
+    path = tmp_path / "dropout.csv"
+    np.savetxt(path, imu, delimiter=",", header=HEADER, comments="", fmt="%.17g")
+    rec, _ = open_recording(path, rate=100.0).load()
+    assert np.isnan(rec.dt[100:105]).all()
+    assert rec.dt[105] == pytest.approx(0.06)
+    np.testing.assert_array_equal(np.delete(rec.dt, np.s_[100:106]), 0.01)

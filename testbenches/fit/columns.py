@@ -55,6 +55,12 @@ ROS's messages a motion-capture system or an odometry publishes (TransformStampe
 "orientation" alone, which in a ROS Imu message is the device's own estimate, no reference."""
 
 
+LAST_RESORT: dict[str, tuple[str, ...]] = {"time": ("receive_time", "t")}
+"""Aliases taken only where no other alias fits a name in any of name_forms: a ROS topic's
+receive time where no message stamp is found, however deep in a topic's path ("__time" beside
+PlotJuggler's "/imu/header/stamp"), and "t"."""
+
+
 def norm_name(name: str) -> str:
     """A column name as ALIASES spell them: "Gyroscope X" -> "gyroscope_x", "rotationRateX" ->
     "rotation_rate_x", ROS's "field.angular_velocity.x" -> "angular_velocity_x", "%time" ->
@@ -140,13 +146,16 @@ def find_names(names: list[str], quantity: str, given: str | None = None,
     topics the same field), none where none does."""
     if given:
         forms = [[norm_name(n) for n in names]]
-        wanted: tuple[str, ...] = (norm_name(given),)
+        passes: list[tuple[str, ...]] = [(norm_name(given),)]
     else:
         forms, wanted = name_forms(names), (*ALIASES[quantity], *more)
-    for normed in forms:
-        for alias in wanted:
-            if alias in normed:
-                return [j for j, n in enumerate(normed) if n == alias]
+        last = LAST_RESORT.get(quantity, ())
+        passes = [tuple(a for a in wanted if a not in last), last]
+    for aliases in passes:
+        for normed in forms:
+            for alias in aliases:
+                if alias in normed:
+                    return [j for j, n in enumerate(normed) if n == alias]
     return []
 
 

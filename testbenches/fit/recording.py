@@ -284,7 +284,11 @@ blocks; the rest is converted as they decided."""
 @dataclass
 class _Clock:
     """Each sample's dt and time from a time column, a dt column or a rate, block after block
-    (the last time stamp carried across blocks)."""
+    (the last time stamp carried across blocks). A sample's dt is the time since the last row
+    that holds a sample (`holds`: a number in every accelerometer and gyro column), so that a
+    row the estimators reject, or one that is no sample at all (a merged export's row of
+    another topic), takes no time from the next: its gyro's turn is what it is over the whole
+    span since the last."""
 
     kind: str  # "time", "dt" or "rate"
     scale: float
@@ -293,6 +297,10 @@ class _Clock:
     where: Any
     last_t: float | None = None
     last_row: int = -1
+    last_sample_t: float | None = None
+    last_sample_row: int | None = None
+    pending: float = 0.0
+    """The dt of rows since the last sample (a dt column's)."""
     total: float = 0.0
     wrap: float = 0.0
     """Where the time is a microcontroller's 32-bit counter (ms or us), its modulus [s]: a fall
@@ -303,10 +311,16 @@ class _Clock:
     """What to say where a time repeats: how often it does over the first rows, and the rate
     that would space the samples (a time coarser than the sampling)."""
 
-    def __call__(self, raw: np.ndarray | None, row0: int, n: int
-                 ) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(self, raw: np.ndarray | None, row0: int, n: int,
+                 holds: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Each row's dt [s] (NaN for a row that holds no sample or no time) and time [s]."""
+        if holds is None:
+            holds = np.ones(n, dtype=bool)
         if self.kind == "rate":
-            return np.full(n, self.first_dt), (row0 + np.arange(n)) * self.first_dt
+            dt = np.full(n, np.nan)
+            rows = np.flatnonzero(holds)
+            dt[rows] = self.first_dt * self._rows_since(rows + row0)
+            return dt, (row0 + np.arange(n)) * self.first_dt
         assert raw is not None
         if self.kind == "dt":
             dt = raw * self.scale
@@ -315,13 +329,36 @@ class _Clock:
                 dt[0] = self.first_dt
             t = self.total + np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - self.first_dt
             self.total = float(t[-1] + self.first_dt)
-            return dt, t
-        return self._from_time(raw * self.scale, row0)
+            return self._carried(dt, holds), t
+        return self._from_time(raw * self.scale, row0, holds)
 
-    def _from_time(self, t: np.ndarray, row0: int) -> tuple[np.ndarray, np.ndarray]:
-        """A sample's dt is the time since the last sample with a time (a sample without one
-        gets dt NaN, which the estimators reject, and as its time that last time plus the
-        nominal period per sample since)."""
+    def _rows_since(self, rows: np.ndarray) -> np.ndarray:
+        """Of each sample's row, the rows since the last sample's (1 for the very first)."""
+        last = rows[0] - 1 if self.last_sample_row is None and len(rows) else self.last_sample_row
+        if len(rows):
+            self.last_sample_row = int(rows[-1])
+        return np.diff(np.concatenate([[last], rows])) if len(rows) else rows
+
+    def _carried(self, dt: np.ndarray, holds: np.ndarray) -> np.ndarray:
+        """A dt column's samples, each with the dt of the rows since the last sample added."""
+        extra = np.where(~holds & np.isfinite(dt), dt, 0.0)
+        before = np.concatenate([[0.0], np.cumsum(extra)])  # extra over the rows before each
+        rows = np.flatnonzero(holds)
+        out = np.full(len(dt), np.nan)
+        if not len(rows):
+            self.pending += float(before[-1])
+            return out
+        since = before[rows] - before[np.concatenate([[0], rows[:-1] + 1])]
+        since[0] += self.pending
+        out[rows] = dt[rows] + since
+        self.pending = float(before[-1] - before[rows[-1] + 1])
+        return out
+
+    def _from_time(self, t: np.ndarray, row0: int, holds: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """A sample's dt is the time since the last sample with a time (a row without one gets
+        dt NaN, which the estimators reject, and as its time that last time plus the nominal
+        period per row since; every row's time must rise from the last row's that has one)."""
         if self.wrap > 0.0:
             t = self._unwrapped(t)
         valid = np.flatnonzero(np.isfinite(t))
@@ -343,11 +380,15 @@ class _Clock:
                                                        "increase from")
                 + f" {'the time ' if same else ''}{float(times_all[i]):.6g} s on "
                 f"{self.where(int(rows_all[i]))}" + (self.repeats if same else ""))
-        if self.last_t is not None:
-            dt[valid] = steps
-        elif len(valid):
-            dt[valid[1:]] = steps
-            dt[valid[0]] = self.first_dt
+        samples = np.flatnonzero(np.isfinite(t) & holds)
+        sample_t = t[samples]
+        if self.last_sample_t is not None:
+            dt[samples] = np.diff(np.concatenate([[self.last_sample_t], sample_t]))
+        elif len(samples):
+            dt[samples[1:]] = np.diff(sample_t)
+            dt[samples[0]] = self.first_dt
+        if len(samples):
+            self.last_sample_t = float(sample_t[-1])
         if len(rows_all) == 0:  # no time yet: the period per sample from the first
             return dt, (row0 + np.arange(len(t))) * self.first_dt
         here = row0 + np.arange(len(t))
@@ -440,7 +481,8 @@ class RecordingSource:
         return (f"{n} samples, {duration:.4g} s at {self.rate:.4g} Hz"
                 + (f"; {self.choices}" if choices else "")
                 + (f"; {missing} sample(s) without a number in every column, which the "
-                   "estimators reject and count" if missing else "")
+                   "estimators reject and count (the next sample's dt spans them)"
+                   if missing else "")
                 + (f"; {what} {wrapped} time(s), taken as going on" if wrapped else ""))
 
 
@@ -550,6 +592,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         return acc, gyro if axes is None else gyro @ axes.T
 
     acc, gyro = vectors({q: v[keep] for q, v in prefix.items()})
+    holds = _holds(prefix)  # the rows that are samples, whose times the steps are
     t_unit, time_how = "s", ""
     if time_unit != "auto" and not ("time" in prefix or "dt" in prefix):
         raise RecordingError(f"{path}: --time-unit {time_unit} is given, but the recording has "
@@ -568,7 +611,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     elif timed:
         kind = "time" if "time" in prefix else "dt"
         clock, t_unit, time_how = _time_clock(path, kind, prefix[kind], time_unit,
-                                              units.get(kind), acc, gyro, table.where, keep)
+                                              units.get(kind), acc, gyro, table.where, keep,
+                                              holds)
         time_how += time_taken
     elif rate:
         clock = _Clock("rate", 1.0, 1.0 / rate, path, table.where)
@@ -585,7 +629,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(f"{path}: no time or dt column{hint}: give the sample rate (--rate "
                              "HZ), the time column's name (--time-column NAME) or map it with "
                              "--column time=NAME")
-    dt = replace(clock)(prefix.get(clock.kind), 0, n)[0][keep]
+    dt = replace(clock)(prefix.get(clock.kind), 0, n, holds)[0][keep]
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
         raise RecordingError(f"{path}: no sample holds numbers in every column")
@@ -658,13 +702,13 @@ def _samples(block: np.ndarray, names: list[str], join: Any, clock: _Clock, row0
     it names a row by the file's line."""
     cols = {q: block[:, k] for k, q in enumerate(names)}
     cols, rows = join(cols) if join else (cols, slice(None))
-    dt, t = clock(cols.get(clock.kind), row0, len(block))
+    dt, t = clock(cols.get(clock.kind), row0, len(block), _holds(cols))
     return {q: v[rows] for q, v in cols.items()}, dt[rows], t[rows]
 
 
 def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str | None,
-                acc: np.ndarray, gyro: np.ndarray, where: Any, keep: Any = slice(None)
-                ) -> tuple[_Clock, str, str]:
+                acc: np.ndarray, gyro: np.ndarray, where: Any, keep: Any = slice(None),
+                holds: np.ndarray | None = None) -> tuple[_Clock, str, str]:
     """The clock of a time or dt column from its first rows `raw` (numbers as read), its
     unit and how that was chosen (_time_scale; acc, gyro as read, of the rows `keep` selects,
     are the evidence where the steps leave two units). A time of integers below 2^32 in ms or
@@ -673,7 +717,10 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
     day = stated == TIME_OF_DAY
     zeros, span = 0, (0, 0.0)
     if kind == "time":
-        valid = np.flatnonzero(np.isfinite(raw))
+        timed = np.isfinite(raw)
+        if holds is not None and np.count_nonzero(timed & holds) >= 2:
+            timed &= holds  # the samples' steps, not a merged export's other rows'
+        valid = np.flatnonzero(timed)
         if len(valid) < 2:
             raise RecordingError(f"{path}: fewer than two samples with a time")
         values = raw[valid]
@@ -703,9 +750,10 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
     # the unit from the mean step where the time repeats: a clock coarser than the samples
     # rises by its tick, not by their spacing (whole epoch seconds at 100 Hz)
     unit_step = span[1] / span[0] if zeros and span[1] > 0.0 else step
-    t_unit, scale, how = _time_scale(path, kind, unit_step, unit, stated,
-                                     lambda s: clock_in(s)(raw, 0, len(raw))[0][keep], acc,
-                                     gyro)
+    def dt_of(scale: float) -> np.ndarray:
+        return clock_in(scale)(raw, 0, len(raw), holds)[0][keep]
+
+    t_unit, scale, how = _time_scale(path, kind, unit_step, unit, stated, dt_of, acc, gyro)
     return clock_in(scale), t_unit, how
 
 
@@ -713,6 +761,15 @@ def _rises(t: np.ndarray) -> bool:
     """Whether a time column's numbers rise from each row to the next (NaN rows left out)."""
     values = t[np.isfinite(t)]
     return len(values) > 1 and bool(np.all(np.diff(values) > 0.0))
+
+
+def _holds(cols: dict[str, np.ndarray]) -> np.ndarray:
+    """The rows of a block's columns that hold a sample: a number in every accelerometer and
+    gyro column."""
+    ok = np.isfinite(cols[IMU_COLUMNS[0]])
+    for name in IMU_COLUMNS[1:]:
+        ok &= np.isfinite(cols[name])
+    return ok
 
 
 def _vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
