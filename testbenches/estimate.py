@@ -51,7 +51,7 @@ from .options import (
     positive_int,
     with_calibration,
 )
-from .reader import DATETIME, TIME_OF_DAY, TIME_SCALE
+from .reader import DATETIME, DURATION, TIME_OF_DAY, TIME_SCALE
 from .table_out import FORMATS, TableWriter
 
 OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", "bias_z"),
@@ -170,7 +170,7 @@ def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording
     from .fit.recording import RecordingError
     from .time_unit import candidates, median_step, rates
 
-    if stated in (DATETIME, TIME_OF_DAY):  # read as seconds since 1970, or since midnight
+    if stated in (DATETIME, TIME_OF_DAY, DURATION):  # read as seconds (since 1970, midnight)
         return "s"
     if stated is not None:
         if stated not in TIME_SCALE:

@@ -89,6 +89,9 @@ TIME_OF_DAY = "time of day"
 """The unit of a column of times of day without a date ("12:00:00.010", as a logger with a
 real-time clock or a spreadsheet's time format writes them), which the reader gives as seconds
 since midnight."""
+DURATION = "duration"
+"""The unit of a column of durations written with their unit ("0.01 sec", as MATLAB's
+writetimetable writes a timetable's row times), which the reader gives as seconds."""
 
 _NAME_UNIT = re.compile(r"^(.*?)\s*[\(\[]\s*([^\)\]]*?)\s*[\)\]]\s*$")
 _INDEX = re.compile(r"\w\[\d\]$")
@@ -254,6 +257,9 @@ class _TextLayout:
     """The lines a header written on several rows spans ("lines 3-7"; "" for one row)."""
     rate: float | None = None
     """The sample rate [Hz] a line before the header states (STATED_RATE)."""
+    durations: dict[int, str] = field(default_factory=dict)
+    """Columns of durations written with their unit ("0.01 sec", as MATLAB's writetimetable
+    writes a timetable's row times): index -> the unit (DURATION_UNITS), read as seconds."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -271,6 +277,18 @@ cell of its own). A file's time column governs where it has one; two statements 
 
 _TIME_OF_DAY = re.compile(r"^(\d{1,2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?$")
 """A time of day without a date: "12:00:00.010", a decimal comma, "9:05:00"."""
+
+
+_DURATION = re.compile(r"^([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-z]+)$")
+DURATION_UNITS = {"sec": 1.0, "secs": 1.0, "s": 1.0, "ms": 1e-3, "min": 60.0, "mins": 60.0,
+                  "hr": 3600.0, "hrs": 3600.0}
+"""A duration's number and unit as MATLAB writes a duration ("0.01 sec", "1.5 min", "2 hr")."""
+
+
+def duration_unit(text: str) -> str | None:
+    """The unit of a duration written with one (DURATION_UNITS), None where the text is none."""
+    m = _DURATION.match(text.strip())
+    return m.group(2) if m and m.group(2) in DURATION_UNITS else None
 
 
 def seconds_of_day(text: str) -> float | None:
@@ -354,7 +372,8 @@ def _sniff(path: Path) -> _TextLayout:
     numbered = [(i + 1, line) for i, line in enumerate(lines) if line.strip()]
     if not numbered:
         raise TableError(f"{path}: empty file")
-    found = _find_header(numbered)
+    ends = [k for k, (_, line) in enumerate(numbered) if _END_OF_HEADER.match(line)]
+    found = _find_header(numbered, ends[-1] + 1 if ends else 0)
     if found is None:
         raise _no_table(path, numbered[0])
     delimiter, start = found
@@ -385,7 +404,7 @@ def _sniff(path: Path) -> _TextLayout:
     decimal_comma = (delimiter == ";" and any("," in c for c in cells)
                      and not any("." in c for c in cells))
     padded = any(c != c.strip() for c in cells)
-    datetimes, times_of_day = {}, set()
+    datetimes, times_of_day, durations = {}, set(), {}
     for j in range(len(header)):
         column = [row[j].strip() for row in rows if len(row) == len(header) and row[j].strip()]
         matches = [_ISO_DATETIME.match(c) for c in column]
@@ -393,13 +412,15 @@ def _sniff(path: Path) -> _TextLayout:
             datetimes[j] = all(m.group(8) for m in matches if m)  # with a zone
         elif column and all(seconds_of_day(c) is not None for c in column):
             times_of_day.add(j)
+        elif column and all(duration_unit(c) for c in column):  # in the first cell's unit
+            durations[j] = duration_unit(column[0]) or ""
     skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
                else f"line {preamble[0][0]}") if preamble else ""
     rates = [float(m.group(1).replace(",", ".")) for _, line in preamble
              if (m := STATED_RATE.search(line))]
     return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                        datetimes, times_of_day, skipped, data_after, units_row, stacked,
-                       rates[0] if len(rates) == 1 and rates[0] > 0.0 else None)
+                       rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations)
 
 
 def _cells_of(line: str, delimiter: str) -> list[str]:
@@ -498,11 +519,13 @@ def _cells(line: str, delimiter: str) -> int:
 
 
 def _number_like(cell: str) -> bool:
-    """Whether a cell is a number (a decimal comma too), a date and time or a time of day."""
+    """Whether a cell is a number (a decimal comma too), a date and time, a time of day or a
+    duration with its unit."""
     try:
         float(cell.strip().replace(",", "."))
     except ValueError:
-        return bool(_ISO_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip()))
+        return bool(_ISO_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip())
+                    or duration_unit(cell))
     return True
 
 
@@ -510,12 +533,18 @@ def _all_numbers(line: str, delimiter: str) -> bool:
     return all(_number_like(c) for c in next(csv.reader([line], delimiter=delimiter)))
 
 
-def _find_header(numbered: list[tuple[int, str]]) -> tuple[str, int] | None:
-    """(delimiter, index into numbered) of the header: the first line that, with the
-    HEADER_CHECK lines after it, one delimiter splits into as many cells, more than one (the
-    most cells where several do). Lines before it are a logger's preamble (a comment, a device
-    name, the settings) and are skipped."""
-    content = [k for k, (_, line) in enumerate(numbered) if not _comment(line)]
+_END_OF_HEADER = re.compile(r"^\s*\*\*\*End_of_Header\*\*\*[\s,;|]*$", re.IGNORECASE)
+"""LabVIEW's measurement file (.lvm) closes its file header and each segment's header with this
+line; the table's header row follows the last."""
+
+
+def _find_header(numbered: list[tuple[int, str]], first: int = 0) -> tuple[str, int] | None:
+    """(delimiter, index into numbered) of the header: the first line from numbered[first] on
+    (after LabVIEW's file and segment headers) that, with the HEADER_CHECK lines after it, one
+    delimiter splits into as many cells, more than one (the most cells where several do). Lines
+    before it are a logger's preamble (a comment, a device name, the settings) and are
+    skipped."""
+    content = [k for k, (_, line) in enumerate(numbered) if k >= first and not _comment(line)]
     for i, start in enumerate(content[:PREAMBLE_LINES]):
         window = [numbered[k][1] for k in content[i:i + HEADER_CHECK + 1]]
         best: tuple[str, int] | None = None
@@ -532,7 +561,8 @@ def _find_header(numbered: list[tuple[int, str]]) -> tuple[str, int] | None:
 def _text(path: Path) -> TableSource:
     layout = _sniff(path)
     names, stated = zip(*(split_unit(h) for h in layout.header), strict=True)
-    units = [_clock_of(layout, j) or u or layout.units_row[j] for j, u in enumerate(stated)]
+    units = [_clock_of(layout, j) or (DURATION if j in layout.durations else None) or u
+             or layout.units_row[j] for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         if layout.padded or not _has_pyarrow():
@@ -595,6 +625,20 @@ def _seconds(column: Any) -> np.ndarray:
     return seconds
 
 
+def _duration_seconds(column: Any, unit: str) -> np.ndarray:
+    """A pyarrow string array of durations in `unit` ("0.01 sec") as seconds, its nulls NaN;
+    _ArrowFailed where a cell is no such duration (Python's reader then names its line)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    number = pc.extract_regex(column, rf"^\s*(?P<n>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+                                      rf"\s*{unit}\s*$")
+    if number.null_count != column.null_count:
+        raise _ArrowFailed(f"a cell is no duration in {unit}")
+    values = pc.cast(pc.struct_field(number, "n"), pa.float64())
+    return _float64(values) * DURATION_UNITS[unit]
+
+
 def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
                   ) -> Iterator[np.ndarray]:
     import pyarrow as pa
@@ -604,7 +648,8 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
     wanted = [keys[i] for i in columns]
     types = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
              if i in layout.datetimes else pa.time64("ns") if i in layout.times_of_day
-             else pa.float64() for i in columns}
+             else pa.string() if i in layout.durations else pa.float64() for i in columns}
+    durations = {keys[i]: layout.durations[i] for i in columns if i in layout.durations}
     compression = _compression(path)
     try:
         reader = pc.open_csv(
@@ -622,7 +667,9 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
         held = 0
         for batch in reader:
             part = np.column_stack([_float64(batch.column(k)) if types[k] == pa.float64()
-                                    else _seconds(batch.column(k)) for k in wanted]) \
+                                    else _duration_seconds(batch.column(k), durations[k])
+                                    if k in durations else _seconds(batch.column(k))
+                                    for k in wanted]) \
                 if wanted else np.empty((batch.num_rows, 0))
             pending.append(part)
             held += len(part)
@@ -671,7 +718,8 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
         if k < skip:
             continue
         block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
-                              _clock_of(layout, j)) for j in columns])
+                              _clock_of(layout, j), layout.durations.get(j, ""))
+                      for j in columns])
         if len(block) == rows:
             yield np.array(block, dtype=float).reshape(len(block), len(columns))
             block = []
@@ -686,10 +734,17 @@ def _clock_of(layout: _TextLayout, j: int) -> str:
 
 
 def _number(cell: str, path: Path, line: int, column: str, decimal_comma: bool,
-            clock: str = "") -> float:
+            clock: str = "", duration: str = "") -> float:
     text = cell.strip()
     if text.lower() in MISSING_VALUES:
         return float("nan")  # a missing value: that sample is rejected and counted
+    if duration:  # a number and the column's unit
+        m = _DURATION.match(text)
+        if m is None or m.group(2) != duration:
+            raise TableError(f"{path}, line {line}, column {column!r}: {text[:40]!r} is not "
+                             f"a duration in {duration} as the column's others are (0.01 "
+                             f"{duration}; an empty cell marks a missing value)")
+        return float(m.group(1)) * DURATION_UNITS[duration]
     if clock:  # seconds since 1970, or since midnight
         seconds = (seconds_of if clock == DATETIME else seconds_of_day)(text)
         if seconds is None:
@@ -850,6 +905,7 @@ def _mat(path: Path) -> TableSource:
 __all__ = [
     "BLOCK_ROWS",
     "DATETIME",
+    "DURATION",
     "TIME_OF_DAY",
     "TIME_SCALE",
     "UNIT_ALIASES",

@@ -647,3 +647,65 @@ def test_a_sample_after_a_dropout_spans_it_at_a_given_rate(tmp_path):
     assert np.isnan(rec.dt[100:105]).all()
     assert rec.dt[105] == pytest.approx(0.06)
     np.testing.assert_array_equal(np.delete(rec.dt, np.s_[100:106]), 0.01)
+
+
+@pytest.mark.parametrize("time_text", [False, True])
+def test_matlabs_exported_timetable_is_read(tmp_path, time_text):
+    """MATLAB's writetimetable of a timetable with matrix variables (as MATLAB Mobile's sensor
+    log gives them): "Acceleration_1".."_3", "AngularVelocity_1".."_3" are the axes x, y, z,
+    and the row times are durations written with their unit ("0.01 sec"), read as seconds;
+    a cell in another unit is refused naming its line."""
+    t, imu = _example()
+    header = ",".join(["Time", *(f"Acceleration_{k}" for k in (1, 2, 3)),
+                       *(f"AngularVelocity_{k}" for k in (1, 2, 3))])
+    lines = [header] + [",".join([f"{ti:.2f} sec" if time_text else f"{ti:.2f}",
+                                  *(f"{v:.17g}" for v in row)])
+                        for ti, row in zip(t, imu, strict=True)]
+    path = tmp_path / "timetable.csv"
+    path.write_text("\n".join(lines) + "\n")
+    source = open_recording(path)
+    rec, times = source.load()
+    assert "acc_x='Acceleration_1'" in source.choices
+    assert "gyro_z='AngularVelocity_3'" in source.choices
+    if time_text:
+        assert "time from its durations" in source.choices
+    np.testing.assert_array_equal(rec.acc, imu[:, :3])
+    np.testing.assert_allclose(times, t, atol=1e-12)
+    if time_text:
+        lines[7] = lines[7].replace(" sec", " ms")
+        path.write_text("\n".join(lines) + "\n")
+        with pytest.raises(RecordingError, match=r"line 8, column 'Time': '0.06 ms' is not a "
+                           "duration in sec"):
+            open_recording(path).load()
+
+
+def test_a_quaternions_four_matlab_columns_are_no_axes(tmp_path):
+    """"Orientation_1".."_4" (a quaternion, w or x first) are not read as axes: only a name with
+    exactly the three columns _1, _2, _3 is."""
+    from testbenches.fit.columns import name_forms
+
+    forms = name_forms(["Orientation_1", "Orientation_2", "Orientation_3", "Orientation_4",
+                        "Acceleration_1", "Acceleration_2", "Acceleration_3"])
+    assert forms[3] == ["orientation_1", "orientation_2", "orientation_3", "orientation_4",
+                        "acceleration_x", "acceleration_y", "acceleration_z"]
+
+
+def test_a_labview_measurement_file_is_read_after_its_headers(tmp_path):
+    """LabVIEW's .lvm: a file header and a segment header (each closed by ***End_of_Header***,
+    the segment's rows as wide as the table's), then "X_Value" (the waveforms' time) and the
+    channels' names."""
+    t, imu = _example()
+    head = ("LabVIEW Measurement\t\nWriter_Version\t2\nSeparator\tTab\nX_Columns\tOne\n"
+            "***End_of_Header***\t\n\n"
+            "Channels\t6\t\t\t\t\t\t\n" + "Samples" + "\t1000" * 6 + "\t\n"
+            + "Delta_X" + "\t0.010000" * 6 + "\t\n***End_of_Header***\t\t\t\t\t\t\t\n"
+            "X_Value\tAcc X\tAcc Y\tAcc Z\tGyro X\tGyro Y\tGyro Z\tComment\n")
+    rows = ["\t".join([f"{ti:.6f}", *(f"{v:.10g}" for v in row), ""])
+            for ti, row in zip(t, imu, strict=True)]
+    path = tmp_path / "session.lvm"
+    path.write_text(head + "\n".join(rows) + "\n")
+    source = open_recording(path)
+    rec, _ = source.load()
+    assert "time='X_Value'" in source.choices and "acc_x='Acc X'" in source.choices
+    assert source.rate == pytest.approx(100.0)
+    np.testing.assert_allclose(rec.acc, imu[:, :3], rtol=1e-9)

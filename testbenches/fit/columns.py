@@ -32,7 +32,7 @@ ALIASES: dict[str, tuple[str, ...]] = {
              "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
              "timestamp_unix", "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
              "seconds_elapsed", "time_since_start", "time_since_start_in_ms",
-             "gyro_timestamp_since_reboot", "accelerometer_timestamp_since_reboot",
+             "gyro_timestamp_since_reboot", "accelerometer_timestamp_since_reboot", "x_value",
              "receive_time", "t"),
     **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}",
                   f"q_rs_{c}", f"transform_rotation_{c}", f"pose_orientation_{c}",
@@ -46,7 +46,8 @@ received last but one (rostopic's "%time", PlotJuggler's "__time": "receive_time
 the sample by the transport's delay and bunches where messages arrive together; "t" last, as a
 flight log's "T" is its temperature beside a "timestamp". EuRoC's and TUM-VI's "w_RS_S_x" and
 "a_RS_S_x" (the rate and the specific force of the sensor frame S against the reference R, in
-S). SensorLog's (iOS) gyro's clock before its accelerometer's. Physics Toolbox's g-force "gFx"
+S). SensorLog's (iOS) gyro's clock before its accelerometer's. LabVIEW's measurement file's
+(.lvm) "X_Value", its waveforms' time. Physics Toolbox's g-force "gFx"
 is the accelerometer (its "ax" there leaves gravity out, and is refused for it). A reference
 quaternion's components (sensor to world) too, as motion capture names them ("Rotation W" in
 OptiTrack Motive's stacked header, testbenches.reader), EuRoC's ground truth ("q_RS_w") and
@@ -127,14 +128,33 @@ def _path_tails(names: list[str]) -> list[list[str]]:
              for n, p in zip(names, parts, strict=True)] for k in range(1, deepest - 1)]
 
 
+_ONE_BASED = re.compile(r"(.+)_([1-9])")
+
+
+def _one_based_axes(normed: list[str]) -> list[str]:
+    """The columns MATLAB's writetable makes of a variable of three columns ("Acceleration_1",
+    "_2", "_3") as its axes x, y, z, where a name has exactly these three; the others as they
+    are (a quaternion's "_1" to "_4" among them: its first may be w or x)."""
+    found = [_ONE_BASED.fullmatch(n) for n in normed]
+    indices: dict[str, set[str]] = {}
+    for m in found:
+        if m:
+            indices.setdefault(m.group(1), set()).add(m.group(2))
+    three = {stem for stem, got in indices.items() if got == {"1", "2", "3"}}
+    return [f"{m.group(1)}_{'xyz'[int(m.group(2)) - 1]}" if m and m.group(1) in three else n
+            for n, m in zip(normed, found, strict=True)]
+
+
 def name_forms(names: list[str]) -> list[list[str]]:
     """The names as norm_name spells them, then without a unit word (UNIT_TOKENS), then also
-    without a device's prefix and a "_cal" (_without_device), then without a path's first
-    parts (_path_tails, a topic's): the forms find_name tries in turn, so that a name as
-    written is taken before one read into."""
+    without a device's prefix and a "_cal" (_without_device), then with MATLAB's "_1", "_2",
+    "_3" as the axes (_one_based_axes), then without a path's first parts (_path_tails, a
+    topic's): the forms find_name tries in turn, so that a name as written is taken before one
+    read into."""
     normed = [norm_name(n) for n in names]
     bare = [_without_unit(n)[0] for n in normed]
     return [normed, bare, [_without_unit(n)[0] for n in _without_device(normed)],
+            _one_based_axes(bare),
             *([_without_unit(n)[0] for n in tails] for tails in _path_tails(names))]
 
 

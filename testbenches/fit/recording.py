@@ -873,17 +873,20 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     give IMU rates from the data (testbenches.time_unit; dt_of(scale): each sample's dt [s] in a
     unit of that factor). A step that is no IMU rate in the unit given or stated is refused
     with the rate it would be, and so is a given unit that is not the header's."""
-    from ..reader import DATETIME
+    from ..reader import DATETIME, DURATION
     from ..time_unit import RATE_RANGE, TimeUnit, candidates, listed, rate_in, time_unit
 
-    if stated in (DATETIME, TIME_OF_DAY):
-        holds = "dates and times" if stated == DATETIME else "times of day"
+    if stated in (DATETIME, TIME_OF_DAY, DURATION):
+        holds = {DATETIME: "dates and times", TIME_OF_DAY: "times of day",
+                 DURATION: "durations with their unit"}[stated]
         if unit != "auto":
             raise RecordingError(f"{path}: --time-unit {unit} is given, but the {kind} column "
                                  f"holds {holds}, which are read as such (leave it out)")
         if stated == TIME_OF_DAY:
             return TIME_OF_DAY, 1.0, (f"{kind} from its times of day (seconds since midnight; "
                                       "a midnight passed taken as going on)")
+        if stated == DURATION:
+            return "s", 1.0, f"{kind} from its durations (each with its unit, as seconds)"
         return "s", 1.0, f"{kind} from its dates and times (seconds since 1970, UTC)"
     _given_against_header(path, kind, "time-unit", unit, stated)
     chosen = unit if unit != "auto" else stated
