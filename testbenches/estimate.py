@@ -16,10 +16,10 @@ unit the data contradict is refused with the evidence, and so is a recording who
 tell the unit where none is given. A sample without a number in every column is rejected and
 counted by the estimators, not the file.
 
-A reference, roll and pitch [rad, or deg where its header says so] or a quaternion q_w, q_x,
-q_y, q_z (sensor to a z-up frame), in the recording or in a file of its own (--reference,
-matched by time), gives the inclination RMSE, beside VQF's on the same samples where the `vqf`
-package is installed.
+A reference, roll and pitch [rad or deg: as its header says, else as the accelerometer at rest
+tells] or a quaternion q_w, q_x, q_y, q_z (sensor to a z-up frame), in the recording or in a
+file of its own (--reference, matched by time), gives the inclination RMSE, beside VQF's on the
+same samples where the `vqf` package is installed.
 
 It writes, per estimator, OUT/<recording>_<estimator>.csv (or .parquet, .h5 with --format):
 time, roll, pitch [rad], bias_x..z [rad/s], and for the position filter pos_x..z [m],
@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from .fit.recording import read_columns, reference_up  # the one reader
+from .fit.recording import QUAT_COLUMNS, read_columns, reference_up  # the one reader
 from .options import (
     RECORDING_HELP,
     add_calibration,
@@ -91,8 +91,8 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
                    help="an estimator parameter, for every chosen estimator that has it "
                    "(repeatable; a name none has is refused)")
     p.add_argument("--reference", type=Path, default=None,
-                   help="a CSV of time with roll, pitch [rad] or q_w, q_x, q_y, q_z: the "
-                   "reference, matched by time")
+                   help="a CSV of time with roll, pitch [rad or deg] or q_w, q_x, q_y, q_z: "
+                   "the reference, matched by time")
     p.add_argument("--out", type=out_folder, default=Path("reports/estimate"),
                    help="output folder (reports/estimate)")
     p.add_argument("--format", choices=tuple(FORMATS), default="csv",
@@ -118,9 +118,23 @@ class Reference:
         if "time" not in cols:
             raise RecordingError(f"{path}: a reference needs a time column; it has "
                                  f"{', '.join(found.header)}")
-        up, quat = reference_up(cols, path, found.units)
+        units = dict(found.units)
+        self.angles: tuple[np.ndarray, np.ndarray] | None = None  # roll, pitch as read
+        self.angle_unit, self.angle_how = "", ""
+        if "roll" in cols and "pitch" in cols and not all(c in cols for c in QUAT_COLUMNS):
+            stated = {units.get(c) for c in ("roll", "pitch")} - {None}
+            if not stated:  # rad where the numbers can be radians, else deg: the data decide
+                roll, pitch = np.abs(cols["roll"]), np.abs(cols["pitch"])
+                rad = (np.nanmax(roll, initial=0.0) <= np.pi + 1e-6
+                       and np.nanmax(pitch, initial=0.0) <= np.pi / 2 + 1e-6)
+                self.angle_unit = "rad" if rad else "deg"
+                self.angle_how = "" if rad else "beyond radians' range"
+                units.update(roll=self.angle_unit, pitch=self.angle_unit)
+            elif len(stated) == 1:
+                self.angle_unit, self.angle_how = stated.pop(), "from the header"
+        up, quat = reference_up(cols, path, units)
         if up is None:
-            raise RecordingError(f"{path}: a reference holds roll and pitch [rad] or q_w, q_x, "
+            raise RecordingError(f"{path}: a reference holds roll and pitch or q_w, q_x, "
                                  f"q_y, q_z; it has {', '.join(found.header)}")
         self.time_unit = reference_time_unit(path, cols["time"], found.units.get("time"),
                                              recording_time_unit)
@@ -130,12 +144,56 @@ class Reference:
             raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
                                  "attitude")
         self.path, self.t, self.up = path, t[keep], up[keep]
+        if self.angle_unit:
+            self.angles = (cols["roll"][keep], cols["pitch"][keep])
         self.quat = None
         if quat is not None:  # componentwise between neighbours of one sign, renormalised
             q = quat[keep].copy()
             flips = np.cumsum(np.concatenate([[0], np.sum(q[1:] * q[:-1], axis=1) < 0.0])) % 2
             q[flips == 1] *= -1.0
             self.quat = q
+
+    def angle_unit_from(self, rec: Any, t: np.ndarray) -> str:
+        """For a roll and pitch reference: its unit as the accelerometer at rest sees it on a
+        recording's first block (acc, its samples' times t): the other unit where the one
+        taken misses the measured up direction by more than ANGLE_UNIT_MISS_DEG (median over
+        the quiet samples) and the other by at most WORLD_UP_SPREAD_DEG and a third of that.
+        A unit the header does not state is taken so (self.up follows), and said; one it
+        states that the data contradict is refused with the evidence. "" where there is
+        nothing to say."""
+        from .broad.metric import gravity_from_roll_pitch
+        from .fit.recording import RecordingError
+
+        if self.angles is None:
+            return ""
+        norm = np.linalg.norm(rec.acc, axis=1)
+        quiet = np.isfinite(norm) & (np.abs(norm / np.nanmedian(norm) - 1.0) < 0.05)
+        quiet &= (t >= self.t[0]) & (t <= self.t[-1])
+        if quiet.sum() < 10:
+            return ""
+        seen = rec.acc[quiet] / norm[quiet, None]
+        roll, pitch = (np.interp(t[quiet], self.t, a) for a in self.angles)
+        miss = {}
+        for unit, scale in (("rad", 1.0), ("deg", np.pi / 180.0)):
+            up = gravity_from_roll_pitch(roll * scale, pitch * scale)
+            miss[unit] = float(np.degrees(np.median(np.arccos(np.clip(
+                np.sum(up * seen, axis=1), -1.0, 1.0)))))
+        other = "deg" if self.angle_unit == "rad" else "rad"
+        if not (miss[self.angle_unit] > ANGLE_UNIT_MISS_DEG
+                and miss[other] <= WORLD_UP_SPREAD_DEG
+                and miss[other] <= miss[self.angle_unit] / 3.0):
+            return (f"reference: roll and pitch in {self.angle_unit} ({self.angle_how})"
+                    if self.angle_how else "")
+        evidence = (f"the accelerometer at rest misses their up direction by "
+                    f"{miss[self.angle_unit]:.3g} deg in {self.angle_unit} and by "
+                    f"{miss[other]:.3g} deg in {other} (median)")
+        if self.angle_how == "from the header":
+            raise RecordingError(f"{self.path}: the header states roll and pitch in "
+                                 f"{self.angle_unit}, but {evidence}: correct the header")
+        scale = np.pi / 180.0 if other == "deg" else 1.0
+        self.angle_unit = other
+        self.up = gravity_from_roll_pitch(self.angles[0] * scale, self.angles[1] * scale)
+        return f"reference: roll and pitch in {other} (from the data: {evidence})"
 
     @property
     def span(self) -> tuple[float, float]:
@@ -192,6 +250,10 @@ def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording
 WORLD_UP_SPREAD_DEG = 10.0
 """The most the accelerometer at rest may scatter around the reference's vertical (median
 angle) for that vertical to be taken."""
+ANGLE_UNIT_MISS_DEG = 1.0
+"""A reference's roll and pitch miss the accelerometer at rest by more than this in the unit
+taken, and by a third of it in the other, for the other to be theirs: a degree read as a
+radian misses by tens of degrees, a radian read as a degree by the tilt itself."""
 WORLD_UP_TILT_DEG = 5.0
 """A reference vertical further than this from the world frame's z axis is taken as the
 reference's up (a y-up motion-capture frame), and said so."""
@@ -632,6 +694,8 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                     if n == 0 and reference.span[1] < t[0]:
                         raise RecordingError(reference.overlap_error(float(t[0]),
                                                                      float("nan")))
+                    if n == 0 and (said := reference.angle_unit_from(rec, t)):
+                        notes.append(said)
                     rec.up_ref, rec.ref_quat = reference.at(t)
                     rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
                 if n == 0:

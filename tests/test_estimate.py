@@ -296,7 +296,6 @@ def _reference(path: Path, time: np.ndarray, roll: np.ndarray, pitch: np.ndarray
 
 
 @pytest.mark.parametrize(("make", "says"), [
-    ("degrees", "are in degrees? a reference gives roll and pitch in rad"),
     ("no overlap", "does not overlap the recording's"),
     ("zero quaternions", "none of the reference's 1000 quaternions is a rotation"),
 ])
@@ -305,9 +304,7 @@ def test_a_reference_that_cannot_serve_is_refused_not_scored_as_nan(tmp_path, ca
     truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
     ref = tmp_path / "ref.csv"
     t, roll, pitch = truth[:, 0], truth[:, 1], truth[:, 2]
-    if make == "degrees":
-        _reference(ref, t, np.degrees(roll), np.degrees(pitch))
-    elif make == "no overlap":
+    if make == "no overlap":
         _reference(ref, t + 1000.0, roll, pitch)
     else:
         np.savetxt(ref, np.column_stack([t, np.zeros((len(t), 4))]), delimiter=",",
@@ -315,6 +312,62 @@ def test_a_reference_that_cannot_serve_is_refused_not_scored_as_nan(tmp_path, ca
     assert main(["estimate", str(EXAMPLE), "--reference", str(ref), "--out", str(tmp_path),
                  "--no-plots"]) == 2
     assert says in capsys.readouterr().err
+
+
+def _small_tilts(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sensor tilted 2 deg in roll and 1 deg in pitch, swaying by half a degree, for 30 s at
+    100 Hz (a vehicle's or a building's tilts), and its time, roll and pitch [rad]."""
+    rng = np.random.default_rng(3)
+    t = np.arange(3000) / 100.0
+    roll = np.radians(2.0 + 0.5 * np.sin(2 * np.pi * 0.3 * t))
+    pitch = np.radians(1.0 + 0.3 * np.sin(2 * np.pi * 0.2 * t))
+    g = 9.80665
+    acc = np.column_stack([-g * np.sin(pitch), g * np.cos(pitch) * np.sin(roll),
+                           g * np.cos(pitch) * np.cos(roll)]) + rng.normal(0, 0.02, (3000, 3))
+    gyro = np.column_stack([np.gradient(roll, t), np.gradient(pitch, t), np.zeros(3000)])
+    np.savetxt(path, np.column_stack([t, acc, gyro + rng.normal(0, 0.002, (3000, 3))]),
+               delimiter=",", header="time,ax,ay,az,gx (rad/s),gy (rad/s),gz (rad/s)",
+               comments="")
+    return t, roll, pitch
+
+
+def _kf_rmse(out: str) -> float:
+    return float(next(r for r in out.splitlines() if r.startswith("kf ")).split()[2])
+
+
+def test_a_reference_in_degrees_is_read_in_degrees_whatever_its_range(tmp_path, capsys):
+    """A reference's roll and pitch in degrees, the header silent: beyond radians' range (the
+    example's 29 deg) they can only be degrees; within it (a vehicle's tilts of 1-2 deg, which
+    read as radians were 101 deg off, exit 0) the accelerometer at rest tells: each scores as
+    the reference in radians does, and the command says why it read degrees."""
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
+    rec = tmp_path / "tilts.csv"
+    cases = [(EXAMPLE, truth[:, 0], truth[:, 1], truth[:, 2], "beyond radians' range"),
+             (rec, *_small_tilts(rec), "from the data: the accelerometer at rest misses")]
+    for recording, t, roll, pitch, why in cases:
+        scores = []
+        for name, scale in (("rad.csv", 1.0), ("deg.csv", 180.0 / np.pi)):
+            _reference(tmp_path / name, t, roll * scale, pitch * scale)
+            assert main(["estimate", str(recording), "--estimator", "kf", "--reference",
+                         str(tmp_path / name), "--out", str(tmp_path / "out"),
+                         "--no-plots"]) == 0
+            out = capsys.readouterr().out
+            scores.append(_kf_rmse(out))
+        assert f"roll and pitch in deg ({why}" in out
+        assert scores[1] == pytest.approx(scores[0], abs=1e-6)
+
+
+def test_a_reference_unit_the_data_contradict_is_refused(tmp_path, capsys):
+    """A header that says deg over radians (read as degrees they are level, 2 deg off the
+    accelerometer at rest) is refused with the evidence, not scored."""
+    t, roll, pitch = _small_tilts(tmp_path / "tilts.csv")
+    ref = tmp_path / "ref.csv"
+    np.savetxt(ref, np.column_stack([t, roll, pitch]), delimiter=",",
+               header="time,roll (deg),pitch (deg)", comments="")
+    assert main(["estimate", str(tmp_path / "tilts.csv"), "--reference", str(ref), "--out",
+                 str(tmp_path / "out"), "--no-plots"]) == 2
+    assert ("the header states roll and pitch in deg, but the accelerometer at rest misses "
+            "their up direction by 2.") in capsys.readouterr().err
 
 
 def test_a_file_without_a_calibration_in_it_is_refused_as_calibration(tmp_path, capsys):
