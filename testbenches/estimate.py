@@ -93,6 +93,9 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--reference", type=Path, default=None,
                    help="a CSV of time with roll, pitch [rad or deg] or q_w, q_x, q_y, q_z: "
                    "the reference, matched by time")
+    p.add_argument("--reference-column", action="append", default=[], metavar="QUANTITY=NAME",
+                   help="the reference file's column of a quantity (time, roll, pitch, "
+                   "q_w..q_z) where its name is none the reader knows (repeatable)")
     p.add_argument("--out", type=out_folder, default=Path("reports/estimate"),
                    help="output folder (reports/estimate)")
     p.add_argument("--format", choices=tuple(FORMATS), default="csv",
@@ -111,10 +114,11 @@ class Reference:
     """A reference file (time with roll, pitch or q_w..q_z), read whole (a reference is a
     recording's companion, not its bulk), matched to a recording's times by `at`."""
 
-    def __init__(self, path: Path, recording_time_unit: str = "s") -> None:
+    def __init__(self, path: Path, recording_time_unit: str = "s",
+                 columns: dict[str, str] | None = None) -> None:
         from .fit.recording import RecordingError
 
-        cols, found = read_columns(path)
+        cols, found = read_columns(path, columns=columns)
         if "time" not in cols:
             raise RecordingError(f"{path}: a reference needs a time column; it has "
                                  f"{', '.join(found.header)}")
@@ -135,7 +139,8 @@ class Reference:
         up, quat = reference_up(cols, path, units)
         if up is None:
             raise RecordingError(f"{path}: a reference holds roll and pitch or q_w, q_x, "
-                                 f"q_y, q_z; it has {', '.join(found.header)}")
+                                 f"q_y, q_z; it has {', '.join(found.header)}: map them with "
+                                 "--reference-column QUANTITY=NAME")
         self.time_unit = reference_time_unit(path, cols["time"], found.units.get("time"),
                                              recording_time_unit)
         t = cols["time"] * TIME_SCALE[self.time_unit]
@@ -627,7 +632,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
     from fusion_core.presets import load_preset
     from fusion_core.registry import KEYS, create
 
-    from .fit.recording import source_from_args
+    from .fit.recording import REFERENCE_COLUMNS, RecordingError, parse_columns, source_from_args
     from .options import choose
 
     keys = choose(args.estimator, list(KEYS), "estimator")
@@ -641,10 +646,15 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         import threading  # leaves the second core idle (reading, units and rate are serial)
 
         threading.Thread(target=_import_pyplot, daemon=True).start()
+    mapped = parse_columns(args.reference_column, "--reference-column", REFERENCE_COLUMNS)
+    if mapped and args.reference is None:
+        raise RecordingError("--reference-column is given, but no --reference: it maps a "
+                             "reference file's columns (a reference in the recording's own "
+                             "file is mapped with --column)")
     source = source_from_args(args.recording, args)
     print(f"{args.recording}: {source.choices}")
-    reference = (Reference(args.reference, source.time_unit) if args.reference is not None
-                 else None)
+    reference = (Reference(args.reference, source.time_unit, mapped)
+                 if args.reference is not None else None)
     args.out.mkdir(parents=True, exist_ok=True)
     runs: list[Any] = []
     try:

@@ -370,6 +370,41 @@ def test_a_reference_unit_the_data_contradict_is_refused(tmp_path, capsys):
             "their up direction by 2.") in capsys.readouterr().err
 
 
+def test_a_reference_files_columns_are_mapped_by_their_own_option(tmp_path, capsys):
+    """A reference whose quaternion is q0..q3 (w first here; an index names no order) scores
+    with --reference-column as with the names the reader knows; without it the refusal says
+    how; the option without a reference, or for a quantity no reference has, is refused."""
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
+    t, roll, pitch, yaw = truth[:, 0], truth[:, 1], truth[:, 2], truth[:, 3]
+    cr, sr = np.cos(roll / 2), np.sin(roll / 2)
+    cp, sp = np.cos(pitch / 2), np.sin(pitch / 2)
+    cy, sy = np.cos(yaw / 2), np.sin(yaw / 2)
+    q = np.column_stack([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+                         cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
+    scores = []
+    for name, header in (("named.csv", "stamp,q_w,q_x,q_y,q_z"),
+                         ("indexed.csv", "stamp,q0,q1,q2,q3")):
+        path = tmp_path / name
+        np.savetxt(path, np.column_stack([t, q]), delimiter=",", header=header, comments="")
+        mapped = ["--reference-column", "time=stamp"] + (
+            [f"--reference-column=q_{c}=q{k}" for k, c in enumerate("wxyz")]
+            if name == "indexed.csv" else [])
+        assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference", str(path),
+                     *mapped, "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+        scores.append(_kf_rmse(capsys.readouterr().out))
+    assert scores[1] == scores[0] == pytest.approx(0.5996, abs=1e-4)
+    bare = ["estimate", str(EXAMPLE), "--out", str(tmp_path / "out"), "--no-plots"]
+    assert main([*bare, "--reference", str(tmp_path / "indexed.csv"), "--reference-column",
+                 "time=stamp"]) == 2
+    assert "it has stamp, q0, q1, q2, q3: map them with --reference-column" in \
+        capsys.readouterr().err
+    assert main([*bare, "--reference-column", "q_w=q0"]) == 2
+    assert "--reference-column is given, but no --reference" in capsys.readouterr().err
+    assert main([*bare, "--reference", str(tmp_path / "indexed.csv"), "--reference-column",
+                 "acc_x=q0"]) == 2
+    assert "QUANTITY one of time, roll, pitch, q_w, q_x, q_y, q_z" in capsys.readouterr().err
+
+
 def test_a_file_without_a_calibration_in_it_is_refused_as_calibration(tmp_path, capsys):
     path = tmp_path / "calibration.json"
     path.write_text('{"foo": 1}')

@@ -129,17 +129,22 @@ G_STANDARD = 9.80665
 
 # ----- reading ---------------------------------------------------------------------------------
 
-def parse_columns(specs: list[str]) -> dict[str, str]:
-    """--column QUANTITY=NAME options as {quantity: column name}; RecordingError for a quantity
-    that is not one of ALIASES' or a spec without '='."""
+REFERENCE_COLUMNS = ("time", "roll", "pitch", *QUAT_COLUMNS)
+"""The quantities a reference file's columns may be (estimate's --reference-column)."""
 
+
+def parse_columns(specs: list[str], option: str = "--column",
+                  allowed: tuple[str, ...] | None = None) -> dict[str, str]:
+    """QUANTITY=NAME options as {quantity: column name}; RecordingError for a quantity that is
+    not one of `allowed` (ALIASES' and EXTRA_COLUMNS where None) or a spec without '='."""
+    allowed = allowed or (*ALIASES, *EXTRA_COLUMNS)
     out = {}
     for spec in specs:
         quantity, sep, name = spec.partition("=")
         quantity = quantity.strip()
-        if not sep or quantity not in (*ALIASES, *EXTRA_COLUMNS):
-            raise RecordingError(f"--column {spec!r}: expected QUANTITY=NAME with QUANTITY one "
-                                 f"of {', '.join((*ALIASES, *EXTRA_COLUMNS))}")
+        if not sep or quantity not in allowed:
+            raise RecordingError(f"{option} {spec!r}: expected QUANTITY=NAME with QUANTITY one "
+                                 f"of {', '.join(allowed)}")
         out[quantity] = name.strip()
     return out
 
