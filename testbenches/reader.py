@@ -401,8 +401,8 @@ def _sniff(path: Path) -> _TextLayout:
     rows = [next(csv.reader([line], delimiter=delimiter))
             for no, line in numbered if no > data_after][:49]
     cells = [c for row in rows for c in row if c.strip()]
-    decimal_comma = (delimiter == ";" and any("," in c for c in cells)
-                     and not any("." in c for c in cells))
+    decimal_comma = (any("," in c for c in cells)  # a cell's comma: ';' or tab between cells,
+                     and not any("." in c for c in cells))  # or ',' and the cell quoted
     padded = any(c != c.strip() for c in cells)
     datetimes, times_of_day, durations = {}, set(), {}
     for j in range(len(header)):

@@ -123,8 +123,9 @@ def test_a_calibration_file_is_applied_at_every_estimators_input(tmp_path, capsy
 
 # ----- a file as a logger or a spreadsheet writes it, and units that cannot be silently wrong -----
 def _logger_file(path: Path, delimiter: str = ",", bom: bool = False, deg: bool = True,
-                 g: bool = True, header_units: bool = True) -> None:
-    """tilt_motion.csv as a logger writes it: its own column names with units in them."""
+                 g: bool = True, header_units: bool = True, comma: bool = False) -> None:
+    """tilt_motion.csv as a logger writes it: its own column names with units in them (comma:
+    a decimal comma, each cell quoted where the delimiter is a comma too)."""
     ex = _example()
     acc = ex["acc"] / 9.80665 if g else ex["acc"]
     gyro = np.degrees(ex["gyro"]) if deg else ex["gyro"]
@@ -132,7 +133,14 @@ def _logger_file(path: Path, delimiter: str = ",", bom: bool = False, deg: bool 
     names = ["Time (s)"] + [f"Accelerometer {a} {au if header_units else ''}".strip()
                             for a in "XYZ"] + [
         f"Gyroscope {a} {gu if header_units else ''}".strip() for a in "XYZ"]
-    rows = [delimiter.join(names)] + [delimiter.join(f"{v:.9g}" for v in row) for row in
+    def cell(v: float) -> str:
+        text = f"{v:.9g}"
+        if not comma:
+            return text
+        text = text.replace(".", ",")
+        return f'"{text}"' if delimiter == "," else text
+
+    rows = [delimiter.join(names)] + [delimiter.join(cell(v) for v in row) for row in
                                       np.column_stack([ex["time"], acc, gyro])]
     path.write_text(("\ufeff" if bom else "") + "\n".join(rows) + "\n", encoding="utf-8")
 
@@ -141,13 +149,17 @@ def _kf_roll(tmp_path: Path, name: str) -> np.ndarray:
     return np.loadtxt(tmp_path / f"{name}_kf.csv", delimiter=",", skiprows=1)[:, 1]
 
 
-@pytest.mark.parametrize(("delimiter", "bom"), [(",", False), (";", True), ("\t", False)])
+@pytest.mark.parametrize(("delimiter", "bom", "comma"), [
+    (",", False, False), (";", True, False), ("\t", False, False), (";", False, True),
+    ("\t", False, True), (",", False, True)])
 def test_a_loggers_header_delimiter_and_byte_order_mark_are_read(tmp_path, capsys, delimiter,
-                                                                 bom):
+                                                                 bom, comma):
     """Names like 'Gyroscope X (deg/s)', units in them, semicolons or tabs, a UTF-8 BOM as
-    spreadsheets write: the same estimate as from the SI file, and the choices printed."""
+    spreadsheets write, a decimal comma (German Excel: between semicolons, between tabs as its
+    Unicode Text, or quoted between commas): the same estimate as from the SI file, and the
+    choices printed."""
     path = tmp_path / "logger.csv"
-    _logger_file(path, delimiter, bom)
+    _logger_file(path, delimiter, bom, comma=comma)
     assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path),
                  "--no-plots"]) == 0
     said = capsys.readouterr().out

@@ -709,3 +709,22 @@ def test_a_labview_measurement_file_is_read_after_its_headers(tmp_path):
     assert "time='X_Value'" in source.choices and "acc_x='Acc X'" in source.choices
     assert source.rate == pytest.approx(100.0)
     np.testing.assert_allclose(rec.acc, imu[:, :3], rtol=1e-9)
+
+
+def test_one_numbered_sensor_is_read_and_two_are_refused_naming_both(tmp_path):
+    """A logger of several IMUs numbers each ("acc1_x", "gyro1_x"): one sensor so numbered is
+    read; two are refused naming both columns, and --column gives the one meant."""
+    t, imu = _example()
+    one = ",".join(["time", *(f"{s}1_{a}" for s in ("acc", "gyro") for a in "xyz")])
+    path = _names_and_file(tmp_path / "one.csv", one.split(","), [t, imu])
+    source = open_recording(path)
+    assert "acc_x='acc1_x'" in source.choices
+    np.testing.assert_array_equal(source.load()[0].gyro, imu[:, 3:])
+    two = one.split(",") + [f"{s}2_{a}" for s in ("acc", "gyro") for a in "xyz"]
+    path = _names_and_file(tmp_path / "two.csv", two, [t, imu, imu * 1.01])
+    with pytest.raises(RecordingError, match=r"2 columns' names fit acc_x alike \(columns 2 "
+                       r"'acc1_x', 8 'acc2_x'\)"):
+        open_recording(path)
+    given = {f"{s}_{a}": f"{s}2_{a}" for s in ("acc", "gyro") for a in "xyz"}
+    np.testing.assert_array_equal(open_recording(path, columns=given).load()[0].acc,
+                                  imu[:, :3] * 1.01)

@@ -145,16 +145,26 @@ def _one_based_axes(normed: list[str]) -> list[str]:
             for n, m in zip(normed, found, strict=True)]
 
 
+_NUMBERED = re.compile(r"(?<=[a-z])\d+(?=_[xyz]$)")
+
+
+def _unnumbered(normed: list[str]) -> list[str]:
+    """The names without a sensor's number before the axis ("acc1_x", "gyro2_x": a logger of
+    several IMUs numbers each): the number left out, so that two sensors' columns fit one
+    quantity alike and are refused naming both (find_columns), one sensor's are taken."""
+    return [_NUMBERED.sub("", n) for n in normed]
+
+
 def name_forms(names: list[str]) -> list[list[str]]:
     """The names as norm_name spells them, then without a unit word (UNIT_TOKENS), then also
     without a device's prefix and a "_cal" (_without_device), then with MATLAB's "_1", "_2",
-    "_3" as the axes (_one_based_axes), then without a path's first parts (_path_tails, a
-    topic's): the forms find_name tries in turn, so that a name as written is taken before one
-    read into."""
+    "_3" as the axes (_one_based_axes), then without a sensor's number (_unnumbered), then
+    without a path's first parts (_path_tails, a topic's): the forms find_name tries in
+    turn, so that a name as written is taken before one read into."""
     normed = [norm_name(n) for n in names]
     bare = [_without_unit(n)[0] for n in normed]
     return [normed, bare, [_without_unit(n)[0] for n in _without_device(normed)],
-            _one_based_axes(bare),
+            _one_based_axes(bare), _unnumbered(bare),
             *([_without_unit(n)[0] for n in tails] for tails in _path_tails(names))]
 
 
