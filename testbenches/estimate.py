@@ -93,6 +93,8 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
     p.add_argument("--reference", type=Path, default=None,
                    help="a CSV of time with roll, pitch [rad or deg] or q_w, q_x, q_y, q_z: "
                    "the reference, matched by time")
+    p.add_argument("--reference-topic", default=None, metavar="NAME",
+                   help="a ROS bag reference's pose topic, where it has several")
     p.add_argument("--reference-column", action="append", default=[], metavar="QUANTITY=NAME",
                    help="the reference file's column of a quantity (time, roll, pitch, "
                    "q_w..q_z) where its name is none the reader knows (repeatable)")
@@ -115,10 +117,10 @@ class Reference:
     recording's companion, not its bulk), matched to a recording's times by `at`."""
 
     def __init__(self, path: Path, recording_time_unit: str = "s",
-                 columns: dict[str, str] | None = None) -> None:
+                 columns: dict[str, str] | None = None, topic: str | None = None) -> None:
         from .fit.recording import RecordingError
 
-        cols, found = read_columns(path, columns=columns)
+        cols, found = read_columns(path, columns=columns, want="pose", topic=topic)
         if "time" not in cols:
             raise RecordingError(f"{path}: a reference needs a time column; it has "
                                  f"{', '.join(found.header)}")
@@ -647,13 +649,14 @@ def cmd_estimate(args: argparse.Namespace) -> int:
 
         threading.Thread(target=_import_pyplot, daemon=True).start()
     mapped = parse_columns(args.reference_column, "--reference-column", REFERENCE_COLUMNS)
-    if mapped and args.reference is None:
-        raise RecordingError("--reference-column is given, but no --reference: it maps a "
-                             "reference file's columns (a reference in the recording's own "
-                             "file is mapped with --column)")
+    if (mapped or args.reference_topic) and args.reference is None:
+        raise RecordingError(f"{'--reference-column' if mapped else '--reference-topic'} is "
+                             "given, but no --reference: it names a reference file's columns "
+                             "or topic (a reference in the recording's own file is mapped "
+                             "with --column)")
     source = source_from_args(args.recording, args)
     print(f"{args.recording}: {source.choices}")
-    reference = (Reference(args.reference, source.time_unit, mapped)
+    reference = (Reference(args.reference, source.time_unit, mapped, args.reference_topic)
                  if args.reference is not None else None)
     args.out.mkdir(parents=True, exist_ok=True)
     runs: list[Any] = []

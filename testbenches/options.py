@@ -34,6 +34,8 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
                         "space the samples by it where its time cannot serve (a time coarser "
                         "than the sampling repeats), the time column left")
     parser.add_argument("--time-column", default=None, help="the time column's name")
+    parser.add_argument("--topic", default=None, metavar="NAME",
+                        help="a ROS bag's IMU topic (sensor_msgs/Imu), where it has several")
     parser.add_argument("--time-unit", choices=("auto", "s", "ms", "us", "ns"), default="auto",
                         help="the unit of the time (or dt) column (auto: the header's, else the "
                         "one in which its steps are an IMU's sample rate, the data deciding "

@@ -242,24 +242,34 @@ def _unit_in_name(quantity: str, name: str) -> str | None:
     return suffix if suffix in TIME_SCALE and normed != suffix else None
 
 
-def open_table(path: Path) -> Any:
-    """testbenches.reader.open_table, its TableError as a RecordingError."""
+def open_table(path: Path, want: str = "imu", topic: str | None = None) -> Any:
+    """testbenches.reader.open_table, or for a ROS bag testbenches.bags.open_bag (`want` "imu"
+    for a recording, "pose" for a reference; the topic named, else the only one of its kind),
+    its TableError as a RecordingError."""
+    from ..bags import is_bag, open_bag
     from ..reader import TableError
     from ..reader import open_table as open_any
 
     try:
+        if is_bag(path):
+            return open_bag(path, want, topic)
+        if topic is not None:
+            raise RecordingError(f"{path}: a topic is given ({topic}), but this is no ROS bag "
+                                 "(a .bag, a ROS 2 bag's folder or its .db3 or .mcap file)")
         return open_any(path)
     except TableError as err:
         raise RecordingError(str(err)) from None
 
 
 def read_columns(path: Path, time_column: str | None = None,
-                 columns: dict[str, str] | None = None) -> tuple[dict[str, np.ndarray], Columns]:
+                 columns: dict[str, str] | None = None, want: str = "imu",
+                 topic: str | None = None) -> tuple[dict[str, np.ndarray], Columns]:
     """Every row of the quantities a file holds ({quantity: values}) and where they were
-    found; RecordingError where the file cannot be read."""
+    found (a ROS bag's topic of `want`: open_table); RecordingError where the file cannot be
+    read."""
     from ..reader import TableError
 
-    table = open_table(path)
+    table = open_table(path, want, topic)
     found = find_columns(table, time_column, columns)
     names = list(found.index)
     try:
@@ -520,17 +530,20 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                    acc_unit: str = "auto", gyro_unit: str = "auto",
                    columns: dict[str, str] | None = None,
                    time_unit: str = "auto", acc_sign: str = "auto",
-                   gyro_axes: str = AS_READ_AXES) -> RecordingSource:
+                   gyro_axes: str = AS_READ_AXES, topic: str | None = None) -> RecordingSource:
     """The recording opened for reading in blocks (RecordingSource), its units, columns and
     rate decided from its first PREFIX_ROWS samples: given, stated by the file, or from the
     data (which must not contradict what is given or stated); the gyro's axes in the
     accelerometer's as `gyro_axes` orders them (parse_axes); RecordingError saying what is
     wrong."""
+    from ..bags import is_bag
     from ..reader import TableError
     from .sensor_files import is_sensor_files, open_sensor_files
 
     axes = parse_axes(gyro_axes)
-    if is_sensor_files(path):  # a phone app's export: one file per sensor
+    if is_bag(path) or topic is not None:  # a ROS bag's IMU topic
+        table = open_table(path, "imu", topic)
+    elif is_sensor_files(path):  # a phone app's export: one file per sensor
         others = sorted(set(columns or {}) - {"time"})
         if others:
             raise RecordingError(f"{path}: --column {others[0]}=... maps a file's column; the "
@@ -801,7 +814,8 @@ def source_from_args(path: Path, args: argparse.Namespace) -> RecordingSource:
     return open_recording(path, rate=args.rate, time_column=args.time_column,
                           acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
                           columns=parse_columns(args.column), time_unit=args.time_unit,
-                          acc_sign=args.acc_sign, gyro_axes=args.gyro_axes)
+                          acc_sign=args.acc_sign, gyro_axes=args.gyro_axes,
+                          topic=args.topic)
 
 
 def recording_from_args(path: Path, args: argparse.Namespace) -> Any:

@@ -1,0 +1,153 @@
+"""ROS bags as robotics users record them: the IMU topic as the recording, a motion-capture
+or odometry topic as the reference, from a ROS 1 bag, a ROS 2 bag's folder or its file alone
+(testbenches.bags)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from testbenches.cli import main
+from testbenches.fit.recording import RecordingError, open_recording
+
+pytest.importorskip("rosbags", reason="the rosbags package reads ROS bags (testbench extra)")
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLE = REPO / "examples" / "tilt_motion.csv"
+TRUTH = REPO / "examples" / "tilt_motion_truth.csv"
+EPOCH_NS = 1_700_000_000_000_000_000
+
+
+def _quaternions(truth: np.ndarray) -> np.ndarray:
+    """w, x, y, z of the truth's roll, pitch, yaw (Z-Y-X)."""
+    roll, pitch, yaw = truth[:, 1] / 2, truth[:, 2] / 2, truth[:, 3] / 2
+    cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
+                              np.cos(yaw), np.sin(yaw))
+    return np.column_stack([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+                            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
+
+
+def _messages(ts, imu_topics=("/imu/data",), pose="geometry_msgs/msg/PoseStamped",
+              stamped=True):
+    """(receive time [ns], topic, type, message) of the example's samples on each IMU topic and
+    of its truth as a pose topic, in the order a bag holds them."""
+    t_ = ts.types
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+    truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
+    q = _quaternions(truth)
+
+    def header(ns, frame):
+        fields = t_["std_msgs/msg/Header"].__dataclass_fields__
+        stamp = t_["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+        return t_["std_msgs/msg/Header"](stamp=stamp, frame_id=frame,
+                                         **({"seq": 0} if "seq" in fields else {}))
+
+    def vector(v):
+        return t_["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+    def quat(w, x, y, z):
+        return t_["geometry_msgs/msg/Quaternion"](x=float(x), y=float(y), z=float(z), w=float(w))
+
+    out = []
+    for k, topic in enumerate(imu_topics):
+        for row in data:
+            ns = EPOCH_NS + round(row[0] * 1e9)
+            msg = t_["sensor_msgs/msg/Imu"](
+                header=header(ns if stamped else 0, "imu"), orientation=quat(1, 0, 0, 0),
+                orientation_covariance=np.array([-1.0] + [0.0] * 8),
+                angular_velocity=vector(row[4:7] * (1 + k)),
+                angular_velocity_covariance=np.zeros(9),
+                linear_acceleration=vector(row[1:4]), linear_acceleration_covariance=np.zeros(9))
+            out.append((ns + 300_000, topic, "sensor_msgs/msg/Imu", msg))
+    for row, (w, x, y, z) in zip(truth, q, strict=True):
+        ns = EPOCH_NS + round(row[0] * 1e9)
+        if pose == "geometry_msgs/msg/PoseStamped":
+            point = t_["geometry_msgs/msg/Point"](x=0.0, y=0.0, z=0.0)
+            msg = t_[pose](header=header(ns, "world"),
+                           pose=t_["geometry_msgs/msg/Pose"](position=point,
+                                                             orientation=quat(w, x, y, z)))
+        else:  # TransformStamped, as vicon_bridge publishes it
+            msg = t_[pose](header=header(ns, "world"), child_frame_id="imu",
+                           transform=t_["geometry_msgs/msg/Transform"](
+                               translation=vector((0, 0, 0)), rotation=quat(w, x, y, z)))
+        out.append((ns + 100_000, "/mocap/body", pose, msg))
+    return sorted(out, key=lambda m: m[0])
+
+
+def write_bag(path: Path, kind: str = "ros2", **how) -> Path:
+    """A bag of the example (ROS 1 .bag, or ROS 2 in SQLite or MCAP) with rosbags' writers."""
+    from rosbags.rosbag1 import Writer as Writer1
+    from rosbags.rosbag2 import StoragePlugin
+    from rosbags.rosbag2 import Writer as Writer2
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS1_NOETIC if kind == "ros1" else Stores.ROS2_HUMBLE)
+    writer = (Writer1(path) if kind == "ros1" else
+              Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP if kind == "mcap"
+                      else StoragePlugin.SQLITE3))
+    serialize = ts.serialize_ros1 if kind == "ros1" else ts.serialize_cdr
+    with writer:
+        connections = {}
+        for ns, topic, msgtype, msg in _messages(ts, **how):
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=ts)
+            writer.write(connections[topic], ns, serialize(msg, msgtype))
+    return path
+
+
+def _kf(tmp_path: Path, capsys, recording: Path, *options: str) -> tuple[int, str]:
+    status = main(["estimate", str(recording), "--estimator", "kf", *options, "--out",
+                   str(tmp_path / "out"), "--no-plots"])
+    said = capsys.readouterr()
+    return status, said.out + said.err
+
+
+@pytest.mark.parametrize(("kind", "given"), [("ros1", "run.bag"), ("ros2", "run"),
+                                             ("mcap", "run/run.mcap")])
+def test_a_ros_bag_is_a_recording_and_its_pose_topic_a_reference(tmp_path, capsys, kind,
+                                                                 given):
+    """The IMU topic timed by its messages' stamps, its units the message's, scored against
+    the bag's motion-capture pose topic: what the example's CSV and truth give."""
+    write_bag(tmp_path / ("run.bag" if kind == "ros1" else "run"), kind)
+    bag = tmp_path / given
+    status, said = _kf(tmp_path, capsys, bag, "--reference", str(bag))
+    assert status == 0, said
+    assert "topic /imu/data (sensor_msgs/msg/Imu, 1000 messages)" in said
+    assert "time='header/stamp'" in said and "gyro in rad/s (from the header" in said
+    plain = _kf(tmp_path, capsys, EXAMPLE, "--reference", str(TRUTH))[1]
+    rmse = [float(next(r for r in s.splitlines() if r.startswith("kf ")).split()[2])
+            for s in (said, plain)]
+    assert rmse[0] == pytest.approx(rmse[1], abs=1e-4)
+
+
+def test_a_bags_topics_are_chosen_by_name_where_it_has_several(tmp_path, capsys):
+    """Two IMU topics: refused naming both, --topic takes one (its own samples); a topic of
+    another type, or --topic for a file that is no bag, is refused; a TransformStamped
+    reference serves as a PoseStamped does."""
+    bag = write_bag(tmp_path / "two", imu_topics=("/imu/data", "/imu/data_raw"),
+                    pose="geometry_msgs/msg/TransformStamped")
+    with pytest.raises(RecordingError, match=r"2 topics hold an IMU's \(sensor_msgs/Imu\) "
+                       r"messages \(/imu/data, /imu/data_raw\): give one \(--topic NAME\)"):
+        open_recording(bag)
+    raw, _ = open_recording(bag, topic="/imu/data_raw").load()
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+    np.testing.assert_allclose(raw.gyro, data[:, 4:7] * 2)
+    with pytest.raises(RecordingError, match=r"'/mocap/body' holds "
+                       r"geometry_msgs/msg/TransformStamped, not an IMU's"):
+        open_recording(bag, topic="/mocap/body")
+    with pytest.raises(RecordingError, match="this is no ROS bag"):
+        open_recording(EXAMPLE, topic="/imu/data")
+    status, said = _kf(tmp_path, capsys, bag, "--topic", "/imu/data", "--reference", str(bag))
+    assert status == 0, said
+    assert "reference: 999 of 1000 samples scored" in said
+
+
+def test_a_driver_that_leaves_the_stamp_empty_is_timed_by_the_bag(tmp_path):
+    """A driver that publishes without a stamp (all zero): the stamp repeats, so the time the
+    bag received each message is taken, and said."""
+    source = open_recording(write_bag(tmp_path / "unstamped", stamped=False))
+    assert "'header/stamp' does not rise from row to row, 'receive_time' does" in source.choices
+    rec, _ = source.load()
+    np.testing.assert_allclose(rec.dt[1:], 0.01, atol=1e-6)
