@@ -204,6 +204,16 @@ def open_table(path: str | Path) -> TableSource:
         raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "
                          "table this reader takes: save the sheet as CSV (a zip archive of a "
                          "phone app's files serves under a .zip name)")
+    if magic.startswith(b"ULog\x01\x12\x35"):
+        raise TableError(f"{path}: a PX4 flight log (ULog), which is no table this reader "
+                         "takes: convert it with pyulog's ulog2csv (pip install pyulog; "
+                         "ulog2csv -m sensor_combined FILE.ulg) and give the CSV or the "
+                         "folder it writes (PX4 logs z down: --mounting 180,0,0)")
+    if magic.startswith(b"\xa3\x95") and suffix in (".bin", ".log"):
+        raise TableError(f"{path}: an ArduPilot DataFlash log, which is no table this reader "
+                         "takes: export its IMU messages with pymavlink's mavlogdump.py "
+                         "--types IMU --format csv FILE.bin > imu.csv (ArduPilot logs z down: "
+                         "--mounting 180,0,0)")
     if magic.lstrip()[:1] in (b"[", b"{") and suffix in (".json", ".jsonl", ".ndjson"):
         raise TableError(f"{path}: JSON, which is no table this reader takes: export the "
                          "recording as CSV (phone apps offer both)")

@@ -174,8 +174,13 @@ def test_a_compressed_file_reads_as_the_text_it_holds(tmp_path, compress):
 @pytest.mark.parametrize("name,content,serves", [
     ("book.xlsx", b"PK\x03\x04 a workbook", "save the sheet as CSV"),
     ("export.json", b'[{"sensor": "Accelerometer", "x": "0.1"}]', "export the recording as CSV"),
+    ("flight.ulg", b"ULog\x01\x12\x35\x01" + bytes(64), "a PX4 flight log .* ulog2csv"),
+    ("00000042.BIN", b"\xa3\x95\x80\x80" + bytes(64), "an ArduPilot DataFlash log.*"
+     "mavlogdump.py --types IMU --format csv"),
 ])
 def test_a_workbook_or_json_is_refused_saying_what_serves(tmp_path, name, content, serves):
+    """Files that are no table, told by their first bytes: refused saying what would serve
+    (a flight controller's binary log was read as text: 'no delimiter splits a header')."""
     path = tmp_path / name
     path.write_bytes(content)
     with pytest.raises(RecordingError, match=serves):
