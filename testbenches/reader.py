@@ -13,7 +13,10 @@ any length is read in bounded memory:
 - a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - Parquet: its columns (a timestamp column as seconds);
-- a spreadsheet workbook or JSON is refused, saying to save or export it as CSV;
+- a spreadsheet workbook or JSON is refused, saying to save or export it as CSV, and an
+  ArduPilot DataFlash log saying which tool exports its IMU;
+- a PX4 flight log (ULog, read with pyulog): its sensor_combined topic, named as ulog2csv
+  names its columns;
 - HDF5 (that is not a BROAD trial) and MATLAB .mat (v5, or v7.3 which is HDF5): the top level's
   one-dimensional datasets or variables of one length are columns, and an [N, 3] one (acc, gyro)
   is three (acc_x, acc_y, acc_z); a scalar `rate` (attribute or variable) is the sample rate.
@@ -204,11 +207,8 @@ def open_table(path: str | Path) -> TableSource:
         raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "
                          "table this reader takes: save the sheet as CSV (a zip archive of a "
                          "phone app's files serves under a .zip name)")
-    if magic.startswith(b"ULog\x01\x12\x35"):
-        raise TableError(f"{path}: a PX4 flight log (ULog), which is no table this reader "
-                         "takes: convert it with pyulog's ulog2csv (pip install pyulog; "
-                         "ulog2csv -m sensor_combined FILE.ulg) and give the CSV or the "
-                         "folder it writes (PX4 logs z down: --mounting 180,0,0)")
+    if magic.startswith(ULOG_MAGIC):
+        return _ulog(path)
     if magic.startswith(b"\xa3\x95") and suffix in (".bin", ".log"):
         raise TableError(f"{path}: an ArduPilot DataFlash log, which is no table this reader "
                          "takes: export its IMU messages with pymavlink's mavlogdump.py "
@@ -218,6 +218,33 @@ def open_table(path: str | Path) -> TableSource:
         raise TableError(f"{path}: JSON, which is no table this reader takes: export the "
                          "recording as CSV (phone apps offer both)")
     return _text(path)
+
+
+ULOG_MAGIC = b"ULog\x01\x12\x35"
+ULOG_TOPIC = "sensor_combined"
+"""The topic of a PX4 log that holds its IMU's samples (as ulog2csv names its columns)."""
+
+
+def _ulog(path: Path) -> TableSource:
+    """A PX4 flight log's sensor_combined topic, its columns as ulog2csv names them
+    (`timestamp` in us, `gyro_rad[0]`, `accelerometer_m_s2[0]`), read with pyulog."""
+    try:
+        from pyulog import ULog
+    except ImportError:
+        raise TableError(f"{path}: a PX4 flight log (ULog), which takes the pyulog package to "
+                         "read (pip install pyulog)") from None
+    try:
+        log = ULog(str(path), [ULOG_TOPIC])
+    except Exception as err:  # pyulog raises what its parser meets: an unreadable log
+        raise TableError(f"{path}: not a readable PX4 log ({err})") from None
+    found = [d for d in log.data_list if d.name == ULOG_TOPIC]
+    if not found:
+        raise TableError(f"{path}: a PX4 log without the {ULOG_TOPIC} topic (its IMU's "
+                         "samples as the estimators take them)")
+    arrays = {k: np.asarray(v) for k, v in found[0].data.items()}
+    source = _array_source(path, "PX4 ULog", arrays, {}, {})
+    source.note = f"topic {ULOG_TOPIC} ({len(arrays['timestamp'])} messages)"
+    return source
 
 
 COMPRESSIONS = {b"\x1f\x8b": "gzip", b"BZh": "bz2", b"\xfd7zXZ\x00": "xz"}

@@ -174,7 +174,6 @@ def test_a_compressed_file_reads_as_the_text_it_holds(tmp_path, compress):
 @pytest.mark.parametrize("name,content,serves", [
     ("book.xlsx", b"PK\x03\x04 a workbook", "save the sheet as CSV"),
     ("export.json", b'[{"sensor": "Accelerometer", "x": "0.1"}]', "export the recording as CSV"),
-    ("flight.ulg", b"ULog\x01\x12\x35\x01" + bytes(64), "a PX4 flight log .* ulog2csv"),
     ("00000042.BIN", b"\xa3\x95\x80\x80" + bytes(64), "an ArduPilot DataFlash log.*"
      "mavlogdump.py --types IMU --format csv"),
 ])
@@ -733,3 +732,46 @@ def test_one_numbered_sensor_is_read_and_two_are_refused_naming_both(tmp_path):
     given = {f"{s}_{a}": f"{s}2_{a}" for s in ("acc", "gyro") for a in "xyz"}
     np.testing.assert_array_equal(open_recording(path, columns=given).load()[0].acc,
                                   imu[:, :3] * 1.01)
+
+
+def _ulog(path: Path, topic: str = "sensor_combined") -> Path:
+    """The example as PX4 logs it (ULog: its file header, flag bits, the topic's format, its
+    subscription, one data message per sample; FRD, z down), written by the format's spec."""
+    import struct
+
+    t, imu = _example()
+    frd = np.array([1.0, -1.0, -1.0])
+
+    def message(kind: str, payload: bytes) -> bytes:
+        return struct.pack("<HB", len(payload), ord(kind)) + payload
+
+    fields = ("uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
+              "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
+              "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
+              "uint8_t gyro_clipping;uint8_t accel_calibration_count;"
+              "uint8_t gyro_calibration_count;")
+    out = [b"ULog\x01\x12\x35\x01" + struct.pack("<Q", 0), message("B", bytes(40)),
+           message("F", f"{topic}:{fields}".encode()),
+           message("A", struct.pack("<BH", 0, 0) + topic.encode())]
+    for ti, row in zip(t, imu, strict=True):
+        body = struct.pack("<Q3fIi3fIBBBB", round(ti * 1e6), *(row[3:] * frd), 10000, 0,
+                           *(row[:3] * frd), 10000, 0, 0, 1, 1)
+        out.append(message("D", struct.pack("<H", 0) + body))
+    path.write_bytes(b"".join(out))
+    return path
+
+
+def test_a_px4_flight_log_is_read_as_ulog2csv_writes_its_imu(tmp_path):
+    """A ULog's sensor_combined topic (pyulog), its columns as ulog2csv names them: the
+    example's samples in PX4's z-down frame (float32, as PX4 logs them), at 100 Hz from the
+    timestamp in us. A log without the topic is refused naming it."""
+    pytest.importorskip("pyulog", reason="pyulog reads PX4 logs (testbench extra)")
+    source = open_recording(_ulog(tmp_path / "flight.ulg"))
+    rec, _ = source.load()
+    assert "gyro_x='gyro_rad[0]'" in source.choices and "time in us" in source.choices
+    assert "topic sensor_combined (1000 messages); read as PX4 ULog" in source.choices
+    _, imu = _example()
+    np.testing.assert_allclose(rec.acc, imu[:, :3] * [1, -1, -1], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(rec.dt[1:], 0.01, atol=1e-9)
+    with pytest.raises(RecordingError, match="a PX4 log without the sensor_combined topic"):
+        open_recording(_ulog(tmp_path / "other.ulg", topic="vehicle_status"))
