@@ -775,3 +775,24 @@ def test_a_px4_flight_log_is_read_as_ulog2csv_writes_its_imu(tmp_path):
     np.testing.assert_allclose(rec.dt[1:], 0.01, atol=1e-9)
     with pytest.raises(RecordingError, match="a PX4 log without the sensor_combined topic"):
         open_recording(_ulog(tmp_path / "other.ulg", topic="vehicle_status"))
+
+
+def test_two_sensors_rows_interleaved_are_refused_not_read_as_one(tmp_path):
+    """ArduPilot logs each of its IMUs in IMU messages numbered by "I": exported together,
+    their rows alternate, and read as one sensor they were one at twice the rate, its samples
+    alternating between the two parts (read without a word). Refused naming the numbers; one
+    IMU's rows (every I 0) are read."""
+    t, imu = _example()
+    header = ["TimeUS", "I", "GyrX", "GyrY", "GyrZ", "AccX", "AccY", "AccZ"]
+    one = np.column_stack([np.round(t * 1e6), np.zeros(len(t)), imu[:, 3:], imu[:, :3]])
+    two = np.empty((2 * len(t), one.shape[1]))
+    two[0::2], two[1::2] = one, one
+    two[1::2, 0] += 1500.0
+    two[1::2, 1] = 1.0
+    two[1::2, 2:5] += 0.05
+    path = _names_and_file(tmp_path / "two.csv", header, [two])
+    with pytest.raises(RecordingError, match=r"the rows are 2 sensors', as 'I' numbers them "
+                       r"\(0 on 1000 rows, 1 on 1000 rows"):
+        open_recording(path)
+    rec, _ = open_recording(_names_and_file(tmp_path / "one.csv", header, [one])).load()
+    np.testing.assert_array_equal(rec.gyro, imu[:, 3:])

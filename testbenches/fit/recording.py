@@ -156,6 +156,13 @@ CLOCK_NAMES = {"sample_time_fine": "Xsens's clock, in ticks of 100 us in an MT M
                                    "and of 1 us in a Movella DOT one (--time-unit us)"}
 """Column names of a sensor's clock in a unit its file does not state and no step tells
 (time_unit: both are rates an IMU is sampled at): said where the time is missing, not taken."""
+INSTANCE_NAMES = ("i", "instance", "imu_instance", "imu_id", "imu_index", "sensor_id",
+                  "sensor_index", "sensor_instance")
+"""Column names that number the sensor a row is from (ArduPilot's IMU messages: "I"), where a
+logger interleaves several sensors' rows."""
+INTERLEAVED_SHARE = 0.1
+"""A sensor's number on at least this share of the rows, and another's too: the rows are
+several sensors'."""
 EXTRA_COLUMNS = ("dt", "roll", "pitch")
 """Columns found by their own name only: the sampling and a reference."""
 
@@ -172,6 +179,8 @@ class Columns:
     other_times: list[int] = field(default_factory=list)
     """Further columns a time's name fits, where the time was not given (a logger's epoch
     seconds beside its milliseconds): what serves where the one taken does not rise."""
+    instances: list[int] = field(default_factory=list)
+    """Columns that number a sensor (INSTANCE_NAMES: ArduPilot's "I"), checked to hold one."""
 
     def take(self, table: Any, quantity: str, i: int) -> None:
         """Column i of the table (testbenches.reader.TableSource) as the quantity's."""
@@ -208,6 +217,8 @@ def find_columns(table: Any, time_column: str | None = None,
         taken = set(found.index.values())
         found.other_times = [j for j, forms in enumerate(zip(*name_forms(table.names), strict=True))
                              if j not in taken and set(forms) & set(ALIASES["time"])]
+    found.instances = [j for j, name in enumerate(table.names)
+                       if norm_name(name) in INSTANCE_NAMES and j not in found.index.values()]
     users: dict[int, list[str]] = {}
     for quantity, i in found.index.items():
         users.setdefault(i, []).append(quantity)
@@ -573,13 +584,18 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     names = list(found.index)
     wanted = [found.index[q] for q in names]
     try:
-        prefix_block = table.first_block(wanted + found.other_times, PREFIX_ROWS)
+        prefix_block = table.first_block(wanted + found.other_times + found.instances,
+                                         PREFIX_ROWS)
     except TableError as err:
         raise RecordingError(str(err)) from None
     if prefix_block is None:
-        prefix_block = np.empty((0, len(wanted) + len(found.other_times)))
+        prefix_block = np.empty((0, len(wanted) + len(found.other_times)
+                                 + len(found.instances)))
     prefix = {q: prefix_block[:, k] for k, q in enumerate(names)}
     other_times = {j: prefix_block[:, len(names) + k] for k, j in enumerate(found.other_times)}
+    for k, j in enumerate(found.instances):
+        _one_sensor(path, table.header[j],
+                    prefix_block[:, len(names) + len(found.other_times) + k])
     units = found.units
     n = len(prefix_block)
     if n < 2:
@@ -773,6 +789,21 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
 
     t_unit, scale, how = _time_scale(path, kind, unit_step, unit, stated, dt_of, acc, gyro)
     return clock_in(scale), t_unit, how
+
+
+def _one_sensor(path: Path, name: str, numbers: np.ndarray) -> None:
+    """RecordingError where a column that numbers the sensor (INSTANCE_NAMES) gives two or more
+    numbers on INTERLEAVED_SHARE of the rows each: the rows are several sensors', which read as
+    one would be one sensor at several times the rate, its samples alternating."""
+    values, counts = np.unique(numbers[np.isfinite(numbers)], return_counts=True)
+    many = counts >= INTERLEAVED_SHARE * len(numbers)
+    if many.sum() < 2 or not np.all(values == np.round(values)):
+        return
+    shown = ", ".join(f"{v:g} on {c} rows" for v, c in zip(values, counts, strict=True))
+    raise RecordingError(
+        f"{path}: the rows are {int(many.sum())} sensors', as {name!r} numbers them ({shown}; "
+        "read as one they would alternate): keep one sensor's rows (an ArduPilot log: "
+        "mavlogdump.py --types IMU --condition 'IMU.I==0' --format csv FILE.bin)")
 
 
 def _rises(t: np.ndarray) -> bool:
