@@ -110,16 +110,26 @@ def unit_named(text: str) -> str | None:
     return UNIT_ALIASES.get(text.replace(" ", "").lower())
 
 
+def bracketed(name: str) -> tuple[str, str] | None:
+    """A header cell's name and the text in brackets that ends it ("Gyroscope X (deg/s)" ->
+    ("Gyroscope X", "deg/s")), whatever the text; None where none ends it or it is an index
+    written onto the name (PX4's "gyro_rad[1]")."""
+    m = _NAME_UNIT.match(name.strip())
+    if m is None or _INDEX.search(name.strip()):
+        return None
+    return m.group(1).strip(), m.group(2)
+
+
 def split_unit(name: str) -> tuple[str, str | None]:
     """A header cell as (name, unit): "Gyroscope X (deg/s)" -> ("Gyroscope X", "deg/s"), "q_w []"
     -> ("q_w", None); a bracketed part that is no unit known here stays in the name."""
-    m = _NAME_UNIT.match(name.strip())
-    if m and not _INDEX.search(name.strip()):
-        if not m.group(2):  # EuRoC's "q_RS_w []": no unit
-            return m.group(1).strip(), None
-        unit = unit_named(m.group(2))
+    found = bracketed(name)
+    if found is not None:
+        if not found[1]:  # EuRoC's "q_RS_w []": no unit
+            return found[0], None
+        unit = unit_named(found[1])
         if unit is not None:
-            return m.group(1).strip(), unit
+            return found[0], unit
     return name.strip(), None
 
 

@@ -796,3 +796,19 @@ def test_two_sensors_rows_interleaved_are_refused_not_read_as_one(tmp_path):
         open_recording(path)
     rec, _ = open_recording(_names_and_file(tmp_path / "one.csv", header, [one])).load()
     np.testing.assert_array_equal(rec.gyro, imu[:, 3:])
+
+
+def test_a_unit_the_reader_does_not_know_is_named_in_the_refusal(tmp_path):
+    """"Gyro X (1/s)": the unknown unit kept the column from its name; the refusal names it and
+    what serves, and the columns so mapped are read (the data telling the unit)."""
+    t, imu = _example()
+    header = ["Time (s)", *(f"Acc {a} (m/s2)" for a in "XYZ"), *(f"Gyro {a} (1/s)" for a in "XYZ")]
+    path = _names_and_file(tmp_path / "units.csv", header, [t, imu])
+    with pytest.raises(RecordingError, match=r"\('Gyro X \(1/s\)', 'Gyro Y \(1/s\)', 'Gyro Z "
+                       r"\(1/s\)' state the unit '1/s', which this reader does not know: map "
+                       r"each column with --column QUANTITY=NAME and give its unit"):
+        open_recording(path)
+    given = {f"gyro_{a.lower()}": f"Gyro {a} (1/s)" for a in "XYZ"}
+    source = open_recording(path, columns=given)
+    assert "gyro in rad/s (from the data" in source.choices
+    np.testing.assert_array_equal(source.load()[0].gyro, imu[:, 3:])

@@ -580,7 +580,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         raise RecordingError(
             f"{path}: no column for {', '.join(missing)}: the header has "
             f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
-            "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME")
+            "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME"
+            + _unknown_units(found.header, missing))
     names = list(found.index)
     wanted = [found.index[q] for q in names]
     try:
@@ -789,6 +790,25 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
 
     t_unit, scale, how = _time_scale(path, kind, unit_step, unit, stated, dt_of, acc, gyro)
     return clock_in(scale), t_unit, how
+
+
+def _unknown_units(header: list[str], missing: list[str]) -> str:
+    """Where a missing quantity's column is there but for a unit in brackets this reader does
+    not know ("Gyro X (1/s)"), which kept it from its name: saying so, and what serves."""
+    from ..reader import bracketed, unit_named
+
+    by_unit: dict[str, list[str]] = {}
+    for name in header:
+        found = bracketed(name)
+        if found and unit_named(found[1]) is None and any(
+                find_names([found[0]], q) for q in missing):
+            by_unit.setdefault(found[1], []).append(repr(name))
+    if not by_unit:
+        return ""
+    said = "; ".join(f"{', '.join(names)} state{'s' if len(names) == 1 else ''} the unit "
+                     f"{unit!r}" for unit, names in by_unit.items())
+    return (f" ({said}, which this reader does not know: map each column with --column "
+            "QUANTITY=NAME and give its unit with --acc-unit or --gyro-unit)")
 
 
 def _one_sensor(path: Path, name: str, numbers: np.ndarray) -> None:
