@@ -2,7 +2,8 @@
 
 A recording is a delimited text file (CSV) with a header row, a Parquet file, an HDF5 file or a
 MATLAB .mat file (a BROAD trial, or columns as 1-D datasets or variables, acc and gyro also as
-[N, 3] ones, with a time column or a `rate`; testbenches.reader). Columns are found by name: the
+[N, 3] ones, with a time column or a `rate`; testbenches.reader), a PX4 log, or a ROS bag's IMU
+topic (testbenches.bags). Columns are found by name: the
 accelerometer as acc_x/acc_y/acc_z (or ax/ay/az, accX/accY/accZ, acc_x_g, ...), the gyro as
 gyro_x/... (or gx/gy/gz, gyrX/..., wx/wy/wz), the time as time/t/timestamp (or --time-column), the
 sampling as dt or --rate; --column QUANTITY=NAME maps any other name. The delimiter, the
@@ -91,8 +92,9 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
                    help="an estimator parameter, for every chosen estimator that has it "
                    "(repeatable; a name none has is refused)")
     p.add_argument("--reference", type=Path, default=None,
-                   help="a CSV of time with roll, pitch [rad or deg] or q_w, q_x, q_y, q_z: "
-                   "the reference, matched by time")
+                   help="a file of time with roll, pitch [rad or deg] or q_w, q_x, q_y, q_z "
+                   "(any the reader takes; a ROS bag's pose topic): the reference, matched by "
+                   "time")
     p.add_argument("--reference-topic", default=None, metavar="NAME",
                    help="a ROS bag reference's pose topic, where it has several")
     p.add_argument("--reference-column", action="append", default=[], metavar="QUANTITY=NAME",

@@ -11,9 +11,10 @@ from typing import Any
 PRESET_HELP = ("estimator parameters: recommended (the defaults, for real MEMS sensors), paper "
                "(the seed papers' own filters, fusion_core.papers), or a JSON file of "
                "parameters per estimator")
-RECORDING_HELP = ("CSV (and its kin), Parquet, HDF5 or MAT, or a phone app's export: a folder or "
-                  "zip archive of one file per sensor")
-"""What a recording a command reads may be (testbenches.reader, testbenches.fit.sensor_files)."""
+RECORDING_HELP = ("CSV (and its kin), Parquet, HDF5 or MAT, a ROS bag or a PX4 log, or a phone "
+                  "app's export: a folder or zip archive of one file per sensor")
+"""What a recording a command reads may be (testbenches.reader, testbenches.bags,
+testbenches.fit.sensor_files)."""
 SENSOR_HELP = ("ImuSensor parameters: realistic (the defaults: an MPU-6050 as a user meets it), "
                "ideal (white noise only, the papers' simulations), or a JSON file of sensor "
                "parameters")

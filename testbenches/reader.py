@@ -6,12 +6,15 @@ any length is read in bounded memory:
 - delimited text (CSV and its kin), also compressed (gzip, bz2 or xz: .csv.gz and the like,
   told by the file's first bytes): the encoding (UTF-8 with or without a byte-order mark,
   UTF-16 as Windows' "Unicode" exports write it, else Latin-1), the delimiter (comma,
-  semicolon, tab or bar; a decimal comma with semicolons) and the header row are found from the
-  file's start; pyarrow's CSV reader parses it, and where it cannot (text where a number
-  belongs, a row of the wrong length, padded cells) the file is read by Python's csv module,
-  which names the file's line, the column and the value;
+  semicolon, tab or bar; a decimal comma where the numbers have one) and the header row are
+  found from the file's start (after LabVIEW's ***End_of_Header*** lines); pyarrow's CSV reader
+  parses it, and where it cannot (text where a number belongs, a row of the wrong length,
+  padded cells) the file is read by Python's csv module, which names the file's line, the
+  column and the value;
 - a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
+- a column of durations written with their unit ("0.01 sec", as MATLAB's writetimetable writes
+  a timetable's row times) as seconds;
 - Parquet: its columns (a timestamp column as seconds);
 - a spreadsheet workbook or JSON is refused, saying to save or export it as CSV, and an
   ArduPilot DataFlash log saying which tool exports its IMU;
@@ -326,7 +329,8 @@ _TIME_OF_DAY = re.compile(r"^(\d{1,2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?$")
 """A time of day without a date: "12:00:00.010", a decimal comma, "9:05:00"."""
 
 
-_DURATION = re.compile(r"^([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-z]+)$")
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_DURATION = re.compile(rf"^({_NUMBER})\s*([a-z]+)$")
 DURATION_UNITS = {"sec": 1.0, "secs": 1.0, "s": 1.0, "ms": 1e-3, "min": 60.0, "mins": 60.0,
                   "hr": 3600.0, "hrs": 3600.0}
 """A duration's number and unit as MATLAB writes a duration ("0.01 sec", "1.5 min", "2 hr")."""
@@ -678,8 +682,7 @@ def _duration_seconds(column: Any, unit: str) -> np.ndarray:
     import pyarrow as pa
     import pyarrow.compute as pc
 
-    number = pc.extract_regex(column, rf"^\s*(?P<n>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
-                                      rf"\s*{unit}\s*$")
+    number = pc.extract_regex(column, rf"^\s*(?P<n>{_NUMBER})\s*{unit}\s*$")
     if number.null_count != column.null_count:
         raise _ArrowFailed(f"a cell is no duration in {unit}")
     values = pc.cast(pc.struct_field(number, "n"), pa.float64())
