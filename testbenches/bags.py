@@ -77,6 +77,78 @@ def _fields(want: str, msgtype: str) -> list[tuple[str, str | None, Callable[[An
                lambda m, c=c: float(getattr(quaternion(m), c))) for c in "wxyz")]
 
 
+IMU_DOUBLES = 37
+"""An Imu message's doubles after its header: orientation (4), its covariance (9),
+angular_velocity (3), its covariance (9), linear_acceleration (3), its covariance (9)."""
+ANGULAR, LINEAR = 13, 25
+"""The index of angular_velocity's and of linear_acceleration's first double among them."""
+
+
+def _imu_layout(raw: bytes, cdr: bool) -> tuple[int, int] | None:
+    """(the offset of the stamp's seconds, of the first double) in an Imu message as a ROS 2 bag
+    (CDR, little-endian: a 4-byte encapsulation, then the fields aligned to their size from
+    there) or a ROS 1 bag (packed, its header's seq first) holds it; None where the message is
+    not laid out so (big-endian CDR, another length)."""
+    if len(raw) < 16 or (cdr and raw[:2] != b"\x00\x01"):
+        return None
+    name = int.from_bytes(raw[12:16], "little")  # frame_id's length (CDR: with its NUL)
+    first = 16 + name
+    if cdr:
+        first += (-(first - 4)) % 8
+    return (4, first) if first + 8 * IMU_DOUBLES == len(raw) else None
+
+
+def _imu_rows(bag: Any, block: list[tuple[Any, int, bytes]],
+              layouts: dict[int, tuple[int, int] | None]) -> np.ndarray | None:
+    """A block of Imu messages as rows (open_bag's columns) read off their bytes with numpy, no
+    message object built for each; None where a message's layout is not the one known. Each
+    length of message met is checked once against the message deserialized (`layouts`: its
+    layout, None where that differs)."""
+    cdr = bool(getattr(bag, "is2", False))
+    raws = [raw for _, _, raw in block]
+    out = np.empty((len(block), 8))
+    lengths = np.array([len(raw) for raw in raws])
+    for length in np.unique(lengths):
+        at = np.flatnonzero(lengths == length)
+        if int(length) not in layouts:
+            layouts[int(length)] = _checked(bag, block[at[0]], cdr)
+        layout = layouts[int(length)]
+        if layout is None:
+            return None
+        stamp, first = layout
+        buf = np.frombuffer(b"".join(raws[i] for i in at), dtype=np.uint8).reshape(len(at), -1)
+        sec = buf[:, stamp:stamp + 4].copy().view("<i4" if cdr else "<u4")[:, 0]
+        nanosec = buf[:, stamp + 4:stamp + 8].copy().view("<u4")[:, 0]
+        doubles = buf[:, first:first + 8 * IMU_DOUBLES].copy().view("<f8")
+        out[at, 0] = sec + nanosec * 1e-9
+        out[at, 1:4] = doubles[:, LINEAR:LINEAR + 3]
+        out[at, 4:7] = doubles[:, ANGULAR:ANGULAR + 3]
+    out[:, 7] = np.array([received for _, received, _ in block]) * 1e-9
+    return out
+
+
+def _checked(bag: Any, message: tuple[Any, int, bytes], cdr: bool) -> tuple[int, int] | None:
+    """The layout of a message (_imu_layout) where the values read off it by that layout are
+    the deserialized message's, else None."""
+    connection, _, raw = message
+    layout = _imu_layout(raw, cdr)
+    if layout is None or not 0 <= layout[1] <= len(raw) - 8 * IMU_DOUBLES:
+        return None
+    stamp, first = layout
+    m = bag.deserialize(raw, connection.msgtype)
+    doubles = np.frombuffer(raw, dtype="<f8", count=IMU_DOUBLES, offset=first)
+    sec = int.from_bytes(raw[stamp:stamp + 4], "little", signed=cdr)
+    nanosec = int.from_bytes(raw[stamp + 4:stamp + 8], "little")
+    same = (sec == m.header.stamp.sec and nanosec == m.header.stamp.nanosec
+            and list(doubles[LINEAR:LINEAR + 3]) == [m.linear_acceleration.x,
+                                                      m.linear_acceleration.y,
+                                                      m.linear_acceleration.z]
+            and list(doubles[ANGULAR:ANGULAR + 3]) == [m.angular_velocity.x,
+                                                        m.angular_velocity.y,
+                                                        m.angular_velocity.z])
+    return layout if same else None
+
+
 def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSource:
     """The bag's table of `want` ("imu": the recording's, "pose": a reference's) from the topic
     named, else from the only topic of such a type; TableError where the bag cannot be read,
@@ -116,17 +188,26 @@ def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSo
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
         values = [get for _, _, get in fields]
-        block: list[list[float]] = []
+        layouts: dict[int, tuple[int, int] | None] = {}  # raw length -> _ImuLayout's, checked
+
+        def rows_of(bag: Any, block: list[tuple[Any, int, bytes]]) -> np.ndarray:
+            if want == "imu":
+                fast = _imu_rows(bag, block, layouts)
+                if fast is not None:
+                    return fast
+            return np.array([[get(bag.deserialize(raw, c.msgtype)) for get in values]
+                             + [received * 1e-9] for c, received, raw in block])
+
         with AnyReader([path]) as bag:
             connections = [c for c in bag.connections if c.topic == chosen]
-            for connection, received, raw in bag.messages(connections=connections):
-                m = bag.deserialize(raw, connection.msgtype)
-                block.append([get(m) for get in values] + [received * 1e-9])
+            block: list[tuple[Any, int, bytes]] = []
+            for message in bag.messages(connections=connections):
+                block.append(message)
                 if len(block) == rows:
-                    yield np.array(block)[:, columns]
+                    yield rows_of(bag, block)[:, columns]
                     block = []
-        if block:
-            yield np.array(block)[:, columns]
+            if block:
+                yield rows_of(bag, block)[:, columns]
 
     return TableSource(path, header, list(header), units, "ROS bag", n, read,
                        lambda row: f"message {row + 1} of {chosen}",
