@@ -152,6 +152,7 @@ class Reference:
         if not keep.any():
             raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
                                  "attitude")
+        _rising(path, t, keep, found.where)
         self.path, self.t, self.up = path, t[keep], up[keep]
         if self.angle_unit:
             self.angles = (cols["roll"][keep], cols["pitch"][keep])
@@ -227,6 +228,25 @@ class Reference:
                                               right=np.nan) for i in range(4)])
             q_at /= np.linalg.norm(q_at, axis=1, keepdims=True)
         return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
+
+
+def _rising(path: Path, t: np.ndarray, keep: np.ndarray, where: Any) -> None:
+    """RecordingError where a reference's time (of its rows `keep`) repeats or goes back,
+    naming the rows: matched by time, such a reference would be read between the wrong rows
+    (two takes appended, rows written twice) and score a number that is none."""
+    from .fit.recording import RecordingError
+
+    rows = np.flatnonzero(keep)
+    steps = np.diff(t[rows])
+    bad = np.flatnonzero(~(steps > 0.0))
+    if not len(bad):
+        return
+    a, b = int(rows[bad[0]]), int(rows[bad[0] + 1])
+    how = "repeats" if t[b] == t[a] else "does not increase from"
+    raise RecordingError(f"{path}, {where(b)}: the reference's time {t[b]:.6g} s {how} "
+                         f"{t[a]:.6g} s on {where(a)} ({len(bad)} such step(s)): a reference's "
+                         "time rises from row to row (two takes appended, or rows written "
+                         "twice?)")
 
 
 def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording: str) -> str:

@@ -309,6 +309,8 @@ def _reference(path: Path, time: np.ndarray, roll: np.ndarray, pitch: np.ndarray
 
 @pytest.mark.parametrize(("make", "says"), [
     ("no overlap", "does not overlap the recording's"),
+    ("two takes", "line 502: the reference's time 0.01 s does not increase from 5 s on line 501"),
+    ("rows twice", "line 3: the reference's time 0.01 s repeats 0.01 s on line 2 (500 such"),
     ("zero quaternions", "none of the reference's 1000 quaternions is a rotation"),
 ])
 def test_a_reference_that_cannot_serve_is_refused_not_scored_as_nan(tmp_path, capsys, make,
@@ -318,6 +320,10 @@ def test_a_reference_that_cannot_serve_is_refused_not_scored_as_nan(tmp_path, ca
     t, roll, pitch = truth[:, 0], truth[:, 1], truth[:, 2]
     if make == "no overlap":
         _reference(ref, t + 1000.0, roll, pitch)
+    elif make == "two takes":  # a clock started again halfway: read between the wrong rows
+        _reference(ref, np.where(np.arange(len(t)) >= 500, t - 5.0, t), roll, pitch)
+    elif make == "rows twice":
+        _reference(ref, np.repeat(t[::2], 2)[:len(t)], roll, pitch)
     else:
         np.savetxt(ref, np.column_stack([t, np.zeros((len(t), 4))]), delimiter=",",
                    header="time,q_w,q_x,q_y,q_z", comments="")

@@ -181,6 +181,9 @@ class Columns:
     seconds beside its milliseconds): what serves where the one taken does not rise."""
     instances: list[int] = field(default_factory=list)
     """Columns that number a sensor (INSTANCE_NAMES: ArduPilot's "I"), checked to hold one."""
+    where: Any = None
+    """Where a row (counting from 0) is in the file, as its reader counts ("line 201"; the
+    table's `where`)."""
 
     def take(self, table: Any, quantity: str, i: int) -> None:
         """Column i of the table (testbenches.reader.TableSource) as the quantity's."""
@@ -195,7 +198,7 @@ def find_columns(table: Any, time_column: str | None = None,
     given = dict(columns or {})
     if time_column:
         given.setdefault("time", time_column)
-    found = Columns({}, {}, {}, table.header)
+    found = Columns({}, {}, {}, table.header, where=table.where)
     alike: dict[str, list[int]] = {}  # quantity -> every column whose name fits as its does
     for quantity in (*ALIASES, *EXTRA_COLUMNS):
         name = given.get(quantity)
