@@ -95,6 +95,9 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
                    help="a file of time with roll, pitch [rad or deg] or q_w, q_x, q_y, q_z "
                    "(any the reader takes; a ROS bag's pose topic): the reference, matched by "
                    "time")
+    p.add_argument("--reference-offset", type=float, default=0.0, metavar="SECONDS",
+                   help="added to the reference's time: its clock against the recording's "
+                   "(estimate says the offset the turn rates show)")
     p.add_argument("--reference-topic", default=None, metavar="NAME",
                    help="a ROS bag reference's pose topic, where it has several")
     p.add_argument("--reference-column", action="append", default=[], metavar="QUANTITY=NAME",
@@ -119,7 +122,8 @@ class Reference:
     recording's companion, not its bulk), matched to a recording's times by `at`."""
 
     def __init__(self, path: Path, recording_time_unit: str = "s",
-                 columns: dict[str, str] | None = None, topic: str | None = None) -> None:
+                 columns: dict[str, str] | None = None, topic: str | None = None,
+                 offset: float = 0.0) -> None:
         from .fit.recording import RecordingError
 
         cols, found = read_columns(path, columns=columns, want="pose", topic=topic)
@@ -153,7 +157,8 @@ class Reference:
             raise RecordingError(f"{path}: no row of the reference holds a time and a valid "
                                  "attitude")
         _rising(path, t, keep, found.where)
-        self.path, self.t, self.up = path, t[keep], up[keep]
+        self.path, self.t, self.up = path, t[keep] + offset, up[keep]
+        self.offset = offset
         if self.angle_unit:
             self.angles = (cols["roll"][keep], cols["pitch"][keep])
         self.quat = None
@@ -205,6 +210,46 @@ class Reference:
         self.up = gravity_from_roll_pitch(self.angles[0] * scale, self.angles[1] * scale)
         return f"reference: roll and pitch in {other} (from the data: {evidence})"
 
+    def lag_note(self, rec: Any, t: np.ndarray) -> str:
+        """Where the reference's clock runs apart from the recording's (a first block's samples
+        rec at times t): the offset at which the reference's turn rate agrees best with the
+        gyro's (a quaternion's whole turn with the gyro's norm; roll and pitch's tilt with the
+        gyro's rate across the measured up direction), by their correlation within
+        LAG_SEARCH_S, said where it is two samples or more and agrees clearly better than
+        the clocks as read (LAG_CORRELATION, LAG_GAIN); "" otherwise."""
+        period = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
+        if not period > 0.0 or len(t) * period < 2 * LAG_SEARCH_S:
+            return ""
+        up, quat = self.at(t)
+        ref_rate = np.full(len(t), np.nan)  # central: the turn over the sample's two neighbours
+        if quat is not None:  # the whole turn, the gyro's norm
+            cos = np.abs(np.sum(quat[2:] * quat[:-2], axis=1))
+            ref_rate[1:-1] = 2.0 * np.arccos(np.clip(cos, -1.0, 1.0))
+            gyro_rate = np.linalg.norm(rec.gyro, axis=1)
+        else:  # the tilt's turn, the gyro across the measured up direction
+            ref_rate[1:-1] = np.arccos(np.clip(np.sum(up[2:] * up[:-2], axis=1), -1.0, 1.0))
+            norm = np.linalg.norm(rec.acc, axis=1, keepdims=True)
+            gyro_rate = np.linalg.norm(np.cross(rec.gyro, rec.acc / norm), axis=1)
+        ref_rate[1:-1] /= t[2:] - t[:-2]
+        k = max(1, round(0.1 / period))  # both smoothed over 0.1 s
+        a, b = (_smoothed(x, k) for x in (gyro_rate, ref_rate))
+        lags, corr = _correlation(a, b, round(LAG_SEARCH_S / period))
+        if corr is None:
+            return ""
+        best = int(np.argmax(corr))
+        at_zero = float(corr[lags == 0][0])
+        if (abs(lags[best]) < 2 or corr[best] < LAG_CORRELATION
+                or (1.0 - at_zero) < LAG_GAIN * (1.0 - corr[best])):
+            return ""
+        lag = float(lags[best]) * period
+        if 0 < best < len(corr) - 1:  # the peak between samples (a parabola through three)
+            c0, c1, c2 = corr[best - 1], corr[best], corr[best + 1]
+            if c0 - 2.0 * c1 + c2 < 0.0:
+                lag += 0.5 * (c0 - c2) / (c0 - 2.0 * c1 + c2) * period
+        return (f"reference: its clock runs {lag:+.3g} s from the recording's (their turn rates "
+                f"agree best so: correlation {corr[best]:.2f}, {at_zero:.2f} as read): give "
+                f"--reference-offset {self.offset - lag:.4g} to align them")
+
     @property
     def span(self) -> tuple[float, float]:
         return float(self.t.min()), float(self.t.max())
@@ -228,6 +273,35 @@ class Reference:
                                               right=np.nan) for i in range(4)])
             q_at /= np.linalg.norm(q_at, axis=1, keepdims=True)
         return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
+
+
+LAG_SEARCH_S = 2.0
+"""How far apart the clocks of a recording and its reference are looked for [s]."""
+LAG_CORRELATION = 0.5
+"""The least correlation of the turn rates at an offset for it to be said."""
+LAG_GAIN = 1.5
+"""How many times more of the turn rates the clocks as read leave unexplained (one minus the
+correlation) than the offset does, at least, for the offset to be said."""
+
+
+def _smoothed(x: np.ndarray, k: int) -> np.ndarray:
+    """x's moving average over k samples, its non-numbers as 0."""
+    x = np.where(np.isfinite(x), x, 0.0)
+    return np.convolve(x, np.ones(k) / k, mode="same")
+
+
+def _correlation(a: np.ndarray, b: np.ndarray, most: int
+                 ) -> tuple[np.ndarray, np.ndarray | None]:
+    """The correlation coefficient of a[i] with b[i + lag] for lag in -most..most (by FFT),
+    and the lags; None where either does not vary."""
+    a, b = a - a.mean(), b - b.mean()
+    scale = np.sqrt(np.sum(a * a) * np.sum(b * b))
+    lags = np.arange(-most, most + 1)
+    if not scale > 0.0:
+        return lags, None
+    size = 1 << int(np.ceil(np.log2(2 * len(a))))
+    full = np.fft.irfft(np.conj(np.fft.rfft(a, size)) * np.fft.rfft(b, size), size)
+    return lags, full[lags % size] / scale
 
 
 def _rising(path: Path, t: np.ndarray, keep: np.ndarray, where: Any) -> None:
@@ -678,8 +752,8 @@ def cmd_estimate(args: argparse.Namespace) -> int:
                              "with --column)")
     source = source_from_args(args.recording, args)
     print(f"{args.recording}: {source.choices}")
-    reference = (Reference(args.reference, source.time_unit, mapped, args.reference_topic)
-                 if args.reference is not None else None)
+    reference = (Reference(args.reference, source.time_unit, mapped, args.reference_topic,
+                           args.reference_offset) if args.reference is not None else None)
     args.out.mkdir(parents=True, exist_ok=True)
     runs: list[Any] = []
     try:
@@ -737,6 +811,8 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                     world_up, note = find_world_up(rec, args.reference or args.recording)
                     notes += [note] if note else []
                     notes += [z_down] if (z_down := _z_down_note(rec, args)) else []
+                    if reference is not None and (lag := reference.lag_note(rec, t)):
+                        notes.append(lag)
                     if rec.up_ref is not None and not args.no_vqf:
                         vqf = _VqfRun(source.rate, vqf_params)
                 if world_up is not None and rec.ref_quat is not None:
