@@ -217,6 +217,8 @@ class Reference:
         gyro's rate across the measured up direction), by their correlation within
         LAG_SEARCH_S, said where it is two samples or more and agrees clearly better than
         the clocks as read (LAG_CORRELATION, LAG_GAIN); "" otherwise."""
+        from .gyro_unit import moving_average
+
         period = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
         if not period > 0.0 or len(t) * period < 2 * LAG_SEARCH_S:
             return ""
@@ -231,8 +233,9 @@ class Reference:
             norm = np.linalg.norm(rec.acc, axis=1, keepdims=True)
             gyro_rate = np.linalg.norm(np.cross(rec.gyro, rec.acc / norm), axis=1)
         ref_rate[1:-1] /= t[2:] - t[:-2]
-        k = max(1, round(0.1 / period))  # both smoothed over 0.1 s
-        a, b = (_smoothed(x, k) for x in (gyro_rate, ref_rate))
+        k = max(1, round(0.1 / period))  # both averaged over 0.1 s, their non-numbers as 0
+        a, b = (moving_average(np.where(np.isfinite(x), x, 0.0)[:, None], k)[:, 0]
+                for x in (gyro_rate, ref_rate))
         lags, corr = _correlation(a, b, round(LAG_SEARCH_S / period))
         if corr is None:
             return ""
@@ -282,12 +285,6 @@ LAG_CORRELATION = 0.5
 LAG_GAIN = 1.5
 """How many times more of the turn rates the clocks as read leave unexplained (one minus the
 correlation) than the offset does, at least, for the offset to be said."""
-
-
-def _smoothed(x: np.ndarray, k: int) -> np.ndarray:
-    """x's moving average over k samples, its non-numbers as 0."""
-    x = np.where(np.isfinite(x), x, 0.0)
-    return np.convolve(x, np.ones(k) / k, mode="same")
 
 
 def _correlation(a: np.ndarray, b: np.ndarray, most: int

@@ -83,7 +83,7 @@ class UnitEvidence:
                 "acceleration fills the windows")
 
 
-def _moving_average(x: np.ndarray, n: int) -> np.ndarray:
+def moving_average(x: np.ndarray, n: int) -> np.ndarray:
     """The mean of each row and the n - 1 before it (the first rows: the first full mean); n
     at most the rows there are."""
     n = min(n, len(x))
@@ -124,7 +124,7 @@ def window_misses(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
     if not (n > 2 and period > 0.0):
         return none
     k = max(1, round(WINDOW_S / period))
-    smooth = _moving_average(acc, max(1, round(LOWPASS_S / period)))
+    smooth = moving_average(acc, max(1, round(LOWPASS_S / period)))
     norm = np.linalg.norm(smooth, axis=1)
     g = float(np.median(norm))
     if not g > 0.0 or n <= k:
