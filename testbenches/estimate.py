@@ -898,6 +898,20 @@ def _import_pyplot() -> Any:
     return plt
 
 
+ORIGIN_SHOWN_S = 1e5
+"""A recording whose time starts this far from 0 [s] (a clock since 1970, as bags and loggers'
+epochs count) is plotted from its first sample, the axis naming when that was."""
+
+
+def _when(t: float) -> str:
+    """The instant a time [s] names: a date where it counts since 1970, else the number."""
+    import datetime as dt
+
+    if 1e8 <= t <= 4.1e9:
+        return dt.datetime.fromtimestamp(t, dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
+    return f"{t:.9g} s"
+
+
 def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> str:
     """The up direction each estimator finds (its three components: readable at any attitude,
     where roll is not near 90 deg of pitch), the reference's, and with a reference each one's
@@ -913,10 +927,12 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
     series = [(run.key, run.trace) for run in runs]
     if vqf is not None and vqf.stream is not None:
         series.append(("vqf", vqf.trace))
+    firsts = [float(trace.values["t"][0]) for _, trace in series if trace.values]
+    origin = min(firsts) if firsts and abs(min(firsts)) >= ORIGIN_SHOWN_S else 0.0
     for key, trace in series:
         if not trace.values:
             continue
-        t, up = trace.values["t"], trace.values["up"]
+        t, up = trace.values["t"] - origin, trace.values["up"]
         for i, ax in enumerate(axes[:3]):
             ax.plot(t, up[:, i], lw=0.9, label=key)
         if scored:  # the same rows: every series is thinned alike
@@ -925,14 +941,14 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
             axes[3].plot(t[a], np.maximum(err, 1e-3), lw=0.8, label=key)
     if scored:
         for i, ax in enumerate(axes[:3]):
-            ax.plot(truth.values["t"], truth.values["up"][:, i], "k--", lw=0.8,
+            ax.plot(truth.values["t"] - origin, truth.values["up"][:, i], "k--", lw=0.8,
                     label="reference")
         axes[3].set_ylabel("inclination\nerror [deg]")
         axes[3].set_yscale("log")
     for i, ax in enumerate(axes[:3]):
         ax.set_ylabel(f"up, {'xyz'[i]}")
         ax.set_ylim(-1.05, 1.05)
-    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlabel(f"time [s] since {_when(origin)}" if origin else "time [s]")
     axes[0].legend(fontsize=8, ncol=4, loc="lower right")
     axes[0].set_title(f"{name}: the up direction in the sensor frame (gravity's, unit length)")
     # fixed margins that fit these labels: tight_layout would measure every tick label

@@ -449,6 +449,30 @@ def test_a_reference_clock_apart_from_the_recordings_is_said_and_an_offset_align
     assert "clock runs" not in capsys.readouterr().out
 
 
+def test_a_recording_timed_since_1970_is_plotted_from_its_first_sample(tmp_path, monkeypatch):
+    """A bag's or a logger's epoch times (1.7e9 s) plotted as they are read "+1.7e9" under an
+    axis of seconds: the plot starts at the first sample and its axis names when that was."""
+    pytest.importorskip("matplotlib")
+    import matplotlib.axes
+
+    from testbenches import estimate
+
+    assert estimate._when(1.7e9) == "2023-11-14 22:13:20 UTC"
+    assert estimate._when(2.0e5) == "200000 s"
+    ex = _example()
+    path = tmp_path / "epoch.csv"
+    np.savetxt(path, np.column_stack([1.7e9 + ex["time"], ex["acc"], ex["gyro"]]),
+               delimiter=",", header="time,ax,ay,az,gx (rad/s),gy (rad/s),gz (rad/s)",
+               comments="", fmt="%.17g")
+    labels = []
+    real = matplotlib.axes.Axes.set_xlabel
+    monkeypatch.setattr(matplotlib.axes.Axes, "set_xlabel",
+                        lambda self, text, *a, **k: labels.append(text) or real(self, text))
+    assert main(["estimate", str(path), "--estimator", "kf", "--out", str(tmp_path)]) == 0
+    assert [x for x in labels if x] == ["time [s] since 2023-11-14 22:13:20 UTC"]
+    assert (tmp_path / "epoch.png").is_file()
+
+
 def test_a_file_without_a_calibration_in_it_is_refused_as_calibration(tmp_path, capsys):
     path = tmp_path / "calibration.json"
     path.write_text('{"foo": 1}')
