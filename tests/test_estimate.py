@@ -356,7 +356,7 @@ def _kf_rmse(out: str) -> float:
 def test_a_reference_in_degrees_is_read_in_degrees_whatever_its_range(tmp_path, capsys):
     """A reference's roll and pitch in degrees, the header silent: beyond radians' range (the
     example's 29 deg) they can only be degrees; within it (a vehicle's tilts of 1-2 deg, which
-    read as radians were 101 deg off, exit 0) the accelerometer at rest tells: each scores as
+    read as radians are tens of degrees off) the accelerometer at rest tells: each scores as
     the reference in radians does, and the command says why it read degrees."""
     truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
     rec = tmp_path / "tilts.csv"

@@ -615,7 +615,7 @@ def test_rows_of_another_topic_take_no_time_from_the_samples(tmp_path, kind):
     rows of another sensor between the IMU's, their IMU cells empty. Each such row is a sample
     the estimators reject and count, and the next sample's dt spans it: the samples' dt are the
     IMU's own (with dt from one row to the next, every IMU row lost the time since the other
-    topic's row, and the recording ran 12 deg off)."""
+    topic's row, and the recording ran tens of degrees off)."""
     t, imu = _example()
     other = t[:-1] + 0.0037  # a 2nd topic's row between each two IMU rows
     times = np.concatenate([t, other])
