@@ -501,10 +501,10 @@ def _names_and_file(path: Path, header: list[str], columns: list[np.ndarray]) ->
 @pytest.mark.parametrize("kind", ["euroc", "plotjuggler", "sensorlog"])
 def test_robotics_datasets_and_topic_exports_are_read_as_written(tmp_path, kind):
     """EuRoC's and TUM-VI's imu0/data.csv ("#timestamp [ns]", "w_RS_S_x [rad s^-1]", "a_RS_S_x
-    [m s^-2]"), PlotJuggler's export of a ROS topic ("/imu/angular_velocity/x", timed by the
-    message's "/imu/header/stamp" before "__time") and iOS SensorLog's clocks
-    ("gyroTimestamp_sinceReboot(s)" beside its accelerometer's): the example's own samples, at
-    its rate, each column named in the choices."""
+    [m s^-2]"), PlotJuggler's export of a ROS topic ("/imu/angular_velocity/x", timed by its
+    "__time") and iOS SensorLog's clocks ("gyroTimestamp_sinceReboot(s)" beside its
+    accelerometer's): the example's own samples, at its rate, each column named in the
+    choices."""
     t, imu = _example()
     acc, gyro = imu[:, :3], imu[:, 3:]
     if kind == "euroc":
@@ -518,7 +518,7 @@ def test_robotics_datasets_and_topic_exports_are_read_as_written(tmp_path, kind)
                   *(f"/imu/orientation/{c}" for c in "wxyz")]
         one, zero = np.ones_like(t), np.zeros_like(t)
         cols = [1.7e9 + t, gyro, 1.7e9 + t, acc, one, zero, zero, zero]
-        time = "/imu/header/stamp"  # the message's own stamp before PlotJuggler's timeline
+        time = "__time"  # PlotJuggler's timeline: on every row of an export of several topics
     else:
         header = ["loggingSample(N)", "accelerometerTimestamp_sinceReboot(s)",
                   *(f"accelerometerAcceleration{a}(G)" for a in "XYZ"),
@@ -812,3 +812,38 @@ def test_a_unit_the_reader_does_not_know_is_named_in_the_refusal(tmp_path):
     source = open_recording(path, columns=given)
     assert "gyro in rad/s (from the data" in source.choices
     np.testing.assert_array_equal(source.load()[0].gyro, imu[:, 3:])
+
+
+def test_a_plotjuggler_export_of_an_imu_and_a_mocap_topic_serves_as_both(tmp_path, capsys):
+    """PlotJuggler's export of two topics: the rows are the union of both topics' messages,
+    each topic's columns and its own header stamp empty on the other's rows, "__time" on all.
+    The file is the recording (its IMU topic, timed by __time) and the reference (its mocap
+    topic) at once, and scores as the example with its truth does."""
+    from testbenches.cli import main
+
+    t, imu = _example()
+    truth = np.loadtxt(REPO / "examples" / "tilt_motion_truth.csv", delimiter=",", skiprows=1)
+    at = truth[:-1, 0] + 0.004  # the mocap's own instants, between the IMU's
+    r, p, y = (np.interp(at, truth[:, 0], truth[:, k]) / 2 for k in (1, 2, 3))
+    quat = np.column_stack([  # x, y, z, w of Z-Y-X roll, pitch, yaw
+        np.sin(r) * np.cos(p) * np.cos(y) - np.cos(r) * np.sin(p) * np.sin(y),
+        np.cos(r) * np.sin(p) * np.cos(y) + np.sin(r) * np.cos(p) * np.sin(y),
+        np.cos(r) * np.cos(p) * np.sin(y) - np.sin(r) * np.sin(p) * np.cos(y),
+        np.cos(r) * np.cos(p) * np.cos(y) + np.sin(r) * np.sin(p) * np.sin(y)])
+    header = ["__time", *(f"/imu/angular_velocity/{a}" for a in "xyz"),
+              *(f"/imu/linear_acceleration/{a}" for a in "xyz"), "/imu/header/stamp",
+              "/vicon/body/header/stamp", *(f"/vicon/body/transform/rotation/{c}" for c in "xyzw")]
+    imu_rows = np.full((len(t), len(header)), np.nan)
+    imu_rows[:, 0], imu_rows[:, 1:4], imu_rows[:, 4:7], imu_rows[:, 7] = t, imu[:, 3:], \
+        imu[:, :3], t
+    mocap = np.full((len(at), len(header)), np.nan)
+    mocap[:, 0], mocap[:, 8], mocap[:, 9:] = at, at, quat
+    rows = np.concatenate([imu_rows, mocap])
+    path = _names_and_file(tmp_path / "export.csv", header,
+                           [rows[np.argsort(rows[:, 0], kind="stable")]])
+    assert main(["estimate", str(path), "--estimator", "kf", "--reference", str(path),
+                 "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    said = capsys.readouterr().out
+    assert "time='__time'" in said
+    kf = float(next(x for x in said.splitlines() if x.startswith("kf ")).split()[2])
+    assert kf == pytest.approx(0.5996, abs=0.01)

@@ -56,10 +56,11 @@ ROS's messages a motion-capture system or an odometry publishes (TransformStampe
 "orientation" alone, which in a ROS Imu message is the device's own estimate, no reference."""
 
 
-LAST_RESORT: dict[str, tuple[str, ...]] = {"time": ("receive_time", "t")}
-"""Aliases taken only where no other alias fits a name in any of name_forms: a ROS topic's
-receive time where no message stamp is found, however deep in a topic's path ("__time" beside
-PlotJuggler's "/imu/header/stamp"), and "t"."""
+LAST_RESORT: dict[str, tuple[str, ...]] = {"time": ("t",)}
+"""Aliases taken only where no other alias fits a name in any of name_forms: "t", a flight
+log's temperature beside a device's prefixed timestamp. PlotJuggler's "__time" is taken before
+a topic's ".../header/stamp": an export of several topics has one such stamp per topic, empty
+on the others' rows, and "__time" on every row."""
 
 
 def norm_name(name: str) -> str:
