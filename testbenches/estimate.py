@@ -215,12 +215,14 @@ class Reference:
         rec at times t): the offset at which the reference's turn rate agrees best with the
         gyro's (a quaternion's whole turn with the gyro's norm; roll and pitch's tilt with the
         gyro's rate across the measured up direction), by their correlation within
-        LAG_SEARCH_S, said where it is two samples or more and agrees clearly better than
-        the clocks as read (LAG_CORRELATION, LAG_GAIN); "" otherwise."""
+        LAG_SEARCH_S (a third of the block), said where it is two samples or more and agrees
+        clearly better than the clocks as read (LAG_CORRELATION, LAG_GAIN); "" otherwise (or
+        for a block shorter than LAG_SHORTEST_S)."""
         from .gyro_unit import moving_average
 
         period = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
-        if not period > 0.0 or len(t) * period < 2 * LAG_SEARCH_S:
+        span = len(t) * period
+        if not period > 0.0 or span < LAG_SHORTEST_S:
             return ""
         up, quat = self.at(t)
         ref_rate = np.full(len(t), np.nan)  # central: the turn over the sample's two neighbours
@@ -236,7 +238,7 @@ class Reference:
         k = max(1, round(0.1 / period))  # both averaged over 0.1 s, their non-numbers as 0
         a, b = (moving_average(np.where(np.isfinite(x), x, 0.0)[:, None], k)[:, 0]
                 for x in (gyro_rate, ref_rate))
-        lags, corr = _correlation(a, b, round(LAG_SEARCH_S / period))
+        lags, corr = _correlation(a, b, round(min(LAG_SEARCH_S, span / 3.0) / period))
         if corr is None:
             return ""
         best = int(np.argmax(corr))
@@ -278,8 +280,11 @@ class Reference:
         return out / np.linalg.norm(out, axis=1, keepdims=True), q_at
 
 
-LAG_SEARCH_S = 2.0
-"""How far apart the clocks of a recording and its reference are looked for [s]."""
+LAG_SEARCH_S = 30.0
+"""How far apart the clocks of a recording and its reference are looked for [s], at most a
+third of the first block's span (two thirds of it then overlap at the farthest)."""
+LAG_SHORTEST_S = 4.0
+"""The shortest first block [s] whose clock offset is looked for."""
 LAG_CORRELATION = 0.5
 """The least correlation of the turn rates at an offset for it to be said."""
 LAG_GAIN = 1.5
