@@ -41,7 +41,12 @@ from typing import Any
 
 import numpy as np
 
-from .fit.recording import QUAT_COLUMNS, read_columns, reference_up  # the one reader
+from .fit.recording import (  # the one reader
+    QUAT_COLUMNS,
+    in_radians,
+    read_columns,
+    reference_up,
+)
 from .options import (
     RECORDING_HELP,
     add_calibration,
@@ -136,9 +141,7 @@ class Reference:
         if "roll" in cols and "pitch" in cols and not all(c in cols for c in QUAT_COLUMNS):
             stated = {units.get(c) for c in ("roll", "pitch")} - {None}
             if not stated:  # rad where the numbers can be radians, else deg: the data decide
-                roll, pitch = np.abs(cols["roll"]), np.abs(cols["pitch"])
-                rad = (np.nanmax(roll, initial=0.0) <= np.pi + 1e-6
-                       and np.nanmax(pitch, initial=0.0) <= np.pi / 2 + 1e-6)
+                rad = in_radians(cols["roll"], cols["pitch"])
                 self.angle_unit = "rad" if rad else "deg"
                 self.angle_how = "" if rad else "beyond radians' range"
                 units.update(roll=self.angle_unit, pitch=self.angle_unit)
@@ -176,23 +179,19 @@ class Reference:
         A unit the header does not state is taken so (self.up follows), and said; one it
         states that the data contradict is refused with the evidence. "" where there is
         nothing to say."""
-        from .broad.metric import gravity_from_roll_pitch
+        from .broad.metric import gravity_from_roll_pitch, inclination_error
         from .fit.recording import RecordingError
 
         if self.angles is None:
             return ""
-        norm = np.linalg.norm(rec.acc, axis=1)
-        quiet = np.isfinite(norm) & (np.abs(norm / np.nanmedian(norm) - 1.0) < 0.05)
-        quiet &= (t >= self.t[0]) & (t <= self.t[-1])
+        quiet = _quiet(rec.acc) & (t >= self.t[0]) & (t <= self.t[-1])
         if quiet.sum() < 10:
             return ""
-        seen = rec.acc[quiet] / norm[quiet, None]
         roll, pitch = (np.interp(t[quiet], self.t, a) for a in self.angles)
         miss = {}
         for unit, scale in (("rad", 1.0), ("deg", np.pi / 180.0)):
             up = gravity_from_roll_pitch(roll * scale, pitch * scale)
-            miss[unit] = float(np.degrees(np.median(np.arccos(np.clip(
-                np.sum(up * seen, axis=1), -1.0, 1.0)))))
+            miss[unit] = float(np.degrees(np.median(inclination_error(up, rec.acc[quiet]))))
         other = "deg" if self.angle_unit == "rad" else "rad"
         if not (miss[self.angle_unit] > ANGLE_UNIT_MISS_DEG
                 and miss[other] <= WORLD_UP_SPREAD_DEG
@@ -218,6 +217,7 @@ class Reference:
         LAG_SEARCH_S (a third of the block), said where it is two samples or more and agrees
         clearly better than the clocks as read (LAG_CORRELATION, LAG_GAIN); "" otherwise (or
         for a block shorter than LAG_SHORTEST_S)."""
+        from .broad.metric import inclination_error
         from .gyro_unit import moving_average
 
         period = float(np.nanmedian(np.diff(t))) if len(t) > 1 else 0.0
@@ -231,7 +231,7 @@ class Reference:
             ref_rate[1:-1] = 2.0 * np.arccos(np.clip(cos, -1.0, 1.0))
             gyro_rate = np.linalg.norm(rec.gyro, axis=1)
         else:  # the tilt's turn, the gyro across the measured up direction
-            ref_rate[1:-1] = np.arccos(np.clip(np.sum(up[2:] * up[:-2], axis=1), -1.0, 1.0))
+            ref_rate[1:-1] = inclination_error(up[2:], up[:-2])
             norm = np.linalg.norm(rec.acc, axis=1, keepdims=True)
             gyro_rate = np.linalg.norm(np.cross(rec.gyro, rec.acc / norm), axis=1)
         ref_rate[1:-1] /= t[2:] - t[:-2]
@@ -371,6 +371,17 @@ def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return v + w * t + np.cross(u, t)
 
 
+QUIET_NORM = 0.05
+"""A sample whose accelerometer's norm is within this share of the median norm is taken as at
+rest, its direction the up direction (the reference's world vertical and its angles' unit)."""
+
+
+def _quiet(acc: np.ndarray) -> np.ndarray:
+    """The samples whose accelerometer's norm is within QUIET_NORM of the median norm."""
+    norm = np.linalg.norm(acc, axis=1)
+    return np.isfinite(norm) & (np.abs(norm / np.nanmedian(norm) - 1.0) < QUIET_NORM)
+
+
 def find_world_up(rec: Any, path: Path) -> tuple[np.ndarray | None, str]:
     """For a quaternion reference (rec.ref_quat, sensor to world): the world's vertical as the
     accelerometer at rest sees it, heading-free (the mean over quiet samples of the measured
@@ -383,8 +394,7 @@ def find_world_up(rec: Any, path: Path) -> tuple[np.ndarray | None, str]:
     if q is None:
         return None, ""
     norm = np.linalg.norm(rec.acc, axis=1)
-    quiet = np.isfinite(norm) & np.all(np.isfinite(q), axis=1)
-    quiet &= np.abs(norm / np.nanmedian(norm) - 1.0) < 0.05
+    quiet = _quiet(rec.acc) & np.all(np.isfinite(q), axis=1)
     if quiet.sum() < 10:
         return None, ""
     seen = _rotate(q[quiet], rec.acc[quiet] / norm[quiet, None])

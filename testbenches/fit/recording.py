@@ -1167,6 +1167,12 @@ QUAT_NORM_TOLERANCE = 0.1
 left out (and counted)."""
 
 
+def in_radians(roll: np.ndarray, pitch: np.ndarray) -> bool:
+    """Whether roll and pitch can be radians: within pi and pi/2 (NaN left out)."""
+    return bool(np.nanmax(np.abs(roll), initial=0.0) <= np.pi + 1e-6
+                and np.nanmax(np.abs(pitch), initial=0.0) <= np.pi / 2 + 1e-6)
+
+
 def reference_up(cols: dict[str, np.ndarray], path: Path,
                  units: dict[str, str | None] | None = None
                  ) -> tuple[np.ndarray | None, np.ndarray | None]:
@@ -1196,7 +1202,7 @@ def reference_up(cols: dict[str, np.ndarray], path: Path,
                                  "or deg serves")
         scale = np.pi / 180.0 if stated == {"deg"} else 1.0
         roll, pitch = cols["roll"] * scale, cols["pitch"] * scale
-        if np.nanmax(np.abs(roll)) > np.pi + 1e-6 or np.nanmax(np.abs(pitch)) > np.pi / 2 + 1e-6:
+        if not in_radians(roll, pitch):
             raise RecordingError(
                 f"{path}: the reference's roll reaches {float(np.nanmax(np.abs(roll))):.4g} and "
                 f"its pitch {float(np.nanmax(np.abs(pitch))):.4g}, beyond pi and pi/2: they "
