@@ -757,11 +757,13 @@ def cmd_estimate(args: argparse.Namespace) -> int:
 
         threading.Thread(target=_import_pyplot, daemon=True).start()
     mapped = parse_columns(args.reference_column, "--reference-column", REFERENCE_COLUMNS)
-    if (mapped or args.reference_topic) and args.reference is None:
-        raise RecordingError(f"{'--reference-column' if mapped else '--reference-topic'} is "
-                             "given, but no --reference: it names a reference file's columns "
-                             "or topic (a reference in the recording's own file is mapped "
-                             "with --column)")
+    given = [name for name, value in (("--reference-column", mapped),
+                                      ("--reference-topic", args.reference_topic),
+                                      ("--reference-offset", args.reference_offset)) if value]
+    if given and args.reference is None:
+        raise RecordingError(f"{given[0]} is given, but no --reference: it names a reference "
+                             "file's columns, topic or clock offset (a reference in the "
+                             "recording's own file is mapped with --column)")
     source = source_from_args(args.recording, args)
     print(f"{args.recording}: {source.choices}")
     reference = (Reference(args.reference, source.time_unit, mapped, args.reference_topic,

@@ -418,6 +418,8 @@ def test_a_reference_files_columns_are_mapped_by_their_own_option(tmp_path, caps
         capsys.readouterr().err
     assert main([*bare, "--reference-column", "q_w=q0"]) == 2
     assert "--reference-column is given, but no --reference" in capsys.readouterr().err
+    assert main([*bare, "--reference-offset", "0.3"]) == 2
+    assert "--reference-offset is given, but no --reference" in capsys.readouterr().err
     assert main([*bare, "--reference", str(tmp_path / "indexed.csv"), "--reference-column",
                  "acc_x=q0"]) == 2
     assert "QUANTITY one of time, roll, pitch, q_w, q_x, q_y, q_z" in capsys.readouterr().err
