@@ -50,12 +50,14 @@ SOURCES = _sources()
 """The library's C sources."""
 HEADERS = _headers()
 """The headers, in the order the binding declares them."""
-CFLAGS = ("-std=c99", "-O2", "-fno-semantic-interposition", "-fPIC", "-shared",
+CFLAGS = ("-std=c99", "-O3", "-fno-semantic-interposition", "-fPIC", "-shared",
           "-ffp-contract=off", "-fno-fast-math")
 """No fused multiply-add (-ffp-contract=off) and no fast-math: each operation rounds as
-Python's does, which is what makes the twins equal. -fno-semantic-interposition lets the compiler
-inline the small shared functions of fc_core.c (the angles, the low-pass stages) into their
-callers, as it does outside a shared library: nothing outside interposes them."""
+Python's does, which is what makes the twins equal; -O3 inlines and unrolls more than -O2 (fewer
+instructions per sample) and leaves every rounding as it is.
+-fno-semantic-interposition lets the compiler inline the small shared functions of a source
+into their callers in it (fc_core.c's angles and low-pass stages), as it does outside a shared
+library: nothing outside interposes them."""
 PREBUILT = HERE / "libfusion_core.so"
 """A library built beside the sources, as the pythonfmu FMUs ship it (fmu_src.build): loaded
 first where it loads (same platform); elsewhere the library is built or Python runs."""
