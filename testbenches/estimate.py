@@ -936,6 +936,8 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
     plt = _import_pyplot()
     if plt is None:
         return "(no plot: matplotlib is not installed)"
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
     from .broad.metric import inclination_error
 
     scored = len(truth.rows) > 0
@@ -946,6 +948,7 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
         series.append(("vqf", vqf.trace))
     firsts = [float(trace.values["t"][0]) for _, trace in series if trace.values]
     origin = min(firsts) if firsts and abs(min(firsts)) >= ORIGIN_SHOWN_S else 0.0
+    decades = [np.inf, -np.inf]  # the error's span, log10 [deg]
     for key, trace in series:
         if not trace.values:
             continue
@@ -954,14 +957,24 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
             ax.plot(t, up[:, i], lw=0.9, label=key)
         if scored:  # the same rows: every series is thinned alike
             _, a, b = np.intersect1d(trace.rows, truth.rows, return_indices=True)
-            err = np.degrees(inclination_error(up[a], truth.values["up"][b]))
-            axes[3].plot(t[a], np.maximum(err, 1e-3), lw=0.8, label=key)
+            err = np.maximum(np.degrees(inclination_error(up[a], truth.values["up"][b])), 1e-3)
+            axes[3].plot(t[a], err, lw=0.8, label=key)
+            if np.isfinite(err).any():
+                decades = [min(decades[0], np.log10(np.nanmin(err))),
+                           max(decades[1], np.log10(np.nanmax(err)))]
     if scored:
         for i, ax in enumerate(axes[:3]):
             ax.plot(truth.values["t"] - origin, truth.values["up"][:, i], "k--", lw=0.8,
                     label="reference")
         axes[3].set_ylabel("inclination\nerror [deg]")
         axes[3].set_yscale("log")
+        # plain numbers (0.1, 1, 10; and 0.2, 0.5 where the error spans few decades, so that
+        # any span has labels): the default labels are typeset by mathtext, whose parser is
+        # built on its first use, a third of a short recording's plot
+        few = decades[1] - decades[0] <= 3.0
+        axes[3].yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0) if few else (1.0,)))
+        axes[3].yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        axes[3].yaxis.set_minor_formatter(NullFormatter())
     for i, ax in enumerate(axes[:3]):
         ax.set_ylabel(f"up, {'xyz'[i]}")
         ax.set_ylim(-1.05, 1.05)
