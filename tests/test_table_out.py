@@ -1,0 +1,92 @@
+"""testbenches.table_out: every format gives back the doubles written, to the bit, block after
+block; a file appears under its name only when committed."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from testbenches.table_out import FORMATS, TableWriter
+
+NAMES = ["time", "roll", "bias_x"]
+
+
+def _blocks() -> list[list[np.ndarray]]:
+    """Two blocks of awkward doubles: signed zeros, NaN, infinities, the smallest subnormal,
+    thirds, large and small magnitudes, and a strided column (as bias[:, 0] is)."""
+    rng = np.random.default_rng(3)
+    odd = np.array([0.0, -0.0, np.nan, np.inf, -np.inf, 5e-324, 1 / 3, -2 / 3, 1e22, 1.5e-7,
+                    123456789012.345, 0.1])
+    wide = rng.normal(size=(len(odd), 3)) * 10.0 ** rng.integers(-12, 12, size=(len(odd), 3))
+    first = [np.arange(len(odd)) * 0.01, odd, wide[:, 1]]
+    second = [np.arange(5) * 0.01 + 1.0, rng.normal(size=5), np.zeros(5)]
+    return [first, second]
+
+
+def _read(path: Path, fmt: str) -> dict[str, np.ndarray]:
+    if fmt == "csv":
+        lines = path.read_text().splitlines()
+        assert lines[0] == ",".join(NAMES)
+        rows = [[float(cell) for cell in line.split(",")] for line in lines[1:]]
+        return {n: np.array([r[i] for r in rows]) for i, n in enumerate(NAMES)}
+    if fmt == "parquet":
+        import pyarrow.parquet as pq
+
+        table = pq.read_table(path)
+        return {n: np.asarray(table[n].to_pylist(), dtype=float) for n in NAMES}
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        return {n: f[n][:] for n in NAMES}
+
+
+def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.shape == b.shape and bool(np.all((a.view(np.int64) == b.view(np.int64))
+                                              | (np.isnan(a) & np.isnan(b))))
+
+
+@pytest.mark.parametrize("fmt", list(FORMATS))
+def test_each_format_gives_back_the_doubles_written(tmp_path: Path, fmt: str) -> None:
+    path = tmp_path / f"out{FORMATS[fmt]}"
+    writer = TableWriter(path, fmt, NAMES)
+    blocks = _blocks()
+    for block in blocks:
+        writer.write(block)
+    assert not path.exists()  # only the hidden partial file until committed
+    assert writer.commit() == path
+    assert not writer.partial.exists()
+    got = _read(path, fmt)
+    for i, name in enumerate(NAMES):
+        want = np.concatenate([block[i] for block in blocks])
+        assert _same_bits(got[name], want), name
+
+
+def test_csv_without_polars_gives_back_the_same_doubles(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without polars numpy writes %.17g: other text, the same doubles."""
+    monkeypatch.setitem(sys.modules, "polars", None)  # import polars raises ImportError
+    path = tmp_path / "out.csv"
+    writer = TableWriter(path, "csv", NAMES)
+    blocks = _blocks()
+    for block in blocks:
+        writer.write(block)
+    writer.commit()
+    got = _read(path, "csv")
+    for i, name in enumerate(NAMES):
+        assert _same_bits(got[name], np.concatenate([block[i] for block in blocks])), name
+
+
+def test_a_discarded_writer_leaves_no_file(tmp_path: Path) -> None:
+    path = tmp_path / "out.csv"
+    writer = TableWriter(path, "csv", NAMES)
+    writer.write(_blocks()[0])
+    writer.discard()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unknown_format_is_refused_naming_the_allowed() -> None:
+    with pytest.raises(ValueError, match="output format 'xlsx': allowed csv, parquet, hdf5"):
+        TableWriter(Path("out.xlsx"), "xlsx", NAMES)
