@@ -970,7 +970,7 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
         axes[3].set_yscale("log")
         # plain numbers (0.1, 1, 10; and 0.2, 0.5 where the error spans few decades, so that
         # any span has labels): the default labels are typeset by mathtext, whose parser is
-        # built on its first use, a third of a short recording's plot
+        # built on its first use, at a cost a short recording's plot feels
         few = decades[1] - decades[0] <= 3.0
         axes[3].yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0) if few else (1.0,)))
         axes[3].yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))

@@ -3,9 +3,8 @@
 A writer writes to a hidden partial file beside its destination and renames it into place on
 `commit()`, so a run that is refused or stopped half way leaves no file that looks complete;
 `discard()` removes the partial file. CSV cells are the shortest decimal that reads back as the
-same double (polars' writer, Ryu's digits: three times pyarrow's CSV writer's speed, which is
-most of a long run's time where six estimators' outputs are written), so no digit of the
-estimate is lost.
+same double, so no digit of the estimate is lost: polars' writer (Ryu's digits), which formats
+them for less than pyarrow's, where formatting is most of a long run's writing.
 """
 
 from __future__ import annotations
