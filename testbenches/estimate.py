@@ -525,15 +525,27 @@ class Thinned:
     def add_at(self, row0: int, n: int,
                make: Callable[[np.ndarray], dict[str, np.ndarray]]) -> None:
         """A block of n rows from row row0 whose series `make` gives at the block's indices
-        it is passed: only the rows kept are computed."""
+        it is passed: only the rows kept are computed (k is doubled first as far as the block
+        would double it: a long first block is not computed whole to be thinned)."""
+
+        def kept(k: int) -> int:
+            return int(np.count_nonzero(self.rows % k == 0)) + len(range(-row0 % k, n, k))
+
+        k = self.k
+        while kept(k) > 2 * PLOT_POINTS:
+            k *= 2
+        self._thin(k)
         at = np.arange(-row0 % self.k, n, self.k)  # the block's rows r with r % k == 0
         self.rows = np.concatenate([self.rows, row0 + at])
         for name, v in make(at).items():
             old = self.values.get(name)
             self.values[name] = v if old is None else np.concatenate([old, v])
-        while len(self.rows) > 2 * PLOT_POINTS:
-            self.k *= 2
-            keep = self.rows % self.k == 0
+
+    def _thin(self, k: int) -> None:
+        """Every kth sample of those kept (k a power-of-two multiple of self.k)."""
+        if k != self.k:
+            self.k = k
+            keep = self.rows % k == 0
             self.rows = self.rows[keep]
             self.values = {name: v[keep] for name, v in self.values.items()}
 

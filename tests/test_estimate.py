@@ -721,3 +721,29 @@ def test_a_reference_whose_header_states_degrees_is_read_in_degrees(tmp_path, ca
     assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference", str(bad),
                  "--out", str(tmp_path / "out"), "--no-plots"]) == 2
     assert "states the unit(s) deg, g for roll and pitch" in capsys.readouterr().err
+
+
+def test_the_plot_keeps_every_kth_sample_and_computes_no_more() -> None:
+    """Thinned keeps the rows that are multiples of one k (at most 2 * PLOT_POINTS of them,
+    the same whichever blocks they came in), and asks a block's `make` for those rows alone:
+    a long first block is not computed whole to be thinned afterwards."""
+    from testbenches.estimate import PLOT_POINTS, Thinned
+
+    asked: list[int] = []
+
+    def make(at: np.ndarray, row0: int) -> dict[str, np.ndarray]:
+        asked.append(len(at))
+        return {"t": (row0 + at) * 0.01}
+
+    rows = 10 * 262144 + 12345
+    blocks = [(0, 262144), (262144, 5), (262149, rows - 262149)]
+    trace = Thinned()
+    for row0, n in blocks:
+        trace.add_at(row0, n, lambda at, row0=row0: make(at, row0))
+    assert len(trace.rows) <= 2 * PLOT_POINTS
+    assert np.array_equal(trace.rows, np.arange(0, rows, trace.k))
+    assert np.array_equal(trace.values["t"], trace.rows * 0.01)
+    assert max(asked) <= 2 * PLOT_POINTS  # the first block's 262144 rows were never asked for
+    whole = Thinned()
+    whole.add(0, {"t": np.arange(rows) * 0.01})
+    assert whole.k == trace.k and np.array_equal(whole.rows, trace.rows)
