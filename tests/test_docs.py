@@ -1,10 +1,12 @@
 """The documentation: the site builds with warnings as errors, the README stays a page, and no
-product file or page depends on the folder our CI keeps beside the project."""
+product file or page depends on the folder our CI keeps beside the project; commands the
+pages give are the code's."""
 
 from __future__ import annotations
 
 import importlib.util
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -106,3 +108,24 @@ def test_a_named_command_imports_its_own_module_only() -> None:
     proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True,
                           text=True, check=True)
     assert proc.stdout.strip() == "[]", proc.stdout
+
+
+def _by_hand_commands(text: str) -> list[list[str]]:
+    """The `cc ... libfusion_core.so ...` commands in a text, continuation lines joined, split
+    into words."""
+    joined = re.sub(r"\\\\?\n\s*", " ", text)
+    return [line.split() for line in re.findall(r"cc -std=c99[^\n`]*libfusion_core\.so[^\n`]*",
+                                                 joined)]
+
+
+def test_the_c_twins_by_hand_command_has_the_librarys_flags() -> None:
+    """The guide's and the module's one command for the library by hand compiles as the cached
+    build does (fusion_core.native.CFLAGS): where the flags change, so must they."""
+    from fusion_core.native import CFLAGS
+
+    for path in (REPO / "docs" / "guide" / "backends.md",
+                 REPO / "fusion_core" / "native" / "__init__.py"):
+        commands = _by_hand_commands(path.read_text())
+        assert commands, f"{path}: no by-hand command found"
+        for words in commands:
+            assert tuple(words[1:1 + len(CFLAGS)]) == CFLAGS, (path, words)

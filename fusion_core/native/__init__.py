@@ -15,8 +15,8 @@ backend="auto")` uses the native twin where there is one and it is available.
 
 By hand, the library is one command:
 
-    cc -std=c99 -O2 -fPIC -shared -ffp-contract=off -fno-fast-math \\
-        -o libfusion_core.so fusion_core/native/*.c -lm
+    cc -std=c99 -O3 -fno-semantic-interposition -fPIC -shared -ffp-contract=off \\
+        -fno-fast-math -o libfusion_core.so fusion_core/native/*.c -lm
 """
 
 from __future__ import annotations
