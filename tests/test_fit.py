@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -29,13 +30,15 @@ ACC_DENSITY = 400e-6 * G  # m/s^2/sqrt(Hz)
 
 def static_csv(path: Path, seconds: float, rate: float, seed: int = 0,
                gyro_density: float = GYRO_DENSITY, acc_density: float = ACC_DENSITY,
-               turn: float = 0.0) -> Path:
+               turn: float = 0.0, gyro_bias: tuple[float, float, float] = (0.01, -0.02, 0.005)
+               ) -> Path:
     """A static recording with white noise of known densities (per-sample std = density *
-    sqrt(rate)), a gyro bias and gravity on a tilted z; `turn` [rad/s] adds a slow rotation."""
+    sqrt(rate)), a gyro bias [rad/s] and gravity on a tilted z; `turn` [rad/s] adds a slow
+    rotation."""
     rng = np.random.default_rng(seed)
     n = int(seconds * rate)
     t = np.arange(n) / rate
-    gyro = np.array([0.01, -0.02, 0.005]) + gyro_density * np.sqrt(rate) * rng.standard_normal(
+    gyro = np.array(gyro_bias) + gyro_density * np.sqrt(rate) * rng.standard_normal(
         (n, 3))
     gyro[:, 0] += turn
     angle = 0.1 + turn * t
@@ -247,3 +250,47 @@ def test_noise_reads_a_static_recording_in_g_and_deg_s_with_its_units_in_the_hea
     a, b = (json.loads((tmp_path / n / "noise.json").read_text()) for n in ("si", "logger"))
     assert b["gyro_psd"] == pytest.approx(a["gyro_psd"], rel=1e-6)
     assert b["acc_psd"] == pytest.approx(a["acc_psd"], rel=1e-6)
+
+
+def test_noise_on_a_still_recording_says_where_the_gyro_unit_given_is_wrong(tmp_path, capsys):
+    """Still data cannot confirm a gyro unit, so a wrong --gyro-unit shows only in what the
+    numbers mean. deg/s data given as rad/s: the noise reads as rotation, and the refusal says
+    that in deg/s the sensor was still. rad/s data given as deg/s: a noise 57 times below a
+    MEMS gyro's, which the note names with the figure in rad/s."""
+    from testbenches.__main__ import main
+
+    # a bias of a tenth of a deg/s: read 57 times too large it turns gravity little within
+    # testbenches.gravity's window (a larger one is refused as the file is read: the
+    # accelerometer holds no gravity as read, units named)
+    si = static_csv(tmp_path / "si.csv", 30.0, 100.0, gyro_bias=(0.002, -0.001, 0.001))
+    data = np.loadtxt(si, delimiter=",", skiprows=1)
+    degs = tmp_path / "degs.csv"
+    np.savetxt(degs, np.column_stack([data[:, :4], np.degrees(data[:, 4:7])]), delimiter=",",
+               header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z", comments="")
+    assert main(["noise", str(degs), "--gyro-unit", "rad/s", "--no-plots", "--out",
+                 str(tmp_path / "a")]) == 2
+    said = capsys.readouterr().err
+    assert "not static: rotation seen in the gyro" in said
+    assert re.search(r"Or it was at rest and its gyro is not in rad/s.*in deg/s its 1 s means "
+                     r"move by 0\.0\d+ deg/s \(--gyro-unit deg/s\)", said)
+    assert main(["noise", str(degs), "--gyro-unit", "deg/s", "--no-plots", "--out",
+                 str(tmp_path / "b")]) == 0
+    assert "navigation-grade" not in capsys.readouterr().out
+
+    assert main(["noise", str(si), "--gyro-unit", "deg/s", "--no-plots", "--out",
+                 str(tmp_path / "c")]) == 0
+    said = capsys.readouterr().out
+    density = math.degrees(GYRO_DENSITY)  # deg/s/sqrt(Hz), as the note gives it
+    found = re.search(r"navigation-grade.*its gyro is not in deg/s.*in rad/s the noise is "
+                      r"([0-9.e-]+) deg/s/sqrt\(Hz\) \(--gyro-unit rad/s\)", said)
+    assert found and float(found.group(1)) == pytest.approx(density, rel=0.1)
+    assert "null in noise.json" in said and "None" not in said
+
+
+def test_noise_takes_a_navigation_grade_gyro_whose_unit_the_data_confirm(tmp_path):
+    """A gyro below any MEMS part's noise is noted as such, without doubting a unit the data
+    confirmed (the BROAD and SI loads: rad/s by their format)."""
+    rec = load(static_csv(tmp_path / "fog.csv", 30.0, 100.0, gyro_density=1e-5 * DEG))
+    noise, _ = analyse(rec)
+    assert "navigation-grade" in noise["note"] and "--gyro-unit" not in noise["note"]
+

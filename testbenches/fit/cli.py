@@ -89,7 +89,8 @@ def cmd_noise(args: argparse.Namespace) -> int:
           f"(gyro_psd {g * g:.4g} rad2/s)")
     print(f"  acc white noise {noise['acc_density_ug_sqrt_hz']:.4g} ug/sqrt(Hz) "
           f"(acc_psd {a * a:.4g} m2/s3)")
-    print(f"  gyro range +-{args.gyro_range:g} deg/s (gyro_range {noise['gyro_range']:.6g} rad/s)")
+    print(f"  gyro range +-{args.gyro_range:g} deg/s (gyro_range {noise['gyro_range']:.6g} rad/s; "
+          "--gyro-range: a static recording cannot show it)")
     if args.gyro_bias_std > 0.0:
         print(f"  gyro turn-on bias +-{args.gyro_bias_std:g} deg/s (1 sigma): the Kalman "
               "filters' init_bias_std at least that")

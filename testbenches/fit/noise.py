@@ -12,6 +12,7 @@ from), so the command and the defaults cannot drift apart.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,7 @@ from fusion_core.presets import noise_preset
 from fusion_core.registry import create
 from fusion_core.types import DEG, GYRO_RANGE_DEFAULT, G
 
+from ..gyro_unit import UNITS
 from .allan import AllanFit, allan_deviation, fit
 from .recording import Recording, RecordingError
 
@@ -31,6 +33,11 @@ LONG_DURATION_S = 2 * 3600.0
 long to resolve them (the usual 2 h static recording)."""
 MAX_GYRO_SWING = 1.0 * DEG
 """Peak-to-peak of the gyro's 1 s means [rad/s] beyond which the recording is not static."""
+QUIETEST_MEMS_GYRO = 2e-4 * DEG
+"""Gyro white-noise density [rad/s/sqrt(Hz)] below the quietest MEMS parts' (high-end MEMS
+IMUs reach about 3e-4 deg/s/sqrt(Hz), an angle random walk of 0.02 deg/sqrt(h); consumer parts
+5e-3 to 1e-2): a figure below it is a fibre-optic or ring-laser gyro's, or a MEMS gyro's read in
+a unit 57 times too large (rad/s data read as deg/s)."""
 MAX_TILT_CHANGE = 1.0 * DEG
 """Change of the accelerometer's direction (1 s means) beyond which the sensor moved."""
 AXES = ("x", "y", "z")
@@ -51,7 +58,11 @@ def check_static(rec: Recording) -> None:
         raise RecordingError(
             f"{rec.name}: not static: rotation seen in the gyro (its 1 s means move by "
             f"{np.degrees(swing):.2f} deg/s, allowed {np.degrees(MAX_GYRO_SWING):.1f}); record "
-            "with the sensor at rest")
+            "with the sensor at rest" + ("" if (other := _other_unit(
+                rec, swing, lambda v: v <= MAX_GYRO_SWING)) is None else
+                f". Or it was at rest and its gyro is not in {rec.gyro_unit}, which a still "
+                f"recording cannot confirm: in {other[0]} its 1 s means move by "
+                f"{np.degrees(other[1]):.3g} deg/s (--gyro-unit {other[0]})"))
     a_means = rec.acc[:n].reshape(-1, block, 3).mean(axis=1)
     u = a_means / np.linalg.norm(a_means, axis=1, keepdims=True)
     tilt = float(np.max(np.arccos(np.clip(u @ u[0], -1.0, 1.0))))
@@ -60,6 +71,17 @@ def check_static(rec: Recording) -> None:
             f"{rec.name}: not static: the accelerometer's direction changed by "
             f"{np.degrees(tilt):.2f} deg (allowed {np.degrees(MAX_TILT_CHANGE):.1f}): the sensor "
             "moved")
+
+
+def _other_unit(rec: Recording, value: float, passes: Any) -> tuple[str, float] | None:
+    """Where rec's gyro unit is unconfirmed by the data: the unit nearest to it in which a gyro
+    figure (`value`, proportional to the gyro's readings) would pass (`passes(value)`), and the
+    figure in that unit; None where none would or the data confirmed the unit."""
+    if rec.gyro_unit_checked:
+        return None
+    ratios = sorted(((f / UNITS[rec.gyro_unit], u) for u, f in UNITS.items()
+                     if u != rec.gyro_unit), key=lambda ru: abs(math.log(ru[0])))
+    return next(((u, value * r) for r, u in ratios if passes(value * r)), None)
 
 
 def _axes(values: list[float | None]) -> dict[str, float | None]:
@@ -105,10 +127,23 @@ def analyse(rec: Recording) -> tuple[dict[str, Any], dict[str, list[AllanFit]]]:
     out["acc_norm"] = norm
     out["acc_norm_g"] = norm / G
     out["acc_sample_std"] = float(np.mean(np.std(rec.acc, axis=0)))
+    notes = []
     if rec.duration < LONG_DURATION_S:
-        out["note"] = (f"{rec.duration:.0f} s of data: bias instability and random walk need "
-                       f"about {LONG_DURATION_S / 3600:.0f} h at rest to be resolved; None where "
-                       "this recording does not reach them")
+        notes.append(f"{rec.duration:.0f} s of data: bias instability and random walk need "
+                     f"about {LONG_DURATION_S / 3600:.0f} h at rest to be resolved; null in "
+                     "noise.json where this recording does not reach them")
+    density = out["gyro_density"]["mean"]
+    if density < QUIETEST_MEMS_GYRO:
+        other = _other_unit(rec, density, lambda v: v >= QUIETEST_MEMS_GYRO)
+        notes.append(
+            f"a gyro white noise of {np.degrees(density):.3g} deg/s/sqrt(Hz) is a "
+            "navigation-grade gyro's (fibre-optic or ring laser), below any MEMS part's "
+            f"({np.degrees(QUIETEST_MEMS_GYRO):.1g} and more)" + ("" if other is None else
+            f": if the part is MEMS, its gyro is not in {rec.gyro_unit}, which a still "
+            f"recording cannot confirm: in {other[0]} the noise is {np.degrees(other[1]):.3g} "
+            f"deg/s/sqrt(Hz) (--gyro-unit {other[0]})"))
+    if notes:
+        out["note"] = "; ".join(notes)
     return out, fits
 
 

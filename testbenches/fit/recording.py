@@ -22,7 +22,7 @@ import numpy as np
 
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
-from ..gyro_unit import median_period
+from ..gyro_unit import UNITS, median_period
 from ..reader import TIME_OF_DAY, TIME_SCALE
 from ..time_unit import median_step
 from .columns import ALIASES, find_names, name_forms, norm_name, unit_in_name
@@ -62,6 +62,12 @@ class Recording:
     """A quaternion reference's unit quaternions [N, 4], sensor to world (None: none)."""
     described: str = ""
     """Which columns, units and rate were taken, and why (load_recording)."""
+    gyro_unit: str = "rad/s"
+    """The unit the file's gyro was read in (testbenches.gyro_unit.UNITS)."""
+    gyro_unit_checked: bool = True
+    """False where gyro_unit was given or stated by the header and the data could not confirm
+    it (no turns to compare, as in a still recording): a wrong one then shows only in what the
+    numbers mean (a noise density no gyro has, rotation a still sensor cannot have)."""
 
     @property
     def sensor(self) -> dict[str, Any]:
@@ -84,12 +90,9 @@ class Recording:
         return float(np.sum(self.dt))
 
     def slice(self, start: int, stop: int) -> Recording:
-        return Recording(
-            self.name, self.acc[start:stop], self.gyro[start:stop], self.dt[start:stop],
-            self.rate, self.gyro_sampling,
-            None if self.up_ref is None else self.up_ref[start:stop],
-            None if self.counts is None else self.counts[start:stop], self.sensor_delay,
-        )
+        """Samples start to stop, with what is said of the whole recording."""
+        return replace(self, **{name: None if (v := getattr(self, name)) is None
+                                else v[start:stop] for name in PER_SAMPLE})
 
 
 def load(path: str | Path, rate: float | None = None) -> Recording:
@@ -113,6 +116,10 @@ def trial_recording(trial: Any) -> Recording:
     return Recording(trial.name, trial.acc, trial.gyro, np.full(trial.n, trial.dt), trial.rate,
                      trial.gyro_sampling, up, trial.movement & np.all(np.isfinite(up), axis=1),
                      trial.sensor_delay)
+
+
+PER_SAMPLE = ("acc", "gyro", "dt", "up_ref", "counts", "ref_quat")
+"""Recording's fields that hold a row per sample (the others describe the whole recording)."""
 
 
 def rest(rec: Recording) -> Recording:
@@ -517,15 +524,12 @@ class RecordingSource:
 
 def concatenate(parts: list[Recording]) -> Recording:
     """The blocks of one recording as one."""
-    first = parts[0]
 
     def joined(name: str) -> np.ndarray | None:
         values = [getattr(p, name) for p in parts]
         return None if values[0] is None else np.concatenate(values)
 
-    return Recording(first.name, joined("acc"), joined("gyro"), joined("dt"), first.rate,
-                     first.gyro_sampling, joined("up_ref"), joined("counts"), first.sensor_delay,
-                     joined("ref_quat"))
+    return replace(parts[0], **{name: joined(name) for name in PER_SAMPLE})
 
 
 def _broad_source(path: Path, trial: Any) -> RecordingSource:
@@ -688,9 +692,10 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                 yield (*vectors(cols), d)
             row0 += len(block)
 
-    gyro_scale, gyro_how, used = _gyro_scale(
+    found_unit = _gyro_unit(
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
         more if n == PREFIX_ROWS else None)
+    gyro_scale, gyro_how, used = UNITS[found_unit.unit], found_unit.how, found_unit.samples
     if axes is not None:
         gyro_how += ("; its axes as the accelerometer's "
                      f"{', '.join(c.strip() for c in gyro_axes.split(','))} (given)")
@@ -724,7 +729,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             acc, gyro = acc * acc_scale, gyro * gyro_scale
             up, ref_quat = reference_up(cols, path, units)
             counts = None if up is None else np.all(np.isfinite(up), axis=1)
-            rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts)
+            rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts,
+                            gyro_unit=found_unit.unit, gyro_unit_checked=found_unit.checked)
             rec.ref_quat = ref_quat
             read_notes["wraps"] = run_clock.wraps
             yield rec, t
@@ -1081,15 +1087,26 @@ def parse_axes(text: str) -> np.ndarray | None:
     return None if np.array_equal(m, np.eye(3)) else m
 
 
-def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
-                stated: str | None, more: Any = None) -> tuple[float, str, int]:
-    """The factor to rad/s, how it was chosen and over how many samples: the unit in which the
+@dataclass(frozen=True)
+class _GyroUnit:
+    unit: str
+    how: str
+    """How it was chosen, for the choices printed."""
+    samples: int
+    """Over how many samples."""
+    checked: bool
+    """Whether the data confirmed it (Recording.gyro_unit_checked)."""
+
+
+def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
+               stated: str | None, more: Any = None) -> _GyroUnit:
+    """The gyro's unit, how it was chosen and over how many samples: the unit in which the
     gyro's turn explains the accelerometer's turn of gravity (testbenches.gyro_unit), the
     windows of further blocks (`more`: (acc, gyro, dt) each) pooled while the first cannot
     tell and no unit is given. A unit given or stated by the header that the data contradict
     is refused with the evidence; where the data cannot tell and no unit is given or stated,
     the recording is refused, and so is a given unit that is not the header's."""
-    from ..gyro_unit import MIN_WINDOWS, UNITS, verdict, window_misses
+    from ..gyro_unit import MIN_WINDOWS, verdict, window_misses
     from ..time_unit import listed
 
     _given_against_header(path, "gyro", "gyro-unit", unit, stated)
@@ -1116,13 +1133,14 @@ def _gyro_scale(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, u
                 f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
                 f"{evidence.describe()}, so it reads in {evidence.unit}; give --gyro-unit "
                 f"{evidence.unit}, or check the columns")
-        return UNITS[chosen], f"{chosen} ({how}" + (
-            ", and the data agree)" if evidence.unit else ")"), used
+        return _GyroUnit(chosen, f"{chosen} ({how}" + (
+            ", and the data agree)" if evidence.unit else ")"), used, evidence.unit is not None)
     if evidence.unit is None:
         raise RecordingError(
             f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
             f"give --gyro-unit {listed(list(UNITS))}")
-    return UNITS[evidence.unit], f"{evidence.unit} (from the data: {evidence.describe()})", used
+    return _GyroUnit(evidence.unit, f"{evidence.unit} (from the data: {evidence.describe()})",
+                     used, True)
 
 
 def _axes_as_read(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
