@@ -294,3 +294,11 @@ def test_noise_takes_a_navigation_grade_gyro_whose_unit_the_data_confirm(tmp_pat
     noise, _ = analyse(rec)
     assert "navigation-grade" in noise["note"] and "--gyro-unit" not in noise["note"]
 
+
+def test_tune_refuses_a_recording_without_a_reference_before_it_starts(tmp_path, capsys):
+    from testbenches.__main__ import main
+
+    assert main(["tune", "--estimator", "kf", str(REPO / "examples" / "tilt_motion.csv"),
+                 "--no-plots", "--out", str(tmp_path / "t")]) == 2
+    err = capsys.readouterr().err
+    assert "no reference" in err and "run/s" not in err  # no progress bar started

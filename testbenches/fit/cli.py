@@ -107,10 +107,12 @@ def cmd_tune(args: argparse.Namespace) -> int:
     from fusion_core.presets import load_preset
 
     from .recording import recording_from_args
-    from .tune import fmu_score, tune, write
+    from .tune import fmu_score, require_reference, tune, write
 
     fit_recs = [recording_from_args(p, args)[0] for p in args.files]
     val_recs = [recording_from_args(p, args)[0] for p in args.validate]
+    for rec in (*fit_recs, *val_recs):  # before the progress bar starts
+        require_reference(rec)
     start = with_calibration(load_preset(args.start), args.calibration)[args.estimator]
     names = [n.strip() for n in args.params.split(",")] if args.params else None
     with tqdm(total=args.max_evaluations, unit="run", file=sys.stderr) as bar:

@@ -116,11 +116,16 @@ def dimension(p: Param, start: float) -> Dimension:
     return Dimension(p.name, lo, hi, False)
 
 
-def score(key: str, params: dict[str, Any], rec: Recording) -> float:
-    """Inclination RMSE [deg] of the estimator with params on one recording."""
+def require_reference(rec: Recording) -> None:
+    """RecordingError where rec has no reference to score against."""
     if rec.up_ref is None:
         raise RecordingError(f"{rec.name}: no reference (q_w, q_x, q_y, q_z or roll, pitch "
                              "columns, or a BROAD trial): tune cannot score it")
+
+
+def score(key: str, params: dict[str, Any], rec: Recording) -> float:
+    """Inclination RMSE [deg] of the estimator with params on one recording."""
+    require_reference(rec)
     est = create(key, {**rec.sensor, **params})
     out = est.run(rec.acc, rec.gyro, rec.dt)
     g = gravity_from_roll_pitch(out["roll"], out["pitch"])
