@@ -610,7 +610,7 @@ def plot(results: Results, path: Path) -> None:
 
 
 def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    from .options import add_cluster, out_folder, positive_int
+    from .options import add_cluster, add_no_plots, out_folder, positive_int
 
     p = sub.add_parser(
         "battery", help="every attitude filter beside VQF on a battery of motions x parts of "
@@ -623,7 +623,7 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
     add_cluster(p)
     p.add_argument("--out", type=out_folder, default=Path("reports/battery"),
                    help="where battery.json, battery.md, one page per motion and the plot go")
-    p.add_argument("--no-plots", action="store_true", help="no battery.png")
+    add_no_plots(p, "battery.png")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a parameter value for every attitude filter that has it (repeatable), "
                    "on top of each sensor class's values: what a value is worth beside VQF, "

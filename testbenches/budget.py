@@ -30,6 +30,7 @@ from fusion_core.scenarios import ESTIMATION_SCENARIOS
 from .contract import accuracy_limits
 from .options import (
     add_calibration,
+    add_no_plots,
     add_preset,
     add_sensor,
     choose,
@@ -198,8 +199,7 @@ def add_budget_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[
     add_sensor(p)
     p.add_argument("--out", type=out_folder, default=Path("reports/budget"),
                    help="report folder (reports/budget)")
-    p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
-                   help="skip the bar chart")
+    add_no_plots(p, "the bar chart")
 
 
 def cmd_budget(args: argparse.Namespace) -> int:

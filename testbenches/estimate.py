@@ -50,6 +50,7 @@ from .fit.recording import (  # the one reader
 from .options import (
     RECORDING_HELP,
     add_calibration,
+    add_no_plots,
     add_preset,
     add_recording_options,
     out_folder,
@@ -117,7 +118,7 @@ def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignor
                    "(default roll,pitch,bias,pos,vel; pos and vel for the position filter)")
     p.add_argument("--every", type=positive_int, default=1, metavar="N",
                    help="write every Nth sample (the estimators still take every one)")
-    p.add_argument("--no-plots", action="store_true", help="skip the PNG plot")
+    add_no_plots(p, "the PNG plot")
     p.add_argument("--no-vqf", action="store_true",
                    help="with a reference, leave out VQF's row (and its line in the plot)")
 

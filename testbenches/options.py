@@ -136,6 +136,12 @@ def jitter_fraction(text: str) -> float:
     return _number(text, float, "a fraction in [0, 1)", lambda v: 0.0 <= v < 1.0)
 
 
+def add_no_plots(parser: argparse.ArgumentParser, skipped: str) -> None:
+    """--no-plots (or --no-plot): every command that draws takes it, to skip `skipped`."""
+    parser.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
+                        help=f"skip {skipped}")
+
+
 def out_folder(text: str) -> Path:
     """argparse type: the folder a command writes to (--out), made where missing; a file of
     that name is refused before anything runs (mkdir would raise on it after the work)."""

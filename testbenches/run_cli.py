@@ -16,6 +16,7 @@ from .fmus import DEFAULT_FMU_DIR, ESTIMATOR_FMUS, KINDS, kind_dir
 from .master import MASTERS
 from .options import (
     add_calibration,
+    add_no_plots,
     add_preset,
     add_sensor,
     choose,
@@ -70,7 +71,7 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
                      "one before it, the default) or jacobi (each on the others' outputs of "
                      "the previous step, as libcosim, Ecos and parallel containers do: the "
                      "chain adds 2 steps of delay, by which the truth is aligned)")
-    run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    add_no_plots(run, "the PNG plots")
     run.add_argument("--jobs", type=positive_int, default=2,
                      help="worker processes (2: the campaign on two cores; 1: all in this one)")
     run.add_argument("--no-timing-check", action="store_true",

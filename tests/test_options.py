@@ -93,3 +93,21 @@ def test_a_sensor_file_that_is_not_there_is_said_so(tmp_path):
 
     with pytest.raises(ValueError, match=r"sensor file .*none\.json: no such file$"):
         load_sensor(tmp_path / "none.json")
+
+
+def test_every_command_that_draws_takes_no_plots_alike():
+    """--no-plots (and --no-plot) in every command that writes a PNG, from one definition
+    (testbenches.options.add_no_plots): calibrate lacked it, four spelt it their own way."""
+    import argparse
+
+    from testbenches.cli import _parser
+
+    parser = _parser("imu-fusion")
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    for name in ("estimate", "run", "broad", "noise", "tune", "calibrate", "battery",
+                 "campaign", "budget"):
+        action = next((a for a in sub.choices[name]._actions if "--no-plots" in a.option_strings),
+                      None)
+        assert action is not None, f"{name} has no --no-plots"
+        assert action.option_strings == ["--no-plots", "--no-plot"], name
+        assert action.help.startswith("skip "), name

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from fusion_core.registry import keys_help
 
 from ..fmus import DEFAULT_FMU_DIR
-from ..options import add_calibration, add_preset, choose, out_folder, positive_float
+from ..options import add_calibration, add_no_plots, add_preset, choose, out_folder, positive_float
 
 if TYPE_CHECKING:
     from .cv import CvResult, Grid
@@ -56,8 +56,7 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    help="use only the first SECONDS of every trial (a quick look)")
     p.add_argument("--out", type=out_folder, default=Path("reports/broad"),
                    help="report folder (reports/broad)")
-    p.add_argument("--no-plots", "--no-plot", dest="no_plots", action="store_true",
-                   help="skip the bar chart")
+    add_no_plots(p, "the bar chart")
     p.add_argument("--cv", action="store_true",
                    help="cross-validate the defaults: each parameter a scan chooses ("
                    + ", ".join(CV_GRID) + ") chosen again without each motion fold (slow "

@@ -30,7 +30,13 @@ import numpy as np
 from fusion_core.calibration import Calibration
 from fusion_core.types import G
 
-from ..options import RECORDING_HELP, add_recording_options, out_folder, positive_float
+from ..options import (
+    RECORDING_HELP,
+    add_no_plots,
+    add_recording_options,
+    out_folder,
+    positive_float,
+)
 from . import ferraris as fer
 from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
 from .heldout import HeldOut, ferraris_held_out, tedaldi_held_out
@@ -54,6 +60,7 @@ def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: igno
                    help=f"local gravity [m/s^2] ({G})")
     p.add_argument("--out", type=out_folder, default=Path("calibration"),
                    help="output folder (calibration)")
+    add_no_plots(p, "calibration.png")
     p.set_defaults(func=run)
 
 
@@ -199,15 +206,17 @@ def run(args: argparse.Namespace) -> int:
     cal = _calibration(acc_fit, gyro_fit, extra)
     args.out.mkdir(parents=True, exist_ok=True)
     cal.write(args.out / "calibration.json")
-    if session is not None:
-        spans = [(s.start, s.stop, "static") for s in session.statics]
-    else:
-        assert sections is not None
-        spans = [(lo, hi, "static" if name in fer.POSES else "turn")
-                 for name, (lo, hi) in sections.items()]
-    _plot(args.out / "calibration.png", t, acc, gyro, spans, acc_fit, gyro_fit, held, method)
+    if not args.no_plots:
+        if session is not None:
+            spans = [(s.start, s.stop, "static") for s in session.statics]
+        else:
+            assert sections is not None
+            spans = [(lo, hi, "static" if name in fer.POSES else "turn")
+                     for name, (lo, hi) in sections.items()]
+        _plot(args.out / "calibration.png", t, acc, gyro, spans, acc_fit, gyro_fit, held, method)
     lines += _report(method, session, acc_fit, gyro_fit, held, comparisons)
-    lines.append(f"wrote {args.out / 'calibration.json'} and {args.out / 'calibration.png'}")
+    lines.append(f"wrote {args.out / 'calibration.json'}" + (
+        "" if args.no_plots else f" and {args.out / 'calibration.png'}"))
     print("\n".join(lines))
     return 0
 

@@ -13,6 +13,7 @@ from fusion_core.registry import estimator_class
 from ..options import (
     RECORDING_HELP,
     add_calibration,
+    add_no_plots,
     add_preset,
     add_recording_options,
     non_negative_float,
@@ -43,7 +44,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
                        "datasheet's zero-rate offset tolerance (a static recording shows one "
                        "start's bias, not the spread); the Kalman filters' bias prior is at "
                        "least this (0: a part calibrated at start-up)")
-    noise.add_argument("--no-plots", action="store_true", help="skip allan.png")
+    add_no_plots(noise, "allan.png")
 
     tune = sub.add_parser(
         "tune", help="fit an estimator's tunable parameters to recordings with a reference, "
@@ -72,7 +73,7 @@ def add_fit_parsers(sub: argparse._SubParsersAction) -> None:
     tune.add_argument("--fmu-dir", type=Path, default=Path("dist"), help="built FMUs (dist)")
     tune.add_argument("--out", type=out_folder, default=Path("reports/tune"),
                       help="folder for preset.json, tune.json, tune.png")
-    tune.add_argument("--no-plots", action="store_true", help="skip tune.png")
+    add_no_plots(tune, "tune.png")
 
 
 def cmd_noise(args: argparse.Namespace) -> int:

@@ -13,6 +13,7 @@ from ..fmus import ESTIMATOR_FMUS
 from ..options import (
     add_calibration,
     add_cluster,
+    add_no_plots,
     add_preset,
     add_sensor,
     non_negative_int,
@@ -60,7 +61,7 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fmu-dir", type=Path, default=Path("dist"), help="built FMUs (dist)")
     p.add_argument("--out", type=out_folder, default=Path("reports/campaign"),
                    help="folder: runs/*.parquet, summary.json, summary.md, plots")
-    p.add_argument("--no-plots", action="store_true", help="skip the plots")
+    add_no_plots(p, "the plots")
 
 
 def cmd_campaign(args: argparse.Namespace) -> int:
