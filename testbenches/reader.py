@@ -10,7 +10,8 @@ any length is read in bounded memory:
   found from the file's start (after LabVIEW's ***End_of_Header*** lines); pyarrow's CSV reader
   parses it, and where it cannot (text where a number belongs, a row of the wrong length,
   padded cells) the file is read by Python's csv module, which names the file's line, the
-  column and the value;
+  column and the value; a last line a logger cut short mid-write and the NUL bytes of a
+  preallocated file's unwritten rest are left out, and said (`TableSource.note`);
 - a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - a column of durations written with their unit ("0.01 sec", as MATLAB's writetimetable writes
@@ -310,6 +311,11 @@ class _TextLayout:
     durations: dict[int, str] = field(default_factory=dict)
     """Columns of durations written with their unit ("0.01 sec", as MATLAB's writetimetable
     writes a timetable's row times): index -> the unit (DURATION_UNITS), read as seconds."""
+    data_end: int | None = None
+    """The byte where the table ends before a tail a logger stopped mid-write leaves (None:
+    the file's end; _tail)."""
+    tail: str = ""
+    """What was left out at the end and why ("" for nothing)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -469,9 +475,99 @@ def _sniff(path: Path) -> _TextLayout:
                else f"line {preamble[0][0]}") if preamble else ""
     rates = [float(m.group(1).replace(",", ".")) for _, line in preamble
              if (m := STATED_RATE.search(line))]
-    return _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
-                       datetimes, times_of_day, skipped, data_after, units_row, stacked,
-                       rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations)
+    layout = _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
+                         datetimes, times_of_day, skipped, data_after, units_row, stacked,
+                         rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations)
+    if _compression(path) is None and encoding in ("utf-8", "latin-1"):
+        layout.data_end, layout.tail = _tail(path, layout)
+    return layout
+
+
+TAIL_BYTES = 1 << 16
+"""How much of a text file's end is looked at for what a logger stopped mid-write leaves."""
+
+
+def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
+    """Where the table ends before what a logger leaves when it stops mid-write, and what that
+    was: NUL bytes after the last line (a file preallocated on an SD card, its unwritten rest)
+    and a last line cut short (fewer cells than the header, no line end after it: power lost
+    while it was written, its last cell's digits perhaps cut too). (None, "") where the file
+    ends with its table. A short line that ends with a line end is no cut (a footer: refused
+    as a row of the wrong length, naming its line)."""
+    size = stop = path.stat().st_size
+    with path.open("rb") as f:
+        while True:  # back over windows of NULs to the last byte written
+            start = max(0, stop - TAIL_BYTES)
+            f.seek(start)
+            kept = f.read(stop - start).rstrip(b"\x00")
+            if kept or start == 0:
+                break
+            stop = start
+    nul = size - start - len(kept)
+    said = []
+    last = kept.rfind(b"\n") + 1
+    line = kept[last:]
+    end = start + len(kept)
+    if line.strip() and start + last > 0:
+        values = _cells_of(line.decode(layout.encoding, errors="replace"), layout.delimiter)
+        cells = len(values)
+        if cells < len(layout.header) and _row_start(values):
+            end = start + last
+            number = _lines_before(path, end) + 1
+            said.append(f"line {number}, the last, cut short ({cells} of "
+                        f"{len(layout.header)} values: a logger stopped mid-write): left out")
+    if nul:
+        said.append(f"{nul} NUL bytes after the last line (the unwritten rest of a "
+                    "preallocated file): ignored")
+    return (end, "; ".join(said)) if said else (None, "")
+
+
+_NUMBER_START = re.compile(r"^[-+]?[0-9]*[.,]?[0-9]*(?:[eE][-+]?[0-9]*)?$")
+"""What a number cut after any of its characters can be ("1.59", "-", "2e", "")."""
+
+
+def _row_start(cells: list[str]) -> bool:
+    """Whether cells can be a data row's start cut mid-write: every cell a number or missing,
+    the last perhaps cut (a footer's text is no row: refused by its line)."""
+    *whole, cut = cells
+    return (all(_number_like(c) or c.lower() in MISSING_VALUES for c in whole)
+            and (_number_like(cut) or bool(_NUMBER_START.match(cut))))
+
+
+def _lines_before(path: Path, end: int) -> int:
+    """The line ends in the file's first `end` bytes."""
+    count = 0
+    with path.open("rb") as f:
+        while end > 0 and (chunk := f.read(min(end, 1 << 22))):
+            count += chunk.count(b"\n")
+            end -= len(chunk)
+    return count
+
+
+class _Head(io.RawIOBase):
+    """A binary file's first `size` bytes, as a file."""
+
+    def __init__(self, path: Path, size: int) -> None:
+        self._f, self._left = path.open("rb"), size
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        n = self._f.readinto(memoryview(buffer)[:max(0, min(len(buffer), self._left))])
+        self._left -= n or 0
+        return n or 0
+
+    def close(self) -> None:
+        self._f.close()
+        super().close()
+
+
+def _table_bytes(path: Path, layout: _TextLayout) -> IO[bytes]:
+    """The file's bytes up to the table's end (decompressed where it is compressed)."""
+    if layout.data_end is None:
+        return _open_bytes(path)
+    return io.BufferedReader(_Head(path, layout.data_end))
 
 
 def _cells_of(line: str, delimiter: str) -> list[str]:
@@ -634,6 +730,7 @@ def _text(path: Path) -> TableSource:
     note = (f"the header on {spans}" + (f", {layout.skipped} before it skipped"
                                         if layout.skipped else "")
             if layout.skipped or layout.stacked else "")
+    note = "; ".join(n for n in (note, layout.tail) if n)
     attrs = {} if layout.rate is None else {"rate": layout.rate}
     return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
                        where, attrs, note=note)
@@ -703,7 +800,8 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
     compression = _compression(path)
     try:
         reader = pc.open_csv(
-            path if compression is None
+            path if compression is None and layout.data_end is None
+            else pa.PythonFile(_table_bytes(path, layout), mode="r") if compression is None
             else pa.input_stream(str(path), compression=compression)
             if compression in ARROW_COMPRESSIONS else pa.PythonFile(_open_bytes(path), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.data_after,
@@ -736,7 +834,7 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
 
 def _rows(path: Path, layout: _TextLayout) -> Iterator[tuple[int, list[str]]]:
     """(line, cells) of every data row, blank lines skipped."""
-    with io.TextIOWrapper(_open_bytes(path), newline="",
+    with io.TextIOWrapper(_table_bytes(path, layout), newline="",
                           encoding="utf-8-sig" if layout.encoding == "utf-8"
                           else layout.encoding) as f:
         reader = csv.reader(f, delimiter=layout.delimiter)

@@ -847,3 +847,63 @@ def test_a_plotjuggler_export_of_an_imu_and_a_mocap_topic_serves_as_both(tmp_pat
     assert "time='__time'" in said
     kf = float(next(x for x in said.splitlines() if x.startswith("kf ")).split()[2])
     assert kf == pytest.approx(0.5996, abs=0.01)
+
+
+def _cut(path: Path, tail: bytes, *, cut: int = 40, nul: int = 0, crlf: bool = False) -> Path:
+    """The example as a logger that lost power leaves it: its last `cut` bytes not written,
+    `nul` NUL bytes after them (a preallocated file's unwritten rest); `tail` appended first."""
+    text = EXAMPLE.read_bytes() + tail
+    if crlf:
+        text = text.replace(b"\n", b"\r\n")
+    path.write_bytes(text[:len(text) - cut] + b"\0" * nul)
+    return path
+
+
+@pytest.mark.parametrize("nul", [0, 4096])
+@pytest.mark.parametrize("padded", [False, True])  # pyarrow's reader, Python's
+@pytest.mark.parametrize("crlf", [False, True])
+def test_a_last_line_cut_mid_write_and_nul_padding_are_left_out_and_said(tmp_path, nul,
+                                                                          padded, crlf):
+    """Power lost mid-write: the last line cut short, NULs after it on an SD card. The file
+    was refused naming its last line; the rows before it are read now, and both are said."""
+    whole, _ = open_recording(EXAMPLE).load()
+    source = EXAMPLE.read_bytes()
+    if padded:  # a cell with spaces around it: Python's reader
+        source = source.replace(b",0.01\n", b", 0.01\n", 3)
+    path = tmp_path / "cut.csv"
+    path.write_bytes(source)
+    path = _cut(path, b"", nul=nul, crlf=crlf)
+    opened = open_recording(path, gyro_unit="rad/s")
+    rec, _ = opened.load()
+    assert len(rec.dt) == len(whole.dt) - 1
+    np.testing.assert_array_equal(rec.acc, whole.acc[:-1])
+    np.testing.assert_array_equal(rec.gyro, whole.gyro[:-1])
+    assert "line 1001, the last, cut short (5 of 8 values: a logger stopped mid-write): " \
+           "left out" in opened.choices
+    assert (f"{nul} NUL bytes after the last line" in opened.choices) == bool(nul)
+
+
+def test_nul_padding_after_whole_lines_is_ignored_and_said(tmp_path):
+    whole, _ = open_recording(EXAMPLE).load()
+    opened = open_recording(_cut(tmp_path / "padded.csv", b"", cut=0, nul=100000))
+    rec, _ = opened.load()
+    np.testing.assert_array_equal(rec.gyro, whole.gyro)
+    assert "100000 NUL bytes after the last line" in opened.choices
+    assert "cut short" not in opened.choices
+
+
+@pytest.mark.parametrize("ending", [b"END OF LOG", b"END OF LOG\n"])
+def test_a_footer_is_no_cut_line(tmp_path, ending):
+    """Text after the table, with a line end or without one, is refused by its line as before:
+    only numbers can be a row cut mid-write."""
+    path = _cut(tmp_path / "footer.csv", ending, cut=0)
+    with pytest.raises(RecordingError, match=r"line 1002: 1 value\(s\) where the header has 8"):
+        open_recording(path).load()
+
+
+def test_a_whole_last_line_without_a_line_end_is_read(tmp_path):
+    whole, _ = open_recording(EXAMPLE).load()
+    opened = open_recording(_cut(tmp_path / "noeol.csv", b"", cut=1))
+    rec, _ = opened.load()
+    np.testing.assert_array_equal(rec.gyro, whole.gyro)
+    assert "cut short" not in opened.choices
