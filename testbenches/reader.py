@@ -4,7 +4,8 @@
 any length is read in bounded memory:
 
 - delimited text (CSV and its kin), also compressed (gzip, bz2 or xz: .csv.gz and the like,
-  told by the file's first bytes): the encoding (UTF-8 with or without a byte-order mark,
+  told by the file's first bytes; a stream cut before its end read up to the cut, and said
+  in TableSource.found): the encoding (UTF-8 with or without a byte-order mark,
   UTF-16 as Windows' "Unicode" exports write it, else Latin-1), the delimiter (comma,
   semicolon, tab or bar; a decimal comma where the numbers have one) and the header row are
   found from the file's start (after LabVIEW's ***End_of_Header*** lines); pyarrow's CSV reader
@@ -164,6 +165,10 @@ class TableSource:
     note: str = ""
     """What the reader did that a user should know (lines before the header skipped)."""
 
+    found: list[str] = field(default_factory=list)
+    """What reading the rows found left out, which opening could not see (a compressed stream
+    cut short), as reads find it."""
+
     platform: str = ""
     """The platform a phone app's export says it was recorded on ("iOS", "Android"; "" where it
     says none)."""
@@ -263,8 +268,6 @@ def _ulog(path: Path) -> TableSource:
 
 COMPRESSIONS = {b"\x1f\x8b": "gzip", b"BZh": "bz2", b"\xfd7zXZ\x00": "xz"}
 """A compressed text file's magic bytes and its compression: read as the text it holds."""
-ARROW_COMPRESSIONS = ("gzip", "bz2")
-"""Those pyarrow decompresses itself; the others Python's modules do."""
 
 
 def _compression(path: Path) -> str | None:
@@ -273,15 +276,79 @@ def _compression(path: Path) -> str | None:
     return next((kind for m, kind in COMPRESSIONS.items() if magic.startswith(m)), None)
 
 
-def _open_bytes(path: Path) -> IO[bytes]:
-    """The file's bytes, decompressed where it is compressed (COMPRESSIONS)."""
+def _open_bytes(path: Path, found: list[str] | None = None) -> IO[bytes]:
+    """The file's bytes, decompressed where it is compressed (COMPRESSIONS), up to where the
+    compressed stream was cut if it was (_Salvaged: what was left out said in `found`)."""
     import bz2
     import gzip
     import lzma
 
     kind = _compression(path)
     opener = {"gzip": gzip.open, "bz2": bz2.open, "xz": lzma.open}.get(kind or "")
-    return opener(path, "rb") if opener else path.open("rb")  # type: ignore[return-value]
+    if opener is None:
+        return path.open("rb")
+    return io.BufferedReader(_Salvaged(opener(path, "rb"), path, kind or "", found),
+                             buffer_size=SALVAGE_CHUNK)
+
+
+SALVAGE_CHUNK = 1 << 20
+"""Decompressed bytes read at a time."""
+
+
+def _cut_stream(kind: str) -> str:
+    return (f"its {kind} stream ends before its end (the file was cut: a copy or download "
+            "interrupted, or a logger stopped)")
+
+
+class _Salvaged(io.RawIOBase):
+    """A decompressing file's bytes up to where its compressed stream ends before its end marker
+    (the file cut: a download or a copy interrupted, a logger that compressed as it wrote
+    stopped), the line the cut fell in left out and said in `found` (None: not said). A
+    damaged stream is refused (TableError), not read past."""
+
+    def __init__(self, inner: Any, path: Path, kind: str, found: list[str] | None) -> None:
+        self._inner, self._path, self._kind, self._found = inner, path, kind, found
+        self._out = memoryview(b"")  # ready to be read
+        self._held = b""  # after the last line end so far: read once more follows
+        self._done = False
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        while not self._out and not self._done:
+            self._fill()
+        n = min(len(buffer), len(self._out))
+        memoryview(buffer).cast("B")[:n] = self._out[:n]
+        self._out = self._out[n:]
+        return n
+
+    def _fill(self) -> None:
+        import lzma
+        import zlib
+
+        try:
+            chunk = self._inner.read1(SALVAGE_CHUNK)  # one read: data before a cut kept
+        except EOFError:  # the stream ends before its end marker: the file was cut
+            self._done = True
+            if self._found is not None:
+                self._found.append(f"{_cut_stream(self._kind)}: read up to the cut" + (
+                    ", the line it fell in left out" if self._held.strip() else ""))
+            return
+        except (OSError, zlib.error, lzma.LZMAError) as err:
+            raise TableError(f"{self._path}: its {self._kind} stream cannot be decompressed "
+                             f"({err}): the file is damaged") from None
+        if not chunk:
+            self._done = True
+            self._out, self._held = memoryview(self._held), b""
+            return
+        data = self._held + chunk
+        cut = data.rfind(b"\n") + 1
+        self._out, self._held = memoryview(data)[:cut], data[cut:]
+
+    def close(self) -> None:
+        self._inner.close()
+        super().close()
 
 
 # ----- delimited text --------------------------------------------------------------------------
@@ -316,6 +383,9 @@ class _TextLayout:
     the file's end; _tail)."""
     tail: str = ""
     """What was left out at the end and why ("" for nothing)."""
+    found: list[str] = field(default_factory=list)
+    """What a read found left out that the file's start and end did not show (a compressed
+    stream cut short: _Salvaged)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -410,7 +480,8 @@ def _decoded(raw: bytes, encoding: str, cut: bool) -> str:
 
 
 def _sniff(path: Path) -> _TextLayout:
-    with _open_bytes(path) as f:
+    cut: list[str] = []
+    with _open_bytes(path, cut) as f:
         raw = f.read(SNIFF_BYTES)
     encoding = "utf-8"
     try:
@@ -428,7 +499,8 @@ def _sniff(path: Path) -> _TextLayout:
     lines = text.splitlines()
     numbered = [(i + 1, line) for i, line in enumerate(lines) if line.strip()]
     if not numbered:
-        raise TableError(f"{path}: empty file")
+        raise TableError(f"{path}: " + (f"{_cut_stream(_compression(path) or '')}, before "
+                                        "any whole line" if cut else "empty file"))
     ends = [k for k, (_, line) in enumerate(numbered) if _END_OF_HEADER.match(line)]
     found = _find_header(numbered, ends[-1] + 1 if ends else 0)
     if found is None:
@@ -564,9 +636,10 @@ class _Head(io.RawIOBase):
 
 
 def _table_bytes(path: Path, layout: _TextLayout) -> IO[bytes]:
-    """The file's bytes up to the table's end (decompressed where it is compressed)."""
+    """The file's bytes up to the table's end (decompressed where it is compressed, what the
+    read finds said in layout.found)."""
     if layout.data_end is None:
-        return _open_bytes(path)
+        return _open_bytes(path, layout.found)
     return io.BufferedReader(_Head(path, layout.data_end))
 
 
@@ -733,7 +806,7 @@ def _text(path: Path) -> TableSource:
     note = "; ".join(n for n in (note, layout.tail) if n)
     attrs = {} if layout.rate is None else {"rate": layout.rate}
     return TableSource(path, list(layout.header), list(names), list(units), "text", None, read,
-                       where, attrs, note=note)
+                       where, attrs, note=note, found=layout.found)
 
 
 class _ArrowFailed(Exception):
@@ -801,9 +874,7 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
     try:
         reader = pc.open_csv(
             path if compression is None and layout.data_end is None
-            else pa.PythonFile(_table_bytes(path, layout), mode="r") if compression is None
-            else pa.input_stream(str(path), compression=compression)
-            if compression in ARROW_COMPRESSIONS else pa.PythonFile(_open_bytes(path), mode="r"),
+            else pa.PythonFile(_table_bytes(path, layout), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.data_after,
                                         encoding="utf8" if layout.encoding == "utf-8"
                                         else layout.encoding, block_size=1 << 22),

@@ -907,3 +907,51 @@ def test_a_whole_last_line_without_a_line_end_is_read(tmp_path):
     rec, _ = opened.load()
     np.testing.assert_array_equal(rec.gyro, whole.gyro)
     assert "cut short" not in opened.choices
+
+
+def _long_example(rows: int = 60000) -> tuple[str, np.ndarray]:
+    """The example's rows over and over, timed on (several of bz2's 900 kB blocks)."""
+    _, imu = _example()
+    imu = np.tile(imu, (rows // len(imu) + 1, 1))[:rows]
+    t = np.arange(rows) * 0.01
+    lines = [f"time,{HEADER}"] + [",".join(f"{v:.10g}" for v in (t[i], *imu[i]))
+                                  for i in range(rows)]
+    return "\n".join(lines) + "\n", imu
+
+
+@pytest.mark.parametrize("compress", ["gzip", "bz2", "lzma"])
+def test_a_compressed_file_cut_short_is_read_up_to_the_cut_and_said(tmp_path, compress):
+    """A .csv.gz (.bz2, .xz) whose copy, download or logger stopped: a traceback ('Compressed
+    file ended before the end-of-stream marker was reached'). The whole lines before the cut
+    are read now, the one it fell in left out, and the read says so."""
+    import importlib
+
+    text, imu = _long_example()
+    whole = importlib.import_module(compress).compress(text.encode())
+    path = tmp_path / "cut.csv.z"
+    path.write_bytes(whole[:len(whole) * 2 // 3])
+    source = open_recording(path, gyro_unit="rad/s")
+    rec, _ = source.load()
+    n = len(rec.dt)
+    assert 0 < n < len(imu)
+    np.testing.assert_array_equal(rec.gyro, imu[:n, 3:])
+    said = source.summary(n, 0.0, 0)
+    kind = {"lzma": "xz"}.get(compress, compress)
+    assert f"its {kind} stream ends before its end (the file was cut" in said
+    assert "read up to the cut" in said
+
+
+def test_a_compressed_file_cut_before_its_first_line_or_damaged_is_refused(tmp_path):
+    import gzip
+
+    whole = gzip.compress(EXAMPLE.read_bytes())
+    cut = tmp_path / "cut.csv.gz"
+    cut.write_bytes(whole[:12])
+    with pytest.raises(RecordingError, match=r"its gzip stream ends before its end \(the file "
+                       r"was cut.*before any whole line"):
+        open_recording(cut)
+    damaged = tmp_path / "damaged.csv.gz"
+    damaged.write_bytes(whole[:2000] + bytes(range(256)) * 8 + whole[4048:])
+    with pytest.raises(RecordingError, match=r"its gzip stream cannot be decompressed .*: the "
+                       "file is damaged"):
+        open_recording(damaged).load()

@@ -488,6 +488,8 @@ class RecordingSource:
     """The unit of the file's time column (s where the times come from a rate or the format)."""
     read_notes: dict[str, int] = field(default_factory=dict)
     """What the last read found ("wraps": how often the time's counter started again)."""
+    found: list[str] = field(default_factory=list)
+    """What reading found left out (the table's: TableSource.found)."""
 
     def blocks(self, rows: int | None = None) -> Iterator[tuple[Recording, np.ndarray]]:
         """(Recording, time [s]) of each block of samples, from the first; RecordingError where
@@ -519,7 +521,8 @@ class RecordingSource:
                 + (f"; {missing} sample(s) without a number in every column, which the "
                    "estimators reject and count (the next sample's dt spans them)"
                    if missing else "")
-                + (f"; {what} {wrapped} time(s), taken as going on" if wrapped else ""))
+                + (f"; {what} {wrapped} time(s), taken as going on" if wrapped else "")
+                + "".join(f"; {said}" for said in dict.fromkeys(self.found)))
 
 
 def concatenate(parts: list[Recording]) -> Recording:
@@ -736,7 +739,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             yield rec, t
 
     return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit,
-                           read_notes)
+                           read_notes, table.found)
 
 
 def _samples(block: np.ndarray, names: list[str], join: Any, clock: _Clock, row0: int
