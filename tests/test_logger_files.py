@@ -955,3 +955,37 @@ def test_a_compressed_file_cut_before_its_first_line_or_damaged_is_refused(tmp_p
     with pytest.raises(RecordingError, match=r"its gzip stream cannot be decompressed .*: the "
                        "file is damaged"):
         open_recording(damaged).load()
+
+
+@pytest.mark.parametrize("kind", ["parquet", "h5", "mat"])
+def test_a_binary_file_cut_short_is_refused_in_one_line(tmp_path, kind):
+    """Parquet, HDF5 and MATLAB files cut before their end cannot be read up to the cut (their
+    index is at the end, or the file states its length): refused naming the format. A cut HDF5
+    file was a traceback (h5py's OSError, from the BROAD trial check that runs first)."""
+    import h5py
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    import scipy.io
+
+    from testbenches.broad.data import NotABroadTrial, load_trial
+
+    data = np.genfromtxt(EXAMPLE, delimiter=",", names=True)
+    columns = {n: data[n] for n in data.dtype.names}
+    whole = tmp_path / f"whole.{kind}"
+    if kind == "parquet":
+        pq.write_table(pa.table(columns), whole)
+    elif kind == "h5":
+        with h5py.File(whole, "w") as f:
+            for name, values in columns.items():
+                f[name] = values
+    else:
+        scipy.io.savemat(whole, columns)
+    assert len(open_recording(whole).load()[0].dt) == len(data)
+    raw = whole.read_bytes()
+    cut = tmp_path / f"cut.{kind}"
+    cut.write_bytes(raw[:len(raw) * 2 // 3])
+    with pytest.raises(RecordingError, match=r"cut\.\w+: not a readable"):
+        open_recording(cut).load()
+    if kind != "parquet":
+        with pytest.raises(NotABroadTrial, match="not a BROAD trial: "):
+            load_trial(cut)

@@ -145,13 +145,16 @@ def _read_hdf5(path: Path) -> tuple[dict[str, Any], str]:
             "reading BROAD's HDF5 files needs h5py: pip install 'h5py>=3.8'"
         ) from err
     fields: dict[str, Any] = {}
-    with h5py.File(path, "r") as f:
-        for name in REQUIRED_FIELDS:
-            if name in f and isinstance(f[name], h5py.Dataset):
-                fields[name] = f[name][()]
-            elif name in f.attrs:
-                fields[name] = f.attrs[name]
-        info = f.attrs.get("info", "")
+    try:
+        with h5py.File(path, "r") as f:
+            for name in REQUIRED_FIELDS:
+                if name in f and isinstance(f[name], h5py.Dataset):
+                    fields[name] = f[name][()]
+                elif name in f.attrs:
+                    fields[name] = f.attrs[name]
+            info = f.attrs.get("info", "")
+    except OSError as err:  # h5py's for a damaged or cut file ("truncated file: eof = ...")
+        raise NotABroadTrial(f"{path}: not a BROAD trial: unreadable HDF5 file ({err})") from None
     return fields, info.decode() if isinstance(info, bytes) else str(info)
 
 
