@@ -43,6 +43,7 @@ import datetime as dt
 import io
 import itertools
 import re
+import zipfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -222,6 +223,9 @@ def open_table(path: str | Path) -> TableSource:
         return _hdf5(path)
     if suffix == ".mat":
         return _mat(path)
+    if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
+        raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
+                         "directory of its files at its end): copy or download it again")
     if magic.startswith(b"PK\x03\x04") or suffix in (".xlsx", ".xls", ".ods"):
         raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "
                          "table this reader takes: save the sheet as CSV (a zip archive of a "

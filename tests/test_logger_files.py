@@ -989,3 +989,17 @@ def test_a_binary_file_cut_short_is_refused_in_one_line(tmp_path, kind):
     if kind != "parquet":
         with pytest.raises(NotABroadTrial, match="not a BROAD trial: "):
             load_trial(cut)
+
+
+def test_a_zip_archive_cut_short_is_refused_as_cut_not_as_a_workbook(tmp_path):
+    import zipfile
+
+    whole = tmp_path / "export.zip"
+    with zipfile.ZipFile(whole, "w") as z:
+        z.write(EXAMPLE, "Accelerometer.csv")
+    raw = whole.read_bytes()
+    cut = tmp_path / "cut.zip"
+    cut.write_bytes(raw[:len(raw) * 2 // 3])
+    with pytest.raises(RecordingError, match=r"cut\.zip: a zip archive that does not open: cut "
+                       "or damaged"):
+        open_recording(cut)
