@@ -149,6 +149,19 @@ def _checked(bag: Any, message: tuple[Any, int, bytes], cdr: bool) -> tuple[int,
     return layout if same else None
 
 
+def _repair(path: Path, err: Exception) -> str:
+    """How a bag whose recording stopped before its end is repaired, where its error shows it
+    (a ROS 1 bag's index or an MCAP file's summary is written last)."""
+    text = str(err)
+    if "index" in text.lower() and path.suffix == ".bag":
+        return (": a recording stopped before the bag's index was written; `rosbag reindex "
+                f"{path.name}` rebuilds it")
+    if "end magic" in text.lower():
+        return (": an MCAP recording stopped before its end was written; `mcap recover FILE "
+                "-o FIXED.mcap` (the mcap command) keeps what it holds")
+    return ""
+
+
 def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSource:
     """The bag's table of `want` ("imu": the recording's, "pose": a reference's) from the topic
     named, else from the only topic of such a type; TableError where the bag cannot be read,
@@ -166,7 +179,7 @@ def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSo
             for c in bag.connections:
                 counts.setdefault(c.topic, [c.msgtype, 0])[1] += c.msgcount
     except Exception as err:  # rosbags raises its own per format: any is an unreadable bag
-        raise TableError(f"{path}: not a readable ROS bag ({err})") from None
+        raise TableError(f"{path}: not a readable ROS bag ({err}){_repair(path, err)}") from None
     fits = sorted(t for t, (kind, _) in counts.items() if kind in types)
     listed = ", ".join(f"{t} ({k})" for t, (k, _) in sorted(counts.items()))
     if topic is not None:

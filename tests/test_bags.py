@@ -178,3 +178,22 @@ def test_imu_messages_read_off_their_bytes_are_the_deserialized_ones(tmp_path, k
         assert bags._imu_rows(bag, block, {}) is None
     rec, _ = open_recording(bag_path).load()
     np.testing.assert_array_equal(rec.acc, slow[:, 1:4])
+
+
+@pytest.mark.parametrize("kind,says", [
+    ("ros1", r"not a readable ROS bag \(.*\): a recording stopped before the bag's index was "
+             r"written; `rosbag reindex cut\.bag` rebuilds it"),
+    ("mcap", r"not a readable ROS bag \(.*\): an MCAP recording stopped before its end was "
+             r"written; `mcap recover FILE -o FIXED\.mcap`"),
+])
+def test_a_bag_whose_recording_stopped_is_refused_saying_how_it_is_repaired(tmp_path, kind,
+                                                                            says):
+    """A recorder killed or powered off leaves a ROS 1 bag without its index and an MCAP file
+    without its end: refused, with the tool that repairs each."""
+    bag = write_bag(tmp_path / ("whole.bag" if kind == "ros1" else "whole"), kind)
+    data = bag if kind == "ros1" else next(bag.glob("*.mcap"))
+    raw = data.read_bytes()
+    cut = tmp_path / ("cut.bag" if kind == "ros1" else "cut.mcap")
+    cut.write_bytes(raw[:len(raw) * 2 // 3])
+    with pytest.raises(RecordingError, match=says):
+        open_recording(cut)
