@@ -136,9 +136,13 @@ def measured_delay(truth_all: np.ndarray, estimate: np.ndarray, max_delay: int =
 
     truth_all[j] is the truth at t_j (j = 0 the start), estimate[k] the raw output after step k
     (time t_{k + 1}); a delay d pairs estimate[k] with truth_all[k + 1 - d]. Scored
-    by the RMSE over the second half of the run (after convergence), all columns together."""
+    by the RMSE over the second half of the run (after convergence), all columns together; -1
+    where the run has no step after max_delay to score (a run of a step or two, as a benchmark
+    times its setup by)."""
     n = len(estimate)
     start = max(n // 2, max_delay)
+    if start >= n:
+        return -1
     errors = []
     for d in range(max_delay + 1):
         k = np.arange(start, n)

@@ -468,3 +468,18 @@ def test_t2_holds_under_jacobi_where_the_sensor_knows_its_inputs_hold_at_a_steps
                           sensor_params={**contract.NOISE_FREE, "inputs_at": "end"}, **kw)
     assert wrong.sensor_params["inputs_at"] == "end"
     assert not contract.check_t2(fixed, wrong).passed
+
+
+def test_a_run_too_short_to_show_its_delay_says_so_without_a_warning():
+    """A run of a step or two (a benchmark's setup timing) has no step after the largest delay
+    to score: -1, where a mean of nothing warned and argmin of NaNs gave 0, a delay."""
+    import warnings
+
+    from testbenches.master import measured_delay
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert measured_delay(np.zeros((3, 2)), np.zeros((2, 2))) == -1
+        truth = np.column_stack([np.sin(np.arange(41) * 0.3), np.cos(np.arange(41) * 0.2)])
+        assert measured_delay(truth, truth[1:]) == 0  # estimate[k] of the truth at t_{k+1}
+        assert measured_delay(truth, truth[:-1]) == 1
