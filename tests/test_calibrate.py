@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -241,3 +242,41 @@ def test_tedaldis_held_out_residuals_are_each_pose_left_out() -> None:
     assert np.sqrt(np.mean(held.acc ** 2)) > np.sqrt(np.mean(session.acc.after ** 2))
     assert np.sqrt(np.mean(held.acc ** 2)) < 0.01
     assert np.degrees(np.sqrt(np.mean(held.gyro ** 2))) < 0.2
+
+
+@needs_imucal_data
+def test_a_session_with_empty_cells_is_filled_and_a_long_gap_refused(tmp_path, capsys) -> None:
+    """A logger's empty cells in a session ('cannot convert float NaN to integer'): filled from
+    their neighbours, said, and the calibration is the whole session's to 1e-4; a run of them
+    longer than MAX_FILLED_S would make up part of a turn, and is refused naming the samples
+    (numbered as --sections numbers them)."""
+    from testbenches.calibrate.cli import MAX_FILLED_S
+
+    lines = SESSION.read_text().splitlines()
+    args = ["--rate", "102.4", "--gyro-unit", "deg/s", "--no-plots"]
+    assert main(["calibrate", str(SESSION), *args, "--out", str(tmp_path / "whole")]) == 0
+    capsys.readouterr()
+    holes = list(lines)
+    for row in (1000, 5000, 9000):  # a cell each, in poses and turns
+        cells = holes[row].split(",")
+        cells[2 + row % 3] = ""
+        holes[row] = ",".join(cells)
+    path = tmp_path / "holes.csv"
+    path.write_text("\n".join(holes) + "\n")
+    assert main(["calibrate", str(path), *args, "--out", str(tmp_path / "holes")]) == 0
+    assert "3 sample(s) without a number in every column filled" in capsys.readouterr().out
+    whole, filled = (json.loads((tmp_path / n / "calibration.json").read_text())
+                     for n in ("whole", "holes"))
+    for sensor in ("acc_cal", "gyro_cal"):
+        np.testing.assert_allclose(filled[sensor]["matrix"], whole[sensor]["matrix"], atol=1e-4)
+    gap = list(lines)
+    rows = int(0.3 * 102.4)
+    assert rows / 102.4 > MAX_FILLED_S
+    for row in range(3001, 3001 + rows):
+        cells = gap[row].split(",")
+        cells[2] = ""
+        gap[row] = ",".join(cells)
+    path.write_text("\n".join(gap) + "\n")
+    assert main(["calibrate", str(path), *args, "--out", str(tmp_path / "gap")]) == 2
+    assert re.search(r"samples 3000 to 3029 \(from 0, as --sections numbers them\) lack a "
+                     r"number .*record the session again", capsys.readouterr().err)

@@ -126,12 +126,54 @@ def _matrix_rows(label: str, m: np.ndarray) -> str:
     return f"  {label:<28}" + "  ".join(" ".join(f"{v:+.4f}" for v in row) for row in m)
 
 
+MAX_FILLED_S = 0.1
+"""The longest run of samples without a number [s] that a session's values are filled across
+(linearly in time): a pose holds still and a turn's rate changes little over it; a longer one
+would make up part of a turn, which the gyro's fit integrates."""
+
+
+def _filled(rec: Any, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """acc, gyro and dt of the session with its samples that lack a number filled linearly in
+    time from their neighbours, and a note counting them ("" where none). A session's samples
+    are numbered by --sections and its fits integrate every turn, so none is left out; a run
+    of them longer than MAX_FILLED_S is refused."""
+    from ..fit.recording import RecordingError
+
+    valid = rec.valid & np.isfinite(t)
+    if valid.all():
+        return rec.acc, rec.gyro, rec.dt, ""
+    if valid.sum() < 2:
+        raise RecordingError(f"{rec.name}: no two samples have a number in every column")
+    index = np.arange(len(t))
+    times = np.interp(index, index[valid], t[valid])  # a missing time: between its neighbours
+    starts = np.flatnonzero(np.diff(np.concatenate([[1], valid.astype(int)])) == -1)
+    ends = np.flatnonzero(np.diff(np.concatenate([valid.astype(int), [1]])) == 1) + 1
+    runs = [(times[min(e, len(t) - 1)] - times[max(b - 1, 0)], b, e)  # neighbour to neighbour
+            for b, e in zip(starts, ends, strict=True)]
+    longest, b, e = max(runs)
+    if longest > MAX_FILLED_S:
+        raise RecordingError(
+            f"{rec.name}: samples {b} to {e - 1} (from 0, as --sections numbers them) lack a "
+            f"number ({longest:.2f} s from "
+            f"{times[b]:.2f} s): a session is filled across at most {MAX_FILLED_S:g} s, as its "
+            "turns are integrated sample by sample; record the session again")
+    acc, gyro = rec.acc.copy(), rec.gyro.copy()
+    for values in (acc, gyro):
+        for k in range(3):
+            ok = np.isfinite(values[:, k]) & valid
+            values[~ok, k] = np.interp(times[~ok], times[ok], values[ok, k])
+    dt = np.concatenate([[rec.dt[0]], np.diff(times)])
+    return acc, gyro, dt, (f"{int((~valid).sum())} sample(s) without a number in every "
+                           "column filled from their neighbours (linearly in time)")
+
+
 def run(args: argparse.Namespace) -> int:
     """Calibrate, write calibration.json and calibration.png, print the result."""
     from ..fit.recording import recording_from_args
 
     rec, t = recording_from_args(args.recording, args)
-    acc, gyro, dt, g = rec.acc, rec.gyro, rec.dt, args.gravity
+    acc, gyro, dt, filled = _filled(rec, t)
+    g = args.gravity
     rate = 1.0 / float(np.median(dt))
     gyro_range = math.radians(args.gyro_range)
     session: Session | None = None
@@ -142,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
         refused = str(err)
     comparisons: dict[str, Any] = {}
     given = fer.read_sections(args.sections) if args.sections else None
-    lines: list[str] = []
+    lines: list[str] = [filled] if filled else []
     own = None
     if given is not None or session is None:
         own = _own_sections(acc, gyro, dt, g)
@@ -193,6 +235,8 @@ def run(args: argparse.Namespace) -> int:
                      if method == "tedaldi" else "the session's other poses and the moves "
                      "between them, under the calibration fitted to Ferraris's sections"),
     }
+    if filled:
+        extra["filled"] = filled
     if sections is not None:
         extra["sections"] = {k: list(v) for k, v in sections.items()}
     if session is not None:
