@@ -270,7 +270,7 @@ def test_noise_on_a_still_recording_says_where_the_gyro_unit_given_is_wrong(tmp_
     assert main(["noise", str(degs), "--gyro-unit", "rad/s", "--no-plots", "--out",
                  str(tmp_path / "a")]) == 2
     said = capsys.readouterr().err
-    assert "not static: rotation seen in the gyro" in said
+    assert "not static: rotation seen in the gyro" in said and "too short to be used" in said
     assert re.search(r"Or it was at rest and its gyro is not in rad/s.*in deg/s its 1 s means "
                      r"move by 0\.0\d+ deg/s \(--gyro-unit deg/s\)", said)
     assert main(["noise", str(degs), "--gyro-unit", "deg/s", "--no-plots", "--out",
@@ -302,3 +302,49 @@ def test_tune_refuses_a_recording_without_a_reference_before_it_starts(tmp_path,
                  "--no-plots", "--out", str(tmp_path / "t")]) == 2
     err = capsys.readouterr().err
     assert "no reference" in err and "run/s" not in err  # no progress bar started
+
+
+def test_noise_leaves_out_samples_without_numbers_and_says_how_many(tmp_path):
+    """Three empty cells in a static recording were a traceback (numpy's gradient of nothing):
+    those samples are left out now, the densities as without them."""
+    path = static_csv(tmp_path / "static.csv", 60.0, 100.0)
+    lines = path.read_text().splitlines()
+    for row in (1000, 2000, 3000):
+        cells = lines[row].split(",")
+        cells[row // 1000 + 3] = ""
+        lines[row] = ",".join(cells)
+    holes = tmp_path / "holes.csv"
+    holes.write_text("\n".join(lines) + "\n")
+    noise, _ = analyse(load(holes))
+    whole, _ = analyse(load(path))
+    assert "3 of 6000 samples without a number in every column left out" in noise["note"]
+    assert noise["gyro_density"]["mean"] == pytest.approx(whole["gyro_density"]["mean"],
+                                                          rel=0.01)
+    assert noise["recording"]["samples"] == 5997
+
+
+def test_noise_takes_the_longest_still_stretch_of_a_recording_the_sensor_moved_in(tmp_path):
+    """A bump tilting the sensor 5 deg two minutes into a five-minute recording: the stretch
+    after it is used and said (the recording was refused as not static); where no stretch is
+    still for 20 s, it is refused as before, with the longest."""
+    path = static_csv(tmp_path / "static.csv", 300.0, 100.0)
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    t = data[:, 0]
+    k0, k1 = 12000, 12200  # 2 s about x, 5 deg, then still again
+    tilt = np.interp(t, [t[k0], t[k1]], [0.0, 5 * DEG])
+    data[k0:k1, 4] += 5 * DEG / 2.0
+    angle = 0.1 + tilt  # static_csv's gravity on a tilted z
+    noise_y = data[:, 2] - G * np.sin(0.1)
+    noise_z = data[:, 3] - G * np.cos(0.1)
+    data[:, 2], data[:, 3] = G * np.sin(angle) + noise_y, G * np.cos(angle) + noise_z
+    bumped = tmp_path / "bumped.csv"
+    np.savetxt(bumped, data, delimiter=",", header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z",
+               comments="")
+    noise, _ = analyse(load(bumped))
+    assert re.search(r"the sensor moved: its longest still stretch used, 12\d-300 s of 300 s",
+                     noise["note"])
+    assert 170.0 < noise["recording"]["duration_s"] < 180.0
+    assert noise["gyro_density"]["mean"] == pytest.approx(GYRO_DENSITY, rel=0.15)
+    with pytest.raises(RecordingError, match=r"not static: .*Its longest still stretch, \d+ s "
+                       r"of 60 s, is too short to be used instead \(at least 20 s and 50 % of"):
+        analyse(load(static_csv(tmp_path / "turning.csv", 60.0, 100.0, turn=0.2 * DEG)))

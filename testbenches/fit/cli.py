@@ -85,7 +85,7 @@ def cmd_noise(args: argparse.Namespace) -> int:
                       gyro_range=math.radians(args.gyro_range),
                       gyro_bias_std=math.radians(args.gyro_bias_std))
     g, a = noise["gyro_density"]["mean"], noise["acc_density"]["mean"]
-    print(f"{rec.name}: {rec.duration:.0f} s at {rec.rate:g} Hz")
+    print(f"{rec.name}: {noise['recording']['duration_s']:.0f} s at {rec.rate:g} Hz")
     print(f"  gyro white noise {noise['gyro_density_deg_s_sqrt_hz']:.4g} deg/s/sqrt(Hz) "
           f"(gyro_psd {g * g:.4g} rad2/s)")
     print(f"  acc white noise {noise['acc_density_ug_sqrt_hz']:.4g} ug/sqrt(Hz) "

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +25,7 @@ from fusion_core.types import DEG, GYRO_RANGE_DEFAULT, G
 
 from ..gyro_unit import UNITS
 from .allan import AllanFit, allan_deviation, fit
-from .recording import Recording, RecordingError
+from .recording import PER_SAMPLE, Recording, RecordingError
 
 MIN_DURATION_S = 20.0
 """The white-noise fit needs taus up to a few seconds, each averaged over ten clusters at least."""
@@ -40,6 +41,13 @@ IMUs reach about 3e-4 deg/s/sqrt(Hz), an angle random walk of 0.02 deg/sqrt(h); 
 a unit 57 times too large (rad/s data read as deg/s)."""
 MAX_TILT_CHANGE = 1.0 * DEG
 """Change of the accelerometer's direction (1 s means) beyond which the sensor moved."""
+STILL_SHARE = 0.5
+"""A recording the sensor moved in is analysed on its longest still stretch where that holds at
+least this share of it (a bump or two on the table)."""
+STRETCH_MARGIN = 0.5
+"""A stretch taken out of a recording the sensor moved in keeps within this share of the
+bounds above: still, not just within them (a recording whose gyro noise reads as rotation, its
+unit wrong, holds stretches just within them by chance)."""
 AXES = ("x", "y", "z")
 
 
@@ -73,6 +81,89 @@ def check_static(rec: Recording) -> None:
             "moved")
 
 
+def numbers_only(rec: Recording) -> tuple[Recording, str]:
+    """rec without its samples that lack a number in a column (a logger's empty cell, NaN),
+    the rest taken as one series at its rate, and a note counting them ("" where none): the
+    Allan deviation needs every sample, and a few taken out move a static recording's noise
+    figures by nothing a fit resolves (as the estimators reject and count such samples)."""
+    valid = rec.valid
+    if valid.all():
+        return rec, ""
+    kept = replace(rec, **{name: None if (v := getattr(rec, name)) is None else v[valid]
+                           for name in PER_SAMPLE})
+    return kept, (f"{int((~valid).sum())} of {len(valid)} samples without a number in every "
+                  "column left out, the others taken as one series")
+
+
+def still_part(rec: Recording) -> tuple[Recording, str]:
+    """rec where it is static throughout (check_static), else its longest stretch of whole
+    seconds that is, and a note saying which: a bump on the table an hour into a two-hour
+    recording costs the hour, not the recording. RecordingError where rec is too short, or its
+    longest still stretch is shorter than MIN_DURATION_S or STILL_SHARE of it (check_static's
+    refusal, with the stretch): a recording that moves that much was no still one, or its gyro
+    unit is wrong, whose noise then reads as rotation with still flukes between."""
+    try:
+        check_static(rec)
+        return rec, ""
+    except RecordingError as moved:
+        if rec.duration < MIN_DURATION_S:
+            raise
+        lo, hi = _longest_still(rec)
+        part = rec.slice(lo, hi)
+        if part.duration < max(MIN_DURATION_S, STILL_SHARE * rec.duration):
+            raise RecordingError(
+                f"{moved}. Its longest still stretch, {part.duration:.0f} s of "
+                f"{rec.duration:.0f} s, is too short to be used instead (at least "
+                f"{MIN_DURATION_S:.0f} s and {STILL_SHARE * 100:.0f} % of the recording)"
+            ) from None
+    check_static(part)
+    t = np.cumsum(rec.dt) - rec.dt[0]
+    return part, (f"the sensor moved: its longest still stretch used, {t[lo]:.0f}-{t[hi - 1]:.0f}"
+                  f" s of {rec.duration:.0f} s")
+
+
+def _longest_still(rec: Recording) -> tuple[int, int]:
+    """The samples [lo, hi) of rec's longest run of whole seconds within which the gyro's 1 s
+    means move by at most STRETCH_MARGIN of MAX_GYRO_SWING per axis and the accelerometer's
+    direction's by at most that of MAX_TILT_CHANGE per component (a window's subwindows keep
+    both: a sliding window finds it)."""
+    import collections
+
+    block = max(1, round(rec.rate))
+    n = len(rec.dt) // block
+    g = rec.gyro[:n * block].reshape(n, block, 3).mean(axis=1)
+    a = rec.acc[:n * block].reshape(n, block, 3).mean(axis=1)
+    u = a / np.linalg.norm(a, axis=1, keepdims=True)
+    features = np.column_stack([g, u])
+    limits = [STRETCH_MARGIN * MAX_GYRO_SWING] * 3 + [STRETCH_MARGIN * MAX_TILT_CHANGE] * 3
+    highs: list[collections.deque[int]] = [collections.deque() for _ in limits]
+    lows: list[collections.deque[int]] = [collections.deque() for _ in limits]
+    best, left = (0, 0), 0
+    for right in range(n):
+        row = features[right]
+        if not np.all(np.isfinite(row)):  # a second with a missing value ends a stretch
+            left = right + 1
+            for q in (*highs, *lows):
+                q.clear()
+            continue
+        for k, value in enumerate(row):
+            while highs[k] and features[highs[k][-1], k] <= value:
+                highs[k].pop()
+            highs[k].append(right)
+            while lows[k] and features[lows[k][-1], k] >= value:
+                lows[k].pop()
+            lows[k].append(right)
+        while any(features[highs[k][0], k] - features[lows[k][0], k] > limit
+                  for k, limit in enumerate(limits)):
+            left += 1
+            for q in (*highs, *lows):
+                while q and q[0] < left:
+                    q.popleft()
+        if right + 1 - left > best[1] - best[0]:
+            best = (left, right + 1)
+    return best[0] * block, best[1] * block
+
+
 def _other_unit(rec: Recording, value: float, passes: Any) -> tuple[str, float] | None:
     """Where rec's gyro unit is unconfirmed by the data: the unit nearest to it in which a gyro
     figure (`value`, proportional to the gyro's readings) would pass (`passes(value)`), and the
@@ -96,8 +187,10 @@ def _squared(d: dict[str, float | None]) -> dict[str, float | None]:
 
 
 def analyse(rec: Recording) -> tuple[dict[str, Any], dict[str, list[AllanFit]]]:
-    """noise.json's content for a static recording, and the fits per signal (for the plot)."""
-    check_static(rec)
+    """noise.json's content for a static recording (its longest still stretch where the sensor
+    moved: still_part), and the fits per signal (for the plot)."""
+    rec, missing = numbers_only(rec)
+    rec, moved = still_part(rec)
     fits = {
         "gyro": [fit(*allan_deviation(rec.gyro[:, i], rec.rate)) for i in range(3)],
         "acc": [fit(*allan_deviation(rec.acc[:, i], rec.rate)) for i in range(3)],
@@ -127,7 +220,7 @@ def analyse(rec: Recording) -> tuple[dict[str, Any], dict[str, list[AllanFit]]]:
     out["acc_norm"] = norm
     out["acc_norm_g"] = norm / G
     out["acc_sample_std"] = float(np.mean(np.std(rec.acc, axis=0)))
-    notes = []
+    notes = [n for n in (missing, moved) if n]
     if rec.duration < LONG_DURATION_S:
         notes.append(f"{rec.duration:.0f} s of data: bias instability and random walk need "
                      f"about {LONG_DURATION_S / 3600:.0f} h at rest to be resolved; null in "
@@ -229,5 +322,5 @@ def run_noise(rec: Recording, out_dir: Path, plots: bool = True,
     (out_dir / "sensor.json").write_text(json.dumps(sensor_params(noise), indent=1))
     if plots:
         plot(fits, out_dir / "allan.png",
-             f"{rec.name}: {rec.duration:.0f} s at {rec.rate:g} Hz")
+             f"{rec.name}: {noise['recording']['duration_s']:.0f} s at {rec.rate:g} Hz")
     return noise
