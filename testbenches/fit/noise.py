@@ -58,27 +58,33 @@ def check_static(rec: Recording) -> None:
             f"{rec.name}: {rec.duration:.1f} s is too short: the white-noise fit needs at least "
             f"{MIN_DURATION_S:.0f} s at rest ({LONG_DURATION_S / 3600:.0f} h to resolve the bias "
             "instability and the random walk)")
+    if (moved := _moved(rec)) is not None:
+        raise RecordingError("".join(moved))
+
+
+def _moved(rec: Recording) -> tuple[str, str] | None:
+    """Why rec is not static, and where a wrong gyro unit would explain it, the unit that
+    would (else ""); None where it is static."""
     block = max(1, round(rec.rate))
     n = len(rec.dt) // block * block
     g_means = rec.gyro[:n].reshape(-1, block, 3).mean(axis=1)
     swing = float(np.max(np.ptp(g_means, axis=0)))
     if swing > MAX_GYRO_SWING:
-        raise RecordingError(
-            f"{rec.name}: not static: rotation seen in the gyro (its 1 s means move by "
-            f"{np.degrees(swing):.2f} deg/s, allowed {np.degrees(MAX_GYRO_SWING):.1f}); record "
-            "with the sensor at rest" + ("" if (other := _other_unit(
-                rec, swing, lambda v: v <= MAX_GYRO_SWING)) is None else
+        other = _other_unit(rec, swing, lambda v: v <= MAX_GYRO_SWING)
+        return (f"{rec.name}: not static: rotation seen in the gyro (its 1 s means move by "
+                f"{np.degrees(swing):.2f} deg/s, allowed {np.degrees(MAX_GYRO_SWING):.1f}); "
+                "record with the sensor at rest", "" if other is None else
                 f". Or it was at rest and its gyro is not in {rec.gyro_unit}, which a still "
                 f"recording cannot confirm: in {other[0]} its 1 s means move by "
-                f"{np.degrees(other[1]):.3g} deg/s (--gyro-unit {other[0]})"))
+                f"{np.degrees(other[1]):.3g} deg/s (--gyro-unit {other[0]})")
     a_means = rec.acc[:n].reshape(-1, block, 3).mean(axis=1)
     u = a_means / np.linalg.norm(a_means, axis=1, keepdims=True)
     tilt = float(np.max(np.arccos(np.clip(u @ u[0], -1.0, 1.0))))
     if tilt > MAX_TILT_CHANGE:
-        raise RecordingError(
-            f"{rec.name}: not static: the accelerometer's direction changed by "
-            f"{np.degrees(tilt):.2f} deg (allowed {np.degrees(MAX_TILT_CHANGE):.1f}): the sensor "
-            "moved")
+        return (f"{rec.name}: not static: the accelerometer's direction changed by "
+                f"{np.degrees(tilt):.2f} deg (allowed {np.degrees(MAX_TILT_CHANGE):.1f}): the "
+                "sensor moved", "")
+    return None
 
 
 def numbers_only(rec: Recording) -> tuple[Recording, str]:
@@ -102,20 +108,17 @@ def still_part(rec: Recording) -> tuple[Recording, str]:
     longest still stretch is shorter than MIN_DURATION_S or STILL_SHARE of it (check_static's
     refusal, with the stretch): a recording that moves that much was no still one, or its gyro
     unit is wrong, whose noise then reads as rotation with still flukes between."""
-    try:
+    if rec.duration < MIN_DURATION_S or (moved := _moved(rec)) is None:
         check_static(rec)
         return rec, ""
-    except RecordingError as moved:
-        if rec.duration < MIN_DURATION_S:
-            raise
-        lo, hi = _longest_still(rec)
-        part = rec.slice(lo, hi)
-        if part.duration < max(MIN_DURATION_S, STILL_SHARE * rec.duration):
-            raise RecordingError(
-                f"{moved}. Its longest still stretch, {part.duration:.0f} s of "
-                f"{rec.duration:.0f} s, is too short to be used instead (at least "
-                f"{MIN_DURATION_S:.0f} s and {STILL_SHARE * 100:.0f} % of the recording)"
-            ) from None
+    lo, hi = _longest_still(rec)
+    part = rec.slice(lo, hi)
+    if part.duration < max(MIN_DURATION_S, STILL_SHARE * rec.duration):
+        why, unit = moved
+        raise RecordingError(
+            f"{why}. Its longest still stretch, {part.duration:.0f} s of {rec.duration:.0f} s, "
+            f"is too short to be used instead (at least {MIN_DURATION_S:.0f} s and "
+            f"{STILL_SHARE * 100:.0f} % of the recording){unit}")
     check_static(part)
     t = np.cumsum(rec.dt) - rec.dt[0]
     return part, (f"the sensor moved: its longest still stretch used, {t[lo]:.0f}-{t[hi - 1]:.0f}"
