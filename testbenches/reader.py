@@ -7,7 +7,8 @@ any length is read in bounded memory:
   told by the file's first bytes; a stream cut before its end read up to the cut, and said
   in TableSource.found): the encoding (UTF-8 with or without a byte-order mark,
   UTF-16 as Windows' "Unicode" exports write it, else Latin-1), the delimiter (comma,
-  semicolon, tab or bar; a decimal comma where the numbers have one) and the header row are
+  semicolon, tab or bar, one after the rows' or the header's last cell read through; else
+  runs of spaces; a decimal comma where the numbers have one) and the header row are
   found from the file's start (after LabVIEW's ***End_of_Header*** lines); pyarrow's CSV reader
   parses it, and where it cannot (text where a number belongs, a row of the wrong length,
   padded cells) the file is read by Python's csv module, which names the file's line, the
@@ -390,6 +391,9 @@ class _TextLayout:
     found: list[str] = field(default_factory=list)
     """What a read found left out that the file's start and end did not show (a compressed
     stream cut short: _Salvaged)."""
+    spaced: bool = False
+    """Cells split by runs of spaces or tabs (numpy.savetxt's default, a C printf, TUM's
+    trajectories): every line is read with each run as WHITESPACE_AS (_Spaced)."""
 
 
 _ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
@@ -507,8 +511,13 @@ def _sniff(path: Path) -> _TextLayout:
                                         "any whole line" if cut else "empty file"))
     ends = [k for k, (_, line) in enumerate(numbered) if _END_OF_HEADER.match(line)]
     found = _find_header(numbered, ends[-1] + 1 if ends else 0)
-    if found is None:
-        raise _no_table(path, numbered[0])
+    spaced = False
+    if found is None:  # cells split by runs of spaces: each run read as WHITESPACE_AS
+        spaced_lines = [(no, _spaced_line(line)) for no, line in numbered]
+        found = _find_header(spaced_lines, ends[-1] + 1 if ends else 0)
+        if found is None or found[0] != WHITESPACE_AS:
+            raise _no_table(path, numbered[0])
+        numbered, spaced = spaced_lines, True
     delimiter, start = found
     header_line, header_text = numbered[start]
     preamble = numbered[:start]
@@ -533,6 +542,7 @@ def _sniff(path: Path) -> _TextLayout:
                                                                        delimiter)
     rows = [next(csv.reader([line], delimiter=delimiter))
             for no, line in numbered if no > data_after][:49]
+    header, units_row = _trailing_delimiter(header, units_row, rows)
     cells = [c for row in rows for c in row if c.strip()]
     decimal_comma = (any("," in c for c in cells)  # a cell's comma: ';' or tab between cells,
                      and not any("." in c for c in cells))  # or ',' and the cell quoted
@@ -553,7 +563,8 @@ def _sniff(path: Path) -> _TextLayout:
              if (m := STATED_RATE.search(line))]
     layout = _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                          datetimes, times_of_day, skipped, data_after, units_row, stacked,
-                         rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations)
+                         rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations,
+                         spaced=spaced)
     if _compression(path) is None and encoding in ("utf-8", "latin-1"):
         layout.data_end, layout.tail = _tail(path, layout)
     return layout
@@ -585,7 +596,8 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
     line = kept[last:]
     end = start + len(kept)
     if line.strip() and start + last > 0:
-        values = _cells_of(line.decode(layout.encoding, errors="replace"), layout.delimiter)
+        text = line.decode(layout.encoding, errors="replace")
+        values = _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
         cells = len(values)
         if cells < len(layout.header) and _row_start(values):
             end = start + last
@@ -642,9 +654,22 @@ class _Head(io.RawIOBase):
 def _table_bytes(path: Path, layout: _TextLayout) -> IO[bytes]:
     """The file's bytes up to the table's end (decompressed where it is compressed, what the
     read finds said in layout.found)."""
-    if layout.data_end is None:
-        return _open_bytes(path, layout.found)
-    return io.BufferedReader(_Head(path, layout.data_end))
+    raw = (_open_bytes(path, layout.found) if layout.data_end is None
+           else io.BufferedReader(_Head(path, layout.data_end)))
+    return io.BufferedReader(_Spaced(raw), buffer_size=SALVAGE_CHUNK) if layout.spaced else raw
+
+
+def _trailing_delimiter(header: list[str], units: list[str | None], rows: list[list[str]]
+                        ) -> tuple[list[str], list[str | None]]:
+    """The header as wide as the rows where one of them ends with a delimiter the other lacks:
+    rows of one cell more, empty in every row, get an unnamed column (read, and taken by no
+    quantity); a header that ends with an empty name the rows lack loses it."""
+    widths = {len(row) for row in rows}
+    if widths == {len(header) + 1} and not any(row[-1].strip() for row in rows):
+        return [*header, ""], [*units, None]
+    if widths == {len(header) - 1} and not header[-1]:
+        return header[:-1], units[:-1]
+    return header, units
 
 
 def _cells_of(line: str, delimiter: str) -> list[str]:
@@ -726,7 +751,55 @@ def _stacked(numbered: list[tuple[int, str]], at: int, header: list[str], delimi
 def _no_table(path: Path, first: tuple[int, str]) -> TableError:
     line, text = first
     return TableError(f"{path}: no delimiter splits a header and the rows after it alike (tried "
-                      f"comma, semicolon, tab and bar); line {line} reads {text[:80]!r}")
+                      f"comma, semicolon, tab, bar and runs of spaces); line {line} reads "
+                      f"{text[:80]!r}")
+
+
+WHITESPACE_AS = ";"
+"""What a run of spaces or tabs between cells is read as: a delimiter no number holds, so that
+a decimal comma stays one ("0,01 9,81")."""
+
+
+def _spaced_line(line: str) -> str:
+    """A line whose cells runs of spaces split, with WHITESPACE_AS between them (a comment's
+    mark kept apart: numpy.savetxt's "# time acc_x ...")."""
+    text = line.strip()
+    mark = next((c for c in COMMENTS if text.startswith(c)), "")
+    cells = text[len(mark):].split()
+    return (f"{mark} " if mark else "") + WHITESPACE_AS.join(cells)
+
+
+class _Spaced(io.RawIOBase):
+    """A file's bytes with the runs of spaces or tabs between cells read as WHITESPACE_AS, line
+    by line (as many lines, so that line numbers stay the file's)."""
+
+    def __init__(self, inner: IO[bytes]) -> None:
+        self._inner = inner
+        self._out = memoryview(b"")
+        self._held = b""
+        self._done = False
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        while not self._out and not self._done:
+            chunk = self._inner.read(SALVAGE_CHUNK)
+            data = self._held + chunk
+            cut = len(data) if not chunk else data.rfind(b"\n") + 1
+            self._done = not chunk
+            whole, self._held = data[:cut], data[cut:]
+            between = WHITESPACE_AS.encode()  # bytes.split: ten times re.sub's pace
+            self._out = memoryview(b"\n".join(between.join(line.split())
+                                              for line in whole.split(b"\n")))
+        n = min(len(buffer), len(self._out))
+        memoryview(buffer).cast("B")[:n] = self._out[:n]
+        self._out = self._out[n:]
+        return n
+
+    def close(self) -> None:
+        self._inner.close()
+        super().close()
 
 
 def _comment(line: str) -> str:
@@ -765,9 +838,10 @@ line; the table's header row follows the last."""
 def _find_header(numbered: list[tuple[int, str]], first: int = 0) -> tuple[str, int] | None:
     """(delimiter, index into numbered) of the header: the first line from numbered[first] on
     (after LabVIEW's file and segment headers) that, with the HEADER_CHECK lines after it, one
-    delimiter splits into as many cells, more than one (the most cells where several do). Lines
-    before it are a logger's preamble (a comment, a device name, the settings) and are
-    skipped."""
+    delimiter splits into as many cells, more than one (the most cells where several do), or
+    as many but for a delimiter that ends the header or the rows alone (a sketch that prints a
+    comma after every value, its header without one). Lines before it are a logger's preamble
+    (a comment, a device name, the settings) and are skipped."""
     content = [k for k, (_, line) in enumerate(numbered) if k >= first and not _comment(line)]
     for i, start in enumerate(content[:PREAMBLE_LINES]):
         window = [numbered[k][1] for k in content[i:i + HEADER_CHECK + 1]]
@@ -775,6 +849,8 @@ def _find_header(numbered: list[tuple[int, str]], first: int = 0) -> tuple[str, 
         cells = 1
         for d in DELIMITERS:
             counts = {_cells(line, d) for line in window}
+            if len(counts) != 1:
+                counts = {_cells(line.rstrip().removesuffix(d), d) for line in window}
             if len(counts) == 1 and (n := counts.pop()) > cells:
                 best, cells = (d, start), n
         if best is not None:
@@ -877,7 +953,7 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
     compression = _compression(path)
     try:
         reader = pc.open_csv(
-            path if compression is None and layout.data_end is None
+            path if compression is None and layout.data_end is None and not layout.spaced
             else pa.PythonFile(_table_bytes(path, layout), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.data_after,
                                         encoding="utf8" if layout.encoding == "utf-8"

@@ -1003,3 +1003,70 @@ def test_a_zip_archive_cut_short_is_refused_as_cut_not_as_a_workbook(tmp_path):
     with pytest.raises(RecordingError, match=r"cut\.zip: a zip archive that does not open: cut "
                        "or damaged"):
         open_recording(cut)
+
+
+@pytest.mark.parametrize("style", ["savetxt", "aligned", "tabs"])
+def test_cells_split_by_runs_of_spaces_are_read(tmp_path, style):
+    """numpy.savetxt's default (a space, its header a '# ' comment), a C printf's aligned
+    columns and tabs with spaces: refused ('no delimiter splits a header ...'), read now as the
+    comma-separated file is; a bad cell is named by its line and column as there."""
+    data = np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+    names = EXAMPLE.read_text().splitlines()[0].split(",")
+    path = tmp_path / f"{style}.txt"
+    if style == "savetxt":
+        np.savetxt(path, data, header=" ".join(names))
+    elif style == "aligned":
+        path.write_text("".join(f"{n:>16}" for n in names) + "\n" + "".join(
+            "".join(f"{v:16.10f}" for v in row) + "\n" for row in data))
+    else:
+        path.write_text("\t".join(names) + "\n" + "".join(
+            " \t".join(f"{v:.10g}" for v in row) + "  \n" for row in data))
+    rec, _ = open_recording(path).load()
+    plain, _ = open_recording(EXAMPLE).load()
+    np.testing.assert_allclose(rec.acc, plain.acc, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(rec.gyro, plain.gyro, rtol=1e-9, atol=1e-9)
+    lines = path.read_text().splitlines()
+    lines[500] = lines[500].replace(lines[500].split()[1], "abc", 1)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(RecordingError, match="line 501, column 'acc_x': 'abc' is not a number"):
+        open_recording(path).load()
+
+
+def test_a_tum_trajectory_is_a_reference(tmp_path, capsys):
+    """TUM's ground truth ('# timestamp tx ty tz qx qy qz qw', spaces between, w last) is a
+    reference: scored, it gives what the truth file gives."""
+    from scipy.spatial.transform import Rotation
+
+    from testbenches.cli import main
+
+    truth = np.genfromtxt(REPO / "examples" / "tilt_motion_truth.csv", delimiter=",",
+                          names=True)
+    xyzw = Rotation.from_euler("xyz", np.column_stack(
+        [truth["roll"], truth["pitch"], truth["yaw"]])).as_quat()
+    rows = np.column_stack([truth["time"], np.zeros((len(xyzw), 3)), xyzw])
+    tum = tmp_path / "groundtruth.txt"
+    tum.write_text("# timestamp tx ty tz qx qy qz qw\n" + "".join(
+        " ".join(f"{v:.9f}" for v in row) + "\n" for row in rows))
+    scores = []
+    for reference in (REPO / "examples" / "tilt_motion_truth.csv", tum):
+        assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference",
+                     str(reference), "--no-plots", "--out", str(tmp_path / "out")]) == 0
+        said = capsys.readouterr().out
+        scores.append(float(next(r for r in said.splitlines() if r.startswith("kf ")).split()[2]))
+    assert scores[1] == pytest.approx(scores[0], abs=1e-3)
+
+
+@pytest.mark.parametrize("where", ["rows", "header", "both"])
+def test_a_delimiter_after_the_last_cell_of_the_rows_or_the_header_is_read_through(tmp_path,
+                                                                                 where):
+    """A sketch that prints a comma after every value and its header without one: the first
+    row was taken for the header ('no column for acc_x ...: the header has 0, 0.0281...')."""
+    lines = EXAMPLE.read_text().splitlines()
+    ends = {"rows": (False, True), "header": (True, False), "both": (True, True)}[where]
+    lines = [line + ("," if ends[k > 0] else "") for k, line in enumerate(lines)]
+    path = tmp_path / "trailing.csv"
+    path.write_text("\n".join(lines) + "\n")
+    rec, _ = open_recording(path).load()
+    plain, _ = open_recording(EXAMPLE).load()
+    np.testing.assert_array_equal(rec.gyro, plain.gyro)
+    np.testing.assert_array_equal(rec.dt, plain.dt)
