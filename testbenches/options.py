@@ -33,7 +33,8 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--rate", type=positive_float, default=None,
                         help="sample rate [Hz]: where the file has no time or dt column, or to "
                         "space the samples by it where its time cannot serve (a time coarser "
-                        "than the sampling repeats), the time column left")
+                        "than the sampling repeats), the time column left; beside a time that "
+                        "serves it must agree with its steps within 2 %%")
     parser.add_argument("--time-column", default=None, help="the time column's name")
     parser.add_argument("--topic", default=None, metavar="NAME",
                         help="a ROS bag's IMU topic (sensor_msgs/Imu), where it has several")

@@ -240,3 +240,17 @@ def test_a_time_coarser_than_the_samples_is_sized_by_its_mean_step(tmp_path):
     path = _write(tmp_path / "epoch.csv", "timestamp", 1_700_000_000 + np.floor(t), imu)
     with pytest.raises(RecordingError, match=r"the time 1\.7e\+09 s repeats .* give --rate 111 "):
         open_recording(path)
+
+
+def test_a_given_rate_that_contradicts_a_time_that_serves_is_refused(tmp_path):
+    """--rate overrides a file's time column, for a time that cannot serve: given with one that
+    can, at another rate (200 Hz on the example's 100 Hz, with --gyro-unit so that no other
+    evidence refuses it), the estimators integrated the gyro over half the time, said only as
+    'time from the rate given'. Refused now, with the column's rate; within 2 % it is taken."""
+    t, imu = _example()
+    path = _write(tmp_path / "timed.csv", "time", t, imu)
+    with pytest.raises(RecordingError, match=r"--rate 200 contradicts its time column 'time', "
+                                             r"whose steps give 100 Hz: leave --rate out"):
+        open_recording(path, gyro_unit="rad/s", rate=200.0)
+    source = open_recording(path, gyro_unit="rad/s", rate=101.0)
+    assert "time from the rate given (101 Hz)" in source.choices

@@ -651,6 +651,14 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                                                     "of their own, which their time joins"
                                                     if split else "so is --time-unit")
                 + ": leave one of them out")
+        column_rate = _column_rate(path, kind, prefix[kind], units.get(kind), acc, gyro,
+                                   table.where, keep, holds)
+        if column_rate is not None and abs(column_rate / given_rate - 1.0) > RATE_AGREES:
+            raise RecordingError(
+                f"{path}: --rate {given_rate:g} contradicts its {kind} column "
+                f"{found.source[kind]!r}, whose steps give {column_rate:.4g} Hz: leave --rate out "
+                "to take the column's (--rate spaces the samples of a file whose time cannot: "
+                "none, or one that repeats)")
         clock = _Clock("rate", 1.0, 1.0 / given_rate, path, table.where)
         time_how = f"time from the rate given ({given_rate:g} Hz), the file's {kind} column left"
     elif timed:
@@ -751,6 +759,24 @@ def _samples(block: np.ndarray, names: list[str], join: Any, clock: _Clock, row0
     cols, rows = join(cols) if join else (cols, slice(None))
     dt, t = clock(cols.get(clock.kind), row0, len(block), _holds(cols))
     return {q: v[rows] for q, v in cols.items()}, dt[rows], t[rows]
+
+
+RATE_AGREES = 0.02
+"""A rate given and a file's time agree within this fraction (a crystal's and a logger's clock,
+a nominal rate against the measured one)."""
+
+
+def _column_rate(path: Path, kind: str, raw: np.ndarray, stated: str | None, acc: np.ndarray,
+                 gyro: np.ndarray, where: Any, keep: Any, holds: np.ndarray | None
+                 ) -> float | None:
+    """The rate [Hz] a time or dt column's steps give (_time_clock's reading of it), None where
+    it cannot serve (it repeats, does not rise, or its unit cannot be told)."""
+    try:
+        clock = _time_clock(path, kind, raw, "auto", stated, acc, gyro, where, keep, holds)[0]
+        period = median_period(replace(clock)(raw, 0, len(raw), holds)[0])
+    except RecordingError:
+        return None
+    return 1.0 / period if np.isfinite(period) and period > 0.0 else None
 
 
 def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str | None,
