@@ -112,6 +112,6 @@ def main(argv: list[str] | None = None, prog: str = "imu-fusion") -> int:
     args = _parser(prog, argv[0] if argv and argv[0] in COMMANDS else None).parse_args(argv)
     try:
         return int(args.func(args))
-    except (ValueError, FileNotFoundError, ConnectionError) as err:
+    except (ValueError, OSError) as err:  # what is wrong in the input or the machine: one line
         print(f"error: {err}", file=sys.stderr)
         return 2

@@ -789,6 +789,7 @@ def cmd_estimate(args: argparse.Namespace) -> int:
             runs.append(_Run(key, est, path, args.format, names[key]))
         vqf_params = estimator_params(args, preset[keys[0]], has[keys[0]])  # calibration, mounting
         vqf, found = _run_blocks(args, source, reference, runs, vqf_params)
+        written = [run.writer.commit() for run in runs]  # one that fails: the rest discarded
     except BaseException:
         for run in runs:
             run.writer.discard()
@@ -798,9 +799,9 @@ def cmd_estimate(args: argparse.Namespace) -> int:
         print(line)
     print(f"{'estimator':<10} {'rejected':>8} {'incl. RMSE [deg]':>17}  output")
     scored = found["scored"]
-    for run in runs:
+    for run, path in zip(runs, written, strict=True):
         shown = f"{run.score.rmse:17.4f}" if scored else f"{'-':>17}"
-        print(f"{run.key:<10} {run.rejected:>8} {shown}  {run.writer.commit()}")
+        print(f"{run.key:<10} {run.rejected:>8} {shown}  {path}")
     if scored and vqf is not None:
         shown = f"{vqf.score.rmse:17.4f}" if vqf.stream is not None else f"{'-':>17}"
         print(f"{'vqf':<10} {'-':>8} {shown}  {vqf.note}")
@@ -998,8 +999,13 @@ def _plot(path: Path, runs: list[Any], vqf: Any, truth: Thinned, name: str) -> s
     # first, a third of the plot's time on a long recording
     fig.subplots_adjust(left=0.1, right=0.98, bottom=0.07 if scored else 0.09,
                         top=0.95 if scored else 0.93, hspace=0.1)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        fig.savefig(path, dpi=110)
+    except OSError as err:  # a full disk: no half-written picture left
+        path.unlink(missing_ok=True)
+        raise OSError(f"{path}: cannot be written ({err})") from None
+    finally:
+        plt.close(fig)
     return f"plot: {path}"
 
 

@@ -9,6 +9,8 @@ them for less than pyarrow's, where formatting is most of a long run's writing.
 
 from __future__ import annotations
 
+import errno
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +18,14 @@ import numpy as np
 
 FORMATS = {"csv": ".csv", "parquet": ".parquet", "hdf5": ".h5"}
 """Output format -> file suffix."""
+CELL_BYTES = {"csv": 25, "parquet": 8, "hdf5": 8}
+"""Bytes a value takes at most in each format (CSV: 17 digits, a sign, an exponent, a comma)."""
+CHUNK_ROWS = 1 << 16
+"""Rows of an HDF5 dataset's chunk (written whole)."""
+FREE_MARGIN = 4
+"""A block is written where its disk holds this many times what it may take, chunks included:
+the other estimators' writers share the disk, and a library that meets a full disk mid-write
+may not recover (HDF5's close, which flushes its cache, crashed the process)."""
 
 
 def _float64_array(values: np.ndarray) -> Any:
@@ -39,6 +49,14 @@ class TableWriter:
         self._sink: Any = None
         self._writer: Any = None
         self._schema: Any = None
+        try:
+            self._open()
+        except OSError as err:
+            self.discard()
+            raise OSError(f"{self.path}: cannot be written ({err})") from None
+
+    def _open(self) -> None:
+        fmt = self.fmt
         if fmt == "csv":
             self._sink = self.partial.open("wb")
             self._sink.write((",".join(self.names) + "\n").encode())
@@ -57,13 +75,28 @@ class TableWriter:
             self._sink = h5py.File(self.partial, "w")
             for n in self.names:
                 self._sink.create_dataset(n, shape=(0,), maxshape=(None,), dtype="f8",
-                                          chunks=(1 << 16,))
+                                          chunks=(CHUNK_ROWS,))
 
     def write(self, columns: list[np.ndarray]) -> None:
-        """One block: an array per name, all of one length."""
+        """One block: an array per name, all of one length. OSError naming the file where it
+        cannot be written (a full disk), the partial file removed."""
+        try:
+            self._write(columns)
+        except OSError as err:
+            self.discard()
+            raise OSError(f"{self.path}: cannot be written ({err})") from None
+
+    def _write(self, columns: list[np.ndarray]) -> None:
         n = len(columns[0]) if columns else 0
         if n == 0:
             return
+        chunks = CHUNK_ROWS * 8 if self.fmt == "hdf5" else 0  # HDF5 writes whole chunks
+        need = FREE_MARGIN * len(columns) * (n * CELL_BYTES[self.fmt] + chunks)
+        free = shutil.disk_usage(self.partial.parent).free
+        if free < need:  # before the library meets a full disk (HDF5's close then crashes)
+            raise OSError(errno.ENOSPC, f"{free / 1e6:.1f} MB free on its disk, where a block of "
+                          f"{n} rows wants {need / 1e6:.1f} MB: free some, write to another "
+                          "disk (--out), or fewer rows or outputs (--every, --outputs)")
         if self.fmt == "hdf5":
             for name, values in zip(self.names, columns, strict=True):
                 ds = self._sink[name]
@@ -95,11 +128,18 @@ class TableWriter:
 
     def commit(self) -> Path:
         """Close and rename into place; the destination."""
-        self._close()
-        self.partial.replace(self.path)
+        try:
+            self._close()
+            self.partial.replace(self.path)
+        except OSError as err:
+            self.discard()
+            raise OSError(f"{self.path}: cannot be written ({err})") from None
         return self.path
 
     def discard(self) -> None:
-        """Close and remove the partial file."""
-        self._close()
+        """Close and remove the partial file (a close that fails, as on a full disk, too)."""
+        try:
+            self._close()
+        except OSError:
+            self._sink = self._writer = None
         self.partial.unlink(missing_ok=True)

@@ -86,3 +86,43 @@ def test_a_discarded_writer_leaves_no_file(tmp_path: Path) -> None:
 def test_an_unknown_format_is_refused_naming_the_allowed() -> None:
     with pytest.raises(ValueError, match="output format 'xlsx': allowed csv, parquet, hdf5"):
         TableWriter(Path("out.xlsx"), "xlsx", NAMES)
+
+
+def _full_disk(monkeypatch: pytest.MonkeyPatch, free: int) -> None:
+    """The output disk with `free` bytes left, as shutil.disk_usage reports it."""
+    import shutil
+
+    from testbenches import table_out
+
+    usage = shutil.disk_usage(".")
+    monkeypatch.setattr(table_out.shutil, "disk_usage",
+                        lambda _: usage._replace(free=free))
+
+
+@pytest.mark.parametrize("fmt", list(FORMATS))
+def test_a_block_the_disk_cannot_hold_is_refused_naming_the_file_and_leaves_none(
+        tmp_path: Path, fmt: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """On a full disk polars' and pyarrow's writers raised their own errors as tracebacks, and
+    HDF5's close, flushing its cache, crashed the process (a segmentation fault, partial files
+    left). A block is now refused before it is written where the disk lacks room for it."""
+    writer = TableWriter(tmp_path / f"out{FORMATS[fmt]}", fmt, NAMES)
+    _full_disk(monkeypatch, 1_000)
+    with pytest.raises(OSError, match=rf"out{FORMATS[fmt]}: cannot be written \(\[Errno 28\] "
+                       r"0\.0 MB free on its disk, where a block of 12 rows wants"):
+        writer.write(_blocks()[0])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_estimate_on_a_full_disk_says_so_in_one_line_and_leaves_no_file(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+        ) -> None:
+    from testbenches.cli import main
+
+    _full_disk(monkeypatch, 100_000)
+    example = Path(__file__).resolve().parents[1] / "examples" / "tilt_motion.csv"
+    out = tmp_path / "out"
+    assert main(["estimate", str(example), "--format", "hdf5", "--no-plots", "--out",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and ".h5: cannot be written" in err
+    assert "Traceback" not in err and list(out.iterdir()) == []
