@@ -39,6 +39,7 @@ testbench extra, and say so where it is missing.
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import sys
 
@@ -75,9 +76,12 @@ def _parser(prog: str, command: str | None = None) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=prog, description="IMU sensor-fusion estimators as FMUs: the project's commands "
         f"(`{prog} COMMAND --help` for one).", epilog=__doc__.strip().split("\n\n")[-1],
-        formatter_class=argparse.RawDescriptionHelpFormatter)
+        formatter_class=argparse.RawDescriptionHelpFormatter, allow_abbrev=False)
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    # no option by a prefix of its name: estimate's `--sensor 0.02` was --sensor-delay
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                parser_class=functools.partial(argparse.ArgumentParser,
+                                                               allow_abbrev=False))
     from . import missing_modules
 
     if command is not None:

@@ -5,6 +5,7 @@ duration or retry count would record every run as failed, zero seeds would repor
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import pytest
 
@@ -111,3 +112,14 @@ def test_every_command_that_draws_takes_no_plots_alike():
         assert action is not None, f"{name} has no --no-plots"
         assert action.option_strings == ["--no-plots", "--no-plot"], name
         assert action.help.startswith("skip "), name
+
+
+def test_an_option_is_not_taken_by_a_prefix_of_its_name(capsys):
+    """argparse took `estimate --sensor 0.02` for --sensor-delay 0.02 (a delay of 20 ms, with
+    no word) and `--ref FILE` for --reference: every command takes its options by their whole
+    names only."""
+    example = str(Path(__file__).resolve().parents[1] / "examples" / "tilt_motion.csv")
+    for prefix in ("--sensor", "--ref", "--est"):
+        with pytest.raises(SystemExit):
+            main(["estimate", example, prefix, "0.02"])
+        assert f"unrecognized arguments: {prefix} 0.02" in capsys.readouterr().err
