@@ -305,55 +305,72 @@ def _cut_stream(kind: str) -> str:
             "interrupted, or a logger stopped)")
 
 
-class _Salvaged(io.RawIOBase):
+class _Lines(io.RawIOBase):
+    """A file's bytes handed on whole lines at a time, the bytes after the last line end held
+    until more follow (or the file ends): what the streams that read a file's lines as
+    something else share. `_chunk` gives the next bytes (None: the file was cut, and the line
+    the cut fell in is left out), `_lines` what whole lines are read as."""
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+        self._out = memoryview(b"")  # ready to be read
+        self._held = b""  # after the last line end so far
+        self._done = False
+
+    def readable(self) -> bool:
+        return True
+
+    def _chunk(self) -> bytes | None:
+        return bytes(self._inner.read(SALVAGE_CHUNK))
+
+    def _lines(self, whole: bytes) -> bytes:
+        return whole
+
+    def readinto(self, buffer: Any) -> int:
+        while not self._out and not self._done:
+            chunk = self._chunk()
+            if chunk is None:
+                self._done = True
+                break
+            data = self._held + chunk
+            cut = len(data) if not chunk else data.rfind(b"\n") + 1
+            self._done = not chunk
+            whole, self._held = data[:cut], data[cut:]
+            self._out = memoryview(self._lines(whole))
+        n = min(len(buffer), len(self._out))
+        memoryview(buffer).cast("B")[:n] = self._out[:n]
+        self._out = self._out[n:]
+        return n
+
+    def close(self) -> None:
+        self._inner.close()
+        super().close()
+
+
+class _Salvaged(_Lines):
     """A decompressing file's bytes up to where its compressed stream ends before its end marker
     (the file cut: a download or a copy interrupted, a logger that compressed as it wrote
     stopped), the line the cut fell in left out and said in `found` (None: not said). A
     damaged stream is refused (TableError), not read past."""
 
     def __init__(self, inner: Any, path: Path, kind: str, found: list[str] | None) -> None:
-        self._inner, self._path, self._kind, self._found = inner, path, kind, found
-        self._out = memoryview(b"")  # ready to be read
-        self._held = b""  # after the last line end so far: read once more follows
-        self._done = False
+        super().__init__(inner)
+        self._path, self._kind, self._found = path, kind, found
 
-    def readable(self) -> bool:
-        return True
-
-    def readinto(self, buffer: Any) -> int:
-        while not self._out and not self._done:
-            self._fill()
-        n = min(len(buffer), len(self._out))
-        memoryview(buffer).cast("B")[:n] = self._out[:n]
-        self._out = self._out[n:]
-        return n
-
-    def _fill(self) -> None:
+    def _chunk(self) -> bytes | None:
         import lzma
         import zlib
 
         try:
-            chunk = self._inner.read1(SALVAGE_CHUNK)  # one read: data before a cut kept
+            return bytes(self._inner.read1(SALVAGE_CHUNK))  # one read: data before a cut kept
         except EOFError:  # the stream ends before its end marker: the file was cut
-            self._done = True
             if self._found is not None:
                 self._found.append(f"{_cut_stream(self._kind)}: read up to the cut" + (
                     ", the line it fell in left out" if self._held.strip() else ""))
-            return
+            return None
         except (OSError, zlib.error, lzma.LZMAError) as err:
             raise TableError(f"{self._path}: its {self._kind} stream cannot be decompressed "
                              f"({err}): the file is damaged") from None
-        if not chunk:
-            self._done = True
-            self._out, self._held = memoryview(self._held), b""
-            return
-        data = self._held + chunk
-        cut = data.rfind(b"\n") + 1
-        self._out, self._held = memoryview(data)[:cut], data[cut:]
-
-    def close(self) -> None:
-        self._inner.close()
-        super().close()
 
 
 # ----- delimited text --------------------------------------------------------------------------
@@ -769,37 +786,13 @@ def _spaced_line(line: str) -> str:
     return (f"{mark} " if mark else "") + WHITESPACE_AS.join(cells)
 
 
-class _Spaced(io.RawIOBase):
+class _Spaced(_Lines):
     """A file's bytes with the runs of spaces or tabs between cells read as WHITESPACE_AS, line
     by line (as many lines, so that line numbers stay the file's)."""
 
-    def __init__(self, inner: IO[bytes]) -> None:
-        self._inner = inner
-        self._out = memoryview(b"")
-        self._held = b""
-        self._done = False
-
-    def readable(self) -> bool:
-        return True
-
-    def readinto(self, buffer: Any) -> int:
-        while not self._out and not self._done:
-            chunk = self._inner.read(SALVAGE_CHUNK)
-            data = self._held + chunk
-            cut = len(data) if not chunk else data.rfind(b"\n") + 1
-            self._done = not chunk
-            whole, self._held = data[:cut], data[cut:]
-            between = WHITESPACE_AS.encode()  # bytes.split: ten times re.sub's pace
-            self._out = memoryview(b"\n".join(between.join(line.split())
-                                              for line in whole.split(b"\n")))
-        n = min(len(buffer), len(self._out))
-        memoryview(buffer).cast("B")[:n] = self._out[:n]
-        self._out = self._out[n:]
-        return n
-
-    def close(self) -> None:
-        self._inner.close()
-        super().close()
+    def _lines(self, whole: bytes) -> bytes:
+        between = WHITESPACE_AS.encode()  # bytes.split: ten times re.sub's pace
+        return b"\n".join(between.join(line.split()) for line in whole.split(b"\n"))
 
 
 def _comment(line: str) -> str:
