@@ -9,8 +9,10 @@ them for less than pyarrow's, where formatting is most of a long run's writing.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -49,8 +51,14 @@ class TableWriter:
         self._sink: Any = None
         self._writer: Any = None
         self._schema: Any = None
-        try:
+        with self._or_discarded():
             self._open()
+
+    @contextlib.contextmanager
+    def _or_discarded(self) -> Iterator[None]:
+        """An OSError inside (a full disk) raised naming the file, its partial file removed."""
+        try:
+            yield
         except OSError as err:
             self.discard()
             raise OSError(f"{self.path}: cannot be written ({err})") from None
@@ -80,11 +88,8 @@ class TableWriter:
     def write(self, columns: list[np.ndarray]) -> None:
         """One block: an array per name, all of one length. OSError naming the file where it
         cannot be written (a full disk), the partial file removed."""
-        try:
+        with self._or_discarded():
             self._write(columns)
-        except OSError as err:
-            self.discard()
-            raise OSError(f"{self.path}: cannot be written ({err})") from None
 
     def _write(self, columns: list[np.ndarray]) -> None:
         n = len(columns[0]) if columns else 0
@@ -128,12 +133,9 @@ class TableWriter:
 
     def commit(self) -> Path:
         """Close and rename into place; the destination."""
-        try:
+        with self._or_discarded():
             self._close()
             self.partial.replace(self.path)
-        except OSError as err:
-            self.discard()
-            raise OSError(f"{self.path}: cannot be written ({err})") from None
         return self.path
 
     def discard(self) -> None:
