@@ -154,13 +154,13 @@ def _filled(rec: Any, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     if longest > MAX_FILLED_S:
         raise RecordingError(
             f"{rec.name}: samples {b} to {e - 1} (from 0, as --sections numbers them) lack a "
-            f"number ({longest:.2f} s from "
-            f"{times[b]:.2f} s): a session is filled across at most {MAX_FILLED_S:g} s, as its "
-            "turns are integrated sample by sample; record the session again")
+            f"number ({longest:.2f} s from {times[b]:.2f} s): a session is filled across at "
+            f"most {MAX_FILLED_S:g} s, as its turns are integrated sample by sample; record the "
+            "session again")
     acc, gyro = rec.acc.copy(), rec.gyro.copy()
     for values in (acc, gyro):
         for k in range(3):
-            ok = np.isfinite(values[:, k]) & valid
+            ok = np.isfinite(values[:, k])  # a row's other numbers are kept
             values[~ok, k] = np.interp(times[~ok], times[ok], values[ok, k])
     dt = np.concatenate([[rec.dt[0]], np.diff(times)])
     return acc, gyro, dt, (f"{int((~valid).sum())} sample(s) without a number in every "
