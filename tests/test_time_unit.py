@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from testbenches.cli import main
-from testbenches.fit.recording import RecordingError, open_recording
+from testbenches.fit.recording import RecordingError, concatenate, open_recording
 from testbenches.time_unit import RATE_RANGE, candidates
 
 REPO = Path(__file__).resolve().parents[1]
@@ -254,3 +254,26 @@ def test_a_given_rate_that_contradicts_a_time_that_serves_is_refused(tmp_path):
         open_recording(path, gyro_unit="rad/s", rate=200.0)
     source = open_recording(path, gyro_unit="rad/s", rate=101.0)
     assert "time from the rate given (101 Hz)" in source.choices
+
+
+@pytest.mark.parametrize("at", [500, 499, 0])  # in a block, the first of the second, the first
+def test_a_row_written_twice_is_rejected_and_counted_not_a_refusal(tmp_path, at):
+    """A logger that writes a row twice (its time and every number): the file was refused
+    ('the time 4.99 s repeats ...'). The row is now a sample without a time, which the
+    estimators reject and count, said apart from rows without numbers; the rest as without it,
+    across a block's edge too."""
+    t, imu = _example()
+    rows = np.insert(np.arange(len(t)), at + 1, at)
+    path = _write(tmp_path / "twice.csv", "time", t[rows], imu[rows])
+    source = open_recording(path)
+    parts = list(source.blocks(500))
+    rec = concatenate([p for p, _ in parts])
+    assert len(rec.dt) == len(t) + 1 and int((~rec.valid).sum()) == 1
+    assert not rec.valid[at + 1]
+    kept = np.delete(np.arange(len(rec.dt)), at + 1)
+    once = _read(_write(tmp_path / "once.csv", "time", t, imu))[1]
+    np.testing.assert_array_equal(rec.gyro[kept], once.gyro)
+    np.testing.assert_array_equal(rec.dt[kept][1:], once.dt[1:])
+    said = source.summary(len(rec.dt), 0.0, 1)
+    assert "1 row(s) repeat the row before them, time and numbers" in said
+    assert "without a number in every column" not in said

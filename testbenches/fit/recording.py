@@ -343,6 +343,10 @@ class _Clock:
     by about that much is the counter starting again, not time going back (0: none)."""
     offset: float = 0.0
     wraps: int = 0
+    twice: int = 0
+    """Rows that repeat the row before them, time and numbers (_repeated_rows)."""
+    last_values: Any = None
+    """The last row's numbers (for the next block's first row)."""
     repeats: str = ""
     """What to say where a time repeats: how often it does over the first rows, and the rate
     that would space the samples (a time coarser than the sampling)."""
@@ -514,6 +518,8 @@ class RecordingSource:
         """What was read: the count and length, the choices (unless told not to), the samples
         without numbers."""
         wrapped = self.read_notes.get("wraps", 0)
+        twice = self.read_notes.get("twice", 0)
+        missing -= twice  # said on their own
         what = ("the time of day passed midnight" if self.time_unit == TIME_OF_DAY
                 else "the time's 32-bit counter started again")
         return (f"{n} samples, {duration:.4g} s at {self.rate:.4g} Hz"
@@ -522,6 +528,9 @@ class RecordingSource:
                    "estimators reject and count (the next sample's dt spans them)"
                    if missing else "")
                 + (f"; {what} {wrapped} time(s), taken as going on" if wrapped else "")
+                + (f"; {twice} row(s) repeat the row before them, time and numbers (a logger "
+                   "wrote them twice): rejected and counted, as samples without a time"
+                   if twice else "")
                 + "".join(f"; {said}" for said in dict.fromkeys(self.found)))
 
 
@@ -603,6 +612,9 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         prefix_block = np.empty((0, len(wanted) + len(found.other_times)
                                  + len(found.instances)))
     prefix = {q: prefix_block[:, k] for k, q in enumerate(names)}
+    if "time" in prefix and not _split_rows(*_vectors(prefix)):  # as _samples does
+        twice = _repeated_rows(prefix, None)[0]
+        prefix["time"] = np.where(twice, np.nan, prefix["time"])
     other_times = {j: prefix_block[:, len(names) + k] for k, j in enumerate(found.other_times)}
     for k, j in enumerate(found.instances):
         _one_sensor(path, table.header[j],
@@ -743,7 +755,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             rec = Recording(name, acc, gyro, dt, 1.0 / period, "point", up, counts,
                             gyro_unit=found_unit.unit, gyro_unit_checked=found_unit.checked)
             rec.ref_quat = ref_quat
-            read_notes["wraps"] = run_clock.wraps
+            read_notes["wraps"], read_notes["twice"] = run_clock.wraps, run_clock.twice
             yield rec, t
 
     return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit,
@@ -756,9 +768,28 @@ def _samples(block: np.ndarray, names: list[str], join: Any, clock: _Clock, row0
     on rows of their own (join: a _JoinedRows, or None), the clock run over every row so that
     it names a row by the file's line."""
     cols = {q: block[:, k] for k, q in enumerate(names)}
+    if join is None and clock.kind == "time":  # a row written twice: no time of its own
+        twice, clock.last_values = _repeated_rows(cols, clock.last_values)
+        if twice.any():
+            cols["time"] = np.where(twice, np.nan, cols["time"])
+            clock.twice += int(twice.sum())
     cols, rows = join(cols) if join else (cols, slice(None))
     dt, t = clock(cols.get(clock.kind), row0, len(block), _holds(cols))
     return {q: v[rows] for q, v in cols.items()}, dt[rows], t[rows]
+
+
+def _repeated_rows(cols: dict[str, np.ndarray], before: np.ndarray | None
+                   ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Which rows repeat the row before them in every column, time included (`before`: the
+    previous block's last row), and this block's last row: a logger that wrote a row twice.
+    A sensor's noise makes two samples' six numbers and times alike only where a row was
+    written twice; a time column with whole samples alike at rest differs in its time."""
+    if "time" not in cols or not len(cols["time"]):
+        return np.zeros(len(next(iter(cols.values()))), dtype=bool), before
+    table = np.column_stack([cols[q] for q in sorted(cols)])
+    previous = np.vstack([table[:1] * np.nan if before is None else before[None, :],
+                          table[:-1]])
+    return np.all(table == previous, axis=1), table[-1].copy()
 
 
 RATE_AGREES = 0.02
@@ -814,10 +845,11 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         repeats = ""
         if zeros and span[1] > 0.0:
             mean_rate = span[0] / (span[1] * scale)
-            repeats = (f" ({zeros} of the first {span[0]} steps are 0: rows written twice, or "
-                       "a time coarser than the samples' spacing, which is "
-                       f"{mean_rate:.4g} Hz on average; remove the rows, or give --rate "
-                       f"{mean_rate:.4g} to space the samples by a rate, the time left)")
+            repeats = (f" ({zeros} of the first {span[0]} steps are 0 between rows of other "
+                       "numbers (a row written twice whole is rejected and counted): a time "
+                       "coarser than the samples' spacing, which is "
+                       f"{mean_rate:.4g} Hz on average; give --rate {mean_rate:.4g} to space "
+                       "the samples by a rate, the time left)")
         return _Clock(kind, scale, first, path, where, wrap=wrap, repeats=repeats)
 
     # the unit from the mean step where the time repeats: a clock coarser than the samples
