@@ -531,8 +531,8 @@ def _sniff(path: Path) -> _TextLayout:
     spaced = False
     if found is None:  # cells split by runs of spaces: each run read as WHITESPACE_AS
         spaced_lines = [(no, _spaced_line(line)) for no, line in numbered]
-        found = _find_header(spaced_lines, ends[-1] + 1 if ends else 0)
-        if found is None or found[0] != WHITESPACE_AS:
+        found = _find_header(spaced_lines, ends[-1] + 1 if ends else 0, WHITESPACE_AS)
+        if found is None:
             raise _no_table(path, numbered[0])
         numbered, spaced = spaced_lines, True
     delimiter, start = found
@@ -828,7 +828,8 @@ _END_OF_HEADER = re.compile(r"^\s*\*\*\*End_of_Header\*\*\*[\s,;|]*$", re.IGNORE
 line; the table's header row follows the last."""
 
 
-def _find_header(numbered: list[tuple[int, str]], first: int = 0) -> tuple[str, int] | None:
+def _find_header(numbered: list[tuple[int, str]], first: int = 0,
+                 delimiters: str = DELIMITERS) -> tuple[str, int] | None:
     """(delimiter, index into numbered) of the header: the first line from numbered[first] on
     (after LabVIEW's file and segment headers) that, with the HEADER_CHECK lines after it, one
     delimiter splits into as many cells, more than one (the most cells where several do), or
@@ -840,15 +841,23 @@ def _find_header(numbered: list[tuple[int, str]], first: int = 0) -> tuple[str, 
         window = [numbered[k][1] for k in content[i:i + HEADER_CHECK + 1]]
         best: tuple[str, int] | None = None
         cells = 1
-        for d in DELIMITERS:
+        for d in delimiters:
             counts = {_cells(line, d) for line in window}
             if len(counts) != 1:
                 counts = {_cells(line.rstrip().removesuffix(d), d) for line in window}
-            if len(counts) == 1 and (n := counts.pop()) > cells:
+            if (len(counts) == 1 and (n := counts.pop()) > cells
+                    and not _spaced_numbers(window, d)):
                 best, cells = (d, start), n
         if best is not None:
             return best
     return None
+
+
+def _spaced_numbers(lines: list[str], delimiter: str) -> bool:
+    """Whether a cell of the lines holds numbers with spaces between: the delimiter is a
+    decimal comma of cells that runs of spaces split ("0,01 9,81"), not the cells' own."""
+    return any(len(words := cell.split()) > 1 and all(_number_like(w) for w in words)
+               for line in lines for cell in next(csv.reader([line], delimiter=delimiter)))
 
 
 def _text(path: Path) -> TableSource:

@@ -1032,9 +1032,11 @@ def test_cells_split_by_runs_of_spaces_are_read(tmp_path, style):
         open_recording(path).load()
 
 
-def test_a_tum_trajectory_is_a_reference(tmp_path, capsys):
+@pytest.mark.parametrize("point", [".", ","])
+def test_a_tum_trajectory_is_a_reference(tmp_path, capsys, point):
     """TUM's ground truth ('# timestamp tx ty tz qx qy qz qw', spaces between, w last) is a
-    reference: scored, it gives what the truth file gives."""
+    reference: scored, it gives what the truth file gives. With a decimal comma too (and the
+    recording written so): the comma was taken for the delimiter, each cell two numbers."""
     from scipy.spatial.transform import Rotation
 
     from testbenches.cli import main
@@ -1046,10 +1048,15 @@ def test_a_tum_trajectory_is_a_reference(tmp_path, capsys):
     rows = np.column_stack([truth["time"], np.zeros((len(xyzw), 3)), xyzw])
     tum = tmp_path / "groundtruth.txt"
     tum.write_text("# timestamp tx ty tz qx qy qz qw\n" + "".join(
-        " ".join(f"{v:.9f}" for v in row) + "\n" for row in rows))
+        " ".join(f"{v:.9f}".replace(".", point) for v in row) + "\n" for row in rows))
+    recording = tmp_path / "imu.txt"
+    names = EXAMPLE.read_text().splitlines()[0].split(",")
+    recording.write_text(" ".join(names) + "\n" + "".join(
+        " ".join(f"{v:.10g}".replace(".", point) for v in row) + "\n"
+        for row in np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)))
     scores = []
     for reference in (REPO / "examples" / "tilt_motion_truth.csv", tum):
-        assert main(["estimate", str(EXAMPLE), "--estimator", "kf", "--reference",
+        assert main(["estimate", str(recording), "--estimator", "kf", "--reference",
                      str(reference), "--no-plots", "--out", str(tmp_path / "out")]) == 0
         said = capsys.readouterr().out
         scores.append(float(next(r for r in said.splitlines() if r.startswith("kf ")).split()[2]))
