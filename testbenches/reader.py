@@ -788,7 +788,8 @@ def _spaced_line(line: str) -> str:
 
 class _Spaced(_Lines):
     """A file's bytes with the runs of spaces or tabs between cells read as WHITESPACE_AS, line
-    by line (as many lines, so that line numbers stay the file's)."""
+    by line (as many lines, so that line numbers stay the file's): _spaced_line on bytes,
+    without its comment mark, as the rows that are read come after the header."""
 
     def _lines(self, whole: bytes) -> bytes:
         between = WHITESPACE_AS.encode()  # bytes.split: ten times re.sub's pace

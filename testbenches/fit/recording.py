@@ -344,7 +344,7 @@ class _Clock:
     offset: float = 0.0
     wraps: int = 0
     twice: int = 0
-    """Rows that repeat the row before them, time and numbers (_repeated_rows)."""
+    """Rows that repeat the row before them, time and numbers (_without_twice)."""
     last_values: Any = None
     """The last row's numbers (for the next block's first row)."""
     repeats: str = ""
@@ -612,9 +612,6 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         prefix_block = np.empty((0, len(wanted) + len(found.other_times)
                                  + len(found.instances)))
     prefix = {q: prefix_block[:, k] for k, q in enumerate(names)}
-    if "time" in prefix and not _split_rows(*_vectors(prefix)):  # as _samples does
-        twice = _repeated_rows(prefix, None)[0]
-        prefix["time"] = np.where(twice, np.nan, prefix["time"])
     other_times = {j: prefix_block[:, len(names) + k] for k, j in enumerate(found.other_times)}
     for k, j in enumerate(found.instances):
         _one_sensor(path, table.header[j],
@@ -626,6 +623,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     given_rate = rate
     rate = rate or table.attrs.get("rate")
     split = _split_rows(*_vectors(prefix))
+    if "time" in prefix and not split:  # rows written twice take no time, as in _samples
+        prefix["time"] = _without_twice(prefix, None)[0]
     joiner = None
     keep: Any = slice(None)  # the rows that are samples (all, unless split)
     if split:
@@ -769,27 +768,26 @@ def _samples(block: np.ndarray, names: list[str], join: Any, clock: _Clock, row0
     it names a row by the file's line."""
     cols = {q: block[:, k] for k, q in enumerate(names)}
     if join is None and clock.kind == "time":  # a row written twice: no time of its own
-        twice, clock.last_values = _repeated_rows(cols, clock.last_values)
-        if twice.any():
-            cols["time"] = np.where(twice, np.nan, cols["time"])
-            clock.twice += int(twice.sum())
+        cols["time"], clock.last_values, twice = _without_twice(cols, clock.last_values)
+        clock.twice += twice
     cols, rows = join(cols) if join else (cols, slice(None))
     dt, t = clock(cols.get(clock.kind), row0, len(block), _holds(cols))
     return {q: v[rows] for q, v in cols.items()}, dt[rows], t[rows]
 
 
-def _repeated_rows(cols: dict[str, np.ndarray], before: np.ndarray | None
-                   ) -> tuple[np.ndarray, np.ndarray | None]:
-    """Which rows repeat the row before them in every column, time included (`before`: the
-    previous block's last row), and this block's last row: a logger that wrote a row twice.
-    A sensor's noise makes two samples' six numbers and times alike only where a row was
-    written twice; a time column with whole samples alike at rest differs in its time."""
-    if "time" not in cols or not len(cols["time"]):
-        return np.zeros(len(next(iter(cols.values()))), dtype=bool), before
+def _without_twice(cols: dict[str, np.ndarray], before: np.ndarray | None
+                   ) -> tuple[np.ndarray, np.ndarray | None, int]:
+    """The time column with NaN for the rows that repeat the row before them in every column,
+    time included (`before`: the previous block's last row), this block's last row, and how
+    many: a logger that wrote a row twice. A sensor's noise makes two samples' six numbers and
+    times alike only there; whole samples alike at rest differ in their time."""
+    if not len(cols["time"]):
+        return cols["time"], before, 0
     table = np.column_stack([cols[q] for q in sorted(cols)])
     previous = np.vstack([table[:1] * np.nan if before is None else before[None, :],
                           table[:-1]])
-    return np.all(table == previous, axis=1), table[-1].copy()
+    twice = np.all(table == previous, axis=1)
+    return np.where(twice, np.nan, cols["time"]), table[-1].copy(), int(twice.sum())
 
 
 RATE_AGREES = 0.02
