@@ -1,16 +1,17 @@
 """A ROS bag as a table: one topic's messages, one row each, read with the rosbags package.
 
-ROS 1 bags (`.bag`) and ROS 2 bags (a folder with its `metadata.yaml`, or its `.db3` or
-`.mcap` file alone) are told by their first bytes or by that folder. A recording is the bag's
-`sensor_msgs/Imu` topic (the only one, or the one `--topic` names): its columns are the
-message's fields as ROS names them (`header/stamp`, `angular_velocity/x`,
+ROS 1 bags (`.bag`) and ROS 2 bags (a folder with its `metadata.yaml` or one `.mcap` file, or
+its `.db3` or `.mcap` file alone) are told by their first bytes or by that folder. A recording
+is the bag's `sensor_msgs/Imu` topic (the only one, or the one `--topic` names): its columns
+are the message's fields as ROS names them (`header/stamp`, `angular_velocity/x`,
 `linear_acceleration/x`, with the units the message definition gives them: s, rad/s, m/s2) and
 `receive_time`, when the bag received it, which serves where a driver leaves the stamp empty. A
 reference is the bag's pose topic (`geometry_msgs/PoseStamped`, `PoseWithCovarianceStamped`,
 `TransformStamped`, `QuaternionStamped` or `nav_msgs/Odometry`: a motion-capture system's or an
 odometry's), its quaternion's columns named as the message nests them (`pose/orientation/w`).
 Times are seconds since 1970, as the stamps count them, so that a recording and its reference
-from one bag or from two recorded together are matched by their clock.
+from one bag or from two recorded together are matched by their clock. A bag whose recording
+stopped before it was closed is read by testbenches.bag_salvage.
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ def is_bag(path: Path) -> bool:
     """Whether the path is a ROS bag: a ROS 1 bag, a ROS 2 bag's folder, or its .db3 or .mcap
     file."""
     if path.is_dir():
-        return (path / "metadata.yaml").is_file()
+        return (path / "metadata.yaml").is_file() or _lone_mcap(path) is not None
     if not path.is_file():
         return False
     with path.open("rb") as f:
@@ -149,9 +150,16 @@ def _checked(bag: Any, message: tuple[Any, int, bytes], cdr: bool) -> tuple[int,
     return layout if same else None
 
 
+def _lone_mcap(folder: Path) -> Path | None:
+    """A ROS 2 bag folder's one MCAP file (a recorder stopped before writing metadata.yaml
+    leaves it alone); None where it has none or several."""
+    found = sorted(folder.glob("*.mcap"))
+    return found[0] if len(found) == 1 else None
+
+
 def _repair(path: Path, err: Exception) -> str:
     """How a bag whose recording stopped before its end is repaired, where its error shows it
-    (a ROS 1 bag's index or an MCAP file's summary is written last)."""
+    (a ROS 1 bag's index or an MCAP file's summary is written last); "" for another error."""
     text = str(err)
     if "index" in text.lower() and path.suffix == ".bag":
         return (": a recording stopped before the bag's index was written; `rosbag reindex "
@@ -162,24 +170,52 @@ def _repair(path: Path, err: Exception) -> str:
     return ""
 
 
+def _opener(path: Path) -> tuple[Callable[[], Any], dict[str, list[Any]], str]:
+    """How the bag is opened (rosbags' AnyReader; bag_salvage's reader where the recording
+    stopped before the bag's index or end was written), its topics' [type, message count] and
+    what a user should know of how it was read; TableError where it cannot be read."""
+    from rosbags.highlevel import AnyReader
+
+    from .bag_salvage import SalvagedBag, SalvageError
+
+    def topics(bag: Any) -> dict[str, list[Any]]:
+        counts: dict[str, list[Any]] = {}
+        for c in bag.connections:
+            counts.setdefault(c.topic, [c.msgtype, 0])[1] += c.msgcount
+        return counts
+
+    if path.is_dir() and not (path / "metadata.yaml").is_file():
+        path = _lone_mcap(path) or path
+    try:
+        with AnyReader([path]) as bag:
+            return (lambda: AnyReader([path])), topics(bag), ""
+    except Exception as err:  # rosbags raises its own per format: any is an unreadable bag
+        refused = f"{path}: not a readable ROS bag ({err})"
+        repair = _repair(path, err)
+        data = _lone_mcap(path) if path.is_dir() else path
+        if not repair or data is None:
+            raise TableError(refused + repair) from None
+    try:
+        with SalvagedBag(data) as salvaged:
+            return (lambda: SalvagedBag(data)), topics(salvaged), salvaged.stopped()
+    except SalvageError as why:
+        raise TableError(f"{refused}{repair}; read record by record, {why}") from None
+
+
 def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSource:
     """The bag's table of `want` ("imu": the recording's, "pose": a reference's) from the topic
     named, else from the only topic of such a type; TableError where the bag cannot be read,
-    holds no such topic or several (naming them), or the topic named is none of them."""
+    holds no such topic or several (naming them), or the topic named is none of them. A bag
+    whose recording stopped before its index or end was written is read up to where it stops
+    (testbenches.bag_salvage), and its note says so."""
     try:
-        from rosbags.highlevel import AnyReader
+        import rosbags.highlevel  # noqa: F401
     except ImportError:
         raise TableError(f"{path}: a ROS bag, which takes the rosbags package to read (pip "
                          "install rosbags); or export the topic as CSV (rostopic echo -p, "
                          "PlotJuggler)") from None
     types = IMU_TYPES if want == "imu" else tuple(POSE_TYPES)
-    try:
-        with AnyReader([path]) as bag:
-            counts: dict[str, list[Any]] = {}
-            for c in bag.connections:
-                counts.setdefault(c.topic, [c.msgtype, 0])[1] += c.msgcount
-    except Exception as err:  # rosbags raises its own per format: any is an unreadable bag
-        raise TableError(f"{path}: not a readable ROS bag ({err}){_repair(path, err)}") from None
+    opener, counts, how = _opener(path)
     fits = sorted(t for t, (kind, _) in counts.items() if kind in types)
     listed = ", ".join(f"{t} ({k})" for t, (k, _) in sorted(counts.items()))
     if topic is not None:
@@ -211,7 +247,7 @@ def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSo
             return np.array([[get(bag.deserialize(raw, c.msgtype)) for get in values]
                              + [received * 1e-9] for c, received, raw in block])
 
-        with AnyReader([path]) as bag:
+        with opener() as bag:
             connections = [c for c in bag.connections if c.topic == chosen]
             block: list[tuple[Any, int, bytes]] = []
             for message in bag.messages(connections=connections):
@@ -224,4 +260,5 @@ def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSo
 
     return TableSource(path, header, list(header), units, "ROS bag", n, read,
                        lambda row: f"message {row + 1} of {chosen}",
-                       note=f"topic {chosen} ({msgtype}, {n} messages)")
+                       note=f"topic {chosen} ({msgtype}, {n} messages)"
+                       + (f"; {how}" if how else ""))

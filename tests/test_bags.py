@@ -4,6 +4,7 @@ or odometry topic as the reference, from a ROS 1 bag, a ROS 2 bag's folder or it
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -76,10 +77,12 @@ def _messages(ts, imu_topics=("/imu/data",), pose="geometry_msgs/msg/PoseStamped
     return sorted(out, key=lambda m: m[0])
 
 
-def write_bag(path: Path, kind: str = "ros2", **how) -> Path:
-    """A bag of the example (ROS 1 .bag, or ROS 2 in SQLite or MCAP) with rosbags' writers."""
+def write_bag(path: Path, kind: str = "ros2", compression: str = "none", **how) -> Path:
+    """A bag of the example (ROS 1 .bag, or ROS 2 in SQLite or MCAP) with rosbags' writers;
+    a ROS 1 bag's chunks compressed as given (in chunks of 64 kB), an MCAP file's with zstd
+    where compression is "zstd"."""
     from rosbags.rosbag1 import Writer as Writer1
-    from rosbags.rosbag2 import StoragePlugin
+    from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin
     from rosbags.rosbag2 import Writer as Writer2
     from rosbags.typesys import Stores, get_typestore
 
@@ -87,6 +90,11 @@ def write_bag(path: Path, kind: str = "ros2", **how) -> Path:
     writer = (Writer1(path) if kind == "ros1" else
               Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP if kind == "mcap"
                       else StoragePlugin.SQLITE3))
+    if kind == "ros1" and compression != "none":
+        writer.set_compression(Writer1.CompressionFormat[compression.upper()])
+        writer.chunk_threshold = 64 * 1024
+    elif compression != "none":
+        writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
     serialize = ts.serialize_ros1 if kind == "ros1" else ts.serialize_cdr
     with writer:
         connections = {}
@@ -180,20 +188,92 @@ def test_imu_messages_read_off_their_bytes_are_the_deserialized_ones(tmp_path, k
     np.testing.assert_array_equal(rec.acc, slow[:, 1:4])
 
 
+def _killed(raw: bytes) -> bytes:
+    """A ROS 1 bag as `rosbag record` leaves it when killed: the bag header's index position
+    0, its open chunk's sizes the placeholders (0) written when the chunk began, and no index
+    (the bag's records up to where the chunk's data ends)."""
+    def record(at: int) -> tuple[dict[str, tuple[int, bytes]], int, int]:
+        n = int.from_bytes(raw[at:at + 4], "little")
+        fields, k = {}, at + 4
+        while k < at + 4 + n:
+            m = int.from_bytes(raw[k:k + 4], "little")
+            name, _, value = raw[k + 4:k + 4 + m].partition(b"=")
+            fields[name.decode()] = (k + 4 + len(name) + 1, value)
+            k += 4 + m
+        return fields, at + 4 + n, int.from_bytes(raw[at + 4 + n:at + 8 + n], "little")
+
+    out = bytearray(raw)
+    header, data_at, size = record(len(b"#ROSBAG V2.0\n"))
+    out[header["index_pos"][0]:header["index_pos"][0] + 8] = bytes(8)
+    chunk, chunk_data, chunk_size = record(data_at + 4 + size)
+    assert chunk["compression"][1] == b"none"
+    out[chunk["size"][0]:chunk["size"][0] + 4] = bytes(4)
+    out[chunk_data:chunk_data + 4] = bytes(4)
+    return bytes(out[:chunk_data + 4 + chunk_size])
+
+
+@pytest.mark.parametrize("kind,compression", [("ros1", "none"), ("ros1", "bz2"),
+                                              ("ros1", "lz4"), ("ros1", "killed"),
+                                              ("mcap", "none"), ("mcap", "zstd")])
+def test_a_bag_whose_recording_stopped_is_read_up_to_where_it_stops(tmp_path, capsys, kind,
+                                                                    compression):
+    """A recorder killed or powered off leaves a ROS 1 bag without its index and an MCAP file
+    without its summary and end, its last record cut: read record by record, every whole
+    message before the cut the whole bag's, and said."""
+    bag = write_bag(tmp_path / ("whole.bag" if kind == "ros1" else "whole"), kind,
+                    compression="none" if compression == "killed" else compression)
+    data = bag if kind == "ros1" else next(bag.glob("*.mcap"))
+    raw = data.read_bytes()
+    cut = tmp_path / ("cut.bag" if kind == "ros1" else "cut.mcap")
+    cut.write_bytes(_killed(raw) if compression == "killed" else raw[:len(raw) * 2 // 3])
+    whole, _ = open_recording(bag).load()
+    rec, _ = open_recording(cut).load()
+    assert 0.3 * len(whole.acc) < len(rec.acc) < len(whole.acc) * (
+        1 if compression != "killed" else 1.001)
+    for got, want in ((rec.acc, whole.acc), (rec.gyro, whole.gyro), (rec.dt, whole.dt)):
+        np.testing.assert_array_equal(got, want[:len(got)])
+    status, said = _kf(tmp_path, capsys, cut, "--reference", str(cut))
+    assert status == 0, said
+    lacks = "its index" if kind == "ros1" else "its summary and end"
+    assert f"read record by record, {lacks} never written" in said
+    if compression != "killed":
+        assert "it ends inside a record (from byte" in said
+    assert re.search(r"kf\s+0\s+0\.[0-9]+", said), said
+
+
+@pytest.mark.parametrize("metadata", [True, False])
+def test_a_ros2_bag_folder_whose_mcap_was_cut_is_read_from_its_one_mcap_file(tmp_path,
+                                                                            metadata):
+    """rosbag2 writes metadata.yaml when it closes the bag: a recorder stopped leaves the folder
+    with its MCAP file cut, and with or without a metadata.yaml of an earlier close."""
+    bag = write_bag(tmp_path / "run", "mcap")
+    mcap = next(bag.glob("*.mcap"))
+    raw = mcap.read_bytes()
+    whole, _ = open_recording(bag).load()
+    mcap.write_bytes(raw[:len(raw) // 2])
+    if not metadata:
+        (bag / "metadata.yaml").unlink()
+    rec, _ = open_recording(bag).load()
+    assert 0.3 * len(whole.acc) < len(rec.acc) < len(whole.acc)
+    np.testing.assert_array_equal(rec.acc, whole.acc[:len(rec.acc)])
+
+
 @pytest.mark.parametrize("kind,says", [
     ("ros1", r"not a readable ROS bag \(.*\): a recording stopped before the bag's index was "
-             r"written; `rosbag reindex cut\.bag` rebuilds it"),
+             r"written; `rosbag reindex cut\.bag` rebuilds it; read record by record, no whole "
+             r"message"),
     ("mcap", r"not a readable ROS bag \(.*\): an MCAP recording stopped before its end was "
-             r"written; `mcap recover FILE -o FIXED\.mcap`"),
+             r"written; `mcap recover FILE -o FIXED\.mcap`.*; read record by record, no whole "
+             r"message"),
 ])
-def test_a_bag_whose_recording_stopped_is_refused_saying_how_it_is_repaired(tmp_path, kind,
-                                                                            says):
-    """A recorder killed or powered off leaves a ROS 1 bag without its index and an MCAP file
-    without its end: refused, with the tool that repairs each."""
+def test_a_bag_cut_before_its_first_message_is_refused_saying_how_it_is_repaired(tmp_path,
+                                                                                 kind, says):
+    """Cut before any whole message, nothing is left to read: refused, with the tool that
+    repairs each kind."""
     bag = write_bag(tmp_path / ("whole.bag" if kind == "ros1" else "whole"), kind)
     data = bag if kind == "ros1" else next(bag.glob("*.mcap"))
     raw = data.read_bytes()
     cut = tmp_path / ("cut.bag" if kind == "ros1" else "cut.mcap")
-    cut.write_bytes(raw[:len(raw) * 2 // 3])
+    cut.write_bytes(raw[:raw.index(b"/imu/data") + 20])
     with pytest.raises(RecordingError, match=says):
         open_recording(cut)
