@@ -616,15 +616,61 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
         text = line.decode(layout.encoding, errors="replace")
         values = _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
         cells = len(values)
-        if cells < len(layout.header) and _row_start(values):
+        short = cells < len(layout.header) and _row_start(values)
+        cut = (cells == len(layout.header) and _row_start(values)
+               and _cut_value(values[-1], kept[:last], layout))
+        if short or cut:
             end = start + last
             number = _lines_before(path, end) + 1
             said.append(f"line {number}, the last, cut short ({cells} of "
-                        f"{len(layout.header)} values: a logger stopped mid-write): left out")
+                        f"{len(layout.header)} values: a logger stopped mid-write): left out"
+                        if short else
+                        f"line {number}, the last, cut mid-write (no line end after it, and its "
+                        f"last value {values[-1]!r} {cut}): left out")
     if nul:
         said.append(f"{nul} NUL bytes after the last line (the unwritten rest of a "
                     "preallocated file): ignored")
     return (end, "; ".join(said)) if said else (None, "")
+
+
+_SHAPE = re.compile(r"[-+]?([0-9]*)(?:[.,]([0-9]*))?(?:[eE][-+]?([0-9]*))?")
+SHAPE_LINES = 10
+"""The whole lines before an unterminated last line that must all show its last column's
+width for a shorter last value to be taken for a cut."""
+
+
+def _shape(cell: str) -> tuple[int, int, int] | None:
+    """A number's (digits of an integer, digits after its decimal point, digits of its
+    exponent): what a logger writing a column with one format keeps, and a cut shortens."""
+    m = _SHAPE.fullmatch(cell)
+    if m is None:
+        return None
+    whole, fraction, exponent = m.groups()
+    plain = fraction is None and exponent is None
+    return (len(whole) if plain else 0, len(fraction or ""), len(exponent or ""))
+
+
+def _cut_value(cell: str, before: bytes, layout: _TextLayout) -> str:
+    """Why a whole-width last line without a line end has its last value cut ("" where
+    nothing shows it): it is no number yet ("1.5e-"), or has fewer digits after its point, in
+    its exponent or (an integer column) in all than that column's value on each of the up to
+    100 whole lines before it (at least SHAPE_LINES of them)."""
+    if not _number_like(cell):
+        return "is no number"
+    shape = _shape(cell)
+    shapes = []
+    for raw in before.splitlines()[-100:]:
+        text = raw.decode(layout.encoding, errors="replace")
+        values = _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
+        if len(values) == len(layout.header) and (seen := _shape(values[-1])) is not None:
+            shapes.append(seen)
+    if shape is None or len(shapes) < SHAPE_LINES:
+        return ""
+    fewest = np.min(shapes, axis=0)
+    if any(have < want for have, want in zip(shape, fewest, strict=True)):
+        return (f"has fewer digits than that column's value on each of the {len(shapes)} "
+                "lines before it")
+    return ""
 
 
 _NUMBER_START = re.compile(r"^[-+]?[0-9]*[.,]?[0-9]*(?:[eE][-+]?[0-9]*)?$")

@@ -909,6 +909,44 @@ def test_a_whole_last_line_without_a_line_end_is_read(tmp_path):
     assert "cut short" not in opened.choices
 
 
+@pytest.mark.parametrize("dt,cut,value,why", [
+    (b"0.01", 2, "0.0", "has fewer digits than that column's value on each of the 100 lines "
+                        "before it"),
+    (b"1.00e-02", 2, "1.00e-0", "has fewer digits than that column's value on each of the "
+                                "100 lines before it"),
+    (b"1.00e-02", 3, "1.00e-", "is no number"),
+])
+def test_a_last_line_of_every_value_its_last_cut_mid_write_is_left_out(tmp_path, dt, cut,
+                                                                       value, why):
+    """Cut after the last delimiter, a line has the header's width: its last value, shorter
+    than the column's format writes it, was kept as a wrong number ('0.01' read as 0.0,
+    '1.00e-02' as 1) or refused the file."""
+    whole, _ = open_recording(EXAMPLE).load()
+    path = tmp_path / "cut.csv"
+    text = EXAMPLE.read_bytes().replace(b",0.01\n", b"," + dt + b"\n")
+    path.write_bytes(text[:-cut])
+    opened = open_recording(path)
+    rec, _ = opened.load()
+    np.testing.assert_array_equal(rec.dt, whole.dt[:-1])
+    np.testing.assert_array_equal(rec.gyro, whole.gyro[:-1])
+    assert ("line 1001, the last, cut mid-write (no line end after it, and its last value "
+            f"{value!r} {why}): left out") in opened.choices
+
+
+@pytest.mark.parametrize("last", [b"0.500000", b"-0.500000", b"12.500000"])
+def test_a_whole_last_value_of_another_sign_or_size_is_no_cut(tmp_path, last):
+    """A fixed format's width changes with the sign and the integer part, not its decimals:
+    such a last value without a line end is read."""
+    rows = [f"{k / 100:.2f},0.1,0.2,9.8,0.01,-0.02,{-0.3 - k / 1000:.6f}" for k in range(50)]
+    path = tmp_path / "fixed.csv"
+    path.write_bytes(("time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z\n" + "\n".join(rows)
+                      + "\n0.50,0.1,0.2,9.8,0.01,-0.02,").encode() + last)
+    opened = open_recording(path, gyro_unit="rad/s")
+    rec, _ = opened.load()
+    assert len(rec.dt) == 51 and rec.gyro[-1, 2] == float(last)
+    assert "cut" not in opened.choices
+
+
 def _long_example(rows: int = 60000) -> tuple[str, np.ndarray]:
     """The example's rows over and over, timed on (several of bz2's 900 kB blocks)."""
     _, imu = _example()
