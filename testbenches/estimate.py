@@ -581,9 +581,14 @@ class _VqfRun:
     samples they reject left out), block by block; `note` says why there is none."""
 
     def __init__(self, rate: float, params: dict[str, Any]) -> None:
+        from fusion_core.base import COMMON_PARAMS
+
         from .peers import PeerUnavailable, VqfStream
 
         self.params, self.score, self.trace = params, Score(), Thinned()
+        max_dt = next(float(p.default) for p in COMMON_PARAMS if p.name == "max_dt")
+        self.rate, self.most = rate, max(1, round(max_dt * rate))
+        self.missed = 0  # samples rejected since the last one taken
         try:
             self.stream: Any = VqfStream(rate)
             self.note = "VQF on the same samples"
@@ -595,8 +600,18 @@ class _VqfRun:
             return
         valid = rec.valid
         acc, gyro = conditioned(rec.acc[valid], rec.gyro[valid], self.params)
+        # VQF takes no sample the estimators rejected; as they integrate the sample after
+        # such samples over its dt, which spans them, VQF takes it once per sampling period
+        # its dt spans, up to once more per sample missed (not for a row written twice,
+        # which takes no time) and to max_dt's
+        where = np.flatnonzero(valid)
+        missed = np.diff(where, prepend=-1 - self.missed) - 1
+        self.missed = len(valid) - 1 - int(where[-1]) if len(where) else self.missed + len(valid)
+        steps = np.nan_to_num(np.rint(rec.dt[valid] * self.rate), nan=1.0)
+        repeats = np.clip(steps, 1, np.minimum(1 + missed, self.most)).astype(int)
         up = np.full((len(valid), 3), np.nan)
-        up[valid] = self.stream(acc, gyro)  # VQF takes no sample the estimators rejected
+        up[valid] = self.stream(np.repeat(acc, repeats, axis=0),
+                                np.repeat(gyro, repeats, axis=0))[np.cumsum(repeats) - 1]
         self.score.add(up, rec)
         self.trace.add(row0, {"t": t, "up": up})
 
