@@ -63,7 +63,9 @@ MISSING_VALUES = ("", "#n/a", "#n/a n/a", "#na", "-1.#ind", "-1.#qnan", "-nan", 
 Python's reader takes as well. Its sample is rejected and counted; a row of them is a row of
 data, not a header's row of names."""
 HEADER_CHECK = 20
-"""The header must split into as many cells as this many lines after it."""
+"""The header must split into as many cells as this many lines after it, but for
+HEADER_CHECK_ODD of them (a line a logger garbled: a sample without numbers, _python_blocks)."""
+HEADER_CHECK_ODD = 1
 PREAMBLE_LINES = 30
 """The header is looked for among the first this many lines that are not comments."""
 BLOCK_ROWS = 1 << 18
@@ -595,9 +597,10 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
     """Where the table ends before what a logger leaves when it stops mid-write, and what that
     was: NUL bytes after the last line (a file preallocated on an SD card, its unwritten rest)
     and a last line cut short (fewer cells than the header, no line end after it: power lost
-    while it was written, its last cell's digits perhaps cut too). (None, "") where the file
-    ends with its table. A short line that ends with a line end is no cut (a footer: refused
-    as a row of the wrong length, naming its line)."""
+    while it was written, its last cell's digits perhaps cut too; _cut_value), and a last line
+    of text, with a line end or without (a footer a logger appends: "END OF LOG"). (None, "")
+    where the file ends with its table. A short line of numbers that ends with a line end is
+    no cut: a line that is no row (_python_blocks)."""
     size = stop = path.stat().st_size
     with path.open("rb") as f:
         while True:  # back over windows of NULs to the last byte written
@@ -609,24 +612,29 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
             stop = start
     nul = size - start - len(kept)
     said = []
-    last = kept.rfind(b"\n") + 1
-    line = kept[last:]
+    terminated = kept.endswith(b"\n")
+    body = kept.rstrip(b"\r\n") if terminated else kept
+    last = body.rfind(b"\n") + 1
+    line = body[last:]
     end = start + len(kept)
     if line.strip() and start + last > 0:
         text = line.decode(layout.encoding, errors="replace")
         values = _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
         cells = len(values)
-        short = cells < len(layout.header) and _row_start(values)
-        cut = (cells == len(layout.header) and _row_start(values)
+        short = not terminated and cells < len(layout.header) and _row_start(values)
+        cut = (not terminated and cells == len(layout.header) and _row_start(values)
                and _cut_value(values[-1], kept[:last], layout))
-        if short or cut:
+        footer = not (short or cut) and cells != len(layout.header) and _footer(values)
+        if short or cut or footer:
             end = start + last
             number = _lines_before(path, end) + 1
             said.append(f"line {number}, the last, cut short ({cells} of "
                         f"{len(layout.header)} values: a logger stopped mid-write): left out"
                         if short else
                         f"line {number}, the last, cut mid-write (no line end after it, and its "
-                        f"last value {values[-1]!r} {cut}): left out")
+                        f"last value {values[-1]!r} {cut}): left out" if cut else
+                        f"line {number}, the last, is text after the table ({text.strip()[:40]!r}"
+                        "): left out as a footer")
     if nul:
         said.append(f"{nul} NUL bytes after the last line (the unwritten rest of a "
                     "preallocated file): ignored")
@@ -671,6 +679,13 @@ def _cut_value(cell: str, before: bytes, layout: _TextLayout) -> str:
         return (f"has fewer digits than that column's value on each of the {len(shapes)} "
                 "lines before it")
     return ""
+
+
+def _footer(cells: list[str]) -> bool:
+    """Whether a line's cells are text, no row (a summary a logger appends: "END OF LOG"; its
+    caller asks that they be not as many as the header's, as a row's with a text column are)."""
+    return (any(ch.isalpha() for c in cells for ch in c)
+            and not all(_number_like(c) or c.lower() in MISSING_VALUES for c in cells))
 
 
 _NUMBER_START = re.compile(r"^[-+]?[0-9]*[.,]?[0-9]*(?:[eE][-+]?[0-9]*)?$")
@@ -879,21 +894,25 @@ def _find_header(numbered: list[tuple[int, str]], first: int = 0,
                  delimiters: str = DELIMITERS) -> tuple[str, int] | None:
     """(delimiter, index into numbered) of the header: the first line from numbered[first] on
     (after LabVIEW's file and segment headers) that, with the HEADER_CHECK lines after it, one
-    delimiter splits into as many cells, more than one (the most cells where several do), or
-    as many but for a delimiter that ends the header or the rows alone (a sketch that prints a
-    comma after every value, its header without one). Lines before it are a logger's preamble
-    (a comment, a device name, the settings) and are skipped."""
+    delimiter splits into as many cells (but for HEADER_CHECK_ODD of them), more than one (the
+    most cells where several do), or as many but for a delimiter that ends the header or the
+    rows alone (a sketch that prints a comma after every value, its header without one). Lines
+    before it are a logger's preamble (a comment, a device name, the settings) and are
+    skipped."""
     content = [k for k, (_, line) in enumerate(numbered) if k >= first and not _comment(line)]
     for i, start in enumerate(content[:PREAMBLE_LINES]):
         window = [numbered[k][1] for k in content[i:i + HEADER_CHECK + 1]]
         best: tuple[str, int] | None = None
         cells = 1
         for d in delimiters:
-            counts = {_cells(line, d) for line in window}
-            if len(counts) != 1:
-                counts = {_cells(line.rstrip().removesuffix(d), d) for line in window}
-            if (len(counts) == 1 and (n := counts.pop()) > cells
-                    and not _spaced_numbers(window, d)):
+            for cut in ("", d):  # as written; without a delimiter that ends a line
+                counts = [_cells(line.rstrip().removesuffix(cut) if cut else line, d)
+                          for line in window]
+                if sum(c != counts[0] for c in counts[1:]) <= HEADER_CHECK_ODD:
+                    break
+            else:
+                continue
+            if (n := counts[0]) > cells and not _spaced_numbers(window, d):
                 best, cells = (d, start), n
         if best is not None:
             return best
@@ -1052,27 +1071,64 @@ def _line_of_row(path: Path, layout: _TextLayout, row: int) -> int:
     return -1
 
 
+GARBLED_SHARE = 0.01
+"""Lines that are no row of the table (a serial link's lost or garbled bytes, two rows run
+together, the header written again by a logger restarted) are taken as samples without a
+number where they are at most this share of the rows: more say the file is not the table its
+header and first rows describe, and it is refused naming the line (as soon as they pass one
+more than the share of the rows read, else at the end)."""
+
+
 def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int, skip: int
                    ) -> Iterator[np.ndarray]:
-    """The rows from row `skip` on, cell by cell: an empty cell as NaN, text refused by line
-    and column."""
+    """The rows from row `skip` on, cell by cell: an empty cell as NaN; a line that is no row
+    of the table (the header's count of numbers) as a row of NaN, counted and said in
+    layout.found when the read ends, and refused by its line and column where such lines are
+    more than GARBLED_SHARE of the rows."""
     width = len(layout.header)
     block: list[list[float]] = []
+    garbled, first, seen = 0, "", 0
+    nan_row = [float("nan")] * len(columns)
     for k, (line, row) in enumerate(_rows(path, layout)):
-        if len(row) != width:
-            text = layout.delimiter.join(row)
-            raise TableError(f"{path}, line {line}: {len(row)} value(s) where the header has "
-                             f"{width} columns ({text[:60]!r})")
+        seen = k + 1
         if k < skip:
             continue
-        block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
-                              _clock_of(layout, j), layout.durations.get(j, ""))
-                      for j in columns])
+        try:
+            if len(row) != width:
+                text = layout.delimiter.join(row)
+                raise TableError(f"{path}, line {line}: {len(row)} value(s) where the header "
+                                 f"has {width} columns ({text[:60]!r})")
+            if [c.strip() for c in row] == layout.header:
+                raise TableError(f"{path}, line {line}: the header again (a logger restarted "
+                                 "and wrote on)")
+            block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
+                                  _clock_of(layout, j), layout.durations.get(j, ""))
+                          for j in columns])
+        except TableError as err:
+            garbled += 1
+            first = first or str(err)
+            if garbled > 1 + GARBLED_SHARE * seen:  # the first is weighed at the end
+                raise _garbled(str(err), garbled, seen) from None
+            block.append(nan_row)
         if len(block) == rows:
             yield np.array(block, dtype=float).reshape(len(block), len(columns))
             block = []
+    if garbled > GARBLED_SHARE * seen:
+        raise _garbled(first, garbled, seen)
     if block:
         yield np.array(block, dtype=float).reshape(len(block), len(columns))
+    if garbled:
+        first = first.removeprefix(f"{path}, ")
+        layout.found.append(f"{garbled} line(s) no row of the table, taken as samples without "
+                            f"a number (a logger's garbled or lost bytes; the first: {first})")
+
+
+def _garbled(said: str, garbled: int, rows: int) -> TableError:
+    """The refusal of a file with more lines that are no row than GARBLED_SHARE allows: the
+    line's own refusal, and the count."""
+    return TableError(f"{said}; {garbled} of {rows} rows are no row of the table (more than "
+                      f"{GARBLED_SHARE:.0%} of them, which would be taken as samples without a "
+                      "number)" if garbled > 1 else said)
 
 
 def _clock_of(layout: _TextLayout, j: int) -> str:

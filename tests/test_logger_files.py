@@ -84,13 +84,31 @@ def test_numpys_commented_header_is_the_header_and_a_file_without_one_is_refused
         open_recording(bare)
 
 
-def test_a_line_after_the_table_is_refused_by_its_line_and_text(tmp_path):
-    """A summary line a logger appends ("END OF LOG") is no sample: refused naming it."""
+@pytest.mark.parametrize("footer", ["END OF LOG\n", "END OF LOG", "Total: 1000 samples\r\n\n"])
+def test_a_line_of_text_after_the_table_is_left_out_as_a_footer(tmp_path, footer):
+    """A summary line a logger appends ("END OF LOG") is no sample: it was refused; it is left
+    out, naming it."""
     path = tmp_path / "trailer.csv"
-    path.write_text(EXAMPLE.read_text() + "END OF LOG\n")
-    with pytest.raises(RecordingError, match=r"line 1002: 1 value\(s\) where the header has 8 "
-                       r"columns \('END OF LOG'\)"):
-        open_recording(path).load()
+    path.write_text(EXAMPLE.read_text() + footer, newline="")
+    whole, _ = open_recording(EXAMPLE).load()
+    opened = open_recording(path)
+    rec, _ = opened.load()
+    np.testing.assert_array_equal(rec.gyro, whole.gyro)
+    assert rec.valid.all()
+    assert (f"line 1002, the last, is text after the table ({footer.strip()!r}): left out as a "
+            "footer") in opened.choices
+
+
+def test_a_text_column_s_last_row_is_no_footer(tmp_path):
+    """A row with a text column (a status) has the header's width: read, not left out."""
+    lines = EXAMPLE.read_text().splitlines()
+    path = tmp_path / "status.csv"
+    path.write_text("\n".join([lines[0] + ",status"] + [x + ",OK" for x in lines[1:]]))
+    whole, _ = open_recording(EXAMPLE).load()
+    opened = open_recording(path)
+    rec, _ = opened.load()
+    np.testing.assert_array_equal(rec.gyro, whole.gyro)
+    assert "footer" not in opened.choices
 
 
 def test_accelerometer_and_gyro_on_rows_of_their_own_are_joined(tmp_path):
@@ -167,8 +185,7 @@ def test_a_compressed_file_reads_as_the_text_it_holds(tmp_path, compress):
     lines[500] = ",".join([cells[0], "abc", *cells[2:]])
     with module.open(path, "wt") as f:
         f.write("\n".join(lines))
-    with pytest.raises(RecordingError, match="line 501, column 'acc_x': 'abc' is not a number"):
-        open_recording(path).load()
+    assert "the first: line 501, column 'acc_x': 'abc' is not a number" in _no_row(path)
 
 
 @pytest.mark.parametrize("name,content,serves", [
@@ -394,8 +411,7 @@ def test_a_utf16_file_reads_as_the_text_it_holds(tmp_path, codec, delimiter, com
     lines[5] = lines[5].replace("0.0", "x.0", 1)
     bad = tmp_path / "bad.txt"
     bad.write_bytes("".join(lines).encode(codec))
-    with pytest.raises(RecordingError, match=r"line 6, column 'time': 'x\.04' is not a number"):
-        open_recording(bad).load()
+    assert "the first: line 6, column 'time': 'x.04' is not a number" in _no_row(bad)
 
 
 def test_a_rate_the_preamble_states_times_a_file_without_a_time_column(tmp_path):
@@ -678,9 +694,8 @@ def test_matlabs_exported_timetable_is_read(tmp_path, time_text):
     if time_text:
         lines[7] = lines[7].replace(" sec", " ms")
         path.write_text("\n".join(lines) + "\n")
-        with pytest.raises(RecordingError, match=r"line 8, column 'Time': '0.06 ms' is not a "
-                           "duration in sec"):
-            open_recording(path).load()
+        assert "the first: line 8, column 'Time': '0.06 ms' is not a duration in sec" in \
+            _no_row(path)
 
 
 def test_a_quaternions_four_matlab_columns_are_no_axes(tmp_path):
@@ -849,6 +864,15 @@ def test_a_plotjuggler_export_of_an_imu_and_a_mocap_topic_serves_as_both(tmp_pat
     assert kf == pytest.approx(0.5996, abs=0.01)
 
 
+def _no_row(path: Path) -> str:
+    """What reading a file with one line that is no row says of it (the line a sample without
+    numbers)."""
+    rec, _ = open_recording(path).load()
+    assert (~rec.valid).sum() == 1
+    assert "1 line(s) no row of the table, taken as samples without a number" in rec.described
+    return rec.described
+
+
 def _cut(path: Path, tail: bytes, *, cut: int = 40, nul: int = 0, crlf: bool = False) -> Path:
     """The example as a logger that lost power leaves it: its last `cut` bytes not written,
     `nul` NUL bytes after them (a preallocated file's unwritten rest); `tail` appended first."""
@@ -890,15 +914,6 @@ def test_nul_padding_after_whole_lines_is_ignored_and_said(tmp_path):
     np.testing.assert_array_equal(rec.gyro, whole.gyro)
     assert "100000 NUL bytes after the last line" in opened.choices
     assert "cut short" not in opened.choices
-
-
-@pytest.mark.parametrize("ending", [b"END OF LOG", b"END OF LOG\n"])
-def test_a_footer_is_no_cut_line(tmp_path, ending):
-    """Text after the table, with a line end or without one, is refused by its line as before:
-    only numbers can be a row cut mid-write."""
-    path = _cut(tmp_path / "footer.csv", ending, cut=0)
-    with pytest.raises(RecordingError, match=r"line 1002: 1 value\(s\) where the header has 8"):
-        open_recording(path).load()
 
 
 def test_a_whole_last_line_without_a_line_end_is_read(tmp_path):
@@ -945,6 +960,50 @@ def test_a_whole_last_value_of_another_sign_or_size_is_no_cut(tmp_path, last):
     rec, _ = opened.load()
     assert len(rec.dt) == 51 and rec.gyro[-1, 2] == float(last)
     assert "cut" not in opened.choices
+
+
+@pytest.mark.parametrize("padded", [False, True])  # pyarrow's reader, then Python's; Python's
+@pytest.mark.parametrize("line,says", [
+    ("4.98,-0.2,0.1", "line 500: 3 value(s) where the header has 8 columns ('4.98,-0.2,0.1')"),
+    ("4.98,-0.2,0.1,9.8,0.01,0.02,0.03,0.014.99,0.1,0.2,9.8,0.01,0.02,0.03,0.01",
+     "line 500: 15 value(s) where the header has 8 columns"),
+    ("4.98,-0.2,0.1,9$8,0.01,0.02,0.03,0.01", "line 500, column 'acc_z': '9$8' is not a "
+                                              "number"),
+    ("time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z,dt", "line 500: the header again (a logger "
+                                                       "restarted and wrote on)"),
+])
+def test_a_line_that_is_no_row_is_a_sample_without_numbers(tmp_path, padded, line, says):
+    """A serial link's lost or garbled bytes make a line no row of the table (too few or too
+    many values, text in a cell, the header written again): the file was refused naming the
+    line; the line is now a sample without numbers, rejected and counted, and said."""
+    whole, _ = open_recording(EXAMPLE).load()
+    lines = EXAMPLE.read_text().splitlines(keepends=True)
+    if padded:
+        lines = [x.replace(",0.01\n", ", 0.01\n") for x in lines]
+    path = tmp_path / "garbled.csv"
+    path.write_text("".join([*lines[:499], line + "\n", *lines[500:]]))
+    opened = open_recording(path, gyro_unit="rad/s")
+    rec, _ = opened.load()
+    assert len(rec.dt) == len(whole.dt) and (~rec.valid).sum() == 1 and not rec.valid[498]
+    keep = np.arange(len(whole.dt)) != 498
+    np.testing.assert_array_equal(rec.gyro[keep], whole.gyro[keep])
+    assert ("1 sample(s) without a number in every column" in rec.described
+            and "1 line(s) no row of the table, taken as samples without a number (a "
+                f"logger's garbled or lost bytes; the first: {says}" in rec.described)
+
+
+def test_more_lines_that_are_no_rows_than_one_in_a_hundred_refuse_the_file(tmp_path):
+    """Many lines that are no row say the file is not the table its header describes: refused
+    naming the line that tipped it."""
+    lines = EXAMPLE.read_text().splitlines(keepends=True)
+    for k in (200, 210, 220, 230, 240):
+        lines[k] = "garbled\n"
+    path = tmp_path / "garbled.csv"
+    path.write_text("".join(lines))
+    with pytest.raises(RecordingError, match=r"line 231: 1 value\(s\) where the header has 8 "
+                       r"columns \('garbled'\); 4 of 230 rows are no row of the table \(more "
+                       r"than 1% of them, which would be taken as samples without a number\)"):
+        open_recording(path, gyro_unit="rad/s").load()
 
 
 def _long_example(rows: int = 60000) -> tuple[str, np.ndarray]:
@@ -1066,8 +1125,7 @@ def test_cells_split_by_runs_of_spaces_are_read(tmp_path, style):
     lines = path.read_text().splitlines()
     lines[500] = lines[500].replace(lines[500].split()[1], "abc", 1)
     path.write_text("\n".join(lines) + "\n")
-    with pytest.raises(RecordingError, match="line 501, column 'acc_x': 'abc' is not a number"):
-        open_recording(path).load()
+    assert "the first: line 501, column 'acc_x': 'abc' is not a number" in _no_row(path)
 
 
 @pytest.mark.parametrize("point", [".", ","])
