@@ -253,17 +253,21 @@ class SalvagedBag:
         self._file = self.path.open("rb")
         self._map = mmap.mmap(self._file.fileno(), 0, access=mmap.ACCESS_READ)
         self._buf = memoryview(self._map)
-        scan = _Scan()
-        counts: dict[int, int] = {}
-        for conn, _, _ in self._scan_of(self._buf, scan):
-            counts[conn] = counts.get(conn, 0) + 1
-        self.scan = scan
-        self.connections = [c for c in scan.connections.values() if counts.get(c.id)]
-        for c in self.connections:
-            c.msgcount = counts[c.id]
-        if not self.connections:
-            raise SalvageError("no whole message before where the file stops")
-        self.typestore = _typestore(self.connections)
+        try:
+            scan = _Scan()
+            counts: dict[int, int] = {}
+            for conn, _, _ in self._scan_of(self._buf, scan):
+                counts[conn] = counts.get(conn, 0) + 1
+            self.scan = scan
+            self.connections = [c for c in scan.connections.values() if counts.get(c.id)]
+            for c in self.connections:
+                c.msgcount = counts[c.id]
+            if not self.connections:
+                raise SalvageError("no whole message before where the file stops")
+            self.typestore = _typestore(self.connections)
+        except BaseException:
+            self.__exit__()
+            raise
         return self
 
     def __exit__(self, *exc: object) -> None:
