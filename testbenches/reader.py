@@ -64,7 +64,7 @@ Python's reader takes as well. Its sample is rejected and counted; a row of them
 data, not a header's row of names."""
 HEADER_CHECK = 20
 """The header must split into as many cells as this many lines after it, but for
-HEADER_CHECK_ODD of them (a line a logger garbled: a sample without numbers, _python_blocks)."""
+HEADER_CHECK_ODD of them (a line a logger garbled: a sample without numbers, _python_parts)."""
 HEADER_CHECK_ODD = 1
 PREAMBLE_LINES = 30
 """The header is looked for among the first this many lines that are not comments."""
@@ -600,7 +600,7 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
     while it was written, its last cell's digits perhaps cut too; _cut_value), and a last line
     of text, with a line end or without (a footer a logger appends: "END OF LOG"). (None, "")
     where the file ends with its table. A short line of numbers that ends with a line end is
-    no cut: a line that is no row (_python_blocks)."""
+    no cut: a line that is no row (_python_parts)."""
     size = stop = path.stat().st_size
     with path.open("rb") as f:
         while True:  # back over windows of NULs to the last byte written
@@ -726,6 +726,41 @@ class _Head(io.RawIOBase):
 
     def close(self) -> None:
         self._f.close()
+        super().close()
+
+
+class _AfterLines(io.RawIOBase):
+    """A binary stream without its first `lines` lines (counted by their line ends, as
+    pyarrow's reader skips them), found a megabyte at a time without decoding them."""
+
+    def __init__(self, inner: IO[bytes], lines: int) -> None:
+        self._inner, self._left, self._pending = inner, lines, b""
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        while self._left:
+            chunk = self._inner.read(1 << 20)
+            if not chunk:
+                self._left = 0
+                break
+            if (ends := chunk.count(b"\n")) < self._left:
+                self._left -= ends
+                continue
+            at = -1
+            for _ in range(self._left):
+                at = chunk.index(b"\n", at + 1)
+            self._pending, self._left = chunk[at + 1:], 0
+        if self._pending:
+            n = min(len(buffer), len(self._pending))
+            buffer[:n] = self._pending[:n]
+            self._pending = self._pending[n:]
+            return n
+        return self._inner.readinto(buffer)
+
+    def close(self) -> None:
+        self._inner.close()
         super().close()
 
 
@@ -933,16 +968,11 @@ def _text(path: Path) -> TableSource:
              or layout.units_row[j] for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
-        if layout.padded or not _has_pyarrow():
-            yield from _python_blocks(path, layout, columns, rows, 0)
-            return
-        done = 0
-        try:
-            for block in _arrow_blocks(path, layout, columns, rows):
-                yield block
-                done += len(block)
-        except _ArrowFailed:  # Python's reader names the line, or reads what arrow would not
-            yield from _python_blocks(path, layout, columns, rows, done)
+        tally = _Tally(path, layout)
+        parts = (_python_parts(path, layout, columns, 0, tally)
+                 if layout.padded or not _has_pyarrow() else
+                 _text_parts(path, layout, columns, tally))
+        yield from _reblocked(parts, rows, len(columns), tally.finish)
 
     def where(row: int) -> str:
         return f"line {_line_of_row(path, layout, row)}"
@@ -1007,8 +1037,10 @@ def _duration_seconds(column: Any, unit: str) -> np.ndarray:
     return _float64(values) * DURATION_UNITS[unit]
 
 
-def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
-                  ) -> Iterator[np.ndarray]:
+def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
+                 ) -> Iterator[np.ndarray]:
+    """The chosen columns of the rows after the file's first `skip` lines, a batch of
+    pyarrow's reader at a time; _ArrowFailed where a line is no row it can read."""
     import pyarrow as pa
     import pyarrow.csv as pc
 
@@ -1019,49 +1051,110 @@ def _arrow_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int
              else pa.string() if i in layout.durations else pa.float64() for i in columns}
     durations = {keys[i]: layout.durations[i] for i in columns if i in layout.durations}
     compression = _compression(path)
+    after = skip > layout.data_after  # lines pyarrow cannot skip itself (past its first block)
     try:
         reader = pc.open_csv(
-            path if compression is None and layout.data_end is None and not layout.spaced
-            else pa.PythonFile(_table_bytes(path, layout), mode="r"),
-            read_options=pc.ReadOptions(column_names=keys, skip_rows=layout.data_after,
+            path if (compression is None and layout.data_end is None and not layout.spaced
+                     and not after)
+            else pa.PythonFile(io.BufferedReader(_AfterLines(_table_bytes(path, layout), skip))
+                               if after else _table_bytes(path, layout), mode="r"),
+            read_options=pc.ReadOptions(column_names=keys, skip_rows=0 if after else skip,
                                         encoding="utf8" if layout.encoding == "utf-8"
-                                        else layout.encoding, block_size=1 << 22),
+                                        else layout.encoding, block_size=ARROW_BLOCK),
             parse_options=pc.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
             convert_options=pc.ConvertOptions(
                 column_types=types, include_columns=wanted,
                 decimal_point="," if layout.decimal_comma else "."))
-        pending: list[np.ndarray] = []
-        held = 0
         for batch in reader:
-            part = np.column_stack([_float64(batch.column(k)) if types[k] == pa.float64()
-                                    else _duration_seconds(batch.column(k), durations[k])
-                                    if k in durations else _seconds(batch.column(k))
-                                    for k in wanted]) \
+            yield np.column_stack([_float64(batch.column(k)) if types[k] == pa.float64()
+                                   else _duration_seconds(batch.column(k), durations[k])
+                                   if k in durations else _seconds(batch.column(k))
+                                   for k in wanted]) \
                 if wanted else np.empty((batch.num_rows, 0))
-            pending.append(part)
-            held += len(part)
-            while held >= rows:
-                merged = np.concatenate(pending)
-                yield merged[:rows]
-                rest = merged[rows:]
-                pending, held = ([rest] if len(rest) else []), len(rest)
-        if held:
-            yield np.concatenate(pending)
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as err:
         raise _ArrowFailed(str(err)) from None
 
 
-def _rows(path: Path, layout: _TextLayout) -> Iterator[tuple[int, list[str]]]:
-    """(line, cells) of every data row, blank lines skipped."""
-    with io.TextIOWrapper(_table_bytes(path, layout), newline="",
-                          encoding="utf-8-sig" if layout.encoding == "utf-8"
+def _reblocked(parts: Iterator[np.ndarray], rows: int, width: int,
+               before_last: Callable[[], None]) -> Iterator[np.ndarray]:
+    """The rows of parts of any length in blocks of `rows` (the last shorter), before_last
+    called once the parts are read and before the last block (which a refusal of the whole
+    read then precedes)."""
+    pending: list[np.ndarray] = []
+    held = 0
+    for part in parts:
+        pending.append(part)
+        held += len(part)
+        while held > rows:
+            merged = np.concatenate(pending)
+            yield merged[:rows]
+            rest = merged[rows:]
+            pending, held = [rest], len(rest)
+    before_last()
+    if held:
+        yield np.concatenate(pending).reshape(held, width)
+
+
+ARROW_BLOCK = 1 << 18
+"""Bytes per batch of pyarrow's reader (about 4500 rows of an IMU's text): the rows Python's
+reader parses again where a batch holds a line that is no row (as fast as larger batches)."""
+RESUME_ROWS = 2_000
+"""Where pyarrow's reader meets a line that is no row, Python's reads from its batch through
+that line and on to at least this many rows (about what it costs pyarrow's to start again
+there), then pyarrow's goes on: a few such lines in a long log cost a few stretches read by
+Python. Where pyarrow's meets the next within fewer rows, Python's stretch doubles."""
+ASCII_LINES = ("utf-8", "latin-1")
+"""The encodings whose line ends are the byte b"\\n" (_AfterLines counts them so)."""
+
+
+def _text_parts(path: Path, layout: _TextLayout, columns: list[int], tally: _Tally
+                ) -> Iterator[np.ndarray]:
+    """The chosen columns of every row: pyarrow's reader, and where it meets a line it cannot
+    read, Python's from the start of that batch through that line (naming it, or taking it as
+    a sample without numbers), pyarrow's again after it."""
+    done, skip, least = 0, layout.data_after, RESUME_ROWS
+    lines_by_bytes = layout.encoding in ASCII_LINES  # else lines are not counted in bytes
+    while True:
+        started = (skip, done) if lines_by_bytes else (0, 0)  # lines skipped, rows before
+        try:
+            for part in _arrow_parts(path, layout, columns, skip):
+                yield part
+                done += len(part)
+                tally.rows = max(tally.rows, done)
+            return
+        except _ArrowFailed:
+            least = least * 2 if done - started[1] < least else RESUME_ROWS
+            tally.stopped = None
+            for part in _python_parts(path, layout, columns, done, tally,
+                                      stop=least if lines_by_bytes else 0, after=started):
+                yield part
+                done += len(part)
+            if tally.stopped is None:  # it read to the end
+                return
+            skip = tally.stopped
+
+
+def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
+          ) -> Iterator[tuple[int, list[str]]]:
+    """(line, cells) of every data row after the file's first `after` lines and its first
+    `skip` data rows (passed over as lines, not parsed), blank lines skipped."""
+    raw = _table_bytes(path, layout)
+    with io.TextIOWrapper(io.BufferedReader(_AfterLines(raw, after)) if after else raw,
+                          newline="", encoding="utf-8-sig" if layout.encoding == "utf-8"
                           else layout.encoding) as f:
+        blank, passed = " \t\r\n" + layout.delimiter, after
+        for text in f if skip else ():
+            passed += 1
+            if passed > layout.data_after and text.strip(blank):
+                skip -= 1
+                if not skip:
+                    break
         reader = csv.reader(f, delimiter=layout.delimiter)
         for row in reader:
-            if reader.line_num <= layout.data_after or not row or not any(
+            if reader.line_num + passed <= layout.data_after or not row or not any(
                     c.strip() for c in row):
                 continue
-            yield reader.line_num, row
+            yield reader.line_num + passed, row
 
 
 def _line_of_row(path: Path, layout: _TextLayout, row: int) -> int:
@@ -1079,20 +1172,56 @@ header and first rows describe, and it is refused naming the line (as soon as th
 more than the share of the rows read, else at the end)."""
 
 
-def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: int, skip: int
-                   ) -> Iterator[np.ndarray]:
-    """The rows from row `skip` on, cell by cell: an empty cell as NaN; a line that is no row
-    of the table (the header's count of numbers) as a row of NaN, counted and said in
-    layout.found when the read ends, and refused by its line and column where such lines are
-    more than GARBLED_SHARE of the rows."""
+class _Tally:
+    """A read's lines that are no row of the table (GARBLED_SHARE): how many, the first's
+    refusal, and where Python's reader stopped after one for pyarrow's to go on."""
+
+    def __init__(self, path: Path, layout: _TextLayout) -> None:
+        self.path, self.layout = path, layout
+        self.garbled, self.first, self.rows = 0, "", 0
+        self.stopped: int | None = None
+        """The line after which pyarrow's reader goes on (None: Python's read to the end)."""
+
+    def add(self, err: TableError, rows: int) -> None:
+        """A line that is no row, the rows-th: refused where they are more than one beyond
+        GARBLED_SHARE of the rows read (the first is weighed at the end)."""
+        self.garbled += 1
+        self.first = self.first or str(err)
+        if self.garbled > 1 + GARBLED_SHARE * rows:
+            raise self._refusal(str(err), rows)
+
+    def finish(self) -> None:
+        """At the end of the read: refused where such lines are more than GARBLED_SHARE of
+        the rows, else said (layout.found)."""
+        if self.garbled > GARBLED_SHARE * max(self.rows, 1):
+            raise self._refusal(self.first, self.rows)
+        if self.garbled:
+            first = self.first.removeprefix(f"{self.path}, ")
+            self.layout.found.append(
+                f"{self.garbled} line(s) no row of the table, taken as samples without a "
+                f"number (a logger's garbled or lost bytes; the first: {first})")
+
+    def _refusal(self, said: str, rows: int) -> TableError:
+        return TableError(f"{said}; {self.garbled} of {rows} rows are no row of the table "
+                          f"(more than {GARBLED_SHARE:.0%} of them, which would be taken as "
+                          "samples without a number)" if self.garbled > 1 else said)
+
+
+def _python_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int,
+                  tally: _Tally, stop: int = 0, after: tuple[int, int] = (0, 0)
+                  ) -> Iterator[np.ndarray]:
+    """The rows from row `skip` on, cell by cell, in parts: an empty cell as NaN; a line that
+    is no row of the table (the header's count of numbers) as a row of NaN, counted in tally.
+    Where `stop`, the read ends once it has passed such a line and read `stop` rows, with
+    tally.stopped its last line. after: (lines, rows) the file holds before where the read
+    may start (where pyarrow's reader started)."""
     width = len(layout.header)
-    block: list[list[float]] = []
-    garbled, first, seen = 0, "", 0
+    part: list[list[float]] = []
     nan_row = [float("nan")] * len(columns)
-    for k, (line, row) in enumerate(_rows(path, layout)):
-        seen = k + 1
-        if k < skip:
-            continue
+    met = False
+    for k, (line, row) in enumerate(_rows(path, layout, after[0], skip - after[1]),
+                                    start=skip):
+        tally.rows = max(tally.rows, k + 1)
         try:
             if len(row) != width:
                 text = layout.delimiter.join(row)
@@ -1101,34 +1230,21 @@ def _python_blocks(path: Path, layout: _TextLayout, columns: list[int], rows: in
             if [c.strip() for c in row] == layout.header:
                 raise TableError(f"{path}, line {line}: the header again (a logger restarted "
                                  "and wrote on)")
-            block.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
-                                  _clock_of(layout, j), layout.durations.get(j, ""))
-                          for j in columns])
+            part.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
+                                 _clock_of(layout, j), layout.durations.get(j, ""))
+                         for j in columns])
         except TableError as err:
-            garbled += 1
-            first = first or str(err)
-            if garbled > 1 + GARBLED_SHARE * seen:  # the first is weighed at the end
-                raise _garbled(str(err), garbled, seen) from None
-            block.append(nan_row)
-        if len(block) == rows:
-            yield np.array(block, dtype=float).reshape(len(block), len(columns))
-            block = []
-    if garbled > GARBLED_SHARE * seen:
-        raise _garbled(first, garbled, seen)
-    if block:
-        yield np.array(block, dtype=float).reshape(len(block), len(columns))
-    if garbled:
-        first = first.removeprefix(f"{path}, ")
-        layout.found.append(f"{garbled} line(s) no row of the table, taken as samples without "
-                            f"a number (a logger's garbled or lost bytes; the first: {first})")
-
-
-def _garbled(said: str, garbled: int, rows: int) -> TableError:
-    """The refusal of a file with more lines that are no row than GARBLED_SHARE allows: the
-    line's own refusal, and the count."""
-    return TableError(f"{said}; {garbled} of {rows} rows are no row of the table (more than "
-                      f"{GARBLED_SHARE:.0%} of them, which would be taken as samples without a "
-                      "number)" if garbled > 1 else said)
+            tally.add(err, k + 1)
+            part.append(nan_row)
+            met = True
+        if stop and met and k + 1 - skip >= stop:
+            tally.stopped = line
+            break
+        if len(part) == BLOCK_ROWS:
+            yield np.array(part, dtype=float).reshape(len(part), len(columns))
+            part = []
+    if part:
+        yield np.array(part, dtype=float).reshape(len(part), len(columns))
 
 
 def _clock_of(layout: _TextLayout, j: int) -> str:

@@ -992,6 +992,41 @@ def test_a_line_that_is_no_row_is_a_sample_without_numbers(tmp_path, padded, lin
                 f"logger's garbled or lost bytes; the first: {says}" in rec.described)
 
 
+@pytest.mark.parametrize("least", [1, 10**6])
+def test_pyarrows_reader_goes_on_after_each_line_that_is_no_row(tmp_path, monkeypatch, least):
+    """Python's reader takes over where pyarrow's meets a line that is no row, and pyarrow's
+    goes on after it once Python's has read RESUME_ROWS (a long log with a garbled line is
+    read at pyarrow's speed but for that stretch): the samples are the same as Python's
+    reader gives throughout, a blank line and lines of every kind of fault between."""
+    import testbenches.reader as reader
+
+    monkeypatch.setattr(reader, "RESUME_ROWS", least)
+    arrow, started = reader._arrow_parts, []
+
+    def counted(*args):
+        started.append(args[-1])  # the lines it skips
+        return arrow(*args)
+
+    monkeypatch.setattr(reader, "_arrow_parts", counted)
+    lines = EXAMPLE.read_text().splitlines(keepends=True)
+    bad = {200: "4.98,-0.2\n", 450: "x,1,2,3,4,5,6,7\n", 700: lines[0], 900: "1,2,3\n"}
+    text = [bad.get(k, x) for k, x in enumerate(lines)]
+    text.insert(600, "\n")
+    path = tmp_path / "garbled.csv"
+    path.write_text("".join(text))
+    rec, _ = open_recording(path, gyro_unit="rad/s").load()
+    keep = np.ones(len(lines) - 1, bool)
+    keep[[k - 1 for k in bad]] = False
+    np.testing.assert_array_equal(rec.valid, keep)
+    whole, _ = open_recording(EXAMPLE).load()
+    np.testing.assert_array_equal(rec.gyro[keep], whole.gyro[keep])
+    np.testing.assert_array_equal(rec.acc[keep], whole.acc[keep])
+    assert "4 line(s) no row of the table" in rec.described
+    assert "the first: line 201: 2 value(s)" in rec.described
+    runs = 5 if least == 1 else 1  # after each of the 4; or Python's to the end
+    assert started[:runs] == [1, 201, 451, 702, 902][:runs]
+
+
 def test_more_lines_that_are_no_rows_than_one_in_a_hundred_refuse_the_file(tmp_path):
     """Many lines that are no row say the file is not the table its header describes: refused
     naming the line that tipped it."""
