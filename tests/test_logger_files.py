@@ -1027,6 +1027,25 @@ def test_pyarrows_reader_goes_on_after_each_line_that_is_no_row(tmp_path, monkey
     assert started[:runs] == [1, 201, 451, 702, 902][:runs]
 
 
+def test_a_logger_that_restarted_and_wrote_on_is_refused_saying_to_split_the_file(tmp_path):
+    """A logger restarted appends its header and a time from 0 again: the header is a line
+    that is no row, and the time going back is refused saying what it is; two rows out of
+    order are not taken for a restart."""
+    lines = EXAMPLE.read_text().splitlines(keepends=True)
+    path = tmp_path / "restarted.csv"
+    path.write_text("".join(lines + lines[:300]))
+    with pytest.raises(RecordingError, match=r"line 1003: the time 0 s does not increase from "
+                       r"9\.99 s on line 1001; a time that starts again is a recording written "
+                       r"on after another \(a logger that restarted and appended to the same "
+                       r"file\): split the file there"):
+        open_recording(path).load()
+    lines[500], lines[501] = lines[501], lines[500]
+    path.write_text("".join(lines))
+    with pytest.raises(RecordingError, match=r"line 502: the time 4\.99 s does not increase "
+                       r"from 5 s on line 501$"):
+        open_recording(path).load()
+
+
 def test_more_lines_that_are_no_rows_than_one_in_a_hundred_refuse_the_file(tmp_path):
     """Many lines that are no row say the file is not the table its header describes: refused
     naming the line that tipped it."""

@@ -419,7 +419,11 @@ class _Clock:
                 f"{float(times_all[i + 1]):.6g} s " + ("repeats" if same else "does not "
                                                        "increase from")
                 + f" {'the time ' if same else ''}{float(times_all[i]):.6g} s on "
-                f"{self.where(int(rows_all[i]))}" + (self.repeats if same else ""))
+                f"{self.where(int(rows_all[i]))}" + (
+                    self.repeats if same else "" if steps[i] > -RESTART_S else
+                    "; a time that starts again is a recording written on after another (a "
+                    "logger that restarted and appended to the same file): split the file "
+                    "there"))
         samples = np.flatnonzero(np.isfinite(t) & holds)
         sample_t = t[samples]
         if self.last_sample_t is not None:
@@ -1054,6 +1058,9 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     return found.unit, found.scale, f"{kind} in {found.unit} ({found.how})"
 
 
+RESTART_S = 1.0
+"""A time that goes back by more than this [s] started again (a logger restarted), where a
+smaller step back is rows out of order."""
 ACC_UNITS = {"m/s2": 1.0, "g": G_STANDARD, "mg": G_STANDARD / 1000.0}
 """The accelerometer's units and their factor to m/s^2."""
 ACC_NORMS = {"g": (0.5, 2.0), "m/s2": (5.0, 20.0), "mg": (500.0, 2000.0)}
