@@ -413,12 +413,26 @@ class _TextLayout:
     spaced: bool = False
     """Cells split by runs of spaces or tabs (numpy.savetxt's default, a C printf, TUM's
     trajectories): every line is read with each run as WHITESPACE_AS (_Spaced)."""
+    not_iso: set[int] = field(default_factory=set)
+    """Columns of dates and times in one of _DATETIME's forms other than ISO 8601's."""
 
 
-_ISO_DATETIME = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?"
-                       r"\s*(Z|[+-]\d{2}(?::?\d{2})?)?$")
-"""An ISO 8601 date and time as loggers write it: "2024-05-01T12:00:00.010", a space for the T,
-a decimal comma, a zone (Z, +02:00, +0200) or none."""
+_DATETIME = re.compile(
+    r"^(?:(?P<y>\d{4})(?P<sep>[-/])(?P<m>\d{2})(?P=sep)(?P<d>\d{2})"
+    r"|(?P<d2>\d{2})\.(?P<m2>\d{2})\.(?P<y2>\d{4}))"
+    r"[T ](?P<H>\d{2}):(?P<M>\d{2}):(?P<S>\d{2})(?:[.,](?P<f>\d{1,9}))?"
+    r"\s*(?P<zone>Z|[+-]\d{2}(?::?\d{2})?)?$")
+"""A date and time as loggers write it: ISO 8601's "2024-05-01T12:00:00.010" (a space for the
+T, a decimal comma, a zone: Z, +02:00, +0200, or none), the year first with slashes
+("2024/05/01 12:00:00.010", as East Asian locales write it) or the day first with dots
+("01.05.2024 12:00:00,010", as German and other European locales do). A day and month with
+slashes ("05/01/2024") is refused: it reads as May 1 or January 5 alike."""
+_DAY_MONTH = re.compile(r"^\d{1,2}/\d{1,2}/\d{2,4}[T ]\d{1,2}:\d{2}")
+"""A date with slashes, the day and month before the year (US and UK locales alike)."""
+_TO_ISO = ((r"^(\d{2})\.(\d{2})\.(\d{4})", r"\3-\2-\1"), (r"^(\d{4})/(\d{2})/(\d{2})", r"\1-\2-\3"),
+           (r"(:\d{2}),(\d)", r"\1.\2"))
+"""_DATETIME's other forms rewritten as ISO 8601 (regular expression, replacement), for
+pyarrow's reader, which parses only that."""
 
 
 STATED_RATE = re.compile(r"\b(?:update|sample|sampling|output|data)[ _-]?(?:rate|frequency)"
@@ -459,14 +473,15 @@ def seconds_of_day(text: str) -> float | None:
 
 
 def seconds_of(text: str) -> float | None:
-    """Seconds since 1970-01-01 UTC of an ISO 8601 date and time (_ISO_DATETIME; without a zone
+    """Seconds since 1970-01-01 UTC of a date and time (_DATETIME; without a zone
     taken as UTC, as both a recording and its reference are read), None where the text is
     none."""
-    m = _ISO_DATETIME.match(text.strip())
+    m = _DATETIME.match(text.strip())
     if m is None:
         return None
-    year, month, day, hour, minute, second = (int(g) for g in m.groups()[:6])
-    fraction, zone = m.group(7), m.group(8)
+    year, month, day = (int(m.group(k) or m.group(k + "2")) for k in "ymd")
+    hour, minute, second = (int(m.group(k)) for k in "HMS")
+    fraction, zone = m.group("f"), m.group("zone")
     try:
         t = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.timezone.utc)
     except ValueError:
@@ -562,20 +577,29 @@ def _sniff(path: Path) -> _TextLayout:
     rows = [next(csv.reader([line], delimiter=delimiter))
             for no, line in numbered if no > data_after][:49]
     header, units_row = _trailing_delimiter(header, units_row, rows)
-    cells = [c for row in rows for c in row if c.strip()]
-    decimal_comma = (any("," in c for c in cells)  # a cell's comma: ';' or tab between cells,
-                     and not any("." in c for c in cells))  # or ',' and the cell quoted
-    padded = any(c != c.strip() for c in cells)
-    datetimes, times_of_day, durations = {}, set(), {}
+    datetimes, times_of_day, durations, rewritten = {}, set(), {}, set()
     for j in range(len(header)):
         column = [row[j].strip() for row in rows if len(row) == len(header) and row[j].strip()]
-        matches = [_ISO_DATETIME.match(c) for c in column]
+        matches = [_DATETIME.match(c) for c in column]
         if column and all(matches):
-            datetimes[j] = all(m.group(8) for m in matches if m)  # with a zone
+            datetimes[j] = all(m.group("zone") for m in matches if m)  # with a zone
+            if any(m.group("sep") != "-" or "," in c for m, c in zip(matches, column,
+                                                                      strict=True) if m):
+                rewritten.add(j)
+        elif column and all(_DAY_MONTH.match(c) for c in column):
+            raise TableError(f"{path}, column {header[j]!r}: dates with the day and the month "
+                             f"before the year ({column[0][:30]!r}), which read as the month "
+                             "first or the day first alike: export the time as ISO 8601 "
+                             "(2024-05-01 12:00:00.010) or as seconds")
         elif column and all(seconds_of_day(c) is not None for c in column):
             times_of_day.add(j)
         elif column and all(duration_unit(c) for c in column):  # in the first cell's unit
             durations[j] = duration_unit(column[0]) or ""
+    cells = [c for row in rows for j, c in enumerate(row)
+             if c.strip() and j not in datetimes and j not in times_of_day]
+    decimal_comma = (any("," in c for c in cells)  # a cell's comma: ';' or tab between cells,
+                     and not any("." in c for c in cells))  # or ',' and the cell quoted
+    padded = any(c != c.strip() for row in rows for c in row if c.strip())
     skipped = (f"lines {preamble[0][0]}-{preamble[-1][0]}" if len(preamble) > 1
                else f"line {preamble[0][0]}") if preamble else ""
     rates = [float(m.group(1).replace(",", ".")) for _, line in preamble
@@ -583,7 +607,7 @@ def _sniff(path: Path) -> _TextLayout:
     layout = _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                          datetimes, times_of_day, skipped, data_after, units_row, stacked,
                          rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations,
-                         spaced=spaced)
+                         spaced=spaced, not_iso=rewritten)
     if _compression(path) is None and encoding in ("utf-8", "latin-1"):
         layout.data_end, layout.tail = _tail(path, layout)
     return layout
@@ -911,7 +935,7 @@ def _number_like(cell: str) -> bool:
     try:
         float(cell.strip().replace(",", "."))
     except ValueError:
-        return bool(_ISO_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip())
+        return bool(_DATETIME.match(cell.strip()) or _TIME_OF_DAY.match(cell.strip())
                     or duration_unit(cell))
     return True
 
@@ -1013,6 +1037,16 @@ def _float64(column: Any) -> np.ndarray:
     return x
 
 
+def _as_iso(column: Any, kind: Any) -> Any:
+    """A pyarrow string array of dates and times in _DATETIME's other forms as timestamps of
+    `kind` (rewritten as ISO 8601, which pyarrow parses); ArrowInvalid where one is none."""
+    import pyarrow.compute as pc
+
+    for pattern, replacement in _TO_ISO:
+        column = pc.replace_substring_regex(column, pattern, replacement)
+    return column.cast(kind)
+
+
 def _seconds(column: Any) -> np.ndarray:
     """A pyarrow timestamp array [ns] as seconds since 1970, its nulls NaN."""
     import pyarrow as pa
@@ -1046,10 +1080,13 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
 
     keys = [f"c{i}" for i in range(len(layout.header))]
     wanted = [keys[i] for i in columns]
-    types = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
+    types = {keys[i]: pa.string() if i in layout.not_iso or i in layout.durations
+             else pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
              if i in layout.datetimes else pa.time64("ns") if i in layout.times_of_day
-             else pa.string() if i in layout.durations else pa.float64() for i in columns}
+             else pa.float64() for i in columns}
     durations = {keys[i]: layout.durations[i] for i in columns if i in layout.durations}
+    not_iso = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
+               for i in columns if i in layout.not_iso}
     compression = _compression(path)
     after = skip > layout.data_after  # lines pyarrow cannot skip itself (past its first block)
     try:
@@ -1063,12 +1100,14 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
                                         else layout.encoding, block_size=ARROW_BLOCK),
             parse_options=pc.ParseOptions(delimiter=layout.delimiter, ignore_empty_lines=True),
             convert_options=pc.ConvertOptions(
-                column_types=types, include_columns=wanted,
+                column_types=types, include_columns=wanted, strings_can_be_null=True,
                 decimal_point="," if layout.decimal_comma else "."))
         for batch in reader:
             yield np.column_stack([_float64(batch.column(k)) if types[k] == pa.float64()
                                    else _duration_seconds(batch.column(k), durations[k])
-                                   if k in durations else _seconds(batch.column(k))
+                                   if k in durations else
+                                   _seconds(_as_iso(batch.column(k), not_iso[k]))
+                                   if k in not_iso else _seconds(batch.column(k))
                                    for k in wanted]) \
                 if wanted else np.empty((batch.num_rows, 0))
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as err:

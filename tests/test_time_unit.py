@@ -278,3 +278,39 @@ def test_a_row_written_twice_is_rejected_and_counted_not_a_refusal(tmp_path, at)
     said = source.summary(len(rec.dt), 0.0, 1)
     assert "1 row(s) repeat the row before them, time and numbers" in said
     assert "without a number in every column" not in said
+
+
+@pytest.mark.parametrize("form", ["%Y-%m-%dT%H:%M:%S.%f", "%Y/%m/%d %H:%M:%S.%f",
+                                  "%d.%m.%Y %H:%M:%S,%f"])
+def test_dates_and_times_as_locales_write_them_are_read_at_pyarrows_speed(tmp_path,
+                                                                          monkeypatch, form):
+    """The year first with slashes (East Asian locales) and the day first with dots and a
+    decimal comma (German, with semicolons and decimal commas in the numbers as well): the
+    same times as ISO 8601, through pyarrow's reader (rewritten as ISO 8601 for it), not
+    Python's. A day and month with slashes is refused: it reads either way."""
+    import datetime as dt
+
+    import testbenches.reader as reader
+
+    t, imu = _example()
+    start = dt.datetime(2024, 5, 1, 23, 59, 55)  # across midnight
+    stamps = [(start + dt.timedelta(seconds=float(s))).strftime(form)[:-3] for s in t]
+    comma = "," in form
+    rows = [";".join([s, *(f"{v:.10g}".replace(".", ",") for v in row)]) if comma else
+            ",".join([s, *(f"{v:.10g}" for v in row)]) for s, row in zip(stamps, imu, strict=True)]
+    path = tmp_path / "dates.csv"
+    path.write_text("\n".join([f"time{';' if comma else ','}"
+                               + HEADER.replace(",", ";" if comma else ","), *rows]) + "\n")
+    monkeypatch.setattr(reader, "_python_parts", None)  # pyarrow's reader alone
+    source, rec, times = _read(path)
+    assert "time from its dates and times" in source.choices
+    np.testing.assert_allclose(times - times[0], t - t[0], atol=1e-6)
+    assert times[0] == pytest.approx(start.replace(tzinfo=dt.timezone.utc).timestamp())
+    np.testing.assert_allclose(rec.gyro, imu[:, 3:], rtol=1e-9)
+    us = tmp_path / "us.csv"
+    us.write_text("time,ax,ay,az,gx,gy,gz\n" + "".join(
+        f"05/01/2024 12:00:{k / 100:05.2f},0,0,9.8,0,0,0\n" for k in range(50)))
+    with pytest.raises(RecordingError, match=r"column 'time': dates with the day and the "
+                       r"month before the year \('05/01/2024 12:00:00.00'\), which read as "
+                       r"the month first or the day first alike"):
+        open_recording(us)
