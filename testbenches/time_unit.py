@@ -34,6 +34,10 @@ rate of MEMS IMUs (32 kHz). A step then leaves two units only where it is below 
 longer one (and so above 2 kHz in the shorter): a file at 50 Hz or more reads as one unit."""
 
 
+DAY_S = 86_400.0
+"""Seconds in a day: the unit of a spreadsheet's dates and times saved as numbers."""
+
+
 @dataclass(frozen=True)
 class TimeUnit:
     """The unit chosen for a time or dt column, its factor to seconds and how it was chosen."""
@@ -90,9 +94,14 @@ def time_unit(column: str, step: float, dt_of: Callable[[float], np.ndarray], ac
     says why no unit can be chosen and what would serve."""
     found = candidates(step)
     if not found:
+        days = 1.0 / (step * DAY_S) if np.isfinite(step) and step > 0.0 else float("nan")
+        spreadsheet = (f"; in days it is {days:.4g} Hz: a spreadsheet's dates and times saved "
+                       "as numbers (days since 1899-12-30)? Format the column as a date and time "
+                       "(yyyy-mm-dd hh:mm:ss.000) before saving it" if
+                       RATE_RANGE[0] <= days < RATE_RANGE[1] else "")
         return (f"the {column} column states no unit, and its median step {step:.4g} is a rate "
                 f"no IMU has in any of s, ms, us, ns ({rates(step, list(TIME_SCALE))}): give "
-                "--time-unit, or --rate HZ")
+                f"--time-unit, or --rate HZ{spreadsheet}")
     if len(found) == 1:
         u = found[0]
         return TimeUnit(u, TIME_SCALE[u], f"from its steps: a median step of {step:.4g} is "

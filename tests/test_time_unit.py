@@ -314,3 +314,18 @@ def test_dates_and_times_as_locales_write_them_are_read_at_pyarrows_speed(tmp_pa
                        r"month before the year \('05/01/2024 12:00:00.00'\), which read as "
                        r"the month first or the day first alike"):
         open_recording(us)
+
+
+def test_a_spreadsheets_dates_saved_as_numbers_are_named_in_the_refusal(tmp_path):
+    """A sheet's date and time column saved as numbers (days since 1899-12-30: 45413.5...)
+    steps by 1.16e-7 at 100 Hz, a rate in no unit the reader takes: refused, naming what it
+    likely is and how to save it."""
+    t, imu = _example()
+    days = 45413.5 + t / 86400.0
+    path = tmp_path / "sheet.csv"
+    np.savetxt(path, np.column_stack([days, imu]), delimiter=",", header=f"time,{HEADER}",
+               comments="", fmt=["%.10f"] + ["%.10g"] * 6)
+    with pytest.raises(RecordingError, match=r"in days it is 100 Hz: a spreadsheet's dates and "
+                       r"times saved as numbers \(days since 1899-12-30\)\? Format the column "
+                       r"as a date and time"):
+        open_recording(path)
