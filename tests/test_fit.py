@@ -6,6 +6,7 @@ import json
 import math
 import os
 import re
+from dataclasses import replace
 import subprocess
 import sys
 from pathlib import Path
@@ -321,6 +322,33 @@ def test_noise_leaves_out_samples_without_numbers_and_says_how_many(tmp_path):
     assert noise["gyro_density"]["mean"] == pytest.approx(whole["gyro_density"]["mean"],
                                                           rel=0.01)
     assert noise["recording"]["samples"] == 5997
+
+
+def test_a_still_stretch_serves_where_the_motion_confirms_the_gyro_unit(tmp_path):
+    """A log that rests 60 s and then rolls for 140 s: its turns confirm the gyro unit, so the
+    rest serves though it is under half the recording; unconfirmed (a still recording's unit
+    cannot be), the same share is refused."""
+    rate, rng = 100.0, np.random.default_rng(3)
+    t = np.arange(int(200 * rate)) / rate
+    moving = t >= 60.0
+    roll = np.where(moving, 0.6 * np.sin(2 * np.pi * 0.3 * (t - 60.0)), 0.0)
+    rate_x = np.gradient(roll, t)
+    gyro = np.column_stack([rate_x, np.zeros_like(t), np.zeros_like(t)]) + np.array(
+        [0.01, -0.02, 0.005]) + GYRO_DENSITY * np.sqrt(rate) * rng.standard_normal((len(t), 3))
+    acc = np.column_stack([np.zeros_like(t), G * np.sin(roll), G * np.cos(roll)])
+    acc += ACC_DENSITY * np.sqrt(rate) * rng.standard_normal((len(t), 3))
+    path = tmp_path / "rest_then_roll.csv"
+    np.savetxt(path, np.column_stack([t, acc, gyro]), delimiter=",",
+               header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z", comments="")
+    rec = load(path)
+    assert rec.gyro_unit_checked
+    noise, _ = analyse(rec)
+    assert re.search(r"the sensor moved: its longest still stretch used, 0-\d\d s of 200 s",
+                     noise["note"])
+    assert noise["gyro_density"]["mean"] == pytest.approx(GYRO_DENSITY, rel=0.2)
+    with pytest.raises(RecordingError, match=r"too short to be used instead \(at least 20 s and "
+                       r"50 % of the recording, its gyro unit unconfirmed by its data\)"):
+        analyse(replace(rec, gyro_unit_checked=False))
 
 
 def test_noise_takes_the_longest_still_stretch_of_a_recording_the_sensor_moved_in(tmp_path):

@@ -42,8 +42,11 @@ a unit 57 times too large (rad/s data read as deg/s)."""
 MAX_TILT_CHANGE = 1.0 * DEG
 """Change of the accelerometer's direction (1 s means) beyond which the sensor moved."""
 STILL_SHARE = 0.5
-"""A recording the sensor moved in is analysed on its longest still stretch where that holds at
-least this share of it (a bump or two on the table)."""
+"""A recording the sensor moved in, its gyro unit not confirmed by its data, is analysed on its
+longest still stretch where that holds at least this share of it (a bump or two on the table):
+a gyro read in a unit 57 times too large makes noise look like rotation with still flukes
+between. Where its turns confirmed the unit (testbenches.gyro_unit), any still stretch of
+MIN_DURATION_S serves (a log that rests before it moves)."""
 STRETCH_MARGIN = 0.5
 """A stretch taken out of a recording the sensor moved in keeps within this share of the
 bounds above: still, not just within them (a recording whose gyro noise reads as rotation, its
@@ -105,20 +108,23 @@ def still_part(rec: Recording) -> tuple[Recording, str]:
     """rec where it is static throughout (check_static), else its longest stretch of whole
     seconds that is, and a note saying which: a bump on the table an hour into a two-hour
     recording costs the hour, not the recording. RecordingError where rec is too short, or its
-    longest still stretch is shorter than MIN_DURATION_S or STILL_SHARE of it (check_static's
-    refusal, with the stretch): a recording that moves that much was no still one, or its gyro
-    unit is wrong, whose noise then reads as rotation with still flukes between."""
+    longest still stretch is shorter than MIN_DURATION_S or, its gyro unit unconfirmed by its
+    data, STILL_SHARE of it (check_static's refusal, with the stretch): such a recording that
+    moves that much may have its gyro unit wrong, whose noise then reads as rotation with still
+    flukes between."""
     if rec.duration < MIN_DURATION_S or (moved := _moved(rec)) is None:
         check_static(rec)
         return rec, ""
     lo, hi = _longest_still(rec)
     part = rec.slice(lo, hi)
-    if part.duration < max(MIN_DURATION_S, STILL_SHARE * rec.duration):
+    share = 0.0 if rec.gyro_unit_checked else STILL_SHARE
+    if part.duration < max(MIN_DURATION_S, share * rec.duration):
         why, unit = moved
         raise RecordingError(
             f"{why}. Its longest still stretch, {part.duration:.0f} s of {rec.duration:.0f} s, "
-            f"is too short to be used instead (at least {MIN_DURATION_S:.0f} s and "
-            f"{STILL_SHARE * 100:.0f} % of the recording){unit}")
+            f"is too short to be used instead (at least {MIN_DURATION_S:.0f} s"
+            + (f" and {STILL_SHARE * 100:.0f} % of the recording, its gyro unit unconfirmed "
+               "by its data" if share else "") + f"){unit}")
     check_static(part)
     t = np.cumsum(rec.dt) - rec.dt[0]
     return part, (f"the sensor moved: its longest still stretch used, {t[lo]:.0f}-{t[hi - 1]:.0f}"
