@@ -6,9 +6,9 @@ import json
 import math
 import os
 import re
-from dataclasses import replace
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
