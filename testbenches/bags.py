@@ -78,6 +78,9 @@ def _fields(want: str, msgtype: str) -> list[tuple[str, str | None, Callable[[An
                lambda m, c=c: float(getattr(quaternion(m), c))) for c in "wxyz")]
 
 
+MESSAGE_BATCH = 16384
+"""Messages held as bytes at once: each a few hundred bytes and a Python object, where its row
+is 64 bytes, so a block is made of such batches' rows (its bytes would be ten times its rows)."""
 IMU_DOUBLES = 37
 """An Imu message's doubles after its header: orientation (4), its covariance (9),
 angular_velocity (3), its covariance (9), linear_acceleration (3), its covariance (9)."""
@@ -249,14 +252,22 @@ def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSo
 
         with opener() as bag:
             connections = [c for c in bag.connections if c.topic == chosen]
-            block: list[tuple[Any, int, bytes]] = []
+            batch: list[tuple[Any, int, bytes]] = []  # messages, as bytes until made rows
+            done: list[np.ndarray] = []  # their rows, until a block's are
+            held = 0
             for message in bag.messages(connections=connections):
-                block.append(message)
-                if len(block) == rows:
-                    yield rows_of(bag, block)[:, columns]
-                    block = []
-            if block:
-                yield rows_of(bag, block)[:, columns]
+                batch.append(message)
+                if len(batch) == min(rows - held, MESSAGE_BATCH):
+                    done.append(rows_of(bag, batch)[:, columns])
+                    held += len(batch)
+                    batch = []
+                    if held == rows:
+                        yield np.concatenate(done)
+                        done, held = [], 0
+            if batch:
+                done.append(rows_of(bag, batch)[:, columns])
+            if done:
+                yield np.concatenate(done)
 
     return TableSource(path, header, list(header), units, "ROS bag", n, read,
                        lambda row: f"message {row + 1} of {chosen}",

@@ -277,3 +277,22 @@ def test_a_bag_cut_before_its_first_message_is_refused_saying_how_it_is_repaired
     cut.write_bytes(raw[:raw.index(b"/imu/data") + 20])
     with pytest.raises(RecordingError, match=says):
         open_recording(cut)
+
+
+@pytest.mark.parametrize("kind", ["ros1", "mcap"])
+def test_a_bags_blocks_are_made_of_batches_of_messages_each_block_whole(tmp_path, monkeypatch,
+                                                                       kind):
+    """Messages are made rows a batch at a time (their bytes are ten times their rows): every
+    block but the last has the rows asked for, and the blocks are the whole table."""
+    from testbenches import bags
+
+    bag = write_bag(tmp_path / ("run.bag" if kind == "ros1" else "run"), kind)
+    monkeypatch.setattr(bags, "MESSAGE_BATCH", 7)
+    source = bags.open_bag(bag)
+    columns = list(range(len(source.header)))
+    whole = source.read(columns)
+    assert len(whole) == 1000
+    for rows in (5, 7, 20, 1000, 10**6):
+        blocks = list(source.blocks(columns, rows))
+        assert {len(b) for b in blocks[:-1]} <= {rows}
+        np.testing.assert_array_equal(np.concatenate(blocks), whole)
