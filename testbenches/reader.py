@@ -415,6 +415,9 @@ class _TextLayout:
     trajectories): every line is read with each run as WHITESPACE_AS (_Spaced)."""
     not_iso: set[int] = field(default_factory=set)
     """Columns of dates and times in one of _DATETIME's forms other than ISO 8601's."""
+    day_month: dict[int, str] = field(default_factory=dict)
+    """Columns of dates with the day and month before the year (_DAY_MONTH) -> a cell: refused
+    where read."""
 
 
 _DATETIME = re.compile(
@@ -578,6 +581,7 @@ def _sniff(path: Path) -> _TextLayout:
             for no, line in numbered if no > data_after][:49]
     header, units_row = _trailing_delimiter(header, units_row, rows)
     datetimes, times_of_day, durations, rewritten = {}, set(), {}, set()
+    day_month: dict[int, str] = {}
     for j in range(len(header)):
         column = [row[j].strip() for row in rows if len(row) == len(header) and row[j].strip()]
         matches = [_DATETIME.match(c) for c in column]
@@ -587,10 +591,7 @@ def _sniff(path: Path) -> _TextLayout:
                                                                       strict=True) if m):
                 rewritten.add(j)
         elif column and all(_DAY_MONTH.match(c) for c in column):
-            raise TableError(f"{path}, column {header[j]!r}: dates with the day and the month "
-                             f"before the year ({column[0][:30]!r}), which read as the month "
-                             "first or the day first alike: export the time as ISO 8601 "
-                             "(2024-05-01 12:00:00.010) or as seconds")
+            day_month[j] = column[0]
         elif column and all(seconds_of_day(c) is not None for c in column):
             times_of_day.add(j)
         elif column and all(duration_unit(c) for c in column):  # in the first cell's unit
@@ -607,7 +608,7 @@ def _sniff(path: Path) -> _TextLayout:
     layout = _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                          datetimes, times_of_day, skipped, data_after, units_row, stacked,
                          rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations,
-                         spaced=spaced, not_iso=rewritten)
+                         spaced=spaced, not_iso=rewritten, day_month=day_month)
     if _compression(path) is None and encoding in ("utf-8", "latin-1"):
         layout.data_end, layout.tail = _tail(path, layout)
     return layout
@@ -992,6 +993,12 @@ def _text(path: Path) -> TableSource:
              or layout.units_row[j] for j, u in enumerate(stated)]
 
     def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
+        for j in columns:
+            if j in layout.day_month:
+                raise TableError(f"{path}, column {layout.header[j]!r}: dates with the day and "
+                                 f"the month before the year ({layout.day_month[j][:30]!r}), "
+                                 "which read as the month first or the day first alike: export "
+                                 "the time as ISO 8601 (2024-05-01 12:00:00.010) or as seconds")
         tally = _Tally(path, layout)
         parts = (_python_parts(path, layout, columns, 0, tally)
                  if layout.padded or not _has_pyarrow() else

@@ -313,7 +313,12 @@ def test_dates_and_times_as_locales_write_them_are_read_at_pyarrows_speed(tmp_pa
     with pytest.raises(RecordingError, match=r"column 'time': dates with the day and the "
                        r"month before the year \('05/01/2024 12:00:00.00'\), which read as "
                        r"the month first or the day first alike"):
-        open_recording(us)
+        open_recording(us).load()
+    beside = tmp_path / "beside.csv"  # such a column is refused only where it is read
+    beside.write_text("date,time,ax,ay,az,gx,gy,gz\n" + "".join(
+        f"05/01/2024 12:00:{k / 100:05.2f},{k / 100},0,0,9.8,0,0,0\n" for k in range(50)))
+    rec, times = open_recording(beside, gyro_unit="rad/s").load()
+    np.testing.assert_allclose(times, np.arange(50) / 100)
 
 
 def test_a_spreadsheets_dates_saved_as_numbers_are_named_in_the_refusal(tmp_path):
