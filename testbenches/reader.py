@@ -644,7 +644,7 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
     end = start + len(kept)
     if line.strip() and start + last > 0:
         text = line.decode(layout.encoding, errors="replace")
-        values = _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
+        values = _line_cells(text, layout)
         cells = len(values)
         short = not terminated and cells < len(layout.header) and _row_start(values)
         cut = (not terminated and cells == len(layout.header) and _row_start(values)
@@ -693,8 +693,7 @@ def _cut_value(cell: str, before: bytes, layout: _TextLayout) -> str:
     shape = _shape(cell)
     shapes = []
     for raw in before.splitlines()[-100:]:
-        text = raw.decode(layout.encoding, errors="replace")
-        values = _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
+        values = _line_cells(raw.decode(layout.encoding, errors="replace"), layout)
         if len(values) == len(layout.header) and (seen := _shape(values[-1])) is not None:
             shapes.append(seen)
     if shape is None or len(shapes) < SHAPE_LINES:
@@ -710,7 +709,7 @@ def _footer(cells: list[str]) -> bool:
     """Whether a line's cells are text, no row (a summary a logger appends: "END OF LOG"; its
     caller asks that they be not as many as the header's, as a row's with a text column are)."""
     return (any(ch.isalpha() for c in cells for ch in c)
-            and not all(_number_like(c) or c.lower() in MISSING_VALUES for c in cells))
+            and not all(_value_like(c) for c in cells))
 
 
 _NUMBER_START = re.compile(r"^[-+]?[0-9]*[.,]?[0-9]*(?:[eE][-+]?[0-9]*)?$")
@@ -719,10 +718,21 @@ _NUMBER_START = re.compile(r"^[-+]?[0-9]*[.,]?[0-9]*(?:[eE][-+]?[0-9]*)?$")
 
 def _row_start(cells: list[str]) -> bool:
     """Whether cells can be a data row's start cut mid-write: every cell a number or missing,
-    the last perhaps cut (a footer's text is no row: refused by its line)."""
+    the last perhaps cut (a footer's text is no row: _footer)."""
     *whole, cut = cells
-    return (all(_number_like(c) or c.lower() in MISSING_VALUES for c in whole)
+    return (all(_value_like(c) for c in whole)
             and (_number_like(cut) or bool(_NUMBER_START.match(cut))))
+
+
+def _value_like(cell: str) -> bool:
+    """Whether a cell is a number or marks a missing one."""
+    return _number_like(cell) or cell.lower() in MISSING_VALUES
+
+
+def _line_cells(text: str, layout: _TextLayout) -> list[str]:
+    """A line's cells as the layout splits them (runs of spaces as one delimiter where the
+    file is so written)."""
+    return _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
 
 
 def _lines_before(path: Path, end: int) -> int:

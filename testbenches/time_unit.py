@@ -35,7 +35,8 @@ longer one (and so above 2 kHz in the shorter): a file at 50 Hz or more reads as
 
 
 DAY_S = 86_400.0
-"""Seconds in a day: the unit of a spreadsheet's dates and times saved as numbers."""
+"""Seconds in a day: the unit of a spreadsheet's dates and times saved as numbers, and the
+step by which a time of day starts again at midnight."""
 
 
 @dataclass(frozen=True)

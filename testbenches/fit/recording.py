@@ -24,7 +24,7 @@ from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import UNITS, median_period
 from ..reader import TIME_OF_DAY, TIME_SCALE
-from ..time_unit import median_step
+from ..time_unit import DAY_S, median_step
 from .columns import ALIASES, find_names, name_forms, norm_name, unit_in_name
 
 IMU_COLUMNS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z")
@@ -461,8 +461,6 @@ class _Clock:
         return t
 
 
-DAY_S = 86400.0
-"""A time of day starts again at midnight: a fall by a day is the next day."""
 COUNTER_WRAP = 2.0 ** 32
 """A microcontroller's time counter (millis(), micros()) is 32 bits: micros() starts again
 every 71.6 minutes."""
