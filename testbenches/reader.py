@@ -1193,22 +1193,26 @@ def _text_parts(path: Path, layout: _TextLayout, columns: list[int], tally: _Tal
 def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
           ) -> Iterator[tuple[int, list[str]]]:
     """(line, cells) of every data row after the file's first `after` lines and its first
-    `skip` data rows (passed over as lines, not parsed), blank lines skipped."""
+    `skip` data rows (passed over as lines, not parsed), blank lines skipped: a line of
+    spaces and delimiters alone, but for one of the header's count of cells, which is a row of
+    empty cells (a sample without numbers) as pyarrow's reader reads it."""
     raw = _table_bytes(path, layout)
+    width = len(layout.header)
     with io.TextIOWrapper(io.BufferedReader(_AfterLines(raw, after)) if after else raw,
                           newline="", encoding="utf-8-sig" if layout.encoding == "utf-8"
                           else layout.encoding) as f:
         blank, passed = " \t\r\n" + layout.delimiter, after
         for text in f if skip else ():
             passed += 1
-            if passed > layout.data_after and text.strip(blank):
+            if passed > layout.data_after and (text.strip(blank) or (
+                    text.strip() and text.count(layout.delimiter) == width - 1)):
                 skip -= 1
                 if not skip:
                     break
         reader = csv.reader(f, delimiter=layout.delimiter)
         for row in reader:
-            if reader.line_num + passed <= layout.data_after or not row or not any(
-                    c.strip() for c in row):
+            if reader.line_num + passed <= layout.data_after or not row or (
+                    len(row) != width and not any(c.strip() for c in row)):
                 continue
             yield reader.line_num + passed, row
 

@@ -1027,6 +1027,37 @@ def test_pyarrows_reader_goes_on_after_each_line_that_is_no_row(tmp_path, monkey
     assert started[:runs] == [1, 201, 451, 702, 902][:runs]
 
 
+def _both_readers(path, monkeypatch):
+    """The recording as read with pyarrow's reader (batches of 4 kB: many per file), and
+    as Python's reader reads it throughout."""
+    import testbenches.reader as reader
+
+    monkeypatch.setattr(reader, "ARROW_BLOCK", 1 << 12)
+    arrow, _ = open_recording(path, gyro_unit="rad/s").load()
+    with monkeypatch.context() as m:
+        m.setattr(reader, "_has_pyarrow", lambda: False)
+        python, _ = open_recording(path, gyro_unit="rad/s").load()
+    return arrow, python
+
+
+def test_a_row_of_empty_cells_is_a_sample_to_either_reader(tmp_path, monkeypatch):
+    """A row of the header's count of empty cells is a sample without numbers to both
+    readers, and where Python's reader takes over from pyarrow's (at a cell that is no
+    number, batches later) it starts at the row pyarrow's reached: Python's reader took the row
+    for a blank line, so it started one row late and a sample was lost."""
+    lines = EXAMPLE.read_text().splitlines(keepends=True)
+    lines.insert(100, ",,,,,,,\n")
+    lines[800] = lines[800].replace(",", "$", 1)
+    path = tmp_path / "empty_row.csv"
+    path.write_text("".join(lines))
+    arrow, python = _both_readers(path, monkeypatch)
+    for rec in (arrow, python):
+        assert len(rec.dt) == 1001 and np.flatnonzero(~rec.valid).tolist() == [99, 799]
+    np.testing.assert_array_equal(arrow.gyro, python.gyro)
+    whole, _ = open_recording(EXAMPLE).load()
+    np.testing.assert_array_equal(arrow.gyro[arrow.valid], np.delete(whole.gyro, 798, axis=0))
+
+
 def test_a_logger_that_restarted_and_wrote_on_is_refused_saying_to_split_the_file(tmp_path):
     """A logger restarted appends its header and a time from 0 again: the header is a line
     that is no row, and the time going back is refused saying what it is; two rows out of
