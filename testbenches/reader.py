@@ -1088,30 +1088,42 @@ def _duration_seconds(column: Any, unit: str) -> np.ndarray:
     return _float64(values) * DURATION_UNITS[unit]
 
 
-def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
-                 ) -> Iterator[np.ndarray]:
-    """The chosen columns of the rows after the file's first `skip` lines, a batch of
-    pyarrow's reader at a time; _ArrowFailed where a line is no row it can read."""
+def _read_as_number(layout: _TextLayout, j: int) -> bool:
+    """Whether pyarrow's reader reads a column as numbers (float64): not as text it converts
+    after (a date Python's ISO parser would not take, a duration with its unit) or a time."""
+    return not (j in layout.not_iso or j in layout.durations or j in layout.datetimes
+                or j in layout.times_of_day)
+
+
+def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int,
+                 mended: _Mended | None = None) -> Iterator[np.ndarray]:
+    """The chosen columns of the rows after the file's first `skip` lines (the lines read
+    through `mended` where given), a batch of pyarrow's reader at a time; _ArrowFailed where a
+    line is no row it can read."""
     import pyarrow as pa
     import pyarrow.csv as pc
 
     keys = [f"c{i}" for i in range(len(layout.header))]
     wanted = [keys[i] for i in columns]
-    types = {keys[i]: pa.string() if i in layout.not_iso or i in layout.durations
+    types = {keys[i]: pa.float64() if _read_as_number(layout, i)
+             else pa.string() if i in layout.not_iso or i in layout.durations
              else pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
-             if i in layout.datetimes else pa.time64("ns") if i in layout.times_of_day
-             else pa.float64() for i in columns}
+             if i in layout.datetimes else pa.time64("ns") for i in columns}
     durations = {keys[i]: layout.durations[i] for i in columns if i in layout.durations}
     not_iso = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
                for i in columns if i in layout.not_iso}
     compression = _compression(path)
-    after = skip > layout.data_after  # lines pyarrow cannot skip itself (past its first block)
+    # lines pyarrow cannot skip itself (past its first block), or lines read mended
+    after = skip > layout.data_after or mended is not None
+    stream: IO[bytes] | None = _AfterLines(_table_bytes(path, layout), skip) if after else None
+    if mended is not None:
+        stream = mended.reading(stream)
     try:
         reader = pc.open_csv(
             path if (compression is None and layout.data_end is None and not layout.spaced
                      and not after)
-            else pa.PythonFile(io.BufferedReader(_AfterLines(_table_bytes(path, layout), skip))
-                               if after else _table_bytes(path, layout), mode="r"),
+            else pa.PythonFile(io.BufferedReader(stream) if stream is not None
+                               else _table_bytes(path, layout), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=0 if after else skip,
                                         encoding="utf8" if layout.encoding == "utf-8"
                                         else layout.encoding, block_size=ARROW_BLOCK),
@@ -1129,6 +1141,118 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
                 if wanted else np.empty((batch.num_rows, 0))
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as err:
         raise _ArrowFailed(str(err)) from None
+
+
+class _Mended(io.RawIOBase):
+    """A table's bytes from where a read starts, its first `drop` rows (read before) left out,
+    with each line that is no row of the table (another count of cells than the header's, a
+    cell read as a number that is none, the header again: a serial link's lost or garbled
+    bytes, two rows run together) made a row of empty cells, which pyarrow's reader takes as a
+    sample without numbers, as Python's reader takes such a line; each such line's refusal
+    kept for the tally. numpy finds the lines, counts their delimiters and finds the bytes no
+    number holds in the columns read as numbers; only those lines are parsed (_row_numbers, as
+    Python's reader does), so that a log with such lines every few rows is read at pyarrow's
+    pace. A line of spaces and delimiters alone is blank, as Python's reader takes it; one that
+    quotes is left as it is, as is a cell of a number's bytes that is still none (pyarrow's
+    reader then stops there)."""
+
+    def __init__(self, path: Path, layout: _TextLayout, columns: list[int], line: int, row: int,
+                 drop: int) -> None:
+        self.path, self.layout, self.columns = path, layout, columns
+        self.line, self.row, self.drop = line, row, drop  # lines and rows before the next
+        self.found: list[tuple[int, str]] = []  # (rows through the line, its refusal)
+        self._inner: IO[bytes] | None = None
+        self._out, self._at, self._tail, self._end = b"", 0, b"", False
+        self._delimiter = layout.delimiter.encode(layout.encoding)
+        self._width = width = len(layout.header)
+        self._empty = self._delimiter * (width - 1)
+        numbers = (b"0123456789.+-eE \t\r\n" + self._delimiter + b"#/nNaAiIdDqQuUlLfFtTyY"
+                   + (b"," if layout.decimal_comma else b""))
+        self._number_byte = np.zeros(256, dtype=bool)
+        self._number_byte[list(numbers)] = True
+        self._number_column = np.zeros(width, dtype=bool)  # read by pyarrow as float64
+        self._number_column[[j for j in columns if _read_as_number(layout, j)]] = True
+
+    def reading(self, inner: IO[bytes] | None) -> _Mended:
+        self._inner = inner
+        return self
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        assert self._inner is not None
+        while self._at == len(self._out) and not self._end:
+            chunk = self._inner.read(SALVAGE_CHUNK)
+            data = self._tail + chunk
+            end = data.rfind(b"\n") + 1 if chunk else len(data)
+            self._end = not chunk
+            self._out, self._at, self._tail = self._mended(data[:end]), 0, data[end:]
+        n = min(len(buffer), len(self._out) - self._at)
+        buffer[:n] = self._out[self._at:self._at + n]
+        self._at += n
+        return n
+
+    def close(self) -> None:
+        if self._inner is not None:
+            self._inner.close()
+        super().close()
+
+    def tally(self, tally: _Tally, rows: int) -> None:
+        """The lines made rows among the first `rows` rows, added to the tally (those after
+        are read again where the read stops before them)."""
+        while self.found and self.found[0][0] <= rows:
+            through, said = self.found.pop(0)
+            tally.add(TableError(said), through)
+
+    def _mended(self, whole: bytes) -> bytes:
+        """Whole lines (the last without its line end at the stream's end), mended."""
+        if not whole:
+            return whole
+        a = np.frombuffer(whole, dtype=np.uint8)
+        ends = np.flatnonzero(a == ord("\n"))
+        if not whole.endswith(b"\n"):
+            ends = np.append(ends, len(a))
+        starts = np.concatenate(([0], ends[:-1] + 1)).astype(np.int64)
+        stops = ends - ((ends > starts) & (a[np.maximum(ends - 1, 0)] == ord("\r")))
+        rows = stops > starts  # pyarrow's reader passes empty lines over
+        if self.drop:  # rows read before, every one a row of the table
+            k = np.flatnonzero(rows)
+            if len(k) <= self.drop:
+                self.drop -= len(k)
+                self.line, self.row = self.line + len(ends), self.row + len(k)
+                return b""
+            first = int(k[self.drop])
+            self.line, self.row, self.drop = self.line + first, self.row + self.drop, 0
+            return self._mended(whole[starts[first]:])
+        at_delimiter = np.flatnonzero(a == self._delimiter[0])
+        cells = (np.searchsorted(at_delimiter, stops) - np.searchsorted(at_delimiter, starts)
+                 + 1)
+        odd = rows & (cells != self._width)
+        odd_byte = np.flatnonzero(~self._number_byte[a])  # in a column read as a number?
+        line = np.searchsorted(ends, odd_byte)
+        cell = np.searchsorted(at_delimiter, odd_byte) - np.searchsorted(at_delimiter,
+                                                                         starts[line])
+        odd[line[self._number_column[np.minimum(cell, self._width - 1)]]] = True
+        pieces, at = [], 0
+        for i in np.flatnonzero(odd & rows):
+            text = whole[starts[i]:stops[i]]
+            if b'"' in text:
+                continue
+            said = text.decode(self.layout.encoding, "replace")
+            cells_of = next(csv.reader([said], delimiter=self.layout.delimiter))
+            rows[i] = len(cells_of) == self._width or any(c.strip() for c in cells_of)
+            try:
+                if rows[i]:
+                    _row_numbers(self.path, self.layout, self.columns, self.line + i + 1,
+                                 cells_of)
+                    continue  # a row after all, which pyarrow's reader reads or stops at
+            except TableError as err:
+                self.found.append((self.row + int(rows[:i + 1].sum()), str(err)))
+            pieces += [whole[at:starts[i]], self._empty if rows[i] else b""]
+            at = int(stops[i])
+        self.line, self.row = self.line + len(ends), self.row + int(rows.sum())
+        return b"".join([*pieces, whole[at:]]) if pieces else whole
 
 
 def _reblocked(parts: Iterator[np.ndarray], rows: int, width: int,
@@ -1158,7 +1282,9 @@ RESUME_ROWS = 2_000
 """Where pyarrow's reader meets a line that is no row, Python's reads from its batch through
 that line and on to at least this many rows (about what it costs pyarrow's to start again
 there), then pyarrow's goes on: a few such lines in a long log cost a few stretches read by
-Python. Where pyarrow's meets the next within fewer rows, Python's stretch doubles."""
+Python. Where pyarrow's meets the next within fewer rows, it reads on with such lines mended
+(_Mended), and where it still meets one (a cell of a number's bytes that is none), Python's
+stretch doubles."""
 ASCII_LINES = ("utf-8", "latin-1")
 """The encodings whose line ends are the byte b"\\n" (_AfterLines counts them so)."""
 
@@ -1167,19 +1293,30 @@ def _text_parts(path: Path, layout: _TextLayout, columns: list[int], tally: _Tal
                 ) -> Iterator[np.ndarray]:
     """The chosen columns of every row: pyarrow's reader, and where it meets a line it cannot
     read, Python's from the start of that batch through that line (naming it, or taking it as
-    a sample without numbers), pyarrow's again after it."""
-    done, skip, least = 0, layout.data_after, RESUME_ROWS
+    a sample without numbers), pyarrow's again after it. Where it meets one again within the
+    rows Python's read last (RESUME_ROWS: such lines come often), pyarrow's reads that batch
+    again with each such line made a row without numbers, and so on to the end (_Mended,
+    whose passes of numpy over the bytes a line or two in a long file would not repay)."""
+    done, skip, base, least = 0, layout.data_after, 0, RESUME_ROWS
     lines_by_bytes = layout.encoding in ASCII_LINES  # else lines are not counted in bytes
+    mend = False
     while True:
-        started = (skip, done) if lines_by_bytes else (0, 0)  # lines skipped, rows before
+        started = (skip, base) if lines_by_bytes else (0, 0)  # lines skipped, rows before
+        mended = _Mended(path, layout, columns, skip, base, done - base) if mend else None
         try:
-            for part in _arrow_parts(path, layout, columns, skip):
+            for part in _arrow_parts(path, layout, columns, skip, mended=mended):
                 yield part
                 done += len(part)
                 tally.rows = max(tally.rows, done)
+                if mended is not None:
+                    mended.tally(tally, done)
             return
         except _ArrowFailed:
-            least = least * 2 if done - started[1] < least else RESUME_ROWS
+            soon = done - started[1] < least  # after the start or the last stretch
+            if lines_by_bytes and soon and started[1] and not mend:
+                mend = True  # such lines come often: that batch again, mended from there on
+                continue
+            least = least * 2 if soon else RESUME_ROWS
             tally.stopped = None
             for part in _python_parts(path, layout, columns, done, tally,
                                       stop=least if lines_by_bytes else 0, after=started):
@@ -1187,7 +1324,7 @@ def _text_parts(path: Path, layout: _TextLayout, columns: list[int], tally: _Tal
                 done += len(part)
             if tally.stopped is None:  # it read to the end
                 return
-            skip = tally.stopped
+            skip, base = tally.stopped, done
 
 
 def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
@@ -1275,7 +1412,6 @@ def _python_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
     Where `stop`, the read ends once it has passed such a line and read `stop` rows, with
     tally.stopped its last line. after: (lines, rows) the file holds before where the read
     may start (where pyarrow's reader started)."""
-    width = len(layout.header)
     part: list[list[float]] = []
     nan_row = [float("nan")] * len(columns)
     met = False
@@ -1283,16 +1419,7 @@ def _python_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
                                     start=skip):
         tally.rows = max(tally.rows, k + 1)
         try:
-            if len(row) != width:
-                text = layout.delimiter.join(row)
-                raise TableError(f"{path}, line {line}: {len(row)} value(s) where the header "
-                                 f"has {width} columns ({text[:60]!r})")
-            if [c.strip() for c in row] == layout.header:
-                raise TableError(f"{path}, line {line}: the header again (a logger restarted "
-                                 "and wrote on)")
-            part.append([_number(row[j], path, line, layout.header[j], layout.decimal_comma,
-                                 _clock_of(layout, j), layout.durations.get(j, ""))
-                         for j in columns])
+            part.append(_row_numbers(path, layout, columns, line, row))
         except TableError as err:
             tally.add(err, k + 1)
             part.append(nan_row)
@@ -1305,6 +1432,22 @@ def _python_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int
             part = []
     if part:
         yield np.array(part, dtype=float).reshape(len(part), len(columns))
+
+
+def _row_numbers(path: Path, layout: _TextLayout, columns: list[int], line: int,
+                 row: list[str]) -> list[float]:
+    """The chosen columns' numbers of a row's cells; TableError naming the line where it is no
+    row of the table (another count of cells, the header again, a cell that is no number)."""
+    width = len(layout.header)
+    if len(row) != width:
+        text = layout.delimiter.join(row)
+        raise TableError(f"{path}, line {line}: {len(row)} value(s) where the header has "
+                         f"{width} columns ({text[:60]!r})")
+    if [c.strip() for c in row] == layout.header:
+        raise TableError(f"{path}, line {line}: the header again (a logger restarted and "
+                         "wrote on)")
+    return [_number(row[j], path, line, layout.header[j], layout.decimal_comma,
+                    _clock_of(layout, j), layout.durations.get(j, "")) for j in columns]
 
 
 def _clock_of(layout: _TextLayout, j: int) -> str:

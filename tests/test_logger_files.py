@@ -994,18 +994,20 @@ def test_a_line_that_is_no_row_is_a_sample_without_numbers(tmp_path, padded, lin
 
 @pytest.mark.parametrize("least", [1, 10**6])
 def test_pyarrows_reader_goes_on_after_each_line_that_is_no_row(tmp_path, monkeypatch, least):
-    """Python's reader takes over where pyarrow's meets a line that is no row, and pyarrow's
-    goes on after it once Python's has read RESUME_ROWS (a long log with a garbled line is
-    read at pyarrow's speed but for that stretch): the samples are the same as Python's
-    reader gives throughout, a blank line and lines of every kind of fault between."""
+    """Where pyarrow's reader meets a line that is no row, it reads that batch again with the
+    lines of another count of cells made rows without numbers, and where it still meets one,
+    Python's reader takes over and pyarrow's goes on after it once Python's has read
+    RESUME_ROWS (a long log with a garbled line is read at pyarrow's speed but for that
+    stretch): the samples are the same as Python's reader gives throughout, a blank line and
+    lines of every kind of fault between."""
     import testbenches.reader as reader
 
     monkeypatch.setattr(reader, "RESUME_ROWS", least)
     arrow, started = reader._arrow_parts, []
 
-    def counted(*args):
-        started.append(args[-1])  # the lines it skips
-        return arrow(*args)
+    def counted(*args, mended=None):
+        started.append((args[-1], mended is not None))  # the lines it skips, mended or not
+        return arrow(*args, mended=mended)
 
     monkeypatch.setattr(reader, "_arrow_parts", counted)
     lines = EXAMPLE.read_text().splitlines(keepends=True)
@@ -1023,8 +1025,12 @@ def test_pyarrows_reader_goes_on_after_each_line_that_is_no_row(tmp_path, monkey
     np.testing.assert_array_equal(rec.acc[keep], whole.acc[keep])
     assert "4 line(s) no row of the table" in rec.described
     assert "the first: line 201: 2 value(s)" in rec.described
-    runs = 5 if least == 1 else 1  # after each of the 4; or Python's to the end
-    assert started[:runs] == [1, 201, 451, 702, 902][:runs]
+    # Python's from the batch that failed through the line and `least` rows; pyarrow's again
+    # after them, and where it fails again within them (such lines come often), on that batch
+    # and to the end with every such line mended (_Mended)
+    runs = [(1, False), (201, False), (201, True)] if least == 1 else [(1, False)]
+    assert started[:len(runs)] == runs and started[len(runs)] == (1, False)  # then `whole`
+
 
 
 def _both_readers(path, monkeypatch):
@@ -1038,6 +1044,47 @@ def _both_readers(path, monkeypatch):
         m.setattr(reader, "_has_pyarrow", lambda: False)
         python, _ = open_recording(path, gyro_unit="rad/s").load()
     return arrow, python
+
+
+def test_lines_that_are_no_row_every_few_rows_are_read_by_pyarrow(tmp_path, monkeypatch):
+    """A serial link that garbles a line every hundred rows (too few values, two rows run
+    together, a byte in a number, text in a cell, the header again, a line of delimiters
+    alone) leaves Python's reader one stretch to read: once the next such line comes within
+    the rows it read, pyarrow's reads them as rows without numbers (_Mended), in CRLF files
+    too, and the samples and what is said are those of Python's reader throughout."""
+    import testbenches.reader as reader
+
+    parsed = []
+    python = reader._python_parts
+
+    def counted(*args, **kwargs):
+        for part in python(*args, **kwargs):
+            parsed.append(len(part))
+            yield part
+
+    lines = EXAMPLE.read_text().splitlines()
+    faults = ["4.98,-0.2", ",,,", lines[0], "1,2,3,4,5,6,7,8,9" + lines[300],
+              lines[400].replace(".", "$", 2), "x" + lines[500][1:], "   "]
+    for k in range(100, 1000, 100):
+        lines[k] = faults[k // 100 % len(faults)]
+    for end in ("\n", "\r\n"):
+        path = tmp_path / "garbled.csv"
+        path.write_bytes((end.join(lines) + end).encode())
+        parsed.clear()
+        with monkeypatch.context() as m:
+            m.setattr(reader, "_python_parts", counted)
+            m.setattr(reader, "ARROW_BLOCK", 1 << 12)
+            m.setattr(reader, "RESUME_ROWS", 150)
+            arrow, _ = open_recording(path, gyro_unit="rad/s").load()
+        assert len(parsed) == 1 and parsed[0] < 400  # Python's reader: its first stretch
+        _, python_alone = _both_readers(path, monkeypatch)
+        for name in ("acc", "gyro", "dt", "valid"):
+            np.testing.assert_array_equal(getattr(arrow, name), getattr(python_alone, name))
+        assert arrow.described == python_alone.described
+        assert (~arrow.valid).sum() == 6 and len(arrow.dt) == 997  # 3 blank, 6 garbled
+        assert ("6 line(s) no row of the table, taken as samples without a number (a "
+                "logger's garbled or lost bytes; the first: line 201: the header again") \
+            in arrow.described
 
 
 def test_a_row_of_empty_cells_is_a_sample_to_either_reader(tmp_path, monkeypatch):
