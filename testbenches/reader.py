@@ -1342,7 +1342,7 @@ def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
         for text in f if skip else ():
             passed += 1
             if passed > layout.data_after and (text.strip(blank) or (
-                    text.strip() and text.count(layout.delimiter) == width - 1)):
+                    text.strip("\r\n") and text.count(layout.delimiter) == width - 1)):
                 skip -= 1
                 if not skip:
                     break

@@ -1087,16 +1087,18 @@ def test_lines_that_are_no_row_every_few_rows_are_read_by_pyarrow(tmp_path, monk
             in arrow.described
 
 
-def test_a_row_of_empty_cells_is_a_sample_to_either_reader(tmp_path, monkeypatch):
+@pytest.mark.parametrize("delimiter", [",", "\t"])
+def test_a_row_of_empty_cells_is_a_sample_to_either_reader(tmp_path, monkeypatch, delimiter):
     """A row of the header's count of empty cells is a sample without numbers to both
     readers, and where Python's reader takes over from pyarrow's (at a cell that is no
     number, batches later) it starts at the row pyarrow's reached: Python's reader took the row
-    for a blank line, so it started one row late and a sample was lost."""
+    for a blank line, so it started one row late and a sample was lost (tabs, which are
+    white space as well as the delimiter, too)."""
     lines = EXAMPLE.read_text().splitlines(keepends=True)
     lines.insert(100, ",,,,,,,\n")
     lines[800] = lines[800].replace(",", "$", 1)
     path = tmp_path / "empty_row.csv"
-    path.write_text("".join(lines))
+    path.write_text("".join(lines).replace(",", delimiter))
     arrow, python = _both_readers(path, monkeypatch)
     for rec in (arrow, python):
         assert len(rec.dt) == 1001 and np.flatnonzero(~rec.valid).tolist() == [99, 799]
