@@ -1065,11 +1065,14 @@ def _as_iso(column: Any, kind: Any) -> Any:
 
 
 def _seconds(column: Any) -> np.ndarray:
-    """A pyarrow timestamp array [ns] as seconds since 1970, its nulls NaN."""
+    """A pyarrow timestamp or time of day array [ns] as seconds since 1970 or midnight, its
+    nulls NaN: the whole seconds and their fraction added, as seconds_of and seconds_of_day
+    add them, so that both readers give the same seconds to the bit (one rounding; the
+    nanoseconds times 1e-9 round twice)."""
     import pyarrow as pa
 
-    ns = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
-    seconds = np.asarray(ns, dtype=float) * 1e-9
+    ns = column.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False)
+    seconds = (ns // 10**9).astype(float) + (ns % 10**9) / 1e9
     if column.null_count:
         seconds[np.asarray(column.is_null().to_numpy(zero_copy_only=False))] = np.nan
     return seconds

@@ -321,6 +321,29 @@ def test_dates_and_times_as_locales_write_them_are_read_at_pyarrows_speed(tmp_pa
     np.testing.assert_allclose(times, np.arange(50) / 100)
 
 
+@pytest.mark.parametrize("form", ["%Y-%m-%dT%H:%M:%S.%f", "%Y/%m/%d %H:%M:%S.%f", "%H:%M:%S.%f"])
+def test_dates_and_times_are_the_same_seconds_to_either_reader(tmp_path, monkeypatch, form):
+    """pyarrow's reader and Python's give a date's or a time of day's seconds to the last bit:
+    its whole seconds and its fraction added (one rounding); pyarrow's took its nanoseconds
+    times 1e-9, which rounds twice, so that the samples' dt parted by up to 5e-7 s."""
+    import datetime as dt
+
+    import testbenches.reader as reader
+
+    t, imu = _example()
+    start = dt.datetime(2024, 5, 1, 12, 0, 0)
+    stamps = [(start + dt.timedelta(seconds=float(s))).strftime(form)[:-3] for s in t]
+    path = tmp_path / "dates.csv"
+    path.write_text("\n".join([f"time,{HEADER}", *(",".join([s, *(f"{v:.10g}" for v in row)])
+                                                  for s, row in zip(stamps, imu, strict=True))])
+                    + "\n")
+    arrow, arrow_t = open_recording(path, gyro_unit="rad/s").load()
+    monkeypatch.setattr(reader, "_has_pyarrow", lambda: False)
+    python, python_t = open_recording(path, gyro_unit="rad/s").load()
+    np.testing.assert_array_equal(arrow_t, python_t)
+    np.testing.assert_array_equal(arrow.dt, python.dt)
+
+
 def test_a_spreadsheets_dates_saved_as_numbers_are_named_in_the_refusal(tmp_path):
     """A sheet's date and time column saved as numbers (days since 1899-12-30: 45413.5...)
     steps by 1.16e-7 at 100 Hz, a rate in no unit the reader takes: refused, naming what it
