@@ -620,12 +620,8 @@ TAIL_BYTES = 1 << 16
 
 def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
     """Where the table ends before what a logger leaves when it stops mid-write, and what that
-    was: NUL bytes after the last line (a file preallocated on an SD card, its unwritten rest)
-    and a last line cut short (fewer cells than the header, no line end after it: power lost
-    while it was written, its last cell's digits perhaps cut too; _cut_value), and a last line
-    of text, with a line end or without (a footer a logger appends: "END OF LOG"). (None, "")
-    where the file ends with its table. A short line of numbers that ends with a line end is
-    no cut: a line that is no row (_python_parts)."""
+    was (_tail_of), from the file's last bytes: back over windows of NULs to the last byte
+    written."""
     size = stop = path.stat().st_size
     with path.open("rb") as f:
         while True:  # back over windows of NULs to the last byte written
@@ -635,7 +631,20 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
             if kept or start == 0:
                 break
             stop = start
-    nul = size - start - len(kept)
+    return _tail_of(kept, start, size - start - len(kept), layout,
+                    lambda end: _lines_before(path, end))
+
+
+def _tail_of(kept: bytes, start: int, nul: int, layout: _TextLayout,
+             lines_before: Callable[[int], int]) -> tuple[int | None, str]:
+    """Where the table ends before what a logger leaves when it stops mid-write, and what that
+    was: NUL bytes after the last line (a file preallocated on an SD card, its unwritten rest)
+    and a last line cut short (fewer cells than the header, no line end after it: power lost
+    while it was written, its last cell's digits perhaps cut too; _cut_value), and a last line
+    of text, with a line end or without (a footer a logger appends: "END OF LOG"). (None, "")
+    where the file ends with its table. A short line of numbers that ends with a line end is
+    no cut: a line that is no row (_python_parts). kept: the file's last bytes but its `nul`
+    NULs, from byte `start`; lines_before(end): the line ends before byte `end`."""
     said = []
     terminated = kept.endswith(b"\n")
     body = kept.rstrip(b"\r\n") if terminated else kept
@@ -652,7 +661,7 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
         footer = not (short or cut) and cells != len(layout.header) and _footer(values)
         if short or cut or footer:
             end = start + last
-            number = _lines_before(path, end) + 1
+            number = lines_before(end) + 1
             said.append(f"line {number}, the last, cut short ({cells} of "
                         f"{len(layout.header)} values: a logger stopped mid-write): left out"
                         if short else
@@ -664,6 +673,56 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
         said.append(f"{nul} NUL bytes after the last line (the unwritten rest of a "
                     "preallocated file): ignored")
     return (end, "; ".join(said)) if said else (None, "")
+
+
+class _Tailed(io.RawIOBase):
+    """A stream's bytes (a compressed file's, decompressed), its last TAIL_BYTES held until it
+    ends and its trailing NULs counted, then passed on up to where the table ends before what
+    a logger stopped mid-write leaves (_tail_of), which `found` is told: what _tail finds from
+    a file's end, for a file read through to its end once."""
+
+    def __init__(self, inner: IO[bytes], layout: _TextLayout, found: list[str]) -> None:
+        self._inner, self._layout, self._found = inner, layout, found
+        self._out = memoryview(b"")
+        self._held, self._nul, self._passed, self._line_ends = b"", 0, 0, 0
+        self._done = False
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        while not self._out and not self._done:
+            chunk = self._inner.read(SALVAGE_CHUNK)
+            if not chunk:
+                self._done = True
+                self._out = memoryview(self._ending())
+                break
+            written = chunk.rstrip(b"\x00")
+            if not written:  # NULs alone so far: counted, not held
+                self._nul += len(chunk)
+                continue
+            data = self._held + b"\x00" * self._nul + written  # NULs before more: data
+            self._nul = len(chunk) - len(written)
+            keep = max(0, len(data) - TAIL_BYTES)
+            self._out, self._held = memoryview(data[:keep]), data[keep:]
+            self._passed += keep
+            self._line_ends += data.count(b"\n", 0, keep)
+        n = min(len(buffer), len(self._out))
+        memoryview(buffer).cast("B")[:n] = self._out[:n]
+        self._out = self._out[n:]
+        return n
+
+    def _ending(self) -> bytes:
+        held, start = self._held, self._passed
+        end, said = _tail_of(held, start, self._nul, self._layout,
+                             lambda at: self._line_ends + held.count(b"\n", 0, at - start))
+        if said:
+            self._found.append(said)
+        return held if end is None else held[:end - start]
+
+    def close(self) -> None:
+        self._inner.close()
+        super().close()
 
 
 _SHAPE = re.compile(r"[-+]?([0-9]*)(?:[.,]([0-9]*))?(?:[eE][-+]?([0-9]*))?")
@@ -804,6 +863,8 @@ def _table_bytes(path: Path, layout: _TextLayout) -> IO[bytes]:
     read finds said in layout.found)."""
     raw = (_open_bytes(path, layout.found) if layout.data_end is None
            else io.BufferedReader(_Head(path, layout.data_end)))
+    if _compression(path) is not None and layout.encoding in ASCII_LINES:
+        raw = io.BufferedReader(_Tailed(raw, layout, layout.found), buffer_size=SALVAGE_CHUNK)
     return io.BufferedReader(_Spaced(raw), buffer_size=SALVAGE_CHUNK) if layout.spaced else raw
 
 

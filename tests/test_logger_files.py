@@ -1172,6 +1172,44 @@ def test_a_compressed_file_cut_short_is_read_up_to_the_cut_and_said(tmp_path, co
     assert "read up to the cut" in said
 
 
+@pytest.mark.parametrize("compress", ["gzip", "bz2", "lzma"])
+@pytest.mark.parametrize("ending,says", [
+    ("0.0", "line 1001, the last, cut mid-write (no line end after it, and its last value "
+            "'0.0' has fewer digits than that column's value on each of the 100 lines before "
+            "it): left out"),
+    ("", "line 1001, the last, cut short (5 of 8 values: a logger stopped mid-write): left out"),
+    ("END OF LOG\n", "line 1002, the last, is text after the table ('END OF LOG'): left out as "
+                     "a footer"),
+    ("\x00" * 300_000, "300000 NUL bytes after the last line (the unwritten rest of a "
+                       "preallocated file): ignored"),
+], ids=["value_cut", "line_cut", "footer", "nul_padding"])
+def test_a_compressed_file_s_last_line_as_a_logger_stopped_is_read_as_the_plain_file(
+        tmp_path, compress, ending, says):
+    """What a logger leaves when it stops mid-write (a last value cut, a last line cut short,
+    a footer, NUL padding) is found in a compressed copy of its file as in the file: the last
+    line was read as it stood there (a cut value as the wrong number, silently), a footer as
+    a line that is no row."""
+    import importlib
+
+    text = EXAMPLE.read_text()
+    if ending == "0.0":  # the last value, 0.01, cut to 0.0
+        text = text.rstrip("\n")[:-1]
+    elif ending == "":  # the last line cut after its fifth value
+        text = text[:text.rstrip("\n").rfind("\n") + 1] + ",".join(
+            text.rstrip("\n").rsplit("\n", 1)[1].split(",")[:5])
+    else:
+        text += ending
+    plain = tmp_path / "logged.csv"
+    plain.write_text(text)
+    packed = tmp_path / "logged.csv.z"
+    packed.write_bytes(importlib.import_module(compress).compress(text.encode()))
+    got = [open_recording(path, gyro_unit="rad/s") for path in (plain, packed)]
+    (rec, _), (packed_rec, _) = (source.load() for source in got)
+    for name in ("acc", "gyro", "dt", "valid"):
+        np.testing.assert_array_equal(getattr(packed_rec, name), getattr(rec, name))
+    assert says in rec.described and says in packed_rec.described
+
+
 def test_a_compressed_file_cut_before_its_first_line_or_damaged_is_refused(tmp_path):
     import gzip
 

@@ -118,3 +118,25 @@ def test_a_logger_file_reads_the_same_through_either_reader(tmp_path, monkeypatc
         np.testing.assert_array_equal(getattr(a, name), getattr(p, name), err_msg=name)
     np.testing.assert_array_equal(a_t, p_t)
     assert a.described == p.described
+
+
+@pytest.mark.parametrize("seed", SEEDS[::3])
+def test_a_logger_file_reads_the_same_compressed(tmp_path, seed):
+    """A gzip copy of the file reads as the file: what its end holds (a cut line, a footer)
+    is found in the decompressed stream as at the file's end."""
+    import gzip
+
+    path = _logged(random.Random(seed), tmp_path / "logged.csv")
+    packed = tmp_path / "logged.csv.gz"
+    packed.write_bytes(gzip.compress(path.read_bytes()))
+    plain, compressed = _read(path), _read(packed)
+    assert plain[0] == compressed[0]
+    if plain[0] == "refused":
+        assert str(compressed[1]).replace(packed.name, path.name) == plain[1]
+        return
+    (a, a_t), (p, p_t) = plain[1], compressed[1]
+    for name in ("acc", "gyro", "dt", "valid"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(p, name), err_msg=name)
+    np.testing.assert_array_equal(a_t, p_t)
+    said = sorted(a.described.split("; "))  # a footer's said where the stream ends
+    assert sorted(p.described.replace(packed.name, path.name).split("; ")) == said
