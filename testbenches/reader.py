@@ -229,7 +229,8 @@ def open_table(path: str | Path) -> TableSource:
     if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
         raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
                          "directory of its files at its end): copy or download it again")
-    if magic.startswith(b"PK\x03\x04") or suffix in (".xlsx", ".xls", ".ods"):
+    if ((magic.startswith(b"PK\x03\x04") and zipped_table(path) is None)
+            or suffix in (".xlsx", ".xls", ".ods")):
         raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "
                          "table this reader takes: save the sheet as CSV (a zip archive of a "
                          "phone app's files serves under a .zip name)")
@@ -277,10 +278,37 @@ COMPRESSIONS = {b"\x1f\x8b": "gzip", b"BZh": "bz2", b"\xfd7zXZ\x00": "xz"}
 """A compressed text file's magic bytes and its compression: read as the text it holds."""
 
 
+ZIPPED_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
+"""The suffixes of the one file a zip archive may hold to be read as that text file (a
+recording zipped to be sent); an archive of more files is a phone app's export."""
+
+
+def zipped_table(path: Path) -> str | None:
+    """The one text file a zip archive holds (ZIPPED_SUFFIXES; macOS's resource forks and
+    hidden files aside), None for any other archive or file."""
+    if not zipfile.is_zipfile(path):
+        return None
+    with zipfile.ZipFile(path) as z:
+        names = [i.filename for i in z.infolist() if not i.is_dir()
+                 and not any(part.startswith((".", "__MACOSX")) for part in i.filename.split("/"))]
+    if len(names) == 1 and Path(names[0]).suffix.lower() in ZIPPED_SUFFIXES:
+        return names[0]
+    return None
+
+
 def _compression(path: Path) -> str | None:
     with path.open("rb") as f:
         magic = f.read(6)
+    if magic.startswith(b"PK\x03\x04") and zipped_table(path) is not None:
+        return "zip"
     return next((kind for m, kind in COMPRESSIONS.items() if magic.startswith(m)), None)
+
+
+def _unzipped(path: Path, mode: str) -> IO[bytes]:
+    """The one text file of a zip archive (zipped_table), as a stream of its bytes."""
+    member = zipped_table(path)
+    assert member is not None
+    return zipfile.ZipFile(path).open(member)  # the archive closes with its member's stream
 
 
 def _open_bytes(path: Path, found: list[str] | None = None) -> IO[bytes]:
@@ -291,7 +319,8 @@ def _open_bytes(path: Path, found: list[str] | None = None) -> IO[bytes]:
     import lzma
 
     kind = _compression(path)
-    opener = {"gzip": gzip.open, "bz2": bz2.open, "xz": lzma.open}.get(kind or "")
+    opener = {"gzip": gzip.open, "bz2": bz2.open, "xz": lzma.open,
+              "zip": _unzipped}.get(kind or "")
     if opener is None:
         return path.open("rb")
     return io.BufferedReader(_Salvaged(opener(path, "rb"), path, kind or "", found),
@@ -370,7 +399,7 @@ class _Salvaged(_Lines):
                 self._found.append(f"{_cut_stream(self._kind)}: read up to the cut" + (
                     ", the line it fell in left out" if self._held.strip() else ""))
             return None
-        except (OSError, zlib.error, lzma.LZMAError) as err:
+        except (OSError, zlib.error, lzma.LZMAError, zipfile.BadZipFile) as err:
             raise TableError(f"{self._path}: its {self._kind} stream cannot be decompressed "
                              f"({err}): the file is damaged") from None
 

@@ -1260,6 +1260,38 @@ def test_a_binary_file_cut_short_is_refused_in_one_line(tmp_path, kind):
             load_trial(cut)
 
 
+def test_a_zip_archive_of_one_text_file_is_read_as_that_file(tmp_path):
+    """A recording zipped to be sent (with macOS's resource fork beside it) is read as the text
+    file it holds, its end looked at as that file's (a last value cut mid-write left out): it
+    was refused as a phone app's export without a file named for the accelerometer. An
+    archive of two files is still an export, and a workbook still refused."""
+    import zipfile
+
+    text = EXAMPLE.read_text().rstrip("\n")[:-1]  # its last value, 0.01, cut to 0.0
+    plain = tmp_path / "logged.csv"
+    plain.write_text(text)
+    packed = tmp_path / "logged.zip"
+    with zipfile.ZipFile(packed, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("recording/logged.csv", text)
+        z.writestr("__MACOSX/recording/._logged.csv", b"\x00\x05\x16\x07")
+    (rec, _), (packed_rec, _) = (open_recording(p, gyro_unit="rad/s").load()
+                                 for p in (plain, packed))
+    assert len(packed_rec.dt) == 999
+    for name in ("acc", "gyro", "dt", "valid"):
+        np.testing.assert_array_equal(getattr(packed_rec, name), getattr(rec, name))
+    assert "line 1001, the last, cut mid-write" in packed_rec.described
+    with zipfile.ZipFile(packed, "a") as z:
+        z.writestr("notes.txt", "held by hand\n")
+    with pytest.raises(RecordingError, match="no file named for the accelerometer"):
+        open_recording(packed).load()
+    workbook = tmp_path / "sheet.xlsx"
+    with zipfile.ZipFile(workbook, "w") as z:
+        z.writestr("[Content_Types].xml", "<Types/>")
+        z.writestr("xl/worksheets/sheet1.xml", "<worksheet/>")
+    with pytest.raises(RecordingError, match="a spreadsheet workbook"):
+        open_recording(workbook).load()
+
+
 def test_a_zip_archive_cut_short_is_refused_as_cut_not_as_a_workbook(tmp_path):
     import zipfile
 

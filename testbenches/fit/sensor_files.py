@@ -37,7 +37,7 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from ..reader import TableError, TableSource, open_table
+from ..reader import TableError, TableSource, open_table, zipped_table
 from .columns import ALIASES, find_name, norm_name
 
 TABLE_SUFFIXES = (".csv", ".txt", ".tsv", ".parquet", ".pq")
@@ -52,8 +52,10 @@ SENSORS = {"acc": "accelerometer", "gyro": "gyro"}
 
 
 def is_sensor_files(path: Path) -> bool:
-    """Whether the path is a folder or a zip archive (read as one file per sensor)."""
-    return path.is_dir() or (path.suffix.lower() == ".zip" and zipfile.is_zipfile(path))
+    """Whether the path is a folder or a zip archive (read as one file per sensor), not an
+    archive of one text file (read as that file: reader.zipped_table)."""
+    return path.is_dir() or (path.suffix.lower() == ".zip" and zipfile.is_zipfile(path)
+                             and zipped_table(path) is None)
 
 
 def _rank(sensor: str, name: str) -> int | None:
