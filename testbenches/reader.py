@@ -1425,12 +1425,14 @@ def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
     """(line, cells) of every data row after the file's first `after` lines and its first
     `skip` data rows (passed over as lines, not parsed), blank lines skipped: a line of
     spaces and delimiters alone, but for one of the header's count of cells, which is a row of
-    empty cells (a sample without numbers) as pyarrow's reader reads it."""
+    empty cells (a sample without numbers) as pyarrow's reader reads it. Bytes that are no
+    character of the encoding (a serial link's garbled byte, past where the encoding was
+    found) are read as U+FFFD, which makes their cell no number and the line no row."""
     raw = _table_bytes(path, layout)
     width = len(layout.header)
     with io.TextIOWrapper(io.BufferedReader(_AfterLines(raw, after)) if after else raw,
                           newline="", encoding="utf-8-sig" if layout.encoding == "utf-8"
-                          else layout.encoding) as f:
+                          else layout.encoding, errors="replace") as f:
         blank, passed = " \t\r\n" + layout.delimiter, after
         for text in f if skip else ():
             passed += 1

@@ -992,6 +992,28 @@ def test_a_line_that_is_no_row_is_a_sample_without_numbers(tmp_path, padded, lin
                 f"logger's garbled or lost bytes; the first: {says}" in rec.described)
 
 
+@pytest.mark.parametrize("pyarrow", [True, False])
+def test_a_byte_that_is_no_utf8_character_makes_its_line_no_row(tmp_path, monkeypatch,
+                                                               pyarrow):
+    """A serial link's garbled byte that is no UTF-8 character, past the lines the encoding
+    was found from, was a refusal naming neither file nor line ("'utf-8' codec can't decode
+    byte 0xb7 in position 4223"); it makes its cell no number, and its line a sample without
+    numbers, said, by either reader."""
+    import testbenches.reader as reader
+
+    if not pyarrow:
+        monkeypatch.setattr(reader, "_has_pyarrow", lambda: False)
+    lines = EXAMPLE.read_bytes().split(b"\n")
+    lines[900] = lines[900].replace(b".", b"\xb7", 1)
+    path = tmp_path / "garbled.csv"
+    path.write_bytes(b"\n".join(lines))
+    rec, _ = open_recording(path, gyro_unit="rad/s").load()
+    assert len(rec.dt) == 1000 and np.flatnonzero(~rec.valid).tolist() == [899]
+    assert ("1 line(s) no row of the table, taken as samples without a number (a logger's "
+            "garbled or lost bytes; the first: line 901, column 'time': '8\ufffd99' is not a "
+            "number") in rec.described
+
+
 @pytest.mark.parametrize("least", [1, 10**6])
 def test_pyarrows_reader_goes_on_after_each_line_that_is_no_row(tmp_path, monkeypatch, least):
     """Where pyarrow's reader meets a line that is no row, it reads that batch again with the
