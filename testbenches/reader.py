@@ -1236,7 +1236,7 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int,
         raise _ArrowFailed(str(err)) from None
 
 
-class _Mended(io.RawIOBase):
+class _Mended(_Lines):
     """A table's bytes from where a read starts, its first `drop` rows (read before) left out,
     with each line that is no row of the table (another count of cells than the header's, a
     cell read as a number that is none, the header again: a serial link's lost or garbled
@@ -1254,8 +1254,7 @@ class _Mended(io.RawIOBase):
         self.path, self.layout, self.columns = path, layout, columns
         self.line, self.row, self.drop = line, row, drop  # lines and rows before the next
         self.found: list[tuple[int, str]] = []  # (rows through the line, its refusal)
-        self._inner: IO[bytes] | None = None
-        self._out, self._at, self._tail, self._end = b"", 0, b"", False
+        super().__init__(None)  # the stream it reads is given by `reading`
         self._delimiter = layout.delimiter.encode(layout.encoding)
         self._width = width = len(layout.header)
         self._empty = self._delimiter * (width - 1)
@@ -1270,27 +1269,6 @@ class _Mended(io.RawIOBase):
         self._inner = inner
         return self
 
-    def readable(self) -> bool:
-        return True
-
-    def readinto(self, buffer: Any) -> int:
-        assert self._inner is not None
-        while self._at == len(self._out) and not self._end:
-            chunk = self._inner.read(SALVAGE_CHUNK)
-            data = self._tail + chunk
-            end = data.rfind(b"\n") + 1 if chunk else len(data)
-            self._end = not chunk
-            self._out, self._at, self._tail = self._mended(data[:end]), 0, data[end:]
-        n = min(len(buffer), len(self._out) - self._at)
-        buffer[:n] = self._out[self._at:self._at + n]
-        self._at += n
-        return n
-
-    def close(self) -> None:
-        if self._inner is not None:
-            self._inner.close()
-        super().close()
-
     def tally(self, tally: _Tally, rows: int) -> None:
         """The lines made rows among the first `rows` rows, added to the tally (those after
         are read again where the read stops before them)."""
@@ -1298,7 +1276,7 @@ class _Mended(io.RawIOBase):
             through, said = self.found.pop(0)
             tally.add(TableError(said), through)
 
-    def _mended(self, whole: bytes) -> bytes:
+    def _lines(self, whole: bytes) -> bytes:
         """Whole lines (the last without its line end at the stream's end), mended."""
         if not whole:
             return whole
@@ -1317,7 +1295,7 @@ class _Mended(io.RawIOBase):
                 return b""
             first = int(k[self.drop])
             self.line, self.row, self.drop = self.line + first, self.row + self.drop, 0
-            return self._mended(whole[starts[first]:])
+            return self._lines(whole[starts[first]:])
         at_delimiter = np.flatnonzero(a == self._delimiter[0])
         cells = (np.searchsorted(at_delimiter, stops) - np.searchsorted(at_delimiter, starts)
                  + 1)
