@@ -39,6 +39,7 @@ other formats count rows from 1.
 
 from __future__ import annotations
 
+import collections
 import csv
 import datetime as dt
 import io
@@ -638,7 +639,7 @@ def _sniff(path: Path) -> _TextLayout:
                          datetimes, times_of_day, skipped, data_after, units_row, stacked,
                          rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations,
                          spaced=spaced, not_iso=rewritten, day_month=day_month)
-    if _compression(path) is None and encoding in ("utf-8", "latin-1"):
+    if _compression(path) is None and encoding in ASCII_LINES:
         layout.data_end, layout.tail = _tail(path, layout)
     return layout
 
@@ -1253,13 +1254,16 @@ class _Mended(_Lines):
                  drop: int) -> None:
         self.path, self.layout, self.columns = path, layout, columns
         self.line, self.row, self.drop = line, row, drop  # lines and rows before the next
-        self.found: list[tuple[int, str]] = []  # (rows through the line, its refusal)
+        self.found: collections.deque[tuple[int, str]] = collections.deque()
+        """(rows through a line made a row, its refusal), until the tally is told."""
         super().__init__(None)  # the stream it reads is given by `reading`
         self._delimiter = layout.delimiter.encode(layout.encoding)
         self._width = width = len(layout.header)
         self._empty = self._delimiter * (width - 1)
-        numbers = (b"0123456789.+-eE \t\r\n" + self._delimiter + b"#/nNaAiIdDqQuUlLfFtTyY"
-                   + (b"," if layout.decimal_comma else b""))
+        marks = "".join(MISSING_VALUES) + "infinity"  # letters a cell of a number may hold
+        numbers = (b"0123456789.+-eE \t\r\n" + self._delimiter
+                   + (marks.lower() + marks.upper()).encode() + (b"," if layout.decimal_comma
+                                                                else b""))
         self._number_byte = np.zeros(256, dtype=bool)
         self._number_byte[list(numbers)] = True
         self._number_column = np.zeros(width, dtype=bool)  # read by pyarrow as float64
@@ -1273,7 +1277,7 @@ class _Mended(_Lines):
         """The lines made rows among the first `rows` rows, added to the tally (those after
         are read again where the read stops before them)."""
         while self.found and self.found[0][0] <= rows:
-            through, said = self.found.pop(0)
+            through, said = self.found.popleft()
             tally.add(TableError(said), through)
 
     def _lines(self, whole: bytes) -> bytes:
@@ -1312,7 +1316,7 @@ class _Mended(_Lines):
                 continue
             said = text.decode(self.layout.encoding, "replace")
             cells_of = next(csv.reader([said], delimiter=self.layout.delimiter))
-            rows[i] = len(cells_of) == self._width or any(c.strip() for c in cells_of)
+            rows[i] = not _blank(cells_of, self._width)
             try:
                 if rows[i]:
                     _row_numbers(self.path, self.layout, self.columns, self.line + i + 1,
@@ -1398,6 +1402,13 @@ def _text_parts(path: Path, layout: _TextLayout, columns: list[int], tally: _Tal
             skip, base = tally.stopped, done
 
 
+def _blank(cells: list[str], width: int) -> bool:
+    """Whether a line's cells are no row: none, or spaces alone and not the header's count of
+    them (which is a row of empty cells, a sample without numbers, as pyarrow's reader reads
+    it)."""
+    return not cells or (len(cells) != width and not any(c.strip() for c in cells))
+
+
 def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
           ) -> Iterator[tuple[int, list[str]]]:
     """(line, cells) of every data row after the file's first `after` lines and its first
@@ -1421,8 +1432,7 @@ def _rows(path: Path, layout: _TextLayout, after: int = 0, skip: int = 0
                     break
         reader = csv.reader(f, delimiter=layout.delimiter)
         for row in reader:
-            if reader.line_num + passed <= layout.data_after or not row or (
-                    len(row) != width and not any(c.strip() for c in row)):
+            if reader.line_num + passed <= layout.data_after or _blank(row, width):
                 continue
             yield reader.line_num + passed, row
 
