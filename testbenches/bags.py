@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .reader import TableError, TableSource
+from .table import TableError, TableSource
 
 ROS1_MAGIC = b"#ROSBAG V2.0"
 MCAP_MAGIC = b"\x89MCAP0\r\n"

@@ -58,7 +58,7 @@ from .options import (
     positive_int,
     with_calibration,
 )
-from .reader import DATETIME, DURATION, TIME_OF_DAY, TIME_SCALE
+from .table import DATETIME, DURATION, TIME_OF_DAY, TIME_SCALE
 from .table_out import FORMATS, TableWriter
 
 OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", "bias_z"),

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .gyro_unit import MIN_WINDOWS, UnitEvidence, verdict, window_misses
-from .reader import TIME_SCALE
+from .table import TIME_SCALE
 
 RATE_RANGE = (2.0, 50_000.0)
 """The sample rates [Hz] an IMU recording may have, [low, high): from two samples a second,

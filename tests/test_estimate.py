@@ -537,10 +537,10 @@ def test_vqf_integrates_over_the_samples_missing_as_the_estimators_do(tmp_path, 
     (1.11 deg against 0.97 for one sample missed at 5 s). It takes it once per period missed,
     across a block's edge too; a row written twice takes no time and changes nothing."""
     pytest.importorskip("vqf", reason="the bench extra: pip install -e '.[bench]'")
-    import testbenches.reader as reader
+    import testbenches.table as table
 
     if block_rows:
-        monkeypatch.setattr(reader, "BLOCK_ROWS", block_rows)
+        monkeypatch.setattr(table, "BLOCK_ROWS", block_rows)
     lines = EXAMPLE.read_text().splitlines(keepends=True)
 
     def vqf_row(name: str, text: list[str]) -> float:

@@ -377,7 +377,7 @@ def test_a_clock_in_an_unstated_unit_is_named_and_an_index_is_no_unit(tmp_path):
     rec, _ = open_recording(path, time_column="SampleTimeFine", time_unit="us").load()
     np.testing.assert_allclose(rec.dt[1:], open_recording(EXAMPLE).load()[0].dt[1:], rtol=1e-6)
 
-    from testbenches.reader import split_unit
+    from testbenches.table import split_unit
 
     assert split_unit("q_w [1]") == ("q_w", "1")
     assert split_unit("gyro_rad[1]") == ("gyro_rad[1]", None)

@@ -196,9 +196,9 @@ def test_an_unknown_output_is_refused_naming_the_allowed(tmp_path, capsys):
 
 def test_a_refusal_half_way_leaves_no_output_file(tmp_path, monkeypatch, capsys):
     """The time goes back in the third block: refused, and no file that looks complete."""
-    import testbenches.reader as reader
+    import testbenches.table as table
 
-    monkeypatch.setattr(reader, "BLOCK_ROWS", 200)
+    monkeypatch.setattr(table, "BLOCK_ROWS", 200)
     monkeypatch.setattr(recording, "PREFIX_ROWS", 100)  # the units from the first 100
     ex = _example()
     t = ex["time"].copy()
@@ -214,13 +214,13 @@ def test_a_refusal_half_way_leaves_no_output_file(tmp_path, monkeypatch, capsys)
 
 def test_the_plot_and_scores_hold_over_many_blocks(tmp_path, monkeypatch, capsys):
     """Blocks of 64 samples: the same scores as one block, to the last digit printed."""
-    import testbenches.reader as reader
+    import testbenches.table as table
 
     args = ["estimate", str(EXAMPLE), "--reference", str(TRUTH), "--estimator", "kf,cf",
             "--out", str(tmp_path)]
     assert main(args) == 0
     whole = capsys.readouterr().out.splitlines()
-    monkeypatch.setattr(reader, "BLOCK_ROWS", 64)
+    monkeypatch.setattr(table, "BLOCK_ROWS", 64)
     assert main(args) == 0
     blocks = capsys.readouterr().out.splitlines()
     rows = [r for r in whole if r.split()[0] in ("kf", "cf", "vqf")]

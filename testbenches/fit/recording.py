@@ -23,7 +23,7 @@ import numpy as np
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import UNITS, median_period
-from ..reader import TIME_OF_DAY, TIME_SCALE
+from ..table import TIME_OF_DAY, TIME_SCALE
 from ..time_unit import DAY_S, median_step
 from .columns import ALIASES, find_names, name_forms, norm_name, unit_in_name
 
@@ -500,7 +500,7 @@ class RecordingSource:
     def blocks(self, rows: int | None = None) -> Iterator[tuple[Recording, np.ndarray]]:
         """(Recording, time [s]) of each block of samples, from the first; RecordingError where
         a row cannot serve."""
-        from ..reader import BLOCK_ROWS, TableError
+        from ..table import BLOCK_ROWS, TableError
 
         try:
             yield from self._blocks(rows or BLOCK_ROWS)
@@ -865,7 +865,7 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
 def _unknown_units(header: list[str], missing: list[str]) -> str:
     """Where a missing quantity's column is there but for a unit in brackets this reader does
     not know ("Gyro X (1/s)"), which kept it from its name: saying so, and what serves."""
-    from ..reader import bracketed, unit_named
+    from ..table import bracketed, unit_named
 
     by_unit: dict[str, list[str]] = {}
     for name in header:
@@ -1013,7 +1013,7 @@ def _time_scale(path: Path, kind: str, step: float, unit: str, stated: str | Non
     give IMU rates from the data (testbenches.time_unit; dt_of(scale): each sample's dt [s] in a
     unit of that factor). A step that is no IMU rate in the unit given or stated is refused
     with the rate it would be, and so is a given unit that is not the header's."""
-    from ..reader import DATETIME, DURATION
+    from ..table import DATETIME, DURATION
     from ..time_unit import RATE_RANGE, TimeUnit, candidates, listed, rate_in, time_unit
 
     if stated in (DATETIME, TIME_OF_DAY, DURATION):

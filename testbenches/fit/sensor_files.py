@@ -37,7 +37,8 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from ..reader import TableError, TableSource, open_table, zipped_table
+from ..reader import open_table, zipped_table
+from ..table import TableError, TableSource
 from .columns import ALIASES, find_name, norm_name
 
 TABLE_SUFFIXES = (".csv", ".txt", ".tsv", ".parquet", ".pq")
