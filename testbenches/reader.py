@@ -18,14 +18,15 @@ any length is read in bounded memory:
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - a column of durations written with their unit ("0.01 sec", as MATLAB's writetimetable writes
   a timetable's row times) as seconds;
-- Parquet: its columns (a timestamp column as seconds);
+- Parquet and Arrow IPC (Feather): its columns (a timestamp column as seconds), a struct of
+  numbers or a list of k numbers a row as a column per number;
 - a spreadsheet workbook or JSON is refused, saying to save or export it as CSV, and an
   ArduPilot DataFlash log saying which tool exports its IMU;
 - a PX4 flight log (ULog, read with pyulog): its sensor_combined topic, named as ulog2csv
   names its columns;
-- HDF5 (that is not a BROAD trial) and MATLAB .mat (v5, or v7.3 which is HDF5): the top level's
-  one-dimensional datasets or variables of one length are columns, and an [N, 3] one (acc, gyro)
-  is three (acc_x, acc_y, acc_z); a scalar `rate` (attribute or variable) is the sample rate.
+- HDF5 (that is not a BROAD trial) and MATLAB .mat: their arrays of samples, at any depth of
+  groups or structs, by testbenches.array_files (vectors, matrices of a column per quantity,
+  compound datasets, pandas' HDFStore).
 
 A header may span several rows (motion capture's: OptiTrack Motive names a rigid body's
 quaternion X, Y, Z, W under a row of "Rotation"): its names are its last row of text, each after
@@ -44,6 +45,7 @@ import csv
 import datetime as dt
 import io
 import re
+import warnings
 import zipfile
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -52,6 +54,7 @@ from typing import IO, Any
 
 import numpy as np
 
+from .array_files import arrays_table, hdf5_table, mat_table
 from .table import (
     BLOCK_ROWS,
     DATETIME,
@@ -62,6 +65,7 @@ from .table import (
     TableError,
     TableSource,
     split_unit,
+    ticks_seconds,
     unit_named,
     unit_of,
 )
@@ -98,10 +102,12 @@ def open_table(path: str | Path) -> TableSource:
         magic = f.read(8)
     if magic.startswith(b"PAR1") or suffix in (".parquet", ".pq"):
         return _parquet(path)
+    if magic.startswith(ARROW_MAGIC) or suffix in (".feather", ".arrow", ".ipc"):
+        return _arrow_ipc(path)
     if magic.startswith(b"\x89HDF") or suffix in (".h5", ".hdf5"):
-        return _hdf5(path)
+        return hdf5_table(path)
     if suffix == ".mat":
-        return _mat(path)
+        return mat_table(path)
     if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
         raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
                          "directory of its files at its end): copy or download it again")
@@ -145,7 +151,7 @@ def _ulog(path: Path) -> TableSource:
         raise TableError(f"{path}: a PX4 log without the {ULOG_TOPIC} topic (its IMU's "
                          "samples as the estimators take them)")
     arrays = {k: np.asarray(v) for k, v in found[0].data.items()}
-    source = _array_source(path, "PX4 ULog", arrays, {}, {})
+    source = arrays_table(path, "PX4 ULog", arrays)
     source.note = f"topic {ULOG_TOPIC} ({len(arrays['timestamp'])} messages)"
     return source
 
@@ -1038,7 +1044,7 @@ def _seconds(column: Any) -> np.ndarray:
     import pyarrow as pa
 
     ns = column.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False)
-    seconds = (ns // 10**9).astype(float) + (ns % 10**9) / 1e9
+    seconds = ticks_seconds(ns, 10**9)
     if column.null_count:
         seconds[np.asarray(column.is_null().to_numpy(zero_copy_only=False))] = np.nan
     return seconds
@@ -1455,132 +1461,165 @@ def _parquet(path: Path) -> TableSource:
         pf = pq.ParquetFile(path)
     except (pa.ArrowInvalid, OSError) as err:
         raise TableError(f"{path}: not a readable Parquet file ({err})") from None
-    schema = pf.schema_arrow
-    header = list(schema.names)
-    named = [unit_of(f.name, (f.metadata or {}).get(b"unit", (f.metadata or {}).get(b"units")))
-             for f in schema]
-    named = [(n, DATETIME if pa.types.is_timestamp(f.type) else u)
-             for (n, u), f in zip(named, schema, strict=True)]
 
-    def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
-        wanted = [header[i] for i in columns]
-        for batch in pf.iter_batches(batch_size=rows, columns=wanted):
-            yield np.column_stack([_arrow_float(batch.column(k), path, k)
-                                   for k in wanted]) if wanted else np.empty((batch.num_rows, 0))
+    def batches(names: list[str], rows: int) -> Iterator[Any]:
+        return iter(pf.iter_batches(batch_size=rows, columns=names))
 
-    return TableSource(path, header, [n for n, _ in named], [u for _, u in named], "parquet",
-                       pf.metadata.num_rows, read, lambda row: f"row {row + 1}")
+    def first(name: str) -> Any:
+        return pf.read_row_group(0, columns=[name]).column(0) if pf.num_row_groups else None
+
+    return _arrow_source(path, "parquet", pf.schema_arrow, pf.metadata.num_rows, batches, first)
+
+
+ARROW_MAGIC = (b"ARROW1", b"FEA1")
+"""The first bytes of an Arrow IPC file (Feather v2, `.arrow`) and of a Feather v1 file."""
+
+
+def _arrow_ipc(path: Path) -> TableSource:
+    """An Arrow IPC file (pandas' to_feather, Polars' write_ipc), memory-mapped and read a
+    written batch at a time (each decompressed as it is read); Feather v1, which has no
+    batches, read whole."""
+    import pyarrow as pa
+    import pyarrow.feather as feather
+
+    try:
+        ipc = pa.ipc.open_file(pa.memory_map(str(path)))
+    except (pa.ArrowInvalid, OSError):
+        ipc = None
+    if ipc is not None:
+        def batches(names: list[str], rows: int) -> Iterator[Any]:
+            return (ipc.get_batch(i).select(names) for i in range(ipc.num_record_batches))
+
+        def first(name: str) -> Any:
+            return ipc.get_batch(0).column(name) if ipc.num_record_batches else None
+
+        rows = sum(ipc.get_batch(i).num_rows for i in range(ipc.num_record_batches))
+        return _arrow_source(path, "arrow", ipc.schema, rows, batches, first)
+    try:
+        with warnings.catch_warnings():  # pyarrow's: v1 is deprecated (it reads it still)
+            warnings.simplefilter("ignore", DeprecationWarning)
+            table = feather.read_table(str(path))
+    except (pa.ArrowInvalid, OSError) as err:
+        raise TableError(f"{path}: not a readable Arrow IPC (Feather) file ({err})") from None
+    return _arrow_source(path, "arrow", table.schema, table.num_rows,
+                         lambda names, rows: iter(table.select(names).to_batches(rows)),
+                         lambda name: table.column(name).chunk(0)
+                         if table.column(name).num_chunks else None)
+
+
+def _arrow_columns(field: Any, first: Callable[[str], Any]
+                   ) -> list[tuple[str, tuple[Any, ...], Any]]:
+    """A top-level Arrow field's columns as (name, the parts to its numbers, its metadata): a
+    number's own; each number of a struct ("acc.x", "header.stamp.sec"); each of a list's k
+    numbers where every list holds k (k from the first row group): "acc_x", "acc_y", "acc_z"
+    for three, "q_1" ... "q_k" otherwise, as array_files names a matrix's columns."""
+    import pyarrow as pa
+
+    def numeric(kind: Any) -> bool:
+        return (pa.types.is_floating(kind) or pa.types.is_integer(kind)
+                or pa.types.is_timestamp(kind) or pa.types.is_duration(kind))
+
+    def walk(f: Any, name: str, parts: tuple[Any, ...]) -> list[tuple[str, tuple[Any, ...], Any]]:
+        kind = f.type
+        if pa.types.is_struct(kind):
+            return [c for child in kind for c in walk(child, f"{name}.{child.name}",
+                                                      (*parts, child.name))]
+        if (pa.types.is_list(kind) or pa.types.is_large_list(kind)
+                or pa.types.is_fixed_size_list(kind)) and numeric(kind.value_type) and not parts:
+            k = kind.list_size if pa.types.is_fixed_size_list(kind) else _list_width(first(name))
+            if k:
+                names = ([f"{name}_{axis}" for axis in "xyz"] if k == 3
+                         else [f"{name}_{i + 1}" for i in range(k)])
+                return [(n, (*parts, (i, k)), f.metadata) for i, n in enumerate(names)]
+        return [(name, parts, f.metadata)]
+
+    return walk(field, field.name, ())
+
+
+def _list_width(column: Any) -> int | None:
+    """The length most lists of a column's first chunk have (a list of another length is a
+    sample without numbers), None for none."""
+    import pyarrow.compute as pc
+
+    if column is None or len(column) == 0:
+        return None
+    counts = pc.value_counts(pc.drop_null(pc.list_value_length(column))).to_pylist()
+    width = max(counts, key=lambda c: c["counts"])["values"] if counts else 0
+    return width if width > 0 else None
+
+
+def _arrow_part(column: Any, parts: tuple[Any, ...], path: Path, name: str) -> np.ndarray:
+    """The numbers at `parts` of a top-level column (a struct's field, a list's element), as
+    float64: a null struct or list, or a list of another length, a sample without numbers."""
+    import pyarrow.compute as pc
+
+    missing = None
+    for part in parts:
+        valid = np.asarray(column.is_valid().to_numpy(zero_copy_only=False))
+        if isinstance(part, str):
+            column = column.field(part)
+        else:  # (the element, the lists' length)
+            lengths = pc.list_value_length(column).fill_null(0).to_numpy(zero_copy_only=False)
+            valid &= lengths == part[1]
+            column = pc.list_element(column.filter(valid), part[0])
+            spread = np.full(len(valid), np.nan)
+            spread[valid] = _arrow_float(column, path, name)
+            return spread if missing is None else np.where(missing, np.nan, spread)
+        missing = ~valid if missing is None else missing | ~valid
+    values = _arrow_float(column, path, name)
+    if missing is not None and missing.any():
+        values = np.where(missing, np.nan, values)
+    return values
+
+
+def _arrow_source(path: Path, kind: str, schema: Any, rows: int, batches: Callable[..., Any],
+                  first: Callable[[str], Any]) -> TableSource:
+    """A Parquet or Arrow file's columns (_arrow_columns), read in blocks through `batches(names,
+    rows)`; a unit from a field's `unit` or `units` metadata, timestamps as DATETIME."""
+    import pyarrow as pa
+
+    columns = [(field.name, *c) for field in schema for c in _arrow_columns(field, first)]
+    header = [name for _, name, _, _ in columns]
+    named = [unit_of(name, (meta or {}).get(b"unit", (meta or {}).get(b"units")))
+             for _, name, _, meta in columns]
+
+    def leaf_type(top: str, parts: tuple[Any, ...]) -> Any:
+        kind = schema.field(top).type
+        for part in parts:
+            kind = kind.field(part).type if isinstance(part, str) else kind.value_type
+        return kind
+
+    named = [(n, DATETIME if pa.types.is_timestamp(leaf_type(top, parts)) else u)
+             for (n, u), (top, _, parts, _) in zip(named, columns, strict=True)]
+
+    def parts(chosen: list[int], size: int) -> Iterator[np.ndarray]:
+        tops = list(dict.fromkeys(columns[i][0] for i in chosen))
+        for batch in batches(tops, size):
+            yield np.column_stack([
+                _arrow_part(batch.column(columns[i][0]), columns[i][2], path, header[i])
+                for i in chosen]) if chosen else np.empty((batch.num_rows, 0))
+
+    def read(chosen: list[int], size: int) -> Iterator[np.ndarray]:
+        return _reblocked(parts(chosen, size), size, len(chosen), lambda: None)
+
+    return TableSource(path, header, [n for n, _ in named], [u for _, u in named], kind, rows,
+                       read, lambda row: f"row {row + 1}")
 
 
 def _arrow_float(column: Any, path: Path, name: str) -> np.ndarray:
-    """A Parquet column as float64: numbers as they are, a timestamp or duration as seconds."""
+    """An Arrow column as float64: numbers as they are, a timestamp or duration as seconds."""
     import pyarrow as pa
 
     kind = column.type
     if pa.types.is_timestamp(kind) or pa.types.is_duration(kind):
-        scale = TIME_SCALE[kind.unit]
-        ints = column.cast(pa.int64()).to_numpy(zero_copy_only=False)
-        return np.asarray(ints, dtype=float) * scale
+        ticks = column.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False)
+        seconds = ticks_seconds(ticks, round(1.0 / TIME_SCALE[kind.unit]))
+        if column.null_count:
+            seconds[np.asarray(column.is_null().to_numpy(zero_copy_only=False))] = np.nan
+        return seconds
     if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
         raise TableError(f"{path}, column {name!r}: holds {kind}, not numbers")
     return np.asarray(column.cast(pa.float64()).to_numpy(zero_copy_only=False), dtype=float)
-
-
-# ----- HDF5 and MAT ----------------------------------------------------------------------------
-
-def _columns_of(arrays: dict[str, Any], path: Path
-                ) -> tuple[list[str], list[tuple[str, int | None]], int]:
-    """The columns of named arrays: each 1-D one of the common length, each [N, 3] (or [3, N])
-    as name_x, name_y, name_z. Returns the names, each name's (array, axis index) and N."""
-    lengths = []
-    for a in arrays.values():
-        shape = tuple(a.shape)
-        if len(shape) == 1 and shape[0] > 1:
-            lengths.append(shape[0])
-        elif len(shape) == 2 and 3 in shape and max(shape) > 3:
-            lengths.append(max(shape))
-    if not lengths:
-        raise TableError(f"{path}: no dataset or variable of samples: columns are 1-D arrays of "
-                         "one length, or [N, 3] arrays (acc, gyro); it has "
-                         f"{', '.join(f'{k} {tuple(v.shape)}' for k, v in arrays.items())}")
-    n = max(set(lengths), key=lengths.count)
-    header: list[str] = []
-    where: list[tuple[str, int | None]] = []
-    for name, a in arrays.items():
-        shape = tuple(a.shape)
-        if shape == (n,):
-            header.append(name)
-            where.append((name, None))
-        elif len(shape) == 2 and max(shape) == n and 3 in shape:
-            for i, axis in enumerate("xyz"):
-                header.append(f"{name}_{axis}")
-                where.append((name, i))
-    return header, where, n
-
-
-def _array_source(path: Path, kind: str, arrays: dict[str, Any], units: dict[str, Any],
-                  attrs: dict[str, float]) -> TableSource:
-    header, where, n = _columns_of(arrays, path)
-    named = [unit_of(h, units.get(src)) for h, (src, _) in zip(header, where, strict=True)]
-
-    def column(i: int, lo: int, hi: int) -> np.ndarray:
-        src, axis = where[i]
-        a = arrays[src]
-        if axis is None:
-            return np.asarray(a[lo:hi], dtype=float)
-        if a.shape[0] == n:
-            return np.asarray(a[lo:hi, axis], dtype=float)
-        return np.asarray(a[axis, lo:hi], dtype=float)
-
-    def read(columns: list[int], rows: int) -> Iterator[np.ndarray]:
-        for lo in range(0, n, rows):
-            hi = min(lo + rows, n)
-            yield np.column_stack([column(i, lo, hi) for i in columns]) if columns else \
-                np.empty((hi - lo, 0))
-
-    return TableSource(path, header, [nm for nm, _ in named], [u for _, u in named], kind, n,
-                       read, lambda row: f"row {row + 1}", attrs)
-
-
-def _hdf5(path: Path) -> TableSource:
-    import h5py
-
-    try:
-        f = h5py.File(path, "r")
-    except OSError as err:
-        raise TableError(f"{path}: not a readable HDF5 file ({err})") from None
-    arrays = {k: v for k, v in f.items() if isinstance(v, h5py.Dataset)}
-    units = {k: v.attrs.get("unit", v.attrs.get("units")) for k, v in arrays.items()}
-    attrs = _rate(dict(f.attrs), arrays)
-    return _array_source(path, "hdf5", arrays, units, attrs)
-
-
-def _rate(attrs: dict[str, Any], arrays: dict[str, Any]) -> dict[str, float]:
-    """A scalar `rate` (or fs, sample_rate) [Hz] among the file's attributes or variables."""
-    for key in ("rate", "fs", "sample_rate", "sampling_rate"):
-        value = attrs.get(key, arrays.get(key))
-        if value is None:
-            continue
-        value = np.asarray(value[()] if hasattr(value, "shape") else value)
-        if value.size == 1 and value.dtype.kind in "fiu":
-            return {"rate": float(value.reshape(-1)[0])}
-    return {}
-
-
-def _mat(path: Path) -> TableSource:
-    import h5py
-
-    if h5py.is_hdf5(path):  # MATLAB v7.3: HDF5, arrays stored transposed
-        return _hdf5(path)
-    import scipy.io
-
-    try:
-        data = scipy.io.loadmat(path, squeeze_me=True)
-    except (ValueError, NotImplementedError, OSError) as err:
-        raise TableError(f"{path}: not a readable MATLAB file ({err})") from None
-    arrays = {k: np.asarray(v) for k, v in data.items() if not k.startswith("__")}
-    arrays = {k: v for k, v in arrays.items() if v.dtype.kind in "fiu"}
-    return _array_source(path, "mat", arrays, {}, _rate({}, arrays))
 
 
 __all__ = [

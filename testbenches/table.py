@@ -155,6 +155,17 @@ class TableSource:
         return self._where(row)
 
 
+def ticks_seconds(ticks: np.ndarray, per_second: int) -> np.ndarray:
+    """Integer ticks since an epoch (`per_second` a second: a timestamp's nanoseconds) as
+    seconds, the smallest integer (pandas' NaT) NaN: the whole seconds and their fraction
+    added, one rounding, as the text reader adds a date's (ticks / per_second rounds the same
+    way, but the ticks times 1 / per_second twice)."""
+    ticks = np.asarray(ticks, dtype=np.int64)
+    seconds = (ticks // per_second).astype(float) + (ticks % per_second) / per_second
+    seconds[ticks == np.iinfo(np.int64).min] = np.nan
+    return seconds
+
+
 __all__ = [
     "BLOCK_ROWS",
     "DATETIME",
@@ -167,6 +178,7 @@ __all__ = [
     "TableSource",
     "bracketed",
     "split_unit",
+    "ticks_seconds",
     "unit_named",
     "unit_of",
 ]

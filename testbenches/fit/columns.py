@@ -122,11 +122,16 @@ def _without_device(normed: list[str]) -> list[str]:
 def _path_tails(names: list[str]) -> list[list[str]]:
     """The names without the first 1, 2, ... parts of a path ("/imu/data/angular_velocity/x",
     as PlotJuggler names a ROS topic's field: "data/angular_velocity/x", then
-    "angular_velocity/x"), as norm_name spells them; a name of fewer parts as it is."""
+    "angular_velocity/x"), then the last part alone where it is a name of more than one letter
+    (an HDF5 file's "imu0/acc_x", testbenches.array_files), as norm_name spells them; a name
+    of fewer parts as it is."""
     parts = [[p for p in n.split("/") if p] for n in names]
     deepest = max((len(p) for p in parts if len(p) > 1), default=1)
-    return [[norm_name("/".join(p[k:])) if len(p) > k + 1 else norm_name(n)
-             for n, p in zip(names, parts, strict=True)] for k in range(1, deepest - 1)]
+    tails = [[norm_name("/".join(p[k:])) if len(p) > k + 1 else norm_name(n)
+              for n, p in zip(names, parts, strict=True)] for k in range(1, deepest - 1)]
+    leaves = [norm_name(p[-1]) if len(p) > 1 and len(norm_name(p[-1])) > 1 else norm_name(n)
+              for n, p in zip(names, parts, strict=True)]
+    return [*tails, leaves] if deepest > 1 else tails
 
 
 _ONE_BASED = re.compile(r"(.+)_([1-9])")

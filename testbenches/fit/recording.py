@@ -602,7 +602,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             f"{path}: no column for {', '.join(missing)}: the header has "
             f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
             "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME"
-            + _unknown_units(found.header, missing))
+            + _unknown_units(found.header, missing) + (f" ({table.note})" if table.note else ""))
     names = list(found.index)
     wanted = [found.index[q] for q in names]
     try:

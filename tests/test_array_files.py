@@ -1,0 +1,241 @@
+"""HDF5 and MATLAB recordings as users write them (testbenches.array_files): MATLAB's vectors
+as [N, 1] or [1, N] matrices (v7.3 stores every matrix transposed), arrays in groups and in
+structs at any depth, compound datasets, pandas' HDFStore (fixed and table formats, written
+here with the layout and attributes pandas writes, pytables not being a dependency), a matrix
+whose columns an attribute names: each gives the samples the CSV gives. Arrays of another
+length, two sensors' alike names and MATLAB's class objects are refused saying what to do."""
+
+from __future__ import annotations
+
+import pickle
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from testbenches.fit.recording import RecordingError, open_recording
+
+h5py = pytest.importorskip("h5py")
+scipy_io = pytest.importorskip("scipy.io")
+
+REPO = Path(__file__).resolve().parents[1]
+EXAMPLE = REPO / "examples" / "tilt_motion.csv"
+NAMES = ["time", "acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "dt"]
+
+
+def _example() -> np.ndarray:
+    return np.loadtxt(EXAMPLE, delimiter=",", skiprows=1)
+
+
+def _samples(path: Path, **options: object) -> tuple[np.ndarray, ...]:
+    rec, t = open_recording(path, gyro_unit="rad/s", **options).load()
+    return rec.acc, rec.gyro, rec.dt, t
+
+
+def _same_as_csv(path: Path, **options: object) -> None:
+    for got, want in zip(_samples(path, **options), _samples(EXAMPLE), strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
+def _matlab_v73(path: Path, variables: dict[str, np.ndarray]) -> Path:
+    """A MATLAB v7.3 file as MATLAB writes one: HDF5 after a 512-byte header, each variable a
+    dataset of its MATLAB_class, every matrix stored transposed ([N, 1] as [1, N])."""
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, value in variables.items():
+            matrix = value.reshape(-1, 1) if value.ndim == 1 else value
+            f[name] = matrix.T
+            f[name].attrs["MATLAB_class"] = np.bytes_(b"double")
+        label = f.create_dataset("label", data=np.frombuffer("imu".encode("utf-16-le"),
+                                                             dtype=np.uint16).reshape(-1, 1))
+        label.attrs["MATLAB_class"] = np.bytes_(b"char")
+    with path.open("r+b") as f:
+        f.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 .".ljust(124)
+                + b"\x00\x02IM")
+    return path
+
+
+def test_matlab_v73_column_vectors_and_transposed_matrices(tmp_path):
+    """A [N, 1] time in MATLAB is [1, N] in the file: it was no column ("no time or dt
+    column"), and the [N, 3] matrices, stored [3, N], are read along their long side."""
+    ex = _example()
+    path = _matlab_v73(tmp_path / "rec.mat", {"time": ex[:, 0], "acc": ex[:, 1:4],
+                                              "gyro": ex[:, 4:7]})
+    _same_as_csv(path)
+
+
+def test_arrays_in_groups_and_structs_at_any_depth(tmp_path):
+    ex = _example()
+    h5 = tmp_path / "groups.h5"
+    with h5py.File(h5, "w") as f:
+        f["session/imu/time"] = ex[:, 0]
+        f["session/imu/acc"] = ex[:, 1:4]
+        f["session/imu/gyro"] = ex[:, 4:7]
+        f["session/notes"] = np.bytes_(b"hand-held")
+    _same_as_csv(h5)
+    sensors = tmp_path / "sensors.h5"  # a group per sensor, a dataset per axis
+    with h5py.File(sensors, "w") as f:
+        for i, axis in enumerate("xyz"):
+            f[f"accelerometer/{axis}"] = ex[:, 1 + i]
+            f[f"gyroscope/{axis}"] = ex[:, 4 + i]
+        f["timestamp"] = ex[:, 0]
+    _same_as_csv(sensors)
+    mat = tmp_path / "struct.mat"  # a struct, and a struct in a 1x1 struct array
+    scipy_io.savemat(mat, {"log": {"imu": {"time": ex[:, :1], "acc": ex[:, 1:4],
+                                           "gyro": ex[:, 4:7]}, "label": "bench"}})
+    _same_as_csv(mat)
+    cells = tmp_path / "cells.mat"
+    scipy_io.savemat(cells, {"log": np.array([{"time": ex[:, :1], "acc": ex[:, 1:4],
+                                               "gyro": ex[:, 4:7]}], dtype=object)})
+    _same_as_csv(cells)
+
+
+def test_a_compound_dataset_and_a_matrix_whose_columns_are_named(tmp_path):
+    ex = _example()
+    compound = tmp_path / "compound.h5"
+    rows = np.zeros(len(ex), dtype=[(n, "f8") for n in NAMES])
+    for j, name in enumerate(NAMES):
+        rows[name] = ex[:, j]
+    with h5py.File(compound, "w") as f:
+        f["data"] = rows
+    _same_as_csv(compound)
+    matrix = tmp_path / "matrix.h5"  # its units per column: g and deg/s, read off them
+    scaled = np.column_stack([ex[:, 0], ex[:, 1:4] / 9.80665, np.degrees(ex[:, 4:7])])
+    with h5py.File(matrix, "w") as f:
+        f["imu"] = scaled
+        f["imu"].attrs["columns"] = ["t", "ax", "ay", "az", "gx", "gy", "gz"]
+        f["imu"].attrs["units"] = ["s", "g", "g", "g", "deg/s", "deg/s", "deg/s"]
+    rec, _ = open_recording(matrix).load()
+    np.testing.assert_allclose(rec.acc, ex[:, 1:4], rtol=1e-14)
+    np.testing.assert_allclose(rec.gyro, ex[:, 4:7], rtol=1e-14)
+
+
+def _pickled(names: list[str]) -> np.bytes_:
+    return np.bytes_(pickle.dumps(names, protocol=0))
+
+
+def test_pandas_hdfstore_fixed_and_table_formats(tmp_path):
+    """df.to_hdf(path, key="imu") and the same with format="table", the index the time
+    (df.set_index("time")) and a column of datetime64[ns] beside it."""
+    ex = _example()
+    fixed = tmp_path / "fixed.h5"
+    with h5py.File(fixed, "w") as f:
+        g = f.create_group("imu")
+        g.attrs.update({"pandas_type": np.bytes_(b"frame"), "nblocks": np.int64(1),
+                        "ndim": np.int64(2)})
+        g["axis0"] = np.array([n.encode() for n in NAMES[1:]])
+        g["axis1"] = ex[:, 0]
+        g["axis1"].attrs.update({"kind": np.bytes_(b"float"), "name": np.bytes_(b"time")})
+        g["block0_items"] = np.array([n.encode() for n in NAMES[1:]])
+        g["block0_values"] = ex[:, 1:]
+    _same_as_csv(fixed)
+    table = tmp_path / "table.h5"
+    stamp = 1714521600 * 10**9 + np.round(ex[:, 0] * 100).astype(np.int64) * 10**7
+    with h5py.File(table, "w") as f:
+        g = f.create_group("imu")
+        g.attrs.update({"pandas_type": np.bytes_(b"frame_table"),
+                        "info": np.bytes_(pickle.dumps({"index": {"index_name": "n"}},
+                                                       protocol=0))})
+        rows = np.zeros(len(ex), dtype=[("index", "<i8"), ("values_block_0", "<f8", (7,)),
+                                        ("values_block_1", "<i8", (1,))])
+        rows["index"] = np.arange(len(ex))
+        rows["values_block_0"] = ex[:, [1, 2, 3, 4, 5, 6, 0]]
+        rows["values_block_1"] = stamp[:, None]
+        g["table"] = rows
+        g["table"].attrs.update({
+            "values_block_0_kind": _pickled(["acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y",
+                                             "gyro_z", "seconds"]),
+            "values_block_1_kind": _pickled(["stamp"]),
+            "values_block_1_dtype": np.bytes_(b"datetime64[ns]"),
+            "index_kind": np.bytes_(b"integer")})
+    acc, gyro, dt, _ = _samples(table, time_column="stamp")
+    want = _samples(EXAMPLE)
+    np.testing.assert_array_equal(acc, want[0])
+    np.testing.assert_array_equal(gyro, want[1])
+    np.testing.assert_allclose(dt, want[2], atol=5e-7)  # epoch seconds: steps of 2.4e-7 s
+    from testbenches.reader import open_table
+
+    opened = open_table(table)
+    assert opened.header == ["n", "acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z",
+                             "seconds", "stamp"]
+    assert opened.units[-1] == "datetime"
+    assert opened.read([8])[0, 0] == 1714521600.0  # seconds since 1970, whole
+
+
+def test_names_pickled_with_code_are_not_run(tmp_path):
+    """pandas keeps a table's names pickled: a pickle that names a function is not loaded
+    (the columns get their field's names), so a file cannot run code."""
+    ex = _example()
+    path = tmp_path / "evil.h5"
+    marker = tmp_path / "ran"
+    evil = (b"cos\nsystem\n(V" + f"touch {marker}".encode() + b"\ntR.")
+    with h5py.File(path, "w") as f:
+        g = f.create_group("imu")
+        g.attrs["pandas_type"] = np.bytes_(b"frame_table")
+        rows = np.zeros(len(ex), dtype=[("values_block_0", "<f8", (7,))])
+        rows["values_block_0"] = ex[:, :7]
+        g["table"] = rows
+        g["table"].attrs["values_block_0_kind"] = np.bytes_(evil)
+    with pytest.raises(RecordingError, match="values_block_0_1, values_block_0_2"):
+        open_recording(path)
+    assert not marker.exists()
+
+
+def test_arrays_of_another_length_are_said_where_a_sensor_is_missing(tmp_path):
+    ex = _example()
+    path = tmp_path / "rates.h5"
+    with h5py.File(path, "w") as f:
+        f["acc"] = np.repeat(ex[:, 1:4], 2, axis=0)
+        f["acc_time"] = np.arange(2 * len(ex)) * 0.005
+        f["gyro"] = ex[:, 4:7]
+    with pytest.raises(RecordingError, match=r"no column for gyro_x, gyro_y, gyro_z: .*"
+                       r"\(1 array\(s\) of another length than the 2000 samples left out: "
+                       r"gyro \(1000, 3\)\)"):
+        open_recording(path)
+
+
+def test_two_sensors_alike_are_refused_naming_both(tmp_path):
+    ex = _example()
+    path = tmp_path / "two.h5"
+    with h5py.File(path, "w") as f:
+        for imu in ("imu0", "imu1"):
+            f[f"{imu}/time"] = ex[:, 0]
+            f[f"{imu}/acc"] = ex[:, 1:4]
+            f[f"{imu}/gyro"] = ex[:, 4:7]
+    with pytest.raises(RecordingError, match=r"2 columns' names fit acc_x alike \(columns 1 "
+                       r"'imu0/acc_x', 8 'imu1/acc_x'\)"):
+        open_recording(path)
+    columns = {f"{q}_{a}": f"imu1/{q}_{a}" for q in ("acc", "gyro") for a in "xyz"}
+    _same_as_csv(path, columns={**columns, "time": "imu1/time"})
+
+
+def test_a_matrix_of_unnamed_columns_is_refused_naming_its_columns(tmp_path):
+    ex = _example()
+    path = tmp_path / "matrix.mat"
+    scipy_io.savemat(path, {"data": ex[:, :7]})
+    with pytest.raises(RecordingError, match=r"the header has data_1, data_2, data_3, data_4, "
+                                             r"data_5, data_6, data_7; .* --column"):
+        open_recording(path)
+    columns = dict(zip(NAMES[:7], (f"data_{j}" for j in range(1, 8)), strict=True))
+    _same_as_csv(path, columns=columns)
+
+
+def test_matlab_class_objects_are_refused_saying_how_to_save_them(tmp_path):
+    from scipy.io.matlab import MatlabOpaque
+
+    from testbenches.array_files import _mat_found, _table
+    from testbenches.table import TableError
+
+    path = _matlab_v73(tmp_path / "tt.mat", {})
+    with h5py.File(path, "r+") as f:
+        del f["label"]
+        tt = f.create_dataset("TT", data=np.zeros((1, 6), dtype=np.uint32))
+        tt.attrs["MATLAB_class"] = np.bytes_(b"timetable")
+        tt.attrs["MATLAB_object_decode"] = np.int32(3)
+        f["#subsystem#/MCOS"] = np.zeros(100)
+    with pytest.raises(RecordingError, match=r"TT is a MATLAB timetable, an object only MATLAB "
+                       r"reads, .* writetimetable\(TT, 'FILE.csv'\)"):
+        open_recording(path)
+    table = np.empty((1,), dtype=[("s0", "O"), ("s1", "O"), ("s2", "O"), ("arr", "O")])
+    table[0] = (b"T", b"MCOS", b"table", None)  # scipy's opaque object, as loadmat gives it
+    with pytest.raises(TableError, match=r"T is a MATLAB table, .* writetable\(T, 'FILE.csv'\)"):
+        _table(tmp_path / "t.mat", "mat", _mat_found({"T": table.view(MatlabOpaque)}))
