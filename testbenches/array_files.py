@@ -235,7 +235,7 @@ def _hdf5_found(f: Any) -> _Found:
             arrays.extend(_pandas_table(group, path))
             return
         for name, item in group.items():
-            if name in HIDDEN:
+            if name in HIDDEN or item is None:  # None: a link to nothing
                 continue
             where = (*path, name)
             matlab = _attr(item.attrs, "MATLAB_class")
@@ -279,9 +279,10 @@ def hdf5_table(path: Path) -> TableSource:
 
     try:
         f = h5py.File(path, "r")
-    except OSError as err:
+        found = _hdf5_found(f)
+    except (OSError, KeyError, ValueError, RuntimeError) as err:  # h5py's, of a damaged file
         raise TableError(f"{path}: not a readable HDF5 file ({err})") from None
-    return _table(path, "hdf5", _hdf5_found(f), owner=f)
+    return _table(path, "hdf5", found, owner=f)
 
 
 # ----- MATLAB v4 to v7 ------------------------------------------------------------------------
@@ -345,7 +346,7 @@ def mat_table(path: Path) -> TableSource:
 
     try:
         data = scipy.io.loadmat(path, simplify_cells=True)
-    except (ValueError, NotImplementedError, OSError, TypeError) as err:
+    except Exception as err:  # scipy raises several types for a damaged file (as broad.data)
         raise TableError(f"{path}: not a readable MATLAB file ({err})") from None
     return _table(path, "mat", _mat_found(data))
 
@@ -421,6 +422,17 @@ def _rate(found: _Found) -> dict[str, float]:
     return {}
 
 
+def _read(path: Path, a: _Array, lo: int, hi: int) -> np.ndarray:
+    """Rows lo..hi of an array; TableError naming the array and the rows where the file's bytes
+    there do not read (h5py's error names neither)."""
+    try:
+        return a.read(lo, hi)
+    except (OSError, KeyError, ValueError, RuntimeError) as err:
+        raise TableError(f"{path}: {'/'.join(a.path)}, rows {lo + 1} to {hi}, does not read "
+                         f"({err}): the file is damaged (cut, or changed since it was "
+                         "written); copy or export it again") from None
+
+
 def _table(path: Path, kind: str, found: _Found, owner: Any = None) -> TableSource:
     lengths = Counter(n for a in found.arrays if (n := _length(a.shape)) is not None)
     if not lengths:
@@ -453,7 +465,7 @@ def _table(path: Path, kind: str, found: _Found, owner: Any = None) -> TableSour
         arrays = {id(where[i][0]): where[i][0] for i in columns}  # each read once a block
         for lo in range(0, n, rows):
             hi = min(lo + rows, n)
-            parts = {key: a.read(lo, hi) for key, a in arrays.items()}
+            parts = {key: _read(path, a, lo, hi) for key, a in arrays.items()}
             yield np.column_stack([column(parts[id(where[i][0])], i) for i in columns]) \
                 if columns else np.empty((hi - lo, 0))
 

@@ -239,3 +239,24 @@ def test_matlab_class_objects_are_refused_saying_how_to_save_them(tmp_path):
     table[0] = (b"T", b"MCOS", b"table", None)  # scipy's opaque object, as loadmat gives it
     with pytest.raises(TableError, match=r"T is a MATLAB table, .* writetable\(T, 'FILE.csv'\)"):
         _table(tmp_path / "t.mat", "mat", _mat_found({"T": table.view(MatlabOpaque)}))
+
+
+def test_a_damaged_hdf5_file_is_refused_naming_the_array_and_rows(tmp_path):
+    """A changed byte in a compressed chunk (h5py: "filter returned failure during read",
+    naming neither file nor dataset), and links to nothing beside the arrays (a traceback)."""
+    ex = _example()
+    path = tmp_path / "damaged.h5"
+    with h5py.File(path, "w") as f:
+        f.create_dataset("time", data=ex[:, 0], chunks=(100,), compression="gzip")
+        f.create_dataset("acc", data=ex[:, 1:4], chunks=(100, 3), compression="gzip")
+        f.create_dataset("gyro", data=ex[:, 4:7], chunks=(100, 3), compression="gzip")
+        f["old"] = h5py.SoftLink("/nowhere")
+        f["elsewhere"] = h5py.ExternalLink("missing.h5", "/x")
+        chunk = f["gyro"].id.get_chunk_info(0)
+    _same_as_csv(path)
+    with path.open("r+b") as f:
+        f.seek(chunk.byte_offset + chunk.size // 2)
+        f.write(b"\xff\x00\xff\x00")
+    with pytest.raises(RecordingError, match=r"damaged.h5: gyro, rows 1 to \d+, does not read "
+                       r"\(.*\): the file is damaged"):
+        open_recording(path, gyro_unit="rad/s").load()

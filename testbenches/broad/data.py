@@ -153,7 +153,8 @@ def _read_hdf5(path: Path) -> tuple[dict[str, Any], str]:
                 elif name in f.attrs:
                     fields[name] = f.attrs[name]
             info = f.attrs.get("info", "")
-    except OSError as err:  # h5py's for a damaged or cut file ("truncated file: eof = ...")
+    except (OSError, RuntimeError, KeyError, ValueError) as err:  # h5py's for a damaged or
+        # cut file ("truncated file: eof = ...", "addr overflow" as it follows a link)
         raise NotABroadTrial(f"{path}: not a BROAD trial: unreadable HDF5 file ({err})") from None
     return fields, info.decode() if isinstance(info, bytes) else str(info)
 
