@@ -77,11 +77,15 @@ def _take(buf: memoryview, at: int, n: int) -> memoryview:
 
 
 def _partial(decompress: Callable[[bytes], bytes], data: bytes) -> bytes:
-    """What a streaming decompressor gives of data that may end before its stream does."""
+    """What a streaming decompressor gives of data that may end before its stream does;
+    SalvageError where the data is no such stream (changed bytes, not a cut)."""
     try:
         return decompress(data)
     except EOFError:
         return b""
+    except Exception as err:  # bz2's OSError, lz4's RuntimeError, zstd's ZstdError
+        raise SalvageError(f"a chunk does not decompress ({type(err).__name__}: {err}): the "
+                           "bag is damaged besides") from None
 
 
 def _decompressor(kind: str, compression: str) -> Callable[[bytes], bytes]:
@@ -272,8 +276,11 @@ class SalvagedBag:
 
     def __exit__(self, *exc: object) -> None:
         if self._buf is not None:
-            self._buf.release()
-            self._map.close()
+            try:
+                self._buf.release()
+                self._map.close()
+            except BufferError:  # a view of it lives on in an error's traceback: closed with it
+                pass
         if self._file is not None:
             self._file.close()
         self._buf = self._file = None

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from .reader import GARBLED_SHARE
 from .table import TableError, TableSource
 
 ROS1_MAGIC = b"#ROSBAG V2.0"
@@ -139,7 +140,10 @@ def _checked(bag: Any, message: tuple[Any, int, bytes], cdr: bool) -> tuple[int,
     if layout is None or not 0 <= layout[1] <= len(raw) - 8 * IMU_DOUBLES:
         return None
     stamp, first = layout
-    m = bag.deserialize(raw, connection.msgtype)
+    try:
+        m = bag.deserialize(raw, connection.msgtype)
+    except Exception:  # a message whose bytes were changed: rows_of says so
+        return None
     doubles = np.frombuffer(raw, dtype="<f8", count=IMU_DOUBLES, offset=first)
     sec = int.from_bytes(raw[stamp:stamp + 4], "little", signed=cdr)
     nanosec = int.from_bytes(raw[stamp + 4:stamp + 8], "little")
@@ -205,6 +209,65 @@ def _opener(path: Path) -> tuple[Callable[[], Any], dict[str, list[Any]], str]:
         raise TableError(f"{refused}{repair}; read record by record, {why}") from None
 
 
+def _messages(path: Path, bag: Any, connections: list[Any], topic: str
+              ) -> Iterator[tuple[Any, int, bytes]]:
+    """The topic's messages as the bag gives them; TableError naming the last whole one where
+    the bag's bytes do not read on (rosbags, its decompressors and SQLite raise errors of their
+    own for a bag changed since it was written)."""
+    n = 0
+    try:
+        for message in bag.messages(connections=connections):
+            yield message
+            n += 1
+    except Exception as err:  # any of rosbags', zstd's, lz4's, bz2's, apsw's: a damaged bag
+        where = f"after message {n} of {topic}" if n else f"before its first message of {topic}"
+        why = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
+        raise TableError(f"{path}: damaged {where}: it does not read on from there ({why}); "
+                         "copy or record it again") from None
+
+
+class _Unread:
+    """A read's messages that do not deserialize (their bytes changed since they were
+    written): samples without numbers, said, where they are at most GARBLED_SHARE of the
+    messages, as a text file's lines that are no row are; refused where more."""
+
+    def __init__(self, path: Path, topic: str, found: list[str]) -> None:
+        self.path, self.topic, self.found = path, topic, found
+        self.count, self.first = 0, ""
+
+    def add(self, index: int, err: Exception) -> None:
+        self.count += 1
+        self.first = self.first or (f"message {index + 1}: {type(err).__name__}: {err}"
+                                    if str(err) else f"message {index + 1}: "
+                                    f"{type(err).__name__}")
+        if self.count > 1 + GARBLED_SHARE * (index + 1):
+            raise self._refusal(index + 1)
+
+    def finish(self, messages: int, counted: int) -> None:
+        """At the end of the read of `messages` of the `counted` the bag's index counts (a
+        damaged record can hide the messages after it in its chunk): refused where more than
+        GARBLED_SHARE are unread or do not deserialize, else said."""
+        if self.count > GARBLED_SHARE * max(messages, 1):
+            raise self._refusal(messages)
+        lost = counted - messages
+        if lost > GARBLED_SHARE * max(counted, 1):
+            raise TableError(f"{self.path}: {messages} of the {counted} messages of "
+                             f"{self.topic} its index counts read: the bag is damaged; copy or "
+                             "record it again")
+        if lost > 0:
+            self.found.append(f"{lost} of the {counted} messages of {self.topic} its index "
+                              "counts not read (the bag is damaged)")
+        if self.count:
+            self.found.append(f"{self.count} message(s) of {self.topic} do not deserialize "
+                              "(their bytes changed), taken as samples without a number (the "
+                              f"first: {self.first})")
+
+    def _refusal(self, messages: int) -> TableError:
+        return TableError(f"{self.path}: {self.count} of {messages} messages of {self.topic} "
+                          f"do not deserialize (more than {GARBLED_SHARE:.0%} of them; the "
+                          f"first: {self.first}): the bag is damaged; copy or record it again")
+
+
 def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSource:
     """The bag's table of `want` ("imu": the recording's, "pose": a reference's) from the topic
     named, else from the only topic of such a type; TableError where the bag cannot be read,
@@ -242,34 +305,48 @@ def open_bag(path: Path, want: str = "imu", topic: str | None = None) -> TableSo
         values = [get for _, _, get in fields]
         layouts: dict[int, tuple[int, int] | None] = {}  # raw length -> _ImuLayout's, checked
 
-        def rows_of(bag: Any, block: list[tuple[Any, int, bytes]]) -> np.ndarray:
+        bad = _Unread(path, chosen, found)
+
+        def rows_of(bag: Any, block: list[tuple[Any, int, bytes]], before: int) -> np.ndarray:
             if want == "imu":
                 fast = _imu_rows(bag, block, layouts)
                 if fast is not None:
                     return fast
-            return np.array([[get(bag.deserialize(raw, c.msgtype)) for get in values]
-                             + [received * 1e-9] for c, received, raw in block])
+            out = np.full((len(block), len(values) + 1), np.nan)
+            for k, (c, received, raw) in enumerate(block):
+                try:
+                    message = bag.deserialize(raw, c.msgtype)
+                    out[k, :-1] = [get(message) for get in values]
+                except Exception as err:  # its bytes changed: a sample without numbers
+                    bad.add(before + k, err)
+                out[k, -1] = received * 1e-9
+            return out
 
         with opener() as bag:
             connections = [c for c in bag.connections if c.topic == chosen]
             batch: list[tuple[Any, int, bytes]] = []  # messages, as bytes until made rows
             done: list[np.ndarray] = []  # their rows, until a block's are
             held = 0
-            for message in bag.messages(connections=connections):
+            count = 0
+            for message in _messages(path, bag, connections, chosen):
                 batch.append(message)
                 if len(batch) == min(rows - held, MESSAGE_BATCH):
-                    done.append(rows_of(bag, batch)[:, columns])
+                    done.append(rows_of(bag, batch, count)[:, columns])
                     held += len(batch)
+                    count += len(batch)
                     batch = []
                     if held == rows:
                         yield np.concatenate(done)
                         done, held = [], 0
             if batch:
-                done.append(rows_of(bag, batch)[:, columns])
+                done.append(rows_of(bag, batch, count)[:, columns])
+                count += len(batch)
+            bad.finish(count, n)
             if done:
                 yield np.concatenate(done)
 
+    found: list[str] = []
     return TableSource(path, header, list(header), units, "ROS bag", n, read,
                        lambda row: f"message {row + 1} of {chosen}",
                        note=f"topic {chosen} ({msgtype}, {n} messages)"
-                       + (f"; {how}" if how else ""))
+                       + (f"; {how}" if how else ""), found=found)
