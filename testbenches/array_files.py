@@ -71,7 +71,7 @@ class _Array:
     path: tuple[str, ...]
     shape: tuple[int, ...]
     read: Callable[[int, int], np.ndarray]
-    """read(lo, hi): the rows lo..hi along the sample axis, as stored."""
+    """read(lo, hi): the samples lo..hi, [rows] or [rows, k] (a matrix stored [k, N] turned)."""
     names: list[str] | None = None
     units: list[Any] | None = None
     seconds_per_tick: int = 0
@@ -102,7 +102,7 @@ class _NoGlobals(pickle.Unpickler):
 def _unpickled(value: Any) -> Any:
     try:
         return _NoGlobals(io.BytesIO(bytes(value))).load()
-    except (pickle.UnpicklingError, EOFError, ValueError, TypeError, IndexError, KeyError):
+    except Exception:  # whatever a damaged or foreign pickle raises: no names
         return None
 
 
@@ -434,6 +434,8 @@ def _read(path: Path, a: _Array, lo: int, hi: int) -> np.ndarray:
 
 
 def _table(path: Path, kind: str, found: _Found, owner: Any = None) -> TableSource:
+    """The arrays of the common length as a table (the module docstring): their columns named,
+    each array read once a block; TableError where none holds samples."""
     lengths = Counter(n for a in found.arrays if (n := _length(a.shape)) is not None)
     if not lengths:
         raise _refusal(path, found)
@@ -448,10 +450,10 @@ def _table(path: Path, kind: str, found: _Found, owner: Any = None) -> TableSour
         for j, name in enumerate(names):
             header.append("/".join((*a.path[:-1], name)) if counts[name] > 1 else name)
             where.append((a, j, units[j]))
-    named = [(name, DATETIME) if a.seconds_per_tick else (name, unit)
-             for (name, unit), (a, _, _) in zip((unit_of(h, u) for h, (_, _, u) in
-                                                 zip(header, where, strict=True)),
-                                                where, strict=True)]
+    named = []
+    for h, (a, _, stated) in zip(header, where, strict=True):
+        name, unit = unit_of(h, stated)
+        named.append((name, DATETIME if a.seconds_per_tick else unit))
 
     def column(part: np.ndarray, i: int) -> np.ndarray:
         a, j, _ = where[i]
