@@ -15,8 +15,10 @@ Every numeric array whose samples run along its longest axis is one column or se
 
 Arrays in groups (HDF5) and in structs (MATLAB, also in a struct array's elements) are found
 at any depth, each named by its own name, or by its path ("imu0/acc_x") where another column
-has that name. N is the length the most arrays share, the longest of those that tie (an IMU
-samples faster than what is logged beside it); arrays of other lengths are left out, and said.
+has that name. N is the length of the arrays that hold what is read (a recording's IMU, a
+reference's pose: WANTED), else the length the most arrays share, the longest of those that
+tie; arrays of other lengths are left out, and said. So one file may hold an IMU and a motion
+capture at their own rates, read as the recording and as its reference.
 Text, cell arrays, references, empty arrays and the groups MATLAB and pandas keep for
 themselves (#refs#, #subsystem#, an index's _i_table) hold no samples. A MATLAB table,
 timetable or other class object is stored so that only MATLAB reads it: where it is all a file
@@ -39,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from .fit.columns import ALIASES, find_names, norm_name
 from .table import DATETIME, TableError, TableSource, ticks_seconds, unit_of
 
 RATE_NAMES = ("rate", "fs", "sample_rate", "sampling_rate")
@@ -61,6 +64,11 @@ MATLAB_HINT = {
 for as arrays of numbers."""
 _SHOWN = 6
 """At most this many names in a message that lists arrays."""
+WANTED = {"imu": ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z"),
+          "pose": ("roll", "pitch", "q_w", "q_x", "q_y", "q_z")}
+"""What a recording's table (open_table's want "imu") and a reference's ("pose") hold, by
+which the length of the arrays taken is chosen where arrays of several lengths are stored
+(an IMU's and a motion capture's in one file)."""
 
 
 @dataclass
@@ -274,7 +282,7 @@ def _hdf5_found(f: Any) -> _Found:
     return _Found(arrays, objects, scalars)
 
 
-def hdf5_table(path: Path) -> TableSource:
+def hdf5_table(path: Path, want: str = "imu") -> TableSource:
     import h5py
 
     try:
@@ -282,7 +290,7 @@ def hdf5_table(path: Path) -> TableSource:
         found = _hdf5_found(f)
     except (OSError, KeyError, ValueError, RuntimeError) as err:  # h5py's, of a damaged file
         raise TableError(f"{path}: not a readable HDF5 file ({err})") from None
-    return _table(path, "hdf5", found, owner=f)
+    return _table(path, "hdf5", found, owner=f, want=want)
 
 
 # ----- MATLAB v4 to v7 ------------------------------------------------------------------------
@@ -337,18 +345,18 @@ def _mat_found(data: dict[str, Any]) -> _Found:
     return _Found(arrays, objects, scalars)
 
 
-def mat_table(path: Path) -> TableSource:
+def mat_table(path: Path, want: str = "imu") -> TableSource:
     import h5py
 
     if h5py.is_hdf5(path):  # MATLAB v7.3: HDF5, arrays stored transposed
-        return hdf5_table(path)
+        return hdf5_table(path, want)
     import scipy.io
 
     try:
         data = scipy.io.loadmat(path, simplify_cells=True)
     except Exception as err:  # scipy raises several types for a damaged file (as broad.data)
         raise TableError(f"{path}: not a readable MATLAB file ({err})") from None
-    return _table(path, "mat", _mat_found(data))
+    return _table(path, "mat", _mat_found(data), want=want)
 
 
 def arrays_table(path: Path, kind: str, arrays: dict[str, np.ndarray]) -> TableSource:
@@ -433,15 +441,16 @@ def _read(path: Path, a: _Array, lo: int, hi: int) -> np.ndarray:
                          "written); copy or export it again") from None
 
 
-def _table(path: Path, kind: str, found: _Found, owner: Any = None) -> TableSource:
-    """The arrays of the common length as a table (the module docstring): their columns named,
-    each array read once a block; TableError where none holds samples."""
-    lengths = Counter(n for a in found.arrays if (n := _length(a.shape)) is not None)
-    if not lengths:
-        raise _refusal(path, found)
-    n = max(lengths, key=lambda m: (lengths[m], m))
-    used = [a for a in found.arrays if _length(a.shape) == n]
-    left = [a for a in found.arrays if _length(a.shape) not in (None, n)]
+def _holds(header: list[str], quantity: str) -> bool:
+    """Whether a column's name fits the quantity (its aliases; roll and pitch by their own)."""
+    if quantity in ALIASES:
+        return bool(find_names(header, quantity))
+    return quantity in (norm_name(h) for h in header)
+
+
+def _columns(used: list[_Array]) -> tuple[list[str], list[tuple[_Array, int, Any]]]:
+    """The header of these arrays' columns (_column_names; a path where two share a name) and
+    each column's (array, index in it, stated unit)."""
     own = [_column_names(a) for a in used]
     counts = Counter(name for names in own for name in names)
     header, where = [], []
@@ -450,6 +459,23 @@ def _table(path: Path, kind: str, found: _Found, owner: Any = None) -> TableSour
         for j, name in enumerate(names):
             header.append("/".join((*a.path[:-1], name)) if counts[name] > 1 else name)
             where.append((a, j, units[j]))
+    return header, where
+
+
+def _table(path: Path, kind: str, found: _Found, owner: Any = None, want: str = "imu"
+           ) -> TableSource:
+    """The arrays of one length as a table (the module docstring): the length whose columns
+    hold the most of what is wanted (WANTED: a recording's IMU, a reference's pose), then the
+    one the most arrays share, then the longest; their columns named, each array read once a
+    block; TableError where none holds samples."""
+    lengths = Counter(n for a in found.arrays if (n := _length(a.shape)) is not None)
+    if not lengths:
+        raise _refusal(path, found)
+    tables = {m: _columns([a for a in found.arrays if _length(a.shape) == m]) for m in lengths}
+    n = max(lengths, key=lambda m: (sum(_holds(tables[m][0], q) for q in WANTED.get(want, ())),
+                                    lengths[m], m))
+    header, where = tables[n]
+    left = [a for a in found.arrays if _length(a.shape) not in (None, n)]
     named = []
     for h, (a, _, stated) in zip(header, where, strict=True):
         name, unit = unit_of(h, stated)

@@ -91,9 +91,10 @@ SNIFF_BYTES = 1 << 16
 
 
 
-def open_table(path: str | Path) -> TableSource:
+def open_table(path: str | Path, want: str = "imu") -> TableSource:
     """The file's table (the module docstring), by its content and suffix; TableError saying
-    what is wrong."""
+    what is wrong. `want` ("imu" or "pose") chooses among the arrays of an HDF5 or MATLAB
+    file those of the length that holds it (array_files.WANTED)."""
     path = Path(path)
     if not path.is_file():
         raise TableError(f"{path}: no such file")
@@ -105,9 +106,9 @@ def open_table(path: str | Path) -> TableSource:
     if magic.startswith(ARROW_MAGIC) or suffix in (".feather", ".arrow", ".ipc"):
         return _arrow_ipc(path)
     if magic.startswith(b"\x89HDF") or suffix in (".h5", ".hdf5"):
-        return hdf5_table(path)
+        return hdf5_table(path, want)
     if suffix == ".mat":
-        return mat_table(path)
+        return mat_table(path, want)
     if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
         raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
                          "directory of its files at its end): copy or download it again")

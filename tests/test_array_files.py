@@ -260,3 +260,33 @@ def test_a_damaged_hdf5_file_is_refused_naming_the_array_and_rows(tmp_path):
     with pytest.raises(RecordingError, match=r"damaged.h5: gyro, rows 1 to \d+, does not read "
                        r"\(.*\): the file is damaged"):
         open_recording(path, gyro_unit="rad/s").load()
+
+
+def test_an_imu_and_a_motion_capture_at_their_own_rates_in_one_file(tmp_path, capsys):
+    """Arrays of two lengths: the recording takes those that hold the IMU, the reference those
+    that hold the pose, though the motion capture's are more (the arrays the most share were
+    taken: "no column for acc_x ... 3 array(s) of another length left out: imu/acc ...")."""
+    from testbenches.cli import main
+
+    ex = _example()
+    truth = np.genfromtxt(REPO / "examples" / "tilt_motion_truth.csv", delimiter=",",
+                          names=True)
+    half = 0.5
+    cr, sr = np.cos(half * truth["roll"]), np.sin(half * truth["roll"])
+    cp, sp = np.cos(half * truth["pitch"]), np.sin(half * truth["pitch"])
+    cy, sy = np.cos(half * truth["yaw"]), np.sin(half * truth["yaw"])
+    quat = {"q_w": cr * cp * cy + sr * sp * sy, "q_x": sr * cp * cy - cr * sp * sy,
+            "q_y": cr * sp * cy + sr * cp * sy, "q_z": cr * cp * sy - sr * sp * cy}
+    path = tmp_path / "both.h5"
+    with h5py.File(path, "w") as f:
+        f["imu/time"] = ex[:, 0]
+        f["imu/acc"] = ex[:, 1:4]
+        f["imu/gyro"] = ex[:, 4:7]
+        f["mocap/time"] = truth["time"][::2]
+        for name, values in quat.items():
+            f[f"mocap/{name}"] = values[::2]
+    _same_as_csv(path)
+    assert main(["estimate", str(path), "--estimator", "kf", "--reference", str(path),
+                 "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    row = next(r for r in capsys.readouterr().out.splitlines() if r.startswith("kf "))
+    assert float(row.split()[2]) == pytest.approx(0.5996, abs=0.002)  # the CSV's: 0.5996

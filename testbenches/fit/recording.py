@@ -277,7 +277,7 @@ def open_table(path: Path, want: str = "imu", topic: str | None = None) -> Any:
         if topic is not None:
             raise RecordingError(f"{path}: a topic is given ({topic}), but this is no ROS bag "
                                  "(a .bag, a ROS 2 bag's folder or its .db3 or .mcap file)")
-        return open_any(path)
+        return open_any(path, want)
     except TableError as err:
         raise RecordingError(str(err)) from None
 
