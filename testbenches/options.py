@@ -44,7 +44,9 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
                         "where two are)")
     parser.add_argument("--column", action="append", default=[], metavar="QUANTITY=NAME",
                         help="the column of a quantity (acc_x..gyro_z, time, dt, roll, pitch, "
-                        "q_w..q_z) where its name is none the reader knows (repeatable)")
+                        "q_w..q_z) where its name is none the reader knows (repeatable); "
+                        "acc=NAME or gyro=NAME for a sensor's three (NAME_x, NAME.x, NAME[0] or "
+                        "NAME_1 and on), acc=X,Y,Z to name them")
     parser.add_argument("--acc-unit", choices=("auto", "m/s2", "g", "mg"), default="auto",
                         help="the accelerometer's unit (auto: the header's, else from its norm)")
     parser.add_argument("--acc-sign", choices=("auto", "+1", "-1"), default="auto",

@@ -290,3 +290,31 @@ def test_an_imu_and_a_motion_capture_at_their_own_rates_in_one_file(tmp_path, ca
                  "--out", str(tmp_path / "out"), "--no-plots"]) == 0
     row = next(r for r in capsys.readouterr().out.splitlines() if r.startswith("kf "))
     assert float(row.split()[2]) == pytest.approx(0.5996, abs=0.002)  # the CSV's: 0.5996
+
+
+def test_a_sensors_three_columns_mapped_at_once(tmp_path, capsys):
+    """--column acc=NAME maps NAME_x, NAME_y, NAME_z (as the header spells them), acc=X,Y,Z
+    three names: a Simulink "Structure With Time" log's values_1 ... values_6 and one of two
+    IMUs in three options instead of seven."""
+    from testbenches.cli import main
+    from testbenches.fit.recording import parse_columns
+
+    ex = _example()
+    simulink = tmp_path / "simout.mat"
+    scipy_io.savemat(simulink, {"simout": {"time": ex[:, :1], "signals": {
+        "values": ex[:, 1:7], "dimensions": 6, "label": "imu"}, "blockName": "m/To Workspace"}})
+    columns = parse_columns(["acc=values_1,values_2,values_3", "gyro=values_4, values_5, "
+                             "values_6"])
+    _same_as_csv(simulink, columns=columns)
+    two = tmp_path / "two.h5"
+    with h5py.File(two, "w") as f:
+        for imu in ("imu0", "imu1"):
+            f[f"{imu}/time"] = ex[:, 0]
+            f[f"{imu}/acc"] = ex[:, 1:4] * (1.0 if imu == "imu1" else 2.0)
+            f[f"{imu}/gyro"] = ex[:, 4:7]
+    _same_as_csv(two, columns=parse_columns(["acc=imu1/acc", "gyro=imu1/gyro",
+                                             "time=imu1/time"]))
+    assert main(["estimate", str(simulink), "--column", "acc=values_1,values_2", "--out",
+                 str(tmp_path)]) == 2
+    assert ("--column 'acc=values_1,values_2': a sensor's columns are one name (acc=NAME, for "
+            "NAME_x, NAME_y, NAME_z) or three (acc=X,Y,Z)") in capsys.readouterr().err

@@ -180,8 +180,9 @@ def find_names(names: list[str], quantity: str, given: str | None = None,
     unit), else the first of its aliases and then of `more` in the first of name_forms that
     has one; every column that spells it so (two where a header names one twice, or two
     topics the same field), none where none does."""
-    if given:
-        forms = [[norm_name(n) for n in names]]
+    if given:  # as written, then with MATLAB's "_1", "_2", "_3" as the axes (acc=NAME)
+        normed = [norm_name(n) for n in names]
+        forms = [normed, _one_based_axes(normed)]
         passes: list[tuple[str, ...]] = [(norm_name(given),)]
     else:
         forms, wanted = name_forms(names), (*ALIASES[quantity], *more)

@@ -140,18 +140,37 @@ REFERENCE_COLUMNS = ("time", "roll", "pitch", *QUAT_COLUMNS)
 """The quantities a reference file's columns may be (estimate's --reference-column)."""
 
 
+SENSORS = ("acc", "gyro")
+"""The quantities --column takes for a sensor's three axes at once: acc=NAME for acc_x=NAME_x,
+acc_y=NAME_y, acc_z=NAME_z (NAME_x found as the header spells it: NAME.x, NAME[0], NAMEX,
+NAME_1 of a variable of three columns), or acc=X,Y,Z naming the three."""
+
+
 def parse_columns(specs: list[str], option: str = "--column",
                   allowed: tuple[str, ...] | None = None) -> dict[str, str]:
-    """QUANTITY=NAME options as {quantity: column name}; RecordingError for a quantity that is
-    not one of `allowed` (ALIASES' and EXTRA_COLUMNS where None) or a spec without '='."""
+    """QUANTITY=NAME options as {quantity: column name}, a sensor's (SENSORS, where allowed is
+    None) as its three axes'; RecordingError for a quantity that is not one of `allowed`
+    (ALIASES' and EXTRA_COLUMNS where None), a spec without '=' or a sensor given other than
+    one name or three."""
+    sensors = SENSORS if allowed is None else ()
     allowed = allowed or (*ALIASES, *EXTRA_COLUMNS)
     out = {}
     for spec in specs:
         quantity, sep, name = spec.partition("=")
         quantity = quantity.strip()
+        if sep and quantity in sensors:
+            names = [n.strip() for n in name.split(",")]
+            if len(names) not in (1, 3) or not all(names):
+                raise RecordingError(f"{option} {spec!r}: a sensor's columns are one name "
+                                     f"({quantity}=NAME, for NAME_x, NAME_y, NAME_z) or three "
+                                     f"({quantity}=X,Y,Z)")
+            axes = names if len(names) == 3 else [f"{names[0]}_{a}" for a in "xyz"]
+            out.update({f"{quantity}_{a}": n for a, n in zip("xyz", axes, strict=True)})
+            continue
         if not sep or quantity not in allowed:
+            more = f" (or {' or '.join(sensors)} for the three axes)" if sensors else ""
             raise RecordingError(f"{option} {spec!r}: expected QUANTITY=NAME with QUANTITY one "
-                                 f"of {', '.join(allowed)}")
+                                 f"of {', '.join(allowed)}{more}")
         out[quantity] = name.strip()
     return out
 
