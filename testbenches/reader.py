@@ -100,14 +100,22 @@ def open_table(path: str | Path, want: str = "imu") -> TableSource:
         raise TableError(f"{path}: no such file")
     suffix = path.suffix.lower()
     with path.open("rb") as f:
-        magic = f.read(8)
-    if magic.startswith(b"PAR1") or suffix in (".parquet", ".pq"):
+        head = f.read(TEXT_CHECK)
+    magic = head[:8]
+    binary = _binary_format(head)
+    if binary is None and suffix in BINARY_SUFFIXES and _text_like(head):
+        source = _text(path)  # a CSV renamed (or saved under the wrong name): read as it is
+        source.note = "; ".join(filter(None, [f"named {suffix} but text: read as text",
+                                              source.note]))
+        return source
+    binary = binary or BINARY_SUFFIXES.get(suffix)
+    if binary == "parquet":
         return _parquet(path)
-    if magic.startswith(ARROW_MAGIC) or suffix in (".feather", ".arrow", ".ipc"):
+    if binary == "arrow":
         return _arrow_ipc(path)
-    if magic.startswith(b"\x89HDF") or suffix in (".h5", ".hdf5"):
+    if binary == "hdf5":
         return hdf5_table(path, want)
-    if suffix == ".mat":
+    if binary == "mat":
         return mat_table(path, want)
     if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
         raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
@@ -128,6 +136,35 @@ def open_table(path: str | Path, want: str = "imu") -> TableSource:
         raise TableError(f"{path}: JSON, which is no table this reader takes: export the "
                          "recording as CSV (phone apps offer both)")
     return _text(path)
+
+
+BINARY_SUFFIXES = {".parquet": "parquet", ".pq": "parquet", ".feather": "arrow",
+                   ".arrow": "arrow", ".ipc": "arrow", ".h5": "hdf5", ".hdf5": "hdf5",
+                   ".mat": "mat"}
+"""The formats a suffix names, where the file's first bytes name none (a MATLAB v4 file has no
+magic bytes); the first bytes decide where they name one (a file saved under another
+suffix), and a file of such a suffix whose first bytes are text is read as text."""
+TEXT_CHECK = 4096
+"""How many of a file's first bytes tell text from a binary format."""
+
+
+def _binary_format(head: bytes) -> str | None:
+    """The binary format a file's first bytes name: Parquet, Arrow IPC (Feather), HDF5 (also
+    after MATLAB v7.3's 512-byte header) or MATLAB v5; None for none of them."""
+    if head.startswith(b"PAR1"):
+        return "parquet"
+    if head.startswith(ARROW_MAGIC):
+        return "arrow"
+    if head.startswith(b"\x89HDF") or head[512:520] == b"\x89HDF\r\n\x1a\n":
+        return "hdf5"
+    if head.startswith(b"MATLAB 5.0 MAT-file"):
+        return "mat"
+    return None
+
+
+def _text_like(head: bytes) -> bool:
+    """Whether a file's first bytes are text: no NUL byte, or UTF-16's byte-order mark."""
+    return head.startswith((b"\xff\xfe", b"\xfe\xff")) or (bool(head) and b"\x00" not in head)
 
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"

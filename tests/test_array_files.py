@@ -318,3 +318,32 @@ def test_a_sensors_three_columns_mapped_at_once(tmp_path, capsys):
                  str(tmp_path)]) == 2
     assert ("--column 'acc=values_1,values_2': a sensor's columns are one name (acc=NAME, for "
             "NAME_x, NAME_y, NAME_z) or three (acc=X,Y,Z)") in capsys.readouterr().err
+
+
+def test_a_file_under_another_formats_suffix_is_read_as_what_it_holds(tmp_path):
+    """A CSV saved as .h5, .mat, .parquet or .feather was refused in the named format's words
+    ("file signature not found"), a MATLAB file saved as .csv as text ("no delimiter
+    splits ..."), an Arrow file as .parquet as Parquet: the first bytes decide, the suffix
+    only where they name no format."""
+    import pyarrow as pa
+    import pyarrow.feather as feather
+
+    ex = _example()
+    text = EXAMPLE.read_bytes()
+    for suffix in (".h5", ".mat", ".parquet", ".feather"):
+        path = tmp_path / f"renamed{suffix}"
+        path.write_bytes(text)
+        source = open_recording(path, gyro_unit="rad/s")
+        assert f"named {suffix} but text: read as text" in source.choices
+        _same_as_csv(path)
+    mat = tmp_path / "matlab.csv"
+    scipy_io.savemat(tmp_path / "m.mat", {"time": ex[:, 0], "acc": ex[:, 1:4],
+                                         "gyro": ex[:, 4:7]})
+    mat.write_bytes((tmp_path / "m.mat").read_bytes())
+    _same_as_csv(mat)
+    arrow = tmp_path / "arrow.parquet"
+    feather.write_feather(pa.table(dict(zip(NAMES[:7], ex[:, :7].T, strict=True))), arrow)
+    _same_as_csv(arrow)
+    v73 = _matlab_v73(tmp_path / "v73.dat", {"time": ex[:, 0], "acc": ex[:, 1:4],
+                                              "gyro": ex[:, 4:7]})
+    _same_as_csv(v73)
