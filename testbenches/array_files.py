@@ -53,7 +53,9 @@ HIDDEN = ("#refs#", "#subsystem#", "_i_table")
 table index."""
 MATLAB_NUMBERS = frozenset({"double", "single", "int8", "uint8", "int16", "uint16", "int32",
                             "uint32", "int64", "uint64"})
-"""MATLAB classes of arrays of numbers (not "char", "logical", "cell" or a class object)."""
+"""MATLAB classes of arrays of numbers (not MATLAB_NO_SAMPLES' or a class object)."""
+MATLAB_NO_SAMPLES = ("char", "logical", "cell")
+"""MATLAB classes of arrays that hold no samples: text, truth values, cells (references)."""
 MATLAB_HINT = {
     "table": "writetable({var}, 'FILE.csv') saves it as CSV, or s = table2struct({var}, "
              "'ToScalar', true); save('FILE.mat', '-struct', 's') as arrays",
@@ -160,15 +162,16 @@ def _in_memory(path: tuple[str, ...], a: np.ndarray) -> _Array:
 
 
 def _field(path: tuple[str, ...], ds: Any, name: str, names: list[str] | None,
-           ticks: int = 0) -> _Array:
-    """A compound dataset's field: a column, or k columns where it holds k numbers a row."""
+           ticks: int = 0, leaf: str | None = None) -> _Array:
+    """A compound dataset's field: a column, or k columns where it holds k numbers a row;
+    named `leaf` where given (pandas' data column by its own name), else as the field."""
     sub = ds.dtype.fields[name][0].shape
     shape = (ds.shape[0], *sub)
 
     def read(lo: int, hi: int) -> np.ndarray:
         return np.asarray(ds.fields(name)[lo:hi])
 
-    return _Array((*path, name), shape, read, names, None, ticks)
+    return _Array((*path, leaf or name), shape, read, names, None, ticks)
 
 
 def _ticks(dtype_text: Any) -> int:
@@ -189,7 +192,7 @@ def _pandas_fixed(group: Any, path: tuple[str, ...]) -> list[_Array]:
         name = _attr(index.attrs, "name")
         kind = _attr(index.attrs, "kind") or ""
         found.append(_dataset((*path, "index" if name in (None, "N.") else name), index,
-                              ticks=_ticks(kind if kind.startswith("datetime64") else "")))
+                              ticks=_ticks(kind)))
     for i in range(int(group.attrs.get("nblocks", 0))):
         values, items = group.get(f"block{i}_values"), group.get(f"block{i}_items")
         if values is None or items is None or values.ndim != 2 or values.dtype.kind not in "iuf":
@@ -219,11 +222,8 @@ def _pandas_table(group: Any, path: tuple[str, ...]) -> list[_Array]:
         if name == "index":
             names = [index_name if isinstance(index_name, str) else "index"]
             ticks = _ticks(_attr(table.attrs, "index_kind"))
-        if sub:
-            found.append(_field(path, table, name, names, ticks))
-        else:  # a data column, or the index: one column under its own name
-            found.append(_field(path, table, name, None, ticks))
-            found[-1].path = (*path, names[0] if names else name)
+        leaf = None if sub or not names else names[0]  # a data column, the index: its name
+        found.append(_field(path, table, name, names if sub else None, ticks, leaf))
     return found
 
 
@@ -255,12 +255,11 @@ def _hdf5_found(f: Any) -> _Found:
                 continue
             if not isinstance(item, h5py.Dataset) or item.shape is None:
                 continue
-            if "MATLAB_object_decode" in item.attrs or (matlab and matlab not in MATLAB_NUMBERS
-                                                         and matlab not in ("char", "logical",
-                                                                            "cell")):
+            if ("MATLAB_object_decode" in item.attrs
+                    or matlab not in (None, *MATLAB_NUMBERS, *MATLAB_NO_SAMPLES)):
                 objects.append(("/".join(where), matlab or "object"))
                 continue
-            if matlab not in (None, *MATLAB_NUMBERS) or "MATLAB_empty" in item.attrs:
+            if matlab in MATLAB_NO_SAMPLES or "MATLAB_empty" in item.attrs:
                 continue
             if item.dtype.names:
                 for field in item.dtype.names:

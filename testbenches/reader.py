@@ -1549,8 +1549,9 @@ def _arrow_columns(field: Any, first: Callable[[str], Any]
                    ) -> list[tuple[str, tuple[Any, ...], Any]]:
     """A top-level Arrow field's columns as (name, the parts to its numbers, its metadata): a
     number's own; each number of a struct ("acc.x", "header.stamp.sec"); each of a list's k
-    numbers where every list holds k (k from the first row group): "acc_x", "acc_y", "acc_z"
-    for three, "q_1" ... "q_k" otherwise, as array_files names a matrix's columns."""
+    numbers, k the length of most lists of the first row group (a fixed-size list's own):
+    "acc_x", "acc_y", "acc_z" for three, "q_1" ... "q_k" otherwise, as array_files names a
+    matrix's columns."""
     import pyarrow as pa
 
     def numeric(kind: Any) -> bool:
@@ -1587,27 +1588,26 @@ def _list_width(column: Any) -> int | None:
 
 
 def _arrow_part(column: Any, parts: tuple[Any, ...], path: Path, name: str) -> np.ndarray:
-    """The numbers at `parts` of a top-level column (a struct's field, a list's element), as
-    float64: a null struct or list, or a list of another length, a sample without numbers."""
+    """The numbers at `parts` of a top-level column (a struct's fields by name, then a list's
+    (element, length)), as float64: a null struct or list, or a list of another length, a
+    sample without numbers."""
     import pyarrow.compute as pc
 
-    missing = None
+    missing = np.zeros(len(column), dtype=bool)
     for part in parts:
-        valid = np.asarray(column.is_valid().to_numpy(zero_copy_only=False))
+        missing |= ~np.asarray(column.is_valid().to_numpy(zero_copy_only=False))
         if isinstance(part, str):
             column = column.field(part)
-        else:  # (the element, the lists' length)
-            lengths = pc.list_value_length(column).fill_null(0).to_numpy(zero_copy_only=False)
-            valid &= lengths == part[1]
-            column = pc.list_element(column.filter(valid), part[0])
-            spread = np.full(len(valid), np.nan)
-            spread[valid] = _arrow_float(column, path, name)
-            return spread if missing is None else np.where(missing, np.nan, spread)
-        missing = ~valid if missing is None else missing | ~valid
+            continue
+        element, width = part
+        lengths = pc.list_value_length(column).fill_null(0).to_numpy(zero_copy_only=False)
+        missing |= lengths != width
+        values = np.full(len(missing), np.nan)
+        values[~missing] = _arrow_float(pc.list_element(column.filter(~missing), element), path,
+                                        name)
+        return values
     values = _arrow_float(column, path, name)
-    if missing is not None and missing.any():
-        values = np.where(missing, np.nan, values)
-    return values
+    return np.where(missing, np.nan, values) if missing.any() else values
 
 
 def _arrow_source(path: Path, kind: str, schema: Any, rows: int, batches: Callable[..., Any],
@@ -1618,17 +1618,13 @@ def _arrow_source(path: Path, kind: str, schema: Any, rows: int, batches: Callab
 
     columns = [(field.name, *c) for field in schema for c in _arrow_columns(field, first)]
     header = [name for _, name, _, _ in columns]
-    named = [unit_of(name, (meta or {}).get(b"unit", (meta or {}).get(b"units")))
-             for _, name, _, meta in columns]
-
-    def leaf_type(top: str, parts: tuple[Any, ...]) -> Any:
+    named = []
+    for top, name, parts, meta in columns:
         kind = schema.field(top).type
         for part in parts:
             kind = kind.field(part).type if isinstance(part, str) else kind.value_type
-        return kind
-
-    named = [(n, DATETIME if pa.types.is_timestamp(leaf_type(top, parts)) else u)
-             for (n, u), (top, _, parts, _) in zip(named, columns, strict=True)]
+        bare, unit = unit_of(name, (meta or {}).get(b"unit", (meta or {}).get(b"units")))
+        named.append((bare, DATETIME if pa.types.is_timestamp(kind) else unit))
 
     def parts(chosen: list[int], size: int) -> Iterator[np.ndarray]:
         tops = list(dict.fromkeys(columns[i][0] for i in chosen))
