@@ -209,6 +209,11 @@ def _opener(path: Path) -> tuple[Callable[[], Any], dict[str, list[Any]], str]:
         raise TableError(f"{refused}{repair}; read record by record, {why}") from None
 
 
+def _why(err: Exception) -> str:
+    """An error of a damaged bag as its type and its text (an AssertionError has none)."""
+    return f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
+
+
 def _messages(path: Path, bag: Any, connections: list[Any], topic: str
               ) -> Iterator[tuple[Any, int, bytes]]:
     """The topic's messages as the bag gives them; TableError naming the last whole one where
@@ -221,8 +226,7 @@ def _messages(path: Path, bag: Any, connections: list[Any], topic: str
             n += 1
     except Exception as err:  # any of rosbags', zstd's, lz4's, bz2's, apsw's: a damaged bag
         where = f"after message {n} of {topic}" if n else f"before its first message of {topic}"
-        why = f"{type(err).__name__}: {err}" if str(err) else type(err).__name__
-        raise TableError(f"{path}: damaged {where}: it does not read on from there ({why}); "
+        raise TableError(f"{path}: damaged {where}: it does not read on from there ({_why(err)}); "
                          "copy or record it again") from None
 
 
@@ -237,9 +241,7 @@ class _Unread:
 
     def add(self, index: int, err: Exception) -> None:
         self.count += 1
-        self.first = self.first or (f"message {index + 1}: {type(err).__name__}: {err}"
-                                    if str(err) else f"message {index + 1}: "
-                                    f"{type(err).__name__}")
+        self.first = self.first or f"message {index + 1}: {_why(err)}"
         if self.count > 1 + GARBLED_SHARE * (index + 1):
             raise self._refusal(index + 1)
 
