@@ -1074,15 +1074,15 @@ def _as_iso(column: Any, kind: Any) -> Any:
     return column.cast(kind)
 
 
-def _seconds(column: Any) -> np.ndarray:
-    """A pyarrow timestamp or time of day array [ns] as seconds since 1970 or midnight, its
-    nulls NaN: the whole seconds and their fraction added, as seconds_of and seconds_of_day
-    add them, so that both readers give the same seconds to the bit (one rounding; the
-    nanoseconds times 1e-9 round twice)."""
+def _seconds(column: Any, per_second: int = 10**9) -> np.ndarray:
+    """A pyarrow timestamp, duration or time of day array (per_second ticks a second: [ns] by
+    default) as seconds since 1970 or midnight, its nulls NaN: the whole seconds and their
+    fraction added, as seconds_of and seconds_of_day add them, so that both readers give the
+    same seconds to the bit (one rounding; the nanoseconds times 1e-9 round twice)."""
     import pyarrow as pa
 
-    ns = column.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False)
-    seconds = ticks_seconds(ns, 10**9)
+    ticks = column.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False)
+    seconds = ticks_seconds(ticks, per_second)
     if column.null_count:
         seconds[np.asarray(column.is_null().to_numpy(zero_copy_only=False))] = np.nan
     return seconds
@@ -1646,11 +1646,7 @@ def _arrow_float(column: Any, path: Path, name: str) -> np.ndarray:
 
     kind = column.type
     if pa.types.is_timestamp(kind) or pa.types.is_duration(kind):
-        ticks = column.cast(pa.int64()).fill_null(0).to_numpy(zero_copy_only=False)
-        seconds = ticks_seconds(ticks, round(1.0 / TIME_SCALE[kind.unit]))
-        if column.null_count:
-            seconds[np.asarray(column.is_null().to_numpy(zero_copy_only=False))] = np.nan
-        return seconds
+        return _seconds(column, round(1.0 / TIME_SCALE[kind.unit]))
     if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
         raise TableError(f"{path}, column {name!r}: holds {kind}, not numbers")
     return np.asarray(column.cast(pa.float64()).to_numpy(zero_copy_only=False), dtype=float)
