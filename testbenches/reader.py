@@ -144,22 +144,31 @@ BINARY_SUFFIXES = {".parquet": "parquet", ".pq": "parquet", ".feather": "arrow",
 """The formats a suffix names, where the file's first bytes name none (a MATLAB v4 file has no
 magic bytes); the first bytes decide where they name one (a file saved under another
 suffix), and a file of such a suffix whose first bytes are text is read as text."""
-TEXT_CHECK = 4096
-"""How many of a file's first bytes tell text from a binary format."""
+TEXT_CHECK = 1 << 14
+"""How many of a file's first bytes tell text from a binary format (past the last place an
+HDF5 signature is looked for, HDF5_SIGNATURE_AT)."""
 
 
 def _binary_format(head: bytes) -> str | None:
     """The binary format a file's first bytes name: Parquet, Arrow IPC (Feather), HDF5 (also
-    after MATLAB v7.3's 512-byte header) or MATLAB v5; None for none of them."""
+    after a user block, as MATLAB v7.3's 512-byte header) or MATLAB v5; None for none of
+    them."""
     if head.startswith(b"PAR1"):
         return "parquet"
     if head.startswith(ARROW_MAGIC):
         return "arrow"
-    if head.startswith(b"\x89HDF") or head[512:520] == b"\x89HDF\r\n\x1a\n":
+    if any(head[at:at + 8] == HDF5_SIGNATURE for at in HDF5_SIGNATURE_AT):
         return "hdf5"
     if head.startswith(b"MATLAB 5.0 MAT-file"):
         return "mat"
     return None
+
+
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+HDF5_SIGNATURE_AT = (0, 512, 1024, 2048, 4096, 8192)
+"""Where HDF5 looks for its superblock's signature: at 0 or after a user block of 512 bytes
+times a power of two (MATLAB v7.3 writes 512; h5py's userblock_size takes any such size).
+The first TEXT_CHECK bytes, which decide the format, reach past the last listed."""
 
 
 def _text_like(head: bytes) -> bool:

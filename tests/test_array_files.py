@@ -323,8 +323,9 @@ def test_a_sensors_three_columns_mapped_at_once(tmp_path, capsys):
 def test_a_file_under_another_formats_suffix_is_read_as_what_it_holds(tmp_path):
     """A CSV saved as .h5, .mat, .parquet or .feather was refused in the named format's words
     ("file signature not found"), a MATLAB file saved as .csv as text ("no delimiter
-    splits ..."), an Arrow file as .parquet as Parquet: the first bytes decide, the suffix
-    only where they name no format."""
+    splits ..."), an Arrow file as .parquet as Parquet, HDF5 after a user block of 8 kB as
+    .dat as text ("line 1 reads '\\x00\\x00...'"): the first bytes decide, the suffix only where
+    they name no format."""
     import pyarrow as pa
     import pyarrow.feather as feather
 
@@ -347,3 +348,7 @@ def test_a_file_under_another_formats_suffix_is_read_as_what_it_holds(tmp_path):
     v73 = _matlab_v73(tmp_path / "v73.dat", {"time": ex[:, 0], "acc": ex[:, 1:4],
                                               "gyro": ex[:, 4:7]})
     _same_as_csv(v73)
+    block = tmp_path / "userblock.dat"  # HDF5 after a user block of another size than MATLAB's
+    with h5py.File(block, "w", userblock_size=8192) as f:
+        f["time"], f["acc"], f["gyro"] = ex[:, 0], ex[:, 1:4], ex[:, 4:7]
+    _same_as_csv(block)
