@@ -6,7 +6,8 @@ any length is read in bounded memory:
 - delimited text (CSV and its kin), also compressed (gzip, bz2 or xz: .csv.gz and the like,
   told by the file's first bytes; a stream cut before its end read up to the cut, and said
   in TableSource.found): the encoding (UTF-8 with or without a byte-order mark,
-  UTF-16 as Windows' "Unicode" exports write it, else Latin-1), the delimiter (comma,
+  UTF-16 as Windows' "Unicode" exports write it, else Latin-1), the line end (a line feed,
+  with a carriage return before it or not, or a carriage return alone), the delimiter (comma,
   semicolon, tab or bar, one after the rows' or the header's last cell read through; else
   runs of spaces; a decimal comma where the numbers have one) and the header row are
   found from the file's start (after LabVIEW's ***End_of_Header*** lines); pyarrow's CSV reader
@@ -286,6 +287,10 @@ class _Lines(io.RawIOBase):
     def _lines(self, whole: bytes) -> bytes:
         return whole
 
+    def _cut(self, data: bytes) -> int:
+        """Where the whole lines of `data` end."""
+        return data.rfind(b"\n") + 1
+
     def readinto(self, buffer: Any) -> int:
         while not self._out and not self._done:
             chunk = self._chunk()
@@ -293,7 +298,7 @@ class _Lines(io.RawIOBase):
                 self._done = True
                 break
             data = self._held + chunk
-            cut = len(data) if not chunk else data.rfind(b"\n") + 1
+            cut = len(data) if not chunk else self._cut(data)
             self._done = not chunk
             whole, self._held = data[:cut], data[cut:]
             self._out = memoryview(self._lines(whole))
@@ -317,6 +322,11 @@ class _Salvaged(_Lines):
         super().__init__(inner)
         self._path, self._kind, self._found = path, kind, found
 
+    def _cut(self, data: bytes) -> int:
+        """Where the whole lines of `data` end, by either line end: a file whose lines end with
+        a carriage return alone (_CrLines reads them after) is not held whole."""
+        return max(data.rfind(b"\n"), data.rfind(b"\r")) + 1
+
     def _chunk(self) -> bytes | None:
         import lzma
         import zlib
@@ -331,6 +341,28 @@ class _Salvaged(_Lines):
         except (OSError, zlib.error, lzma.LZMAError, zipfile.BadZipFile) as err:
             raise TableError(f"{self._path}: its {self._kind} stream cannot be decompressed "
                              f"({err}): the file is damaged") from None
+
+
+class _CrLines(io.RawIOBase):
+    """A stream's bytes with each carriage return a line feed: the lines of a file whose lines
+    end with a carriage return alone (_TextLayout.cr_lines), as every reader here counts lines,
+    by their line feeds."""
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        view = memoryview(buffer).cast("B")
+        n = self._inner.readinto(view) or 0
+        view[:n] = bytes(view[:n]).replace(b"\r", b"\n")
+        return n
+
+    def close(self) -> None:
+        self._inner.close()
+        super().close()
 
 
 # ----- delimited text --------------------------------------------------------------------------
@@ -376,6 +408,10 @@ class _TextLayout:
     day_month: dict[int, str] = field(default_factory=dict)
     """Columns of dates with the day and month before the year (_DAY_MONTH) -> a cell: refused
     where read."""
+    cr_lines: bool = False
+    """Lines that end with a carriage return alone (classic Mac OS text, Excel for Mac's "CSV
+    (Macintosh)"): the file's bytes are read through _CrLines, its lines counted by their
+    carriage returns."""
 
 
 _DATETIME = re.compile(
@@ -497,6 +533,10 @@ def _sniff(path: Path) -> _TextLayout:
             text = raw[:err.start].decode("utf-8-sig")  # a character cut at the end
         else:
             encoding, text = "latin-1", raw.decode("latin-1")
+    # lines that end with a carriage return alone (not UTF-16's, whose bytes pair)
+    cr_lines = b"\r" in raw and b"\n" not in raw and _utf16(raw) is None
+    if cr_lines:
+        raw = raw.replace(b"\r", b"\n")
     if len(raw) == SNIFF_BYTES:  # the last line may be cut
         text = text[:text.rfind("\n") + 1] or text
     lines = text.splitlines()
@@ -566,7 +606,8 @@ def _sniff(path: Path) -> _TextLayout:
     layout = _TextLayout(encoding, delimiter, header_line, header, decimal_comma, padded,
                          datetimes, times_of_day, skipped, data_after, units_row, stacked,
                          rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations,
-                         spaced=spaced, not_iso=rewritten, day_month=day_month)
+                         spaced=spaced, not_iso=rewritten, day_month=day_month,
+                         cr_lines=cr_lines)
     if _compression(path) is None and encoding in ASCII_LINES:
         layout.data_end, layout.tail = _tail(path, layout)
     return layout
@@ -589,8 +630,9 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
             if kept or start == 0:
                 break
             stop = start
-    return _tail_of(kept, start, size - start - len(kept), layout,
-                    lambda end: _lines_before(path, end))
+    end = b"\r" if layout.cr_lines else b"\n"
+    return _tail_of(kept.replace(end, b"\n"), start, size - start - len(kept), layout,
+                    lambda at: _lines_before(path, at, end))
 
 
 def _tail_of(kept: bytes, start: int, nul: int, layout: _TextLayout,
@@ -752,12 +794,12 @@ def _line_cells(text: str, layout: _TextLayout) -> list[str]:
     return _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
 
 
-def _lines_before(path: Path, end: int) -> int:
-    """The line ends in the file's first `end` bytes."""
+def _lines_before(path: Path, end: int, line_end: bytes = b"\n") -> int:
+    """The line ends (`line_end`) in the file's first `end` bytes."""
     count = 0
     with path.open("rb") as f:
         while end > 0 and (chunk := f.read(min(end, 1 << 22))):
-            count += chunk.count(b"\n")
+            count += chunk.count(line_end)
             end -= len(chunk)
     return count
 
@@ -821,6 +863,8 @@ def _table_bytes(path: Path, layout: _TextLayout) -> IO[bytes]:
     read finds said in layout.found)."""
     raw = (_open_bytes(path, layout.found) if layout.data_end is None
            else io.BufferedReader(_Head(path, layout.data_end)))
+    if layout.cr_lines:
+        raw = io.BufferedReader(_CrLines(raw), buffer_size=SALVAGE_CHUNK)
     if _compression(path) is not None and layout.encoding in ASCII_LINES:
         raw = io.BufferedReader(_Tailed(raw, layout, layout.found), buffer_size=SALVAGE_CHUNK)
     return io.BufferedReader(_Spaced(raw), buffer_size=SALVAGE_CHUNK) if layout.spaced else raw
@@ -1143,7 +1187,7 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int,
     try:
         reader = pc.open_csv(
             path if (compression is None and layout.data_end is None and not layout.spaced
-                     and not after)
+                     and not after and not layout.cr_lines)
             else pa.PythonFile(io.BufferedReader(stream) if stream is not None
                                else _table_bytes(path, layout), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=0 if after else skip,

@@ -162,3 +162,47 @@ def test_a_logger_file_reads_the_same_compressed(tmp_path, seed):
     np.testing.assert_array_equal(a_t, p_t)
     said = sorted(a.described.split("; "))  # a footer's said where the stream ends
     assert sorted(p.described.replace(packed.name, path.name).split("; ")) == said
+
+
+def _same_reads(want: tuple[str, object], got: tuple[str, object], path: Path, as_path: Path
+                ) -> None:
+    """got (a read of `path`) as want (of `as_path`): the same samples to the bit, words and
+    refusals, the file's name aside."""
+    assert got[0] == want[0], (want, got)
+    if want[0] == "refused":
+        assert str(got[1]).replace(str(path), str(as_path)) == want[1]
+        return
+    (a, a_t), (p, p_t) = want[1], got[1]
+    for name in ("acc", "gyro", "dt", "valid"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(p, name), err_msg=name)
+    np.testing.assert_array_equal(a_t, p_t)
+    assert (sorted(p.described.replace(str(path), str(as_path)).split("; "))
+            == sorted(a.described.split("; ")))
+
+
+@pytest.mark.parametrize("seed", SEEDS[::2])
+def test_a_logger_file_whose_lines_end_with_a_carriage_return_alone(tmp_path, monkeypatch,
+                                                                   seed):
+    """Classic Mac OS text and Excel for Mac's "CSV (Macintosh)" end each line with a carriage
+    return alone: such a file was a traceback (csv's "new-line character seen in unquoted
+    field", from the look at its end). It reads as the same file with line feeds, plain and
+    gzipped, with NULs after its last line too: the same samples, words (line numbers) and
+    refusals."""
+    import gzip
+
+    import testbenches.reader as reader
+
+    monkeypatch.setattr(reader, "ARROW_BLOCK", 1 << 12)  # both readers in turn (as above)
+    monkeypatch.setattr(reader, "RESUME_ROWS", 30)
+    text = _logged(random.Random(seed), tmp_path / "any.csv").read_bytes().replace(b"\r\n",
+                                                                                  b"\n")
+    lf, cr, packed = (tmp_path / "lf.csv", tmp_path / "cr.csv", tmp_path / "cr.csv.gz")
+    lf.write_bytes(text)
+    cr.write_bytes(text.replace(b"\n", b"\r"))
+    packed.write_bytes(gzip.compress(cr.read_bytes()))
+    want = _read(lf)
+    _same_reads(want, _read(cr), cr, lf)
+    _same_reads(want, _read(packed), packed, lf)
+    lf.write_bytes(text + b"\x00" * 5000)  # a preallocated file's unwritten rest
+    cr.write_bytes(text.replace(b"\n", b"\r") + b"\x00" * 5000)
+    _same_reads(_read(lf), _read(cr), cr, lf)
