@@ -343,21 +343,37 @@ class _Salvaged(_Lines):
                              f"({err}): the file is damaged") from None
 
 
+LONE_CR = re.compile(rb"\r(?!\n)")
+"""A carriage return without a line feed after it: a line end of its own, as Python's csv module
+and pyarrow's reader take it (classic Mac OS text ends every line so, a serial log some; a
+sketch that prints "\\n\\r" ends each line with an empty one)."""
+
+
 class _CrLines(io.RawIOBase):
-    """A stream's bytes with each carriage return a line feed: the lines of a file whose lines
-    end with a carriage return alone (_TextLayout.cr_lines), as every reader here counts lines,
-    by their line feeds."""
+    """A stream's bytes with each lone carriage return (LONE_CR) a line feed, as many bytes: a
+    file's lines as every reader here counts them, by their line feeds, at the same byte
+    offsets (_TextLayout.lone_cr). A carriage return that ends a read is held until the next
+    byte shows whether a line feed follows it."""
 
     def __init__(self, inner: Any) -> None:
         self._inner = inner
+        self._out = memoryview(b"")
+        self._held = b""
+        self._done = False
 
     def readable(self) -> bool:
         return True
 
     def readinto(self, buffer: Any) -> int:
-        view = memoryview(buffer).cast("B")
-        n = self._inner.readinto(view) or 0
-        view[:n] = bytes(view[:n]).replace(b"\r", b"\n")
+        while not self._out and not self._done:
+            chunk = self._inner.read(SALVAGE_CHUNK)
+            data = self._held + chunk
+            self._done = not chunk
+            self._held = b"\r" if chunk and data.endswith(b"\r") else b""
+            self._out = memoryview(LONE_CR.sub(b"\n", data[:len(data) - len(self._held)]))
+        n = min(len(buffer), len(self._out))
+        memoryview(buffer).cast("B")[:n] = self._out[:n]
+        self._out = self._out[n:]
         return n
 
     def close(self) -> None:
@@ -408,10 +424,10 @@ class _TextLayout:
     day_month: dict[int, str] = field(default_factory=dict)
     """Columns of dates with the day and month before the year (_DAY_MONTH) -> a cell: refused
     where read."""
-    cr_lines: bool = False
-    """Lines that end with a carriage return alone (classic Mac OS text, Excel for Mac's "CSV
-    (Macintosh)"): the file's bytes are read through _CrLines, its lines counted by their
-    carriage returns."""
+    lone_cr: bool = False
+    """The file holds a carriage return without a line feed after it (LONE_CR: classic Mac OS
+    text and Excel for Mac's "CSV (Macintosh)" end every line so), or may (compressed): its
+    bytes are read through _CrLines, so that each reader counts its lines alike."""
 
 
 _DATETIME = re.compile(
@@ -533,10 +549,11 @@ def _sniff(path: Path) -> _TextLayout:
             text = raw[:err.start].decode("utf-8-sig")  # a character cut at the end
         else:
             encoding, text = "latin-1", raw.decode("latin-1")
-    # lines that end with a carriage return alone (not UTF-16's, whose bytes pair)
-    cr_lines = b"\r" in raw and b"\n" not in raw and _utf16(raw) is None
-    if cr_lines:
-        raw = raw.replace(b"\r", b"\n")
+    # a line end of a carriage return alone (not in UTF-16, whose bytes pair): a compressed
+    # stream is not read twice to look
+    lone_cr = _utf16(raw) is None and (_compression(path) is not None or _has_lone_cr(path))
+    if lone_cr:
+        raw = LONE_CR.sub(b"\n", raw)
     if len(raw) == SNIFF_BYTES:  # the last line may be cut
         text = text[:text.rfind("\n") + 1] or text
     lines = text.splitlines()
@@ -607,7 +624,7 @@ def _sniff(path: Path) -> _TextLayout:
                          datetimes, times_of_day, skipped, data_after, units_row, stacked,
                          rates[0] if len(rates) == 1 and rates[0] > 0.0 else None, durations,
                          spaced=spaced, not_iso=rewritten, day_month=day_month,
-                         cr_lines=cr_lines)
+                         lone_cr=lone_cr)
     if _compression(path) is None and encoding in ASCII_LINES:
         layout.data_end, layout.tail = _tail(path, layout)
     return layout
@@ -630,9 +647,10 @@ def _tail(path: Path, layout: _TextLayout) -> tuple[int | None, str]:
             if kept or start == 0:
                 break
             stop = start
-    end = b"\r" if layout.cr_lines else b"\n"
-    return _tail_of(kept.replace(end, b"\n"), start, size - start - len(kept), layout,
-                    lambda at: _lines_before(path, at, end))
+    if layout.lone_cr:
+        kept = LONE_CR.sub(b"\n", kept)
+    return _tail_of(kept, start, size - start - len(kept), layout,
+                    lambda at: _lines_before(path, at, layout.lone_cr))
 
 
 def _tail_of(kept: bytes, start: int, nul: int, layout: _TextLayout,
@@ -794,12 +812,25 @@ def _line_cells(text: str, layout: _TextLayout) -> list[str]:
     return _cells_of(_spaced_line(text) if layout.spaced else text, layout.delimiter)
 
 
-def _lines_before(path: Path, end: int, line_end: bytes = b"\n") -> int:
-    """The line ends (`line_end`) in the file's first `end` bytes."""
-    count = 0
+def _has_lone_cr(path: Path) -> bool:
+    """Whether the file holds a carriage return without a line feed after it (LONE_CR), read a
+    few megabytes at a time (a pass at the pace of the disk's cache)."""
+    held = b""
     with path.open("rb") as f:
+        while chunk := f.read(1 << 22):
+            data = held + chunk
+            held = b"\r" if data.endswith(b"\r") else b""
+            if LONE_CR.search(data, 0, len(data) - len(held)):
+                return True
+    return bool(held)
+
+
+def _lines_before(path: Path, end: int, lone_cr: bool = False) -> int:
+    """The line ends in the file's first `end` bytes (lone carriage returns too: _CrLines)."""
+    count = 0
+    with (_CrLines(path.open("rb")) if lone_cr else path.open("rb")) as f:
         while end > 0 and (chunk := f.read(min(end, 1 << 22))):
-            count += chunk.count(line_end)
+            count += chunk.count(b"\n")
             end -= len(chunk)
     return count
 
@@ -863,7 +894,7 @@ def _table_bytes(path: Path, layout: _TextLayout) -> IO[bytes]:
     read finds said in layout.found)."""
     raw = (_open_bytes(path, layout.found) if layout.data_end is None
            else io.BufferedReader(_Head(path, layout.data_end)))
-    if layout.cr_lines:
+    if layout.lone_cr:
         raw = io.BufferedReader(_CrLines(raw), buffer_size=SALVAGE_CHUNK)
     if _compression(path) is not None and layout.encoding in ASCII_LINES:
         raw = io.BufferedReader(_Tailed(raw, layout, layout.found), buffer_size=SALVAGE_CHUNK)
@@ -1187,7 +1218,7 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int,
     try:
         reader = pc.open_csv(
             path if (compression is None and layout.data_end is None and not layout.spaced
-                     and not after and not layout.cr_lines)
+                     and not after and not layout.lone_cr)
             else pa.PythonFile(io.BufferedReader(stream) if stream is not None
                                else _table_bytes(path, layout), mode="r"),
             read_options=pc.ReadOptions(column_names=keys, skip_rows=0 if after else skip,
