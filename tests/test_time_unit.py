@@ -186,6 +186,31 @@ def test_a_microcontrollers_counter_that_starts_again_goes_on(tmp_path):
         open_recording(_write(tmp_path / "back.csv", "micros", ticks % 2**32, imu)).load()
 
 
+def test_a_16_bit_counter_that_starts_again_goes_on(tmp_path):
+    """A timer's 16-bit count of ms starts again every 65.5 s: a fall by 2^16 ms from below
+    it was refused as a recording written on after another ("split the file there"); of us,
+    every 6.5 samples at 100 Hz. A 32-bit counter past 2^16 that falls by as much goes back
+    in time, and is still refused."""
+    t, imu = _example()
+    _, _, t_plain = _read(_write(tmp_path / "s.csv", "time", t, imu))
+    for unit, ticks in (("ms", (60_000 + np.round(t * 1e3).astype(np.int64)) % 2**16),
+                        ("us", np.round(t * 1e6).astype(np.int64) % 2**16)):
+        path = _write(tmp_path / f"{unit}16.csv", f"time_{unit}", ticks, imu)
+        source = open_recording(path, gyro_unit="rad/s")
+        assert source.time_unit == unit
+        for rows in (None, 64):
+            got = np.concatenate([tt for _, tt in source.blocks(rows=rows)])
+            np.testing.assert_allclose(got - got[0], t_plain - t_plain[0], atol=1e-9)
+        rec, _ = source.load()
+        assert f"the time's 16-bit counter started again {1 if unit == 'ms' else 152} " \
+               "time(s), taken as going on" in rec.described
+    ticks = 100_000 + np.round(t * 1e3).astype(np.int64)  # a 32-bit ms counter past 2^16
+    ticks[556:] -= 2**16
+    with pytest.raises(RecordingError, match="does not increase"):
+        open_recording(_write(tmp_path / "back.csv", "time_ms", ticks, imu),
+                       gyro_unit="rad/s").load()
+
+
 @pytest.mark.parametrize("start", [12 * 3600.0, 86400.0 - 5.0])
 def test_a_time_of_day_reads_as_seconds_since_midnight_and_passes_midnight(tmp_path, start):
     """A logger's real-time clock or a spreadsheet's time format: "12:00:00.010", no date. A

@@ -357,11 +357,14 @@ class _Clock:
     pending: float = 0.0
     """The dt of rows since the last sample (a dt column's)."""
     total: float = 0.0
-    wrap: float = 0.0
-    """Where the time is a microcontroller's 32-bit counter (ms or us), its modulus [s]: a fall
-    by about that much is the counter starting again, not time going back (0: none)."""
+    moduli: tuple[float, ...] = ()
+    """Where the time is a microcontroller's counter (ms or us), the moduli [s] of the widths it
+    may have (COUNTER_BITS; a time of day's day): a fall by about one of them from below it is
+    the counter starting again, not time going back (none: no counter)."""
     offset: float = 0.0
     wraps: int = 0
+    wrapped_at: float = 0.0
+    """The modulus [s] of the last wrap (which width the counter has: COUNTER_BITS)."""
     twice: int = 0
     """Rows that repeat the row before them, time and numbers (_without_twice)."""
     last_values: Any = None
@@ -418,7 +421,7 @@ class _Clock:
         """A sample's dt is the time since the last sample with a time (a row without one gets
         dt NaN, which the estimators reject, and as its time that last time plus the nominal
         period per row since; every row's time must rise from the last row's that has one)."""
-        if self.wrap > 0.0:
+        if self.moduli:
             t = self._unwrapped(t)
         valid = np.flatnonzero(np.isfinite(t))
         dt = np.full(len(t), np.nan)
@@ -463,37 +466,51 @@ class _Clock:
         return dt, np.where(np.isfinite(t), t, at)
 
     def _unwrapped(self, t: np.ndarray) -> np.ndarray:
-        """The times [s] with the counter's wraps taken out (self.wrap): a step that falls by
-        the modulus less at most WRAP_STEPS periods is the counter going on."""
-        t = t + self.offset
+        """The times [s] with the counter's wraps taken out (self.moduli, wrap_amounts)."""
         valid = np.isfinite(t)
-        times = t[valid]
-        if not len(times):
-            return t
-        last = self.last_t if self.last_t is not None else times[0]
-        wrapped = wraps(np.diff(np.concatenate([[last], times])), self.wrap, self.first_dt)
-        if wrapped.any():
-            t = t.copy()
-            t[valid] = times + np.cumsum(wrapped) * self.wrap
-            self.offset += float(np.sum(wrapped)) * self.wrap
-            self.wraps += int(np.sum(wrapped))
+        raw = t[valid]
+        if not len(raw):
+            return t + self.offset
+        last = self.last_t - self.offset if self.last_t is not None else raw[0]
+        before = np.concatenate([[last], raw[:-1]])
+        amounts = wrap_amounts(before, raw - before, self.moduli, self.first_dt)
+        t = t + self.offset
+        if amounts.any():
+            t[valid] += np.cumsum(amounts)
+            self.offset += float(np.sum(amounts))
+            self.wraps += int(np.count_nonzero(amounts))
+            self.wrapped_at = float(amounts[np.flatnonzero(amounts)[-1]])
         return t
 
 
-COUNTER_WRAP = 2.0 ** 32
-"""A microcontroller's time counter (millis(), micros()) is 32 bits: micros() starts again
-every 71.6 minutes."""
+COUNTER_BITS = (16, 32)
+"""The widths of a microcontroller's time counter: 32 bits (Arduino's millis() and micros():
+micros() starts again every 71.6 minutes) or 16 (a timer's ms count, again every 65.5 s). A
+counter's value is below 2^bits, so a fall by 2^16 from below it is no 32-bit counter's."""
+COUNTER_WRAP = 2.0 ** max(COUNTER_BITS)
+"""The largest counter's modulus: a time of integers below it may be a counter."""
 COUNTER_SCALES = (TIME_SCALE["ms"], TIME_SCALE["us"])
 """The units such a counter counts in (a factor to seconds each)."""
 WRAP_STEPS = 10.0
 """A fall of the time by the counter's modulus less at most this many periods is a wrap."""
 
 
-def wraps(steps: np.ndarray, modulus: float, period: float) -> np.ndarray:
-    """Which steps of a time are its counter starting again: a fall that the modulus turns
-    into a step of at most WRAP_STEPS periods."""
-    up = steps + modulus
-    return (steps < 0.0) & (up > 0.0) & (up <= WRAP_STEPS * period)
+def wrap_amounts(before: np.ndarray, steps: np.ndarray, moduli: tuple[float, ...],
+                 period: float) -> np.ndarray:
+    """Of each step of a time (from the values `before`), the modulus by which its counter
+    started again there (0: none): a fall from below the modulus that the modulus turns into
+    a step of at most WRAP_STEPS periods, the smallest such modulus."""
+    out = np.zeros(len(steps))
+    for modulus in sorted(moduli):
+        up = steps + modulus
+        out[(out == 0.0) & (steps < 0.0) & (before < modulus) & (up > 0.0)
+            & (up <= WRAP_STEPS * period)] = modulus
+    return out
+
+
+def counter_moduli(scale: float) -> tuple[float, ...]:
+    """The moduli [s] of a counter of each of COUNTER_BITS counting in units of `scale` s."""
+    return tuple(2.0 ** bits * scale for bits in COUNTER_BITS)
 
 
 @dataclass
@@ -542,7 +559,7 @@ class RecordingSource:
         twice = self.read_notes.get("twice", 0)
         missing -= twice  # said on their own
         what = ("the time of day passed midnight" if self.time_unit == TIME_OF_DAY
-                else "the time's 32-bit counter started again")
+                else f"the time's {self.read_notes.get('bits', 32)}-bit counter started again")
         return (f"{n} samples, {duration:.4g} s at {self.rate:.4g} Hz"
                 + (f"; {self.choices}" if choices else "")
                 + (f"; {missing} sample(s) without a number in every column, which the "
@@ -776,6 +793,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                             gyro_unit=found_unit.unit, gyro_unit_checked=found_unit.checked)
             rec.ref_quat = ref_quat
             read_notes["wraps"], read_notes["twice"] = run_clock.wraps, run_clock.twice
+            if run_clock.wrapped_at:
+                read_notes["bits"] = round(np.log2(run_clock.wrapped_at / run_clock.scale))
             yield rec, t
 
     return RecordingSource(path, name, 1.0 / period, choices, table.rows, blocks, t_unit,
@@ -851,16 +870,17 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         step = median_step(values)
         counter = bool(np.all((values == np.round(values)) & (values >= 0.0)
                               & (values < COUNTER_WRAP)))
-        increasing = bool(np.all((steps > 0.0) | (counter & wraps(steps, COUNTER_WRAP, step))
-                                 | (day & wraps(steps, DAY_S, step))))
+        moduli = (DAY_S,) if day else tuple(2.0 ** b for b in COUNTER_BITS) if counter else ()
+        increasing = bool(np.all((steps > 0.0)
+                                 | (wrap_amounts(values[:-1], steps, moduli, step) > 0.0)))
         zeros, span = int(np.sum(steps == 0.0)), (len(values) - 1, float(values[-1] - values[0]))
     else:
         step, increasing, counter = median_period(raw[1:]), True, False
 
     def clock_in(scale: float) -> _Clock:
         first = step * scale if increasing else float("nan")
-        wrap = (DAY_S if day else COUNTER_WRAP * scale if counter and scale in COUNTER_SCALES
-                else 0.0)
+        moduli = ((DAY_S,) if day else counter_moduli(scale)
+                  if counter and scale in COUNTER_SCALES else ())
         repeats = ""
         if zeros and span[1] > 0.0:
             mean_rate = span[0] / (span[1] * scale)
@@ -869,7 +889,7 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
                        "coarser than the samples' spacing, which is "
                        f"{mean_rate:.4g} Hz on average; give --rate {mean_rate:.4g} to space "
                        "the samples by a rate, the time left)")
-        return _Clock(kind, scale, first, path, where, wrap=wrap, repeats=repeats)
+        return _Clock(kind, scale, first, path, where, moduli=moduli, repeats=repeats)
 
     # the unit from the mean step where the time repeats: a clock coarser than the samples
     # rises by its tick, not by their spacing (whole epoch seconds at 100 Hz)
