@@ -54,12 +54,14 @@ def test_time_stamps_in_ms_us_or_ns_without_a_unit_are_read_as_such(tmp_path, un
 
 
 def test_a_dt_column_and_a_name_may_carry_the_unit(tmp_path):
-    """dt in ms without a unit is found as the time is; time_ms states its unit by name."""
+    """dt in ms without a unit is found as the time is; time_ms states its unit by name, as
+    t_ms does (it was no time column: "no time or dt column: give the sample rate ...")."""
     t, imu = _example()
     source, _, _ = _read(_write(tmp_path / "dt.csv", "dt", np.full(len(t), 10.0), imu))
     assert source.rate == pytest.approx(100.0) and "dt in ms" in source.choices
-    source, _, _ = _read(_write(tmp_path / "named.csv", "time_ms", t * 1e3, imu))
-    assert source.time_unit == "ms" and "time in ms (from the header)" in source.choices
+    for name in ("time_ms", "t_ms"):
+        source, _, _ = _read(_write(tmp_path / f"{name}.csv", name, t * 1e3, imu))
+        assert source.time_unit == "ms" and "time in ms (from the header)" in source.choices
 
 
 def test_where_two_units_give_imu_rates_the_data_decide(tmp_path):

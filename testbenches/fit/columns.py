@@ -33,7 +33,7 @@ ALIASES: dict[str, tuple[str, ...]] = {
              "timestamp_unix", "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
              "seconds_elapsed", "time_since_start", "time_since_start_in_ms",
              "gyro_timestamp_since_reboot", "accelerometer_timestamp_since_reboot", "x_value",
-             "receive_time", "t"),
+             "t_s", "t_ms", "t_us", "t_ns", "receive_time", "t"),
     **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}",
                   f"q_rs_{c}", f"transform_rotation_{c}", f"pose_orientation_{c}",
                   f"pose_pose_orientation_{c}") for c in "wxyz"},
