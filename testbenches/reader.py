@@ -349,36 +349,17 @@ and pyarrow's reader take it (classic Mac OS text ends every line so, a serial l
 sketch that prints "\\n\\r" ends each line with an empty one)."""
 
 
-class _CrLines(io.RawIOBase):
+class _CrLines(_Lines):
     """A stream's bytes with each lone carriage return (LONE_CR) a line feed, as many bytes: a
     file's lines as every reader here counts them, by their line feeds, at the same byte
     offsets (_TextLayout.lone_cr). A carriage return that ends a read is held until the next
     byte shows whether a line feed follows it."""
 
-    def __init__(self, inner: Any) -> None:
-        self._inner = inner
-        self._out = memoryview(b"")
-        self._held = b""
-        self._done = False
+    def _cut(self, data: bytes) -> int:
+        return len(data) - 1 if data.endswith(b"\r") else len(data)
 
-    def readable(self) -> bool:
-        return True
-
-    def readinto(self, buffer: Any) -> int:
-        while not self._out and not self._done:
-            chunk = self._inner.read(SALVAGE_CHUNK)
-            data = self._held + chunk
-            self._done = not chunk
-            self._held = b"\r" if chunk and data.endswith(b"\r") else b""
-            self._out = memoryview(LONE_CR.sub(b"\n", data[:len(data) - len(self._held)]))
-        n = min(len(buffer), len(self._out))
-        memoryview(buffer).cast("B")[:n] = self._out[:n]
-        self._out = self._out[n:]
-        return n
-
-    def close(self) -> None:
-        self._inner.close()
-        super().close()
+    def _lines(self, whole: bytes) -> bytes:
+        return LONE_CR.sub(b"\n", whole)
 
 
 # ----- delimited text --------------------------------------------------------------------------
