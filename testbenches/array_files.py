@@ -13,8 +13,8 @@ Every numeric array whose samples run along its longest axis is one column or se
 - a column of dates and times (pandas' datetime64) is seconds since 1970, as the text
   reader's.
 
-Arrays in groups (HDF5) and in structs (MATLAB, also in a struct array's elements) are found
-at any depth, each named by its own name, or by its path ("imu0/acc_x") where another column
+Arrays in groups (HDF5) and in structs (MATLAB, also in a struct array's elements; a struct
+array of a sample an element, log(i).acc, as a struct of arrays) are found at any depth, each named by its own name, or by its path ("imu0/acc_x") where another column
 has that name. N is the length of the arrays that hold what is read (a recording's IMU, a
 reference's pose: WANTED), else the length the most arrays share, the longest of those that
 tie; arrays of other lengths are left out, and said. So one file may hold an IMU and a motion
@@ -306,6 +306,38 @@ def _opaque_class(value: Any) -> str:
     return "object"
 
 
+SAMPLE_WIDTH = 16
+"""The most numbers a struct array's element holds in a field for the field to be one sample
+(a time, a vector of three, a quaternion; _struct_samples)."""
+
+
+def _struct_samples(items: list[Any]) -> dict[str, np.ndarray] | None:
+    """A MATLAB struct array of a sample an element (log(i).time, log(i).acc, as a loop that
+    logs sample by sample builds it) as a struct of arrays, an element a row (MATLAB's
+    [log.time]' and vertcat(log.acc)): every field of numbers of at most SAMPLE_WIDTH of them
+    and of one shape in every element, its other fields (text) left out. None for any other
+    list: a cell array, a struct array of whole recordings (a trial an element), elements of
+    other fields or shapes."""
+    if len(items) < 2 or not all(isinstance(x, dict) for x in items):
+        return None
+    names = list(items[0])
+    if any(list(x) != names for x in items):
+        return None
+    out = {}
+    for name in names:
+        values = [np.asarray(x[name]) for x in items]
+        kinds = {v.dtype.kind for v in values}
+        if not kinds <= set("iuf"):
+            continue  # text, a nested struct: no sample
+        shape = values[0].shape
+        if values[0].size > SAMPLE_WIDTH or any(v.shape != shape for v in values):
+            return None
+        out[name] = np.stack([v.reshape(-1) for v in values])
+        if values[0].size == 1:
+            out[name] = out[name].reshape(-1)
+    return out or None
+
+
 def _mat_found(data: dict[str, Any]) -> _Found:
     from scipy.io.matlab import MatlabFunction, MatlabOpaque
 
@@ -319,6 +351,10 @@ def _mat_found(data: dict[str, Any]) -> _Found:
                 if not name.startswith("__"):
                     visit(item, (*path, name))
         elif isinstance(value, list):  # a struct array's elements, a cell array's cells
+            samples = _struct_samples(value)
+            if samples is not None:  # a sample an element (log(i).acc = ...)
+                visit(samples, path)
+                return
             for i, item in enumerate(value):
                 if isinstance(item, dict):
                     visit(item, (*path, str(i + 1)))

@@ -89,6 +89,29 @@ def test_arrays_in_groups_and_structs_at_any_depth(tmp_path):
     _same_as_csv(cells)
 
 
+def test_a_struct_array_of_a_sample_an_element(tmp_path):
+    """A loop that logs sample by sample builds a 1xN struct array (log(i).time, log(i).acc):
+    it was 1000 structs of 3 values each ("no column for acc_x ...: the header has log/1/acc,
+    log/1/gyro, log/2/acc, ..."); each field is a column of N rows, as [log.time]' is in
+    MATLAB, its text fields left out. A struct array of whole recordings (a trial an element)
+    is still each element's own arrays (here the longer trial's, the other's left out by
+    their length)."""
+    ex = _example()
+    samples = np.zeros((1, len(ex)), dtype=[("time", object), ("acc", object),
+                                            ("gyro", object), ("note", object)])
+    for i, row in enumerate(ex):
+        samples[0, i] = (row[0], row[1:4], row[4:7], "ok")
+    path = tmp_path / "samples.mat"
+    scipy_io.savemat(path, {"log": samples})
+    _same_as_csv(path)
+    trials = np.zeros((1, 2), dtype=[("time", object), ("acc", object), ("gyro", object)])
+    trials[0, 0] = (ex[:, :1], ex[:, 1:4], ex[:, 4:7])
+    trials[0, 1] = (ex[:500, :1], ex[:500, 1:4], ex[:500, 4:7])
+    two = tmp_path / "trials.mat"
+    scipy_io.savemat(two, {"trials": trials})
+    _same_as_csv(two)
+
+
 def test_a_compound_dataset_and_a_matrix_whose_columns_are_named(tmp_path):
     ex = _example()
     compound = tmp_path / "compound.h5"
