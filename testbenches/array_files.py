@@ -15,10 +15,11 @@ Every numeric array whose samples run along its longest axis is one column or se
 
 Arrays in groups (HDF5) and in structs (MATLAB, also in a struct array's elements; a struct
 array of a sample an element, log(i).acc, as a struct of arrays) are found at any depth, each
-named by its own name, or by its path ("imu0/acc_x") where another column has that name. N is the length of the arrays that hold what is read (a recording's IMU, a
-reference's pose: WANTED), else the length the most arrays share, the longest of those that
-tie; arrays of other lengths are left out, and said. So one file may hold an IMU and a motion
-capture at their own rates, read as the recording and as its reference.
+named by its own name, or by its path ("imu0/acc_x") where another column has that name. N is
+the length of the arrays that hold what is read (a recording's IMU, a reference's pose: WANTED),
+else the length the most arrays share, the longest of those that tie; arrays of other lengths
+are left out, and said. So one file may hold an IMU and a motion capture at their own rates,
+read as the recording and as its reference.
 Text, cell arrays, references, empty arrays and the groups MATLAB and pandas keep for
 themselves (#refs#, #subsystem#, an index's _i_table) hold no samples. A MATLAB table,
 timetable or other class object is stored so that only MATLAB reads it: where it is all a file
