@@ -801,7 +801,7 @@ def _has_lone_cr(path: Path) -> bool:
         while chunk := f.read(1 << 22):
             data = held + chunk
             held = b"\r" if data.endswith(b"\r") else b""
-            if LONE_CR.search(data, 0, len(data) - len(held)):
+            if b"\r" in data and LONE_CR.search(data, 0, len(data) - len(held)):
                 return True
     return bool(held)
 
