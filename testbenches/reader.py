@@ -519,6 +519,11 @@ def _sniff(path: Path) -> _TextLayout:
     cut: list[str] = []
     with _open_bytes(path, cut) as f:
         raw = f.read(SNIFF_BYTES)
+    # a line end of a carriage return alone (not in UTF-16, whose bytes pair): a compressed
+    # stream is not read twice to look
+    lone_cr = _utf16(raw) is None and (_compression(path) is not None or _has_lone_cr(path))
+    if lone_cr:
+        raw = LONE_CR.sub(b"\n", raw)
     encoding = "utf-8"
     try:
         if (wide := _utf16(raw)) is not None:
@@ -530,11 +535,6 @@ def _sniff(path: Path) -> _TextLayout:
             text = raw[:err.start].decode("utf-8-sig")  # a character cut at the end
         else:
             encoding, text = "latin-1", raw.decode("latin-1")
-    # a line end of a carriage return alone (not in UTF-16, whose bytes pair): a compressed
-    # stream is not read twice to look
-    lone_cr = _utf16(raw) is None and (_compression(path) is not None or _has_lone_cr(path))
-    if lone_cr:
-        raw = LONE_CR.sub(b"\n", raw)
     if len(raw) == SNIFF_BYTES:  # the last line may be cut
         text = text[:text.rfind("\n") + 1] or text
     lines = text.splitlines()
