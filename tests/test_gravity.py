@@ -57,6 +57,26 @@ def test_a_linear_acceleration_read_as_g_is_refused_though_the_gyro_unit_is_give
     assert open_recording(fine, gyro_unit="rad/s").rate == pytest.approx(100.0)
 
 
+def test_the_two_sensors_columns_swapped_are_refused_asking_so(tmp_path):
+    """The accelerometer's columns named gyro and the gyro's acc: refused as a gyro unit no
+    data explain or the data contradict, or as an accelerometer without gravity ("a phone's
+    linear acceleration"), none naming the mistake; each refusal now asks whether the columns
+    are swapped. A refusal for another reason (gravity taken out) does not ask."""
+    t, _, s = battery.part_samples("handheld_slow", "mpu6050", 0)
+    path = _write(tmp_path / "swapped.csv", t, s["gyro"], s["acc"])
+    asked = r"gravity's in m/s2, whose mean vector keeps .*: are the accelerometer's and the " \
+            r"gyro's columns swapped\? Map them with --column acc=NAME --column gyro=NAME"
+    with pytest.raises(RecordingError, match=asked):
+        open_recording(path)
+    with pytest.raises(RecordingError, match=r"contradicts the data.*" + asked):
+        open_recording(path, gyro_unit="rad/s")
+    t, truth, s = battery.part_samples("handheld_fast", "mpu6050", 0)
+    linear = _write(tmp_path / "linear.csv", t, s["acc"] - _gravity(truth), s["gyro"])
+    with pytest.raises(RecordingError, match="holds no gravity") as err:
+        open_recording(linear, gyro_unit="rad/s")
+    assert "swapped" not in str(err.value)
+
+
 def test_a_gyro_whose_axes_are_swapped_is_refused_though_its_unit_is_given(tmp_path):
     """Its turn explains the accelerometer's only with x and y swapped: refused saying so
     (before gravity is looked for), and read with --gyro-axes y,x,z as the part's samples."""

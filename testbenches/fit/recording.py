@@ -760,7 +760,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         gyro_how += ("; its axes as the accelerometer's "
                      f"{', '.join(c.strip() for c in gyro_axes.split(','))} (given)")
     _holds_gravity(path, acc[finite] * acc_scale, gyro[finite] * gyro_scale, dt[finite],
-                   f"acc in {acc_how}; gyro in {gyro_how}")
+                   f"acc in {acc_how}; gyro in {gyro_how}", (acc[finite], gyro[finite]))
     period = median_period(dt)
     if n == PREFIX_ROWS:  # the file may go on
         acc_how += f" over the first {n} samples"
@@ -1235,13 +1235,13 @@ def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, un
             raise RecordingError(
                 f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
                 f"{evidence.describe()}, so it reads in {evidence.unit}; give --gyro-unit "
-                f"{evidence.unit}, or check the columns")
+                f"{evidence.unit}, or check the columns{_swapped(acc, gyro)}")
         return _GyroUnit(chosen, f"{chosen} ({how}" + (
             ", and the data agree)" if evidence.unit else ")"), used, evidence.unit is not None)
     if evidence.unit is None:
         raise RecordingError(
             f"{path}: the gyro's unit cannot be told from the data ({evidence.undecided()}): "
-            f"give --gyro-unit {listed(list(UNITS))}")
+            f"give --gyro-unit {listed(list(UNITS))}{_swapped(acc, gyro)}")
     return _GyroUnit(evidence.unit, f"{evidence.unit} (from the data: {evidence.describe()})",
                      used, True)
 
@@ -1264,10 +1264,42 @@ def _axes_as_read(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
         f"--gyro-axes {order.replace(' ', '')}")
 
 
+SWAP_KEPT = 1.0 / 3.0
+"""The share of its mean norm that an accelerometer's mean vector keeps (gravity keeps its
+direction but where the sensor tumbles: 0.35 shaking to 1.0 in the battery's motions), and a
+gyro's never approaches (its turns go back and forth: at most 0.07 there)."""
+
+
+def _kept(v: np.ndarray) -> float:
+    """The norm of a vector's mean over its mean norm (0 for no finite sample)."""
+    v = v[np.all(np.isfinite(v), axis=1)]
+    norm = float(np.mean(np.linalg.norm(v, axis=1))) if len(v) else 0.0
+    return float(np.linalg.norm(v.mean(axis=0))) / norm if norm > 0.0 else 0.0
+
+
+def _swapped(acc: np.ndarray, gyro: np.ndarray) -> str:
+    """Where the gyro's columns, as read, hold what an accelerometer's would and the
+    accelerometer's what a gyro's would (a norm of gravity's in one of ACC_NORMS' units and a
+    mean vector of at least SWAP_KEPT of it; the accelerometer's columns' mean vector less:
+    a gyro's large turn-on bias keeps a direction too, but then the accelerometer's columns
+    keep gravity's), the question whether the two sensors' columns are swapped, for a
+    refusal; else ""."""
+    norm = float(np.nanmedian(np.linalg.norm(gyro, axis=1))) if len(gyro) else 0.0
+    kept = _kept(gyro)
+    unit = next((u for u, (lo, hi) in ACC_NORMS.items() if lo < norm < hi), None)
+    if unit is None or kept < SWAP_KEPT or _kept(acc) >= SWAP_KEPT:
+        return ""
+    return (f". The gyro's columns read as an accelerometer's would (a median norm of "
+            f"{norm:.4g}, gravity's in {unit}, whose mean vector keeps {kept:.0%} of it): are "
+            "the accelerometer's and the gyro's columns swapped? Map them with --column "
+            "acc=NAME --column gyro=NAME")
+
+
 def _holds_gravity(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
-                   units: str) -> None:
+                   units: str, read: tuple[np.ndarray, np.ndarray] | None = None) -> None:
     """RecordingError where the accelerometer, in SI units with the gyro's, holds no gravity
-    (testbenches.gravity): a phone's linear acceleration, or units or axes taken wrongly."""
+    (testbenches.gravity): a phone's linear acceleration, or units or axes taken wrongly, or the
+    two sensors' columns swapped (read: acc and gyro as read, _swapped)."""
     from ..gravity import WINDOW_S, held_gravity
 
     found = held_gravity(acc, gyro, dt)
@@ -1280,7 +1312,7 @@ def _holds_gravity(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
         "acceleration, from which gravity was taken out: give the accelerometer's own (total) "
         "acceleration (Android's TYPE_ACCELEROMETER, Sensor Logger's TotalAcceleration, "
         f"phyphox's acceleration with g); or the units ({units}) or the axes are not what they "
-        "are taken for")
+        "are taken for" + ("" if read is None else _swapped(*read)))
 
 
 QUAT_NORM_TOLERANCE = 0.1
