@@ -384,3 +384,26 @@ def test_a_spreadsheets_dates_saved_as_numbers_are_named_in_the_refusal(tmp_path
                        r"times saved as numbers \(days since 1899-12-30\)\? Format the column "
                        r"as a date and time"):
         open_recording(path)
+
+
+def test_gaps_in_the_time_are_said(tmp_path):
+    """Samples a logger dropped or a pause leave a step of several periods: the estimators
+    integrate the next sample over it, or reject it past their max_dt, and the read said
+    neither. It says how many, the longest and where, in blocks as whole; a clock's jitter is
+    no gap."""
+    t, imu = _example()
+    t = t.copy()
+    t[300:] += 0.04  # four samples' time dropped before line 302
+    t[700:] += 300.0  # a pause of five minutes before line 702
+    source = open_recording(_write(tmp_path / "gaps.csv", "time", t, imu), gyro_unit="rad/s")
+    rec, _ = source.load()
+    assert ("2 gap(s) in the time of 2.5 sample periods or more (samples dropped, a pause; the "
+            "longest 300 s, before the sample on line 702): the estimators integrate the sample "
+            "after a gap over it, or reject it where the gap exceeds their max_dt (1 s)"
+            in rec.described)
+    list(source.blocks(rows=64))
+    assert source.summary(0, 0.0, 0).endswith(rec.described[rec.described.index("; 2 gap"):])
+    jitter = np.random.default_rng(0).uniform(-0.004, 0.004, len(t))
+    plain, _ = open_recording(_write(tmp_path / "jitter.csv", "time", _example()[0] + jitter,
+                                     imu), gyro_unit="rad/s").load()
+    assert "gap" not in plain.described

@@ -20,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from fusion_core.base import COMMON_PARAMS
+
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
 from ..gyro_unit import UNITS, median_period
@@ -367,6 +369,11 @@ class _Clock:
     """The modulus [s] of the last wrap (which width the counter has: COUNTER_BITS)."""
     twice: int = 0
     """Rows that repeat the row before them, time and numbers (_without_twice)."""
+    gaps: int = 0
+    """Samples whose dt spans GAP_PERIODS sample periods or more (samples a logger dropped, a
+    pause), the longest such dt [s] and where its sample is."""
+    longest_gap: float = 0.0
+    gap_at: str = ""
     last_values: Any = None
     """The last row's numbers (for the next block's first row)."""
     repeats: str = ""
@@ -391,8 +398,19 @@ class _Clock:
                 dt[0] = self.first_dt
             t = self.total + np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - self.first_dt
             self.total = float(t[-1] + self.first_dt)
-            return self._carried(dt, holds), t
-        return self._from_time(raw * self.scale, row0, holds)
+            return self._gaps_counted(self._carried(dt, holds), row0), t
+        dt, t = self._from_time(raw * self.scale, row0, holds)
+        return self._gaps_counted(dt, row0), t
+
+    def _gaps_counted(self, dt: np.ndarray, row0: int) -> np.ndarray:
+        """dt, its samples that span a gap (GAP_PERIODS periods or more) counted."""
+        over = np.flatnonzero(dt >= GAP_PERIODS * self.first_dt)  # NaN: no sample
+        if len(over):
+            self.gaps += len(over)
+            k = int(over[np.argmax(dt[over])])
+            if dt[k] > self.longest_gap:
+                self.longest_gap, self.gap_at = float(dt[k]), self.where(row0 + k)
+        return dt
 
     def _rows_since(self, rows: np.ndarray) -> np.ndarray:
         """Of each sample's row, the rows since the last sample's (1 for the very first)."""
@@ -483,6 +501,11 @@ class _Clock:
         return t
 
 
+MAX_DT = next(p.default for p in COMMON_PARAMS if p.name == "max_dt")
+"""The estimators' default max_dt [s]: a longer gap is a sample they reject."""
+GAP_PERIODS = 2.5
+"""A sample whose dt is this many sample periods or more follows a gap: a sample or more
+dropped (a phone's scheduling stretches a step by half a period at times, never so far)."""
 COUNTER_BITS = (16, 32)
 """The widths of a microcontroller's time counter: 32 bits (Arduino's millis() and micros():
 micros() starts again every 71.6 minutes) or 16 (a timer's ms count, again every 65.5 s). A
@@ -528,7 +551,7 @@ class RecordingSource:
     _blocks: Any
     time_unit: str = "s"
     """The unit of the file's time column (s where the times come from a rate or the format)."""
-    read_notes: dict[str, int] = field(default_factory=dict)
+    read_notes: dict[str, Any] = field(default_factory=dict)
     """What the last read found ("wraps": how often the time's counter started again)."""
     found: list[str] = field(default_factory=list)
     """What reading found left out (the table's: TableSource.found)."""
@@ -569,7 +592,21 @@ class RecordingSource:
                 + (f"; {twice} row(s) repeat the row before them, time and numbers (a logger "
                    "wrote them twice): rejected and counted, as samples without a time"
                    if twice else "")
+                + self._gaps_said()
                 + "".join(f"; {said}" for said in dict.fromkeys(self.found)))
+
+
+    def _gaps_said(self) -> str:
+        """The gaps in the time the last read found (_Clock.gaps), for the summary."""
+        gaps = self.read_notes.get("gaps", 0)
+        if not gaps:
+            return ""
+        longest, at = self.read_notes["longest_gap"], self.read_notes["gap_at"]
+        return (f"; {gaps} gap(s) in the time of {GAP_PERIODS:g} sample periods or more (samples "
+                f"dropped, a pause; the longest {longest:.4g} s, before the sample on {at}): the "
+                "estimators integrate the sample after a gap over it" + (
+                    f", or reject it where the gap exceeds their max_dt ({MAX_DT:g} s)"
+                    if longest > MAX_DT else ""))
 
 
 def concatenate(parts: list[Recording]) -> Recording:
@@ -776,7 +813,7 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                + ("" if table.kind == "text" else f"; read as {table.kind}"))
     name = path.stem
 
-    read_notes: dict[str, int] = {}
+    read_notes: dict[str, Any] = {}
 
     def blocks(rows: int) -> Iterator[tuple[Recording, np.ndarray]]:
         run_clock = replace(clock)
@@ -793,6 +830,9 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                             gyro_unit=found_unit.unit, gyro_unit_checked=found_unit.checked)
             rec.ref_quat = ref_quat
             read_notes["wraps"], read_notes["twice"] = run_clock.wraps, run_clock.twice
+            read_notes["gaps"] = run_clock.gaps
+            read_notes["longest_gap"], read_notes["gap_at"] = (run_clock.longest_gap,
+                                                               run_clock.gap_at)
             if run_clock.wrapped_at:
                 read_notes["bits"] = round(np.log2(run_clock.wrapped_at / run_clock.scale))
             yield rec, t
