@@ -910,7 +910,7 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         step = median_step(values)
         counter = bool(np.all((values == np.round(values)) & (values >= 0.0)
                               & (values < COUNTER_WRAP)))
-        moduli = (DAY_S,) if day else tuple(2.0 ** b for b in COUNTER_BITS) if counter else ()
+        moduli = (DAY_S,) if day else counter_moduli(1.0) if counter else ()
         increasing = bool(np.all((steps > 0.0)
                                  | (wrap_amounts(values[:-1], steps, moduli, step) > 0.0)))
         zeros, span = int(np.sum(steps == 0.0)), (len(values) - 1, float(values[-1] - values[0]))
