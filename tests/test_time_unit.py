@@ -389,8 +389,8 @@ def test_a_spreadsheets_dates_saved_as_numbers_are_named_in_the_refusal(tmp_path
 def test_gaps_in_the_time_are_said(tmp_path):
     """Samples a logger dropped or a pause leave a step of several periods: the estimators
     integrate the next sample over it, or reject it past their max_dt, and the read said
-    neither. It says how many, the longest and where, in blocks as whole; a clock's jitter is
-    no gap."""
+    neither. It says how many, the longest and where, in blocks as whole; a clock's jitter,
+    rows without numbers and rows without a time are no gap."""
     t, imu = _example()
     t = t.copy()
     t[300:] += 0.04  # four samples' time dropped before line 302
@@ -403,7 +403,10 @@ def test_gaps_in_the_time_are_said(tmp_path):
             in rec.described)
     list(source.blocks(rows=64))
     assert source.summary(0, 0.0, 0).endswith(rec.described[rec.described.index("; 2 gap"):])
-    jitter = np.random.default_rng(0).uniform(-0.004, 0.004, len(t))
-    plain, _ = open_recording(_write(tmp_path / "jitter.csv", "time", _example()[0] + jitter,
-                                     imu), gyro_unit="rad/s").load()
-    assert "gap" not in plain.described
+    t = _example()[0] + np.random.default_rng(0).uniform(-0.004, 0.004, len(t))
+    holes = imu.copy()
+    holes[400:403, 0] = np.nan  # three rows without numbers: samples said on their own, as
+    t[500:502] = np.nan  # are two rows without a time
+    plain, _ = open_recording(_write(tmp_path / "jitter.csv", "time", t, holes),
+                              gyro_unit="rad/s").load()
+    assert "gap" not in plain.described and "5 sample(s) without a number" in plain.described

@@ -398,19 +398,21 @@ class _Clock:
                 dt[0] = self.first_dt
             t = self.total + np.cumsum(np.where(np.isfinite(dt), dt, 0.0)) - self.first_dt
             self.total = float(t[-1] + self.first_dt)
-            return self._gaps_counted(self._carried(dt, holds), row0), t
-        dt, t = self._from_time(raw * self.scale, row0, holds)
-        return self._gaps_counted(dt, row0), t
+            self._count_gaps(dt, row0 + np.arange(n), np.ones(n))
+            return self._carried(dt, holds), t
+        return self._from_time(raw * self.scale, row0, holds)
 
-    def _gaps_counted(self, dt: np.ndarray, row0: int) -> np.ndarray:
-        """dt, its samples that span a gap (GAP_PERIODS periods or more) counted."""
-        over = np.flatnonzero(dt >= GAP_PERIODS * self.first_dt)  # NaN: no sample
+    def _count_gaps(self, steps: np.ndarray, rows: np.ndarray, spans: np.ndarray) -> None:
+        """Counts the steps of the time (a time column's from row to row, a dt column's own)
+        over `spans` rows each, before the row in `rows`, that are GAP_PERIODS periods or more
+        beyond a period a row: a gap in the time, not rows without numbers (their samples
+        are said on their own) or without a time."""
+        over = np.flatnonzero(steps >= (spans - 1.0 + GAP_PERIODS) * self.first_dt)
         if len(over):
             self.gaps += len(over)
-            k = int(over[np.argmax(dt[over])])
-            if dt[k] > self.longest_gap:
-                self.longest_gap, self.gap_at = float(dt[k]), self.where(row0 + k)
-        return dt
+            k = int(over[np.argmax(steps[over])])
+            if steps[k] > self.longest_gap:
+                self.longest_gap, self.gap_at = float(steps[k]), self.where(int(rows[k]))
 
     def _rows_since(self, rows: np.ndarray) -> np.ndarray:
         """Of each sample's row, the rows since the last sample's (1 for the very first)."""
@@ -451,6 +453,7 @@ class _Clock:
         else:
             times_all, rows_all = times, rows
         steps = np.diff(times_all)
+        self._count_gaps(steps, rows_all[1:], np.diff(rows_all))
         if not np.all(steps > 0.0):
             i = int(np.argmax(~(steps > 0.0)))
             same = steps[i] == 0.0
