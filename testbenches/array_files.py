@@ -14,12 +14,12 @@ Every numeric array whose samples run along its longest axis is one column or se
   reader's.
 
 Arrays in groups (HDF5) and in structs (MATLAB, also in a struct array's elements; a struct
-array of a sample an element, log(i).acc, as a struct of arrays) are found at any depth, each
-named by its own name, or by its path ("imu0/acc_x") where another column has that name. N is
-the length of the arrays that hold what is read (a recording's IMU, a reference's pose: WANTED),
-else the length the most arrays share, the longest of those that tie; arrays of other lengths
-are left out, and said. So one file may hold an IMU and a motion capture at their own rates,
-read as the recording and as its reference.
+array of a sample an element, log(i).acc, v5 or v7.3, as a struct of arrays) are found at any
+depth, each named by its own name, or by its path ("imu0/acc_x") where another column has that
+name. N is the length of the arrays that hold what is read (a recording's IMU, a reference's
+pose: WANTED), else the length the most arrays share, the longest of those that tie; arrays of
+other lengths are left out, and said. So one file may hold an IMU and a motion capture at their
+own rates, read as the recording and as its reference.
 Text, cell arrays, references, empty arrays and the groups MATLAB and pandas keep for
 themselves (#refs#, #subsystem#, an index's _i_table) hold no samples. A MATLAB table,
 timetable or other class object is stored so that only MATLAB reads it: where it is all a file
@@ -57,11 +57,16 @@ MATLAB_NUMBERS = frozenset({"double", "single", "int8", "uint8", "int16", "uint1
 """MATLAB classes of arrays of numbers (not MATLAB_NO_SAMPLES' or a class object)."""
 MATLAB_NO_SAMPLES = ("char", "logical", "cell")
 """MATLAB classes of arrays that hold no samples: text, truth values, cells (references)."""
+STRUCT_ARRAY = "struct array"
+"""What a MATLAB v7.3 struct array not read as samples (_struct_array) is called in a refusal:
+its elements are references this reader follows only where each holds a sample."""
 MATLAB_HINT = {
     "table": "writetable({var}, 'FILE.csv') saves it as CSV, or s = table2struct({var}, "
              "'ToScalar', true); save('FILE.mat', '-struct', 's') as arrays",
     "timetable": "writetimetable({var}, 'FILE.csv') saves it as CSV (its row times as "
                  "durations or dates, which this reader takes)",
+    STRUCT_ARRAY: "save('FILE.mat', '{var}', '-v7') keeps its elements where this reader "
+                  "reads them (or save each field's samples as one array)",
 }
 """How to save a MATLAB class object's columns as arrays, per class; any other class is asked
 for as arrays of numbers."""
@@ -249,8 +254,13 @@ def _hdf5_found(f: Any) -> _Found:
             where = (*path, name)
             matlab = _attr(item.attrs, "MATLAB_class")
             if isinstance(item, h5py.Group):
+                samples = _struct_array(item) if matlab == "struct" else None
                 if matlab not in (None, "struct"):
                     objects.append(("/".join(where), matlab))
+                elif samples is not None:  # a sample an element (log(i).acc = ...)
+                    arrays.extend(_in_memory((*where, k), a) for k, a in samples.items())
+                elif samples is None and matlab == "struct" and _references(item):
+                    objects.append(("/".join(where), STRUCT_ARRAY))
                 else:
                     visit(item, where)
                 continue
@@ -280,6 +290,52 @@ def _hdf5_found(f: Any) -> _Found:
 
     visit(f, ())
     return _Found(arrays, objects, scalars)
+
+
+def _references(group: Any) -> bool:
+    """Whether every field of a MATLAB struct (an HDF5 group) is a dataset of two or more
+    references: a v7.3 struct array's elements."""
+    import h5py
+
+    fields = list(group.values())
+    return bool(fields) and all(isinstance(ds, h5py.Dataset) and ds.size >= 2
+                                and h5py.check_dtype(ref=ds.dtype) is h5py.Reference
+                                for ds in fields)
+
+
+def _struct_array(group: Any) -> dict[str, np.ndarray] | None:
+    """A MATLAB v7.3 struct array of a sample an element as a struct of arrays, as
+    _struct_samples makes a v5 one: MATLAB stores a struct array as a group whose every field
+    is a dataset of references, an element each (a scalar struct's fields are the arrays
+    themselves). None for any other group, or where an element's field is longer than a sample
+    or of another shape than the first element's. A field's class is its first element's (a
+    field of text is left out); each element is read by HDF5's own calls, a few times faster
+    than h5py's objects, which matters at a reference a number (still some thousands of
+    samples a second: a struct of arrays, or -v7, reads at once)."""
+    import h5py
+
+    fields = dict(group.items())
+    if not _references(group) or any(ds.size != next(iter(fields.values())).size
+                                     for ds in fields.values()):
+        return None
+    refs = {name: np.asarray(ds[()]).reshape(-1) for name, ds in fields.items()}
+    out = {}
+    for name, r in refs.items():
+        first = group.file[r[0]]
+        if not (isinstance(first, h5py.Dataset) and "MATLAB_empty" not in first.attrs
+                and _attr(first.attrs, "MATLAB_class") in MATLAB_NUMBERS):
+            continue  # text, a struct: no sample
+        shape = first.shape
+        if first.size > SAMPLE_WIDTH:
+            return None  # a trial an element, not a sample
+        values = np.empty((len(r), *shape))
+        for i, ref in enumerate(r):
+            element = h5py.h5r.dereference(ref, group.file.id)
+            if not isinstance(element, h5py.h5d.DatasetID) or element.shape != shape:
+                return None  # (read into a buffer of another shape, HDF5 writes past it)
+            element.read(h5py.h5s.ALL, h5py.h5s.ALL, values[i])
+        out[name] = values.reshape(len(r), -1) if first.size > 1 else values.reshape(-1)
+    return out or None
 
 
 def hdf5_table(path: Path, want: str = "imu") -> TableSource:
@@ -448,8 +504,10 @@ def _refusal(path: Path, found: _Found) -> TableError:
         hint = MATLAB_HINT.get(cls, "save its samples as arrays of numbers (a struct of "
                                     "vectors, or an [N, 3] matrix per sensor) or as CSV")
         hint = hint.format(var=where.rpartition("/")[2])
-        return TableError(f"{path}: {where} is a MATLAB {cls}, an object only MATLAB reads, "
-                          f"and the file holds no arrays of samples beside it: {hint}")
+        what = ("whose elements this reader follows in a -v7.3 file only where each holds a "
+                "sample" if cls == STRUCT_ARRAY else "an object only MATLAB reads")
+        return TableError(f"{path}: {where} is a MATLAB {cls}, {what}, and the file holds no "
+                          f"arrays of samples beside it: {hint}")
     has = _listed([_shape_text(a) for a in found.arrays]) or "nothing"
     return TableError(f"{path}: no array of samples: columns are vectors of one length, or "
                       "matrices of a column per quantity ([N, 3] acc, gyro); it has " + has)

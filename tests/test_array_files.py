@@ -89,14 +89,57 @@ def test_arrays_in_groups_and_structs_at_any_depth(tmp_path):
     _same_as_csv(cells)
 
 
+def _matlab_v73_struct_array(path: Path, name: str, rows: np.ndarray) -> Path:
+    """A MATLAB v7.3 file of a 1xN struct array `name` of a sample an element (fields time,
+    acc, gyro and a char note) as MATLAB writes one: a group whose fields are datasets of
+    references, an element each, to arrays in #refs# (each stored transposed)."""
+    with h5py.File(path, "w", userblock_size=512) as f:
+        refs = f.create_group("#refs#")
+        group = f.create_group(name)
+        group.attrs["MATLAB_class"] = np.bytes_(b"struct")
+        for field, cols in (("time", slice(0, 1)), ("acc", slice(1, 4)), ("gyro", slice(4, 7)),
+                            ("note", None)):
+            made = []
+            for i, row in enumerate(rows):
+                if cols is None:
+                    value = refs.create_dataset(f"{field}{i}", data=np.frombuffer(
+                        "ok".encode("utf-16-le"), dtype=np.uint16).reshape(-1, 1))
+                    value.attrs["MATLAB_class"] = np.bytes_(b"char")
+                else:
+                    value = refs.create_dataset(f"{field}{i}", data=row[cols].reshape(-1, 1))
+                    value.attrs["MATLAB_class"] = np.bytes_(b"double")
+                made.append(value.ref)
+            group.create_dataset(field, data=np.array(made, dtype=h5py.ref_dtype).reshape(-1, 1))
+    with path.open("r+b") as f:
+        f.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 .".ljust(124)
+                + b"\x00\x02IM")
+    return path
+
+
 def test_a_struct_array_of_a_sample_an_element(tmp_path):
     """A loop that logs sample by sample builds a 1xN struct array (log(i).time, log(i).acc):
     it was 1000 structs of 3 values each ("no column for acc_x ...: the header has log/1/acc,
-    log/1/gyro, log/2/acc, ..."); each field is a column of N rows, as [log.time]' is in
-    MATLAB, its text fields left out. A struct array of whole recordings (a trial an element)
-    is still each element's own arrays (here the longer trial's, the other's left out by
-    their length)."""
+    log/1/gyro, log/2/acc, ..."), saved -v7.3 nothing ("no array of samples ...; it has
+    nothing"); each field is a column of N rows, as [log.time]' is in MATLAB, its text fields
+    left out. A struct array of whole recordings (a trial an element) is still each element's
+    own arrays (here the longer trial's, the other's left out by their length)."""
     ex = _example()
+    _same_as_csv(_matlab_v73_struct_array(tmp_path / "v73.mat", "log", ex))
+    trials = tmp_path / "trials73.mat"  # -v7.3, a trial an element: refused saying how to save
+    with h5py.File(trials, "w") as f:
+        group = f.create_group("trials")
+        group.attrs["MATLAB_class"] = np.bytes_(b"struct")
+        for field, cols in (("time", slice(0, 1)), ("acc", slice(1, 4)), ("gyro", slice(4, 7))):
+            made = []
+            for i, rows in enumerate((ex, ex[:500])):
+                value = f.create_dataset(f"#refs#/{field}{i}", data=rows[:, cols].T)
+                value.attrs["MATLAB_class"] = np.bytes_(b"double")
+                made.append(value.ref)
+            group.create_dataset(field, data=np.array(made, dtype=h5py.ref_dtype).reshape(-1, 1))
+    with pytest.raises(RecordingError, match=r"trials is a MATLAB struct array, whose elements "
+                       r"this reader follows in a -v7.3 file only where each holds a sample.*"
+                       r"save\('FILE.mat', 'trials', '-v7'\)"):
+        _samples(trials)
     samples = np.zeros((1, len(ex)), dtype=[("time", object), ("acc", object),
                                             ("gyro", object), ("note", object)])
     for i, row in enumerate(ex):
