@@ -310,8 +310,8 @@ def _struct_array(group: Any) -> dict[str, np.ndarray] | None:
     themselves). None for any other group, or where an element's field is longer than a sample
     or of another shape than the first element's. A field's class is its first element's (a
     field of text is left out); each element is read by HDF5's own calls, a few times faster
-    than h5py's objects, which matters at a reference a number (still some thousands of
-    samples a second: a struct of arrays, or -v7, reads at once)."""
+    than h5py's objects, which matters at a reference a number (a struct of arrays, or -v7,
+    still reads far faster: at once)."""
     import h5py
 
     fields = dict(group.items())
