@@ -259,7 +259,7 @@ def _hdf5_found(f: Any) -> _Found:
                     objects.append(("/".join(where), matlab))
                 elif samples is not None:  # a sample an element (log(i).acc = ...)
                     arrays.extend(_in_memory((*where, k), a) for k, a in samples.items())
-                elif samples is None and matlab == "struct" and _references(item):
+                elif matlab == "struct" and _references(item):
                     objects.append(("/".join(where), STRUCT_ARRAY))
                 else:
                     visit(item, where)
