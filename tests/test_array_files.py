@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import pickle
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -48,6 +49,11 @@ def _matlab_v73(path: Path, variables: dict[str, np.ndarray]) -> Path:
         label = f.create_dataset("label", data=np.frombuffer("imu".encode("utf-16-le"),
                                                              dtype=np.uint16).reshape(-1, 1))
         label.attrs["MATLAB_class"] = np.bytes_(b"char")
+    return _matlab_header(path)
+
+
+def _matlab_header(path: Path) -> Path:
+    """MATLAB v7.3's 128-byte header written into an HDF5 file's 512-byte user block."""
     with path.open("r+b") as f:
         f.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 .".ljust(124)
                 + b"\x00\x02IM")
@@ -89,31 +95,25 @@ def test_arrays_in_groups_and_structs_at_any_depth(tmp_path):
     _same_as_csv(cells)
 
 
-def _matlab_v73_struct_array(path: Path, name: str, rows: np.ndarray) -> Path:
-    """A MATLAB v7.3 file of a 1xN struct array `name` of a sample an element (fields time,
-    acc, gyro and a char note) as MATLAB writes one: a group whose fields are datasets of
-    references, an element each, to arrays in #refs# (each stored transposed)."""
+def _matlab_v73_struct_array(path: Path, name: str, elements: list[dict[str, Any]]) -> Path:
+    """A MATLAB v7.3 file of a 1xN struct array `name` as MATLAB writes one: a group whose
+    fields are datasets of references, an element each, to arrays in #refs# (each stored
+    transposed; a str as char)."""
     with h5py.File(path, "w", userblock_size=512) as f:
-        refs = f.create_group("#refs#")
         group = f.create_group(name)
         group.attrs["MATLAB_class"] = np.bytes_(b"struct")
-        for field, cols in (("time", slice(0, 1)), ("acc", slice(1, 4)), ("gyro", slice(4, 7)),
-                            ("note", None)):
+        for field in elements[0]:
             made = []
-            for i, row in enumerate(rows):
-                if cols is None:
-                    value = refs.create_dataset(f"{field}{i}", data=np.frombuffer(
-                        "ok".encode("utf-16-le"), dtype=np.uint16).reshape(-1, 1))
-                    value.attrs["MATLAB_class"] = np.bytes_(b"char")
-                else:
-                    value = refs.create_dataset(f"{field}{i}", data=row[cols].reshape(-1, 1))
-                    value.attrs["MATLAB_class"] = np.bytes_(b"double")
+            for i, element in enumerate(elements):
+                text = isinstance(element[field], str)
+                data = (np.frombuffer(element[field].encode("utf-16-le"), dtype=np.uint16)
+                        if text else np.asarray(element[field], dtype=float))
+                # MATLAB's matrix (a vector a row), stored transposed
+                value = f.create_dataset(f"#refs#/{field}{i}", data=np.atleast_2d(data).T)
+                value.attrs["MATLAB_class"] = np.bytes_(b"char" if text else b"double")
                 made.append(value.ref)
             group.create_dataset(field, data=np.array(made, dtype=h5py.ref_dtype).reshape(-1, 1))
-    with path.open("r+b") as f:
-        f.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 .".ljust(124)
-                + b"\x00\x02IM")
-    return path
+    return _matlab_header(path)
 
 
 def test_a_struct_array_of_a_sample_an_element(tmp_path):
@@ -124,18 +124,11 @@ def test_a_struct_array_of_a_sample_an_element(tmp_path):
     left out. A struct array of whole recordings (a trial an element) is still each element's
     own arrays (here the longer trial's, the other's left out by their length)."""
     ex = _example()
-    _same_as_csv(_matlab_v73_struct_array(tmp_path / "v73.mat", "log", ex))
-    trials = tmp_path / "trials73.mat"  # -v7.3, a trial an element: refused saying how to save
-    with h5py.File(trials, "w") as f:
-        group = f.create_group("trials")
-        group.attrs["MATLAB_class"] = np.bytes_(b"struct")
-        for field, cols in (("time", slice(0, 1)), ("acc", slice(1, 4)), ("gyro", slice(4, 7))):
-            made = []
-            for i, rows in enumerate((ex, ex[:500])):
-                value = f.create_dataset(f"#refs#/{field}{i}", data=rows[:, cols].T)
-                value.attrs["MATLAB_class"] = np.bytes_(b"double")
-                made.append(value.ref)
-            group.create_dataset(field, data=np.array(made, dtype=h5py.ref_dtype).reshape(-1, 1))
+    samples = [{"time": row[0], "acc": row[1:4], "gyro": row[4:7], "note": "ok"} for row in ex]
+    _same_as_csv(_matlab_v73_struct_array(tmp_path / "v73.mat", "log", samples))
+    whole = [{"time": rows[:, 0], "acc": rows[:, 1:4], "gyro": rows[:, 4:7]}
+             for rows in (ex, ex[:500])]  # -v7.3, a trial an element: refused saying how to save
+    trials = _matlab_v73_struct_array(tmp_path / "trials73.mat", "trials", whole)
     with pytest.raises(RecordingError, match=r"trials is a MATLAB struct array, whose elements "
                        r"this reader follows in a -v7.3 file only where each holds a sample.*"
                        r"save\('FILE.mat', 'trials', '-v7'\)"):

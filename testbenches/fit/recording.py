@@ -1339,7 +1339,7 @@ def _swapped(acc: np.ndarray, gyro: np.ndarray) -> str:
 
 
 def _holds_gravity(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
-                   units: str, read: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+                   units: str, read: tuple[np.ndarray, np.ndarray]) -> None:
     """RecordingError where the accelerometer, in SI units with the gyro's, holds no gravity
     (testbenches.gravity): a phone's linear acceleration, or units or axes taken wrongly, or the
     two sensors' columns swapped (read: acc and gyro as read, _swapped)."""
@@ -1355,7 +1355,7 @@ def _holds_gravity(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray
         "acceleration, from which gravity was taken out: give the accelerometer's own (total) "
         "acceleration (Android's TYPE_ACCELEROMETER, Sensor Logger's TotalAcceleration, "
         f"phyphox's acceleration with g); or the units ({units}) or the axes are not what they "
-        "are taken for" + ("" if read is None else _swapped(*read)))
+        "are taken for" + _swapped(*read))
 
 
 QUAT_NORM_TOLERANCE = 0.1
