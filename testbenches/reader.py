@@ -966,9 +966,27 @@ def _stacked(numbered: list[tuple[int, str]], at: int, header: list[str], delimi
             break
     if k == at:
         return header, numbered[at][0], numbered[at][0], units, ""
-    joined = [f"{g} {n}".strip() if g and g != n else n for g, n in zip(group, names, strict=True)]
     first, last = numbered[at][0], numbered[k][0]
-    return joined, numbered[names_at][0], last, units, f"lines {first}-{last}"
+    return _grouped(group, names), numbered[names_at][0], last, units, f"lines {first}-{last}"
+
+
+def _grouped(group: list[str], names: list[str]) -> list[str]:
+    """Each name after the group the row above it names, where the names need one: a group
+    tells apart the columns whose names repeat (OptiTrack Motive's X, Y, Z under Rotation and
+    under Position; a spreadsheet's x, y, z under merged cells "Accelerometer" and "Gyroscope",
+    whose heading is written in the first cell alone and spans the empty cells after it, over
+    names that repeat). Where no name repeats (their units aside), the row above names no
+    groups but the table (a title, a device's name, as a spreadsheet pads it to the table's
+    width): the names as they are, not the first one run into it."""
+    bare = [split_unit(n)[0].lower() for n in names]
+    repeated = {b for b in bare if b and bare.count(b) > 1}
+    if not repeated:
+        return names
+    joined, spanning = [], ""
+    for g, n, b in zip(group, names, bare, strict=True):
+        spanning = g or (spanning if b in repeated else "")  # a name of its own ends a span
+        joined.append(f"{spanning} {n}".strip() if spanning and spanning != n else n)
+    return joined
 
 
 def _no_table(path: Path, first: tuple[int, str]) -> TableError:

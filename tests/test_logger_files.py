@@ -463,7 +463,50 @@ def test_a_name_the_header_gives_twice_is_refused_not_chosen(tmp_path):
     lines = EXAMPLE.read_text().splitlines()
     path = _rows(tmp_path / "twice.csv", lines[0] + ",acc_x", [line + ",0" for line in lines[1:]])
     with pytest.raises(RecordingError, match=r"2 columns' names fit acc_x alike \(columns 2 "
-                       r"'acc_x', 9 'acc_x'\).*--column acc_x=NAME"):
+                       r"'acc_x', 9 'acc_x'\).*one name, which no --column can tell apart: "
+                       r"rename them apart in the file's header"):
+        open_recording(path)
+
+
+@pytest.mark.parametrize("above,names,taken", [
+    # a spreadsheet's merged cells: the group's name in its first cell alone
+    (",Accelerometer,,,Gyroscope,,", "time,x,y,z,x,y,z", "acc_y='Accelerometer y'"),
+    ("time,Accelerometer,,,Gyroscope,,", ",x,y,z,x,y,z", "gyro_z='Gyroscope z'"),
+    (",Accelerometer,,,Gyroscope,,", "time,X (m/s^2),Y (m/s^2),Z (m/s^2),X (rad/s),Y (rad/s),"
+     "Z (rad/s)", "gyro_y='Gyroscope Y (rad/s)'"),
+    # a title, or a device's name, in the first cell, padded to the table's width
+    ("IMU log,,,,,,", "time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z", "time='time'"),
+    (",,,IMU log,,,", "time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z", "acc_z='acc_z'"),
+    ("Device,MPU6050,,,,,", "time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z", "acc_x='acc_x'"),
+])
+def test_a_row_above_the_names_names_groups_only_where_the_names_repeat(tmp_path, above,
+                                                                        names, taken):
+    """A row of text above the names names the groups of the columns whose names repeat (x, y,
+    z under "Accelerometer" and "Gyroscope", a merged cell's name written in its first cell
+    and spanning the cells after it that repeat names; a name of its own, the time's, takes
+    none). Above names that do not repeat it is a title or a device's name, as a spreadsheet
+    pads it with commas: the names are read as they are, not the first run into it (which
+    lost the time's column)."""
+    t, imu = _example()
+    path = _rows(tmp_path / "grouped.csv", names,
+                 [",".join(f"{v:.10g}" for v in row) for row in np.column_stack([t, imu])],
+                 before=above + "\n")
+    source = open_recording(path)
+    assert taken in source.choices and "time in s" in source.choices
+    rec, _ = source.load()
+    np.testing.assert_allclose(rec.acc, imu[:, :3], rtol=1e-9)
+    np.testing.assert_allclose(rec.gyro, imu[:, 3:], rtol=1e-9)
+
+
+def test_names_that_repeat_with_no_groups_above_are_refused_saying_what_serves(tmp_path):
+    """x, y, z for the accelerometer's columns and again for the gyro's, nothing above them:
+    which is which no name can say, and no --column either."""
+    t, imu = _example()
+    path = _rows(tmp_path / "xyz.csv", "time,x,y,z,x,y,z",
+                 [",".join(f"{v:.10g}" for v in row) for row in np.column_stack([t, imu])])
+    with pytest.raises(RecordingError, match=r"'x', 'y', 'z' each name more than one column, "
+                       r"which no --column can tell apart: rename them apart.*\"Accelerometer\" "
+                       r"over"):
         open_recording(path)
 
 

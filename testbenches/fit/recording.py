@@ -267,11 +267,30 @@ def find_columns(table: Any, time_column: str | None = None,
     for quantity, same in alike.items():
         if len(same) > 1:  # which one is meant, no name can say
             shown = ", ".join(f"{j + 1} {table.header[j]!r}" for j in same)
+            twins = len({table.header[j].strip().lower() for j in same}) == 1
             raise RecordingError(
                 f"{table.path}: {len(same)} columns' names fit {quantity} alike (columns "
-                f"{shown}), so it could be any of them: rename them apart or give the one "
-                f"meant (--column {quantity}=NAME)")
+                f"{shown}), so it could be any of them: " + (
+                    "they are one name, which no --column can tell apart: rename them apart in "
+                    "the file's header" if twins else
+                    f"rename them apart or give the one meant (--column {quantity}=NAME)"))
     return found
+
+
+def _repeated_names(header: list[str]) -> str:
+    """Where the header names several columns alike (x, y, z for the accelerometer's and the
+    gyro's, with no row above naming the groups: testbenches.reader._grouped), saying so and
+    what serves: no name given with --column can tell such columns apart."""
+    seen: dict[str, list[str]] = {}  # as compared -> as written
+    for name in header:
+        seen.setdefault(name.strip().lower(), []).append(name.strip())
+    repeated = [names[0] for key, names in seen.items() if key and len(names) > 1]
+    if not repeated:
+        return ""
+    return (f" ({', '.join(map(repr, repeated))} each name{'s' if len(repeated) == 1 else ''} "
+            "more than one column, which no --column can tell apart: rename them apart in the "
+            "file's header, acc_x or \"Accelerometer X\", or write the groups' names in a row "
+            "above them, \"Accelerometer\" over the accelerometer's first column)")
 
 
 def _unit_in_name(quantity: str, name: str) -> str | None:
@@ -686,7 +705,8 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             f"{path}: no column for {', '.join(missing)}: the header has "
             f"{', '.join(found.header)}; name them acc_x, acc_y, acc_z, gyro_x, gyro_y, "
             "gyro_z (or ax, ay, az, gx, gy, gz), or map them with --column QUANTITY=NAME"
-            + _unknown_units(found.header, missing) + (f" ({table.note})" if table.note else ""))
+            + _unknown_units(found.header, missing) + _repeated_names(found.header)
+            + (f" ({table.note})" if table.note else ""))
     names = list(found.index)
     wanted = [found.index[q] for q in names]
     try:
