@@ -172,31 +172,40 @@ class Reference:
             q[flips == 1] *= -1.0
             self.quat = q
 
-    def angle_unit_from(self, rec: Any, t: np.ndarray) -> str:
+    def angle_unit_from(self, acc: np.ndarray, t: np.ndarray) -> str:
         """For a roll and pitch reference: its unit as the accelerometer at rest sees it on a
-        recording's first block (acc, its samples' times t): the other unit where the one
-        taken misses the measured up direction by more than ANGLE_UNIT_MISS_DEG (median over
-        the quiet samples) and the other by at most WORLD_UP_SPREAD_DEG and a third of that.
-        A unit the header does not state is taken so (self.up follows), and said; one it
-        states that the data contradict is refused with the evidence. "" where there is
-        nothing to say."""
+        recording's first block (acc as the estimators take it, its samples' times t): the
+        other unit where the one taken misses the measured up direction by more than
+        ANGLE_UNIT_MISS_DEG (median over the quiet samples) and the other by at most
+        WORLD_UP_SPREAD_DEG and a third of that, and the other meets the law that holds in
+        any motion (reference_axes: the specific force along it averages g), which a
+        pendulum's or a shaker's accelerometer, never at rest, needs: its direction where its
+        norm is near g misses a true reference in radians by tens of degrees and lies near the
+        sensor's z axis, as the same numbers read as degrees do. A unit the header does not
+        state is taken so (self.up follows), and said; one it states that the data contradict
+        is refused with the evidence. "" where there is nothing to say."""
         from .broad.metric import gravity_from_roll_pitch, inclination_error
         from .fit.recording import RecordingError
+        from .reference_axes import VERTICAL_TOLERANCE, vertical_share
 
         if self.angles is None:
             return ""
-        quiet = _quiet(rec.acc) & (t >= self.t[0]) & (t <= self.t[-1])
+        within = (t >= self.t[0]) & (t <= self.t[-1])
+        quiet = _quiet(acc) & within
         if quiet.sum() < 10:
             return ""
-        roll, pitch = (np.interp(t[quiet], self.t, a) for a in self.angles)
-        miss = {}
+        roll, pitch = (np.interp(t[within], self.t, a) for a in self.angles)
+        miss, share = {}, {}
         for unit, scale in (("rad", 1.0), ("deg", np.pi / 180.0)):
             up = gravity_from_roll_pitch(roll * scale, pitch * scale)
-            miss[unit] = float(np.degrees(np.median(inclination_error(up, rec.acc[quiet]))))
+            miss[unit] = float(np.degrees(np.median(inclination_error(up[quiet[within]],
+                                                                      acc[quiet]))))
+            share[unit] = vertical_share(acc[within], up)
         other = "deg" if self.angle_unit == "rad" else "rad"
         if not (miss[self.angle_unit] > ANGLE_UNIT_MISS_DEG
                 and miss[other] <= WORLD_UP_SPREAD_DEG
-                and miss[other] <= miss[self.angle_unit] / 3.0):
+                and miss[other] <= miss[self.angle_unit] / 3.0
+                and abs(share[other] - 1.0) <= VERTICAL_TOLERANCE):
             return (f"reference: roll and pitch in {self.angle_unit} ({self.angle_how})"
                     if self.angle_how else "")
         evidence = (f"the accelerometer at rest misses their up direction by "
@@ -209,6 +218,21 @@ class Reference:
         self.angle_unit = other
         self.up = gravity_from_roll_pitch(self.angles[0] * scale, self.angles[1] * scale)
         return f"reference: roll and pitch in {other} (from the data: {evidence})"
+
+    def check_axes(self, seen: tuple[np.ndarray, np.ndarray], dt: np.ndarray, t: np.ndarray,
+                   up: np.ndarray, lag: str, raw: tuple[np.ndarray, np.ndarray]) -> None:
+        """RecordingError where the reference breaks a law of motion on a first block
+        (reference_axes.check_axes): `seen`, the samples (acc, gyro) as the estimators take
+        them, `raw` before a mounting given, dt and t theirs; `up` the reference's up at t in
+        the sensor frame; `lag`, a clock offset found (lag_note)."""
+        from .reference_axes import check_axes
+
+        angles = None
+        if self.angles is not None:
+            scale = np.pi / 180.0 if self.angle_unit == "deg" else 1.0
+            angles = (np.interp(t, self.t, self.angles[0], left=np.nan, right=np.nan) * scale,
+                      np.interp(t, self.t, self.angles[1], left=np.nan, right=np.nan) * scale)
+        check_axes(self.path, seen[0], seen[1], dt, up, angles, lag, raw)
 
     def lag_note(self, rec: Any, t: np.ndarray) -> str:
         """Where the reference's clock runs apart from the recording's (a first block's samples
@@ -354,8 +378,8 @@ def reference_time_unit(path: Path, t: np.ndarray, stated: str | None, recording
 
 
 WORLD_UP_SPREAD_DEG = 10.0
-"""The most the accelerometer at rest may scatter around the reference's vertical (median
-angle) for that vertical to be taken."""
+"""The most the accelerometer at rest may miss a roll and pitch reference's up by in the other
+unit (median angle) for that unit to be taken (Reference.angle_unit_from)."""
 ANGLE_UNIT_MISS_DEG = 1.0
 """A reference's roll and pitch miss the accelerometer at rest by more than this in the unit
 taken, and by a third of it in the other, for the other to be theirs: a degree read as a
@@ -383,30 +407,36 @@ def _quiet(acc: np.ndarray) -> np.ndarray:
     return np.isfinite(norm) & (np.abs(norm / np.nanmedian(norm) - 1.0) < QUIET_NORM)
 
 
-def find_world_up(rec: Any, path: Path) -> tuple[np.ndarray | None, str]:
-    """For a quaternion reference (rec.ref_quat, sensor to world): the world's vertical as the
-    accelerometer at rest sees it, heading-free (the mean over quiet samples of the measured
-    direction turned into the world frame), where it is not the world frame's z axis (None
-    where it is, or where there is nothing to tell), and what was found, for the printout;
-    RecordingError where no vertical explains the accelerometer."""
-    from .fit.recording import RecordingError
+def find_world_up(acc: np.ndarray, q: np.ndarray | None, path: Path
+                  ) -> tuple[np.ndarray | None, str]:
+    """For a quaternion reference (q [N, 4], sensor to world, at the samples acc [N, 3] as the
+    estimators take them [m/s^2]): the world's vertical, heading-free, where it is not the
+    world frame's z axis (None where it is, or where there is nothing to tell), and what was
+    found, for the printout. The specific force turned into the world frame averages gravity
+    over any motion (reference_axes, law 1): its mean is the vertical, and its length g, to
+    within VERTICAL_TOLERANCE, for any reference of this sensor; RecordingError where it is
+    not (no vertical of the world frame explains the accelerometer). The accelerometer at
+    rest would not serve: a pendulum's or a shaker's never rests, and its direction where its
+    norm is near g scatters by tens of degrees about a true vertical."""
+    from fusion_core.types import G
 
-    q = getattr(rec, "ref_quat", None)
+    from .fit.recording import RecordingError
+    from .reference_axes import VERTICAL_TOLERANCE
+
     if q is None:
         return None, ""
-    norm = np.linalg.norm(rec.acc, axis=1)
-    quiet = _quiet(rec.acc) & np.all(np.isfinite(q), axis=1)
-    if quiet.sum() < 10:
+    finite = np.all(np.isfinite(acc), axis=1) & np.all(np.isfinite(q), axis=1)
+    if finite.sum() < 10:
         return None, ""
-    seen = _rotate(q[quiet], rec.acc[quiet] / norm[quiet, None])
-    up = seen.mean(axis=0)
-    up /= np.linalg.norm(up)
-    spread = float(np.degrees(np.median(np.arccos(np.clip(seen @ up, -1.0, 1.0)))))
-    if spread > WORLD_UP_SPREAD_DEG:
+    mean = _rotate(q[finite], acc[finite]).mean(axis=0)
+    share = float(np.linalg.norm(mean)) / G
+    if abs(share - 1.0) > VERTICAL_TOLERANCE:
         raise RecordingError(
-            f"{path}: no vertical of the reference's world frame explains the accelerometer at "
-            f"rest (it scatters {spread:.3g} deg around the best one): is the quaternion the "
+            f"{path}: no vertical of the reference's world frame explains the accelerometer: "
+            f"turned into that frame, its specific force averages {share:.2f} g, where a "
+            "body's motion averages 1 g along the vertical: is the quaternion the "
             "sensor-to-world rotation, w first (q_w, q_x, q_y, q_z), and of the same sensor?")
+    up = mean / np.linalg.norm(mean)
     tilt = float(np.degrees(np.arccos(np.clip(up[2], -1.0, 1.0))))
     if tilt <= WORLD_UP_TILT_DEG:
         return None, f"reference: its world frame is z-up (within {tilt:.2g} deg)"
@@ -842,20 +872,30 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
     try:
         with _progress(source) as bar:
             for rec, t in _read_ahead(source.blocks()):
+                if n == 0:  # the reference's checks on the samples as the estimators take them
+                    seen = conditioned(rec.acc, rec.gyro, vqf_params)
                 if reference is not None:
                     if n == 0 and reference.span[1] < t[0]:
                         raise RecordingError(reference.overlap_error(float(t[0]),
                                                                      float("nan")))
-                    if n == 0 and (said := reference.angle_unit_from(rec, t)):
+                    if n == 0 and (said := reference.angle_unit_from(seen[0], t)):
                         notes.append(said)
                     rec.up_ref, rec.ref_quat = reference.at(t)
                     rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
                 if n == 0:
-                    world_up, note = find_world_up(rec, args.reference or args.recording)
+                    world_up, note = find_world_up(seen[0], rec.ref_quat,
+                                                   args.reference or args.recording)
                     notes += [note] if note else []
                     notes += [z_down] if (z_down := _z_down_note(rec, args)) else []
-                    if reference is not None and (lag := reference.lag_note(rec, t)):
-                        notes.append(lag)
+                    lag = reference.lag_note(rec, t) if reference is not None else ""
+                    notes += [lag] if lag else []
+                    if reference is not None:
+                        up = (rec.up_ref if world_up is None or rec.ref_quat is None
+                              else about_world_up(rec.ref_quat, world_up))
+                        reference.check_axes(seen, rec.dt, t, up, lag,
+                                             conditioned(rec.acc, rec.gyro,
+                                                         {**vqf_params, "mount_roll": 0.0,
+                                                          "mount_pitch": 0.0, "mount_yaw": 0.0}))
                     if rec.up_ref is not None and not args.no_vqf:
                         vqf = _VqfRun(source.rate, vqf_params)
                 if world_up is not None and rec.ref_quat is not None:
