@@ -219,21 +219,6 @@ class Reference:
         self.up = gravity_from_roll_pitch(self.angles[0] * scale, self.angles[1] * scale)
         return f"reference: roll and pitch in {other} (from the data: {evidence})"
 
-    def check_axes(self, seen: tuple[np.ndarray, np.ndarray], dt: np.ndarray, t: np.ndarray,
-                   up: np.ndarray, lag: str, raw: tuple[np.ndarray, np.ndarray]) -> None:
-        """RecordingError where the reference breaks a law of motion on a first block
-        (reference_axes.check_axes): `seen`, the samples (acc, gyro) as the estimators take
-        them, `raw` before a mounting given, dt and t theirs; `up` the reference's up at t in
-        the sensor frame; `lag`, a clock offset found (lag_note)."""
-        from .reference_axes import check_axes
-
-        angles = None
-        if self.angles is not None:
-            scale = np.pi / 180.0 if self.angle_unit == "deg" else 1.0
-            angles = (np.interp(t, self.t, self.angles[0], left=np.nan, right=np.nan) * scale,
-                      np.interp(t, self.t, self.angles[1], left=np.nan, right=np.nan) * scale)
-        check_axes(self.path, seen[0], seen[1], dt, up, angles, lag, raw)
-
     def lag_note(self, rec: Any, t: np.ndarray) -> str:
         """Where the reference's clock runs apart from the recording's (a first block's samples
         rec at times t): the offset at which the reference's turn rate agrees best with the
@@ -889,13 +874,16 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                     notes += [z_down] if (z_down := _z_down_note(rec, args)) else []
                     lag = reference.lag_note(rec, t) if reference is not None else ""
                     notes += [lag] if lag else []
-                    if reference is not None:
+                    if rec.up_ref is not None:  # a reference file's, or the recording's own
+                        from .reference_axes import check_axes
+
                         up = (rec.up_ref if world_up is None or rec.ref_quat is None
                               else about_world_up(rec.ref_quat, world_up))
-                        reference.check_axes(seen, rec.dt, t, up, lag,
-                                             conditioned(rec.acc, rec.gyro,
-                                                         {**vqf_params, "mount_roll": 0.0,
-                                                          "mount_pitch": 0.0, "mount_yaw": 0.0}))
+                        unmounted = {**vqf_params, "mount_roll": 0.0, "mount_pitch": 0.0,
+                                     "mount_yaw": 0.0}
+                        check_axes(args.reference or args.recording, *seen, rec.dt, up,
+                                   rec.ref_quat is None, lag,
+                                   conditioned(rec.acc, rec.gyro, unmounted))
                     if rec.up_ref is not None and not args.no_vqf:
                         vqf = _VqfRun(source.rate, vqf_params)
                 if world_up is not None and rec.ref_quat is not None:

@@ -111,13 +111,13 @@ def mounting_angles(m: np.ndarray) -> tuple[float, float, float]:
 
 
 def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up: np.ndarray,
-               angles: tuple[np.ndarray, np.ndarray] | None = None, lag: str = "",
+               conventions: bool = False, lag: str = "",
                raw: tuple[np.ndarray, np.ndarray] | None = None) -> None:
     """RecordingError where the reference's up direction `up` [N, 3] (sensor frame, at the
     samples' times; NaN where it has none) breaks either law on a first block's samples as the
     estimators take them (acc [m/s^2], gyro [rad/s], dt [s]), naming what would serve:
-    with `angles` (a roll and pitch reference's, [rad], at the samples) the convention that
-    meets both laws; with `raw` (the samples before a mounting given) the mounting that does;
+    with `conventions` (a roll and pitch reference) the convention of its angles that meets
+    both laws; with `raw` (the samples before a mounting given) the mounting that does;
     `lag` (a clock offset found) as the likelier cause."""
     from .broad.metric import gravity_from_roll_pitch
     from .fit.recording import RecordingError
@@ -132,7 +132,8 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
         evidence.append(f"the gyro's turn misses its up direction's turn by {miss:.0%} of it "
                         f"(median over {windows} windows of 0.25 s)")
     serves = [lag.removeprefix("reference: ")] if lag else []
-    if angles is not None:
+    if conventions:  # the angles the up direction is of (broad.metric.gravity_from_roll_pitch)
+        angles = (np.arctan2(up[:, 1], up[:, 2]), -np.arcsin(np.clip(up[:, 0], -1.0, 1.0)))
         serves += [f"they agree with {name} (a convention other than roll about x, then pitch "
                    "about y)" for name, convention in CONVENTIONS.items()
                    if not _fails(acc, gyro, dt, gravity_from_roll_pitch(*convention(*angles)))[0]]

@@ -420,28 +420,37 @@ def test_a_true_reference_of_a_motion_never_at_rest_is_scored(tmp_path, capsys, 
     ("pitch", "they agree with the pitch's sign turned"),
     ("swapped", "they agree with roll and pitch swapped"),
     ("mounted", "they agree with --mounting 90,0,0"),
+    ("own columns", "they agree with the pitch's sign turned"),
 ])
 def test_a_reference_in_other_axes_is_refused_naming_what_serves(tmp_path, capsys, kind,
                                                                   serves):
-    """A reference of another convention (its pitch's sign, roll and pitch swapped) or of a
-    body the sensor sits on turned by 90 deg scored 22-88 deg for VQF and the kf alike, with
-    nothing said: along its up direction the accelerometer does not average 1 g, and the gyro
-    does not turn it as it turns. Refused, with the convention or the mounting that meets
-    both; the mounting given, the example's own score."""
+    """A reference of another convention (its pitch's sign, roll and pitch swapped; in a file
+    of its own or in the recording's own columns) or of a body the sensor sits on turned by
+    90 deg scored 22-88 deg for VQF and the kf alike, with nothing said: along its up direction
+    the accelerometer does not average 1 g, and the gyro does not turn it as it turns.
+    Refused, with the convention or the mounting that meets both; the mounting given, the
+    example's own score."""
     truth = np.loadtxt(TRUTH, delimiter=",", skiprows=1)
-    recording, ref = EXAMPLE, tmp_path / "ref.csv"
     roll, pitch = truth[:, 1], truth[:, 2]
-    _reference(ref, truth[:, 0], *{"pitch": (roll, -pitch), "swapped": (pitch, roll),
-                                   "mounted": (roll, pitch)}[kind])
+    ex = _example()
+    acc, gyro, columns = ex["acc"], ex["gyro"], [ex["time"]]
     if kind == "mounted":  # the sensor turned by 90 deg about x on the body the truth is of
-        ex, recording = _example(), tmp_path / "mounted.csv"
         turn = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
-        np.savetxt(recording, np.column_stack([ex["time"], ex["acc"] @ turn.T,
-                                               ex["gyro"] @ turn.T]), delimiter=",",
-                   header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z", comments="",
-                   fmt="%.17g")
-    args = ["estimate", str(recording), "--estimator", "kf", "--reference", str(ref),
-            "--no-plots", "--out", str(tmp_path / "out")]
+        acc, gyro = acc @ turn.T, gyro @ turn.T
+    angles = {"pitch": (roll, -pitch), "swapped": (pitch, roll)}.get(kind, (roll, pitch))
+    own = []  # the recording's own roll and pitch, the pitch's sign turned
+    if kind == "own columns":
+        own = [np.interp(ex["time"], truth[:, 0], roll),
+               -np.interp(ex["time"], truth[:, 0], pitch)]
+    recording = tmp_path / "recording.csv"
+    np.savetxt(recording, np.column_stack([*columns, acc, gyro, *own]), delimiter=",",
+               comments="", fmt="%.17g", header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z"
+               + (",roll,pitch" if own else ""))
+    args = ["estimate", str(recording), "--estimator", "kf", "--no-plots", "--out",
+            str(tmp_path / "out")]
+    if kind != "own columns":
+        _reference(tmp_path / "ref.csv", truth[:, 0], *angles)
+        args += ["--reference", str(tmp_path / "ref.csv")]
     assert main(args) == 2
     said = capsys.readouterr().err
     assert "the reference does not describe this sensor in its axes" in said and serves in said
