@@ -305,6 +305,25 @@ def test_tune_refuses_a_recording_without_a_reference_before_it_starts(tmp_path,
     assert "no reference" in err and "run/s" not in err  # no progress bar started
 
 
+def test_tune_refuses_a_reference_in_other_axes_before_it_starts(tmp_path, capsys):
+    """A recording whose own roll and pitch are of another convention (the pitch's sign turned)
+    would have the parameters fitted to nothing: refused as estimate refuses it
+    (testbenches.reference_axes), saying which convention meets the laws of motion."""
+    from testbenches.__main__ import main
+
+    data = np.loadtxt(REPO / "examples" / "tilt_motion.csv", delimiter=",", skiprows=1)
+    truth = np.loadtxt(REPO / "examples" / "tilt_motion_truth.csv", delimiter=",", skiprows=1)
+    angles = [np.interp(data[:, 0], truth[:, 0], truth[:, k]) for k in (1, 2)]
+    path = tmp_path / "own.csv"
+    np.savetxt(path, np.column_stack([data[:, :7], angles[0], -angles[1]]), delimiter=",",
+               header="time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z,roll,pitch", comments="")
+    assert main(["tune", "--estimator", "kf", str(path), "--no-plots", "--out",
+                 str(tmp_path / "t")]) == 2
+    err = capsys.readouterr().err
+    assert "does not describe this sensor in its axes" in err and "pitch's sign turned" in err
+    assert "run/s" not in err  # no progress bar started
+
+
 def test_noise_leaves_out_samples_without_numbers_and_says_how_many(tmp_path):
     """Three empty cells in a static recording were a traceback (numpy's gradient of nothing):
     those samples are left out now, the densities as without them."""

@@ -112,9 +112,9 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
     fit_recs = [recording_from_args(p, args)[0] for p in args.files]
     val_recs = [recording_from_args(p, args)[0] for p in args.validate]
-    for rec in (*fit_recs, *val_recs):  # before the progress bar starts
-        require_reference(rec)
     start = with_calibration(load_preset(args.start), args.calibration)[args.estimator]
+    for rec in (*fit_recs, *val_recs):  # before the progress bar starts
+        require_reference(rec, start)
     names = [n.strip() for n in args.params.split(",")] if args.params else None
     with tqdm(total=args.max_evaluations, unit="run", file=sys.stderr) as bar:
         def progress(best: float) -> None:

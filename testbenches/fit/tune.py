@@ -116,11 +116,26 @@ def dimension(p: Param, start: float) -> Dimension:
     return Dimension(p.name, lo, hi, False)
 
 
-def require_reference(rec: Recording) -> None:
-    """RecordingError where rec has no reference to score against."""
+CHECKED_SAMPLES = 1 << 18
+"""The samples of a recording the reference's check takes, as estimate's first block."""
+
+
+def require_reference(rec: Recording, params: dict[str, Any] | None = None) -> None:
+    """RecordingError where rec has no reference to score against; with `params` (the
+    estimator's, whose calibration and mounting condition the samples), also where its
+    reference does not describe the sensor in its axes (testbenches.reference_axes): fitted to
+    a reference of another convention, parameters would be fitted to nothing."""
     if rec.up_ref is None:
         raise RecordingError(f"{rec.name}: no reference (q_w, q_x, q_y, q_z or roll, pitch "
                              "columns, or a BROAD trial): tune cannot score it")
+    if params is not None:
+        from ..estimate import conditioned
+        from ..reference_axes import check_axes
+
+        n = CHECKED_SAMPLES
+        seen = conditioned(rec.acc[:n], rec.gyro[:n], params)
+        check_axes(Path(rec.name), *seen, rec.dt[:n], rec.up_ref[:n],
+                   getattr(rec, "ref_quat", None) is None)
 
 
 def score(key: str, params: dict[str, Any], rec: Recording) -> float:
