@@ -1442,3 +1442,18 @@ def test_a_delimiter_after_the_last_cell_of_the_rows_or_the_header_is_read_throu
     plain, _ = open_recording(EXAMPLE).load()
     np.testing.assert_array_equal(rec.gyro, plain.gyro)
     np.testing.assert_array_equal(rec.dt, plain.dt)
+
+
+def test_a_time_of_too_few_digits_is_refused_saying_why_and_a_rate_serves(tmp_path):
+    """Seconds since 1970 written with C's %g (six significant digits: steps of 1000 s) hold one
+    number over the whole file: refused, saying the time has too few digits and that a rate
+    spaces the samples; given, it does."""
+    t, imu = _example()
+    path = _rows(tmp_path / "epoch.csv", "time," + HEADER,
+                 [f"{1.7e9 + ti:g}," + ",".join(f"{v:.10g}" for v in row)
+                  for ti, row in zip(t, imu, strict=True)])
+    with pytest.raises(RecordingError, match=r"line 3: the time 1.7e\+09 s repeats .*one number "
+                       r"over the first 1000 rows: written with too few digits.*--rate HZ"):
+        open_recording(path)
+    rec, _ = open_recording(path, rate=100.0).load()
+    np.testing.assert_allclose(rec.acc, imu[:, :3], rtol=1e-9)

@@ -956,7 +956,13 @@ def _time_clock(path: Path, kind: str, raw: np.ndarray, unit: str, stated: str |
         moduli = ((DAY_S,) if day else counter_moduli(scale)
                   if counter and scale in COUNTER_SCALES else ())
         repeats = ""
-        if zeros and span[1] > 0.0:
+        if zeros and span[1] == 0.0:
+            repeats = (f" (the time holds one number over the first {span[0] + 1} rows: written "
+                       "with too few digits for the samples' spacing, as 6 significant digits of "
+                       "seconds since 1970 (C's %g) or a 32-bit float (steps of 128 s there) "
+                       "are; write it with more, or give --rate HZ to space the samples by a "
+                       "rate, the time left)")
+        elif zeros and span[1] > 0.0:
             mean_rate = span[0] / (span[1] * scale)
             repeats = (f" ({zeros} of the first {span[0]} steps are 0 between rows of other "
                        "numbers (a row written twice whole is rejected and counted): a time "
