@@ -178,10 +178,9 @@ class Reference:
         other unit where the one taken misses the measured up direction by more than
         ANGLE_UNIT_MISS_DEG (median over the quiet samples) and the other by at most
         WORLD_UP_SPREAD_DEG and a third of that, and the other meets the law that holds in
-        any motion (reference_axes: the specific force along it averages g), which a
-        pendulum's or a shaker's accelerometer, never at rest, needs: its direction where its
-        norm is near g misses a true reference in radians by tens of degrees and lies near the
-        sensor's z axis, as the same numbers read as degrees do. A unit the header does not
+        any motion (reference_axes: the specific force along it averages g): a pendulum's
+        accelerometer, never at rest, points near the sensor's z axis where its norm is near
+        g, as a swing in radians read as degrees does. A unit the header does not
         state is taken so (self.up follows), and said; one it states that the data contradict
         is refused with the evidence. "" where there is nothing to say."""
         from .broad.metric import gravity_from_roll_pitch, inclination_error
@@ -400,9 +399,7 @@ def find_world_up(acc: np.ndarray, q: np.ndarray | None, path: Path
     found, for the printout. The specific force turned into the world frame averages gravity
     over any motion (reference_axes, law 1): its mean is the vertical, and its length g, to
     within VERTICAL_TOLERANCE, for any reference of this sensor; RecordingError where it is
-    not (no vertical of the world frame explains the accelerometer). The accelerometer at
-    rest would not serve: a pendulum's or a shaker's never rests, and its direction where its
-    norm is near g scatters by tens of degrees about a true vertical."""
+    not (no vertical of the world frame explains the accelerometer)."""
     from fusion_core.types import G
 
     from .fit.recording import RecordingError
@@ -857,33 +854,21 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
     try:
         with _progress(source) as bar:
             for rec, t in _read_ahead(source.blocks()):
-                if n == 0:  # the reference's checks on the samples as the estimators take them
+                if n == 0:  # the samples as the estimators take them, for the checks
                     seen = conditioned(rec.acc, rec.gyro, vqf_params)
-                if reference is not None:
-                    if n == 0 and reference.span[1] < t[0]:
+                    if reference is not None and reference.span[1] < t[0]:
                         raise RecordingError(reference.overlap_error(float(t[0]),
                                                                      float("nan")))
-                    if n == 0 and (said := reference.angle_unit_from(seen[0], t)):
+                    if reference is not None and (said := reference.angle_unit_from(seen[0],
+                                                                                     t)):
                         notes.append(said)
+                if reference is not None:
                     rec.up_ref, rec.ref_quat = reference.at(t)
                     rec.counts = np.all(np.isfinite(rec.up_ref), axis=1)
                 if n == 0:
-                    world_up, note = find_world_up(seen[0], rec.ref_quat,
-                                                   args.reference or args.recording)
-                    notes += [note] if note else []
-                    notes += [z_down] if (z_down := _z_down_note(rec, args)) else []
-                    lag = reference.lag_note(rec, t) if reference is not None else ""
-                    notes += [lag] if lag else []
-                    if rec.up_ref is not None:  # a reference file's, or the recording's own
-                        from .reference_axes import check_axes
-
-                        up = (rec.up_ref if world_up is None or rec.ref_quat is None
-                              else about_world_up(rec.ref_quat, world_up))
-                        unmounted = {**vqf_params, "mount_roll": 0.0, "mount_pitch": 0.0,
-                                     "mount_yaw": 0.0}
-                        check_axes(args.reference or args.recording, *seen, rec.dt, up,
-                                   rec.ref_quat is None, lag,
-                                   conditioned(rec.acc, rec.gyro, unmounted))
+                    world_up, said_first = _first_block(rec, t, seen, args, reference,
+                                                        vqf_params)
+                    notes += said_first
                     if rec.up_ref is not None and not args.no_vqf:
                         vqf = _VqfRun(source.rate, vqf_params)
                 if world_up is not None and rec.ref_quat is not None:
@@ -920,6 +905,27 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
     found = {"read": f"read {source.summary(n, duration, missing, choices=False)}", "notes": notes,
              "scored": scored, "trace": truth}
     return vqf, found
+
+
+def _first_block(rec: Any, t: np.ndarray, seen: tuple[np.ndarray, np.ndarray],
+                 args: argparse.Namespace, reference: Reference | None,
+                 params: dict[str, Any]) -> tuple[np.ndarray | None, list[str]]:
+    """A first block's (rec at times t; `seen`, its acc and gyro as `params` condition them)
+    world vertical of a quaternion reference (find_world_up) and what to say of it, of a z axis
+    down and of a reference's clock; RecordingError where its reference (a file's or its own
+    columns') breaks a law of motion (reference_axes.check_axes)."""
+    from .reference_axes import check_axes
+
+    path = args.reference or args.recording
+    world_up, note = find_world_up(seen[0], rec.ref_quat, path)
+    lag = reference.lag_note(rec, t) if reference is not None else ""
+    if rec.up_ref is not None:
+        up = (rec.up_ref if world_up is None or rec.ref_quat is None
+              else about_world_up(rec.ref_quat, world_up))
+        unmounted = {**params, "mount_roll": 0.0, "mount_pitch": 0.0, "mount_yaw": 0.0}
+        check_axes(path, *seen, rec.dt, up, rec.ref_quat is None, lag,
+                   conditioned(rec.acc, rec.gyro, unmounted))
+    return world_up, [said for said in (note, _z_down_note(rec, args), lag) if said]
 
 
 Z_DOWN_COS = -0.9
