@@ -287,10 +287,11 @@ def _repeated_names(header: list[str]) -> str:
     repeated = [names[0] for key, names in seen.items() if key and len(names) > 1]
     if not repeated:
         return ""
-    return (f" ({', '.join(map(repr, repeated))} each name{'s' if len(repeated) == 1 else ''} "
-            "more than one column, which no --column can tell apart: rename them apart in the "
-            "file's header, acc_x or \"Accelerometer X\", or write the groups' names in a row "
-            "above them, \"Accelerometer\" over the accelerometer's first column)")
+    return (f" ({', '.join(map(repr, repeated))} "
+            f"{'names' if len(repeated) == 1 else 'each name'} more than one column, which no "
+            "--column can tell apart: rename them apart in the file's header, acc_x or "
+            "\"Accelerometer X\", or write the groups' names in a row above them, "
+            "\"Accelerometer\" over the accelerometer's first column)")
 
 
 def _unit_in_name(quantity: str, name: str) -> str | None:
@@ -502,7 +503,7 @@ class _Clock:
             self.last_sample_t = float(sample_t[-1])
         if len(rows_all) == 0:  # no time yet: the period per sample from the first
             return dt, (row0 + np.arange(len(t))) * self.first_dt
-        if len(valid) == len(t):  # every row has its time
+        if len(valid) == len(t) > 0:  # every row has its time
             self.last_t, self.last_row = float(times[-1]), int(rows[-1])
             return dt, t
         here = row0 + np.arange(len(t))

@@ -116,10 +116,6 @@ def dimension(p: Param, start: float) -> Dimension:
     return Dimension(p.name, lo, hi, False)
 
 
-CHECKED_SAMPLES = 1 << 18
-"""The samples of a recording the reference's check takes, as estimate's first block."""
-
-
 def require_reference(rec: Recording, params: dict[str, Any] | None = None) -> None:
     """RecordingError where rec has no reference to score against; with `params` (the
     estimator's, whose calibration and mounting condition the samples), also where its
@@ -131,8 +127,9 @@ def require_reference(rec: Recording, params: dict[str, Any] | None = None) -> N
     if params is not None:
         from ..estimate import conditioned
         from ..reference_axes import check_axes
+        from .recording import PREFIX_ROWS
 
-        n = CHECKED_SAMPLES
+        n = PREFIX_ROWS  # as a recording's units and estimate's reference are checked
         seen = conditioned(rec.acc[:n], rec.gyro[:n], params)
         check_axes(Path(rec.name), *seen, rec.dt[:n], rec.up_ref[:n],
                    getattr(rec, "ref_quat", None) is None)
