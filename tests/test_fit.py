@@ -395,3 +395,31 @@ def test_noise_takes_the_longest_still_stretch_of_a_recording_the_sensor_moved_i
     with pytest.raises(RecordingError, match=r"not static: .*Its longest still stretch, \d+ s "
                        r"of 60 s, is too short to be used instead \(at least 20 s and 50 % of"):
         analyse(load(static_csv(tmp_path / "turning.csv", 60.0, 100.0, turn=0.2 * DEG)))
+
+
+@pytest.mark.parametrize("how", ["header", "given"])
+def test_a_still_gyro_in_deg_s_said_to_be_rad_s_is_refused_by_its_noise(tmp_path, capsys, how):
+    """A still recording's gyro in deg/s (0.016 deg/s/sqrt(Hz), a bias of 0.3 deg/s) that the
+    header or --gyro-unit calls rad/s: no turn of gravity confirms or contradicts the unit, and
+    read so its noise, 0.9 deg/s/sqrt(Hz), is more than any MEMS gyro's; the estimators swung
+    by tens of degrees with nothing said. Refused by its noise, saying what serves; in rad/s a
+    still MPU-6050's gyro reads as it did."""
+    from testbenches.__main__ import main
+
+    path = static_csv(tmp_path / "still.csv", 60.0, 100.0, gyro_density=0.016,
+                      gyro_bias=(0.3, -0.2, 0.25))  # the numbers as deg/s
+    if how == "header":
+        lines = path.read_text().splitlines()
+        lines[0] = "time,acc_x,acc_y,acc_z,gyro_x (rad/s),gyro_y (rad/s),gyro_z (rad/s)"
+        path.write_text("\n".join(lines) + "\n")
+    given = ["--gyro-unit", "rad/s"] if how == "given" else []
+    args = ["estimate", str(path), "--estimator", "kf", "--no-plots", "--out",
+            str(tmp_path / "out")]
+    assert main([*args, *given]) == 2
+    err = capsys.readouterr().err
+    assert "has a white noise of 0.9" in err and "more than ten times any MEMS gyro's" in err
+    assert ("correct the header's unit to deg/s" if how == "header"
+            else "give --gyro-unit deg/s") in err
+    still = static_csv(tmp_path / "mpu.csv", 60.0, 100.0)  # 0.005 deg/s/sqrt(Hz) in rad/s
+    assert main(["estimate", str(still), "--gyro-unit", "rad/s", "--estimator", "kf",
+                 "--no-plots", "--out", str(tmp_path / "out2")]) == 0

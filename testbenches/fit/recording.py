@@ -13,6 +13,7 @@ finds their rest segment (the start, before `movement` begins).
 from __future__ import annotations
 
 import argparse
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from fusion_core.base import COMMON_PARAMS
+from fusion_core.types import G
 
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
@@ -1312,6 +1314,8 @@ def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, un
         if chosen not in UNITS:
             raise RecordingError(f"{path}: the gyro's unit {chosen!r} is not one of "
                                  f"{', '.join(UNITS)}")
+        if evidence.unit is None and chosen == "rad/s":
+            _no_gyro_noise(path, acc, gyro, dt, how)
         if evidence.unit is not None and evidence.unit != chosen:
             raise RecordingError(
                 f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
@@ -1325,6 +1329,47 @@ def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, un
             f"give --gyro-unit {listed(list(UNITS))}{_swapped(acc, gyro)}")
     return _GyroUnit(evidence.unit, f"{evidence.unit} (from the data: {evidence.describe()})",
                      used, True)
+
+
+GYRO_DENSITY_MAX = math.radians(0.3)
+"""The most white noise a MEMS gyro's rate has [rad/s/sqrt(Hz)]: ten times the noisiest
+datasheets' 0.03 deg/s/sqrt(Hz) (an MPU-6050's is 0.005)."""
+ACC_DENSITY_QUIET = 4000e-6 * G
+"""An accelerometer whose white noise, measured as a gyro's is, is at most this [m/s^2/sqrt(Hz)]
+is a sensor at rest or nearly (ten times an MPU-6050's 400 ug/sqrt(Hz)): no vibration or
+shaking moves its gyro."""
+
+
+def _density(x: np.ndarray, dt: np.ndarray) -> float:
+    """The white noise density of the columns of x (the median over them) from their
+    sample-to-sample steps, which leave out a bias and a slow motion: std(step) / sqrt(2)
+    times sqrt(the median period)."""
+    steps = np.diff(x, axis=0)
+    steps = steps[np.all(np.isfinite(steps), axis=1)]
+    period = float(np.nanmedian(dt)) if len(dt) else float("nan")
+    if len(steps) < 10 or not period > 0.0:
+        return float("nan")
+    return float(np.median(np.std(steps, axis=0))) / math.sqrt(2.0) * math.sqrt(period)
+
+
+def _no_gyro_noise(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
+                   how: str) -> None:
+    """RecordingError where a gyro said to be in rad/s (`how`: given or from the header) and
+    not confirmed by the data (no turn of gravity to compare) has a white noise no gyro has
+    (GYRO_DENSITY_MAX) while the accelerometer is quiet (ACC_DENSITY_QUIET), and one a gyro
+    has in deg/s: deg/s read as rad/s, which turns the attitude of a still sensor by tens of
+    degrees."""
+    gyro_density, acc_density = _density(gyro, dt), _density(acc, dt)
+    if not (acc_density <= ACC_DENSITY_QUIET and gyro_density > GYRO_DENSITY_MAX
+            and gyro_density * UNITS["deg/s"] <= GYRO_DENSITY_MAX):
+        return
+    raise RecordingError(
+        f"{path}: the gyro in rad/s ({how}) has a white noise of "
+        f"{math.degrees(gyro_density):.3g} deg/s/sqrt(Hz), more than ten times any MEMS gyro's "
+        f"(an MPU-6050's is 0.005), while the accelerometer is quiet; in deg/s it would be "
+        f"{math.degrees(gyro_density * UNITS['deg/s']):.3g}: "
+        + ("correct the header's unit to deg/s" if how == "from the header"
+           else "give --gyro-unit deg/s") + ", or check the columns")
 
 
 def _axes_as_read(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
