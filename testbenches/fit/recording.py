@@ -22,7 +22,6 @@ from typing import Any
 import numpy as np
 
 from fusion_core.base import COMMON_PARAMS
-from fusion_core.types import G
 
 from ..broad.data import NotABroadTrial, load_trial
 from ..broad.metric import gravity_from_quat
@@ -1334,10 +1333,10 @@ def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, un
 GYRO_DENSITY_MAX = math.radians(0.3)
 """The most white noise a MEMS gyro's rate has [rad/s/sqrt(Hz)]: ten times the noisiest
 datasheets' 0.03 deg/s/sqrt(Hz) (an MPU-6050's is 0.005)."""
-ACC_DENSITY_QUIET = 4000e-6 * G
-"""An accelerometer whose white noise, measured as a gyro's is, is at most this [m/s^2/sqrt(Hz)]
-is a sensor at rest or nearly (ten times an MPU-6050's 400 ug/sqrt(Hz)): no vibration or
-shaking moves its gyro."""
+STILL_DEG = 3.0
+"""A sensor is still where nine in ten of its accelerometer's samples point within this of
+their mean direction [deg] (a MEMS accelerometer's noise turns one by a few tenths at most):
+no motion and no vibration moves its gyro, whose sample-to-sample steps are then its noise."""
 
 
 def _density(x: np.ndarray, dt: np.ndarray) -> float:
@@ -1352,22 +1351,32 @@ def _density(x: np.ndarray, dt: np.ndarray) -> float:
     return float(np.median(np.std(steps, axis=0))) / math.sqrt(2.0) * math.sqrt(period)
 
 
+def _still(acc: np.ndarray) -> bool:
+    """Whether the accelerometer (any unit) shows the sensor still (STILL_DEG)."""
+    acc = acc[np.all(np.isfinite(acc), axis=1)]
+    norm = np.linalg.norm(acc, axis=1)
+    mean = acc.mean(axis=0) if len(acc) else np.zeros(3)
+    if len(acc) < 10 or not np.linalg.norm(mean) > 0.0 or not np.all(norm > 0.0):
+        return False
+    cos = acc @ (mean / np.linalg.norm(mean)) / norm
+    return bool(np.degrees(np.arccos(np.clip(np.quantile(cos, 0.1), -1.0, 1.0))) <= STILL_DEG)
+
+
 def _no_gyro_noise(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
                    how: str) -> None:
     """RecordingError where a gyro said to be in rad/s (`how`: given or from the header) and
     not confirmed by the data (no turn of gravity to compare) has a white noise no gyro has
-    (GYRO_DENSITY_MAX) while the accelerometer is quiet (ACC_DENSITY_QUIET), and one a gyro
-    has in deg/s: deg/s read as rad/s, which turns the attitude of a still sensor by tens of
-    degrees."""
-    gyro_density, acc_density = _density(gyro, dt), _density(acc, dt)
-    if not (acc_density <= ACC_DENSITY_QUIET and gyro_density > GYRO_DENSITY_MAX
-            and gyro_density * UNITS["deg/s"] <= GYRO_DENSITY_MAX):
+    (GYRO_DENSITY_MAX) while the sensor is still (_still), and one a gyro has in deg/s: deg/s
+    read as rad/s, which turns the attitude of a still sensor by tens of degrees."""
+    gyro_density = _density(gyro, dt)
+    if not (gyro_density > GYRO_DENSITY_MAX and gyro_density * UNITS["deg/s"] <= GYRO_DENSITY_MAX
+            and _still(acc)):
         return
     raise RecordingError(
         f"{path}: the gyro in rad/s ({how}) has a white noise of "
         f"{math.degrees(gyro_density):.3g} deg/s/sqrt(Hz), more than ten times any MEMS gyro's "
-        f"(an MPU-6050's is 0.005), while the accelerometer is quiet; in deg/s it would be "
-        f"{math.degrees(gyro_density * UNITS['deg/s']):.3g}: "
+        f"(an MPU-6050's is 0.005), while the accelerometer shows the sensor still; in deg/s it "
+        f"would be {math.degrees(gyro_density * UNITS['deg/s']):.3g}: "
         + ("correct the header's unit to deg/s" if how == "from the header"
            else "give --gyro-unit deg/s") + ", or check the columns")
 
