@@ -1341,14 +1341,16 @@ no motion and no vibration moves its gyro, whose sample-to-sample steps are then
 
 def _density(x: np.ndarray, dt: np.ndarray) -> float:
     """The white noise density of the columns of x (the median over them) from their
-    sample-to-sample steps, which leave out a bias and a slow motion: std(step) / sqrt(2)
-    times sqrt(the median period)."""
+    sample-to-sample steps, which leave out a bias and a slow motion: the steps' standard
+    deviation (from their median absolute deviation, which a few absurd samples do not move)
+    over sqrt(2), times sqrt(the median period)."""
     steps = np.diff(x, axis=0)
     steps = steps[np.all(np.isfinite(steps), axis=1)]
     period = float(np.nanmedian(dt)) if len(dt) else float("nan")
     if len(steps) < 10 or not period > 0.0:
         return float("nan")
-    return float(np.median(np.std(steps, axis=0))) / math.sqrt(2.0) * math.sqrt(period)
+    spread = 1.4826 * np.median(np.abs(steps - np.median(steps, axis=0)), axis=0)
+    return float(np.median(spread)) / math.sqrt(2.0) * math.sqrt(period)
 
 
 def _still(acc: np.ndarray) -> bool:
