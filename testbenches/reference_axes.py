@@ -121,6 +121,7 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
     `lag` (a clock offset found) as the likelier cause."""
     from .broad.metric import gravity_from_roll_pitch
     from .fit.recording import RecordingError
+    from .gyro_unit import WINDOW_S
 
     bad, share, windows, miss = _fails(acc, gyro, dt, up)
     if not bad:
@@ -130,7 +131,7 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
         else []
     if windows >= MIN_WINDOWS and miss > TURN_MISS_MAX:
         evidence.append(f"the gyro's turn misses its up direction's turn by {miss:.0%} of it "
-                        f"(median over {windows} windows of 0.25 s)")
+                        f"(median over {windows} windows of {WINDOW_S:g} s)")
     serves = [lag.removeprefix("reference: ")] if lag else []
     if conventions:  # the angles the up direction is of (broad.metric.gravity_from_roll_pitch)
         angles = (np.arctan2(up[:, 1], up[:, 2]), -np.arcsin(np.clip(up[:, 0], -1.0, 1.0)))
