@@ -122,6 +122,7 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
     from .broad.metric import gravity_from_roll_pitch
     from .fit.recording import RecordingError
     from .gyro_unit import WINDOW_S
+    from .peer_runs import roll_pitch_from_up
 
     bad, share, windows, miss = _fails(acc, gyro, dt, up)
     if not bad:
@@ -133,8 +134,8 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
         evidence.append(f"the gyro's turn misses its up direction's turn by {miss:.0%} of it "
                         f"(median over {windows} windows of {WINDOW_S:g} s)")
     serves = [lag.removeprefix("reference: ")] if lag else []
-    if conventions:  # the angles the up direction is of (broad.metric.gravity_from_roll_pitch)
-        angles = (np.arctan2(up[:, 1], up[:, 2]), -np.arcsin(np.clip(up[:, 0], -1.0, 1.0)))
+    if conventions:  # the angles the up direction is of
+        angles = roll_pitch_from_up(up)
         serves += [f"they agree with {name} (a convention other than roll about x, then pitch "
                    "about y)" for name, convention in CONVENTIONS.items()
                    if not _fails(acc, gyro, dt, gravity_from_roll_pitch(*convention(*angles)))[0]]
