@@ -401,7 +401,8 @@ class _TextLayout:
     """Cells split by runs of spaces or tabs (numpy.savetxt's default, a C printf, TUM's
     trajectories): every line is read with each run as WHITESPACE_AS (_Spaced)."""
     not_iso: set[int] = field(default_factory=set)
-    """Columns of dates and times in one of _DATETIME's forms other than ISO 8601's."""
+    """Columns of dates and times, or of times of day, in one of _DATETIME's or
+    _TIME_OF_DAY's forms other than ISO 8601's."""
     day_month: dict[int, str] = field(default_factory=dict)
     """Columns of dates with the day and month before the year (_DAY_MONTH) -> a cell: refused
     where read."""
@@ -436,8 +437,16 @@ Rate: 100.0Hz", "# Sample rate = 200 Hz", "Sampling frequency,50,Hz" does not (t
 cell of its own). A file's time column governs where it has one; two statements are none."""
 
 
-_TIME_OF_DAY = re.compile(r"^(\d{1,2}):(\d{2}):(\d{2})(?:[.,](\d{1,9}))?$")
-"""A time of day without a date: "12:00:00.010", a decimal comma, "9:05:00"."""
+_TIME_OF_DAY = re.compile(r"^(\d{1,2}):(\d{2}):(\d{2})(?:[.,](\d{1,9})|:(\d{3}))?$")
+"""A time of day without a date: "12:00:00.010", a decimal comma, "9:05:00", and the
+milliseconds after a colon, "12:00:00:010", as Physics Toolbox Sensor Suite writes them
+(exactly three digits: a video timecode's "01:00:00:12" counts frames, and is none)."""
+_ISO_TIME_OF_DAY = re.compile(r"^\d{2}:\d{2}:\d{2}(?:\.\d{1,9})?$")
+"""The times of day pyarrow's reader parses; the other forms of _TIME_OF_DAY it reads as
+text, rewritten as these (_TIME_TO_ISO)."""
+_TIME_TO_ISO = ((r"^(\d):", r"0\1:"), (r"^(\d{2}:\d{2}:\d{2})[,:](\d)", r"\1.\2"))
+"""_TIME_OF_DAY's other forms rewritten as _ISO_TIME_OF_DAY's (regular expression,
+replacement)."""
 
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -461,7 +470,7 @@ def seconds_of_day(text: str) -> float | None:
     hour, minute, second = (int(g) for g in m.groups()[:3])
     if hour > 23 or minute > 59 or second > 60:
         return None
-    fraction = m.group(4)
+    fraction = m.group(4) or m.group(5)
     return (3600.0 * hour + 60.0 * minute + second
             + (int(fraction) / 10 ** len(fraction) if fraction else 0.0))
 
@@ -590,6 +599,8 @@ def _sniff(path: Path) -> _TextLayout:
             day_month[j] = column[0]
         elif column and all(seconds_of_day(c) is not None for c in column):
             times_of_day.add(j)
+            if not all(_ISO_TIME_OF_DAY.match(c) for c in column):
+                rewritten.add(j)
         elif column and all(duration_unit(c) for c in column):  # in the first cell's unit
             durations[j] = duration_unit(column[0]) or ""
     cells = [c for row in rows for j, c in enumerate(row)
@@ -1148,10 +1159,19 @@ def _float64(column: Any) -> np.ndarray:
 
 
 def _as_iso(column: Any, kind: Any) -> Any:
-    """A pyarrow string array of dates and times in _DATETIME's other forms as timestamps of
-    `kind` (rewritten as ISO 8601, which pyarrow parses); ArrowInvalid where one is none."""
+    """A pyarrow string array of dates and times in _DATETIME's other forms, or of times of
+    day in _TIME_OF_DAY's, as `kind` (a timestamp or time64 type; rewritten as ISO 8601, which
+    pyarrow parses; a time of day as that time on 1970-01-01, whose seconds since 1970 are its
+    seconds since midnight: pyarrow casts no text to a time of day); ArrowInvalid where one is
+    none."""
+    import pyarrow as pa
     import pyarrow.compute as pc
 
+    if pa.types.is_time(kind):
+        column = pc.utf8_trim_whitespace(column)
+        for pattern, replacement in (*_TIME_TO_ISO, (r"^", "1970-01-01T")):
+            column = pc.replace_substring_regex(column, pattern, replacement)
+        return column.cast(pa.timestamp("ns"))
     for pattern, replacement in _TO_ISO:
         column = pc.replace_substring_regex(column, pattern, replacement)
     return column.cast(kind)
@@ -1207,6 +1227,7 @@ def _arrow_parts(path: Path, layout: _TextLayout, columns: list[int], skip: int,
              if i in layout.datetimes else pa.time64("ns") for i in columns}
     durations = {keys[i]: layout.durations[i] for i in columns if i in layout.durations}
     not_iso = {keys[i]: pa.timestamp("ns", tz="UTC" if layout.datetimes[i] else None)
+               if i in layout.datetimes else pa.time64("ns")
                for i in columns if i in layout.not_iso}
     compression = _compression(path)
     # lines pyarrow cannot skip itself (past its first block), or lines read mended

@@ -371,6 +371,48 @@ def test_dates_and_times_are_the_same_seconds_to_either_reader(tmp_path, monkeyp
     np.testing.assert_array_equal(arrow.dt, python.dt)
 
 
+@pytest.mark.parametrize("form", ["{h}:{m:02d}:{s:02d}:{ms:03d}",
+                                  "{h:02d}:{m:02d}:{s:02d}:{ms:03d}",
+                                  "{h}:{m:02d}:{s:02d}.{ms:03d}"])
+def test_a_physics_toolbox_time_of_day_reads_alike_in_either_reader(tmp_path, monkeypatch, form):
+    """Physics Toolbox Sensor Suite writes the milliseconds after a colon ("9:05:00:010"), and
+    some loggers an hour of one digit: a time of day pyarrow's reader does not parse. The file
+    was refused ("'17:36:12:010' is not a number"); it is read as times of day, to the same
+    seconds in either reader (the other forms rewritten for pyarrow's, not left to Python's)."""
+    import testbenches.reader as reader
+
+    t, imu = _example()
+    ms = np.round((9 * 3600 + 5 * 60 + t) * 1000).astype(int)
+    stamps = [form.format(h=k // 3_600_000, m=k // 60_000 % 60, s=k // 1000 % 60, ms=k % 1000)
+              for k in ms]
+    path = tmp_path / "ptb.csv"
+    path.write_text("\n".join([f"time,{HEADER}", *(",".join([s, *(f"{v:.10g}" for v in row)])
+                                                   for s, row in zip(stamps, imu, strict=True))])
+                    + "\n")
+    calls = []
+    monkeypatch.setattr(reader, "_python_parts",
+                        lambda *a, **k: calls.append(1) or iter(()))  # pyarrow's alone
+    source = open_recording(path, gyro_unit="rad/s")
+    arrow, arrow_t = source.load()
+    assert not calls and "time from its times of day" in source.choices
+    np.testing.assert_allclose(arrow_t, ms / 1000.0, rtol=0, atol=1e-9)
+    monkeypatch.undo()
+    monkeypatch.setattr(reader, "_has_pyarrow", lambda: False)
+    python, python_t = open_recording(path, gyro_unit="rad/s").load()
+    np.testing.assert_array_equal(arrow_t, python_t)
+    np.testing.assert_array_equal(arrow.dt, python.dt)
+
+
+def test_a_timecode_is_no_time_of_day():
+    """A video timecode's frames after a colon ("01:00:00:12", two digits) are no milliseconds:
+    only three digits after the seconds' colon are."""
+    from testbenches.reader import seconds_of_day
+
+    assert seconds_of_day("01:00:00:12") is None
+    assert seconds_of_day("01:00:00:120") == 3600.12
+    assert seconds_of_day("1:00:00,5") == 3600.5
+
+
 def test_a_spreadsheets_dates_saved_as_numbers_are_named_in_the_refusal(tmp_path):
     """A sheet's date and time column saved as numbers (days since 1899-12-30: 45413.5...)
     steps by 1.16e-7 at 100 Hz, a rate in no unit the reader takes: refused, naming what it
