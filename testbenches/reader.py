@@ -415,17 +415,18 @@ class _TextLayout:
 _DATETIME = re.compile(
     r"^(?:(?P<y>\d{4})(?P<sep>[-/])(?P<m>\d{2})(?P=sep)(?P<d>\d{2})"
     r"|(?P<d2>\d{2})\.(?P<m2>\d{2})\.(?P<y2>\d{4}))"
-    r"[T ](?P<H>\d{2}):(?P<M>\d{2}):(?P<S>\d{2})(?:[.,](?P<f>\d{1,9}))?"
+    r"[T ](?P<H>\d{2}):(?P<M>\d{2}):(?P<S>\d{2})(?:[.,](?P<f>\d{1,9})|:(?P<f2>\d{3}))?"
     r"\s*(?P<zone>Z|[+-]\d{2}(?::?\d{2})?)?$")
 """A date and time as loggers write it: ISO 8601's "2024-05-01T12:00:00.010" (a space for the
 T, a decimal comma, a zone: Z, +02:00, +0200, or none), the year first with slashes
 ("2024/05/01 12:00:00.010", as East Asian locales write it) or the day first with dots
-("01.05.2024 12:00:00,010", as German and other European locales do). A day and month with
+("01.05.2024 12:00:00,010", as German and other European locales do); the milliseconds after
+a colon ("2019-09-07 09:13:29:506", as AndroSensor writes them). A day and month with
 slashes ("05/01/2024") is refused: it reads as May 1 or January 5 alike."""
 _DAY_MONTH = re.compile(r"^\d{1,2}/\d{1,2}/\d{2,4}[T ]\d{1,2}:\d{2}")
 """A date with slashes, the day and month before the year (US and UK locales alike)."""
 _TO_ISO = ((r"^(\d{2})\.(\d{2})\.(\d{4})", r"\3-\2-\1"), (r"^(\d{4})/(\d{2})/(\d{2})", r"\1-\2-\3"),
-           (r"(:\d{2}),(\d)", r"\1.\2"))
+           (r"(\d{2}:\d{2}:\d{2})[,:](\d)", r"\1.\2"))
 """_DATETIME's other forms rewritten as ISO 8601 (regular expression, replacement), for
 pyarrow's reader, which parses only that."""
 
@@ -484,7 +485,7 @@ def seconds_of(text: str) -> float | None:
         return None
     year, month, day = (int(m.group(k) or m.group(k + "2")) for k in "ymd")
     hour, minute, second = (int(m.group(k)) for k in "HMS")
-    fraction, zone = m.group("f"), m.group("zone")
+    fraction, zone = m.group("f") or m.group("f2"), m.group("zone")
     try:
         t = dt.datetime(year, month, day, hour, minute, second, tzinfo=dt.timezone.utc)
     except ValueError:
@@ -592,8 +593,8 @@ def _sniff(path: Path) -> _TextLayout:
         matches = [_DATETIME.match(c) for c in column]
         if column and all(matches):
             datetimes[j] = all(m.group("zone") for m in matches if m)  # with a zone
-            if any(m.group("sep") != "-" or "," in c for m, c in zip(matches, column,
-                                                                      strict=True) if m):
+            if any(m.group("sep") != "-" or "," in c or m.group("f2") for m, c
+                   in zip(matches, column, strict=True) if m):
                 rewritten.add(j)
         elif column and all(_DAY_MONTH.match(c) for c in column):
             day_month[j] = column[0]

@@ -348,7 +348,8 @@ def test_dates_and_times_as_locales_write_them_are_read_at_pyarrows_speed(tmp_pa
     np.testing.assert_allclose(times, np.arange(50) / 100)
 
 
-@pytest.mark.parametrize("form", ["%Y-%m-%dT%H:%M:%S.%f", "%Y/%m/%d %H:%M:%S.%f", "%H:%M:%S.%f"])
+@pytest.mark.parametrize("form", ["%Y-%m-%dT%H:%M:%S.%f", "%Y/%m/%d %H:%M:%S.%f", "%H:%M:%S.%f",
+                                  "%d.%m.%Y %H:%M:%S.%f", "%Y-%m-%d %H:%M:%S:%f"])
 def test_dates_and_times_are_the_same_seconds_to_either_reader(tmp_path, monkeypatch, form):
     """pyarrow's reader and Python's give a date's or a time of day's seconds to the last bit:
     its whole seconds and its fraction added (one rounding); pyarrow's took its nanoseconds
