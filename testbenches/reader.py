@@ -21,7 +21,8 @@ any length is read in bounded memory:
   a timetable's row times) as seconds;
 - Parquet and Arrow IPC (Feather): its columns (a timestamp column as seconds), a struct of
   numbers or a list of k numbers a row as a column per number;
-- a spreadsheet workbook or JSON is refused, saying to save or export it as CSV, and an
+- a spreadsheet workbook or JSON is refused, saying to save or export it as CSV (a table of
+  text named .xls is read as text), and an
   ArduPilot DataFlash log saying which tool exports its IMU;
 - a PX4 flight log (ULog, read with pyulog): its sensor_combined topic, named as ulog2csv
   names its columns;
@@ -121,8 +122,14 @@ def open_table(path: str | Path, want: str = "imu") -> TableSource:
     if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
         raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
                          "directory of its files at its end): copy or download it again")
+    if (suffix in SHEET_SUFFIXES and binary is None and not magic.startswith(b"PK\x03\x04")
+            and _text_like(head) and not head.lstrip().startswith(b"<")):
+        source = _text(path)  # a table of text saved as .xls (an HTML page's is refused)
+        source.note = "; ".join(filter(None, [f"named {suffix} but text: read as text",
+                                              source.note]))
+        return source
     if ((magic.startswith(b"PK\x03\x04") and zipped_table(path) is None)
-            or suffix in (".xlsx", ".xls", ".ods")):
+            or suffix in SHEET_SUFFIXES):
         raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "
                          "table this reader takes: save the sheet as CSV (a zip archive of a "
                          "phone app's files serves under a .zip name)")
@@ -139,6 +146,9 @@ def open_table(path: str | Path, want: str = "imu") -> TableSource:
     return _text(path)
 
 
+SHEET_SUFFIXES = (".xlsx", ".xls", ".ods")
+"""A spreadsheet workbook's names: refused (save the sheet as CSV) unless the file is text,
+as an export that names a CSV or a tab-separated table .xls so that a spreadsheet opens it."""
 BINARY_SUFFIXES = {".parquet": "parquet", ".pq": "parquet", ".feather": "arrow",
                    ".arrow": "arrow", ".ipc": "arrow", ".h5": "hdf5", ".hdf5": "hdf5",
                    ".mat": "mat"}

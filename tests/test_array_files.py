@@ -379,6 +379,27 @@ def test_a_sensors_three_columns_mapped_at_once(tmp_path, capsys):
             "NAME_x, NAME_y, NAME_z) or three (acc=X,Y,Z)") in capsys.readouterr().err
 
 
+def test_a_table_of_text_named_as_a_workbook_is_read_and_a_web_page_refused(tmp_path):
+    """An export that names its CSV or tab-separated table .xls (so that a spreadsheet opens
+    it) was refused as a workbook by its name alone; it is read as the text it is, and says
+    so. A web page's table so named, an old workbook (OLE2) and a zip archive are still
+    refused, saying to save the sheet as CSV."""
+    text = EXAMPLE.read_bytes()
+    for suffix, content in ((".xls", text), (".xls", text.replace(b",", b"\t")),
+                            (".xlsx", text), (".ods", text)):
+        path = tmp_path / f"export{suffix}"
+        path.write_bytes(content)
+        source = open_recording(path, gyro_unit="rad/s")
+        assert f"named {suffix} but text: read as text" in source.choices
+        _same_as_csv(path)
+    for name, content in (("page.xls", b"<html><table><tr><td>time</td></tr></table></html>\n"),
+                          ("old.xls", b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + bytes(600))):
+        path = tmp_path / name
+        path.write_bytes(content)
+        with pytest.raises(RecordingError, match=r"a spreadsheet workbook .* save the sheet as CSV"):
+            open_recording(path)
+
+
 def test_a_file_under_another_formats_suffix_is_read_as_what_it_holds(tmp_path):
     """A CSV saved as .h5, .mat, .parquet or .feather was refused in the named format's words
     ("file signature not found"), a MATLAB file saved as .csv as text ("no delimiter
