@@ -396,7 +396,8 @@ def test_a_table_of_text_named_as_a_workbook_is_read_and_a_web_page_refused(tmp_
                           ("old.xls", b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + bytes(600))):
         path = tmp_path / name
         path.write_bytes(content)
-        with pytest.raises(RecordingError, match=r"a spreadsheet workbook .* save the sheet as CSV"):
+        with pytest.raises(RecordingError,
+                           match=r"a spreadsheet workbook .* save the sheet as CSV"):
             open_recording(path)
 
 
