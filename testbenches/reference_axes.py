@@ -139,6 +139,11 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
         serves += [f"they agree with {name} (a convention other than roll about x, then pitch "
                    "about y)" for name, convention in CONVENTIONS.items()
                    if not _fails(acc, gyro, dt, gravity_from_roll_pitch(*convention(*angles)))[0]]
+        # numbers within pi and pi/2 are taken as radians where no header states a unit
+        if not _fails(acc, gyro, dt, gravity_from_roll_pitch(*np.radians(angles)))[0]:
+            serves.append("they agree with roll and pitch in degrees: state the unit in the "
+                          "header (roll (deg), pitch (deg)); numbers within pi and pi/2 are "
+                          "taken as radians")
     acc0, gyro0 = raw if raw is not None else (acc, gyro)
     m = mounting_fit(acc0, up)
     if not _fails(acc0 @ m.T, gyro0 @ m.T, dt, up)[0]:

@@ -459,6 +459,32 @@ def test_a_reference_in_other_axes_is_refused_naming_what_serves(tmp_path, capsy
         assert _kf_rmse(capsys.readouterr().out) == pytest.approx(0.5996, abs=1e-3)
 
 
+def test_the_recordings_own_angles_in_degrees_are_refused_unless_stated(tmp_path, capsys):
+    """The recording's own roll and pitch in degrees, the header silent, within radians'
+    range (a device logging its own tilts of 1-2 deg): taken as radians, refused by the laws
+    of motion with no hint of why; the refusal now names degrees and how to state them.
+    Stated, they are scored, and the read names the file's columns it took as the reference
+    and their unit (a device's own estimate logged beside its samples is no truth, and the
+    score should not look like one)."""
+    _, roll, pitch = _small_tilts(tmp_path / "tilts.csv")
+    samples = np.loadtxt(tmp_path / "tilts.csv", delimiter=",", skiprows=1)
+    for header, code in (("roll,pitch", 2), ("roll (deg),pitch (deg)", 0)):
+        own = tmp_path / "own.csv"
+        np.savetxt(own, np.column_stack([samples, np.degrees(roll), np.degrees(pitch)]),
+                   delimiter=",", header="time,ax,ay,az,gx (rad/s),gy (rad/s),gz (rad/s),"
+                   + header, comments="")
+        assert main(["estimate", str(own), "--estimator", "kf", "--no-plots", "--out",
+                     str(tmp_path / "out")]) == code
+        said = capsys.readouterr()
+        if code:
+            assert "they agree with roll and pitch in degrees: state the unit in the header " \
+                   "(roll (deg), pitch (deg))" in said.err
+        else:
+            assert ("reference from this file's columns roll='roll (deg)', pitch='pitch (deg)' "
+                    "in deg (from the header)") in said.out
+            assert _kf_rmse(said.out) < 0.1
+
+
 def test_a_reference_unit_the_data_contradict_is_refused(tmp_path, capsys):
     """A header that says deg over radians (read as degrees they are level, 2 deg off the
     accelerometer at rest) is refused with the evidence, not scored."""

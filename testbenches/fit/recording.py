@@ -837,6 +837,13 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         gyro_how += f" over the first {used} samples"
     where = ", ".join(f"{q}={found.source[q]!r}" for q in (*IMU_AXES, "time", "dt")
                       if q in found.source)
+    reference = [q for q in ("roll", "pitch", *QUAT_COLUMNS) if q in found.source]
+    if reference:  # the file's own: said, as a device's own estimate may be what they hold
+        stated = units.get("roll") if "roll" in reference else None
+        where += ("; reference from this file's columns "
+                  + ", ".join(f"{q}={found.source[q]!r}" for q in reference)
+                  + (f" in {stated} (from the header)" if stated
+                     else " in rad" if "roll" in reference else ""))
     if split:
         time_how += ("; the accelerometer and the gyro on rows of their own: each gyro row a "
                      "sample, with the accelerometer's latest row before it")
