@@ -27,6 +27,8 @@ UNIT_ALIASES: dict[str, str] = {
     "m/s2": "m/s2", "m/s^2": "m/s2", "m/s²": "m/s2", "ms^-2": "m/s2", "ms-2": "m/s2",
     "m.s-2": "m/s2", "mps2": "m/s2",
     "s": "s", "sec": "s", "seconds": "s", "ms": "ms", "us": "us", "µs": "us", "ns": "ns",
+    **{f"{since}{sep}{unit}": unit for since in ("epoch", "unix") for sep in ("_", "-", "")
+       for unit in ("s", "ms", "us", "ns")},
     "m/(s^2)": "m/s2", "m/(s2)": "m/s2",
     "rad": "rad", "deg": "deg", "°": "deg", "1": "1",
 }

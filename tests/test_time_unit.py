@@ -64,6 +64,22 @@ def test_a_dt_column_and_a_name_may_carry_the_unit(tmp_path):
         assert source.time_unit == "ms" and "time in ms (from the header)" in source.choices
 
 
+@pytest.mark.parametrize(("name", "unit", "scale"), [
+    ("Timestamp(epoch_ms)", "ms", 1e3), ("unix_time_ms", "ms", 1e3), ("Epoch (s)", "s", 1.0),
+    ("epoch", "s", 1.0), ("timestamp (unix_us)", "us", 1e6)])
+def test_a_time_named_as_since_1970_is_the_time(tmp_path, name, unit, scale):
+    """A logger's time named for its epoch ("Timestamp(epoch_ms)", as an ESP32 sketch writes
+    it; "unix_time_ms"; "epoch") was no time column: "no time or dt column: give the sample
+    rate ...". It is the time, in the unit its name states, else the one its steps give."""
+    t, imu = _example()
+    path = tmp_path / "epoch.csv"
+    np.savetxt(path, np.column_stack([(1.7e9 + t) * scale, imu]), delimiter=",",
+               header=f"{name},{HEADER}", comments="", fmt=["%.6f"] + ["%.10g"] * 6)
+    source, rec, _ = _read(path)
+    assert source.time_unit == unit and f"time='{name}'" in source.choices
+    np.testing.assert_allclose(rec.dt[1:], np.diff(t), atol=2e-6)
+
+
 def test_where_two_units_give_imu_rates_the_data_decide(tmp_path):
     """A step of 0.05 is 20 Hz in s or 20 kHz in ms: in ms the gyro's turn is a thousand times
     too small in any gyro unit, in s one unit explains gravity's turn."""

@@ -30,7 +30,11 @@ ALIASES: dict[str, tuple[str, ...]] = {
                      f"gyro_{a}_dps") for a in "xyz"},
     "time": ("header_stamp", "time", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
              "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
-             "timestamp_unix", "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
+             "timestamp_unix", "unix_time", "unix_timestamp", "epoch", "epoch_time",
+             "timestamp_epoch", *(f"{stem}_{unit}" for stem in ("epoch", "timestamp_epoch",
+                                                                "unix_time")
+                                  for unit in ("s", "ms", "us", "ns")),
+             "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
              "seconds_elapsed", "time_since_start", "time_since_start_in_ms",
              "gyro_timestamp_since_reboot", "accelerometer_timestamp_since_reboot", "x_value",
              "t_s", "t_ms", "t_us", "t_ns", "receive_time", "t"),
