@@ -35,6 +35,7 @@ def _write(path: Path, time_name: str, t: np.ndarray, imu: np.ndarray) -> Path:
     "timeStamp,accelX,accelY,accelZ,rotationRateX,rotationRateY,rotationRateZ",
     "timestamp,accelerometerAccelerationX,accelerometerAccelerationY,"
     "accelerometerAccelerationZ,gyro_x,gyro_y,gyro_z",  # iOS SensorLog
+    "time,AcX,AcY,AcZ,GyX,GyY,GyZ",  # the Arduino MPU-6050 example's names
 ])
 def test_the_names_loggers_give_their_columns_are_found(tmp_path, header):
     """The column names of a ROS topic's CSV, microcontroller sketches and phone apps."""
@@ -46,6 +47,22 @@ def test_the_names_loggers_give_their_columns_are_found(tmp_path, header):
     names = header.split(",")
     assert source.rate == pytest.approx(100.0)
     assert f"acc_x={names[1]!r}" in source.choices and f"gyro_z={names[6]!r}" in source.choices
+
+
+def test_the_arduino_examples_raw_counts_are_named_for_what_they_are(tmp_path):
+    """The Arduino MPU-6050 example prints AcX..GyZ as the converter's counts (16384 per g at
+    +-2 g, 131 per deg/s at +-250 deg/s) beside its temperature: no column was found ("no
+    column for acc_x, ..."); they are, and the counts are refused as counts, saying what to
+    divide them by."""
+    t, imu = _example()
+    counts = np.column_stack([t * 1e3, imu[:, :3] / 9.80665 * 16384, np.full(len(t), 3000.0),
+                              np.degrees(imu[:, 3:]) * 131.0])
+    path = tmp_path / "sketch.csv"
+    np.savetxt(path, np.round(counts), delimiter=",", comments="", fmt="%d",
+               header="millis,AcX,AcY,AcZ,Tmp,GyX,GyY,GyZ")
+    with pytest.raises(RecordingError, match="that is about 16384, a MEMS part's raw counts "
+                                             "per g"):
+        open_recording(path)
 
 
 @pytest.mark.parametrize("before", [

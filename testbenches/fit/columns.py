@@ -24,9 +24,9 @@ def axis_names(stems: tuple[str, ...], axis: str, short: tuple[str, ...]) -> tup
 
 
 ALIASES: dict[str, tuple[str, ...]] = {
-    **{f"acc_{a}": (*axis_names(ACC_STEMS, a, ("g_f", "a", "a_", "a_rs_s_")), f"acc_{a}_g",
-                    f"acc_{a}_ms2") for a in "xyz"},
-    **{f"gyro_{a}": (*axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_", "w_rs_s_")),
+    **{f"acc_{a}": (*axis_names(ACC_STEMS, a, ("g_f", "a", "a_", "a_rs_s_", "ac", "ac_")),
+                    f"acc_{a}_g", f"acc_{a}_ms2") for a in "xyz"},
+    **{f"gyro_{a}": (*axis_names(GYRO_STEMS, a, ("g", "g_", "w", "w_", "w_rs_s_", "gy", "gy_")),
                      f"gyro_{a}_dps") for a in "xyz"},
     "time": ("header_stamp", "time", "timestamp", "time_s", "time_ms", "time_us", "time_ns",
              "timestamp_s", "timestamp_ms", "timestamp_us", "timestamp_ns", "time_stamp",
@@ -51,7 +51,9 @@ the sample by the transport's delay and bunches where messages arrive together; 
 flight log's "T" is its temperature beside a "timestamp". EuRoC's and TUM-VI's "w_RS_S_x" and
 "a_RS_S_x" (the rate and the specific force of the sensor frame S against the reference R, in
 S). SensorLog's (iOS) gyro's clock before its accelerometer's. LabVIEW's measurement file's
-(.lvm) "X_Value", its waveforms' time. Physics Toolbox's g-force "gFx"
+(.lvm) "X_Value", its waveforms' time. The Arduino MPU-6050 example's "AcX" and "GyX" (raw
+counts as it prints them, which the accelerometer's norm then tells). Physics Toolbox's
+g-force "gFx"
 is the accelerometer (its "ax" there leaves gravity out, and is refused for it). A reference
 quaternion's components (sensor to world) too, as motion capture names them ("Rotation W" in
 OptiTrack Motive's stacked header, testbenches.reader), EuRoC's ground truth ("q_RS_w") and
