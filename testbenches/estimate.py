@@ -792,6 +792,10 @@ def cmd_estimate(args: argparse.Namespace) -> int:
                   for key in keys}
     names = {key: output_columns(args.outputs, est.HAS_POSITION)
              for key, est in estimators.items()}
+    if not args.no_plots:  # the plotting library loads while the recording opens, which
+        import threading  # leaves the second core idle (reading, units and rate are serial)
+
+        threading.Thread(target=_import_pyplot, daemon=True).start()
     mapped = parse_columns(args.reference_column, "--reference-column", REFERENCE_COLUMNS)
     given = [name for name, value in (("--reference-column", mapped),
                                       ("--reference-topic", args.reference_topic),
@@ -876,8 +880,6 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                 if lanes is None:  # VQF's lane is known after the first block's reference
                     lanes = _Lanes([*runs, *([vqf] if vqf is not None else [])], bar.update)
                 lanes.submit(len(t), rec, t, n, args.every)  # rec is not changed after this
-                if n == 0 and not args.no_plots:
-                    _start_pyplot_import()
                 if n == 0:
                     first_t = float(t[0])
                 last_t = float(t[-1])
@@ -962,15 +964,6 @@ def conditioned(acc: np.ndarray, gyro: np.ndarray, params: dict[str, Any]
                                    float(params.get("mount_pitch", 0.0)),
                                    float(params.get("mount_yaw", 0.0)))).reshape(3, 3)
     return acc @ r.T, gyro @ r.T
-
-
-def _start_pyplot_import() -> None:
-    """matplotlib's import begun in a thread of its own, once the estimators run: they hold
-    no GIL, so it costs them one core's share for its length. Begun earlier, while the
-    recording opens (Python holding the GIL), it would take its length from the opening."""
-    import threading
-
-    threading.Thread(target=_import_pyplot, daemon=True).start()
 
 
 def _import_pyplot() -> Any:
