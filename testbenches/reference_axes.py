@@ -110,6 +110,27 @@ def mounting_angles(m: np.ndarray) -> tuple[float, float, float]:
             math.degrees(math.atan2(m[1, 0], m[0, 0])))
 
 
+def _in_degrees(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
+                angles: tuple[np.ndarray, np.ndarray], share: float) -> bool:
+    """Whether roll and pitch `angles` [rad], numbers in degrees read as radians (as numbers
+    within pi and pi/2 are where no header states a unit), meet both laws in degrees: read so
+    they tilt the up direction off the specific force (law 1 fails, `share`), and in degrees
+    they meet both laws, turning where the accelerometer's direction turns. Read in degrees a
+    reference is all but level, so that it meets law 1 wherever the sensor is near level, and
+    law 2 says nothing of an up direction that barely turns: a reference of another
+    convention would meet both, but not turn where the sensor does."""
+    from .broad.metric import gravity_from_roll_pitch
+    from .gyro_unit import window_misses
+
+    if abs(share - 1.0) <= VERTICAL_TOLERANCE:
+        return False
+    up = gravity_from_roll_pitch(*np.radians(angles))
+    if _fails(acc, gyro, dt, up)[0]:
+        return False
+    turning = len(window_misses(acc, gyro, dt, {"gyro": np.eye(3)})["gyro"])
+    return turning < MIN_WINDOWS or turn_miss(up, gyro, dt)[0] >= MIN_WINDOWS
+
+
 def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up: np.ndarray,
                conventions: bool = False, lag: str = "",
                raw: tuple[np.ndarray, np.ndarray] | None = None) -> None:
@@ -139,8 +160,7 @@ def check_axes(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, up
         serves += [f"they agree with {name} (a convention other than roll about x, then pitch "
                    "about y)" for name, convention in CONVENTIONS.items()
                    if not _fails(acc, gyro, dt, gravity_from_roll_pitch(*convention(*angles)))[0]]
-        # numbers within pi and pi/2 are taken as radians where no header states a unit
-        if not _fails(acc, gyro, dt, gravity_from_roll_pitch(*np.radians(angles)))[0]:
+        if _in_degrees(acc, gyro, dt, angles, share):
             serves.append("they agree with roll and pitch in degrees: state the unit in the "
                           "header (roll (deg), pitch (deg)); numbers within pi and pi/2 are "
                           "taken as radians")

@@ -454,6 +454,7 @@ def test_a_reference_in_other_axes_is_refused_naming_what_serves(tmp_path, capsy
     assert main(args) == 2
     said = capsys.readouterr().err
     assert "the reference does not describe this sensor in its axes" in said and serves in said
+    assert "in degrees" not in said
     if kind == "mounted":
         assert main([*args, "--mounting", "90,0,0"]) == 0
         assert _kf_rmse(capsys.readouterr().out) == pytest.approx(0.5996, abs=1e-3)
