@@ -64,6 +64,11 @@ def add_recording_options(parser: argparse.ArgumentParser) -> None:
                         help="the gyro's unit (auto: the header's, else the unit in which the "
                         "gyro's turn explains the accelerometer's turn of gravity; a given or "
                         "stated unit the data contradict is refused)")
+    parser.add_argument("--counts", type=counts_pair, default=None, metavar="PER_G,PER_DPS",
+                        help="the accelerometer and the gyro as a converter's raw counts: its "
+                        "counts per g and per deg/s (the datasheet's sensitivity; an MPU-6050's "
+                        "16384,131 at +-2 g and +-250 deg/s), in place of --acc-unit and "
+                        "--gyro-unit; the gyro's scale is still checked against the data")
 
 
 def add_calibration(parser: argparse.ArgumentParser) -> None:
@@ -126,6 +131,20 @@ def non_negative_int(text: str) -> int:
 def positive_float(text: str) -> float:
     """argparse type: a finite number above 0 (durations [s], rates [Hz])."""
     return _number(text, float, "a finite number above 0", lambda v: 0.0 < v < math.inf)
+
+
+def counts_pair(text: str) -> tuple[float, float]:
+    """argparse type: PER_G,PER_DPS, two finite numbers above 0 (--counts)."""
+    parts = text.split(",")
+    try:
+        pair = tuple(float(p) for p in parts)
+    except ValueError:
+        pair = ()
+    if len(pair) != 2 or not all(0.0 < v < math.inf for v in pair):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: allowed two numbers above 0, the counts per g and per deg/s "
+            "(16384,131 for an MPU-6050 at +-2 g and +-250 deg/s)")
+    return pair[0], pair[1]
 
 
 def non_negative_float(text: str) -> float:

@@ -52,8 +52,8 @@ def test_the_names_loggers_give_their_columns_are_found(tmp_path, header):
 def test_the_arduino_examples_raw_counts_are_named_for_what_they_are(tmp_path):
     """The Arduino MPU-6050 example prints AcX..GyZ as the converter's counts (16384 per g at
     +-2 g, 131 per deg/s at +-250 deg/s) beside its temperature: no column was found ("no
-    column for acc_x, ..."); they are, and the counts are refused as counts, saying what to
-    divide them by."""
+    column for acc_x, ..."); they are, the counts are refused as counts naming --counts, and
+    with it they are read (the gyro's scale checked against the data as a unit is)."""
     t, imu = _example()
     counts = np.column_stack([t * 1e3, imu[:, :3] / 9.80665 * 16384, np.full(len(t), 3000.0),
                               np.degrees(imu[:, 3:]) * 131.0])
@@ -61,8 +61,29 @@ def test_the_arduino_examples_raw_counts_are_named_for_what_they_are(tmp_path):
     np.savetxt(path, np.round(counts), delimiter=",", comments="", fmt="%d",
                header="millis,AcX,AcY,AcZ,Tmp,GyX,GyY,GyZ")
     with pytest.raises(RecordingError, match="that is about 16384, a MEMS part's raw counts "
-                                             "per g"):
+                                             r"per g .*give --counts PER_G,PER_DPS"):
         open_recording(path)
+    # --counts reads them: the gyro's scale checked against the data, wrong counts refused
+    source = open_recording(path, counts=(16384.0, 131.0))
+    assert ("acc in g from its counts (16384 per g, --counts); gyro in deg/s from its counts "
+            "(131 per deg/s, --counts, and the data agree)") in source.choices
+    rec, _ = source.load()
+    np.testing.assert_allclose(rec.acc, imu[:, :3], atol=9.80665 / 16384)
+    np.testing.assert_allclose(rec.gyro, imu[:, 3:], atol=np.radians(1 / 131.0))
+    with pytest.raises(RecordingError, match=r"median norm is 8.001 g with 2048 counts per g "
+                                             r"\(--counts\), .* about 1.639e\+04 counts per g "
+                                             r"\(16384: give --counts 16384,...\)"):
+        open_recording(path, counts=(2048.0, 131.0))
+    with pytest.raises(RecordingError, match=r"the gyro's counts per deg/s \(16.4, --counts\) "
+                                             "contradict the data"):
+        open_recording(path, counts=(16384.0, 16.4))
+    with pytest.raises(RecordingError, match="leave --acc-unit and --gyro-unit out"):
+        open_recording(path, counts=(16384.0, 131.0), gyro_unit="deg/s")
+    stated = tmp_path / "stated.csv"
+    stated.write_text(path.read_text().replace("AcX,AcY,AcZ", "AcX (g),AcY (g),AcZ (g)", 1))
+    with pytest.raises(RecordingError, match=r"--counts is given, but the header states the "
+                                             r"unit\(s\) g"):
+        open_recording(stated, counts=(16384.0, 131.0))
 
 
 @pytest.mark.parametrize("before", [

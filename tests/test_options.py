@@ -12,6 +12,7 @@ import pytest
 from testbenches.__main__ import main
 from testbenches.montecarlo.runner import execute
 from testbenches.options import (
+    counts_pair,
     jitter_fraction,
     non_negative_float,
     non_negative_int,
@@ -26,6 +27,8 @@ from testbenches.options import (
     (positive_float, {"60": 60.0, "0.5": 0.5}, ["0", "-5", "nan", "inf", "x"]),
     (non_negative_float, {"0": 0.0, "0.03": 0.03}, ["-0.01", "nan", "inf"]),
     (jitter_fraction, {"0": 0.0, "0.2": 0.2}, ["1", "1.5", "-0.1", "nan"]),
+    (counts_pair, {"16384,131": (16384.0, 131.0), "2048,16.4": (2048.0, 16.4)},
+     ["16384", "16384,0", "a,b", "1,2,3", "inf,131"]),
 ])
 def test_each_number_type_takes_what_it_allows_and_names_it_otherwise(kind, good, bad):
     for text, value in good.items():
@@ -45,6 +48,8 @@ def test_each_number_type_takes_what_it_allows_and_names_it_otherwise(kind, good
     ["campaign", "--batch-size", "0"],
     ["campaign", "--duration", "0"],
     ["budget", "--seeds", "0"],
+    ["estimate", "--counts", "16384", "x.csv"],
+    ["noise", "--counts", "16384,-1", "x.csv"],
 ])
 def test_the_commands_refuse_them_before_running(argv, capsys):
     with pytest.raises(SystemExit) as stop:

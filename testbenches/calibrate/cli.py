@@ -225,7 +225,9 @@ def run(args: argparse.Namespace) -> int:
     extra: dict[str, Any] = {
         "method": method,
         "units": {"acc": "m/s2", "gyro": "rad/s", "matrix": "1"},
-        "input_units": {"acc": args.acc_unit, "gyro": args.gyro_unit},
+        "input_units": {"acc": args.acc_unit, "gyro": args.gyro_unit} if args.counts is None
+        else {"acc": f"counts ({args.counts[0]:g} per g)",
+              "gyro": f"counts ({args.counts[1]:g} per deg/s)"},
         "gravity": g,
         "recording": str(args.recording),
         "acc": _fit_json(acc_fit, "m/s2 (| |a| - g | per pose)", held.acc, held.acc_spans),

@@ -667,12 +667,14 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
                    acc_unit: str = "auto", gyro_unit: str = "auto",
                    columns: dict[str, str] | None = None,
                    time_unit: str = "auto", acc_sign: str = "auto",
-                   gyro_axes: str = AS_READ_AXES, topic: str | None = None) -> RecordingSource:
+                   gyro_axes: str = AS_READ_AXES, topic: str | None = None,
+                   counts: tuple[float, float] | None = None) -> RecordingSource:
     """The recording opened for reading in blocks (RecordingSource), its units, columns and
     rate decided from its first PREFIX_ROWS samples: given, stated by the file, or from the
     data (which must not contradict what is given or stated); the gyro's axes in the
-    accelerometer's as `gyro_axes` orders them (parse_axes); RecordingError saying what is
-    wrong."""
+    accelerometer's as `gyro_axes` orders them (parse_axes); `counts`, a converter's raw
+    counts per g and per deg/s, in place of the units (the gyro's scale still checked against
+    the data); RecordingError saying what is wrong."""
     from ..bags import is_bag
     from ..reader import TableError
     from .sensor_files import is_sensor_files, open_sensor_files
@@ -750,9 +752,14 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
             found.take(table, "time", rising)
             prefix["time"] = other_times[rising]
             wanted = [found.index[q] for q in names]
-    # the samples as read: the time unit's evidence needs their directions only
+    if counts is not None:
+        acc_unit, gyro_unit = _counted_units(path, counts, acc_unit, gyro_unit, units)
+    # the samples as read (counts in g and deg/s): the time unit's evidence needs their
+    # directions only
     def vectors(cols: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         acc, gyro = _vectors(cols)
+        if counts is not None:
+            acc, gyro = acc / counts[0], gyro / counts[1]
         return acc, gyro if axes is None else gyro @ axes.T
 
     acc, gyro = vectors({q: v[keep] for q, v in prefix.items()})
@@ -805,10 +812,14 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
         raise RecordingError(f"{path}: no sample holds numbers in every column")
+    if counts is not None:
+        _counts_hold_gravity(path, acc[finite], counts[0])
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
                                     _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
     sign, sign_how = _acc_sign(path, acc_sign, [table.names[found.index[f"acc_{a}"]]
                                                 for a in "xyz"], table.platform)
+    if counts is not None:
+        acc_how = f"g from its counts ({counts[0]:g} per g, --counts)"
     acc_scale, acc_how = sign * acc_scale, acc_how + sign_how
 
     def more() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -824,8 +835,11 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
 
     found_unit = _gyro_unit(
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
-        more if n == PREFIX_ROWS else None)
+        more if n == PREFIX_ROWS else None, counts[1] if counts is not None else None)
     gyro_scale, gyro_how, used = UNITS[found_unit.unit], found_unit.how, found_unit.samples
+    if counts is not None:
+        gyro_how = (f"deg/s from its counts ({counts[1]:g} per deg/s, --counts"
+                    + (", and the data agree)" if found_unit.checked else ")"))
     if axes is not None:
         gyro_how += ("; its axes as the accelerometer's "
                      f"{', '.join(c.strip() for c in gyro_axes.split(','))} (given)")
@@ -1064,7 +1078,7 @@ def source_from_args(path: Path, args: argparse.Namespace) -> RecordingSource:
                           acc_unit=args.acc_unit, gyro_unit=args.gyro_unit,
                           columns=parse_columns(args.column), time_unit=args.time_unit,
                           acc_sign=args.acc_sign, gyro_axes=args.gyro_axes,
-                          topic=args.topic)
+                          topic=args.topic, counts=getattr(args, "counts", None))
 
 
 def recording_from_args(path: Path, args: argparse.Namespace) -> Any:
@@ -1203,8 +1217,40 @@ def _counts_hint(norm: float) -> str:
     if not near:
         return ""
     return (f"that is about {near[0]}, a MEMS part's raw counts per g (an MPU-6050 gives "
-            "16384 at +-2 g, 2048 at +-16 g): divide the accelerometer's columns by its counts "
-            "per g and give them in g, or ")
+            "16384 at +-2 g, 2048 at +-16 g): give --counts PER_G,PER_DPS, its counts per g "
+            "and per deg/s from its datasheet (an MPU-6050's 16384,131 at +-2 g and +-250 "
+            "deg/s), or ")
+
+
+def _counted_units(path: Path, counts: tuple[float, float], acc_unit: str, gyro_unit: str,
+                   units: dict[str, str | None]) -> tuple[str, str]:
+    """The units --counts gives the numbers (g and deg/s once divided by its counts);
+    RecordingError where a unit is also given or stated by the header."""
+    if acc_unit != "auto" or gyro_unit != "auto":
+        raise RecordingError(f"{path}: --counts gives the accelerometer's and the gyro's units "
+                             "(its counts per g and per deg/s): leave --acc-unit and "
+                             "--gyro-unit out")
+    stated = sorted({u for q, u in units.items() if q in IMU_AXES and u})
+    if stated:
+        raise RecordingError(f"{path}: --counts is given, but the header states the unit(s) "
+                             f"{', '.join(stated)} for the accelerometer or the gyro: numbers "
+                             "in a unit are no counts; leave --counts out")
+    return "g", "deg/s"
+
+
+def _counts_hold_gravity(path: Path, acc_g: np.ndarray, per_g: float) -> None:
+    """RecordingError where the accelerometer divided by its counts per g (`acc_g`) cannot be
+    gravity's (a median norm not within ACC_NORMS' g), saying what counts per g it holds."""
+    norm = float(np.median(np.linalg.norm(acc_g, axis=1)))
+    lo, hi = ACC_NORMS["g"]
+    if lo < norm < hi:
+        return
+    held = norm * per_g
+    near = [c for c in COUNTS_PER_G if abs(held / c - 1.0) < 0.15]
+    raise RecordingError(
+        f"{path}: the accelerometer's median norm is {norm:.4g} g with {per_g:g} counts per g "
+        f"(--counts), which cannot be gravity's: it holds about {held:.4g} counts per g"
+        + (f" ({near[0]}: give --counts {near[0]},...)" if near else ""))
 
 
 def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
@@ -1291,13 +1337,15 @@ class _GyroUnit:
 
 
 def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, unit: str,
-               stated: str | None, more: Any = None) -> _GyroUnit:
+               stated: str | None, more: Any = None, per_dps: float | None = None
+               ) -> _GyroUnit:
     """The gyro's unit, how it was chosen and over how many samples: the unit in which the
     gyro's turn explains the accelerometer's turn of gravity (testbenches.gyro_unit), the
     windows of further blocks (`more`: (acc, gyro, dt) each) pooled while the first cannot
     tell and no unit is given. A unit given or stated by the header that the data contradict
     is refused with the evidence; where the data cannot tell and no unit is given or stated,
-    the recording is refused, and so is a given unit that is not the header's."""
+    the recording is refused, and so is a given unit that is not the header's. `per_dps`:
+    the gyro's numbers are its counts divided by this many per deg/s (--counts), unit deg/s."""
     from ..gyro_unit import MIN_WINDOWS, verdict, window_misses
     from ..time_unit import listed
 
@@ -1322,6 +1370,11 @@ def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, un
                                  f"{', '.join(UNITS)}")
         if evidence.unit is None and chosen == "rad/s":
             _no_gyro_noise(path, acc, gyro, dt, how)
+        if evidence.unit is not None and evidence.unit != chosen and per_dps is not None:
+            raise RecordingError(
+                f"{path}: the gyro's counts per deg/s ({per_dps:g}, --counts) contradict the "
+                f"data: {evidence.describe()}: give the counts per deg/s of the range the part "
+                "was set to (an MPU-6050's 131, 65.5, 32.8 or 16.4 at +-250 to +-2000 deg/s)")
         if evidence.unit is not None and evidence.unit != chosen:
             raise RecordingError(
                 f"{path}: the gyro's unit {chosen} ({how}) contradicts the data: "
