@@ -9,8 +9,8 @@ gyro_x/... (or gx/gy/gz, gyrX/..., wx/wy/wz), the time as time/t/timestamp (or -
 sampling as dt or --rate; --column QUANTITY=NAME maps any other name. The delimiter, the
 encoding and a unit stated in a column's name ("Gyroscope X (deg/s)") are read off the file
 (testbenches.reader). Units are given (--acc-unit g|m/s2, --gyro-unit rad/s|deg/s; raw counts
-with --counts PER_G,PER_DPS), stated by the header, or found from the data: the accelerometer's from its norm (1 in g, 9.81 in m/s^2),
-the gyro's as the unit in which its turn explains the accelerometer's turn of gravity
+with --counts PER_G,PER_DPS), stated by the header, or found from the data: the
+accelerometer's from its norm (1 in g, 9.81 in m/s^2), the gyro's as the unit in which its turn explains the accelerometer's turn of gravity
 (testbenches.gyro_unit), the time's (--time-unit s|ms|us|ns) as the unit in which its steps
 are an IMU's rate, the data deciding where two are (testbenches.time_unit). A given or stated
 unit the data contradict is refused with the evidence, and so is a recording whose data cannot
