@@ -3,19 +3,19 @@
 A recording is a delimited text file (CSV) with a header row, a Parquet file, an HDF5 file or a
 MATLAB .mat file (a BROAD trial, or columns as 1-D datasets or variables, acc and gyro also as
 [N, 3] ones, with a time column or a `rate`; testbenches.reader), a PX4 log, or a ROS bag's IMU
-topic (testbenches.bags). Columns are found by name: the
-accelerometer as acc_x/acc_y/acc_z (or ax/ay/az, accX/accY/accZ, acc_x_g, ...), the gyro as
-gyro_x/... (or gx/gy/gz, gyrX/..., wx/wy/wz), the time as time/t/timestamp (or --time-column), the
-sampling as dt or --rate; --column QUANTITY=NAME maps any other name. The delimiter, the
-encoding and a unit stated in a column's name ("Gyroscope X (deg/s)") are read off the file
-(testbenches.reader). Units are given (--acc-unit g|m/s2, --gyro-unit rad/s|deg/s; raw counts
-with --counts PER_G,PER_DPS), stated by the header, or found from the data: the
-accelerometer's from its norm (1 in g, 9.81 in m/s^2), the gyro's as the unit in which its turn explains the accelerometer's turn of gravity
-(testbenches.gyro_unit), the time's (--time-unit s|ms|us|ns) as the unit in which its steps
-are an IMU's rate, the data deciding where two are (testbenches.time_unit). A given or stated
-unit the data contradict is refused with the evidence, and so is a recording whose data cannot
-tell the unit where none is given. A sample without a number in every column is rejected and
-counted by the estimators, not the file.
+topic (testbenches.bags). Columns are found by name: the accelerometer as acc_x/acc_y/acc_z (or
+ax/ay/az, accX/accY/accZ, acc_x_g, ...), the gyro as gyro_x/... (or gx/gy/gz, gyrX/...,
+wx/wy/wz), the time as time/t/timestamp (or --time-column), the sampling as dt or --rate;
+--column QUANTITY=NAME maps any other name. The delimiter, the encoding and a unit stated in a
+column's name ("Gyroscope X (deg/s)") are read off the file (testbenches.reader). Units are
+given (--acc-unit g|m/s2, --gyro-unit rad/s|deg/s; raw counts with --counts PER_G,PER_DPS),
+stated by the header, or found from the data: the accelerometer's from its norm (1 in g, 9.81 in
+m/s^2), the gyro's as the unit in which its turn explains the accelerometer's turn of gravity
+(testbenches.gyro_unit), the time's (--time-unit s|ms|us|ns) as the unit in which its steps are
+an IMU's rate, the data deciding where two are (testbenches.time_unit). A given or stated unit
+the data contradict is refused with the evidence, and so is a recording whose data cannot tell
+the unit where none is given. A sample without a number in every column is rejected and counted
+by the estimators, not the file.
 
 A reference, roll and pitch [rad or deg: as its header says, else as the accelerometer at rest
 tells] or a quaternion q_w, q_x, q_y, q_z (sensor to a z-up frame), in the recording or in a
