@@ -82,6 +82,31 @@ def test_a_folder_and_its_zip_read_as_the_one_file_of_their_rows(tmp_path):
         np.testing.assert_array_equal(t_read, t_expected)
 
 
+def test_polar_sensor_loggers_files_are_read_by_the_sensors_clock(tmp_path):
+    """Polar Sensor Logger writes ACC and GYRO files of `Phone timestamp;sensor timestamp
+    [ns];X [mg];...` (X [dps] for the gyro): no time column was found ("name it with
+    --time-column"). The sensor's clock is the time; the phone's, when the packets came, is
+    not taken while the sensor's is there."""
+    t, acc, gyro, _ = _part()
+    folder = tmp_path / "polar"
+    folder.mkdir()
+    start = np.datetime64("2022-05-10T12:00:00", "ms")
+    for name, unit, values in (("ACC", "mg", acc / G * 1e3), ("GYRO", "dps", np.degrees(gyro))):
+        phone = [str(start + np.timedelta64(int(k // 10 * 100), "ms")) for k in range(len(t))]
+        sensor = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+        lines = [f"Phone timestamp;sensor timestamp [ns];X [{unit}];Y [{unit}];Z [{unit}]"]
+        lines += [f"{p};{s};" + ";".join(f"{v:.6f}" for v in row)
+                  for p, s, row in zip(phone, sensor, values, strict=True)]
+        (folder / f"Polar_Sense_B5A0D123_20220510_120000_{name}.txt").write_text(
+            "\n".join(lines) + "\n")
+    source = open_recording(folder)
+    rec, _ = source.load()
+    assert "time='sensor timestamp [ns]'" in source.choices
+    assert "acc in mg (from the header); gyro in deg/s (from the header" in source.choices
+    assert source.rate == pytest.approx(1.0 / np.median(np.diff(t)), rel=1e-6)
+    np.testing.assert_allclose(rec.acc[1:], acc[1:], atol=1e-5)
+
+
 def test_sensor_loggers_total_acceleration_is_taken_and_its_accelerometer_refused(tmp_path):
     """Sensor Logger's Accelerometer.csv leaves gravity out, TotalAcceleration.csv holds it:
     the total one is taken and the others are said to be left; without it the accelerometer

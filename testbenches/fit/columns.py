@@ -37,7 +37,8 @@ ALIASES: dict[str, tuple[str, ...]] = {
              "millis", "micros", "elapsed", "elapsed_time", "time_elapsed",
              "seconds_elapsed", "time_since_start", "time_since_start_in_ms",
              "gyro_timestamp_since_reboot", "accelerometer_timestamp_since_reboot", "x_value",
-             "t_s", "t_ms", "t_us", "t_ns", "receive_time", "t"),
+             "t_s", "t_ms", "t_us", "t_ns", "sensor_timestamp", "receive_time",
+             "phone_timestamp", "t"),
     **{f"q_{c}": (f"q_{c}", f"q{c}", f"quat_{c}", f"quaternion_{c}", f"rotation_{c}",
                   f"q_rs_{c}", f"transform_rotation_{c}", f"pose_orientation_{c}",
                   f"pose_pose_orientation_{c}") for c in "wxyz"},
@@ -50,7 +51,9 @@ received last but one (rostopic's "%time", PlotJuggler's "__time": "receive_time
 the sample by the transport's delay and bunches where messages arrive together; "t" last, as a
 flight log's "T" is its temperature beside a "timestamp". EuRoC's and TUM-VI's "w_RS_S_x" and
 "a_RS_S_x" (the rate and the specific force of the sensor frame S against the reference R, in
-S). SensorLog's (iOS) gyro's clock before its accelerometer's. LabVIEW's measurement file's
+S). SensorLog's (iOS) gyro's clock before its accelerometer's. Polar Sensor Logger's "sensor
+timestamp [ns]" (the sensor's clock) before its "Phone timestamp" (when the phone received
+the packet, which bunches its samples). LabVIEW's measurement file's
 (.lvm) "X_Value", its waveforms' time. The Arduino MPU-6050 example's "AcX" and "GyX" (raw
 counts as it prints them, which the accelerometer's norm then tells). Physics Toolbox's
 g-force "gFx"
