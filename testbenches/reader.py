@@ -11,10 +11,12 @@ any length is read in bounded memory:
   semicolon, tab or bar, one after the rows' or the header's last cell read through; else
   runs of spaces; a decimal comma where the numbers have one) and the header row are
   found from the file's start (after LabVIEW's ***End_of_Header*** lines); pyarrow's CSV reader
-  parses it, and where it cannot (text where a number belongs, a row of the wrong length,
-  padded cells) the file is read by Python's csv module, which names the file's line, the
-  column and the value; a last line a logger cut short mid-write and the NUL bytes of a
-  preallocated file's unwritten rest are left out, and said (`TableSource.note`);
+  parses it (numbers with spaces around them too; dates and times so padded, or in other
+  forms than ISO 8601's, as text it rewrites), and where it cannot (text where a number
+  belongs, a row of the wrong length) the file is read by Python's csv module, which names
+  the file's line, the column and the value; a last line a logger cut short mid-write and
+  the NUL bytes of a preallocated file's unwritten rest are left out, and said
+  (`TableSource.note`);
 - a column of ISO 8601 dates and times ("2024-05-01T12:00:00.010", with a zone or without one,
   then taken as UTC) as seconds since 1970, as a Parquet timestamp column;
 - a column of durations written with their unit ("0.01 sec", as MATLAB's writetimetable writes
@@ -381,7 +383,7 @@ class _TextLayout:
     header_line: int  # the header's line in the file, from 1
     header: list[str]
     decimal_comma: bool
-    padded: bool  # cells with spaces around the number: Python's float reads those
+    padded: bool  # cells with spaces around the number (", " between cells)
     datetimes: dict[int, bool] = field(default_factory=dict)
     """Columns of ISO 8601 date-times (read as seconds since 1970): index -> with a zone."""
     times_of_day: set[int] = field(default_factory=set)
@@ -604,13 +606,16 @@ def _sniff(path: Path) -> _TextLayout:
         if column and all(matches):
             datetimes[j] = all(m.group("zone") for m in matches if m)  # with a zone
             if any(m.group("sep") != "-" or "," in c or m.group("f2") for m, c
-                   in zip(matches, column, strict=True) if m):
+                   in zip(matches, column, strict=True) if m) or any(
+                       row[j] != row[j].strip() for row in rows
+                       if len(row) == len(header) and row[j].strip()):  # padded
                 rewritten.add(j)
         elif column and all(_DAY_MONTH.match(c) for c in column):
             day_month[j] = column[0]
         elif column and all(seconds_of_day(c) is not None for c in column):
             times_of_day.add(j)
-            if not all(_ISO_TIME_OF_DAY.match(c) for c in column):
+            if not all(_ISO_TIME_OF_DAY.match(row[j]) for row in rows
+                       if len(row) == len(header) and row[j].strip()):  # padded too
                 rewritten.add(j)
         elif column and all(duration_unit(c) for c in column):  # in the first cell's unit
             durations[j] = duration_unit(column[0]) or ""
@@ -1125,9 +1130,8 @@ def _text(path: Path) -> TableSource:
                                  "which read as the month first or the day first alike: export "
                                  "the time as ISO 8601 (2024-05-01 12:00:00.010) or as seconds")
         tally = _Tally(path, layout)
-        parts = (_python_parts(path, layout, columns, 0, tally)
-                 if layout.padded or not _has_pyarrow() else
-                 _text_parts(path, layout, columns, tally))
+        parts = (_python_parts(path, layout, columns, 0, tally) if not _has_pyarrow()
+                 else _text_parts(path, layout, columns, tally))
         yield from _reblocked(parts, rows, len(columns), tally.finish)
 
     def where(row: int) -> str:
@@ -1178,8 +1182,8 @@ def _as_iso(column: Any, kind: Any) -> Any:
     import pyarrow as pa
     import pyarrow.compute as pc
 
+    column = pc.utf8_trim_whitespace(column)  # a padded cell's
     if pa.types.is_time(kind):
-        column = pc.utf8_trim_whitespace(column)
         for pattern, replacement in (*_TIME_TO_ISO, (r"^", "1970-01-01T")):
             column = pc.replace_substring_regex(column, pattern, replacement)
         return column.cast(pa.timestamp("ns"))
