@@ -590,7 +590,8 @@ def _sniff(path: Path) -> _TextLayout:
             raise TableError(f"{path}, line {header_line}: numbers where a header row naming "
                              "the columns belongs (time,acc_x,acc_y,acc_z,gyro_x,gyro_y,gyro_z "
                              "or the like): add one")
-    header = [c.strip() for c in next(csv.reader([header_text], delimiter=delimiter))]
+    header = [c.strip() for c in next(csv.reader([header_text], delimiter=delimiter,
+                                                  skipinitialspace=True))]  # ", \"name\""
     data_after, units_row, stacked = header_line, [None] * len(header), ""
     if not commented:
         header, header_line, data_after, units_row, stacked = _stacked(numbered, start, header,

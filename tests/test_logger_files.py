@@ -344,6 +344,19 @@ def test_padded_cells_are_read_by_pyarrows_reader_to_the_same_bits(tmp_path, mon
         np.testing.assert_array_equal(getattr(arrow, name), getattr(python, name))
 
 
+def test_a_padded_header_of_quoted_names_is_read(tmp_path):
+    """`"time", "acc_x", ...`: a quote after the space that pads a cell is no quote to
+    Python's csv module, so the names kept their quotes and none was found ("no column for
+    acc_x, ..."). The header's cells are read with the padding skipped."""
+    t, imu = _example()
+    path = tmp_path / "quoted.csv"
+    path.write_text(", ".join(f'"{n}"' for n in ("time", *HEADER.split(","))) + "\n" + "".join(
+        f"{s:.2f}, " + ", ".join(f"{v:.10g}" for v in row) + "\n"
+        for s, row in zip(t, imu, strict=True)))
+    source = open_recording(path, gyro_unit="rad/s")
+    assert "acc_x='ax'" in source.choices and "time='time'" in source.choices
+
+
 @pytest.mark.parametrize("style", ["rule", "markdown"])
 def test_a_rule_under_the_header_is_no_row_of_names(tmp_path, style):
     """A serial monitor's table (a row of dashes under the names) or a Markdown one (|---|)."""
