@@ -107,7 +107,10 @@ def open_table(path: str | Path, want: str = "imu") -> TableSource:
         head = f.read(TEXT_CHECK)
     magic = head[:8]
     binary = _binary_format(head)
-    if binary is None and suffix in BINARY_SUFFIXES and _text_like(head):
+    named_other = suffix in BINARY_SUFFIXES or (  # a workbook's name on a table of text
+        suffix in SHEET_SUFFIXES and not magic.startswith(b"PK\x03\x04")
+        and not head.lstrip().startswith(b"<"))  # (an HTML page so named is refused)
+    if binary is None and named_other and _text_like(head):
         source = _text(path)  # a CSV renamed (or saved under the wrong name): read as it is
         source.note = "; ".join(filter(None, [f"named {suffix} but text: read as text",
                                               source.note]))
@@ -124,12 +127,6 @@ def open_table(path: str | Path, want: str = "imu") -> TableSource:
     if suffix == ".zip" and not zipfile.is_zipfile(path):  # one that opens: a workbook's text
         raise TableError(f"{path}: a zip archive that does not open: cut or damaged (no "
                          "directory of its files at its end): copy or download it again")
-    if (suffix in SHEET_SUFFIXES and binary is None and not magic.startswith(b"PK\x03\x04")
-            and _text_like(head) and not head.lstrip().startswith(b"<")):
-        source = _text(path)  # a table of text saved as .xls (an HTML page's is refused)
-        source.note = "; ".join(filter(None, [f"named {suffix} but text: read as text",
-                                              source.note]))
-        return source
     if ((magic.startswith(b"PK\x03\x04") and zipped_table(path) is None)
             or suffix in SHEET_SUFFIXES):
         raise TableError(f"{path}: a spreadsheet workbook (or another zip archive), which is no "

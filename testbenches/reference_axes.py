@@ -120,14 +120,13 @@ def _in_degrees(acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray,
     law 2 says nothing of an up direction that barely turns: a reference of another
     convention would meet both, but not turn where the sensor does."""
     from .broad.metric import gravity_from_roll_pitch
-    from .gyro_unit import window_misses
 
     if abs(share - 1.0) <= VERTICAL_TOLERANCE:
         return False
     up = gravity_from_roll_pitch(*np.radians(angles))
     if _fails(acc, gyro, dt, up)[0]:
         return False
-    turning = len(window_misses(acc, gyro, dt, {"gyro": np.eye(3)})["gyro"])
+    turning = turn_miss(acc, gyro, dt)[0]  # the windows in which the specific force turns
     return turning < MIN_WINDOWS or turn_miss(up, gyro, dt)[0] >= MIN_WINDOWS
 
 

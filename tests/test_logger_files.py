@@ -65,14 +65,15 @@ def test_the_arduino_examples_raw_counts_are_named_for_what_they_are(tmp_path):
         open_recording(path)
     # --counts reads them: the gyro's scale checked against the data, wrong counts refused
     source = open_recording(path, counts=(16384.0, 131.0))
-    assert ("acc in g from its counts (16384 per g, --counts); gyro in deg/s from its counts "
-            "(131 per deg/s, --counts, and the data agree)") in source.choices
+    assert ("acc in g (from its counts, 16384 per g, --counts); gyro in deg/s (from its "
+            "counts, 131 per deg/s, --counts, and the data agree)") in source.choices
     rec, _ = source.load()
     np.testing.assert_allclose(rec.acc, imu[:, :3], atol=9.80665 / 16384)
     np.testing.assert_allclose(rec.gyro, imu[:, 3:], atol=np.radians(1 / 131.0))
-    with pytest.raises(RecordingError, match=r"median norm is 8.001 g with 2048 counts per g "
-                                             r"\(--counts\), .* about 1.639e\+04 counts per g "
-                                             r"\(16384: give --counts 16384,...\)"):
+    with pytest.raises(RecordingError, match=r"median norm is 78.46 m/s2 in the unit g \(from "
+                                             r"its counts, 2048 per g, --counts\), .* about "
+                                             r"1.639e\+04 counts per g \(16384: give --counts "
+                                             r"16384,...\)"):
         open_recording(path, counts=(2048.0, 131.0))
     with pytest.raises(RecordingError, match=r"the gyro's counts per deg/s \(16.4, --counts\) "
                                              "contradict the data"):

@@ -812,14 +812,11 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
     finite = valid_samples(acc, gyro, dt)
     if not finite.any():
         raise RecordingError(f"{path}: no sample holds numbers in every column")
-    if counts is not None:
-        _counts_hold_gravity(path, acc[finite], counts[0])
     acc_scale, acc_how = _acc_scale(path, acc[finite], acc_unit,
-                                    _stated(units, tuple(f"acc_{a}" for a in "xyz"), path))
+                                    _stated(units, tuple(f"acc_{a}" for a in "xyz"), path),
+                                    counts[0] if counts is not None else None)
     sign, sign_how = _acc_sign(path, acc_sign, [table.names[found.index[f"acc_{a}"]]
                                                 for a in "xyz"], table.platform)
-    if counts is not None:
-        acc_how = f"g from its counts ({counts[0]:g} per g, --counts)"
     acc_scale, acc_how = sign * acc_scale, acc_how + sign_how
 
     def more() -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -837,9 +834,6 @@ def open_recording(path: Path, *, rate: float | None = None, time_column: str | 
         path, acc, gyro, dt, gyro_unit, _stated(units, tuple(f"gyro_{a}" for a in "xyz"), path),
         more if n == PREFIX_ROWS else None, counts[1] if counts is not None else None)
     gyro_scale, gyro_how, used = UNITS[found_unit.unit], found_unit.how, found_unit.samples
-    if counts is not None:
-        gyro_how = (f"deg/s from its counts ({counts[1]:g} per deg/s, --counts"
-                    + (", and the data agree)" if found_unit.checked else ")"))
     if axes is not None:
         gyro_how += ("; its axes as the accelerometer's "
                      f"{', '.join(c.strip() for c in gyro_axes.split(','))} (given)")
@@ -1238,30 +1232,17 @@ def _counted_units(path: Path, counts: tuple[float, float], acc_unit: str, gyro_
     return "g", "deg/s"
 
 
-def _counts_hold_gravity(path: Path, acc_g: np.ndarray, per_g: float) -> None:
-    """RecordingError where the accelerometer divided by its counts per g (`acc_g`) cannot be
-    gravity's (a median norm not within ACC_NORMS' g), saying what counts per g it holds."""
-    norm = float(np.median(np.linalg.norm(acc_g, axis=1)))
-    lo, hi = ACC_NORMS["g"]
-    if lo < norm < hi:
-        return
-    held = norm * per_g
-    near = [c for c in COUNTS_PER_G if abs(held / c - 1.0) < 0.15]
-    raise RecordingError(
-        f"{path}: the accelerometer's median norm is {norm:.4g} g with {per_g:g} counts per g "
-        f"(--counts), which cannot be gravity's: it holds about {held:.4g} counts per g"
-        + (f" ({near[0]}: give --counts {near[0]},...)" if near else ""))
-
-
-def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
-               ) -> tuple[float, str]:
+def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None,
+               per_g: float | None = None) -> tuple[float, str]:
     """The factor to m/s^2 and how it was chosen: given, stated by the header, or from the
     median norm (1 g or 9.81 m/s^2 at rest, and near it on average in motion); refused where
-    the norm in that unit cannot be gravity's, and where a given unit is not the header's."""
+    the norm in that unit cannot be gravity's, and where a given unit is not the header's.
+    `per_g`: the numbers are counts divided by this many per g (--counts), unit g."""
     _given_against_header(path, "accelerometer", "acc-unit", unit, stated)
     norm = float(np.median(np.linalg.norm(acc, axis=1)))
     chosen = unit if unit != "auto" else stated
-    how = "given" if unit != "auto" else "from the header"
+    how = ("given" if per_g is None else f"from its counts, {per_g:g} per g, --counts"
+           ) if unit != "auto" else "from the header"
     if chosen is None:
         chosen = next((u for u, (lo, hi) in ACC_NORMS.items() if lo < norm < hi), None)
         if chosen is None:
@@ -1278,8 +1259,14 @@ def _acc_scale(path: Path, acc: np.ndarray, unit: str, stated: str | None
                              f"{', '.join(ACC_UNITS)}")
     si = norm * scale
     if not 4.0 < si < 40.0:
+        held = ""
+        if per_g is not None:  # the counts per g the numbers hold
+            near = [c for c in COUNTS_PER_G if abs(norm * per_g / c - 1.0) < 0.15]
+            held = (f": it holds about {norm * per_g:.4g} counts per g"
+                    + (f" ({near[0]}: give --counts {near[0]},...)" if near else ""))
         raise RecordingError(f"{path}: the accelerometer's median norm is {si:.4g} m/s2 in the "
-                             f"unit {chosen} ({how}), which cannot be right (gravity is 9.81)")
+                             f"unit {chosen} ({how}), which cannot be right (gravity is "
+                             f"9.81){held}")
     return scale, f"{chosen} ({how})"
 
 
@@ -1364,7 +1351,8 @@ def _gyro_unit(path: Path, acc: np.ndarray, gyro: np.ndarray, dt: np.ndarray, un
         _axes_as_read(path, acc, gyro, dt, {u: UNITS[u] for u in ((chosen,) if chosen in UNITS
                                                                   else UNITS)})
     if chosen is not None:
-        how = "given" if unit != "auto" else "from the header"
+        how = ("given" if per_dps is None else f"from its counts, {per_dps:g} per deg/s, --counts"
+               ) if unit != "auto" else "from the header"
         if chosen not in UNITS:
             raise RecordingError(f"{path}: the gyro's unit {chosen!r} is not one of "
                                  f"{', '.join(UNITS)}")
