@@ -86,21 +86,24 @@ def _pyarrow_read_s(path: Path, repeats: int) -> float:
 
 
 def _estimators_alone_s(path: Path) -> dict[str, float]:
-    """Seconds of each estimator's C twin on the file's samples already in memory (no reading,
-    conditioning, writing or plot): what the command cannot go below but by running them on
-    more cores."""
+    """Seconds of each estimator's C twin the command runs, on the file's samples already in
+    memory (no reading, conditioning, writing or plot): what the command cannot go below but by
+    running them on more cores. An estimator whose outputs another's run gives is not run
+    there, nor here (testbenches.estimate.shared_runs)."""
     import pyarrow.csv as pc
 
     from fusion_core import native
     from fusion_core.registry import REGISTRY
+    from testbenches.estimate import shared_runs
 
     table = pc.read_csv(path)
     acc = np.column_stack([table[f"acc_{a}"].to_numpy() for a in "xyz"])
     gyro = np.column_stack([table[f"gyro_{a}"].to_numpy() for a in "xyz"])
     dt = np.full(len(acc), 1.0 / RATE_HZ)
     seconds = {}
+    given = shared_runs({entry.key: entry.cls() for entry in REGISTRY})
     for entry in REGISTRY:
-        if not native.available() or entry.twin is None:
+        if not native.available() or entry.twin is None or entry.key in given:
             continue
         t0 = time.perf_counter()
         native.run(entry.cls(), acc, gyro, dt)

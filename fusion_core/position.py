@@ -190,6 +190,18 @@ class PositionKalmanFilter(AxisFiltersState, Estimator):
     def attitude_state(self, value: dict) -> None:
         self.att.set_state(value)
 
+    def attitude_params(self) -> dict[str, Any]:
+        """The parameters of an AngleBiasKalmanFilter whose roll, pitch, bias and rejected
+        samples equal this filter's on any samples, to the bit: this filter's input stage
+        (COMMON_PARAMS: its sample rules, calibration, mounting and gyro range condition what
+        the attitude filter takes, and its sensor_delay turns the outputs ahead) with the
+        attitude filter's own parameters. A program that runs both filters on one recording
+        may take the kf's outputs from this one's where its kf has these parameters."""
+        common = {p.name for p in Estimator.COMMON}
+        own = self.params
+        return {name: own[name] if name in common else value
+                for name, value in self.att.params.items()}
+
     def _reset(self) -> None:
         self.tilt.reset()
         self.att.reset()

@@ -571,11 +571,18 @@ class _Run:
         self.key, self.est = key, est
         self.writer = TableWriter(path, fmt, names)
         self.score, self.trace, self.rejected = Score(), Thinned(), 0
+        self.also: list[_Run] = []  # runs whose outputs this one's give (_running)
 
     def block(self, rec: Any, t: np.ndarray, row0: int, every: int) -> None:
+        out = self.est.run(rec.acc, rec.gyro, rec.dt)
+        for run in (self, *self.also):
+            run.take(out, rec, t, row0, every)
+
+    def take(self, out: dict[str, np.ndarray], rec: Any, t: np.ndarray, row0: int,
+             every: int) -> None:
+        """A block's outputs written, scored and kept for the plot."""
         from .broad.metric import gravity_from_roll_pitch
 
-        out = self.est.run(rec.acc, rec.gyro, rec.dt)
         keep = slice(-row0 % every, None, every)  # the recording's rows 0, every, 2 every, ...
         self.writer.write(_columns(out, t, self.writer.names, keep))
         if rec.up_ref is None:  # the up direction for the plot's rows only
@@ -586,6 +593,36 @@ class _Run:
             self.score.add(up, rec)
             self.trace.add(row0, {"t": t, "up": up})
         self.rejected += int(out["rejected"].sum())
+
+
+def shared_runs(estimators: dict[str, Any]) -> dict[str, str]:
+    """Of estimators by key, those whose outputs another's run gives to the bit, each with
+    that one's key: a kf whose roll, pitch, bias and rejected samples the position filter's
+    gives (PositionKalmanFilter.attitude_params: that filter runs the same kf on the same
+    samples) need not run, which spares a sixth of running every estimator."""
+    from fusion_core.kalman import AngleBiasKalmanFilter
+    from fusion_core.position import PositionKalmanFilter
+
+    given: dict[str, str] = {}
+    for pos_key, pos in estimators.items():
+        if type(pos) is not PositionKalmanFilter:
+            continue
+        same = pos.attitude_params()
+        key = next((key for key, est in estimators.items() if key not in given
+                    and type(est) is AngleBiasKalmanFilter and est.params == same), None)
+        if key is not None:
+            given[key] = pos_key
+    return given
+
+
+def _running(runs: list[_Run]) -> list[_Run]:
+    """The runs that run their estimator, each also giving the outputs of those it gives
+    (shared_runs)."""
+    by_key = {run.key: run for run in runs}
+    given = shared_runs({run.key: run.est for run in runs})
+    for key, source in given.items():
+        by_key[source].also.append(by_key[key])
+    return [run for run in runs if run.key not in given]
 
 
 class _VqfRun:
@@ -878,7 +915,8 @@ def _run_blocks(args: argparse.Namespace, source: Any, reference: Reference | No
                     scored += int(rec.counts.sum())
                     truth.add(n, {"t": t, "up": rec.up_ref})
                 if lanes is None:  # VQF's lane is known after the first block's reference
-                    lanes = _Lanes([*runs, *([vqf] if vqf is not None else [])], bar.update)
+                    lanes = _Lanes([*_running(runs), *([vqf] if vqf is not None else [])],
+                                   bar.update)
                 lanes.submit(len(t), rec, t, n, args.every)  # rec is not changed after this
                 if n == 0:
                     first_t = float(t[0])

@@ -38,6 +38,32 @@ def test_estimate_writes_every_estimators_outputs_as_fusion_core_gives_them(tmp_
         assert float(line.split()[2]) < 1.5, line  # inclination RMSE [deg] against the truth
 
 
+@pytest.mark.parametrize("options, shared", [
+    ([], True), (["--sensor-delay", "0.004", "--mounting", "0,0,30"], True),
+    (["--param", "Q_angle=0.01"], False)])
+def test_the_kf_takes_its_outputs_from_the_position_filters_run_where_they_are_its(
+        tmp_path, monkeypatch, options, shared):
+    """The position filter runs the recommended kf inside (PositionKalmanFilter
+    attitude_params): with both estimators and the same kf, the kf is not run a second time
+    and its outputs are still its own; a kf of other parameters runs."""
+    from fusion_core.kalman import AngleBiasKalmanFilter
+
+    calls = []
+    kf_run = AngleBiasKalmanFilter.run
+    monkeypatch.setattr(AngleBiasKalmanFilter, "run",
+                        lambda self, *a, **k: calls.append(1) or kf_run(self, *a, **k))
+    assert main(["estimate", str(EXAMPLE), "--estimator", "kf,poskf", "--out", str(tmp_path),
+                 "--no-plots", *options]) == 0
+    assert (not calls) == shared
+    ex = _example()
+    dt = np.diff(ex["time"], prepend=ex["time"][0] - 0.01)
+    params = {"sensor_delay": 0.004, "mount_yaw": np.radians(30.0)} if len(options) == 4 else (
+        {"Q_angle": 0.01} if options else {})
+    want = create("kf", params).run(ex["acc"], ex["gyro"], dt)
+    got = np.loadtxt(tmp_path / "tilt_motion_kf.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(got[:, 1], want["roll"]) and np.array_equal(got[:, 3:6], want["bias"])
+
+
 def test_units_and_column_names_are_found(tmp_path):
     """acc in g, gyro in deg/s, other column names and a time column of its own name: the
     same estimates as from the SI file (to rounding of the conversions)."""

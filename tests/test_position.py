@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 from helpers import RATE, angle_difference, make, run_recording
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from fusion_core import G, synthetic
 
@@ -153,3 +155,50 @@ def test_the_position_filters_attitude_is_the_kfs_with_the_same_sensor_rail_incl
     for name in ("roll", "pitch", "bias"):
         np.testing.assert_array_equal(runs["poskf"][name], runs["kf"][name])
     assert not np.array_equal(runs["kf"]["roll"], runs["kf at 2000 deg/s"]["roll"])
+
+
+_value = st.one_of(st.floats(-30.0, 30.0), st.sampled_from([np.nan, np.inf, 0.0, 1e300]))
+_sample = st.tuples(st.tuples(_value, _value, _value), st.tuples(_value, _value, _value),
+                    st.one_of(st.floats(1e-3, 0.05), st.sampled_from([0.0, -1.0, 2.0, np.nan])))
+_position_params = st.fixed_dictionaries({}, optional={
+    "sensor_delay": st.sampled_from([0.0, 0.004]), "gyro_range": st.sampled_from([4.0, 35.0]),
+    "max_dt": st.sampled_from([0.02, 1.0]), "gyro_sampling": st.sampled_from(["mean", "point"]),
+    "mount_roll": st.floats(-3.0, 3.0), "mount_yaw": st.floats(-3.0, 3.0),
+    "acc_cal_xy": st.floats(-0.05, 0.05), "gyro_off_z": st.floats(-0.1, 0.1),
+    "q": st.sampled_from([0.5, 20.0]), "zupt_acc": st.sampled_from([0.05, 1.0]),
+})
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(samples=st.lists(_sample, min_size=1, max_size=80), params=_position_params,
+       backend=st.sampled_from(["python", "native"]))
+def test_a_kf_with_the_attitude_params_gives_the_position_filters_attitude(
+        samples: list, params: dict, backend: str) -> None:
+    """PositionKalmanFilter.attitude_params: the kf so made gives the position filter's roll,
+    pitch, bias and rejected samples to the bit, whatever the samples (bad ones included) and
+    the position filter's parameters (its input stage's and its own); `imu-fusion estimate`
+    takes the kf's outputs from the position filter's run where they are so."""
+    from fusion_core import native
+
+    if backend == "native" and not native.available():
+        backend = "python"
+    acc = np.array([s[0] for s in samples], dtype=float)
+    gyro = np.array([s[1] for s in samples], dtype=float)
+    dt = np.array([s[2] for s in samples], dtype=float)
+    pos = make("poskf", **params)
+    kf = make("kf", **pos.attitude_params())
+    with np.errstate(all="ignore"):
+        want = pos.run(acc, gyro, dt, backend=backend)
+        got = kf.run(acc, gyro, dt, backend=backend)
+    for name in ("roll", "pitch", "bias", "rejected"):
+        np.testing.assert_array_equal(got[name], want[name], err_msg=name)
+
+
+def test_the_attitude_params_are_the_kfs_only_where_the_kf_is_the_same() -> None:
+    """A kf's own parameter changed (or one of the input stage) makes another filter: the
+    position filter's attitude_params are then not that kf's."""
+    assert make("poskf").attitude_params() == make("kf").params
+    assert make("poskf").attitude_params() != make("kf", Q_angle=0.01).params
+    assert make("poskf", sensor_delay=0.004).attitude_params() != make("kf").params
+    assert (make("poskf", sensor_delay=0.004, q=20.0).attitude_params()
+            == make("kf", sensor_delay=0.004).params)
