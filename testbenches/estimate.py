@@ -599,7 +599,7 @@ def shared_runs(estimators: dict[str, Any]) -> dict[str, str]:
     """Of estimators by key, those whose outputs another's run gives to the bit, each with
     that one's key: a kf whose roll, pitch, bias and rejected samples the position filter's
     gives (PositionKalmanFilter.attitude_params: that filter runs the same kf on the same
-    samples) need not run, which spares a sixth of running every estimator."""
+    samples) need not run a second time on every sample."""
     from fusion_core.kalman import AngleBiasKalmanFilter
     from fusion_core.position import PositionKalmanFilter
 
