@@ -269,6 +269,8 @@ def test_a_session_with_empty_cells_is_filled_and_a_long_gap_refused(tmp_path, c
                      for n in ("whole", "holes"))
     for sensor in ("acc_cal", "gyro_cal"):
         np.testing.assert_allclose(filled[sensor]["matrix"], whole[sensor]["matrix"], atol=1e-4)
+    assert "filled" in filled
+    Calibration.from_json(filled)  # the file the command wrote is one it reads
     gap = list(lines)
     rows = int(0.3 * 102.4)
     assert rows / 102.4 > MAX_FILLED_S
