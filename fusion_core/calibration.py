@@ -51,7 +51,7 @@ session whose poses are the faces of a case the part sits in at an angle, adds t
 the case; imucal's example session has 6 deg)."""
 FILE_ENTRIES: Final = ("units", "method", "input_units", "gravity", "recording", "acc", "gyro",
                        "poses", "static_intervals", "detector", "turn_degrees", "sections",
-                       "held_out", "comparisons", "filled")
+                       "held_out", "comparisons", "filled", "level")
 """What a calibration file may hold beside acc_cal and gyro_cal: what `imu-fusion calibrate`
 measured and how (units must be the SI ones the matrices and offsets are in)."""
 MAX_CONDITION: Final = 3.0

@@ -158,6 +158,60 @@ def test_ours_beside_imucals_with_the_given_and_with_our_own_sections(tmp_path) 
                          - np.array(comp["imucal"]["gyro_matrix"]))) < 1e-9  # the same method
 
 
+def _level_tilt_deg(acc_matrix: np.ndarray, part_matrix: np.ndarray) -> float:
+    """How far from z up a level housing reads once calibrated [deg]: the part's matrix and
+    the calibration's, the offsets left out (they are the session's)."""
+    f = acc_matrix @ part_matrix @ np.array([0.0, 0.0, 9.80665])
+    return float(np.degrees(np.arccos(f[2] / np.linalg.norm(f))))
+
+
+def test_level_turns_the_calibrated_axes_onto_the_level_pose(tmp_path, capsys) -> None:
+    """A part's triad tilted in its housing (cross-axis errors of 0.67 %) is left tilted by a
+    calibration from poses and turns alone; the session's first pose, held level, shows it
+    (calibrate --level), and both sensors' axes are turned alike."""
+    from testbenches.calibrate.level import levelled
+
+    t, acc, gyro, _, part = simulated(2)
+    csv = tmp_path / "session.csv"
+    np.savetxt(csv, np.column_stack([t, acc, gyro]), delimiter=",",
+               header="time,ax,ay,az,gx,gy,gz", comments="")
+    tilt = {}
+    for option in ([], ["--level"]):
+        out = tmp_path / f"cal{len(option)}"
+        assert main(["calibrate", str(csv), "--out", str(out), "--no-plots", *option]) == 0
+        doc = json.loads((out / "calibration.json").read_text())
+        tilt[bool(option)] = _level_tilt_deg(np.array(doc["acc_cal"]["matrix"]),
+                                             np.array(part.acc_matrix))
+    assert tilt[False] > 0.1 and tilt[True] < 0.01, tilt
+    assert "levelled (--level): the still pose nearest z up read roll" in capsys.readouterr().out
+    assert set(doc["level"]) == {"pose", "roll_deg", "pitch_deg"}
+    Calibration.from_json(doc)  # the file the command wrote is one it reads
+    gyro_cal = np.array(doc["gyro_cal"]["matrix"])
+    u, _, vt = np.linalg.svd(np.array(doc["acc_cal"]["matrix"]) @ np.array(part.acc_matrix))
+    assert frame_error(gyro_cal, np.array(part.gyro_matrix), u @ vt) < 1e-3
+    session = calibrate_session(acc, gyro, np.full(len(t), 0.01))
+    with pytest.raises(ValueError, match=r"reads 90\.0 deg from z up"):
+        levelled(session.acc, session.gyro, session.acc.offset + np.array([9.8, 0.0, 0.0]))
+
+
+@pytest.mark.parametrize("seed", [8, 16])
+def test_a_part_calibrated_first_is_levelled_by_its_sessions_first_pose(seed: int) -> None:
+    """The contract's calibrated-first parts: their session's first pose is level
+    (scenarios.CALIBRATION_POSES_DEG), so the matrices leave a level part reading level but
+    for the session's noise; the session's fit alone leaves these parts 0.1 deg off."""
+    from testbenches.calibrate.part import SESSION, part_calibration
+    from testbenches.samples import scenario_samples
+
+    sensor = sensor_preset("realistic")
+    values = part_calibration(sensor, seed)
+    acc_m = np.array([values[f"acc_cal_{r}{c}"] for r in "xyz" for c in "xyz"]).reshape(3, 3)
+    part = np.array(ImuSensorModel(**{**sensor, "seed": seed}).acc_matrix)
+    assert _level_tilt_deg(acc_m, part) < 0.05
+    _, _, out = scenario_samples(SESSION, seed, {**sensor, "seed": seed})
+    fit = calibrate_session(out["acc"], out["gyro"], out["dt"]).acc.matrix
+    assert _level_tilt_deg(fit, part) > 0.08
+
+
 def test_a_part_calibrated_first_gets_its_own_matrices_undone() -> None:
     from testbenches.calibrate.part import part_calibration
 

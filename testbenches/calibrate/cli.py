@@ -40,6 +40,7 @@ from ..options import (
 from . import ferraris as fer
 from .detect import MULTIPLES, WINDOW_S, noise_floor, static_intervals, variance_magnitude
 from .heldout import HeldOut, ferraris_held_out, tedaldi_held_out
+from .level import level_pose, levelled
 from .tedaldi import CalibrationRefused, Fit, Session, calibrate_session
 
 
@@ -58,6 +59,11 @@ def add_calibrate_parser(sub: argparse._SubParsersAction) -> None:  # type: igno
                    help="the gyro's full-scale range [deg/s] (2000)")
     p.add_argument("--gravity", type=positive_float, default=G,
                    help=f"local gravity [m/s^2] ({G})")
+    p.add_argument("--level", action="store_true",
+                   help="the session's still pose nearest z up was held with the housing "
+                   "level (on a level surface): the calibrated axes are turned so that it reads "
+                   "level, a tilt of the sensor in its housing that poses and turns alone cannot "
+                   "show")
     p.add_argument("--out", type=out_folder, default=Path("calibration"),
                    help="output folder (calibration)")
     add_no_plots(p, "calibration.png")
@@ -222,6 +228,18 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if sections is not None:
         held = ferraris_held_out(acc, gyro, dt, sections, acc_fit, gyro_fit, g)
+    level: dict[str, Any] | None = None
+    if args.level:  # after the held-out fits, which a turn of both frames leaves as they are
+        means = ([s.acc for s in session.statics] if session is not None
+                 else [acc[slice(*sections[p])].mean(axis=0) for p in fer.POSES])
+        try:
+            acc_fit, gyro_fit, level = levelled(acc_fit, gyro_fit, level_pose(means))
+        except ValueError as err:
+            print(f"error: {args.recording}: --level: {err}", file=sys.stderr)
+            return 2
+        lines.append(f"levelled (--level): the still pose nearest z up read roll "
+                     f"{level['roll_deg']:+.3f} deg, pitch {level['pitch_deg']:+.3f} deg; the "
+                     "calibrated axes turned so that it reads level")
     extra: dict[str, Any] = {
         "method": method,
         "units": {"acc": "m/s2", "gyro": "rad/s", "matrix": "1"},
@@ -239,6 +257,8 @@ def run(args: argparse.Namespace) -> int:
     }
     if filled:
         extra["filled"] = filled
+    if level is not None:
+        extra["level"] = {"pose": "the still pose nearest z up, held level (--level)", **level}
     if sections is not None:
         extra["sections"] = {k: list(v) for k, v in sections.items()}
     if session is not None:

@@ -1,7 +1,7 @@
-"""Calibrating a simulated part before it is used (`run --calibrate-first`,
-`campaign --calibrate-first`): the calibration_session scenario recorded through the same sensor
-part (its parameters and seed), calibrated by the calibrate command's own code, the result
-applied at the estimators' input.
+"""Calibrating a simulated part before it is used (`run --calibrate-first`, `campaign
+--calibrate-first`): the calibration_session scenario recorded through the same sensor part (its
+parameters and seed), calibrated by the calibrate command's own code (its first pose held level,
+as `calibrate --level` takes it), the result applied at the estimators' input.
 
 What carries over from the session to the runs is the part's matrices (scale factors,
 misalignment, cross-coupling), not its offsets: a MEMS part's biases change from one power-up
@@ -21,6 +21,7 @@ import numpy as np
 from fusion_core.calibration import matrix_names
 
 from ..samples import scenario_samples
+from .level import level_pose, levelled
 from .tedaldi import CalibrationRefused, calibrate_session
 
 SESSION = "calibration_session"
@@ -36,8 +37,12 @@ def _part_calibration(sensor_json: str) -> tuple[tuple[str, float], ...]:
     except CalibrationRefused as err:
         raise CalibrationRefused(f"the calibration session of part seed {sensor.get('seed')} "
                                  f"could not be calibrated: {err}") from None
-    values = dict(zip(matrix_names("acc"), session.acc.matrix.ravel().tolist(), strict=True))
-    values.update(zip(matrix_names("gyro"), session.gyro.matrix.ravel().tolist(), strict=True))
+    # the session's first pose is level (scenarios.CALIBRATION_POSES_DEG), as `calibrate
+    # --level` takes it
+    acc_fit, gyro_fit, _ = levelled(session.acc, session.gyro,
+                                    level_pose([s.acc for s in session.statics]))
+    values = dict(zip(matrix_names("acc"), acc_fit.matrix.ravel().tolist(), strict=True))
+    values.update(zip(matrix_names("gyro"), gyro_fit.matrix.ravel().tolist(), strict=True))
     return tuple(values.items())
 
 
