@@ -149,6 +149,7 @@ def test_ours_beside_imucals_with_the_given_and_with_our_own_sections(tmp_path) 
     doc = json.loads((tmp_path / "calibration.json").read_text())
     comp = doc["comparisons"]
     assert doc["method"] == "ferraris"  # six poses do not determine Tedaldi's model
+    Calibration.read(tmp_path / "calibration.json")  # the file the command wrote is one it reads
     for ours in ("ferraris", "ferraris_own_sections"):
         for sensor in ("acc", "gyro"):
             diff = np.abs(np.array(comp[ours][f"{sensor}_matrix"])
