@@ -46,6 +46,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     BAND_PARAM,
+    BURST_PARAM,
     HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
@@ -119,6 +120,7 @@ class ComplementaryFilter(Estimator):
         BAND_PARAM,
         LEAK_PARAM,
         HELD_PARAM,
+        BURST_PARAM,
         STRETCH_PARAM,
         MOTION_BIAS_PARAM,
         BIAS_GATE_PARAM,
@@ -156,7 +158,8 @@ class ComplementaryFilter(Estimator):
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
                                           float(p["slow_band_leak"]),
-                                          float(p["held_acceleration"]))
+                                          float(p["held_acceleration"]),
+                                          float(p["burst_acceleration"]))
         self._motion_gain = float(p["motion_bias_gain"])
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
         self._bias_innovation = float(p["bias_innovation"])

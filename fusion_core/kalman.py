@@ -57,6 +57,7 @@ from .kinematics import (
 from .linalg import mat_t_vec, mat_vec
 from .measured_vector import (
     BAND_PARAM,
+    BURST_PARAM,
     HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
@@ -225,6 +226,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         BAND_PARAM,
         LEAK_PARAM,
         HELD_PARAM,
+        BURST_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
@@ -270,7 +272,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
                                           float(p["slow_band_leak"]),
-                                          float(p["held_acceleration"]))
+                                          float(p["held_acceleration"]),
+                                          float(p["burst_acceleration"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))

@@ -5,7 +5,7 @@ An accelerometer sample is gravity plus the body's linear acceleration plus whit
 filters do not measure the raw sample; they measure a low-passed specific force that turns with
 the gyro (Laidig & Seel 2023, VQF: in an almost inertial frame gravity is constant and the linear
 acceleration of a body that ends where it started averages to its velocity change over time).
-Six things follow, and this module is each of them:
+Seven things follow, and this module is each of them:
 
 1. The measured vector `f` is a second-order low-pass: two first-order stages of time constant
    acc_lowpass / 2 each, every stage turned by the gyro's rotation increment. A second-order
@@ -91,6 +91,22 @@ Six things follow, and this module is each of them:
    variance raised to the innovation's (gross_innovation), needs the accelerometer to come
    back. Capped, the measurement noise is at most tan^2 30 deg = 1/3 rad^2 over one sample's,
    the most a held acceleration makes (tests/test_adaptive_noise.py).
+7. A burst: samples of no motion (a glitch, a bus returning garbage, each value within the
+   ranges so that no rule of the input stage refuses it) reach the vector as a disturbance the
+   filters then follow back to gravity over two or three times its length, tens of degrees off
+   for five to ten seconds after one second of them. Two things tell them from any motion: the
+   slow band parts from the reference by more than a body's linear acceleration moves it
+   (BURST_PARAM, g), and the fast power is as white as independent samples', the mean square
+   change from one sample to the next (`diff`) above the fast power itself (`band_in`):
+   independent samples give about twice it, a body's motion at f well below the sampling rate
+   (2 pi f dt)^2 of it. A fast hand's translation may part the slow band by nearly as much, but
+   smoothly; a tap is white, but too short to part the slow band. The vector takes none of a
+   burst's samples: it is only turned with the gyro, as the attitude is, and `fresh` counts the
+   time since the last. After the burst it fills again as after the first sample (each stage
+   half the time since), a mean of the samples since the burst, none older, and the filters
+   take it as they take a filling vector (its tilt, no gyro bias learned from it). The first
+   fill is no burst: the reference is as short then. The contract's scenarios, the battery's
+   motions on the parts that do not glitch and BROAD's trials hold none (tests/test_burst.py).
 
 The statistic of the adaptive length (`dist`: the raw sample against the full-length reference)
 is the first-order pre-filter's, kept: it decides whether there is anything to average.
@@ -167,9 +183,22 @@ STRETCH_PARAM: Final = Param(
 combined motion from rest (tests/test_slow_combined_motion.py) comes within VQF + 10 %. The
 cross-validation over BROAD's motion folds (testbenches.broad.cv.CV_GRID holds 1, 1.5 and 2)
 chooses 1.5 or 2 without every fold, never 1. Module docstring, item 4."""
-MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 7), (REAL, 12)))
+BURST_PARAM: Final = Param(
+    "burst_acceleration", G,
+    "How far the slow band may part from the full-length reference, its fast power as white as "
+    "independent samples', before the samples are taken for a burst of no motion (a glitch): the "
+    "measured vector takes none of them and fills again from the samples after it (0: never)",
+    unit="m/s2", low=0.0, high=1000.0,
+)
+"""Recommended g: the slow band parting from the reference by g means the specific force's slow
+part moved by as much as gravity itself within the vector's length, more than a car's braking
+or a hand's carrying; a fast hand's translation comes near it but not with white fast power,
+while samples anywhere in the ranges part the two by more (their spread is several g).
+Derived, not fitted. Module docstring, item 7."""
+MEASURE_CHECK: Final = Segments(((REAL, 18), (NONNEG, 7), (REAL, 12), (REAL, 3), (NONNEG, 2)))
 """The state check of a Measure (fusion_core.state): six vectors, two mean squares, two
-times, a mean square rate, the slow band's two fast powers and four lag angles."""
+times, a mean square rate, the slow band's two fast powers, four lag angles, the last sample,
+the mean square of its changes and the time since a burst."""
 
 
 class Measure(NamedTuple):
@@ -210,6 +239,15 @@ class Measure(NamedTuple):
     lag_s1: Vec3
     lag_s: Vec3
     """The slow band's lag [rad], the same for its stages."""
+    prev: Vec3
+    """The last raw sample [m/s^2]."""
+    diff: float
+    """Mean square of the change from one raw sample to the next [m^2/s^4] over
+    disturbance_time: beside band_in, how white the fast power is (item 7)."""
+    fresh: float
+    """Time [s] since the last sample of a burst (the slow band further from the reference than
+    burst_acceleration), counted up to the full length (the full length from the start): the
+    vector fills again from the samples since (module docstring, item 7)."""
 
     def settled(self, c: MeasureConstants) -> bool:
         """Whether the vector holds no sample turned by a rotation the gyro did not measure (no
@@ -222,7 +260,7 @@ def measure_start(a: Vec3, c: MeasureConstants) -> Measure:
     """The state at a first sample a: every low-pass starts at it, no disturbance measured, and
     settled (no gyro sample at its rail yet: the vector holds no rotation the gyro missed)."""
     return Measure(a, a, a, a, a, a, 0.0, 0.0, 0.0, 2.0 * c.stage, 0.0, 0.0, 0.0, ZERO, ZERO,
-                   ZERO, ZERO)
+                   ZERO, ZERO, a, 0.0, 2.0 * c.stage)
 
 
 class MeasureConstants(NamedTuple):
@@ -251,19 +289,22 @@ class MeasureConstants(NamedTuple):
     held2: float
     """held_acceleration squared [m^2/s^4]: the most the slow band's statistic counts (0: no
     limit)."""
+    burst2: float
+    """burst_acceleration squared [m^2/s^4]: a slow band further from the reference is a burst
+    (0: none is)."""
 
 
 def measure_constants(acc_lowpass: float, disturbance_time: float, band: float, r: float,
                       gyro_scale_std: float, stretch: float = 1.0, leak: float = 0.0,
-                      held: float = 0.0) -> MeasureConstants:
+                      held: float = 0.0, burst: float = 0.0) -> MeasureConstants:
     """The constants of measure_step from the parameters, one sample's tilt variance r, the
     gyro's scale uncertainty (0: no turn discounted from the slow band), the longest vector's
     multiple of acc_lowpass (STRETCH_PARAM; 1: none), the share of the slow band's fast leak
-    taken off its statistic (LEAK_PARAM; 0: none) and the largest linear acceleration it counts
-    (HELD_PARAM; 0: no limit)."""
+    taken off its statistic (LEAK_PARAM; 0: none), the largest linear acceleration it counts
+    (HELD_PARAM; 0: no limit) and the distance of a burst (BURST_PARAM; 0: none)."""
     return MeasureConstants(0.5 * acc_lowpass, disturbance_time, 3.0 * r * G * G, band, r,
                             3.0 * gyro_scale_std * gyro_scale_std * G * G, stretch, leak,
-                            held * held)
+                            held * held, burst * burst)
 
 
 def two_stage_noise(k: float) -> float:
@@ -302,13 +343,16 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     """One sample a of the measured vector (the module docstring), phi the interval's rotation
     vector with its rotvec_terms; bias_measured: whether a rest has measured the gyro bias (the
     vector may then grow longer, item 4). Returns the new state (its f is the measured vector),
-    the measurement noise r [rad^2] and whether the vector is still filling."""
+    the measurement noise r [rad^2] and whether the vector is filling (after the first sample,
+    or again after a burst)."""
     (f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid, lag_ref1,
-     lag_ref, lag_s1, lag_s) = m
+     lag_ref, lag_s1, lag_s, prev, diff, fresh) = m
     stage = c.stage
     full = 2.0 * stage
-    if settle < full:  # both times counted up to the full length (building_blocks.on_the_mark)
+    if settle < full:  # the times counted up to the full length (building_blocks.on_the_mark)
         settle = on_the_mark(settle + dt, dt, full)
+    if fresh < full:
+        fresh = on_the_mark(fresh + dt, dt, full)
     filling = fill < full
     if filling:  # a mean of the samples so far (each stage half the time since the start)
         fill = on_the_mark(fill + dt, dt, full)
@@ -316,6 +360,7 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
     r = c.r
     tau = stage
     back = rotation_back_matrix(phi, terms)  # once, for the six stages
+    burst = False
     if c.dist_tau > 0.0:
         ref1, ref = _lowpass2(ref1, ref, back, a, dt, stage)
         e0, e1, e2 = a[0] - ref[0], a[1] - ref[1], a[2] - ref[2]
@@ -334,13 +379,22 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
             d0, d1, d2 = lag_ref[0] - lag_s[0], lag_ref[1] - lag_s[1], lag_ref[2] - lag_s[2]
             turn = c.turn * (d0 * d0 + d1 * d1 + d2 * d2)
             inst = inst - turn if inst > turn else 0.0
+            # the fast power before the band's first stage, and that of the change from one
+            # sample to the next: about twice it for white samples, a small share of it for a
+            # body's motion well below the sampling rate (item 7)
+            h0, h1, h2 = a[0] - s1[0], a[1] - s1[1], a[2] - s1[2]
+            band_in += k * (h0 * h0 + h1 * h1 + h2 * h2 - band_in)
+            d0, d1, d2 = a[0] - prev[0], a[1] - prev[1], a[2] - prev[2]
+            diff += k * (d0 * d0 + d1 * d1 + d2 * d2 - diff)
             if c.leak > 0.0:  # less the fast disturbance that leaks through the band (item 5)
-                h0, h1, h2 = a[0] - s1[0], a[1] - s1[1], a[2] - s1[2]
                 q0, q1, q2 = s1[0] - s[0], s1[1] - s[1], s1[2] - s[2]
-                band_in += k * (h0 * h0 + h1 * h1 + h2 * h2 - band_in)
                 band_mid += k * (q0 * q0 + q1 * q1 + q2 * q2 - band_mid)
                 leak = c.leak * band_mid * band_mid / band_in if band_in > 0.0 else 0.0
                 inst = inst - leak if inst > leak else 0.0
+            # further from the reference than a body's linear acceleration moves it, and fast
+            # power as white as samples of no motion: a burst (item 7; not while the vector
+            # first fills, when the reference is as short)
+            burst = c.burst2 > 0.0 and inst > c.burst2 and diff > band_in and not filling
             if c.held2 > 0.0 and inst > c.held2:  # no more than a held acceleration (item 6)
                 inst = c.held2
             rise = DISTURBANCE_ATTACK if inst > slow else c.dist_tau
@@ -352,9 +406,16 @@ def measure_step(m: Measure, a: Vec3, phi: Vec3, terms: tuple[float, float, floa
                 r += excess / (G * G)
                 if c.stretch > 1.0 and bias_measured and not filling:
                     tau = tau * stretched(c, excess, rate2, 2.0 * (stage - c.band), full)
-    f1, f = _lowpass2(f1, f, back, a, dt, tau)
+    if burst:  # none of the burst's samples: the vector turned with the gyro alone (item 7)
+        fresh = 0.0
+        f1, f = mat_vec(back, f1), mat_vec(back, f)
+    else:
+        if fresh < full and not filling:  # after a burst, a mean of the samples since
+            tau = 0.5 * fresh
+        f1, f = _lowpass2(f1, f, back, a, dt, tau)
     return (Measure(f1, f, ref1, ref, s1, s, dist, slow, fill, settle, rate2, band_in, band_mid,
-                    lag_ref1, lag_ref, lag_s1, lag_s), r, filling)
+                    lag_ref1, lag_ref, lag_s1, lag_s, a, diff, fresh), r,
+            filling or fresh < full)
 
 
 def stretched(c: MeasureConstants, excess: float, rate2: float, lag: float, full: float
@@ -383,10 +444,10 @@ def stretched(c: MeasureConstants, excess: float, rate2: float, lag: float, full
 def fill_noise(m: Measure, r: float, dt: float, c: MeasureConstants) -> tuple[float, float]:
     """While the vector fills, its tilt variance and its samples' mean age [s] (half the fill):
     one sample's white variance as much as passes two stages each of half the time since the
-    start (two_stage_noise), plus the disturbance in r (measure_step's noise, less c.r). A
-    filter that takes the vector's tilt then is that sure of it, and a bias error has turned it
-    over that age (kalman.measured_axis, ukf.measured_covariance)."""
-    age = 0.5 * m.fill
+    start or the last burst (two_stage_noise), plus the disturbance in r (measure_step's noise,
+    less c.r). A filter that takes the vector's tilt then is that sure of it, and a bias error
+    has turned it over that age (kalman.measured_axis, ukf.measured_covariance)."""
+    age = 0.5 * (m.fill if m.fill < m.fresh else m.fresh)
     return c.r * two_stage_noise(dt / (age + dt)) + (r - c.r), age
 
 
@@ -457,7 +518,8 @@ def measure_clipped(m: Measure) -> Measure:
 
 def measure_turned(m: Measure, turn) -> Measure:  # type: ignore[no-untyped-def]
     """The state with every vector turned by turn (a function of a vector: the kf's face
-    switch), the lags too."""
+    switch), the lags and the last sample too."""
     return m._replace(f1=turn(m.f1), f=turn(m.f), ref1=turn(m.ref1), ref=turn(m.ref),
                       s1=turn(m.s1), s=turn(m.s), lag_ref1=turn(m.lag_ref1),
-                      lag_ref=turn(m.lag_ref), lag_s1=turn(m.lag_s1), lag_s=turn(m.lag_s))
+                      lag_ref=turn(m.lag_ref), lag_s1=turn(m.lag_s1), lag_s=turn(m.lag_s),
+                      prev=turn(m.prev))

@@ -37,6 +37,7 @@ from .kinematics import (
 )
 from .measured_vector import (
     BAND_PARAM,
+    BURST_PARAM,
     HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
@@ -131,6 +132,7 @@ class GainScheduledComplementaryFilter(Estimator):
         BAND_PARAM,
         LEAK_PARAM,
         MGCF_HELD,
+        BURST_PARAM,
         STRETCH_PARAM,
         MOTION_BIAS_PARAM,
         BIAS_GATE_PARAM,
@@ -169,7 +171,8 @@ class GainScheduledComplementaryFilter(Estimator):
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
                                           float(p["slow_band_leak"]),
-                                          float(p["held_acceleration"]))
+                                          float(p["held_acceleration"]),
+                                          float(p["burst_acceleration"]))
         self._motion_gain = float(p["motion_bias_gain"])
         self._bias_band2 = bias_band2(float(p["bias_gate"]))
 

@@ -35,6 +35,7 @@ from .kinematics import rotvec_terms
 from .linalg import cholesky3, packed_diagonal, packed_index
 from .measured_vector import (
     BAND_PARAM,
+    BURST_PARAM,
     HELD_PARAM,
     LEAK_PARAM,
     MEASURE_CHECK,
@@ -172,6 +173,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         BAND_PARAM,
         LEAK_PARAM,
         HELD_PARAM,
+        BURST_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,
     )
@@ -207,7 +209,8 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                           float(p["gyro_scale_std"]),
                                           float(p["acc_lowpass_stretch"]),
                                           float(p["slow_band_leak"]),
-                                          float(p["held_acceleration"]))
+                                          float(p["held_acceleration"]),
+                                          float(p["burst_acceleration"]))
         self._longest2 = float(p["max_correction_time"]) ** 2
         self._rail_var = float(p["gyro_range"]) ** 2 / 3.0  # the rate beyond the rail, per axis
         self._bias_band2 = bias_band2(float(p["bias_gate"]))

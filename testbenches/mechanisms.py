@@ -53,7 +53,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from fusion_core.building_blocks.gate import BIAS_GATE, BIAS_INNOVATION
-from fusion_core.measured_vector import HELD_PARAM, LEAK_PARAM
+from fusion_core.measured_vector import BURST_PARAM, HELD_PARAM, LEAK_PARAM
 from fusion_core.papers.common import PAPER_GATE
 
 T = TypeVar("T")
@@ -121,6 +121,9 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("held_acceleration", "the slow band's statistic counts no more than a held "
               "linear acceleration, g tan 30 deg (held_acceleration 0)",
               {"held_acceleration": 0.0}, {"held_acceleration": float(HELD_PARAM.default)}),
+    Mechanism("burst", "a burst of white samples far from any motion kept out of the measured "
+              "vector, which fills again after it (burst_acceleration 0)",
+              {"burst_acceleration": 0.0}, {"burst_acceleration": float(BURST_PARAM.default)}),
     Mechanism("longer_vector", "the vector grows where slow linear acceleration reaches it "
               "(acc_lowpass_stretch 1)", {"acc_lowpass_stretch": 1.0}),
     Mechanism("scale_noise", "process noise for the gyro's scale error while it turns "

@@ -200,9 +200,9 @@ def test_a_sensor_without_quantisation_adds_no_converter_noise() -> None:
 def test_a_param_reaches_every_filter_that_has_it_and_an_unknown_one_is_refused(tmp_path,
                                                                                capsys) -> None:
     """`battery --param`: a value goes to the filters that have the parameter (the Kalman
-    filters' gross_innovation, not the complementary filters'), changes their numbers and no
-    other's, and is written to battery.json; a name no filter has, or a value out of range, is
-    refused in one line before any run, saying what is allowed."""
+    filters' gyro_psd, not the complementary filters'), changes their numbers and no other's,
+    and is written to battery.json; a name no filter has, or a value out of range, is refused in
+    one line before any run, saying what is allowed."""
     pytest.importorskip("vqf")
     from testbenches.cli import main
 
@@ -214,10 +214,10 @@ def test_a_param_reaches_every_filter_that_has_it_and_an_unknown_one_is_refused(
         battery.filter_overrides({"scale_time": -1.0})
     status = main(["battery", "--motion", "clipping", "--sensor", "mpu6050_glitch", "--parts", "1",
                    "--out", str(tmp_path), "--no-plots", "--scheduler", "local",
-                   "--param", "gross_innovation=0.1"])
+                   "--param", "gyro_psd=1e-4"])
     assert status == 0
     report = json.loads((tmp_path / "battery.json").read_text())
-    assert report["params"] == {"gross_innovation": 0.1}
+    assert report["params"] == {"gyro_psd": 1e-4}
     got = report["rmse_deg"]["clipping"]["mpu6050_glitch"]
     default = battery.run_battery(["clipping"], ["mpu6050_glitch"], 1, scheduler=None)
     default = default["clipping"]["mpu6050_glitch"]

@@ -16,7 +16,7 @@ void fc_cf_configure(fc_cf *f)
     f->longest = p->max_correction_time;
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
                          p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
-                         &f->measure);
+                         p->burst_acceleration, &f->measure);
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
 }
 

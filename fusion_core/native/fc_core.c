@@ -398,7 +398,7 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise)
 
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
                           fc_real gyro_scale_std, fc_real stretch, fc_real leak, fc_real held,
-                          fc_meas_constants *c)
+                          fc_real burst, fc_meas_constants *c)
 {
     c->stage = 0.5 * acc_lowpass;
     c->dist_tau = disturbance_time;
@@ -409,14 +409,16 @@ void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real
     c->stretch = stretch;
     c->leak = leak;
     c->held2 = held * held;
+    c->burst2 = burst * burst;
 }
 
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c)
 {
     fc_measure_align(m, a);
     m[FC_MEAS_DIST] = m[FC_MEAS_SLOW] = m[FC_MEAS_FILL] = 0.0;
-    m[FC_MEAS_SETTLE] = 2.0 * c->stage;
-    m[FC_MEAS_RATE2] = m[FC_MEAS_BAND_IN] = m[FC_MEAS_BAND_MID] = 0.0;
+    m[FC_MEAS_SETTLE] = m[FC_MEAS_FRESH] = 2.0 * c->stage;
+    m[FC_MEAS_RATE2] = m[FC_MEAS_BAND_IN] = m[FC_MEAS_BAND_MID] = m[FC_MEAS_DIFF] = 0.0;
+    memcpy(m + FC_MEAS_PREV, a, 3 * sizeof *a);
 }
 
 void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
@@ -426,7 +428,7 @@ void fc_measure_align(fc_real m[FC_MEAS_SIZE], const fc_real f[3])
         m[v + 1] = f[1];
         m[v + 2] = f[2];
     }
-    for (int v = FC_MEAS_LAG_REF1; v < FC_MEAS_SIZE; v++) {  /* no lag */
+    for (int v = FC_MEAS_LAG_REF1; v < FC_MEAS_LAG_S + 3; v++) {  /* no lag */
         m[v] = 0.0;
     }
 }
@@ -483,8 +485,11 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
 {
     fc_real stage = c->stage;
     fc_real full = 2.0 * stage;
-    if (m[FC_MEAS_SETTLE] < full) {  /* both counted up to the full length (fc_on_the_mark) */
+    if (m[FC_MEAS_SETTLE] < full) {  /* the times counted up to the full length (fc_on_the_mark) */
         m[FC_MEAS_SETTLE] = fc_on_the_mark(m[FC_MEAS_SETTLE] + dt, dt, full);
+    }
+    if (m[FC_MEAS_FRESH] < full) {
+        m[FC_MEAS_FRESH] = fc_on_the_mark(m[FC_MEAS_FRESH] + dt, dt, full);
     }
     *filling = m[FC_MEAS_FILL] < full;
     if (*filling) {  /* a mean of the samples so far (each stage half the time since the start) */
@@ -494,6 +499,7 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
     fc_real r = c->r;
     fc_real tau = stage, back[9];
     fc_rotation_back_matrix(phi, terms, back);  /* once, for the six stages */
+    int burst = 0;
     if (c->dist_tau > 0.0) {
         fc_real *ref = m + FC_MEAS_REF, *s = m + FC_MEAS_S;
         lowpass2(m + FC_MEAS_REF1, ref, back, a, dt, stage);
@@ -518,17 +524,26 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             fc_real d2 = m[FC_MEAS_LAG_REF + 2] - m[FC_MEAS_LAG_S + 2];
             fc_real turn = c->turn * (d0 * d0 + d1 * d1 + d2 * d2);
             inst = inst > turn ? inst - turn : 0.0;
+            /* the fast power before the band's first stage, and that of the change from one
+             * sample to the next (white samples: about twice it) */
+            const fc_real *s1 = m + FC_MEAS_S1, *prev = m + FC_MEAS_PREV;
+            fc_real h0 = a[0] - s1[0], h1 = a[1] - s1[1], h2 = a[2] - s1[2];
+            m[FC_MEAS_BAND_IN] += k * (h0 * h0 + h1 * h1 + h2 * h2 - m[FC_MEAS_BAND_IN]);
+            fc_real g0 = a[0] - prev[0], g1 = a[1] - prev[1], g2 = a[2] - prev[2];
+            m[FC_MEAS_DIFF] += k * (g0 * g0 + g1 * g1 + g2 * g2 - m[FC_MEAS_DIFF]);
             if (c->leak > 0.0) {  /* less the fast disturbance that leaks through the band */
-                const fc_real *s1 = m + FC_MEAS_S1;
-                fc_real h0 = a[0] - s1[0], h1 = a[1] - s1[1], h2 = a[2] - s1[2];
                 fc_real q0 = s1[0] - s[0], q1 = s1[1] - s[1], q2 = s1[2] - s[2];
-                m[FC_MEAS_BAND_IN] += k * (h0 * h0 + h1 * h1 + h2 * h2 - m[FC_MEAS_BAND_IN]);
                 m[FC_MEAS_BAND_MID] += k * (q0 * q0 + q1 * q1 + q2 * q2 - m[FC_MEAS_BAND_MID]);
                 fc_real leak = m[FC_MEAS_BAND_IN] > 0.0
                     ? c->leak * m[FC_MEAS_BAND_MID] * m[FC_MEAS_BAND_MID] / m[FC_MEAS_BAND_IN]
                     : 0.0;
                 inst = inst > leak ? inst - leak : 0.0;
             }
+            /* further from the reference than a body's linear acceleration moves it, and fast
+             * power as white as samples of no motion: a burst (not while the vector first
+             * fills, when the reference is as short) */
+            burst = c->burst2 > 0.0 && inst > c->burst2 && m[FC_MEAS_DIFF] > m[FC_MEAS_BAND_IN]
+                && !*filling;
             if (c->held2 > 0.0 && inst > c->held2) {  /* no more than a held acceleration */
                 inst = c->held2;
             }
@@ -546,14 +561,28 @@ fc_real fc_measure_step(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_re
             }
         }
     }
-    lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, back, a, dt, tau);
+    if (burst) {  /* none of the burst's samples: the vector turned with the gyro alone */
+        fc_real t[3];
+        m[FC_MEAS_FRESH] = 0.0;
+        fc_mat_vec(back, m + FC_MEAS_F1, t);
+        memcpy(m + FC_MEAS_F1, t, sizeof t);
+        fc_mat_vec(back, m + FC_MEAS_F, t);
+        memcpy(m + FC_MEAS_F, t, sizeof t);
+    } else {
+        if (m[FC_MEAS_FRESH] < full && !*filling) {  /* after a burst, a mean of the samples since */
+            tau = 0.5 * m[FC_MEAS_FRESH];
+        }
+        lowpass2(m + FC_MEAS_F1, m + FC_MEAS_F, back, a, dt, tau);
+    }
+    memcpy(m + FC_MEAS_PREV, a, 3 * sizeof *a);
+    *filling = *filling || m[FC_MEAS_FRESH] < full;
     return r;
 }
 
 void fc_measure_fill_noise(const fc_real m[FC_MEAS_SIZE], fc_real r, fc_real dt,
                            const fc_meas_constants *c, fc_real *var, fc_real *age)
 {
-    fc_real a = 0.5 * m[FC_MEAS_FILL];
+    fc_real a = 0.5 * (m[FC_MEAS_FILL] < m[FC_MEAS_FRESH] ? m[FC_MEAS_FILL] : m[FC_MEAS_FRESH]);
     *var = c->r * two_stage_noise(dt / (a + dt)) + (r - c->r);
     *age = a;
 }

@@ -145,21 +145,23 @@ fc_real fc_adaptive_prefilter_time(fc_real tau, fc_real dist, fc_real noise);
 /* ----- measured_vector.py ------------------------------------------------------------------ */
 /* Measure: the measured vector's state as one array of doubles, in the Python NamedTuple's
  * order: each second-order low-pass as its two stages (the first stage, then the output), the
- * disturbance statistics, the two times and the mean square rate. */
+ * disturbance statistics, the two times and the mean square rate, the slow band's fast powers,
+ * the lags, the last sample, the mean square of its changes and the time since a burst. */
 enum {
     FC_MEAS_F1 = 0, FC_MEAS_F = 3, FC_MEAS_REF1 = 6, FC_MEAS_REF = 9, FC_MEAS_S1 = 12,
     FC_MEAS_S = 15, FC_MEAS_DIST = 18, FC_MEAS_SLOW = 19, FC_MEAS_FILL = 20, FC_MEAS_SETTLE = 21,
     FC_MEAS_RATE2 = 22, FC_MEAS_BAND_IN = 23, FC_MEAS_BAND_MID = 24, FC_MEAS_LAG_REF1 = 25,
-    FC_MEAS_LAG_REF = 28, FC_MEAS_LAG_S1 = 31, FC_MEAS_LAG_S = 34,
-    FC_MEAS_SIZE = 37
+    FC_MEAS_LAG_REF = 28, FC_MEAS_LAG_S1 = 31, FC_MEAS_LAG_S = 34, FC_MEAS_PREV = 37,
+    FC_MEAS_DIFF = 40, FC_MEAS_FRESH = 41,
+    FC_MEAS_SIZE = 42
 };
 /* MeasureConstants */
 typedef struct fc_meas_constants {
-    fc_real stage, dist_tau, noise, band, r, turn, stretch, leak, held2;
+    fc_real stage, dist_tau, noise, band, r, turn, stretch, leak, held2, burst2;
 } fc_meas_constants;
 void fc_measure_constants(fc_real acc_lowpass, fc_real disturbance_time, fc_real band, fc_real r,
                           fc_real gyro_scale_std, fc_real stretch, fc_real leak, fc_real held,
-                          fc_meas_constants *c);
+                          fc_real burst, fc_meas_constants *c);
 /* measure_start: every low-pass at a, no disturbance measured, settled */
 void fc_measure_start(fc_real m[FC_MEAS_SIZE], const fc_real a[3], const fc_meas_constants *c);
 /* measure_step: one sample a (bias_measured: a rest has measured the gyro bias, the vector may

@@ -33,7 +33,7 @@ void fc_kf_configure(fc_kf *f)
                                 f->acc_tau, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r, p->gyro_scale_std,
                          p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
-                         &f->measure);
+                         p->burst_acceleration, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
     f->rail_var = fc_pow(p->input.gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     f->rest_time = p->rest_time;
@@ -318,8 +318,9 @@ static void switch_face(fc_kf *f)
     f->bias_x = b2[0];
     f->bias_y = b2[1];
     f->bias_z = b2[2];
-    /* the measured vector's vectors, then its lags (the statistics between them are scalars) */
-    for (int v = 0; v < FC_MEAS_SIZE; v = v + 3 == FC_MEAS_DIST ? FC_MEAS_LAG_REF1 : v + 3) {
+    /* the measured vector's vectors, then its lags and last sample (the statistics between them
+     * are scalars) */
+    for (int v = 0; v < FC_MEAS_PREV + 3; v = v + 3 == FC_MEAS_DIST ? FC_MEAS_LAG_REF1 : v + 3) {
         fc_real turned[3];
         TURN(f->meas + v, turned);
         memcpy(f->meas + v, turned, sizeof turned);

@@ -25,7 +25,7 @@ void fc_mgcf_configure(fc_mgcf *f)
      * (fc_measure_raw_noise) */
     fc_measure_constants(f->acc_tau, f->dist_tau, p->slow_band_time, f->r_ref, p->gyro_scale_std,
                          p->acc_lowpass_stretch, p->slow_band_leak, p->held_acceleration,
-                         &f->measure);
+                         p->burst_acceleration, &f->measure);
     f->motion_gain = p->motion_bias_gain;
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
 }

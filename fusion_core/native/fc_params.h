@@ -111,6 +111,7 @@ typedef struct fc_cf_params {
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
+    fc_real burst_acceleration;   /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real motion_bias_gain;     /* [0.0, 1.0] */
     fc_real bias_gate;            /* [0.0, 1000.0] */
@@ -137,6 +138,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
     p->held_acceleration = 5.6618720173484425;
+    p->burst_acceleration = 9.80665;
     p->acc_lowpass_stretch = 2.0;
     p->motion_bias_gain = 0.5;
     p->bias_gate = 0.05;
@@ -182,6 +184,7 @@ typedef struct fc_mgcf_params {
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
+    fc_real burst_acceleration;   /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real motion_bias_gain;     /* [0.0, 1.0] */
     fc_real bias_gate;            /* [0.0, 1000.0] */
@@ -206,6 +209,7 @@ static inline void fc_mgcf_params_default(fc_mgcf_params *p)
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
     p->held_acceleration = 0.0;
+    p->burst_acceleration = 9.80665;
     p->acc_lowpass_stretch = 2.0;
     p->motion_bias_gain = 0.5;
     p->bias_gate = 0.05;
@@ -260,6 +264,7 @@ typedef struct fc_kf_params {
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
+    fc_real burst_acceleration;   /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_input_params input;        /* the input stage's */
@@ -289,6 +294,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
     p->held_acceleration = 5.6618720173484425;
+    p->burst_acceleration = 9.80665;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     fc_input_params_default(&p->input);
@@ -345,6 +351,7 @@ typedef struct fc_ukf_params {
     fc_real slow_band_time;       /* [0.01, 10.0] [s] */
     fc_real slow_band_leak;       /* [0.0, 1.0] */
     fc_real held_acceleration;    /* [0.0, 1000.0] [m/s2] */
+    fc_real burst_acceleration;   /* [0.0, 1000.0] [m/s2] */
     fc_real acc_lowpass_stretch;  /* [1.0, 10.0] */
     fc_real max_correction_time;  /* [0.0, 1000000.0] [s] */
     fc_input_params input;        /* the input stage's */
@@ -375,6 +382,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
     p->held_acceleration = 5.6618720173484425;
+    p->burst_acceleration = 9.80665;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
     fc_input_params_default(&p->input);

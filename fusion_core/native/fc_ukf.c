@@ -18,7 +18,7 @@ void fc_ukf_configure(fc_ukf *f)
                                 p->acc_lowpass, &f->q_rotation, &f->dist_tau);
     fc_measure_constants(p->acc_lowpass, f->dist_tau, p->slow_band_time, f->r_acc,
                          p->gyro_scale_std, p->acc_lowpass_stretch, p->slow_band_leak,
-                         p->held_acceleration, &f->measure);
+                         p->held_acceleration, p->burst_acceleration, &f->measure);
     f->longest2 = fc_pow(p->max_correction_time, 2.0);
     f->rail_var = fc_pow(p->input.gyro_range, 2.0) / 3.0;  /* the rate beyond the rail, per axis */
     fc_bias_band2(p->bias_gate, &f->bias_lo2, &f->bias_hi2);
