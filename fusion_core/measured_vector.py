@@ -246,8 +246,8 @@ class Measure(NamedTuple):
     disturbance_time: beside band_in, how white the fast power is (item 7)."""
     fresh: float
     """Time [s] since the last sample of a burst (the slow band further from the reference than
-    burst_acceleration), counted up to the full length (the full length from the start): the
-    vector fills again from the samples since (module docstring, item 7)."""
+    burst_acceleration, its fast power white), counted up to the full length (the full length
+    from the start): the vector fills again from the samples since (module docstring, item 7)."""
 
     def settled(self, c: MeasureConstants) -> bool:
         """Whether the vector holds no sample turned by a rotation the gyro did not measure (no
