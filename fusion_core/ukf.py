@@ -73,6 +73,14 @@ direction's variance first, it lowers the error neither on BROAD's folds left ou
 battery, so `imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays
 for a user's own value."""
 
+UKF_HELD: Final = dataclasses.replace(HELD_PARAM, default=0.0)
+"""The ukf's held_acceleration: 0, no cap on the slow band's statistic. The cap keeps absurd
+samples from counting as more than a held acceleration; with a burst's samples kept out of the
+measured vector (burst_acceleration) and the direction's variance raised after a gross
+innovation (gross_innovation), the ukf's cap lowers the error neither on the battery nor on
+BROAD's folds left out with the grid chosen again, so `imu-fusion mechanisms` drops it (the
+kf's folds keep it: docs/results/mechanisms.md); the parameter stays for a user's own value."""
+
 
 def raised_direction_variance(P: tuple[float, ...], var: float) -> tuple[float, ...]:
     """The packed lower triangle P of [X, b] with each of X's variances at least var
@@ -172,7 +180,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         GROSS_INNOVATION_PARAM,
         BAND_PARAM,
         LEAK_PARAM,
-        HELD_PARAM,
+        UKF_HELD,
         BURST_PARAM,
         STRETCH_PARAM,
         KALMAN_MAX_CORRECTION_TIME,

@@ -381,7 +381,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
-    p->held_acceleration = 5.6618720173484425;
+    p->held_acceleration = 0.0;
     p->burst_acceleration = 9.80665;
     p->acc_lowpass_stretch = 2.0;
     p->max_correction_time = 30.0;
