@@ -248,7 +248,7 @@ def test_cross_validated_the_defaults_meet_issue_32s_targets(shared_cv: Any) -> 
     each motion fold (by regret, among the points the contract allows): the best at most
     0.53 deg and at most VQF's with the same output prediction (0.545, nothing to fit), each
     attitude filter at most 0.60, and cross-validated minus in-sample at most 0.02 deg for
-    each (cf 0.016, mgcf 0.008, kf 0.014, ukf 0.010)."""
+    each (docs/results/broad.md gives the figures)."""
     cv = shared_cv.cv_means()
     vqf = float(np.mean(list(shared_cv.peers["vqf-ahead"].values())))
     assert all(v <= 0.60 for v in cv.values()), cv
