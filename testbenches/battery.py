@@ -32,7 +32,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -288,6 +288,49 @@ SENSOR_CLASSES: dict[str, SensorClass] = {s.name: s for s in (
 )}
 
 
+AT_RATE = "@"
+"""A class's name, this and a rate in Hz ("mpu6050@1000Hz"): the class sampled at that rate
+(sensor_class)."""
+
+
+def at_rate(name: str, rate: float) -> str:
+    """The name of class `name` sampled at `rate` [Hz] (sensor_class reads it back)."""
+    return f"{name}{AT_RATE}{rate:g}Hz"
+
+
+def sensor_class(name: str) -> SensorClass:
+    """A class by its name: one of SENSOR_CLASSES, or one of them at another rate (at_rate's
+    "NAME@RATEHz"): the same part sampled at that rate, each filter given what follows from the
+    rate (filter_params). A name with no such class is a ValueError that says which there
+    are."""
+    base, _, rate = name.partition(AT_RATE)
+    if base not in SENSOR_CLASSES:
+        raise ValueError(f"unknown sensor class {name!r}: allowed {', '.join(SENSOR_CLASSES)}, "
+                         f"each also as NAME{AT_RATE}RATEHz")
+    c = SENSOR_CLASSES[base]
+    if not rate:
+        return c
+    hz = parse_rate(rate.removesuffix("Hz"))
+    return replace(c, name=name, what=f"{c.what} (here sampled at {hz:g} Hz)", rate=hz)
+
+
+RATE_RANGE = (10.0, 10000.0)
+"""The rates [Hz] a class may be sampled at (`--rate`): from a slow logger's to an IMU's
+fastest output."""
+
+
+def parse_rate(text: str) -> float:
+    """A sample rate [Hz] from text; ValueError saying what is allowed."""
+    lo, hi = RATE_RANGE
+    try:
+        hz = float(text)
+    except ValueError:
+        hz = math.nan
+    if not lo <= hz <= hi:
+        raise ValueError(f"sample rate {text!r}: allowed {lo:g} to {hi:g} Hz")
+    return hz
+
+
 def glitched(sample: dict[str, np.ndarray], sensor: SensorClass, start: float, seed: int
              ) -> dict[str, np.ndarray]:
     """The samples with `sensor.glitch` s of absurd ones from `start` [s]: uniform within
@@ -360,7 +403,7 @@ def part_samples(motion: str, sensor: str, seed: int
     samples (ImuSensorModel.run with the part's seed, glitched where its class glitches)."""
     from fusion_core.sensor import ImuSensorModel
 
-    m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
+    m, s = MOTIONS[motion], sensor_class(sensor)
     n = round((m.rest + m.duration) * s.rate) + 1
     t = np.arange(n) / s.rate
     truth = m.trajectory().truth(t)
@@ -383,7 +426,7 @@ def part_rmse(motion: str, sensor: str, seed: int, filters: Sequence[str],
     from .estimate import conditioned
     from .peers import PEERS
 
-    m, s = MOTIONS[motion], SENSOR_CLASSES[sensor]
+    m, s = MOTIONS[motion], sensor_class(sensor)
     t, truth, sample = part_samples(motion, sensor, seed)
     true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
     scored = t >= m.rest + SETTLE_S
@@ -563,7 +606,7 @@ def setup_table(recommended: Results, other: Results, setup: Setup) -> str:
     class's spread of gyro scale factors), and a line that counts the cells where the best of
     ours is ahead of VQF and where kf and ukf are within 5 % of it, both ways."""
     sensors = list(next(iter(recommended.values())))
-    head = [f"{s} ({100.0 * SENSOR_CLASSES[s].value('gyro_scale_std'):g} %)"
+    head = [f"{s} ({100.0 * sensor_class(s).value('gyro_scale_std'):g} %)"
             if setup.known_scale else s for s in sensors]
     rows = ["| motion | " + " | ".join(head) + " |", "|---|" + "---|" * len(sensors)]
     for motion, by_sensor in recommended.items():
@@ -575,6 +618,27 @@ def setup_table(recommended: Results, other: Results, setup: Setup) -> str:
     return ("\n".join(rows) + f"\n\nOf {total} cells, the best of ours is ahead of VQF in {a0} "
             f"as recommended and {a1} {setup.label}; kf and ukf are within 5 % of it in {w0} "
             f"and {w1}.")
+
+
+def rate_table(results: Results) -> str:
+    """Markdown: per motion and sensor class (one class at several rates, at_rate) the best
+    filter's mean RMSE over VQF's, in brackets the worse of kf's and ukf's over VQF's, and VQF's
+    mean RMSE [deg]; and a line that counts, per column, the motions where the best of ours is
+    ahead of VQF and where kf and ukf are within 5 % of it."""
+    sensors = list(next(iter(results.values())))
+    rows = ["| motion | " + " | ".join(sensors) + " |", "|---|" + "---|" * len(sensors)]
+    for motion, by_sensor in results.items():
+        cells = []
+        for s in sensors:
+            v = verdicts(by_sensor[s])
+            cells.append(f"{v['best']} {v['best_vs_vqf']:.2f} ({v['kf_ukf_vs_vqf']:.2f}); "
+                         f"VQF {stats(by_sensor[s]['vqf'])[0]:.3f}")
+        rows.append(f"| {motion} | " + " | ".join(cells) + " |")
+    counts = [aims_met({m: {s: results[m][s]} for m in results}) for s in sensors]
+    ahead = ", ".join(f"{a} ({s})" for s, (a, _) in zip(sensors, counts, strict=True))
+    level = ", ".join(f"{w}" for _, w in counts)
+    return ("\n".join(rows) + f"\n\nOf {len(results)} motions, the best of ours is ahead of VQF "
+            f"in {ahead}; kf and ukf are within 5 % of it or ahead in {level}.")
 
 
 def plot(results: Results, path: Path) -> None:
@@ -618,6 +682,10 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
     p.add_argument("--motion", default="all", help=f"all, or some of {', '.join(MOTIONS)}")
     p.add_argument("--sensor", default="all",
                    help=f"all, or some of {', '.join(SENSOR_CLASSES)}")
+    p.add_argument("--rate", type=_rates, default=[], metavar="HZ[,HZ...]",
+                   help="sample each chosen sensor class at these rates instead of its own "
+                   "(each filter given what follows from the rate), e.g. --sensor mpu6050 "
+                   "--rate 100,1000: what the rate is worth beside VQF")
     p.add_argument("--parts", type=positive_int, default=PARTS,
                    help=f"parts (seeds) of each sensor class (default {PARTS})")
     add_cluster(p)
@@ -639,6 +707,14 @@ def add_battery_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore
     p.set_defaults(func=cmd_battery)
 
 
+def _rates(text: str) -> list[float]:
+    """`--rate`'s comma list of sample rates [Hz]."""
+    try:
+        return [parse_rate(x.strip()) for x in text.split(",")]
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
 def cmd_battery(args: argparse.Namespace) -> int:
     import json
 
@@ -648,6 +724,8 @@ def cmd_battery(args: argparse.Namespace) -> int:
 
     motions = choose(args.motion, list(MOTIONS), "motion")
     sensors = choose(args.sensor, list(SENSOR_CLASSES), "sensor class")
+    if args.rate:
+        sensors = [at_rate(s, hz) for s in sensors for hz in args.rate]
     params = parse_params(args.param)
     overrides = filter_overrides(params)
     with tqdm(total=len(motions) * len(sensors), desc="battery", unit="cell",
@@ -660,11 +738,9 @@ def cmd_battery(args: argparse.Namespace) -> int:
         {"parts": args.parts, "settle_s": SETTLE_S, "params": params,
          "known_scale": args.known_scale, "calibrated_first": args.calibrated_first,
          "motions": {m: MOTIONS[m].what for m in motions},
-         "sensor_classes": {s: {"what": SENSOR_CLASSES[s].what, "rate": SENSOR_CLASSES[s].rate,
-                                "params": SENSOR_CLASSES[s].params,
-                                "filter_params": filter_params(SENSOR_CLASSES[s],
-                                                               args.known_scale)}
-                            for s in sensors},
+         "sensor_classes": {s: {"what": c.what, "rate": c.rate, "params": c.params,
+                                "filter_params": filter_params(c, args.known_scale)}
+                            for s, c in ((s, sensor_class(s)) for s in sensors)},
          "rmse_deg": results}, indent=1))
     overview = overview_table(results)
     (args.out / "battery.md").write_text(overview + "\n")

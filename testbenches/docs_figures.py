@@ -908,6 +908,20 @@ def battery_picture(ctx: dict[str, Path], path: Path) -> None:
     plot(_battery(), path)
 
 
+RATE_SWEEP = (50.0, 100.0, 400.0, 1000.0)
+"""The rates [Hz] of the battery page's sample-rate table: a slow logger's, the MPU-6050's
+usual, the order of BROAD's (286 Hz) and a flight controller's."""
+
+
+def battery_rates(ctx: dict[str, Path]) -> str:
+    """docs/results/battery/index.md: the realistic MPU-6050 at each of RATE_SWEEP, every
+    motion, beside VQF (battery.rate_table)."""
+    from .battery import MOTIONS, PARTS, at_rate, rate_table, run_battery
+
+    sensors = [at_rate("mpu6050", hz) for hz in RATE_SWEEP]
+    return rate_table(run_battery(list(MOTIONS), sensors, PARTS, scheduler=None))
+
+
 def readme_battery(ctx: dict[str, Path]) -> str:
     """The README's battery line: in how many cells (motion class x sensor class) the best of
     ours and kf, ukf are ahead of VQF, and where they are furthest behind; the same counts with
@@ -1017,6 +1031,9 @@ def _battery_figures() -> tuple[Figure, ...]:
                "docs/results/battery/battery.png", ("vqf",)),
         *(Figure(f"battery-{m}", f"docs/results/battery/{m}.md", f"{command} --motion {m}",
                  _battery_motion(m), needs=("vqf",)) for m in MOTIONS),
+        Figure("battery-rates", "docs/results/battery/index.md",
+               f"{command} --sensor mpu6050 --rate "
+               + ",".join(f"{hz:g}" for hz in RATE_SWEEP), battery_rates, needs=("vqf",)),
         Figure("battery-running-switches", "docs/results/battery/running.md",
                f"{command} --motion running,pendulum --sensor mpu6050,worse --param "
                "acc_lowpass_stretch=1 (or held_acceleration=0.1)", battery_running_switches,

@@ -227,6 +227,59 @@ def test_a_param_reaches_every_filter_that_has_it_and_an_unknown_one_is_refused(
     assert "no attitude filter has it" in capsys.readouterr().err
 
 
+def test_a_class_at_another_rate_is_the_same_part_sampled_at_that_rate() -> None:
+    """`--rate`: "NAME@RATEHz" is the class with every sensor parameter as it is and only the
+    rate changed; its filters get one sample's noise at that rate, its parts as many samples
+    per second; an unknown class or a rate out of range is refused saying what is allowed."""
+    base = SENSOR_CLASSES["worse"]
+    fast = battery.sensor_class(battery.at_rate("worse", 1000.0))
+    assert fast.name == "worse@1000Hz" and fast.rate == 1000.0
+    assert fast.params == base.params and fast.glitch == base.glitch
+    assert "sampled at 1000 Hz" in fast.what
+    assert battery.sensor_class("worse") is base
+    slow_noise = battery.filter_params(base)["cf"]["acc_noise"]
+    fast_noise = battery.filter_params(fast)["cf"]["acc_noise"]
+    assert fast_noise > 4.0 * slow_noise  # 20 times the rate: about sqrt(20) times the noise
+    t, _, sample = battery.part_samples("pendulum", "worse@1000Hz", 0)
+    assert np.diff(t)[0] == pytest.approx(1e-3)
+    assert len(sample["acc"]) == len(t)
+    with pytest.raises(ValueError, match=r"unknown sensor class 'wurse@100Hz': allowed better"):
+        battery.sensor_class("wurse@100Hz")
+    with pytest.raises(ValueError, match=r"allowed 10 to 10000 Hz"):
+        battery.sensor_class("worse@5Hz")
+
+
+def test_the_rate_table_counts_each_rate_and_gives_vqfs_error() -> None:
+    """One line per motion, a column per rate: the best of ours over VQF, kf's and ukf's (the
+    worse) in brackets, and VQF's mean RMSE; the last line counts per column."""
+    cell = {"cf": [1.0, 1.0], "mgcf": [2.0, 2.0], "kf": [0.8, 0.8], "ukf": [0.9, 0.9],
+            "vqf": [1.0, 1.0]}
+    behind = {**cell, "cf": [1.2, 1.2], "kf": [1.1, 1.1], "ukf": [1.3, 1.3]}
+    results = {"pendulum": {"a@50Hz": cell, "a@1000Hz": behind},
+               "running": {"a@50Hz": cell, "a@1000Hz": cell}}
+    table = battery.rate_table(results)
+    assert "| pendulum | kf 0.80 (0.90); VQF 1.000 | kf 1.10 (1.30); VQF 1.000 |" in table
+    assert table.endswith("Of 2 motions, the best of ours is ahead of VQF in 2 (a@50Hz), "
+                          "1 (a@1000Hz); kf and ukf are within 5 % of it or ahead in 2, 1.")
+
+
+@pytest.mark.heavy
+def test_the_command_runs_a_class_at_each_rate_given(tmp_path) -> None:
+    pytest.importorskip("vqf")
+    from testbenches.cli import main
+
+    status = main(["battery", "--motion", "pendulum", "--sensor", "better", "--rate", "100,400",
+                   "--parts", "1", "--out", str(tmp_path), "--no-plots", "--scheduler", "local"])
+    assert status == 0
+    report = json.loads((tmp_path / "battery.json").read_text())
+    assert list(report["rmse_deg"]["pendulum"]) == ["better@100Hz", "better@400Hz"]
+    assert report["sensor_classes"]["better@400Hz"]["rate"] == 400.0
+    here = battery.run_battery(["pendulum"], ["better@400Hz"], 1, scheduler=None)
+    assert report["rmse_deg"]["pendulum"]["better@400Hz"] == here["pendulum"]["better@400Hz"]
+    with pytest.raises(SystemExit):
+        main(["battery", "--rate", "100,fast", "--out", str(tmp_path)])
+
+
 def test_the_known_scale_table_compares_each_cell_and_counts_both_ways() -> None:
     """Each cell: the worse of kf's and ukf's mean over VQF's, as recommended -> known; the last
     line counts the aims' cells both ways (a tie with VQF is not ahead, 1.05 is within)."""
