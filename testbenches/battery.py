@@ -586,17 +586,20 @@ def motion_text(results: Results, motion: str) -> str:
     return f"{what[0].upper()}{what[1:]}.\n\n{motion_table(results, motion)}"
 
 
-def overview_table(results: Results) -> str:
+def overview_table(results: Results, pages: bool = True, vqf_rmse: bool = False) -> str:
     """Markdown: per motion and sensor class the best filter's mean RMSE over VQF's and, in
-    brackets, the worse of kf's and ukf's over VQF's (below 1: ahead)."""
+    brackets, the worse of kf's and ukf's over VQF's (below 1: ahead); with vqf_rmse VQF's
+    mean RMSE [deg] after them, with pages each motion linked to its page."""
     sensors = list(next(iter(results.values())))
     rows = ["| motion | " + " | ".join(sensors) + " |", "|---|" + "---|" * len(sensors)]
     for motion, by_sensor in results.items():
         cells = []
         for s in sensors:
             v = verdicts(by_sensor[s])
-            cells.append(f"{v['best']} {v['best_vs_vqf']:.2f} ({v['kf_ukf_vs_vqf']:.2f})")
-        rows.append(f"| [{motion}]({motion}.md) | " + " | ".join(cells) + " |")
+            cells.append(f"{v['best']} {v['best_vs_vqf']:.2f} ({v['kf_ukf_vs_vqf']:.2f})"
+                         + (f"; VQF {stats(by_sensor[s]['vqf'])[0]:.3f}" if vqf_rmse else ""))
+        name = f"[{motion}]({motion}.md)" if pages else motion
+        rows.append(f"| {name} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
 
@@ -621,23 +624,15 @@ def setup_table(recommended: Results, other: Results, setup: Setup) -> str:
 
 
 def rate_table(results: Results) -> str:
-    """Markdown: per motion and sensor class (one class at several rates, at_rate) the best
-    filter's mean RMSE over VQF's, in brackets the worse of kf's and ukf's over VQF's, and VQF's
-    mean RMSE [deg]; and a line that counts, per column, the motions where the best of ours is
-    ahead of VQF and where kf and ukf are within 5 % of it."""
+    """Markdown: overview_table with VQF's mean RMSE of one class at several rates (at_rate),
+    and a line that counts, per column, the motions where the best of ours is ahead of VQF and
+    where kf and ukf are within 5 % of it."""
     sensors = list(next(iter(results.values())))
-    rows = ["| motion | " + " | ".join(sensors) + " |", "|---|" + "---|" * len(sensors)]
-    for motion, by_sensor in results.items():
-        cells = []
-        for s in sensors:
-            v = verdicts(by_sensor[s])
-            cells.append(f"{v['best']} {v['best_vs_vqf']:.2f} ({v['kf_ukf_vs_vqf']:.2f}); "
-                         f"VQF {stats(by_sensor[s]['vqf'])[0]:.3f}")
-        rows.append(f"| {motion} | " + " | ".join(cells) + " |")
     counts = [aims_met({m: {s: results[m][s]} for m in results}) for s in sensors]
     ahead = ", ".join(f"{a} ({s})" for s, (a, _) in zip(sensors, counts, strict=True))
     level = ", ".join(f"{w}" for _, w in counts)
-    return ("\n".join(rows) + f"\n\nOf {len(results)} motions, the best of ours is ahead of VQF "
+    return (overview_table(results, pages=False, vqf_rmse=True)
+            + f"\n\nOf {len(results)} motions, the best of ours is ahead of VQF "
             f"in {ahead}; kf and ukf are within 5 % of it or ahead in {level}.")
 
 
