@@ -560,6 +560,13 @@ def aims_met(results: Results) -> tuple[int, int]:
             sum(v["kf_ukf_vs_vqf"] <= LEVEL for v in cells))
 
 
+def aims_per_class(results: Results) -> list[tuple[int, int]]:
+    """aims_met for each sensor class (a column of overview_table) on its own, in order."""
+    sensors = list(next(iter(results.values())))
+    return [aims_met({m: {s: by_sensor[s]} for m, by_sensor in results.items()})
+            for s in sensors]
+
+
 def motion_table(results: Results, motion: str) -> str:
     """Markdown: per sensor class each filter's mean / p95 over the parts beside VQF's."""
     sensors = list(results[motion])
@@ -628,7 +635,7 @@ def rate_table(results: Results) -> str:
     and a line that counts, per column, the motions where the best of ours is ahead of VQF and
     where kf and ukf are within 5 % of it."""
     sensors = list(next(iter(results.values())))
-    counts = [aims_met({m: {s: results[m][s]} for m in results}) for s in sensors]
+    counts = aims_per_class(results)
     ahead = ", ".join(f"{a} ({s})" for s, (a, _) in zip(sensors, counts, strict=True))
     level = ", ".join(f"{w}" for _, w in counts)
     return (overview_table(results, pages=False, vqf_rmse=True)
