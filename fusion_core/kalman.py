@@ -434,7 +434,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self.P_z += self._q_bias * dt
         if self.rest.quiet_time >= rest_time:
             r = gyro_var / dt
-            if zero_rate_sample(self.rest, gx, gy, gz, r):  # a still gyro's sample
+            if zero_rate_sample(self.rest, r, dt):  # a still gyro's sample
                 self.correct_bias(gx, gy, r)
                 k = self.P_z / (self.P_z + r)
                 self.bias_z += k * (gz - self.bias_z)
@@ -522,7 +522,8 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
         self.meas = measure_turned(self.meas, turn)
         r = self.rest
         self.rest = RestState(*turn((r.wx, r.wy, r.wz)), *turn((r.fx, r.fy, r.fz)), r.quiet_time,
-                              r.measured, *turn((r.ox, r.oy, r.oz)), *turn((r.rx, r.ry, r.rz)))
+                              r.measured, *turn((r.ox, r.oy, r.oz)), *turn((r.rx, r.ry, r.rz)),
+                              *turn((r.zx, r.zy, r.zz)))
         P_roll, P_pitch, P_z = self.P_roll, self.P_pitch, self.P_z
         vertical = (max(P_roll[0], P_pitch[0]), 0.0, 0.0, P_z)
         old = (P_roll, P_pitch, vertical)

@@ -109,10 +109,11 @@ def count(most: int) -> Check:
     return Check("count", float(most))
 
 
-REST: Final = Segments(((REAL, 6), (NONNEG, 1), (FLAG, 1), (REAL, 6)))
+REST: Final = Segments(((REAL, 6), (NONNEG, 1), (FLAG, 1), (REAL, 9)))
 """The rest detector's state (building_blocks.RestState): the running means of the rate and of
 the specific force, the quiet time [s], whether a rest has measured the bias, the mean specific
-force and the mean rate where the quiet time had lasted REST_MEAN_TAU."""
+force and the mean rate where the quiet time had lasted REST_MEAN_TAU, and the rate's short
+mean (ZERO_RATE_TAU)."""
 
 BASE_STATE: Final[dict[str, Check | Segments | Queue]] = {
     "initialized": FLAG, "n_samples": COUNT, "n_rejected": COUNT, "gyro_prev": REAL,

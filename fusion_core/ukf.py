@@ -304,7 +304,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
                                               p["acc_noise"] ** 2 * rest_mean_share(dt), 0.0)
             if self.rest.quiet_time >= p["rest_time"]:
                 r = p["zaru_psd"] / dt
-                if zero_rate_sample(self.rest, gx, gy, gz, r):  # a still gyro's sample
+                if zero_rate_sample(self.rest, r, dt):  # a still gyro's sample
                     self._zero_rate_update((gx, gy, gz), r)
 
     def _zero_rate_update(self, z: tuple[float, float, float], r: float) -> None:

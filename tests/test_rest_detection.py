@@ -131,7 +131,7 @@ def test_only_a_first_rest_that_the_bias_estimate_misses_by_rest_gyro_aligns() -
     th = next(p.default for p in REST_PARAMS if p.name == "rest_gyro")
     mean = (3.0 * th, 0.0, 0.0)
     # a rest just measured
-    rest = RestState(*mean, 0.0, 0.0, G, REST_TIME, 1.0, 0.0, 0.0, G, *mean)
+    rest = RestState(*mean, 0.0, 0.0, G, REST_TIME, 1.0, 0.0, 0.0, G, *mean, *mean)
     assert uncalibrated_first_rest(0.0, rest, (0.0, 0.0, 0.0), th)
     assert not uncalibrated_first_rest(1.0, rest, (0.0, 0.0, 0.0), th)  # not the first rest
     assert not uncalibrated_first_rest(0.0, rest, (2.5 * th, 0.0, 0.0), th)  # calibrated enough
@@ -197,25 +197,59 @@ def test_on_a_slow_swing_every_filter_is_at_most_vqf_s_worst_error(
         assert worst < vqf_worst, f"{key}: {worst:.2f} deg against VQF's {vqf_worst:.2f}"
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
-@pytest.mark.parametrize("key", FILTERS)
-def test_a_turn_that_fades_in_after_a_rest_teaches_the_bias_little(key: str, backend: str
-                                                                  ) -> None:
-    """5 s at rest, then a turn about the vertical that fades in to 10 deg/s over 2 s (a
-    minimum-jerk ramp): for the first few tenths of a second its rate stays within rest_gyro of
-    the running mean, and the rest lasts. A zero-rate update that took those samples learned
-    0.16 deg/s about z (kf, ukf) and 0.41 (cf, mgcf, whose bias follows the gyro at rest); one
-    that takes only the samples of a still gyro (building_blocks.zero_rate_sample) 0.03 and
-    0.07."""
+def fading_in(rate: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """5 s at rest with a gyro bias b, then a turn about the vertical that fades in to 10 deg/s
+    over 2 s (a minimum-jerk ramp) and 3 s at that rate, sampled at `rate` [Hz]: acc, gyro, dt
+    and b."""
     b = np.array([0.1, -0.1, 0.05]) * DEG
-    s = np.arange(round(2.0 * RATE)) / (2.0 * RATE)
+    s = np.arange(round(2.0 * rate)) / (2.0 * rate)
     ramp = 10.0 * DEG * s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
-    wz = np.concatenate([np.zeros(round(5.0 * RATE)), ramp, np.full(round(3.0 * RATE), 10 * DEG)])
+    wz = np.concatenate([np.zeros(round(5.0 * rate)), ramp, np.full(round(3.0 * rate), 10 * DEG)])
     gyro = np.tile(b, (len(wz), 1))
     gyro[:, 2] += wz
     acc = np.tile((0.0, 0.0, G), (len(wz), 1))
-    out = ESTIMATORS[key]().run(acc, gyro, np.full(len(wz), 1.0 / RATE), backend=backend)
+    return acc, gyro, np.full(len(wz), 1.0 / rate), b
+
+
+@pytest.mark.parametrize("rate", [RATE, 10.0 * RATE])
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("key", FILTERS)
+def test_a_turn_that_fades_in_after_a_rest_teaches_the_bias_little(key: str, backend: str,
+                                                                  rate: float) -> None:
+    """The turn of fading_in: for the first few tenths of a second its rate stays within
+    rest_gyro of the running mean, and the rest lasts. A zero-rate update that took those
+    samples learned 0.16 deg/s about z (kf, ukf) and 0.41 (cf, mgcf, whose bias follows the gyro
+    at rest); one that takes only the samples of a still gyro (building_blocks.zero_rate_sample)
+    0.03 and 0.07. At ten times the rate, a gate that judged each sample against one sample's
+    noise would let the turn in until it was three times as fast (ZERO_RATE_TAU)."""
+    acc, gyro, dt, b = fading_in(rate)
+    out = ESTIMATORS[key]().run(acc, gyro, dt, backend=backend)
     assert np.all(np.abs(out["bias"][-1] - b) < 0.1 * DEG), np.degrees(out["bias"][-1] - b)
+
+
+def test_the_zero_rate_gate_shuts_on_a_fading_in_turn_after_the_same_time_at_any_rate() -> None:
+    """The rest detector and the zero-rate update's gate (zero_rate_sample, the realistic gyro's
+    noise density) on fading_in at 50 Hz to 10 kHz: the gate shuts within a few hundredths of a
+    second of the same instant at every rate (0.32-0.35 s into the turn). Judged sample by
+    sample against one sample's noise it shut after 0.34 s at 50 Hz, 0.64 s at 1 kHz and not
+    within the run at 10 kHz, the bias taking the turn's rate all that while."""
+    from fusion_core.building_blocks import rest_start, rest_step, zero_rate_sample
+    from fusion_core.sensor import SENSOR_PARAMS
+
+    psd = next(p.default for p in SENSOR_PARAMS if p.name == "gyro_psd")
+    th = next(p.default for p in REST_PARAMS if p.name == "rest_gyro")
+    acc_th = next(p.default for p in REST_PARAMS if p.name == "rest_acc")
+    bound = next(p.default for p in REST_PARAMS if p.name == "rest_bias_bound")
+    shut = {}
+    for rate in (50.0, 100.0, 1000.0, 10000.0):
+        acc, gyro, dt, b = fading_in(rate)
+        rest = rest_start(*gyro[0], *acc[0])
+        for i, (a, g) in enumerate(zip(acc, gyro, strict=True)):
+            rest = rest_step(rest, *g, *a, tuple(b), dt[i], th, acc_th, REST_TIME, bound)
+            if i * dt[i] > 5.0 and not zero_rate_sample(rest, psd / dt[i], dt[i]):
+                shut[rate] = i * dt[i] - 5.0
+                break
+    assert max(shut.values()) - min(shut.values()) < 0.05, shut
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -28,9 +28,9 @@ def _assert_no_worse_sampled_faster(motion: str, key: str) -> None:
 
 
 @pytest.mark.xfail(strict=True, reason="the slow band's disturbance enters the Kalman filters' "
-                   "measurement noise per sample, not per second, and the zero-rate update's "
-                   "gate widens with one sample's noise: on a sustained acceleration a faster "
-                   "part's filter trusts the accelerometer more (battery page, 'Sample rate')")
+                   "measurement noise per sample, not per second: on a sustained acceleration "
+                   "a faster part's filter trusts the accelerometer more (battery page, "
+                   "'Sample rate')")
 @pytest.mark.parametrize("key", ["kf", "ukf"])
 @pytest.mark.parametrize("motion", ["translation", "vehicle"])
 def test_a_kalman_filter_on_a_sustained_acceleration_is_no_worse_sampled_faster(

@@ -15,8 +15,9 @@ class RestState(NamedTuple):
     """The rest detector's state: running means of the rate (wx, wy, wz) and of the specific
     force (fx, fy, fz), the quiet time [s], measured: 1.0 once a rest has lasted rest_time (the
     bias has been measured), else 0.0, the mean specific force (ox, oy, oz) and the mean rate
-    (rx, ry, rz) where the quiet time had lasted REST_MEAN_TAU (REST_TURN). The C twin holds the
-    same fourteen numbers in order (fc_real rest[FC_REST_SIZE])."""
+    (rx, ry, rz) where the quiet time had lasted REST_MEAN_TAU (REST_TURN), and the rate's
+    short mean (zx, zy, zz) over ZERO_RATE_TAU that a zero-rate update's gate judges. The C twin
+    holds the same seventeen numbers in order (fc_real rest[FC_REST_SIZE])."""
 
     wx: float
     wy: float
@@ -32,9 +33,12 @@ class RestState(NamedTuple):
     rx: float
     ry: float
     rz: float
+    zx: float
+    zy: float
+    zz: float
 
 
-REST_START: Final = RestState(*(0.0,) * 14)
+REST_START: Final = RestState(*(0.0,) * 17)
 """The rest detector's state before the first sample."""
 
 REST_MEAN_TAU: Final = 0.5
@@ -117,30 +121,48 @@ not (a slow swing), gravity's direction turns, and a rest, starting or under way
 
 
 ZERO_RATE_SPREAD: Final = 75.0
-"""A zero-angular-rate update takes a sample only where its rate is within sqrt(ZERO_RATE_SPREAD)
-standard deviations of the gyro's white noise (sqrt(psd / dt) per axis, three axes together:
-5 sigma each) of the rest detector's running mean rate (zero_rate_sample). The detector calls a
-rest by thresholds on smoothed rates (rest_gyro, 2 deg/s) so that noise and a shaky table do not
-end it; a motion that fades in stays below them for a few tenths of a second, and a bias that
-follows the gyro then learns the motion's first turn: on a sensor held in the hand after a rest
-(the realistic MPU-6050, even a perfect one), a Kalman filter learned a bias there which its
-bias gate (linear acceleration keeps the vector's norm off g) then kept for the whole run
-(tests/test_rest_detection.py, a turn that fades in). A sample of a still gyro is further than
-five sigma from the mean in a few per million; the first samples of a fading-in turn are tens
-of sigma off. A gyro several times noisier than the filter's psd says loses a few percent of
-its rest samples to it, and still measures its bias."""
+"""A zero-angular-rate update takes a sample only where the rate's short mean (ZERO_RATE_TAU)
+is within sqrt(ZERO_RATE_SPREAD) standard deviations of its white noise (per axis, three axes
+together: 5 sigma each) of the rest detector's running mean rate (zero_rate_sample). The
+detector calls a rest by thresholds on smoothed rates (rest_gyro, 2 deg/s) so that noise and a
+shaky table do not end it; a motion that fades in stays below them for a few tenths of a
+second, and a bias that follows the gyro then learns the motion's first turn: on a sensor held
+in the hand after a rest (the realistic MPU-6050, even a perfect one), a Kalman filter learned a
+bias there which its bias gate (linear acceleration keeps the vector's norm off g) then kept for
+the whole run (tests/test_rest_detection.py, a turn that fades in). A still gyro's short mean is
+further than five sigma from the mean in a few per million; that of a fading-in turn is tens
+of sigma off within a few hundredths of a second. A gyro several times noisier than the
+filter's psd says loses a few percent of its rest samples to it, and still measures its
+bias."""
+
+ZERO_RATE_TAU: Final = 0.01
+"""Time constant [s] of the rate's short mean that the zero-rate update's gate judges
+(ZERO_RATE_SPREAD). Judged sample by sample, the gate's width is sqrt(psd / dt): a part
+sampled ten times faster lets a turn three times faster through before it shuts, and its
+bias learns the first turn of every motion that starts after a rest (tests/test_rest_detection.py,
+the gate on a turn that fades in at 50 Hz to 10 kHz). A mean over a fixed time has the same
+noise, sqrt(psd / (2 tau)), at every rate above 1 / tau, and a sampling slower than that leaves
+it about the sample itself. The
+time is the one over which a body's first turn rises out of the gyro's noise: a ramp of
+alpha [rad/s^2] leaves a mean of time constant tau by alpha (t - tau), which reaches the
+gate's c sqrt(psd / (2 tau)) soonest for tau^(3/2) = c sqrt(psd / 2) / (2 alpha); a hand's
+first turn (10-50 deg/s^2) on a consumer gyro (0.005-0.015 deg/s/sqrt(Hz)) gives 5-20 ms,
+and 10 ms is the middle of that range. Derived, not fitted."""
 
 CONSTANT_REST_GYRO_VAR: Final = REAL_GYRO_DENSITY * REAL_GYRO_DENSITY
 """The gyro white-noise PSD [rad^2/s] of the filters without a noise model (cf, mgcf) for
 zero_rate_sample: a real MEMS IMU's measured density squared (zero_rate_psd_param's default)."""
 
 
-def zero_rate_sample(rest: RestState, gx: float, gy: float, gz: float, r: float) -> bool:
-    """Whether a gyro sample may update the bias at rest (ZERO_RATE_SPREAD): its rate's squared
-    distance from the rest detector's running mean rate within ZERO_RATE_SPREAD times r, the
-    sample's white-noise variance per axis (psd / dt)."""
-    dx, dy, dz = gx - rest.wx, gy - rest.wy, gz - rest.wz
-    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r
+def zero_rate_sample(rest: RestState, r: float, dt: float) -> bool:
+    """Whether the gyro sample rest_step last took may update the bias at rest
+    (ZERO_RATE_SPREAD): the squared distance of the rate's short mean (ZERO_RATE_TAU) from the
+    rest detector's running mean rate within ZERO_RATE_SPREAD times its white-noise variance
+    per axis: r, one sample's (psd / dt), times the share a first-order low-pass of gain k
+    leaves, k / (2 - k)."""
+    k = dt / (ZERO_RATE_TAU + dt)
+    dx, dy, dz = rest.zx - rest.wx, rest.zy - rest.wy, rest.zz - rest.wz
+    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r * (k / (2.0 - k))
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
@@ -167,7 +189,7 @@ def rest_mean_share(dt: float) -> float:
 def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:
     """The rest detector's state at the first sample: its means start at that sample, quiet time
     0, the bias not measured yet."""
-    return RestState(gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az, gx, gy, gz)
+    return RestState(gx, gy, gz, ax, ay, az, 0.0, 0.0, ax, ay, az, gx, gy, gz, gx, gy, gz)
 
 
 def rest_step(
@@ -180,7 +202,11 @@ def rest_step(
     rest has measured the bias); a rest, starting or under way, lasts while the rate and the
     specific force stay within their thresholds of their running means and the mean specific
     force and the mean rate within REST_TURN of their values early in the quiet time."""
-    wx, wy, wz, fx, fy, fz, quiet, measured, ox, oy, oz, rx, ry, rz = rest
+    wx, wy, wz, fx, fy, fz, quiet, measured, ox, oy, oz, rx, ry, rz, zx, zy, zz = rest
+    k = dt / (ZERO_RATE_TAU + dt)
+    zx += k * (gx - zx)
+    zy += k * (gy - zy)
+    zz += k * (gz - zz)
     k = dt / (REST_MEAN_TAU + dt)
     wx += k * (gx - wx)
     wy += k * (gy - wy)
@@ -209,7 +235,7 @@ def rest_step(
         rx, ry, rz = wx, wy, wz
     quiet = on_the_mark(on_the_mark(quiet + dt, dt, REST_MEAN_TAU), dt, rest_time) if still else 0.0
     return RestState(wx, wy, wz, fx, fy, fz, quiet, 1.0 if quiet >= rest_time else measured,
-                     ox, oy, oz, rx, ry, rz)
+                     ox, oy, oz, rx, ry, rz, zx, zy, zz)
 
 
 def first_rest(measured_before: float, rest: RestState) -> bool:
@@ -284,7 +310,6 @@ def complementary_rest(
     if uncalibrated_first_rest(measured, rest, bias, rest_gyro):
         bias, roll, pitch, f = rest_alignment(rest)
         return rest, bias, (roll, pitch, f)
-    if rest.quiet_time >= rest_time and zero_rate_sample(rest, gx, gy, gz,
-                                                         CONSTANT_REST_GYRO_VAR / dt):
+    if rest.quiet_time >= rest_time and zero_rate_sample(rest, CONSTANT_REST_GYRO_VAR / dt, dt):
         bias = bias_at_rest(bias, gx, gy, gz, dt, rest_time, rest.quiet_time - rest_time)
     return rest, bias, None

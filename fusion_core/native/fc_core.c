@@ -647,6 +647,9 @@ void fc_rest_start(fc_real rest[FC_REST_SIZE], const fc_real gyro[3], const fc_r
     rest[11] = gyro[0];
     rest[12] = gyro[1];
     rest[13] = gyro[2];
+    rest[14] = gyro[0];
+    rest[15] = gyro[1];
+    rest[16] = gyro[2];
 }
 
 void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz, fc_real ax,
@@ -656,7 +659,12 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
     fc_real wx = rest[0], wy = rest[1], wz = rest[2], fx = rest[3], fy = rest[4], fz = rest[5];
     fc_real quiet = rest[6], measured = rest[7], ox = rest[8], oy = rest[9], oz = rest[10];
     fc_real rx = rest[11], ry = rest[12], rz = rest[13];
-    fc_real k = dt / (FC_REST_MEAN_TAU + dt);
+    fc_real zx = rest[14], zy = rest[15], zz = rest[16];
+    fc_real k = dt / (FC_ZERO_RATE_TAU + dt);
+    zx += k * (gx - zx);
+    zy += k * (gy - zy);
+    zz += k * (gz - zz);
+    k = dt / (FC_REST_MEAN_TAU + dt);
     wx += k * (gx - wx);
     wy += k * (gy - wy);
     wz += k * (gz - wz);
@@ -711,6 +719,9 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
     rest[11] = rx;
     rest[12] = ry;
     rest[13] = rz;
+    rest[14] = zx;
+    rest[15] = zy;
+    rest[16] = zz;
 }
 
 fc_real fc_rest_mean_share(fc_real dt)
@@ -764,11 +775,11 @@ void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_rea
 #define REAL_GYRO_DENSITY (0.008 * (FC_PI / 180.0))
 #define CONSTANT_REST_GYRO_VAR (REAL_GYRO_DENSITY * REAL_GYRO_DENSITY)
 
-int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz,
-                        fc_real r)
+int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real r, fc_real dt)
 {
-    fc_real dx = gx - rest[0], dy = gy - rest[1], dz = gz - rest[2];
-    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r;
+    fc_real k = dt / (FC_ZERO_RATE_TAU + dt);
+    fc_real dx = rest[14] - rest[0], dy = rest[15] - rest[1], dz = rest[16] - rest[2];
+    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r * (k / (2.0 - k));
 }
 
 int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],
@@ -783,8 +794,7 @@ int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_
         fc_rest_alignment(rest, bias, roll, pitch, f);
         return 1;
     }
-    if (rest[6] >= rest_time && fc_zero_rate_sample(rest, g[0], g[1], g[2],
-                                                    CONSTANT_REST_GYRO_VAR / dt)) {
+    if (rest[6] >= rest_time && fc_zero_rate_sample(rest, CONSTANT_REST_GYRO_VAR / dt, dt)) {
         fc_bias_at_rest(bias, g[0], g[1], g[2], dt, rest_time, rest[6] - rest_time);
     }
     return 0;

@@ -109,7 +109,8 @@ void fc_rotate_back_terms(const fc_real v[3], const fc_real phi[3], const fc_rea
 /* ----- building_blocks.py ------------------------------------------------------------------ */
 #define FC_REST_MEAN_TAU 0.5
 #define FC_REST_TURN 0.1
-#define FC_REST_SIZE 14  /* building_blocks.RestState */
+#define FC_ZERO_RATE_TAU 0.01
+#define FC_REST_SIZE 17  /* building_blocks.RestState */
 #define FC_SLOWEST_CORRECTION 1e9
 #define FC_FACE_SWITCH_COS 0.5
 extern const fc_real FC_FACES[6][9];
@@ -214,10 +215,10 @@ void fc_rest_alignment(const fc_real rest[FC_REST_SIZE], fc_real bias[3], fc_rea
 /* bias_at_rest: since, the time since the rest was measured (its memory grows with it) */
 void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_real dt,
                      fc_real rest_time, fc_real since);
-/* zero_rate_sample: whether a gyro sample may update the bias at rest (within ZERO_RATE_SPREAD
- * times r, its white-noise variance per axis, of the rest detector's running mean rate) */
-int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz,
-                        fc_real r);
+/* zero_rate_sample: whether the gyro sample fc_rest_step last took may update the bias at rest
+ * (the rate's short mean within ZERO_RATE_SPREAD times its white-noise variance per axis, from
+ * r = psd / dt, of the rest detector's running mean rate) */
+int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real r, fc_real dt);
 /* complementary_rest: the rest detection of cf and mgcf, one sample; returns 1 where they
  * aligned (*roll, *pitch and f, the specific force the vector starts again from, set), else 0 */
 int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],

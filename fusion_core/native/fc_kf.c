@@ -205,7 +205,7 @@ static int zero_rate_update(fc_kf *f, const fc_real a[3], const fc_real g[3], fc
     f->P_z += f->q_bias * dt;
     if (f->rest[6] >= f->rest_time) {
         fc_real r = f->gyro_var / dt;
-        if (fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {  /* a still gyro's sample */
+        if (fc_zero_rate_sample(f->rest, r, dt)) {  /* a still gyro's sample */
             fc_roll_pitch_correct_bias(FC_ROLL_PITCH_AXES(f), g[0], g[1], r);
             fc_real k = f->P_z / (f->P_z + r);
             f->bias_z += k * (g[2] - f->bias_z);
@@ -325,7 +325,7 @@ static void switch_face(fc_kf *f)
         TURN(f->meas + v, turned);
         memcpy(f->meas + v, turned, sizeof turned);
     }
-    for (int v = 0; v < FC_REST_SIZE; v += v == 3 ? 5 : 3) {  /* rates, means, start's mean */
+    for (int v = 0; v < FC_REST_SIZE; v += v == 3 ? 5 : 3) {  /* rates, means, start's, short mean */
         fc_real turned[3];
         TURN(f->rest + v, turned);
         memcpy(f->rest + v, turned, sizeof turned);

@@ -39,7 +39,7 @@ static const fc_field CF_FIELDS[] = {
     {"rest[0:6]", offsetof(fc_cf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_cf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_cf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"rest[8:14]", offsetof(fc_cf, rest[8]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
+    {"rest[8:17]", offsetof(fc_cf, rest[8]), FC_DOUBLE, 9, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_CF_LAYOUT = {"fc_cf", CF_FIELDS, (int)(sizeof CF_FIELDS / sizeof CF_FIELDS[0])};
 
@@ -69,7 +69,7 @@ static const fc_field MGCF_FIELDS[] = {
     {"rest[0:6]", offsetof(fc_mgcf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_mgcf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_mgcf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"rest[8:14]", offsetof(fc_mgcf, rest[8]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
+    {"rest[8:17]", offsetof(fc_mgcf, rest[8]), FC_DOUBLE, 9, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_MGCF_LAYOUT = {"fc_mgcf", MGCF_FIELDS, (int)(sizeof MGCF_FIELDS / sizeof MGCF_FIELDS[0])};
 
@@ -105,7 +105,7 @@ static const fc_field KF_FIELDS[] = {
     {"rest[0:6]", offsetof(fc_kf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_kf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_kf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"rest[8:14]", offsetof(fc_kf, rest[8]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
+    {"rest[8:17]", offsetof(fc_kf, rest[8]), FC_DOUBLE, 9, FC_CHECK_REAL, 0.0},
     {"q_att", offsetof(fc_kf, q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"face", offsetof(fc_kf, face), FC_INT, 1, FC_CHECK_INDEX, 6.0},
 };
@@ -141,7 +141,7 @@ static const fc_field UKF_FIELDS[] = {
     {"rest[0:6]", offsetof(fc_ukf, rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"rest[6]", offsetof(fc_ukf, rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"rest[7]", offsetof(fc_ukf, rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"rest[8:14]", offsetof(fc_ukf, rest[8]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
+    {"rest[8:17]", offsetof(fc_ukf, rest[8]), FC_DOUBLE, 9, FC_CHECK_REAL, 0.0},
 };
 const fc_layout FC_UKF_LAYOUT = {"fc_ukf", UKF_FIELDS, (int)(sizeof UKF_FIELDS / sizeof UKF_FIELDS[0])};
 
@@ -232,7 +232,7 @@ static const fc_field POSKF_FIELDS[] = {
     {"att.rest[0:6]", offsetof(fc_poskf, att.rest[0]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
     {"att.rest[6]", offsetof(fc_poskf, att.rest[6]), FC_DOUBLE, 1, FC_CHECK_NONNEG, 0.0},
     {"att.rest[7]", offsetof(fc_poskf, att.rest[7]), FC_DOUBLE, 1, FC_CHECK_FLAG, 0.0},
-    {"att.rest[8:14]", offsetof(fc_poskf, att.rest[8]), FC_DOUBLE, 6, FC_CHECK_REAL, 0.0},
+    {"att.rest[8:17]", offsetof(fc_poskf, att.rest[8]), FC_DOUBLE, 9, FC_CHECK_REAL, 0.0},
     {"att.q_att", offsetof(fc_poskf, att.q_att), FC_DOUBLE, 4, FC_CHECK_UNIT, 0.0},
     {"att.face", offsetof(fc_poskf, att.face), FC_INT, 1, FC_CHECK_INDEX, 6.0},
 };

@@ -264,7 +264,7 @@ static void advance(fc_ukf *f, const fc_real a[3], const fc_real g[3], fc_real d
         }
         if (f->rest[6] >= p->rest_time) {
             fc_real r = p->zaru_psd / dt;
-            if (fc_zero_rate_sample(f->rest, g[0], g[1], g[2], r)) {  /* a still gyro's sample */
+            if (fc_zero_rate_sample(f->rest, r, dt)) {  /* a still gyro's sample */
                 zero_rate_update(f, g, r);
             }
         }
