@@ -69,6 +69,15 @@ alone keeps the contract's high_dynamics, so `imu-fusion mechanisms` drops it
 (docs/results/mechanisms.md); the parameter stays for a user's own value."""
 
 
+CF_HELD: Final = dataclasses.replace(HELD_PARAM, default=0.0)
+"""The cf's held_acceleration: 0, no cap on the slow band's statistic. The cap keeps absurd
+samples from counting as more than a held acceleration; with a burst's samples kept out of the
+measured vector (burst_acceleration) and a zero-rate update that takes no motion's start for
+rest (building_blocks.ZERO_RATE_TAU), the cf's cap lowers the error neither on the battery nor
+on BROAD's folds left out with the grid chosen again, so `imu-fusion mechanisms` drops it (the
+kf's folds keep it: docs/results/mechanisms.md); the parameter stays for a user's own value."""
+
+
 class ComplementaryFilter(Estimator):
     """The recommended complementary filter (Gui et al. 2015 eq. 1-2; Das & Mary eq. 1).
 
@@ -119,7 +128,7 @@ class ComplementaryFilter(Estimator):
         *COMPLEMENTARY_ADAPTIVE_PARAMS,
         BAND_PARAM,
         LEAK_PARAM,
-        HELD_PARAM,
+        CF_HELD,
         BURST_PARAM,
         STRETCH_PARAM,
         MOTION_BIAS_PARAM,

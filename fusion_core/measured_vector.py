@@ -90,8 +90,9 @@ Seven things follow, and this module is each of them:
    logarithm of its size over the held level: just when the attitude the burst threw, its
    variance raised to the innovation's (gross_innovation), needs the accelerometer to come
    back. Capped, the measurement noise is at most tan^2 30 deg = 1/3 rad^2 over one sample's,
-   the most a held acceleration makes (tests/test_adaptive_noise.py). The cf and the kf cap
-   it; the mgcf and the ukf do not (mgcf.MGCF_HELD, ukf.UKF_HELD give why).
+   the most a held acceleration makes (tests/test_adaptive_noise.py). The kf caps it; the
+   cf, the mgcf and the ukf do not (complementary.CF_HELD, mgcf.MGCF_HELD, ukf.UKF_HELD give
+   why).
 7. A burst: samples of no motion (a glitch, a bus returning garbage, each value within the
    ranges so that no rule of the input stage refuses it) reach the vector as a disturbance the
    filters then follow back to gravity over two or three times its length, tens of degrees off

@@ -137,7 +137,7 @@ static inline void fc_cf_params_default(fc_cf_params *p)
     p->max_correction_time = 3.0;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
-    p->held_acceleration = 5.6618720173484425;
+    p->held_acceleration = 0.0;
     p->burst_acceleration = 9.80665;
     p->acc_lowpass_stretch = 2.0;
     p->motion_bias_gain = 0.5;
