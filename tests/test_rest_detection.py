@@ -240,8 +240,9 @@ def test_the_zero_rate_gate_shuts_on_a_fading_in_turn_after_the_same_time_at_any
     th = next(p.default for p in REST_PARAMS if p.name == "rest_gyro")
     acc_th = next(p.default for p in REST_PARAMS if p.name == "rest_acc")
     bound = next(p.default for p in REST_PARAMS if p.name == "rest_bias_bound")
+    rates = (50.0, 100.0, 1000.0, 10000.0)
     shut = {}
-    for rate in (50.0, 100.0, 1000.0, 10000.0):
+    for rate in rates:
         acc, gyro, dt, b = fading_in(rate)
         rest = rest_start(*gyro[0], *acc[0])
         for i, (a, g) in enumerate(zip(acc, gyro, strict=True)):
@@ -249,6 +250,7 @@ def test_the_zero_rate_gate_shuts_on_a_fading_in_turn_after_the_same_time_at_any
             if i * dt[i] > 5.0 and not zero_rate_sample(rest, psd / dt[i], dt[i]):
                 shut[rate] = i * dt[i] - 5.0
                 break
+    assert set(shut) == set(rates), f"the gate never shut at {set(rates) - set(shut)} Hz"
     assert max(shut.values()) - min(shut.values()) < 0.05, shut
 
 
