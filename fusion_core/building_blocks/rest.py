@@ -158,11 +158,10 @@ def zero_rate_sample(rest: RestState, r: float, dt: float) -> bool:
     """Whether the gyro sample rest_step last took may update the bias at rest
     (ZERO_RATE_SPREAD): the squared distance of the rate's short mean (ZERO_RATE_TAU) from the
     rest detector's running mean rate within ZERO_RATE_SPREAD times its white-noise variance
-    per axis: r, one sample's (psd / dt), times the share a first-order low-pass of gain k
-    leaves, k / (2 - k)."""
-    k = dt / (ZERO_RATE_TAU + dt)
+    per axis: r, one sample's (psd / dt), times the share the short mean leaves of it
+    (mean_share)."""
     dx, dy, dz = rest.zx - rest.wx, rest.zy - rest.wy, rest.zz - rest.wz
-    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r * (k / (2.0 - k))
+    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r * mean_share(dt, ZERO_RATE_TAU)
 
 
 def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
@@ -178,12 +177,17 @@ def zero_rate_psd_param(name: str = "gyro_psd") -> Param:
     )
 
 
-def rest_mean_share(dt: float) -> float:
-    """The share of one sample's white-noise variance left in the rest detector's running mean
-    (time constant REST_MEAN_TAU, gain k = dt / (REST_MEAN_TAU + dt)): k / (2 - k). A filter
-    that takes its tilt from a rest's mean specific force is that sure of it."""
-    k = dt / (REST_MEAN_TAU + dt)
+def mean_share(dt: float, tau: float) -> float:
+    """The share of one sample's white-noise variance left in a first-order running mean of
+    time constant tau (gain k = dt / (tau + dt)): k / (2 - k)."""
+    k = dt / (tau + dt)
     return k / (2.0 - k)
+
+
+def rest_mean_share(dt: float) -> float:
+    """mean_share of the rest detector's running mean (REST_MEAN_TAU). A filter that takes its
+    tilt from a rest's mean specific force is that sure of it."""
+    return mean_share(dt, REST_MEAN_TAU)
 
 
 def rest_start(gx: float, gy: float, gz: float, ax: float, ay: float, az: float) -> RestState:

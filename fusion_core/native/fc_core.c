@@ -724,10 +724,15 @@ void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz
     rest[16] = zz;
 }
 
+fc_real fc_mean_share(fc_real dt, fc_real tau)
+{
+    fc_real k = dt / (tau + dt);
+    return k / (2.0 - k);
+}
+
 fc_real fc_rest_mean_share(fc_real dt)
 {
-    fc_real k = dt / (FC_REST_MEAN_TAU + dt);
-    return k / (2.0 - k);
+    return fc_mean_share(dt, FC_REST_MEAN_TAU);
 }
 
 int fc_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE])
@@ -777,9 +782,9 @@ void fc_bias_at_rest(fc_real bias[3], fc_real gx, fc_real gy, fc_real gz, fc_rea
 
 int fc_zero_rate_sample(const fc_real rest[FC_REST_SIZE], fc_real r, fc_real dt)
 {
-    fc_real k = dt / (FC_ZERO_RATE_TAU + dt);
     fc_real dx = rest[14] - rest[0], dy = rest[15] - rest[1], dz = rest[16] - rest[2];
-    return dx * dx + dy * dy + dz * dz <= ZERO_RATE_SPREAD * r * (k / (2.0 - k));
+    return dx * dx + dy * dy + dz * dz
+           <= ZERO_RATE_SPREAD * r * fc_mean_share(dt, FC_ZERO_RATE_TAU);
 }
 
 int fc_complementary_rest(fc_real rest[FC_REST_SIZE], fc_real bias[3], const fc_real g[3],

@@ -202,7 +202,9 @@ void fc_rest_start(fc_real rest[FC_REST_SIZE], const fc_real gyro[3], const fc_r
 void fc_rest_step(fc_real rest[FC_REST_SIZE], fc_real gx, fc_real gy, fc_real gz, fc_real ax,
                   fc_real ay, fc_real az, const fc_real bias[3], fc_real dt, fc_real th_gyro,
                   fc_real th_acc, fc_real rest_time, fc_real bound);
-/* rest_mean_share: the share of one sample's white variance in the rest detector's mean */
+/* mean_share: the share of one sample's white variance in a first-order mean of time constant
+ * tau; rest_mean_share: that of the rest detector's mean */
+fc_real fc_mean_share(fc_real dt, fc_real tau);
 fc_real fc_rest_mean_share(fc_real dt);
 /* first_rest: measured_before is rest[7] before this sample's fc_rest_step */
 int fc_first_rest(fc_real measured_before, const fc_real rest[FC_REST_SIZE]);
