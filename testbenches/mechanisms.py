@@ -196,6 +196,19 @@ class Worth:
         return float(np.mean(list(self.broad_off.values()))
                      - np.mean(list(self.cv_decided.values())))
 
+    def battery_keeps(self) -> str | None:
+        """Why the battery alone keeps it (its mean lowered by more than the tie, or one cell
+        MOTION_CLASS_GAIN times the error without it), None where it does not or was not run:
+        BROAD's folds alone then never drop it (_at_point, testbenches.broad.cv.nested_cv)."""
+        if not math.isfinite(self.battery_ratio):
+            return None
+        if self.battery_ratio - 1.0 > TIE:
+            return f"its mean error {self.battery_ratio:.3f} times as large without it"
+        cell, ratio = self.battery_best
+        if ratio >= MOTION_CLASS_GAIN:
+            return f"its {cell} error {ratio:.2f} times as large without it"
+        return None
+
     def _at_point(self) -> str:
         """The verdict at the recommended grid point: keep, mixed or drop."""
         if self.contract_lost:
@@ -350,6 +363,19 @@ def battery_worth(worth: dict[tuple[str, str], Worth], parts: int, scheduler: st
         w.battery_best = (cell, ratios[cell])
 
 
+def longer_vector_on_battery(keys: Sequence[str], parts: int, scheduler: str | None,
+                             workers: int, progress: Callable[[], None] | None = None
+                             ) -> dict[str, str | None]:
+    """estimator -> why the battery keeps its longer vector (Worth.battery_keeps), or None:
+    the battery with and without it in each filter of `keys` that has it on, as battery_worth
+    runs it. For `broad --cv`'s nested cross-validation (testbenches.broad.cv.PROCEDURES)."""
+    m = BY_NAME["longer_vector"]
+    worth = {(k, m.name): Worth(k, m.name, {}, {}, [], {}) for k in keys if m.applies(k)}
+    if worth:
+        battery_worth(worth, parts, scheduler, workers, progress)
+    return {k: w.battery_keeps() for (k, _), w in worth.items()}
+
+
 def grid_worth(worth: dict[tuple[str, str], Worth], trials: Sequence[Any],
                groups: Sequence[Sequence[str]],
                progress: Callable[[str], None] | None = None) -> None:
@@ -362,8 +388,11 @@ def grid_worth(worth: dict[tuple[str, str], Worth], trials: Sequence[Any],
     never saw a disturbed trial take a longer band."""
     from .broad.cv import cross_validate
 
+    kept = {k: w.battery_keeps() for (k, name), w in worth.items() if name == "longer_vector"}
+
     def means(key: str, base: dict[str, float] | None) -> tuple[float, float]:
-        e = cross_validate(trials, groups, [key], progress=progress, base=base).estimators[key]
+        e = cross_validate(trials, groups, [key], progress=progress, base=base,
+                           battery_keeps=kept).estimators[key]
         return e.cv_mean(), e.nested_mean()
 
     as_is: dict[str, tuple[float, float]] = {}

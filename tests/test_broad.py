@@ -578,3 +578,72 @@ def test_the_nested_cv_chooses_each_folds_procedure_and_point_without_it() -> No
     assert other.nested_procedure["a"] == base.nested_procedure["a"]
     point = [i for i in range(len(grid)) if base.nested["t0"] == errors[i, 0]]
     assert point and other.nested["t0"] == changed[point[0], 0]  # the same point, rescored
+
+
+def test_cv_on_three_folds_asks_the_battery_about_the_longer_vector(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`broad --cv` with three folds runs the battery with and without the longer vector
+    (stubbed here: its ratio set, as battery_worth sets it) with the parts and scheduler given,
+    and no fold then chooses a point without the vector; with 0 parts it is not asked."""
+    from testbenches import mechanisms
+
+    asked: list[tuple[int, str | None]] = []
+
+    def battery_worth(worth: dict, parts: int, scheduler: str | None, workers: int,
+                      progress: Any = None) -> None:
+        asked.append((parts, scheduler))
+        for w in worth.values():
+            w.battery_ratio = 1.064
+
+    monkeypatch.setattr(mechanisms, "battery_worth", battery_worth)
+    files = [write_slice(tmp_path / "10_undisturbed_slow_translation_A.hdf5"),
+             write_slice(tmp_path / "01_undisturbed_slow_rotation_A.hdf5", 45.0, MAT_TRIAL),
+             write_slice(tmp_path / "24_disturbed_tapping_A.hdf5")]
+    grid = ["--cv-grid", "acc_lowpass_stretch=1,2"]
+    out = tmp_path / "kept"
+    assert main(["broad", *map(str, files), "--estimator", "kf", "--no-plots", "--out", str(out),
+                 *grid, "--cv-battery-parts", "3", "--scheduler", "here:1"]) == 0
+    assert asked == [(3, "here:1")]
+    assert "where the battery keeps it" in capsys.readouterr().out
+    cv = json.loads((out / "cv.json").read_text())["estimators"]["kf"]
+    assert cv["longer_vector_kept_by_battery"] == "its mean error 1.064 times as large without it"
+    assert all(p["acc_lowpass_stretch"] == 2.0 for p in cv["chosen_per_fold"].values())
+    assert main(["broad", *map(str, files), "--estimator", "kf", "--no-plots", "--out",
+                 str(tmp_path / "alone"), *grid, "--cv-battery-parts", "0"]) == 0
+    assert asked == [(3, "here:1")]
+    alone = json.loads((tmp_path / "alone" / "cv.json").read_text())["estimators"]["kf"]
+    assert alone["longer_vector_kept_by_battery"] is None  # BROAD alone: these slices drop it
+    assert any(p["acc_lowpass_stretch"] == 1.0 for p in alone["chosen_per_fold"].values())
+
+
+def test_the_nested_cv_leaves_out_no_mechanism_the_battery_keeps() -> None:
+    """Where the training folds score best without the longer vector, the nested procedure
+    leaves it out, unless the battery keeps it (EstimatorCv.battery_keeps): then only the
+    whole grid is offered, and the outer fold gets the point chosen from it."""
+    import numpy as np
+
+    from testbenches.broad.cv import EstimatorCv, _Allowed, nested_cv
+
+    grid = [{"acc_lowpass_stretch": s, "acc_lowpass": a} for s in (1.0, 2.0) for a in (1.0, 2.0)]
+    trials = [f"t{i}" for i in range(8)]
+    columns = {f: [2 * k, 2 * k + 1] for k, f in enumerate(("a", "b", "c", "d"))}
+    errors = np.array([[0.40] * 6 + [0.90] * 2,  # without the vector: best but on fold d
+                       [0.45] * 6 + [0.95] * 2,
+                       [0.50] * 6 + [0.50] * 2,  # with it: level everywhere
+                       [0.55] * 6 + [0.60] * 2])
+
+    def run(kept: str | None) -> EstimatorCv:
+        cv = EstimatorCv("mgcf", {"acc_lowpass_stretch": 2.0, "acc_lowpass": 1.0}, grid=grid,
+                         errors=errors.copy(), battery_keeps=kept)
+        cv.in_sample = {t: 0.0 for t in trials}
+        nested_cv(cv, columns, _Allowed("mgcf", grid, None, kept))
+        return cv
+
+    alone = run(None)
+    assert alone.nested["t6"] == 0.90  # fold d: left out on the other folds' say
+    kept = run("its mean error 1.064 times as large without it")
+    assert all(p.endswith(", grid") for p in kept.nested_procedure.values())
+    assert kept.nested["t6"] == 0.50 and kept.nested["t0"] == 0.50
+    assert _Allowed("mgcf", grid, None, "its mean error 1.064")(0).startswith(
+        "leaves out the longer vector, which the battery keeps (its mean error 1.064")

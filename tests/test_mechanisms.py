@@ -68,6 +68,22 @@ def test_the_verdict_needs_both_ways_of_scoring() -> None:
     assert level.verdict().startswith("keeps its place: the contract needs it")
 
 
+def test_what_the_battery_keeps_is_never_dropped() -> None:
+    """Worth.battery_keeps (what `broad --cv`'s nested procedures go by) says why exactly where
+    the verdict cannot drop the mechanism on BROAD's folds alone."""
+    on, off = {"a1": 1.0, "b1": 1.0}, {"a1": 0.5, "b1": 0.5}  # BROAD: better without it
+    w = Worth("kf", "longer_vector", on, off, ["slow"], dict(on))
+    assert w.battery_keeps() is None  # the battery not run
+    w.battery_ratio, w.battery_best = 1.064, ("pendulum/better", 2.06)
+    assert w.battery_keeps() == "its mean error 1.064 times as large without it"
+    assert w.verdict().startswith("mixed")
+    w.battery_ratio = 1.004  # level, but one cell needs it
+    assert w.battery_keeps() == "its pendulum/better error 2.06 times as large without it"
+    assert w.verdict() == "keeps its place for pendulum/better"
+    w.battery_best = ("pendulum/better", 1.09)
+    assert w.battery_keeps() is None and w.verdict().startswith("drop")
+
+
 def test_a_drop_waits_for_the_grid_chosen_again_without_it() -> None:
     """Level at the recommended point, the fast leak would go; with the grid chosen again per
     fold it stays where the folds choose worse points without it, and goes where they do not."""

@@ -10,12 +10,21 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from fusion_core.registry import keys_help
 
 from ..fmus import DEFAULT_FMU_DIR
-from ..options import add_calibration, add_no_plots, add_preset, choose, out_folder, positive_float
+from ..options import (
+    add_calibration,
+    add_cluster,
+    add_no_plots,
+    add_preset,
+    choose,
+    non_negative_int,
+    out_folder,
+    positive_float,
+)
 
 if TYPE_CHECKING:
     from .cv import CvResult, Grid
@@ -31,7 +40,8 @@ folders holding them. Peers (--peers) need the bench extra: pip install -e '.[be
 
 def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:  # type: ignore[type-arg]
     """Register the `broad` subcommand on the subparsers of `python -m testbenches`."""
-    from .cv import CHOICES, CV_GRID  # the help names the grid and the choices
+    from ..battery import PARTS as BATTERY_PARTS  # the help names the grid, choices, parts
+    from .cv import CHOICES, CV_GRID
 
     p = sub.add_parser("broad", help="accuracy on BROAD's real recordings (inclination RMSE)",
                        description=HELP)
@@ -81,6 +91,12 @@ def add_broad_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser
                    "point whose worst training fold is least above that fold's best, so that it "
                    "holds on every kind of motion; mean takes the lowest mean over the training "
                    "trials (testbenches.broad.cv.CHOICES); implies --cv")
+    p.add_argument("--cv-battery-parts", type=non_negative_int, default=None, metavar="N",
+                   help="parts per cell of the synthetic battery that says whether a fold's "
+                   "choice, or the nested cross-validation's, may leave a filter's longer vector "
+                   "out (testbenches.broad.cv.PROCEDURES; default "
+                   f"{BATTERY_PARTS}; 0: BROAD's folds alone decide); runs on --scheduler")
+    add_cluster(p)
     p.add_argument("--gyro-fit", action="store_true",
                    help="also fit each trial's gyro against the reference (scale-factor, "
                    "cross-axis and bias errors, its lag; testbenches.broad.gyro): a table and "
@@ -96,6 +112,7 @@ def cmd_broad(args: argparse.Namespace) -> int:
     from fusion_core import ESTIMATORS
     from fusion_core.presets import PRESETS
 
+    from ..battery import PARTS as BATTERY_PARTS
     from ..peers import AHEAD_PEERS, PEERS, PeerUnavailable, check_peers
     from .data import load_trial
     from .report import table, write_reports
@@ -132,9 +149,11 @@ def cmd_broad(args: argparse.Namespace) -> int:
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
                           progress=progress)
     print(table(result))
+    cluster = {"parts": BATTERY_PARTS if args.cv_battery_parts is None else args.cv_battery_parts,
+               "scheduler": args.scheduler, "workers": args.workers}
     cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid,
                            constrained=not args.cv_unconstrained, plot=not args.no_plots,
-                           choice=args.cv_choice or "regret")
+                           choice=args.cv_choice or "regret", battery=cluster)
           if run_cv else None)
     extra = ({"cv_mean_inclination_rmse_deg": cv.cv_means(),
               "nested_cv_mean_inclination_rmse_deg": cv.nested_means()}
@@ -156,23 +175,39 @@ def cmd_broad(args: argparse.Namespace) -> int:
 def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
                      out: Path, peers: bool, grid: Grid | None = None,
                      constrained: bool = True, plot: bool = True,
-                     choice: str = "regret") -> CvResult | None:
+                     choice: str = "regret", battery: dict[str, Any] | None = None
+                     ) -> CvResult | None:
     """The cross-validation (testbenches.broad.cv) of the estimators that have one over grid
     (None: CV_GRID), each fold choosing by choice (cv.CHOICES) among the points that keep the
     contract where constrained, written to DIR/cv.json (and with plot DIR/cv.png); None where
-    none has. The peer the evaluation ran already is taken from it."""
+    none has. The peer the evaluation ran already is taken from it. battery: parts, scheduler
+    and workers of the battery that says whether a choice may leave a filter's longer vector
+    out (testbenches.mechanisms.longer_vector_on_battery; None or 0 parts, or fewer than three
+    folds: not run, BROAD's folds alone decide)."""
     import json
 
     from tqdm import tqdm
 
     from ..peers import AHEAD_PEERS
-    from .cv import CV_ESTIMATORS, cross_validate
+    from .cv import CV_ESTIMATORS, CV_GRID, cross_validate, fold_of
     from .feasible import contract_failure
 
     keys = [k for k in estimators if k in CV_ESTIMATORS]
     if not keys:
         return None
     groups = [t.groups for t in result.trials]
+    kept = None
+    nested = len({fold_of(g) for g in groups}) >= 3  # else nested_cv has no inner split
+    stretch = "acc_lowpass_stretch" in (grid or CV_GRID)
+    if battery and battery["parts"] > 0 and nested and stretch:
+        from ..battery import MOTIONS, SENSOR_CLASSES
+        from ..mechanisms import BY_NAME, longer_vector_on_battery
+
+        with_it = [k for k in keys if BY_NAME["longer_vector"].applies(k)]
+        with tqdm(desc="battery, longer vector", unit="cell", file=sys.stderr,
+                  total=2 * len(MOTIONS) * len(SENSOR_CLASSES)) as bar:
+            kept = longer_vector_on_battery(with_it, battery["parts"], battery["scheduler"],
+                                            battery["workers"], bar.update)
     measured = {c.name: {t.name: t.rmse_deg[c.name] for t in result.trials}
                 for c in result.columns if c.kind == "peer"}
     with tqdm(desc="cross-validation", unit="trial", file=sys.stderr,
@@ -180,7 +215,8 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
         cv = cross_validate(trials, groups, keys,
                             {"vqf-ahead": AHEAD_PEERS["vqf-ahead"]} if peers else None,
                             lambda label: bar.update(), measured, grid,
-                            contract_failure if constrained else None, choice)
+                            contract_failure if constrained else None, choice,
+                            battery_keeps=kept)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cv.json").write_text(json.dumps(cv.as_dict(), indent=1))
     if plot:

@@ -20,6 +20,10 @@ trials' (4 of the 13 shared trials are disturbed or combined, 8 of BROAD's 17 fu
 combined), so a default has to be near the best on every kind of motion rather than best on the
 mean of the mix these trials happen to have; the lowest mean over the training trials
 (`--cv-choice mean`) lets the folds with most trials decide.
+
+A mechanism is not left out on BROAD's folds alone either: where the synthetic battery keeps a
+filter's longer vector (testbenches.mechanisms, run first by `--cv`), no choice takes a grid point
+without it (PROCEDURES says why).
 """
 
 from __future__ import annotations
@@ -115,6 +119,10 @@ class EstimatorCv:
     nested_procedure: dict[str, str] = field(default_factory=dict)
     """fold -> the procedure (PROCEDURES) the other folds chose by their own inner
     cross-validation."""
+    battery_keeps: str | None = None
+    """Why the synthetic battery keeps the longer vector in this filter
+    (testbenches.mechanisms.Worth.battery_keeps), None where it does not or was not run: where
+    it does, no choice leaves the vector out on BROAD's folds alone (_Allowed)."""
 
     def in_sample_mean(self) -> float:
         return float(np.mean(list(self.in_sample.values())))
@@ -135,6 +143,7 @@ class EstimatorCv:
                 "scan_choice": self.scan_choice, "scan_choice_mean_deg": self.scan_mean(),
                 "nested_deg": self.nested, "nested_mean_deg": self.nested_mean(),
                 "nested_procedure_per_fold": self.nested_procedure,
+                "longer_vector_kept_by_battery": self.battery_keeps,
                 "refused_by_contract": self.refused,
                 "grid_points": self.grid,
                 "grid_errors_deg": [[float(v) for v in row] for row in self.errors]}
@@ -200,6 +209,7 @@ def cross_validate(
     constraint: Callable[[str, dict[str, float]], str | None] | None = contract_failure,
     choice: str = "regret",
     base: dict[str, float] | None = None,
+    battery_keeps: Mapping[str, str | None] | None = None,
 ) -> CvResult:
     """The cross-validation of every estimator's grid parameters over the trials (groups: each
     trial's BROAD groups). peers: name -> f(acc, gyro, rate, delay) giving the up direction,
@@ -211,7 +221,10 @@ def cross_validate(
     (testbenches.broad.feasible.contract_failure: the contract's per-run accuracy bounds; None:
     every point may be); a fold, and the scan, choose the best point it allows by choice
     (CHOICES: "regret" or "mean"). base: parameters every run takes, over the point's and
-    the defaults' (a mechanism switched off: testbenches.mechanisms)."""
+    the defaults' (a mechanism switched off: testbenches.mechanisms). battery_keeps:
+    estimator -> why the battery keeps its longer vector, or None
+    (testbenches.mechanisms.longer_vector_on_battery): where it does, no choice takes a point
+    without the vector (acc_lowpass_stretch 1), unless base switches it itself."""
     if choice not in CHOICES:
         raise ValueError(f"choice {choice!r}: allowed {', '.join(CHOICES)}")
     measured = measured or {}
@@ -232,7 +245,9 @@ def cross_validate(
         points = [dict(zip(keys, values, strict=True))
                   for values in itertools.product(*(grid[k] for k in keys))]
         defaults = {k: float(specs[k].default) for k in keys}
-        cv = EstimatorCv(key, defaults, grid=points, errors=np.zeros((len(points), len(trials))))
+        keeps = None if "acc_lowpass_stretch" in (base or {}) else (battery_keeps or {}).get(key)
+        cv = EstimatorCv(key, defaults, grid=points, errors=np.zeros((len(points), len(trials))),
+                         battery_keeps=keeps)
         at_default = points.index(defaults) if defaults in points and not base else None
         for j, trial in enumerate(trials):
             for i, point in enumerate(points):
@@ -245,7 +260,7 @@ def cross_validate(
                 cv.in_sample[trial.name] = float(cv.errors[at_default, j])
             if progress is not None:
                 progress(f"{key} {trial.name[:28]}")
-        allowed = _Allowed(key, [{**p, **(base or {})} for p in points], constraint)
+        allowed = _Allowed(key, [{**p, **(base or {})} for p in points], constraint, keeps)
         columns = {f: [j for j, n in enumerate(names) if folds[n] == f] for f in present}
 
         cv.scan_choice = points[_choose(cv, list(columns.values()), allowed, choice)]
@@ -279,7 +294,12 @@ PROCEDURES: tuple[tuple[str, str], ...] = (("regret", "grid"), ("mean", "grid"),
 """What the nested cross-validation chooses between, besides the point: the choice rule
 (CHOICES) and the grid, whole or without the longer vector (its points with
 acc_lowpass_stretch 1: the mechanism left out). An estimator without acc_lowpass_stretch has
-the whole grid only."""
+the whole grid only, and so has one whose longer vector the battery keeps
+(EstimatorCv.battery_keeps), whose grid then lacks the points without it too: the defaults
+drop a mechanism only where BROAD's folds and the battery both let it go
+(testbenches.mechanisms), and the nested cross-validation scores that procedure, not one that
+decides on BROAD's folds alone. The battery holds none of BROAD's trials, so the outer fold
+still enters no choice."""
 
 
 def _pick(cv: EstimatorCv, folds: list[list[int]], points: list[int], allowed: _Allowed,
@@ -315,7 +335,7 @@ def nested_cv(cv: EstimatorCv, columns: dict[str, list[int]], allowed: _Allowed)
     names = list(cv.in_sample)
     n_points = len(cv.grid)
     grids = {"grid": list(range(n_points))}
-    if "acc_lowpass_stretch" in cv.defaults:
+    if "acc_lowpass_stretch" in cv.defaults and cv.battery_keeps is None:
         grids["no longer vector"] = [i for i, p in enumerate(cv.grid)
                                      if p["acc_lowpass_stretch"] == 1.0]
     procedures = [p for p in PROCEDURES if p[1] in grids and grids[p[1]]]
@@ -351,9 +371,14 @@ class _Allowed:
     key: str
     points: list[dict[str, float]]
     constraint: Callable[[str, dict[str, float]], str | None] | None
+    battery_keeps: str | None = None
+    """Why the battery keeps the longer vector (EstimatorCv.battery_keeps): a point without it
+    may not be chosen."""
     verdicts: dict[int, str | None] = field(default_factory=dict)
 
     def __call__(self, i: int) -> str | None:
+        if self.battery_keeps and self.points[i].get("acc_lowpass_stretch") == 1.0:
+            return f"leaves out the longer vector, which the battery keeps ({self.battery_keeps})"
         if self.constraint is None:
             return None
         if i not in self.verdicts:
@@ -460,6 +485,12 @@ def cv_table(result: CvResult) -> str:
         for key, e in result.estimators.items():
             lines.append(f"  {key:5s} " + "; ".join(f"{f}: {p}"
                                                    for f, p in e.nested_procedure.items()))
+    kept = {key: e.battery_keeps for key, e in result.estimators.items() if e.battery_keeps}
+    if kept:
+        lines.append("")
+        lines.append("no choice above takes a point without the longer vector "
+                     "(acc_lowpass_stretch 1) where the battery keeps it (testbenches.mechanisms):")
+        lines += [f"  {key:5s} {why}" for key, why in kept.items()]
     return "\n".join(lines)
 
 
