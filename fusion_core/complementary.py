@@ -63,8 +63,8 @@ from .types import Estimate, G, Param
 
 CF_BIAS_INNOVATION: Final = dataclasses.replace(BIAS_INNOVATION_PARAM, default=pi)
 """The cf's bias_innovation: pi, no limit. It learns its bias in motion only until the first
-rest, from a settled vector within bias_gate; the kf's 10 deg gate on the innovation lowers the
-error neither on BROAD's folds left out nor on the battery (0.983 without it), and bias_gate
+rest, from a settled vector within bias_gate; a 10 deg gate on the innovation lowers the
+error neither on BROAD's folds left out nor on the battery, and bias_gate
 alone keeps the contract's high_dynamics, so `imu-fusion mechanisms` drops it
 (docs/results/mechanisms.md); the parameter stays for a user's own value."""
 

@@ -29,8 +29,8 @@ error, or where neither does but one of the battery's cells or the contract's sc
 (MOTION_CLASS_GAIN); where nothing does, it is a candidate to drop; else the table says which
 way each points. A dropped mechanism is judged by the same rules with it switched on: where
 they would keep it, it is a candidate to come back. Mechanisms can cover for each other (the two
-bias gates): one switched off at a time shows what the other leaves, and `bias_gates` switches
-both.
+gates on bias learning did): one switched off at a time shows only what the other leaves, so
+they change one at a time and the rest are scored again after each.
 
 The grid values of the other parameters were chosen with the mechanisms as they are. Dropping
 one, or taking a dropped one back, changes what the folds choose as well, so a candidate to
@@ -52,7 +52,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from fusion_core.building_blocks.gate import BIAS_GATE, BIAS_INNOVATION
+from fusion_core.building_blocks.gate import BIAS_GATE, BIAS_INNOVATION, GROSS_INNOVATION
 from fusion_core.measured_vector import BURST_PARAM, HELD_PARAM, LEAK_PARAM
 from fusion_core.papers.common import PAPER_GATE
 
@@ -138,12 +138,9 @@ MECHANISMS: tuple[Mechanism, ...] = (
     Mechanism("bias_innovation", "no bias learning from a tilt innovation beyond 10 deg "
               "(bias_innovation pi)", {"bias_innovation": math.pi},
               {"bias_innovation": BIAS_INNOVATION}),
-    Mechanism("bias_gates", "both gates on bias learning at once (bias_gate 0, bias_innovation "
-              "pi): each covers much of what the other does",
-              {"bias_gate": 0.0, "bias_innovation": math.pi},
-              {"bias_gate": BIAS_GATE, "bias_innovation": BIAS_INNOVATION}),
     Mechanism("gross_innovation", "the angle's variance raised to a tilt innovation beyond 30 "
-              "deg, an attitude grossly off (gross_innovation pi)", {"gross_innovation": math.pi}),
+              "deg, an attitude grossly off (gross_innovation pi)", {"gross_innovation": math.pi},
+              {"gross_innovation": GROSS_INNOVATION}),
     Mechanism("acc_gate", "no correction from a sample whose norm is outside gate_low-gate_high "
               "g (gate_low 0, gate_high 1000)", {"gate_low": 0.0, "gate_high": 1000.0},
               {p.name: float(p.default) for p in PAPER_GATE}),

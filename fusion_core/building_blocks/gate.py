@@ -58,9 +58,11 @@ BIAS_GATE_PARAM = Param(
 )
 
 BIAS_INNOVATION: Final = 10.0 * DEG
-"""Recommended bias_innovation. A gyro bias shows in the accelerometer update as a slow drift of
-the tilt that each correction takes back: innovations of tenths of a degree (after the
-pre-filter, BROAD's largest are a few degrees in the fast trials). An innovation of tens of
+"""bias_innovation where the gate is on (the parameter's default; every recommended filter
+turns it off, pi, as bias_gate covers it: docs/results/mechanisms.md). A gyro bias shows in the
+accelerometer update as a slow drift of the tilt that each correction takes back: innovations
+of tenths of a degree (after the pre-filter, BROAD's largest are a few degrees in the fast
+trials). An innovation of tens of
 degrees means the attitude itself is grossly off (after a stretch of absurd samples, a knock,
 a restart in motion); the filters' linear model of the angle-bias coupling does not hold there,
 and learning from it winds the bias up to tens or hundreds of deg/s, which then takes minutes to
@@ -77,7 +79,8 @@ BIAS_INNOVATION_PARAM = Param(
 
 
 GROSS_INNOVATION: Final = 30.0 * DEG
-"""Recommended gross_innovation. A linear acceleration a held longer than the measured vector's
+"""Recommended gross_innovation (the kf's; the ukf turns it off, pi:
+docs/results/mechanisms.md). A linear acceleration a held longer than the measured vector's
 averaging tilts it by atan(a / g) at most: 30 deg needs 0.58 g held for seconds, more than a
 hand or a vehicle holds (a car's hardest braking is about 1 g for a moment, its turns a few
 tenths of a g). An innovation beyond it says that the attitude itself is off (after a stretch of

@@ -289,7 +289,7 @@ static inline void fc_kf_params_default(fc_kf_params *p)
     p->gyro_psd = 1.949551486634935e-08;
     p->init_bias_std = 0.005235987755982988;
     p->bias_gate = 0.05;
-    p->bias_innovation = 0.17453292519943295;
+    p->bias_innovation = 3.141592653589793;
     p->gross_innovation = 0.5235987755982988;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
@@ -378,7 +378,7 @@ static inline void fc_ukf_params_default(fc_ukf_params *p)
     p->zaru_psd = 1.949551486634935e-08;
     p->bias_gate = 0.05;
     p->bias_innovation = 3.141592653589793;
-    p->gross_innovation = 0.5235987755982988;
+    p->gross_innovation = 3.141592653589793;
     p->slow_band_time = 0.15;
     p->slow_band_leak = 1.0;
     p->held_acceleration = 0.0;
