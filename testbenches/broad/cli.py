@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from fusion_core.registry import keys_help
 
@@ -149,11 +149,11 @@ def cmd_broad(args: argparse.Namespace) -> int:
         result = evaluate(trials, columns, fmu_dir=args.fmu_dir, trials_json=args.trials_json,
                           progress=progress)
     print(table(result))
-    cluster = {"parts": BATTERY_PARTS if args.cv_battery_parts is None else args.cv_battery_parts,
-               "scheduler": args.scheduler, "workers": args.workers}
+    parts = BATTERY_PARTS if args.cv_battery_parts is None else args.cv_battery_parts
     cv = (cross_validation(trials, result, estimators, args.out, args.peers, grid,
                            constrained=not args.cv_unconstrained, plot=not args.no_plots,
-                           choice=args.cv_choice or "regret", battery=cluster)
+                           choice=args.cv_choice or "regret", battery_parts=parts,
+                           scheduler=args.scheduler, workers=args.workers)
           if run_cv else None)
     extra = ({"cv_mean_inclination_rmse_deg": cv.cv_means(),
               "nested_cv_mean_inclination_rmse_deg": cv.nested_means()}
@@ -175,15 +175,15 @@ def cmd_broad(args: argparse.Namespace) -> int:
 def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: list[str],
                      out: Path, peers: bool, grid: Grid | None = None,
                      constrained: bool = True, plot: bool = True,
-                     choice: str = "regret", battery: dict[str, Any] | None = None
-                     ) -> CvResult | None:
+                     choice: str = "regret", battery_parts: int = 0,
+                     scheduler: str | None = "local", workers: int = 2) -> CvResult | None:
     """The cross-validation (testbenches.broad.cv) of the estimators that have one over grid
     (None: CV_GRID), each fold choosing by choice (cv.CHOICES) among the points that keep the
     contract where constrained, written to DIR/cv.json (and with plot DIR/cv.png); None where
-    none has. The peer the evaluation ran already is taken from it. battery: parts, scheduler
-    and workers of the battery that says whether a choice may leave a filter's longer vector
-    out (testbenches.mechanisms.longer_vector_on_battery; None or 0 parts, or fewer than three
-    folds: not run, BROAD's folds alone decide)."""
+    none has. The peer the evaluation ran already is taken from it. battery_parts: parts per
+    cell of the battery that says whether a choice may leave a filter's longer vector out,
+    run on scheduler with workers (testbenches.mechanisms.longer_vector_on_battery; 0, or
+    fewer than three folds: not run, BROAD's folds alone decide)."""
     import json
 
     from tqdm import tqdm
@@ -199,15 +199,15 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
     kept = None
     nested = len({fold_of(g) for g in groups}) >= 3  # else nested_cv has no inner split
     stretch = "acc_lowpass_stretch" in (grid or CV_GRID)
-    if battery and battery["parts"] > 0 and nested and stretch:
+    if battery_parts > 0 and nested and stretch:
         from ..battery import MOTIONS, SENSOR_CLASSES
         from ..mechanisms import BY_NAME, longer_vector_on_battery
 
         with_it = [k for k in keys if BY_NAME["longer_vector"].applies(k)]
         with tqdm(desc="battery, longer vector", unit="cell", file=sys.stderr,
                   total=2 * len(MOTIONS) * len(SENSOR_CLASSES)) as bar:
-            kept = longer_vector_on_battery(with_it, battery["parts"], battery["scheduler"],
-                                            battery["workers"], bar.update)
+            kept = longer_vector_on_battery(with_it, battery_parts, scheduler, workers,
+                                            bar.update)
     measured = {c.name: {t.name: t.rmse_deg[c.name] for t in result.trials}
                 for c in result.columns if c.kind == "peer"}
     with tqdm(desc="cross-validation", unit="trial", file=sys.stderr,
