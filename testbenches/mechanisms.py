@@ -6,7 +6,7 @@ off its slow band and the band's cap at a held acceleration, the longer vector, 
 scale-error process noise, rest detection and its turn-on rule, the bias gates, the variance
 after a gross innovation, the accelerometer gate) on
 by default is switched off by the parameter values that turn it off, and one this test dropped
-from a filter's defaults is switched on again by the values the other filters recommend
+from a filter's defaults is switched on again by the values it has where it is on
 (Mechanism.on), everything else at the recommended values; the filter is scored with and
 without it three ways:
 
@@ -147,8 +147,9 @@ MECHANISMS: tuple[Mechanism, ...] = (
 )
 """Every mechanism the recommended attitude filters have on top of their paper's filter that a
 parameter switches off, and those this test dropped (off by default, Mechanism.dropped; their
-parameters kept for a user's own values, and `on` the values the other filters recommend, or
-the papers' 0.9-1.1 g for the accelerometer gate, papers.common.PAPER_GATE)."""
+parameters kept for a user's own values, and `on` the values it has where it is on: another
+filter's default or its parameter's own (a gate on the innovation at 10 deg, BIAS_INNOVATION),
+or the papers' 0.9-1.1 g for the accelerometer gate, papers.common.PAPER_GATE)."""
 BY_NAME = {m.name: m for m in MECHANISMS}
 
 
