@@ -6,7 +6,7 @@ mechanisms of building_blocks and fusion_core.measured_vector around it (Complem
 from __future__ import annotations
 
 import dataclasses
-from math import pi, sqrt
+from math import sqrt
 from typing import ClassVar, Final
 
 from .base import Estimator, SensorNoise
@@ -60,14 +60,6 @@ from .measured_vector import (
 )
 from .state import ANGLE, HALF_ANGLE, REAL, REST, UNIT, StateSpec
 from .types import Estimate, G, Param
-
-CF_BIAS_INNOVATION: Final = dataclasses.replace(BIAS_INNOVATION_PARAM, default=pi)
-"""The cf's bias_innovation: pi, no limit. It learns its bias in motion only until the first
-rest, from a settled vector within bias_gate; a 10 deg gate on the innovation lowers the
-error neither on BROAD's folds left out nor on the battery, and bias_gate
-alone keeps the contract's high_dynamics, so `imu-fusion mechanisms` drops it
-(docs/results/mechanisms.md); the parameter stays for a user's own value."""
-
 
 CF_HELD: Final = dataclasses.replace(HELD_PARAM, default=0.0)
 """The cf's held_acceleration: 0, no cap on the slow band's statistic. The cap keeps absurd
@@ -133,7 +125,7 @@ class ComplementaryFilter(Estimator):
         STRETCH_PARAM,
         MOTION_BIAS_PARAM,
         BIAS_GATE_PARAM,
-        CF_BIAS_INNOVATION,
+        BIAS_INNOVATION_PARAM,
     )
     TWIN: ClassVar[str | None] = "fc_cf"
     BIAS_IN_MOTION: ClassVar[tuple[int, ...]] = ()

@@ -7,7 +7,7 @@ fusion_core.measured_vector around it (AngleBiasKalmanFilter).
 from __future__ import annotations
 
 import dataclasses
-from math import cos, pi, sin, sqrt
+from math import cos, sin, sqrt
 from typing import ClassVar, Final
 
 from .base import Estimator, SensorNoise
@@ -76,14 +76,6 @@ from .state import ANGLE, COV, HALF_ANGLE, NONNEG, REAL, REST, UNIT, StateSpec, 
 from .types import DEG, Estimate, G, Param
 
 DEG2: Final = DEG * DEG
-KF_BIAS_INNOVATION: Final = dataclasses.replace(BIAS_INNOVATION_PARAM, default=pi)
-"""The kf's bias_innovation: pi, no limit (the papers). With bias_gate keeping the bias from
-learning while linear acceleration reaches the measured vector, and the angle's variance raised
-after a gross innovation (gross_innovation), the 10 deg gate on the innovation lowers the error
-neither on BROAD's folds left out (with the grid chosen again) nor on the battery, nor keeps a
-contract check, so `imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter
-stays for a user's own value."""
-
 KALMAN_MAX_CORRECTION_TIME: Final = dataclasses.replace(MAX_CORRECTION_TIME_PARAM, default=30.0)
 """max_correction_time of the Kalman filters (kf, ukf): 30 s, the longest correction time their
 measurement noise may reach: R is capped at Q T^2 / dt, with Q the step's angle process noise
@@ -184,7 +176,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
       within bias_gate of g (Duong Quoc et al.'s real-sensor cutoff), so is the vector's own
       where the slow band is measured (a disturbance the slow band has passed stays in the
       vector for its length), both innovations are within bias_innovation (a larger one is a gross
-      attitude error, not a bias drift; no limit by default: KF_BIAS_INNOVATION) and the
+      attitude error, not a bias drift; no limit by default: BIAS_INNOVATION_PARAM) and the
       measured vector is settled; otherwise the
       biases are consider states (angle_only_gain). A bias learned wrong on a horizontal axis
       and carried to z by a face switch would stay, as bias_z is observed only at rest (a
@@ -230,7 +222,7 @@ class AngleBiasKalmanFilter(RollPitchAxes, Estimator):
             unit="rad/s", low=0.0, low_open=True, tunable=False, display_unit="deg/s",
         ),
         BIAS_GATE_PARAM,
-        KF_BIAS_INNOVATION,
+        BIAS_INNOVATION_PARAM,
         GROSS_INNOVATION_PARAM,
         BAND_PARAM,
         LEAK_PARAM,

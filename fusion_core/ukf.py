@@ -66,12 +66,6 @@ ACC_GATE: Final = 1.0
 (||f|/g - 1| >= 1): a vector of 2 g is no gravity direction, and one near 0 (free fall) none
 either."""
 
-UKF_BIAS_INNOVATION: Final = dataclasses.replace(BIAS_INNOVATION_PARAM, default=math.pi)
-"""The ukf's bias_innovation: pi, no limit (the papers). A 10 deg gate on the innovation would
-keep a gross attitude error from winding up the bias; in the ukf, with bias_gate, it lowers the
-error neither on BROAD's folds left out nor on the battery, so `imu-fusion mechanisms` drops it
-(docs/results/mechanisms.md); the parameter stays for a user's own value."""
-
 UKF_GROSS_INNOVATION: Final = dataclasses.replace(GROSS_INNOVATION_PARAM, default=math.pi)
 """The ukf's gross_innovation: pi, never (the papers). Raising the direction's variance after an
 innovation beyond 30 deg lowers the error neither on BROAD's folds left out (with the grid
@@ -140,7 +134,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
     (rest_time > 0), and the bias learned only while the slow band of the measured vector
     (measured_vector.gate_norm2; without the vector the raw sample) is within bias_gate of g,
     the measured and the predicted gravity direction within bias_innovation (no limit by
-    default: UKF_BIAS_INNOVATION) and the measured
+    default: BIAS_INNOVATION_PARAM) and the measured
     vector settled (else the biases are consider states). While the measured vector fills, X
     is its direction, with that vector's variance and the covariance with the bias of the turn
     a bias error gave its samples, and at the first rest the rest's mean direction with that
@@ -182,7 +176,7 @@ class UnscentedKalmanFilter(GravityDirectionState, Estimator):
         *REST_PARAMS,
         zero_rate_psd_param("zaru_psd"),
         BIAS_GATE_PARAM,
-        UKF_BIAS_INNOVATION,
+        BIAS_INNOVATION_PARAM,
         UKF_GROSS_INNOVATION,
         BAND_PARAM,
         LEAK_PARAM,

@@ -153,6 +153,11 @@ or the papers' 0.9-1.1 g for the accelerometer gate, papers.common.PAPER_GATE)."
 BY_NAME = {m.name: m for m in MECHANISMS}
 
 
+def _vote(gain: float) -> str:
+    """keep, level or drop for a relative gain from the mechanism (TIE)."""
+    return "keep" if gain > TIE else ("drop" if gain < -TIE else "level")
+
+
 @dataclass
 class Worth:
     """One mechanism of one estimator: BROAD with and without, the folds' decisions and the
@@ -194,18 +199,25 @@ class Worth:
         return float(np.mean(list(self.broad_off.values()))
                      - np.mean(list(self.cv_decided.values())))
 
+    def _battery_vote(self) -> str | None:
+        """What the battery's mean says: keep, level or drop (TIE); None where not run."""
+        return _vote(self.battery_ratio - 1.0) if math.isfinite(self.battery_ratio) else None
+
+    def _needed_by(self) -> tuple[str, float] | None:
+        """The battery cell that needs it (MOTION_CLASS_GAIN times the error without it), or
+        None."""
+        cell, ratio = self.battery_best
+        return (cell, ratio) if ratio >= MOTION_CLASS_GAIN else None
+
     def battery_keeps(self) -> str | None:
         """Why the battery alone keeps it (its mean lowered by more than the tie, or one cell
         MOTION_CLASS_GAIN times the error without it), None where it does not or was not run:
         BROAD's folds alone then never drop it (_at_point, testbenches.broad.cv.nested_cv)."""
-        if not math.isfinite(self.battery_ratio):
-            return None
-        if self.battery_ratio - 1.0 > TIE:
+        if self._battery_vote() == "keep":
             return f"its mean error {self.battery_ratio:.3f} times as large without it"
-        cell, ratio = self.battery_best
-        if ratio >= MOTION_CLASS_GAIN:
-            return f"its {cell} error {ratio:.2f} times as large without it"
-        return None
+        needed = self._needed_by()
+        return f"its {needed[0]} error {needed[1]:.2f} times as large without it" if needed \
+            else None
 
     def _at_point(self) -> str:
         """The verdict at the recommended grid point: keep, mixed or drop."""
@@ -213,18 +225,18 @@ class Worth:
             n = len(self.contract_lost)
             return f"keeps its place: the contract needs it ({n} check{'s' if n != 1 else ''})"
         broad = self.broad_gain() / float(np.mean(list(self.broad_off.values())))
-        says = {"BROAD": "keep" if broad > TIE else ("drop" if broad < -TIE else "level")}
-        if math.isfinite(self.battery_ratio):
-            r = self.battery_ratio - 1.0
-            says["battery"] = "keep" if r > TIE else ("drop" if r < -TIE else "level")
+        says = {"BROAD": _vote(broad)}
+        battery = self._battery_vote()
+        if battery is not None:
+            says["battery"] = battery
         votes = set(says.values())
         if votes == {"keep"} or votes == {"keep", "level"}:
             return "keeps its place"
         if "keep" in votes:
             return "mixed: " + ", ".join(f"{k} {v}" for k, v in says.items())
-        cell, ratio = self.battery_best
-        if ratio >= MOTION_CLASS_GAIN:
-            return f"keeps its place for {cell}"
+        needed = self._needed_by()
+        if needed is not None:
+            return f"keeps its place for {needed[0]}"
         scenario, ratio = self.contract_best
         if ratio >= MOTION_CLASS_GAIN:
             return f"keeps its place for the contract's {scenario} ({ratio:.2f}x without)"

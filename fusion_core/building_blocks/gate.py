@@ -58,24 +58,29 @@ BIAS_GATE_PARAM = Param(
 )
 
 BIAS_INNOVATION: Final = 10.0 * DEG
-"""bias_innovation where the gate is on (the parameter's default; every recommended filter
-turns it off, pi, as bias_gate covers it: docs/results/mechanisms.md). A gyro bias shows in the
-accelerometer update as a slow drift of the tilt that each correction takes back: innovations
-of tenths of a degree (after the pre-filter, BROAD's largest are a few degrees in the fast
-trials). An innovation of tens of
-degrees means the attitude itself is grossly off (after a stretch of absurd samples, a knock,
-a restart in motion); the filters' linear model of the angle-bias coupling does not hold there,
-and learning from it winds the bias up to tens or hundreds of deg/s, which then takes minutes to
-unwind. The angle is corrected as always; only the bias waits (the recovery from absurd but
-accepted samples: `python -m testbenches.recovery`, docs/results/robustness.md)."""
+"""bias_innovation where the gate is on (a user's own value; `imu-fusion mechanisms` switches it
+on with this). A gyro bias shows in the accelerometer update as a slow drift of the tilt that
+each correction takes back: innovations of tenths of a degree (after the pre-filter, BROAD's
+largest are a few degrees in the fast trials). An innovation of tens of degrees means the
+attitude itself is grossly off (after a stretch of absurd samples, a knock, a restart in
+motion); the filters' linear model of the angle-bias coupling does not hold there, and learning
+from it winds the bias up to tens or hundreds of deg/s, which then takes minutes to unwind. The
+angle is corrected as always; only the bias waits."""
 
 BIAS_INNOVATION_PARAM = Param(
-    "bias_innovation", BIAS_INNOVATION,
+    "bias_innovation", math.pi,
     "Largest tilt innovation the gyro bias learns from: beyond it the attitude is grossly off "
     "(not a bias drift) and the accelerometer update corrects the angle only; pi = no limit "
     "(the papers)",
     unit="rad", low=0.0, low_open=True, high=math.pi, display_unit="deg",
 )
+"""The gate on bias learning at a gross innovation, off (pi) in every recommended filter: with
+bias_gate keeping the bias from learning while linear acceleration reaches the measured vector,
+a gate at BIAS_INNOVATION lowers the error neither on BROAD's folds left out (with the grid
+chosen again) nor on the battery, nor keeps a contract check, and after a second of absurd
+samples the filters come back as soon without it (`python -m testbenches.recovery`), so
+`imu-fusion mechanisms` drops it (docs/results/mechanisms.md); the parameter stays for a user's
+own value."""
 
 
 GROSS_INNOVATION: Final = 30.0 * DEG

@@ -142,12 +142,12 @@ sampled ten times faster lets a turn three times faster through before it shuts,
 bias learns the first turn of every motion that starts after a rest (tests/test_rest_detection.py,
 the gate on a turn that fades in at 50 Hz to 10 kHz). A mean over a fixed time has the same
 noise, sqrt(psd / (2 tau)), at every rate above 1 / tau, and a sampling slower than that leaves
-it about the sample itself. The
-time is the one over which a body's first turn rises out of the gyro's noise: a ramp of
-alpha [rad/s^2] leaves a mean of time constant tau by alpha (t - tau), which reaches the
-gate's c sqrt(psd / (2 tau)) soonest for tau^(3/2) = c sqrt(psd / 2) / (2 alpha); a hand's
-first turn (10-50 deg/s^2) on a consumer gyro (0.005-0.015 deg/s/sqrt(Hz)) gives 5-20 ms,
-and 10 ms is the middle of that range. Derived, not fitted."""
+it about the sample itself. The time is the one over which a body's first turn rises out of
+the gyro's noise: a ramp of alpha [rad/s^2] leaves a mean of time constant tau by
+alpha (t - tau), which reaches the gate's c sqrt(psd / (2 tau)) soonest for
+tau^(3/2) = c sqrt(psd / 2) / (2 alpha); a hand's first turn (10-50 deg/s^2) on a consumer gyro
+(0.005-0.015 deg/s/sqrt(Hz)) gives 5-20 ms, and 10 ms is the middle of that range. Derived, not
+fitted."""
 
 CONSTANT_REST_GYRO_VAR: Final = REAL_GYRO_DENSITY * REAL_GYRO_DENSITY
 """The gyro white-noise PSD [rad^2/s] of the filters without a noise model (cf, mgcf) for

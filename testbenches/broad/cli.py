@@ -189,7 +189,7 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
     from tqdm import tqdm
 
     from ..peers import AHEAD_PEERS
-    from .cv import CV_ESTIMATORS, CV_GRID, cross_validate, fold_of
+    from .cv import CV_ESTIMATORS, CV_GRID, NESTED_FOLDS, cross_validate, fold_of
     from .feasible import contract_failure
 
     keys = [k for k in estimators if k in CV_ESTIMATORS]
@@ -197,17 +197,15 @@ def cross_validation(trials: list[BroadTrial], result: BroadResult, estimators: 
         return None
     groups = [t.groups for t in result.trials]
     kept = None
-    nested = len({fold_of(g) for g in groups}) >= 3  # else nested_cv has no inner split
+    nested = len({fold_of(g) for g in groups}) >= NESTED_FOLDS
     stretch = "acc_lowpass_stretch" in (grid or CV_GRID)
     if battery_parts > 0 and nested and stretch:
         from ..battery import MOTIONS, SENSOR_CLASSES
-        from ..mechanisms import BY_NAME, longer_vector_on_battery
+        from ..mechanisms import longer_vector_on_battery
 
-        with_it = [k for k in keys if BY_NAME["longer_vector"].applies(k)]
         with tqdm(desc="battery, longer vector", unit="cell", file=sys.stderr,
                   total=2 * len(MOTIONS) * len(SENSOR_CLASSES)) as bar:
-            kept = longer_vector_on_battery(with_it, battery_parts, scheduler, workers,
-                                            bar.update)
+            kept = longer_vector_on_battery(keys, battery_parts, scheduler, workers, bar.update)
     measured = {c.name: {t.name: t.rmse_deg[c.name] for t in result.trials}
                 for c in result.columns if c.kind == "peer"}
     with tqdm(desc="cross-validation", unit="trial", file=sys.stderr,

@@ -288,6 +288,9 @@ def cross_validate(
                     constraint is not None, choice)
 
 
+NESTED_FOLDS = 3
+"""The fewest motion folds a nested cross-validation needs: an outer one held out and two for
+the inner split."""
 PROCEDURES: tuple[tuple[str, str], ...] = (("regret", "grid"), ("mean", "grid"),
                                           ("regret", "no longer vector"),
                                           ("mean", "no longer vector"))
@@ -330,7 +333,7 @@ def nested_cv(cv: EstimatorCv, columns: dict[str, list[int]], allowed: _Allowed)
     cv.nested and cv.nested_procedure (nothing with fewer than three folds: an inner split
     needs two)."""
     present = list(columns)
-    if len(present) < 3:
+    if len(present) < NESTED_FOLDS:
         return
     names = list(cv.in_sample)
     n_points = len(cv.grid)
