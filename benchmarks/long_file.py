@@ -89,7 +89,7 @@ def _estimators_alone_s(path: Path) -> dict[str, float]:
     """Seconds of each estimator's C twin the command runs, on the file's samples already in
     memory (no reading, conditioning, writing or plot): what the command cannot go below but by
     running them on more cores. An estimator whose outputs another's run gives is not run
-    there, nor here (testbenches.estimate.shared_runs)."""
+    there, nor here (testbenches.estimate.runs.shared_runs)."""
     import pyarrow.csv as pc
 
     from fusion_core import native

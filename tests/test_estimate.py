@@ -597,8 +597,8 @@ def test_a_recording_timed_since_1970_is_plotted_from_its_first_sample(tmp_path,
 
     from testbenches import estimate
 
-    assert estimate._when(1.7e9) == "2023-11-14 22:13:20 UTC"
-    assert estimate._when(2.0e5) == "200000 s"
+    assert estimate.plot.when(1.7e9) == "2023-11-14 22:13:20 UTC"
+    assert estimate.plot.when(2.0e5) == "200000 s"
     ex = _example()
     path = tmp_path / "epoch.csv"
     np.savetxt(path, np.column_stack([1.7e9 + ex["time"], ex["acc"], ex["gyro"]]),
@@ -746,7 +746,7 @@ def test_each_estimator_takes_the_blocks_in_order_at_its_own_pace():
             self.times.append(time.perf_counter())
 
     fast, slow, done = Task(0.0), Task(0.02), []
-    lanes = estimate._Lanes([fast, slow], done.append)
+    lanes = estimate.lanes.Lanes([fast, slow], done.append)
     held = []
     for k in range(10):
         lanes.submit(k + 1, k)
@@ -754,7 +754,7 @@ def test_each_estimator_takes_the_blocks_in_order_at_its_own_pace():
     lanes.close()
     assert fast.seen == slow.seen == list(range(10))
     assert fast.times[-1] < slow.times[-2]  # the fast one ran ahead
-    assert max(held) <= estimate.IN_FLIGHT
+    assert max(held) <= estimate.lanes.IN_FLIGHT
     assert done == [k + 1 for k in range(10)]
 
     class Failing(Task):
@@ -764,7 +764,7 @@ def test_each_estimator_takes_the_blocks_in_order_at_its_own_pace():
             super().block(k)
 
     failing = Failing(0.0)
-    lanes = estimate._Lanes([Task(0.0), failing], lambda n: None)
+    lanes = estimate.lanes.Lanes([Task(0.0), failing], lambda n: None)
     with pytest.raises(ValueError, match="disk full"):
         for k in range(10):
             lanes.submit(1, k)
@@ -795,7 +795,7 @@ def test_the_reader_thread_has_ended_when_the_blocks_loop_does():
 
     before = threading.active_count()
     with pytest.raises(RuntimeError, match="stop"):
-        for _ in estimate._read_ahead(blocks()):
+        for _ in estimate.lanes.read_ahead(blocks()):
             raise RuntimeError("stop")
     assert read == [1]  # the block in hand was finished, no further one read
     assert threading.active_count() == before
