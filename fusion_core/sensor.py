@@ -70,6 +70,13 @@ DLPF_TABLE: dict[int, tuple[float, float, float, float]] = {
 """MPU-6050 DLPF_CFG -> (accelerometer bandwidth [Hz], delay [s], gyro bandwidth [Hz], delay [s])
 (DS register 26, CONFIG). 7 (reserved in the DS) is not offered; -1 turns the filter off."""
 
+
+def dlpf_delay(cfg: int) -> float:
+    """The gyro's delay [s] at DLPF_CFG cfg as the datasheet gives it (DLPF_TABLE; 0 with the
+    filter off): what a user of the part gives the estimators as sensor_delay, their outputs
+    turned ahead over it (docs/guide/own-sensor.md)."""
+    return 0.0 if cfg < 0 else DLPF_TABLE[cfg][3]
+
 Calibrated = tuple[tuple[float, float, float], tuple[float, float, float], float, float]
 CALIBRATION: dict[str, Calibrated] = {
     "startup": ((0.16 * DEG,) * 3, (0.5 * MG,) * 3, 0.001, 0.001),

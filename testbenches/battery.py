@@ -374,11 +374,13 @@ def filter_params(sensor: SensorClass, known_scale: bool = False) -> dict[str, d
     """Each filter's parameters for a sensor of this class: the recommended values with what
     follows from its noise, range and the gyro bias its parts start with (presets.noise_preset:
     what its calibration leaves, sensor.CALIBRATION), one sample's accelerometer noise taken at
-    the class's rate with its quantisation; with known_scale, gyro_scale_std is the class's
+    the class's rate with its quantisation, and the delay of its low-pass filter as the
+    datasheet gives it (sensor_delay: sensor.dlpf_delay, as docs/guide/own-sensor.md asks of a
+    user and BROAD's trials state theirs); with known_scale, gyro_scale_std is the class's
     spread of gyro scale factors (the sensor model's gyro_scale_std, 1 sigma), where a filter
     has the parameter."""
     from fusion_core.presets import noise_preset
-    from fusion_core.sensor import CALIBRATION
+    from fusion_core.sensor import CALIBRATION, dlpf_delay
 
     acc_density = math.sqrt(sensor.value("acc_psd"))
     bits = int(sensor.value("bits"))  # 0: no quantisation
@@ -387,7 +389,8 @@ def filter_params(sensor: SensorClass, known_scale: bool = False) -> dict[str, d
     gyro_bias_std = max(CALIBRATION[sensor.value("calibration")][0])
     preset = noise_preset(math.sqrt(sensor.value("gyro_psd")), acc_density, acc_sample_std,
                           sensor.value("gyro_range"), gyro_bias_std)
-    out = {key: dict(preset[key]) for key in filter_keys()}
+    delay = dlpf_delay(int(sensor.value("dlpf_cfg")))
+    out = {key: {**preset[key], "sensor_delay": delay} for key in filter_keys()}
     if known_scale:
         from fusion_core.registry import estimator_class
 
