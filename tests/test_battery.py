@@ -12,7 +12,7 @@ import pytest
 
 from fusion_core.kalman import RECOMMENDED_INIT_BIAS_STD
 from fusion_core.presets import noise_preset
-from fusion_core.sensor import CALIBRATION, DLPF_TABLE
+from fusion_core.sensor import CALIBRATION
 from fusion_core.types import DEG, G
 from testbenches import battery
 from testbenches.battery import MOTIONS, SENSOR_CLASSES
@@ -72,11 +72,10 @@ def test_each_filter_gets_what_its_sensors_noise_gives(name: str) -> None:
     assert {**noise_preset(gyro_density, math.sqrt(c.value("acc_psd")), acc_std,
                            c.value("gyro_range"))["mgcf"],
             "sensor_delay": params["mgcf"]["sensor_delay"]} == params["mgcf"]
-    # the delay of the part's low-pass filter, its gyro's as the datasheet's table gives it
-    delay = 0.0 if c.value("dlpf_cfg") < 0 else DLPF_TABLE[c.value("dlpf_cfg")][3]
+    # the gyro's delay of the part's low-pass setting, as the datasheet's table gives it:
+    # DLPF_CFG 4 (21 Hz) on the worse part, 0 (the register's reset value) on the others
     for key in battery.filter_keys():
-        assert params[key]["sensor_delay"] == delay
-    assert delay == (8.3e-3 if name == "worse" else 0.98e-3)  # DLPF_CFG 4, and 0 (reset)
+        assert params[key]["sensor_delay"] == (8.3e-3 if name == "worse" else 0.98e-3)
     bias_std = max(CALIBRATION[c.value("calibration")][0])  # what the part starts with
     for key in ("kf", "ukf"):
         assert params[key]["init_bias_std"] == max(bias_std, RECOMMENDED_INIT_BIAS_STD)

@@ -22,30 +22,23 @@ def test_vqf_on_samples_of_the_rate_at_an_instant_is_half_a_sample_ahead() -> No
     ahead further off (why the battery turns ours ahead over the part's delay and not VQF's:
     docs/results/battery/index.md)."""
     pytest.importorskip("vqf")
-    from fusion_core.sensor import SENSOR_PARAMS
+    from fusion_core.sensor import SENSOR_PRESETS
     from testbenches import battery
-    from testbenches.broad.metric import (
-        gravity_from_quat,
-        gravity_from_roll_pitch,
-        inclination_rmse_deg,
-    )
-    from testbenches.peers import _vqf_batch, up_ahead
+    from testbenches.broad.metric import gravity_from_roll_pitch, inclination_rmse_deg
+    from testbenches.peers import run_vqf_ahead
 
-    perfect = {p.name: 0.0 for p in SENSOR_PARAMS
-               if p.name.endswith(("_psd", "_instability", "_std"))}
-    perfect.update(calibration="perfect", dlpf_cfg=-1, bits=0)
     rate = 50.0
+    error_free = {**SENSOR_PRESETS["ideal"], "gyro_psd": 0.0, "acc_psd": 0.0, "bits": 0}
     classes = {**battery.SENSOR_CLASSES,
-               "perfect": battery.SensorClass("perfect", "no errors", rate, perfect)}
+               "error_free": battery.SensorClass("error_free", "no errors", rate, error_free)}
     with pytest.MonkeyPatch.context() as m:
         m.setattr(battery, "SENSOR_CLASSES", classes)
-        t, truth, sample = battery.part_samples("handheld_fast", "perfect", 0)
-    out = _vqf_batch(sample["acc"], sample["gyro"], rate, "the test")
-    up, rate_vec = gravity_from_quat(out["quat6D"]), sample["gyro"] - out["bias"]
+        t, truth, sample = battery.part_samples("handheld_fast", "error_free", 0)
     true_up = gravity_from_roll_pitch(truth["roll"], truth["pitch"])
     scored = t >= battery.MOTIONS["handheld_fast"].rest + battery.SETTLE_S
 
-    def rmse(shift: float) -> float:  # turned ahead by shift samples
-        return inclination_rmse_deg(up_ahead(up, rate_vec, shift / rate), true_up, scored)
+    def rmse(shift: float) -> float:  # VQF's output turned ahead by shift samples
+        up = run_vqf_ahead(sample["acc"], sample["gyro"], rate, shift / rate)
+        return inclination_rmse_deg(up, true_up, scored)
 
     assert rmse(-0.5) < rmse(0.0) / 3.0 and rmse(0.5) > rmse(0.0)

@@ -39,6 +39,8 @@ from typing import Any
 
 import numpy as np
 
+from fusion_core.types import DEG
+
 from ..options import (
     RECORDING_HELP,
     add_calibration,
@@ -63,7 +65,6 @@ OUTPUTS = {"roll": ("roll",), "pitch": ("pitch",), "bias": ("bias_x", "bias_y", 
            "pos": ("pos_x", "pos_y", "pos_z"), "vel": ("vel_x", "vel_y", "vel_z"),
            "rejected": ("rejected",)}
 """The output groups --outputs chooses from, and their columns."""
-DEG = np.pi / 180.0
 
 
 def add_estimate_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
